@@ -1,0 +1,27 @@
+# The front door: `make demo` and `make test` (README.md). Everything else is CMake in build/.
+BUILD ?= build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+CMAKE_FLAGS ?=
+DEMO_OUT ?= demo-out
+
+.PHONY: all deps configure build demo test clean
+
+all: build
+
+deps:
+	@scripts/install-deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo $(CMAKE_FLAGS) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD) -j $(JOBS)
+
+demo: build
+	EGL_PLATFORM=surfaceless $(BUILD)/bin/splinewalk demo -o $(DEMO_OUT)
+
+test: build
+	cd $(BUILD) && EGL_PLATFORM=surfaceless ctest --output-on-failure -j $(JOBS) $(CTEST_FLAGS)
+
+clean:
+	rm -rf $(BUILD) $(DEMO_OUT)

@@ -1,0 +1,89 @@
+/* splinewalk gpu/: an OpenGL 4.x core context (EGL; Mesa's surfaceless platform when there is no
+ * display or GPU), and one converged frame of a scene: every face's Bézier patches drawn as grids
+ * (evaluated on the CPU in this slice, at densities from the Filip bound, Guthe et al. 2005 §5.2),
+ * trimmed faces through a trim texture made on the GPU by triangle-fan parity (§4) and a
+ * fragment-discarding lookup. Frame images go out through OpenImageIO (capture_oiio.cpp).
+ *
+ * Threads: only the thread that created a context may call the functions taking it
+ * (ARCHITECTURE.md: only the GL owner touches GL). Precision: positions are kept in double and
+ * sent relative to the camera in float; depth is reversed-Z with a float depth buffer.
+ */
+#ifndef SW_GPU_H
+#define SW_GPU_H
+
+#include "sw_sg_scene.h"
+
+#include <splinewalk/sw_result.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct sw_gpu_context sw_gpu_context;
+
+/* Creates a headless context (EGL_PLATFORM_SURFACELESS_MESA, else the EGL device platform, else
+ * EGL_DEFAULT_DISPLAY) and makes it current on the calling thread. Errors: SW_ERR_NO_CONTEXT with
+ * what failed and what to try. */
+sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status);
+void sw_gpu_context_free(sw_gpu_context *ctx); /* NULL allowed */
+/* "GL_RENDERER / GL_VERSION" of the context (borrowed). */
+const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
+
+typedef struct sw_gpu_camera {
+    double eye[3], target[3], up[3];
+    double fovy_deg; /* vertical field of view */
+} sw_gpu_camera;
+
+typedef struct sw_gpu_frame_desc {
+    int32_t width, height; /* 0 = 1280 x 720 */
+    double error_px;       /* screen-space error bound ε_img in pixels; 0 = 0.5 */
+    sw_gpu_camera camera;
+    float background[4];   /* RGBA */
+    int32_t want_depth;    /* also read back depth */
+} sw_gpu_frame_desc;
+
+typedef struct sw_gpu_frame_stats {
+    uint64_t faces_drawn, faces_culled;          /* face occurrences */
+    uint64_t patches_trimmed;   /* Bézier patches drawn with a trim-texture lookup */
+    uint64_t patches_untrimmed; /* drawn without one */
+    uint64_t patches_culled;    /* outside the view frustum, or outside their face's trim box */
+    uint64_t triangles;
+    uint64_t trim_textures, trim_texels;
+    double ms_tessellate; /* CPU grid evaluation */
+    double ms_trim;       /* trim-texture generation */
+    double ms_draw;       /* draw submission until glFinish */
+    double ms_readback;
+} sw_gpu_frame_stats;
+
+typedef struct sw_gpu_image {
+    int32_t width, height;
+    uint8_t *rgba;   /* width*height*4, top row first */
+    float *depth;    /* width*height, eye-space distance along the view axis; +INF = background;
+                        NULL unless asked for */
+} sw_gpu_image;
+
+/* Renders one converged frame of `scene` (SW_SG_SEC_ALL required) into `out` (caller frees with
+ * sw_gpu_image_free); `stats` may be NULL. Errors: SW_ERR_GL, SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                              const sw_gpu_frame_desc *desc, sw_gpu_image *out,
+                              sw_gpu_frame_stats *stats, sw_status *status);
+
+/* Renders plain triangles (world-space double positions, 3 per vertex) through the same camera,
+ * projection, depth and shading path as sw_gpu_render_scene — the path an independent reference
+ * mesh is drawn with in tests. */
+sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, uint32_t n_vertices,
+                                  const uint32_t *indices, uint32_t n_indices,
+                                  const sw_gpu_frame_desc *desc, sw_gpu_image *out,
+                                  sw_status *status);
+
+void sw_gpu_image_free(sw_gpu_image *img); /* NULL allowed */
+
+/* Writes an image: .png (RGBA8) or .exr (half RGBA plus a float Z channel when depth exists),
+ * through a temporary name and rename. Errors: SW_ERR_IO, SW_ERR_UNSUPPORTED (extension). */
+sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *path, sw_status *status);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

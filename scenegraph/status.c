@@ -1,0 +1,37 @@
+/* sw_result names and the sw_status helpers shared by every layer. */
+#include "sw_status_util.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+
+const char *sw_result_str(sw_result result)
+{
+    static const char *const names[] = {
+#define SW__RESULT_TEXT(id, text) text,
+        SW_RESULT_XMACRO(SW__RESULT_TEXT)
+#undef SW__RESULT_TEXT
+    };
+    if ((unsigned)result >= (unsigned)SW_RESULT_COUNT)
+        return "unknown result";
+    return names[result];
+}
+
+sw_result sw__fail(sw_status *status, sw_result result, const char *fmt, ...)
+{
+    if (status) {
+        va_list ap;
+        va_start(ap, fmt);
+        status->result = result;
+        vsnprintf(status->message, sizeof status->message, fmt, ap);
+        va_end(ap);
+    }
+    return result;
+}
+
+void sw__status_ok(sw_status *status)
+{
+    if (status) {
+        status->result = SW_OK;
+        status->message[0] = '\0';
+    }
+}

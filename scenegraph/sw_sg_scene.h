@@ -1,0 +1,218 @@
+/* splinewalk scene: faces (trimmed NURBS surfaces), trim loops of 2D rational B-spline curves,
+ * a node tree (group, transform, instance, surface) with colours, and face adjacency.
+ *
+ * The scene is a set of flat arrays of fixed-size records that reference one pool of doubles by
+ * offset. The same arrays are built in memory (sw_sg_builder, used by importers and generators) or
+ * mapped straight from a .sws file (sws_file.c) without parsing every surface up front: records
+ * are plain data, 8-byte aligned, little-endian, with no pointers inside.
+ *
+ * Threads: a finished scene is immutable and may be read from any thread. A builder belongs to
+ * one thread. sw_sg_scene_require() must be called (once, by one thread) before the sections it
+ * names are read; after it returned SW_OK they may be read concurrently.
+ */
+#ifndef SW_SG_SCENE_H
+#define SW_SG_SCENE_H
+
+#include "sw_sg_geom.h"
+
+#include <splinewalk/sw_result.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SW_SG_NONE UINT32_MAX
+
+/* The geometry a face had in its source file, before conversion to NURBS (for `info`). */
+#define SW_SG_SURFACE_KIND_XMACRO(X)                                                               \
+    X(SW_SG_KIND_PLANE, "plane")                                                                   \
+    X(SW_SG_KIND_CYLINDER, "cylinder")                                                             \
+    X(SW_SG_KIND_CONE, "cone")                                                                     \
+    X(SW_SG_KIND_SPHERE, "sphere")                                                                 \
+    X(SW_SG_KIND_TORUS, "torus")                                                                   \
+    X(SW_SG_KIND_REVOLUTION, "revolution")                                                         \
+    X(SW_SG_KIND_EXTRUSION, "extrusion")                                                           \
+    X(SW_SG_KIND_BSPLINE, "bspline")                                                               \
+    X(SW_SG_KIND_BEZIER, "bezier")                                                                 \
+    X(SW_SG_KIND_OFFSET, "offset")                                                                 \
+    X(SW_SG_KIND_OTHER, "other")
+
+typedef enum sw_sg_surface_kind {
+#define SW__KIND_ENUM(id, text) id,
+    SW_SG_SURFACE_KIND_XMACRO(SW__KIND_ENUM)
+#undef SW__KIND_ENUM
+        SW_SG_KIND_COUNT
+} sw_sg_surface_kind;
+const char *sw_sg_surface_kind_str(uint32_t kind);
+
+enum sw_sg_face_flags {
+    SW_SG_FACE_REVERSED = 1u << 0, /* the B-rep face's normal is opposite to Su x Sv */
+    SW_SG_FACE_TRIMMED = 1u << 1,  /* its loops cut the domain (not just the domain's rectangle) */
+};
+
+/* One face: a NURBS surface and its trim loops. Offsets are indices into the double pool. */
+typedef struct sw_sg_face_rec {
+    uint32_t deg_u, deg_v, n_u, n_v;
+    uint64_t knots_u, knots_v, cpw; /* pool offsets: n_u+deg_u+1, n_v+deg_v+1, n_u*n_v*4 doubles */
+    uint32_t first_loop, n_loops;   /* loops [first_loop, first_loop + n_loops) */
+    uint32_t kind;                  /* sw_sg_surface_kind of the source geometry */
+    uint32_t flags;                 /* sw_sg_face_flags */
+    double uv_box[4];               /* u0, u1, v0, v1: trim region's box (domain if untrimmed) */
+    double tolerance;               /* largest 3D edge tolerance of the face in the source */
+} sw_sg_face_rec;
+
+enum sw_sg_loop_flags { SW_SG_LOOP_OUTER = 1u << 0 };
+
+/* A closed trim loop: curves [first_curve, first_curve + n_curves), each one's end equal to the
+ * next one's start bit for bit (the builder snaps them), the last one's end to the first start. */
+typedef struct sw_sg_loop_rec {
+    uint32_t first_curve, n_curves;
+    uint32_t flags;
+    uint32_t reserved; /* zero */
+} sw_sg_loop_rec;
+
+/* A 2D rational B-spline trim curve in the face's (u, v) domain: cpw holds (w*u, w*v, w). */
+typedef struct sw_sg_curve_rec {
+    uint32_t degree, n;
+    uint64_t knots, cpw; /* pool offsets: n+degree+1 and n*3 doubles */
+} sw_sg_curve_rec;
+
+typedef enum sw_sg_node_kind {
+    SW_SG_NODE_GROUP = 0,     /* children, identity transform */
+    SW_SG_NODE_TRANSFORM = 1, /* children under xform */
+    SW_SG_NODE_INSTANCE = 2,  /* draws the subtree of node `ref` under xform */
+    SW_SG_NODE_SURFACE = 3,   /* draws face `ref` under xform */
+} sw_sg_node_kind;
+
+typedef struct sw_sg_node_rec {
+    uint32_t kind;
+    uint32_t parent, first_child, next_sibling; /* SW_SG_NONE when absent */
+    uint32_t ref;                               /* face (SURFACE) or prototype node (INSTANCE) */
+    uint32_t name;                              /* byte offset into strings, SW_SG_NONE if none */
+    float color[4];                             /* linear RGBA; color[3] < 0 inherits the parent's */
+    double xform[12];                           /* row-major 3x4 local-to-parent */
+} sw_sg_node_rec;
+
+/* Two faces sharing a B-rep edge (for super-surface clustering later). */
+typedef struct sw_sg_adjacency_rec {
+    uint32_t face_a, face_b;
+} sw_sg_adjacency_rec;
+
+/* Sections of a scene, as stored in .sws files; used as bit masks in sw_sg_scene_require. */
+typedef enum sw_sg_section {
+    SW_SG_SEC_FACES = 1u << 0,
+    SW_SG_SEC_LOOPS = 1u << 1,
+    SW_SG_SEC_CURVES = 1u << 2,
+    SW_SG_SEC_NODES = 1u << 3,
+    SW_SG_SEC_ADJACENCY = 1u << 4,
+    SW_SG_SEC_POOL = 1u << 5,
+    SW_SG_SEC_STRINGS = 1u << 6,
+    SW_SG_SEC_ALL = (1u << 7) - 1,
+} sw_sg_section;
+
+typedef struct sw_sg_scene sw_sg_scene; /* opaque; arrays read through the accessors below */
+
+/* Read-only view of a scene's arrays (borrowed; valid until sw_sg_scene_free). */
+typedef struct sw_sg_scene_view {
+    const sw_sg_face_rec *faces;
+    const sw_sg_loop_rec *loops;
+    const sw_sg_curve_rec *curves;
+    const sw_sg_node_rec *nodes;
+    const sw_sg_adjacency_rec *adjacency;
+    const double *pool;
+    const char *strings;
+    uint32_t n_faces, n_loops, n_curves, n_nodes, n_adjacency;
+    uint64_t n_pool, n_strings;
+    uint32_t root; /* node the scene is drawn from */
+} sw_sg_scene_view;
+
+const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene);
+/* Path of the file the scene was loaded from, or "" for one built in memory. */
+const char *sw_sg_scene_path_ptr(const sw_sg_scene *scene);
+
+/* Verifies (once) the checksums of the named sections of a mapped scene and, the first time all of
+ * them have been verified, validates every index and offset (sw_sg_scene_validate). In-memory
+ * scenes return SW_OK at once. Errors: SW_ERR_CHECKSUM, SW_ERR_FORMAT, SW_ERR_INVALID_GEOMETRY. */
+sw_result sw_sg_scene_require(sw_sg_scene *scene, uint32_t sections, sw_status *status);
+
+/* Checks every index, offset and count against the array sizes, the node tree for cycles (also
+ * through instances), and each face's and curve's geometry (sw_sg_surface_validate). */
+sw_result sw_sg_scene_validate(const sw_sg_scene_view *view, const char *what, sw_status *status);
+
+/* Borrowed geometry views of face `face` and curve `curve` (indices must be valid). */
+void sw_sg_scene_face_surface(const sw_sg_scene *scene, uint32_t face, sw_sg_surface *out);
+void sw_sg_scene_curve(const sw_sg_scene *scene, uint32_t curve, sw_sg_curve *out);
+
+/* Bytes the scene occupies (arrays, pool, strings, bookkeeping; mapped bytes counted). */
+size_t sw_sg_scene_memory(const sw_sg_scene *scene);
+
+void sw_sg_scene_free(sw_sg_scene *scene); /* NULL allowed */
+
+/* ---- traversal ------------------------------------------------------------------------------- */
+/* Called once per drawn face occurrence with its world transform (row-major 3x4, double) and its
+ * resolved colour. Instances are expanded. Returning non-zero stops the traversal. */
+typedef int (*sw_sg_visit_fn)(void *ctx, uint32_t face, const double world[12],
+                              const float color[4]);
+/* Walks the tree from the root. Precondition: SW_SG_SEC_NODES required and validated. */
+void sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx);
+
+/* ---- building -------------------------------------------------------------------------------- */
+typedef struct sw_sg_builder sw_sg_builder;
+
+sw_sg_builder *sw_sg_builder_create(void); /* NULL when out of memory */
+void sw_sg_builder_free(sw_sg_builder *b); /* NULL allowed */
+/* Appends doubles to the pool; returns their offset, or UINT64_MAX when out of memory. */
+uint64_t sw_sg_builder_push_doubles(sw_sg_builder *b, const double *values, size_t count);
+/* Appends a NUL-terminated string; returns its byte offset, or SW_SG_NONE on failure. */
+uint32_t sw_sg_builder_push_string(sw_sg_builder *b, const char *s);
+/* Append records; each returns the new index, or SW_SG_NONE when out of memory. */
+uint32_t sw_sg_builder_add_face(sw_sg_builder *b, const sw_sg_face_rec *face);
+uint32_t sw_sg_builder_add_loop(sw_sg_builder *b, const sw_sg_loop_rec *loop);
+uint32_t sw_sg_builder_add_curve(sw_sg_builder *b, const sw_sg_curve_rec *curve);
+uint32_t sw_sg_builder_add_adjacency(sw_sg_builder *b, uint32_t face_a, uint32_t face_b);
+/* Adds a node as the last child of `parent` (SW_SG_NONE: a detached node, e.g. a prototype);
+ * links parent/first_child/next_sibling itself. xform NULL = identity, color NULL = inherit. */
+uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind, uint32_t parent,
+                                uint32_t ref, const double xform[12], const float color[4],
+                                const char *name);
+/* Mutable access while building (valid until the next add/push call). */
+double *sw_sg_builder_pool_ptr(sw_sg_builder *b);
+sw_sg_face_rec *sw_sg_builder_face_ptr(sw_sg_builder *b, uint32_t face);
+uint32_t sw_sg_builder_face_count(const sw_sg_builder *b);
+/* Sets the root node (default: node 0, created by sw_sg_builder_create as a group). */
+void sw_sg_builder_set_root(sw_sg_builder *b, uint32_t node);
+/* Validates and turns the builder into an immutable scene; the builder is consumed (freed) in all
+ * cases. Errors: SW_ERR_INVALID_GEOMETRY / SW_ERR_FORMAT with the offending record. */
+sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *status);
+
+/* ---- .sws files (sws_file.c) ----------------------------------------------------------------- */
+/* Writes to PATH.tmp-<pid> and renames it over PATH; nothing is left behind on failure. */
+sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *status);
+/* Maps a .sws file. Checks the header, version, the section table and that the file is as long as
+ * the table says (a short mapping would raise SIGBUS); checksums are verified per section by
+ * sw_sg_scene_require. Errors: SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_VERSION,
+ * SW_ERR_TRUNCATED; the message names the file and the byte offset. */
+sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status);
+
+/* ---- statistics (scene_stats.c) -------------------------------------------------------------- */
+typedef struct sw_sg_scene_stats {
+    uint32_t faces, faces_by_kind[SW_SG_KIND_COUNT];
+    uint32_t trimmed_faces, loops, curves;
+    uint64_t bezier_patches;  /* after extraction of every face */
+    uint32_t max_deg_u, max_deg_v, max_curve_degree;
+    uint64_t control_points;
+    uint32_t nodes, instances;
+    uint64_t face_occurrences; /* faces drawn after instance expansion */
+    uint32_t adjacency;
+    double bbox[6];            /* world box of the control nets (min xyz, max xyz) */
+    size_t memory_bytes;
+} sw_sg_scene_stats;
+/* Precondition: SW_SG_SEC_ALL required. */
+void sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

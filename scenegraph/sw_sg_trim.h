@@ -1,0 +1,44 @@
+/* Trim loops: closing them bit-identically, flattening them into polylines, and classifying
+ * parameter points by even-odd parity (the same rule the GPU's fan parity implements, Guthe et al.
+ * 2005 §4).
+ */
+#ifndef SW_SG_TRIM_H
+#define SW_SG_TRIM_H
+
+#include "sw_sg_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Snaps a loop of curves closed in place: the end control point of each curve and the start of the
+ * next (the last's end and the first's start) are set to one shared Euclidean point (their
+ * midpoint), stored with each curve's own weight. Gaps larger than `max_gap` (parameter units) are
+ * reported as SW_ERR_INVALID_GEOMETRY, `what` naming the face. cpw[k] points at curve k's
+ * homogeneous control points (n[k] * 3 doubles), mutable. */
+sw_result sw_sg_trim_snap_loop(int32_t n_curves, double *const *cpw, const int32_t *n,
+                               double max_gap, const char *what, sw_status *status);
+
+/* A loop flattened to a closed polyline in (u, v): vertex 0 is the loop's first join point; the
+ * closing vertex is not repeated. Every join point is the Euclidean image of the curve's first
+ * control point, so adjacent curves share bit-identical vertices. */
+typedef struct sw_sg_polyline {
+    double *uv;     /* 2 * count */
+    uint32_t count;
+} sw_sg_polyline;
+
+/* Flattens loop `loop` so that every chord is within `tol` (parameter units) of the curve, using a
+ * bound from the control polygon (a subdivided segment is emitted when its control points lie
+ * within tol of its chord). Allocates out->uv (free with sw_sg_polyline_free).
+ * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than `max_vertices`). */
+sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, double tol,
+                                  uint32_t max_vertices, sw_sg_polyline *out, sw_status *status);
+void sw_sg_polyline_free(sw_sg_polyline *p);
+
+/* Even-odd classification of (u, v) against a set of closed polylines: 1 inside, 0 outside. */
+int sw_sg_trim_classify(const sw_sg_polyline *loops, uint32_t n_loops, double u, double v);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
