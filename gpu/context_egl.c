@@ -1,0 +1,283 @@
+/* Headless OpenGL context through EGL (PLATFORM.md, "OpenGL without a GPU"): Mesa's surfaceless
+ * platform first, then the EGL device platform (headless NVIDIA), then the default display; a
+ * desktop GL 4.5 core context (4.3 accepted when glClipControl exists), no surface, rendering
+ * into an FBO with RGBA8 colour and 32-bit float depth for reversed-Z.
+ */
+#include "sw_gpu_internal.h"
+#include "sw_status_util.h"
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/glcorearb.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* eglTerminate ends a display for every context of the process, so displays are counted. */
+static pthread_mutex_t g_display_lock = PTHREAD_MUTEX_INITIALIZER;
+static EGLDisplay g_display = EGL_NO_DISPLAY;
+static int g_display_users;
+static char g_display_platform[64];
+
+double sw__gpu_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+sw_result sw__gpu_check(sw_status *status, const char *what)
+{
+    GLenum e = glGetError();
+    if (e == GL_NO_ERROR)
+        return SW_OK;
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    return sw__fail(status, SW_ERR_GL, "OpenGL error 0x%04x during %s", (unsigned)e, what);
+}
+
+static int has_extension(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    for (const char *p = list; p && (p = strstr(p, name)) != NULL; p += n) {
+        int starts = p == list || p[-1] == ' ';
+        int ends = p[n] == '\0' || p[n] == ' ';
+        if (starts && ends)
+            return 1;
+    }
+    return 0;
+}
+
+static EGLDisplay try_initialize(EGLDisplay dpy)
+{
+    if (dpy == EGL_NO_DISPLAY)
+        return EGL_NO_DISPLAY;
+    EGLint major = 0, minor = 0;
+    if (!eglInitialize(dpy, &major, &minor))
+        return EGL_NO_DISPLAY;
+    return dpy;
+}
+
+static EGLDisplay open_device_display(void)
+{
+    PFNEGLQUERYDEVICESEXTPROC query =
+        (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+    if (!query)
+        return EGL_NO_DISPLAY;
+    EGLDeviceEXT devices[8];
+    EGLint n = 0;
+    if (!query(8, devices, &n))
+        return EGL_NO_DISPLAY;
+    for (EGLint i = 0; i < n; ++i) {
+        EGLDisplay d =
+            try_initialize(eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, devices[i], NULL));
+        if (d != EGL_NO_DISPLAY)
+            return d;
+    }
+    return EGL_NO_DISPLAY;
+}
+
+/* Opens (or shares) the process's display. Caller holds g_display_lock. */
+static EGLDisplay acquire_display(void)
+{
+    if (g_display_users > 0) {
+        ++g_display_users;
+        return g_display;
+    }
+    const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    EGLDisplay d = EGL_NO_DISPLAY;
+    if (has_extension(client, "EGL_MESA_platform_surfaceless")) {
+        d = try_initialize(
+            eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL));
+        snprintf(g_display_platform, sizeof g_display_platform, "surfaceless");
+    }
+    if (d == EGL_NO_DISPLAY && has_extension(client, "EGL_EXT_platform_device")) {
+        d = open_device_display();
+        snprintf(g_display_platform, sizeof g_display_platform, "device");
+    }
+    if (d == EGL_NO_DISPLAY) {
+        d = try_initialize(eglGetDisplay(EGL_DEFAULT_DISPLAY));
+        snprintf(g_display_platform, sizeof g_display_platform, "default");
+    }
+    if (d != EGL_NO_DISPLAY) {
+        g_display = d;
+        g_display_users = 1;
+    }
+    return d;
+}
+
+static void release_display(void)
+{
+    pthread_mutex_lock(&g_display_lock);
+    if (g_display_users > 0 && --g_display_users == 0) {
+        eglTerminate(g_display);
+        g_display = EGL_NO_DISPLAY;
+    }
+    pthread_mutex_unlock(&g_display_lock);
+}
+
+static EGLContext create_gl_context(EGLDisplay dpy, int minor)
+{
+    EGLConfig cfg = EGL_NO_CONFIG_KHR;
+    const char *ext = eglQueryString(dpy, EGL_EXTENSIONS);
+    if (!has_extension(ext, "EGL_KHR_no_config_context")) {
+        const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+        EGLint n = 0;
+        if (!eglChooseConfig(dpy, want, &cfg, 1, &n) || n < 1)
+            return EGL_NO_CONTEXT;
+    }
+    const EGLint attrs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                            4,
+                            EGL_CONTEXT_MINOR_VERSION,
+                            minor,
+                            EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                            EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                            EGL_NONE};
+    return eglCreateContext(dpy, cfg, EGL_NO_CONTEXT, attrs);
+}
+
+static int gl_extension(const char *name)
+{
+    GLint n = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; ++i) {
+        const char *e = (const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i);
+        if (e && strcmp(e, name) == 0)
+            return 1;
+    }
+    return 0;
+}
+
+static sw_result check_gl_version(sw_gpu_context *ctx, sw_status *status)
+{
+    GLint major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    const char *renderer = (const char *)glGetString(GL_RENDERER);
+    const char *version = (const char *)glGetString(GL_VERSION);
+    snprintf(ctx->description, sizeof ctx->description, "%s / %s", renderer ? renderer : "?",
+             version ? version : "?");
+    int ok = major > 4 || (major == 4 && minor >= 3);
+    int clip = major > 4 || (major == 4 && minor >= 5) || gl_extension("GL_ARB_clip_control");
+    if (!ok || !clip)
+        return sw__fail(status, SW_ERR_NO_CONTEXT,
+                        "OpenGL context %s lacks 4.3 core with glClipControl (reversed-Z); "
+                        "try Mesa llvmpipe (EGL_PLATFORM=surfaceless, LIBGL_ALWAYS_SOFTWARE=1)",
+                        ctx->description);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &ctx->max_texture_size);
+    return SW_OK;
+}
+
+static sw_result make_context(sw_gpu_context *ctx, sw_status *status)
+{
+    pthread_mutex_lock(&g_display_lock);
+    EGLDisplay dpy = acquire_display();
+    pthread_mutex_unlock(&g_display_lock);
+    if (dpy == EGL_NO_DISPLAY)
+        return sw__fail(status, SW_ERR_NO_CONTEXT,
+                        "no EGL display (tried the Mesa surfaceless platform, the EGL device "
+                        "platform and EGL_DEFAULT_DISPLAY; EGL error 0x%04x): install "
+                        "libegl-mesa0 and libgl1-mesa-dri, or set EGL_PLATFORM=surfaceless",
+                        (unsigned)eglGetError());
+    ctx->egl_display = dpy;
+    /* Each thread binds the API itself, or context creation fails with EGL_BAD_MATCH. */
+    if (!eglBindAPI(EGL_OPENGL_API))
+        return sw__fail(status, SW_ERR_NO_CONTEXT,
+                        "EGL (%s platform) cannot bind desktop OpenGL (EGL error 0x%04x)",
+                        g_display_platform, (unsigned)eglGetError());
+    EGLContext c = create_gl_context(dpy, 5);
+    if (c == EGL_NO_CONTEXT)
+        c = create_gl_context(dpy, 3);
+    if (c == EGL_NO_CONTEXT)
+        return sw__fail(status, SW_ERR_NO_CONTEXT,
+                        "EGL (%s platform) could not create an OpenGL 4.3+ core context (EGL "
+                        "error 0x%04x); try LIBGL_ALWAYS_SOFTWARE=1 for Mesa llvmpipe",
+                        g_display_platform, (unsigned)eglGetError());
+    ctx->egl_context = c;
+    if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, c))
+        return sw__fail(status, SW_ERR_NO_CONTEXT,
+                        "eglMakeCurrent without a surface failed (EGL error 0x%04x): the driver "
+                        "lacks EGL_KHR_surfaceless_context",
+                        (unsigned)eglGetError());
+    return check_gl_version(ctx, status);
+}
+
+sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status)
+{
+    *out = NULL;
+    sw_gpu_context *ctx = calloc(1, sizeof *ctx);
+    if (!ctx)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
+    sw_result r = make_context(ctx, status);
+    if (r == SW_OK)
+        r = sw__gpu_programs_create(ctx, status);
+    if (r == SW_OK) {
+        glGenVertexArrays(1, &ctx->vao);
+        glGenFramebuffers(1, &ctx->trim_fbo);
+        glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+        r = sw__gpu_check(status, "context set-up");
+    }
+    if (r != SW_OK) {
+        sw_gpu_context_free(ctx);
+        return r;
+    }
+    *out = ctx;
+    sw__status_ok(status);
+    return SW_OK;
+}
+
+void sw_gpu_context_free(sw_gpu_context *ctx)
+{
+    if (!ctx)
+        return;
+    if (ctx->egl_context) {
+        sw__gpu_programs_free(ctx);
+        glDeleteVertexArrays(1, &ctx->vao);
+        glDeleteFramebuffers(1, &ctx->trim_fbo);
+        glDeleteFramebuffers(1, &ctx->fbo);
+        glDeleteRenderbuffers(1, &ctx->rb_color);
+        glDeleteRenderbuffers(1, &ctx->rb_depth);
+        eglMakeCurrent(ctx->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(ctx->egl_display, ctx->egl_context);
+    }
+    if (ctx->egl_display)
+        release_display();
+    free(ctx);
+}
+
+const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx)
+{
+    return ctx->description;
+}
+
+sw_result sw__gpu_target_ensure(sw_gpu_context *ctx, int32_t w, int32_t h, sw_status *status)
+{
+    if (w < 1 || h < 1 || w > ctx->max_texture_size || h > ctx->max_texture_size)
+        return sw__fail(status, SW_ERR_LIMIT, "frame size %dx%d outside 1..%d", (int)w, (int)h,
+                        (int)ctx->max_texture_size);
+    if (ctx->fbo && ctx->fbo_w == w && ctx->fbo_h == h)
+        return SW_OK;
+    if (!ctx->fbo) {
+        glGenFramebuffers(1, &ctx->fbo);
+        glGenRenderbuffers(1, &ctx->rb_color);
+        glGenRenderbuffers(1, &ctx->rb_depth);
+    }
+    glBindRenderbuffer(GL_RENDERBUFFER, ctx->rb_color);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
+    glBindRenderbuffer(GL_RENDERBUFFER, ctx->rb_depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx->fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                              ctx->rb_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
+                              ctx->rb_depth);
+    GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (fs != GL_FRAMEBUFFER_COMPLETE)
+        return sw__fail(status, SW_ERR_GL, "render target %dx%d incomplete (0x%04x)", (int)w,
+                        (int)h, (unsigned)fs);
+    ctx->fbo_w = w;
+    ctx->fbo_h = h;
+    return sw__gpu_check(status, "render target allocation");
+}

@@ -1,0 +1,228 @@
+/* Draw submission and readback shared by the scene path and the plain-triangle path: one program,
+ * reversed-Z depth (cleared to 0, GL_GREATER), trim-texture lookups for trimmed ranges (Guthe et
+ * al. 2005 §4.3), glReadPixels with rows flipped to top-first and depth turned into eye-space
+ * depth. Also sw_gpu_render_triangles, the path an independent reference mesh is drawn with.
+ */
+#include "sw_gpu_internal.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void sw__gpu_desc_defaults(const sw_gpu_frame_desc *in, sw_gpu_frame_desc *out)
+{
+    *out = *in;
+    if (out->width == 0 && out->height == 0) {
+        out->width = 1280;
+        out->height = 720;
+    }
+    if (!(out->error_px > 0.0))
+        out->error_px = 0.5;
+}
+
+double sw__gpu_near_plane(const double eye[3], const double world_box[6])
+{
+    double rel[6], diag2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        rel[k] = world_box[k] - eye[k];
+        rel[3 + k] = world_box[3 + k] - eye[k];
+        double e = world_box[3 + k] - world_box[k];
+        diag2 += e * e;
+    }
+    double diag = sqrt(diag2), dist = sw__gpu_box_distance(rel);
+    double n = fmax(1e-4 * diag, 0.5 * dist);
+    return n > 0.0 && isfinite(n) ? n : 1e-3;
+}
+
+static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
+{
+    if (!ctx->mesh_vbo) {
+        glGenBuffers(1, &ctx->mesh_vbo);
+        glGenBuffers(1, &ctx->mesh_ibo);
+    }
+    glBindVertexArray(ctx->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, ctx->mesh_vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_v * sizeof *mesh->v), mesh->v,
+                 GL_STREAM_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_idx * sizeof *mesh->idx),
+                 mesh->idx, GL_STREAM_DRAW);
+    GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
+                          (const void *)offsetof(sw__gpu_vertex, pos));
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
+                          (const void *)offsetof(sw__gpu_vertex, nrm));
+    glEnableVertexAttribArray(2);
+    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
+                          (const void *)offsetof(sw__gpu_vertex, st));
+}
+
+sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, const float bg[4],
+                             const sw__gpu_mesh *mesh, const sw__gpu_draw *draws, size_t n_draws,
+                             sw_status *status)
+{
+    sw_result r = sw__gpu_target_ensure(ctx, view->width, view->height, status);
+    if (r != SW_OK)
+        return r;
+    glBindFramebuffer(GL_FRAMEBUFFER, ctx->fbo);
+    glViewport(0, 0, view->width, view->height);
+    glDisable(GL_COLOR_LOGIC_OP);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glClearColor(bg[0], bg[1], bg[2], bg[3]);
+    glClearDepth(0.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    bind_mesh(ctx, mesh);
+    glUseProgram(ctx->prog_mesh);
+    glUniformMatrix4fv(ctx->loc_view_proj, 1, GL_FALSE, view->view_proj);
+    glUniform1i(ctx->loc_trim, 0);
+    glActiveTexture(GL_TEXTURE0);
+    for (size_t d = 0; d < n_draws; ++d) {
+        if (draws[d].n_idx == 0)
+            continue;
+        glUniform4fv(ctx->loc_color, 1, draws[d].color);
+        glUniform1i(ctx->loc_trimmed, draws[d].trim_tex != 0);
+        glBindTexture(GL_TEXTURE_2D, draws[d].trim_tex);
+        glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
+                       (const void *)(draws[d].first_idx * sizeof(uint32_t)));
+    }
+    glFinish();
+    return sw__gpu_check(status, "frame draw");
+}
+
+static void flip_rows(const uint8_t *src, uint8_t *dst, int32_t h, size_t row_bytes)
+{
+    for (int32_t y = 0; y < h; ++y)
+        memcpy(dst + (size_t)y * row_bytes, src + (size_t)(h - 1 - y) * row_bytes, row_bytes);
+}
+
+sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int want_depth,
+                           sw_gpu_image *out, sw_status *status)
+{
+    int32_t w = view->width, h = view->height;
+    size_t n = (size_t)w * (size_t)h;
+    memset(out, 0, sizeof *out);
+    _Static_assert(sizeof(float) == 4, "RGBA8 and float depth share the readback buffer");
+    uint8_t *tmp = malloc(n * 4);
+    out->rgba = malloc(n * 4);
+    out->depth = want_depth ? malloc(n * sizeof *out->depth) : NULL;
+    if (!tmp || !out->rgba || (want_depth && !out->depth)) {
+        free(tmp);
+        sw_gpu_image_free(out);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame readback: out of memory");
+    }
+    out->width = w;
+    out->height = h;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, ctx->fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, tmp);
+    flip_rows(tmp, out->rgba, h, (size_t)w * 4);
+    if (want_depth) {
+        glReadPixels(0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, tmp);
+        flip_rows(tmp, (uint8_t *)out->depth, h, (size_t)w * sizeof(float));
+        for (size_t i = 0; i < n; ++i)
+            out->depth[i] = sw__gpu_depth_to_eye(view, out->depth[i]);
+    }
+    free(tmp);
+    sw_result r = sw__gpu_check(status, "frame readback");
+    if (r != SW_OK)
+        sw_gpu_image_free(out);
+    return r;
+}
+
+void sw_gpu_image_free(sw_gpu_image *img)
+{
+    if (!img)
+        return;
+    free(img->rgba);
+    free(img->depth);
+    img->rgba = NULL;
+    img->depth = NULL;
+}
+
+/* Flat-shaded, un-indexed copy of the triangles, eye-relative. */
+static sw_result triangles_to_mesh(const double *pos, uint32_t n_vertices, const uint32_t *indices,
+                                   uint32_t n_indices, const double eye[3], sw__gpu_mesh *mesh,
+                                   sw_status *status)
+{
+    uint32_t n_tri = n_indices / 3;
+    sw_result r = sw__gpu_mesh_reserve(mesh, (size_t)n_tri * 3, (size_t)n_tri * 3, status);
+    if (r != SW_OK)
+        return r;
+    for (uint32_t t = 0; t < n_tri; ++t) {
+        double p[3][3];
+        for (int c = 0; c < 3; ++c) {
+            uint32_t i = indices[3 * t + (uint32_t)c];
+            if (i >= n_vertices)
+                return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                                "triangle %u: index %u >= %u vertices", t, i, n_vertices);
+            for (int k = 0; k < 3; ++k)
+                p[c][k] = pos[3 * (size_t)i + (size_t)k] - eye[k];
+        }
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; ++k) {
+            e1[k] = p[1][k] - p[0][k];
+            e2[k] = p[2][k] - p[0][k];
+        }
+        double nrm[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                         e1[0] * e2[1] - e1[1] * e2[0]};
+        for (int c = 0; c < 3; ++c) {
+            sw__gpu_vertex *v = &mesh->v[mesh->n_v];
+            for (int k = 0; k < 3; ++k) {
+                v->pos[k] = (float)p[c][k];
+                v->nrm[k] = (float)nrm[k];
+            }
+            v->st[0] = v->st[1] = 0.0f;
+            mesh->idx[mesh->n_idx++] = (uint32_t)mesh->n_v++;
+        }
+    }
+    return SW_OK;
+}
+
+static void positions_box(const double *pos, uint32_t n, double box[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        box[k] = INFINITY;
+        box[3 + k] = -INFINITY;
+    }
+    for (uint32_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            box[k] = fmin(box[k], pos[3 * (size_t)i + (size_t)k]);
+            box[3 + k] = fmax(box[3 + k], pos[3 * (size_t)i + (size_t)k]);
+        }
+    if (n == 0)
+        memset(box, 0, 6 * sizeof *box);
+}
+
+sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, uint32_t n_vertices,
+                                  const uint32_t *indices, uint32_t n_indices,
+                                  const sw_gpu_frame_desc *desc_in, sw_gpu_image *out,
+                                  sw_status *status)
+{
+    memset(out, 0, sizeof *out);
+    sw_gpu_frame_desc desc;
+    sw__gpu_desc_defaults(desc_in, &desc);
+    double box[6];
+    positions_box(positions, n_vertices, box);
+    sw__gpu_view view;
+    sw_result r = sw__gpu_view_init(&view, &desc.camera, desc.width, desc.height,
+                                    sw__gpu_near_plane(desc.camera.eye, box), status);
+    sw__gpu_mesh mesh = {0};
+    if (r == SW_OK)
+        r = triangles_to_mesh(positions, n_vertices, indices, n_indices, view.eye, &mesh, status);
+    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, 0};
+    if (r == SW_OK)
+        r = sw__gpu_draw_frame(ctx, &view, desc.background, &mesh, &draw, 1, status);
+    sw__gpu_mesh_free(&mesh);
+    if (r == SW_OK)
+        r = sw__gpu_readback(ctx, &view, desc.want_depth, out, status);
+    if (r == SW_OK)
+        sw__status_ok(status);
+    return r;
+}

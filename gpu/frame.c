@@ -1,0 +1,424 @@
+/* One converged frame of a scene (Guthe et al. 2005 §7, without the bicubic hierarchy in this
+ * slice): traverse the scene, cull face occurrences and then their rational Bézier patches against
+ * the view frustum by their control-net boxes, choose each patch's grid density from the Filip
+ * bound at the object-space tolerance its depth allows (§5.2), evaluate the grids on the CPU, make
+ * one trim texture per trimmed face occurrence at a resolution from its on-screen size (§5.3) by
+ * fan parity on the GPU (§4), draw, read back.
+ *
+ * Phases are timed separately: tessellate (extraction, bounds, grids), trim (flattening and
+ * texture generation, waited for), draw (upload and draw until glFinish), readback.
+ */
+#include "sw_gpu_internal.h"
+#include "sw_lod_sampling.h"
+#include "sw_sg_trim.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum {
+    MAX_SEGMENTS = 256,           /* grid segments per patch and direction */
+    MAX_TRIM_SIDE = 4096,         /* texels per side of one trim texture */
+    MAX_TRIM_LOOP_VERTICES = 1u << 22,
+};
+static const double k_max_frame_vertices = 48e6;  /* ~1.5 GB of grid vertices */
+static const double k_max_frame_texels = 256e6;   /* R8 trim texels per frame */
+
+typedef struct occurrence {
+    uint32_t face;
+    double world[12];
+    float color[4];
+} occurrence;
+
+typedef struct pending_trim {
+    size_t draw;
+    uint32_t face;
+    double width, height; /* wanted resolution before the frame budget */
+} pending_trim;
+
+typedef struct frame {
+    sw_gpu_context *ctx;
+    const sw_sg_scene *scene;
+    const sw_sg_scene_view *sv;
+    sw__gpu_view view;
+    double eps_px;
+    sw_gpu_frame_stats st;
+    occurrence *occ;
+    size_t n_occ, cap_occ;
+    int oom;
+    sw_sg_bezier_set **bez; /* per face, extracted on first use in this frame */
+    sw__gpu_mesh mesh;
+    sw__gpu_draw *draws;
+    size_t n_draws, cap_draws;
+    pending_trim *trims;
+    size_t n_trims, cap_trims;
+} frame;
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 1;
+    size_t c = *cap ? *cap * 2 : 64;
+    while (c < need)
+        c *= 2;
+    void *q = realloc(*p, c * elem);
+    if (!q)
+        return 0;
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
+static int collect(void *user, uint32_t face, const double world[12], const float color[4])
+{
+    frame *f = user;
+    if (!grow((void **)&f->occ, &f->cap_occ, f->n_occ + 1, sizeof *f->occ)) {
+        f->oom = 1;
+        return 1;
+    }
+    occurrence *o = &f->occ[f->n_occ++];
+    o->face = face;
+    memcpy(o->world, world, sizeof o->world);
+    static const float k_default[4] = {0.72f, 0.72f, 0.76f, 1.0f};
+    memcpy(o->color, color && color[3] >= 0.0f ? color : k_default, sizeof o->color);
+    return 0;
+}
+
+/* Homogeneous control point mapped to eye-relative world space: w x' = R (w x) + w (t - eye). */
+static void xform_h(const double m[12], const double eye[3], const double in[4], double out[4])
+{
+    for (int r = 0; r < 3; ++r)
+        out[r] = m[4 * r] * in[0] + m[4 * r + 1] * in[1] + m[4 * r + 2] * in[2] +
+                 in[3] * (m[4 * r + 3] - eye[r]);
+    out[3] = in[3];
+}
+
+static void box_empty(double box[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        box[k] = INFINITY;
+        box[3 + k] = -INFINITY;
+    }
+}
+
+static void box_add(double box[6], const double h[4])
+{
+    for (int k = 0; k < 3; ++k) {
+        double x = h[k] / h[3];
+        box[k] = fmin(box[k], x);
+        box[3 + k] = fmax(box[3 + k], x);
+    }
+}
+
+static void occurrence_box(const frame *f, const occurrence *o, double box[6])
+{
+    sw_sg_surface s;
+    sw_sg_scene_face_surface(f->scene, o->face, &s);
+    box_empty(box);
+    size_t n = (size_t)s.n_u * (size_t)s.n_v;
+    for (size_t i = 0; i < n; ++i) {
+        double h[4];
+        xform_h(o->world, f->view.eye, s.cpw + 4 * i, h);
+        box_add(box, h);
+    }
+}
+
+static double det3(const double m[12])
+{
+    return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
+           m[2] * (m[4] * m[9] - m[5] * m[8]);
+}
+
+static sw_result face_bezier(frame *f, uint32_t face, const sw_sg_bezier_set **out,
+                             sw_status *status)
+{
+    if (!f->bez[face]) {
+        sw_sg_bezier_set *set = calloc(1, sizeof *set);
+        if (!set)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", face);
+        const double *b = f->sv->faces[face].uv_box;
+        sw_sg_surface s;
+        sw_sg_scene_face_surface(f->scene, face, &s);
+        sw_result r = sw_sg_surface_extract_bezier_in(&s, b[0], b[1], b[2], b[3], set, status);
+        if (r != SW_OK) {
+            free(set);
+            return r;
+        }
+        f->bez[face] = set;
+    }
+    *out = f->bez[face];
+    return SW_OK;
+}
+
+/* Texels wanted per direction of a face's trim texture (max over its drawn patches). */
+typedef struct trim_need {
+    double u, v;
+} trim_need;
+
+/* Sets up one patch: eye-relative control points, clipping to the uv box, culling, density. */
+static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch *bp,
+                        const double ub[4], double *cpw, sw__gpu_patch *pt, trim_need *need)
+{
+    size_t n = (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1);
+    double box[6];
+    box_empty(box);
+    for (size_t i = 0; i < n; ++i) {
+        xform_h(o->world, f->view.eye, bp->cpw + 4 * i, cpw + 4 * i);
+        box_add(box, cpw + 4 * i);
+    }
+    *pt = (sw__gpu_patch){bp->deg_u, bp->deg_v, cpw, 0, 1, 0, 1, bp->u0, bp->u1, bp->v0, bp->v1,
+                          0, 0, 0, 1, 1};
+    double du = bp->u1 - bp->u0, dv = bp->v1 - bp->v0;
+    pt->s0 = fmax(0.0, (ub[0] - bp->u0) / du);
+    pt->s1 = fmin(1.0, (ub[1] - bp->u0) / du);
+    pt->t0 = fmax(0.0, (ub[2] - bp->v0) / dv);
+    pt->t1 = fmin(1.0, (ub[3] - bp->v0) / dv);
+    if (!(pt->s1 > pt->s0) || !(pt->t1 > pt->t0) || !sw__gpu_view_box_visible(&f->view, box))
+        return;
+    pt->visible = 1;
+    sw_lod_patch_bounds b;
+    sw_lod_rational_bezier_bounds(bp->deg_u, bp->deg_v, cpw, &b);
+    double eps = sw_lod_object_tolerance(f->eps_px, sw__gpu_view_box_depth(&f->view, box),
+                                         f->view.focal_px, f->view.tan_x, f->view.tan_y);
+    pt->nu = sw_lod_filip_segments(b.d2[0], b.d2[1], pt->s1 - pt->s0, eps, MAX_SEGMENTS);
+    pt->nv = sw_lod_filip_segments(b.d2[2], b.d2[1], pt->t1 - pt->t0, eps, MAX_SEGMENTS);
+    need->u = fmax(need->u, sw_lod_trim_texels(ub[1] - ub[0], b.d1[0], du, eps));
+    need->v = fmax(need->v, sw_lod_trim_texels(ub[3] - ub[2], b.d1[1], dv, eps));
+}
+
+/* One u-density per patch column and one v-density per row: grids meet vertex to vertex. */
+static void unify_densities(sw__gpu_patch *pt, int32_t n_cols, int32_t n_rows)
+{
+    for (int32_t a = 0; a < n_cols; ++a) {
+        int32_t m = 1;
+        for (int32_t b = 0; b < n_rows; ++b)
+            if (pt[b * n_cols + a].visible && pt[b * n_cols + a].nu > m)
+                m = pt[b * n_cols + a].nu;
+        for (int32_t b = 0; b < n_rows; ++b)
+            pt[b * n_cols + a].nu = m;
+    }
+    for (int32_t b = 0; b < n_rows; ++b) {
+        int32_t m = 1;
+        for (int32_t a = 0; a < n_cols; ++a)
+            if (pt[b * n_cols + a].visible && pt[b * n_cols + a].nv > m)
+                m = pt[b * n_cols + a].nv;
+        for (int32_t a = 0; a < n_cols; ++a)
+            pt[b * n_cols + a].nv = m;
+    }
+}
+
+static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int trimmed,
+                          const trim_need *need, sw_status *status)
+{
+    if (!grow((void **)&f->draws, &f->cap_draws, f->n_draws + 1, sizeof *f->draws) ||
+        (trimmed && !grow((void **)&f->trims, &f->cap_trims, f->n_trims + 1, sizeof *f->trims)))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame draws: out of memory");
+    sw__gpu_draw *d = &f->draws[f->n_draws];
+    d->first_idx = first_idx;
+    d->n_idx = f->mesh.n_idx - first_idx;
+    memcpy(d->color, o->color, sizeof d->color);
+    d->trim_tex = 0;
+    if (trimmed)
+        f->trims[f->n_trims++] = (pending_trim){f->n_draws, o->face, need->u, need->v};
+    f->n_draws++;
+    return SW_OK;
+}
+
+static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
+{
+    const sw_sg_face_rec *rec = &f->sv->faces[o->face];
+    const sw_sg_bezier_set *set = NULL;
+    sw_result r = face_bezier(f, o->face, &set, status);
+    if (r != SW_OK)
+        return r;
+    int32_t n_cols = set->n_u, n_rows = set->n_v;
+    size_t n = (size_t)n_cols * (size_t)n_rows, n_cp = 0;
+    for (size_t p = 0; p < n; ++p)
+        n_cp += (size_t)(set->patches[p].deg_u + 1) * (size_t)(set->patches[p].deg_v + 1);
+    sw__gpu_patch *pt = calloc(n ? n : 1, sizeof *pt);
+    double *cpw = malloc((n_cp ? n_cp : 1) * 4 * sizeof *cpw);
+    if (!pt || !cpw) {
+        free(pt);
+        free(cpw);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
+    }
+    trim_need need = {1.0, 1.0};
+    size_t at = 0, drawn = 0;
+    for (size_t p = 0; p < n; ++p) {
+        const sw_sg_bezier_patch *bp = &set->patches[p];
+        patch_setup(f, o, bp, rec->uv_box, cpw + at, &pt[p], &need);
+        pt[p].col = (int32_t)(p % (size_t)n_cols);
+        pt[p].row = (int32_t)(p / (size_t)n_cols);
+        at += (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1) * 4;
+        drawn += (size_t)pt[p].visible;
+    }
+    f->st.patches_culled += n - drawn;
+    int trimmed = (rec->flags & SW_SG_FACE_TRIMMED) && rec->n_loops > 0;
+    if (drawn > 0) {
+        unify_densities(pt, n_cols, n_rows);
+        double sign = (rec->flags & SW_SG_FACE_REVERSED) ? -1.0 : 1.0;
+        if (det3(o->world) < 0.0)
+            sign = -sign;
+        size_t first = f->mesh.n_idx;
+        r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->mesh, status);
+        if (r == SW_OK)
+            r = add_draw(f, o, first, trimmed, &need, status);
+        f->st.faces_drawn++;
+        if (trimmed)
+            f->st.patches_trimmed += drawn;
+        else
+            f->st.patches_untrimmed += drawn;
+    } else {
+        f->st.faces_culled++;
+    }
+    free(pt);
+    free(cpw);
+    if (r == SW_OK && (double)f->mesh.n_v > k_max_frame_vertices)
+        r = sw__fail(status, SW_ERR_LIMIT,
+                     "frame needs more than %.0f grid vertices (error %g px too small for this "
+                     "view?)",
+                     k_max_frame_vertices, f->eps_px);
+    return r;
+}
+
+/* Collects occurrences, sets the view (near plane from the scene's box) and tessellates. */
+static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *status)
+{
+    sw_sg_scene_traverse(f->scene, collect, f);
+    if (f->oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
+    double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes), scene_box[6];
+    if (!boxes)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
+    memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
+    box_empty(scene_box);
+    for (size_t i = 0; i < f->n_occ; ++i) {
+        occurrence_box(f, &f->occ[i], boxes + 6 * i);
+        for (int k = 0; k < 3; ++k) {
+            scene_box[k] = fmin(scene_box[k], boxes[6 * i + k]);
+            scene_box[3 + k] = fmax(scene_box[3 + k], boxes[6 * i + 3 + k]);
+        }
+    }
+    static const double k_origin[3] = {0.0, 0.0, 0.0};
+    double near_plane = f->n_occ ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
+    sw_result r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height,
+                                    near_plane, status);
+    for (size_t i = 0; i < f->n_occ && r == SW_OK; ++i) {
+        if (!sw__gpu_view_box_visible(&f->view, boxes + 6 * i)) {
+            f->st.faces_culled++;
+            continue;
+        }
+        r = draw_face(f, &f->occ[i], status);
+    }
+    free(boxes);
+    return r;
+}
+
+static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_status *status)
+{
+    const sw_sg_face_rec *rec = &f->sv->faces[t->face];
+    double cap = fmin((double)MAX_TRIM_SIDE, (double)f->ctx->max_texture_size);
+    int32_t w = (int32_t)fmin(cap, fmax(8.0, ceil(t->width * scale)));
+    int32_t h = (int32_t)fmin(cap, fmax(8.0, ceil(t->height * scale)));
+    const double *ub = rec->uv_box;
+    double tol = 0.5 * fmin((ub[1] - ub[0]) / w, (ub[3] - ub[2]) / h);
+    sw_sg_polyline *loops = calloc(rec->n_loops, sizeof *loops);
+    if (!loops)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->face);
+    sw_result r = SW_OK;
+    for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k)
+        r = sw_sg_trim_flatten_loop(f->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
+                                    &loops[k], status);
+    GLuint tex = 0;
+    if (r == SW_OK)
+        r = sw__gpu_trim_texture_make(f->ctx, loops, rec->n_loops, ub, w, h, &tex, status);
+    for (uint32_t k = 0; k < rec->n_loops; ++k)
+        sw_sg_polyline_free(&loops[k]);
+    free(loops);
+    if (r != SW_OK)
+        return r;
+    f->draws[t->draw].trim_tex = tex;
+    f->st.trim_textures++;
+    f->st.trim_texels += (uint64_t)w * (uint64_t)h;
+    return SW_OK;
+}
+
+/* Trim textures for every drawn trimmed face, scaled down together if over the frame budget. */
+static sw_result make_trims(frame *f, sw_status *status)
+{
+    double total = 0.0;
+    for (size_t i = 0; i < f->n_trims; ++i)
+        total += f->trims[i].width * f->trims[i].height;
+    double scale = total > k_max_frame_texels ? sqrt(k_max_frame_texels / total) : 1.0;
+    sw_result r = SW_OK;
+    for (size_t i = 0; i < f->n_trims && r == SW_OK; ++i)
+        r = make_trim(f, &f->trims[i], scale, status);
+    glFinish();
+    return r;
+}
+
+static void frame_free(frame *f)
+{
+    for (size_t d = 0; d < f->n_draws; ++d)
+        if (f->draws[d].trim_tex)
+            glDeleteTextures(1, &f->draws[d].trim_tex);
+    if (f->bez) {
+        for (uint32_t i = 0; i < f->sv->n_faces; ++i) {
+            if (f->bez[i]) {
+                sw_sg_bezier_set_free(f->bez[i]);
+                free(f->bez[i]);
+            }
+        }
+    }
+    free(f->bez);
+    free(f->occ);
+    free(f->draws);
+    free(f->trims);
+    sw__gpu_mesh_free(&f->mesh);
+}
+
+sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                              const sw_gpu_frame_desc *desc_in, sw_gpu_image *out,
+                              sw_gpu_frame_stats *stats, sw_status *status)
+{
+    memset(out, 0, sizeof *out);
+    sw_gpu_frame_desc desc;
+    sw__gpu_desc_defaults(desc_in, &desc);
+    frame f;
+    memset(&f, 0, sizeof f);
+    f.ctx = ctx;
+    f.scene = scene;
+    f.sv = sw_sg_scene_view_ptr(scene);
+    f.eps_px = desc.error_px;
+    f.bez = calloc(f.sv->n_faces ? f.sv->n_faces : 1, sizeof *f.bez);
+    if (!f.bez)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
+
+    double t0 = sw__gpu_now_ms();
+    sw_result r = tessellate(&f, &desc, status);
+    double t1 = sw__gpu_now_ms();
+    if (r == SW_OK)
+        r = make_trims(&f, status);
+    double t2 = sw__gpu_now_ms();
+    if (r == SW_OK)
+        r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws,
+                               status);
+    double t3 = sw__gpu_now_ms();
+    if (r == SW_OK)
+        r = sw__gpu_readback(ctx, &f.view, desc.want_depth, out, status);
+    double t4 = sw__gpu_now_ms();
+
+    f.st.triangles = f.mesh.n_idx / 3;
+    f.st.ms_tessellate = t1 - t0;
+    f.st.ms_trim = t2 - t1;
+    f.st.ms_draw = t3 - t2;
+    f.st.ms_readback = t4 - t3;
+    if (stats)
+        *stats = f.st;
+    frame_free(&f);
+    if (r == SW_OK)
+        sw__status_ok(status);
+    return r;
+}

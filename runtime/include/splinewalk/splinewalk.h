@@ -1,0 +1,134 @@
+/* splinewalk — walk through huge trimmed-NURBS CAD models with a guaranteed screen-space error.
+ *
+ * The public C API, first slice: load a scene (.sws, or STEP / IGES / BREP imported through
+ * OpenCASCADE), describe it, save it, and render converged frames headlessly (EGL). Later issues
+ * grow it into the embedding API (scene-graph nodes, a runtime on the host's GL context).
+ *
+ * Style (CONVENTIONS.md): objects are handles holding a pool index and a generation (0 invalid; a
+ * stale handle yields SW_ERR_STALE_HANDLE, never a crash); create calls take a `const *_desc` in
+ * which zero means "default"; failures return an sw_result and fill the optional caller-owned
+ * sw_status with the file, position and what was expected; a failed call changes nothing and calls
+ * no callback after reporting the failure.
+ *
+ * Threads: scene handles may be used from any thread (a loaded scene is immutable). A renderer owns
+ * a GL context and must be used only on the thread that created it (SW_ERR_INVALID_ARGUMENT
+ * otherwise).
+ */
+#ifndef SPLINEWALK_H
+#define SPLINEWALK_H
+
+#include <splinewalk/sw_result.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SW_VERSION_STRING "0.1.0"
+
+typedef struct sw_scene { uint32_t id; } sw_scene;
+typedef struct sw_renderer { uint32_t id; } sw_renderer;
+
+/* ---- scenes ---------------------------------------------------------------------------------- */
+typedef void (*sw_progress_fn)(void *user_data, double fraction, const char *stage);
+typedef void (*sw_warning_fn)(void *user_data, const char *message);
+
+typedef struct sw_scene_load_desc {
+    const char *path;         /* required: .sws, .step/.stp, .iges/.igs, .brep */
+    sw_progress_fn progress;  /* NULL: none; called on the loading thread */
+    sw_warning_fn warning;    /* NULL: none; a face that cannot be converted is reported here */
+    void *user_data;
+} sw_scene_load_desc;
+
+/* Loads or imports a scene. A .sws file is mapped and checked (header, section table, size;
+ * checksums are verified before first use). Errors: SW_ERR_INVALID_ARGUMENT (NULL desc or path),
+ * SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_TRUNCATED, SW_ERR_CHECKSUM, SW_ERR_VERSION,
+ * SW_ERR_UNSUPPORTED, SW_ERR_INVALID_GEOMETRY, SW_ERR_OUT_OF_MEMORY, SW_ERR_INTERNAL. */
+SW_API sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status);
+
+/* Builds the built-in default scene (OCCT's sample furniture arranged in its room, plus a motor)
+ * from the occt-misc data directory `data_dir` (NULL: /usr/share/opencascade/data). */
+SW_API sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *desc,
+                                       sw_scene *out, sw_status *status);
+
+/* Writes the scene as .sws (temporary name, then rename). Errors: SW_ERR_STALE_HANDLE, SW_ERR_IO. */
+SW_API sw_result sw_scene_save(sw_scene scene, const char *path, sw_status *status);
+
+/* Frees the scene; later use of the handle yields SW_ERR_STALE_HANDLE. */
+SW_API sw_result sw_scene_destroy(sw_scene scene);
+
+#define SW_SURFACE_KIND_COUNT 11
+typedef struct sw_scene_info {
+    uint32_t faces, trimmed_faces, loops, curves;
+    uint32_t faces_by_kind[SW_SURFACE_KIND_COUNT]; /* names: sw_surface_kind_name(k) */
+    uint64_t bezier_patches;                       /* after extraction of every face */
+    uint32_t max_degree_u, max_degree_v, max_curve_degree;
+    uint64_t control_points;
+    uint32_t nodes, instances;
+    uint64_t face_occurrences; /* faces drawn, instances expanded */
+    uint32_t adjacent_face_pairs;
+    double bbox_min[3], bbox_max[3];
+    size_t memory_bytes;
+} sw_scene_info;
+
+SW_API sw_result sw_scene_get_info(sw_scene scene, sw_scene_info *out, sw_status *status);
+SW_API const char *sw_surface_kind_name(uint32_t kind); /* "plane", "cylinder", ...; never NULL */
+
+/* ---- cameras --------------------------------------------------------------------------------- */
+typedef struct sw_camera {
+    double eye[3], target[3], up[3];
+    double fovy_deg; /* vertical field of view in degrees; 0 = 40 */
+} sw_camera;
+
+typedef enum sw_view_preset {
+    SW_VIEW_ISO = 0,   /* from (+1,+1,+1), up +Z */
+    SW_VIEW_FRONT = 1, /* from -Y, up +Z */
+    SW_VIEW_TOP = 2,   /* from +Z, up +Y */
+    SW_VIEW_RIGHT = 3, /* from +X, up +Z */
+} sw_view_preset;
+
+/* Fits a preset to the scene's bounding box: fovy 40°, target = box centre, distance =
+ * diagonal / (2 tan(fovy/2)) × 1.1. Errors: SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT. */
+SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *out,
+                               sw_status *status);
+
+/* ---- rendering ------------------------------------------------------------------------------- */
+typedef struct sw_renderer_desc {
+    int32_t reserved; /* zero; the embedding issue adds host-context options */
+} sw_renderer_desc;
+
+/* Creates a headless renderer (EGL; llvmpipe when there is no GPU) owned by the calling thread.
+ * desc may be NULL. Errors: SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY. */
+SW_API sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out,
+                                    sw_status *status);
+SW_API sw_result sw_renderer_destroy(sw_renderer renderer);
+/* "renderer / GL version" of the renderer's context; "" for a stale handle. */
+SW_API const char *sw_renderer_description_ptr(sw_renderer renderer);
+
+typedef struct sw_frame_desc {
+    sw_scene scene;
+    sw_camera camera;
+    int32_t width, height; /* 0 = 1280 x 720 */
+    double error_px;       /* screen-space error ε_img in pixels; 0 = 0.5 */
+    const char *output_path; /* .png or .exr (with depth); NULL = render only */
+} sw_frame_desc;
+
+typedef struct sw_frame_stats {
+    uint64_t faces_drawn, faces_culled;
+    uint64_t patches_trimmed, patches_untrimmed, patches_culled;
+    uint64_t triangles, trim_textures, trim_texels;
+    double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
+} sw_frame_stats;
+
+/* Renders one converged frame (every refinement done before the frame is drawn) and writes it to
+ * desc->output_path. stats may be NULL. Errors: SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT
+ * (wrong thread, size out of 1..16384, error_px not positive and finite), SW_ERR_GL, SW_ERR_IO,
+ * SW_ERR_LIMIT, SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */
+SW_API sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc,
+                                  sw_frame_stats *stats, sw_status *status);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,240 @@
+/* Public scene API: load (.sws mapped, or imported through OCCT), save, describe, fit cameras. */
+#include "sw_rt.h"
+
+#include "sw_sg_import.h"
+#include "sw_status_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+static sw_rt_pool g_scenes = SW_RT_POOL_INIT;
+
+static int has_extension(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n > e && strcasecmp(path + n - e, ext) == 0;
+}
+
+static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
+{
+    sw_rt_scene *scene = calloc(1, sizeof *scene);
+    if (!scene) {
+        sw_sg_scene_free(sg);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    scene->sg = sg;
+    pthread_mutex_init(&scene->once_lock, NULL);
+    uint32_t id = sw_rt_pool_add(&g_scenes, scene);
+    if (!id) {
+        pthread_mutex_destroy(&scene->once_lock);
+        sw_sg_scene_free(sg);
+        free(scene);
+        return sw__fail(status, SW_ERR_LIMIT, "too many scenes loaded at once");
+    }
+    out->id = id;
+    sw__status_ok(status);
+    return SW_OK;
+}
+
+sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status)
+{
+    if (!desc || !desc->path || !out)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load: NULL desc, path or out");
+    out->id = 0;
+    sw_sg_scene *sg = NULL;
+    sw_result r;
+    if (has_extension(desc->path, ".sws")) {
+        r = sw_sg_scene_open(desc->path, &sg, status);
+    } else {
+        sw_sg_import_desc import = {desc->path, desc->progress, desc->warning, desc->user_data};
+        r = sw_sg_import_file(&import, &sg, NULL, status);
+    }
+    if (r != SW_OK)
+        return r;
+    return wrap_scene(sg, out, status);
+}
+
+/* The default scene: OCCT's "modern kitchen" sample models are already placed in Room.brep's
+ * coordinates; a second chair is an instance of the first, and the motor stands on the table. */
+typedef struct default_part {
+    const char *file;
+    int instanced; /* 1: imported once as a prototype, drawn by the instances below */
+} default_part;
+
+static const default_part k_default_parts[] = {
+    {"occ/Room.brep", 0},           {"occ/MODERN_Table_1.brep", 0},
+    {"occ/MODERN_Chair_1.brep", 1}, {"occ/MODERN_Cooker_1.brep", 0},
+    {"occ/MODERN_Exhaust_1.brep", 0}, {"occ/MODERN_MVCooker_1.brep", 0},
+    {"occ/MODERN_Refrigerator_1.brep", 0}, {"occ/MODERN_Sink_1.brep", 0},
+    {"occ/Motor-c.brep", 0},
+};
+
+/* Row-major 3x4 transforms. The chair's twin is turned by 180° about the table's vertical axis
+ * (table centre x = 200, y = 214.3); the motor is scaled by 0.3 onto the table top (z = 60.4). */
+static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+static const double k_chair_twin[12] = {-1, 0, 0, 400.0, 0, -1, 0, 428.6, 0, 0, 1, 0};
+static const double k_motor_on_table[12] = {0.3, 0, 0, 216.4, 0, 0.3, 0, 215.0, 0, 0, 0.3, 82.8};
+
+static sw_result import_part(sw_sg_builder *b, uint32_t parent, const double *xform,
+                             const char *data_dir, const char *file,
+                             const sw_scene_load_desc *desc, sw_status *status)
+{
+    char path[4096];
+    int n = snprintf(path, sizeof path, "%s/%s", data_dir, file);
+    if (n < 0 || (size_t)n >= sizeof path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "data directory path too long");
+    sw_sg_import_desc import = {path, NULL, desc ? desc->warning : NULL,
+                                desc ? desc->user_data : NULL};
+    return sw_sg_import_into(b, parent, xform, &import, NULL, status);
+}
+
+static sw_result build_default(sw_sg_builder *b, const char *data_dir,
+                               const sw_scene_load_desc *desc, sw_status *status)
+{
+    size_t count = sizeof k_default_parts / sizeof k_default_parts[0];
+    for (size_t i = 0; i < count; i++) {
+        const default_part *part = &k_default_parts[i];
+        if (desc && desc->progress)
+            desc->progress(desc->user_data, (double)i / (double)count, part->file);
+        int is_motor = strstr(part->file, "Motor-c") != NULL;
+        uint32_t parent = 0;
+        if (part->instanced) {
+            parent = sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, SW_SG_NONE, 0, NULL, NULL,
+                                            part->file);
+            if (parent == SW_SG_NONE ||
+                sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_identity, NULL,
+                                       "chair") == SW_SG_NONE ||
+                sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_chair_twin, NULL,
+                                       "chair twin") == SW_SG_NONE)
+                return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+        }
+        sw_result r = import_part(b, parent, is_motor ? k_motor_on_table : NULL, data_dir,
+                                  part->file, desc, status);
+        if (r != SW_OK)
+            return r;
+    }
+    if (desc && desc->progress)
+        desc->progress(desc->user_data, 1.0, "done");
+    return SW_OK;
+}
+
+sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *desc,
+                                sw_scene *out, sw_status *status)
+{
+    if (!out)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load_default: NULL out");
+    out->id = 0;
+    if (!data_dir)
+        data_dir = "/usr/share/opencascade/data";
+    sw_sg_builder *b = sw_sg_builder_create();
+    if (!b)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+    sw_result r = build_default(b, data_dir, desc, status);
+    if (r != SW_OK) {
+        sw_sg_builder_free(b);
+        return r;
+    }
+    sw_sg_scene *sg = NULL;
+    r = sw_sg_builder_finish(b, &sg, status);
+    if (r != SW_OK)
+        return r;
+    return wrap_scene(sg, out, status);
+}
+
+sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status)
+{
+    sw_rt_scene *scene = sw_rt_pool_get(&g_scenes, handle.id);
+    if (!scene)
+        return sw__fail(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
+                        handle.id);
+    /* once_lock: the first use verifies every section and computes the stats exactly once. */
+    pthread_mutex_lock(&scene->once_lock);
+    if (!scene->ready) {
+        sw_status local = {0};
+        scene->ready_result = sw_sg_scene_require(scene->sg, SW_SG_SEC_ALL, &local);
+        if (scene->ready_result == SW_OK)
+            sw_sg_scene_compute_stats(scene->sg, &scene->stats);
+        else if (status)
+            *status = local;
+        scene->ready = 1;
+    } else if (scene->ready_result != SW_OK) {
+        sw__fail(status, scene->ready_result, "%s: scene failed verification on first use",
+                 sw_sg_scene_path_ptr(scene->sg));
+    }
+    sw_result r = scene->ready_result;
+    pthread_mutex_unlock(&scene->once_lock);
+    *out = scene;
+    return r;
+}
+
+sw_result sw_scene_save(sw_scene handle, const char *path, sw_status *status)
+{
+    if (!path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_save: NULL path");
+    sw_rt_scene *scene;
+    sw_result r = sw_rt_scene_acquire(handle, &scene, status);
+    if (r != SW_OK)
+        return r;
+    return sw_sg_scene_save(scene->sg, path, status);
+}
+
+sw_result sw_scene_destroy(sw_scene handle)
+{
+    sw_rt_scene *scene = sw_rt_pool_remove(&g_scenes, handle.id);
+    if (!scene)
+        return SW_ERR_STALE_HANDLE;
+    sw_sg_scene_free(scene->sg);
+    pthread_mutex_destroy(&scene->once_lock);
+    free(scene);
+    return SW_OK;
+}
+
+sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *status)
+{
+    if (!out)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_info: NULL out");
+    sw_rt_scene *scene;
+    sw_result r = sw_rt_scene_acquire(handle, &scene, status);
+    if (r != SW_OK)
+        return r;
+    const sw_sg_scene_stats *s = &scene->stats;
+    memset(out, 0, sizeof *out);
+    out->faces = s->faces;
+    out->trimmed_faces = s->trimmed_faces;
+    out->loops = s->loops;
+    out->curves = s->curves;
+    _Static_assert(SW_SURFACE_KIND_COUNT == SW_SG_KIND_COUNT, "surface kinds out of step");
+    memcpy(out->faces_by_kind, s->faces_by_kind, sizeof out->faces_by_kind);
+    out->bezier_patches = s->bezier_patches;
+    out->max_degree_u = s->max_deg_u;
+    out->max_degree_v = s->max_deg_v;
+    out->max_curve_degree = s->max_curve_degree;
+    out->control_points = s->control_points;
+    out->nodes = s->nodes;
+    out->instances = s->instances;
+    out->face_occurrences = s->face_occurrences;
+    out->adjacent_face_pairs = s->adjacency;
+    memcpy(out->bbox_min, s->bbox, sizeof out->bbox_min);
+    memcpy(out->bbox_max, s->bbox + 3, sizeof out->bbox_max);
+    out->memory_bytes = sw_sg_scene_memory(scene->sg);
+    return SW_OK;
+}
+
+const char *sw_surface_kind_name(uint32_t kind)
+{
+    return sw_sg_surface_kind_str(kind);
+}
+
+sw_result sw_camera_fit(sw_scene handle, sw_view_preset view, sw_camera *out, sw_status *status)
+{
+    if (!out || (unsigned)view > SW_VIEW_RIGHT)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_camera_fit: bad view or NULL out");
+    sw_rt_scene *scene;
+    sw_result r = sw_rt_scene_acquire(handle, &scene, status);
+    if (r != SW_OK)
+        return r;
+    sw_rt_camera_fit_box(scene->stats.bbox, view, out);
+    return SW_OK;
+}

@@ -1,0 +1,32 @@
+/* The splinewalk command-line tool's subcommands (runtime/src/cli_*.c). Each returns the process
+ * exit status: 0 success, 1 a failure reported on stderr, 2 a usage error. */
+#ifndef SW_CLI_H
+#define SW_CLI_H
+
+#include <splinewalk/splinewalk.h>
+
+int sw_cli_import(int argc, char **argv);
+int sw_cli_info(int argc, char **argv);
+int sw_cli_render(int argc, char **argv);
+int sw_cli_demo(int argc, char **argv);
+
+/* ---- shared helpers (cli_common.c) ---------------------------------------------------------- */
+int sw_cli_is_help(const char *arg);
+/* Prints "splinewalk <cmd>: <result>: <message>" to stderr; returns 1. */
+int sw_cli_report(const char *cmd, const sw_status *status);
+/* A progress bar on stderr (redrawn in place on a terminal, a line per 10 % otherwise). */
+void sw_cli_progress(void *user_data, double fraction, const char *stage);
+void sw_cli_progress_end(void);
+void sw_cli_warning(void *user_data, const char *message);
+/* Loads a scene with the progress bar and warnings on stderr. */
+sw_result sw_cli_load_scene(const char *path, sw_scene *out, sw_status *status);
+/* "1280x720" → width, height (1..16384). Returns 0 on success. */
+int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h);
+/* "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy" → camera. Returns 0 on success. */
+int sw_cli_parse_camera(const char *text, sw_camera *out);
+/* A positive finite number. Returns 0 on success. */
+int sw_cli_parse_positive(const char *text, double *out);
+double sw_cli_now_ms(void);
+void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s);
+
+#endif

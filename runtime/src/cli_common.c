@@ -1,0 +1,155 @@
+/* Helpers shared by the splinewalk subcommands: argument parsing, progress, error reports. */
+#include "cli.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+int sw_cli_is_help(const char *arg)
+{
+    return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
+}
+
+int sw_cli_report(const char *cmd, const sw_status *status)
+{
+    fprintf(stderr, "splinewalk %s: %s: %s\n", cmd, sw_result_str(status->result),
+            status->message[0] ? status->message : "(no details)");
+    return 1;
+}
+
+static struct {
+    int active;
+    int last_decile;
+    char stage[64];
+} g_progress;
+
+void sw_cli_progress(void *user_data, double fraction, const char *stage)
+{
+    (void)user_data;
+    if (!(fraction >= 0.0))
+        fraction = 0.0;
+    if (fraction > 1.0)
+        fraction = 1.0;
+    if (isatty(STDERR_FILENO)) {
+        int filled = (int)(fraction * 30.0);
+        fprintf(stderr, "\r[%.*s%*s] %3d%% %-40.40s", filled, "==============================",
+                30 - filled, "", (int)(fraction * 100.0), stage ? stage : "");
+        g_progress.active = 1;
+        return;
+    }
+    int decile = (int)(fraction * 10.0);
+    if (!g_progress.active || decile > g_progress.last_decile ||
+        (stage && strncmp(stage, g_progress.stage, sizeof g_progress.stage - 1) != 0)) {
+        fprintf(stderr, "  %3d%% %s\n", (int)(fraction * 100.0), stage ? stage : "");
+        g_progress.last_decile = decile;
+        snprintf(g_progress.stage, sizeof g_progress.stage, "%s", stage ? stage : "");
+        g_progress.active = 1;
+    }
+}
+
+void sw_cli_progress_end(void)
+{
+    if (g_progress.active && isatty(STDERR_FILENO))
+        fputc('\n', stderr);
+    memset(&g_progress, 0, sizeof g_progress);
+}
+
+void sw_cli_warning(void *user_data, const char *message)
+{
+    (void)user_data;
+    if (g_progress.active && isatty(STDERR_FILENO))
+        fputc('\n', stderr);
+    fprintf(stderr, "warning: %s\n", message);
+}
+
+sw_result sw_cli_load_scene(const char *path, sw_scene *out, sw_status *status)
+{
+    sw_scene_load_desc desc = {path, sw_cli_progress, sw_cli_warning, NULL};
+    sw_result r = sw_scene_load(&desc, out, status);
+    sw_cli_progress_end();
+    return r;
+}
+
+int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h)
+{
+    char *end;
+    errno = 0;
+    long a = strtol(text, &end, 10);
+    if (errno || end == text || (*end != 'x' && *end != 'X'))
+        return -1;
+    const char *second = end + 1;
+    long b = strtol(second, &end, 10);
+    if (errno || end == second || *end != '\0' || a < 1 || b < 1 || a > 16384 || b > 16384)
+        return -1;
+    *w = (int32_t)a;
+    *h = (int32_t)b;
+    return 0;
+}
+
+int sw_cli_parse_camera(const char *text, sw_camera *out)
+{
+    double v[10];
+    const char *p = text;
+    for (int i = 0; i < 10; i++) {
+        char *end;
+        errno = 0;
+        v[i] = strtod(p, &end);
+        if (errno || end == p || !isfinite(v[i]))
+            return -1;
+        if (i < 9 && *end != ',')
+            return -1;
+        if (i == 9 && *end != '\0')
+            return -1;
+        p = end + 1;
+    }
+    for (int k = 0; k < 3; k++) {
+        out->eye[k] = v[k];
+        out->target[k] = v[3 + k];
+        out->up[k] = v[6 + k];
+    }
+    out->fovy_deg = v[9];
+    if (!(v[9] > 0.0 && v[9] < 180.0))
+        return -1;
+    double d2 = 0.0, u2 = 0.0;
+    for (int k = 0; k < 3; k++) {
+        d2 += (v[3 + k] - v[k]) * (v[3 + k] - v[k]);
+        u2 += v[6 + k] * v[6 + k];
+    }
+    return d2 > 0.0 && u2 > 0.0 ? 0 : -1;
+}
+
+int sw_cli_parse_positive(const char *text, double *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(text, &end);
+    if (errno || end == text || *end != '\0' || !(v > 0.0) || !isfinite(v))
+        return -1;
+    *out = v;
+    return 0;
+}
+
+double sw_cli_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
+{
+    printf("%s: patches drawn trimmed by trim textures %llu, untrimmed %llu, culled %llu; "
+           "faces drawn %llu, culled %llu; %llu triangles; %llu trim textures (%llu texels)\n",
+           label, (unsigned long long)s->patches_trimmed, (unsigned long long)s->patches_untrimmed,
+           (unsigned long long)s->patches_culled, (unsigned long long)s->faces_drawn,
+           (unsigned long long)s->faces_culled, (unsigned long long)s->triangles,
+           (unsigned long long)s->trim_textures, (unsigned long long)s->trim_texels);
+    printf("%*s  time: tessellate %.1f ms, trim textures %.1f ms, draw %.1f ms, readback %.1f ms, "
+           "write %.1f ms, total %.1f ms\n",
+           (int)strlen(label), "", s->ms_tessellate, s->ms_trim, s->ms_draw, s->ms_readback,
+           s->ms_write, s->ms_total);
+}

@@ -1,0 +1,90 @@
+/* Generation-checked handle pools (CONVENTIONS.md: handles like sokol's sg_buffer). */
+#include "sw_rt.h"
+
+#include <stdlib.h>
+
+static int grow(sw_rt_pool *pool)
+{
+    uint32_t cap = pool->capacity ? pool->capacity * 2 : 16;
+    if (cap > SW_RT_POOL_MAX_SLOTS)
+        cap = SW_RT_POOL_MAX_SLOTS;
+    if (cap <= pool->capacity)
+        return 0;
+    void **items = realloc(pool->items, cap * sizeof *items);
+    if (!items)
+        return 0;
+    pool->items = items;
+    uint16_t *gens = realloc(pool->generations, cap * sizeof *gens);
+    if (!gens)
+        return 0;
+    pool->generations = gens;
+    for (uint32_t i = pool->capacity; i < cap; i++) {
+        items[i] = NULL;
+        gens[i] = 1;
+    }
+    pool->capacity = cap;
+    return 1;
+}
+
+static uint32_t make_id(uint32_t slot, uint16_t generation)
+{
+    return ((uint32_t)generation << 16) | (slot + 1);
+}
+
+/* Locks pool->lock: protects items/generations/capacity. */
+uint32_t sw_rt_pool_add(sw_rt_pool *pool, void *item)
+{
+    uint32_t id = 0;
+    pthread_mutex_lock(&pool->lock);
+    for (int attempt = 0; attempt < 2 && !id; attempt++) {
+        for (uint32_t i = 0; i < pool->capacity; i++) {
+            if (!pool->items[i]) {
+                pool->items[i] = item;
+                id = make_id(i, pool->generations[i]);
+                break;
+            }
+        }
+        if (!id && !grow(pool))
+            break;
+    }
+    pthread_mutex_unlock(&pool->lock);
+    return id;
+}
+
+static int slot_of(const sw_rt_pool *pool, uint32_t id, uint32_t *slot)
+{
+    uint32_t index = id & 0xffffu;
+    if (index == 0 || index > pool->capacity)
+        return 0;
+    *slot = index - 1;
+    return pool->items[*slot] && pool->generations[*slot] == (uint16_t)(id >> 16);
+}
+
+/* Locks pool->lock (see sw_rt_pool_add). */
+void *sw_rt_pool_get(sw_rt_pool *pool, uint32_t id)
+{
+    void *item = NULL;
+    uint32_t slot;
+    pthread_mutex_lock(&pool->lock);
+    if (slot_of(pool, id, &slot))
+        item = pool->items[slot];
+    pthread_mutex_unlock(&pool->lock);
+    return item;
+}
+
+/* Locks pool->lock (see sw_rt_pool_add). The slot's generation moves on (never to 0), so every
+ * handle to the removed item goes stale. */
+void *sw_rt_pool_remove(sw_rt_pool *pool, uint32_t id)
+{
+    void *item = NULL;
+    uint32_t slot;
+    pthread_mutex_lock(&pool->lock);
+    if (slot_of(pool, id, &slot)) {
+        item = pool->items[slot];
+        pool->items[slot] = NULL;
+        uint16_t next = (uint16_t)(pool->generations[slot] + 1);
+        pool->generations[slot] = next ? next : 1;
+    }
+    pthread_mutex_unlock(&pool->lock);
+    return item;
+}

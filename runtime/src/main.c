@@ -1,0 +1,51 @@
+/* splinewalk: the command-line runtime. */
+#include "cli.h"
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} command;
+
+static const command k_commands[] = {
+    {"import", sw_cli_import, "import STEP / IGES / BREP into a .sws scene file"},
+    {"info", sw_cli_info, "describe a scene (surfaces, trims, patches, memory)"},
+    {"render", sw_cli_render, "render one converged frame headlessly to PNG / EXR"},
+    {"demo", sw_cli_demo, "build and render the built-in default scene"},
+};
+
+static void usage(FILE *out)
+{
+    fprintf(out, "usage: splinewalk COMMAND [ARGS]   (splinewalk COMMAND --help for details)\n\n"
+                 "commands:\n");
+    for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
+        fprintf(out, "  %-8s %s\n", k_commands[i].name, k_commands[i].summary);
+    fprintf(out, "\nsplinewalk %s — walk through huge trimmed-NURBS CAD models\n",
+            SW_VERSION_STRING);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (sw_cli_is_help(argv[1])) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(argv[1], "--version")) {
+        printf("splinewalk %s\n", SW_VERSION_STRING);
+        return 0;
+    }
+    for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++) {
+        if (!strcmp(argv[1], k_commands[i].name))
+            return k_commands[i].run(argc - 1, argv + 1);
+    }
+    fprintf(stderr, "splinewalk: unknown command '%s'\n", argv[1]);
+    usage(stderr);
+    return 2;
+}

@@ -1,0 +1,924 @@
+/* The OCCT importer: STEP (XCAF: assembly tree, instances, names, colours), IGES and BREP files
+ * into an sw_sg_builder. Every face is converted to a NURBS surface (BRepBuilderAPI_NurbsConvert)
+ * whose wires' pcurves become 2D rational B-spline trim loops, snapped closed (sw_sg_trim.h) as
+ * Guthe et al. 2005 §4's parity-based trim textures require. Shapes shared with different
+ * locations become one prototype subtree drawn by INSTANCE nodes. Faces sharing an edge are
+ * recorded as adjacent (for Kumar et al. 1997's super-surfaces).
+ *
+ * This is a C++ shim: no exception leaves it. Reader failures become SW_ERR_FORMAT, a face that
+ * cannot be converted becomes a warning and a count, anything else SW_ERR_INTERNAL.
+ */
+#include "sw_sg_import_occt.hpp"
+#include "sw_sg_trim.h"
+#include "sw_status_util.h"
+
+#include <BRepAdaptor_Surface.hxx>
+#include <BRepBuilderAPI_NurbsConvert.hxx>
+#include <BRepTools.hxx>
+#include <BRepTools_WireExplorer.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Geom2dConvert.hxx>
+#include <Geom2d_BSplineCurve.hxx>
+#include <Geom2d_TrimmedCurve.hxx>
+#include <GeomConvert.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <IGESCAFControl_Reader.hxx>
+#include <IGESControl_Reader.hxx>
+#include <NCollection_DataMap.hxx>
+#include <Quantity_ColorRGBA.hxx>
+#include <STEPCAFControl_Reader.hxx>
+#include <STEPControl_Reader.hxx>
+#include <Standard_Failure.hxx>
+#include <TDF_LabelMapHasher.hxx>
+#include <TDF_LabelSequence.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopTools_IndexedDataMapOfShapeListOfShape.hxx>
+#include <TopTools_IndexedMapOfShape.hxx>
+#include <TopTools_ShapeMapHasher.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Iterator.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_ColorTool.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <new>
+#include <set>
+#include <string>
+#include <sys/stat.h>
+#include <unordered_map>
+#include <unordered_set>
+#include <vector>
+
+namespace {
+
+struct oom_error {};
+
+/* A face converted but not yet in the builder: nothing is added unless all of it succeeded. */
+struct curve_data {
+    int32_t degree = 0;
+    std::vector<double> knots, cpw; /* flat knots; (w*u, w*v, w) */
+};
+struct loop_data {
+    uint32_t flags = 0;
+    std::vector<curve_data> curves;
+};
+struct face_data {
+    sw_sg_face_rec rec{};
+    std::vector<double> knots_u, knots_v, cpw;
+    std::vector<loop_data> loops;
+};
+
+/* A face that cannot be converted; the message says why. */
+struct face_error {
+    std::string why;
+};
+
+double now_ms()
+{
+    using namespace std::chrono;
+    return duration<double, std::milli>(steady_clock::now().time_since_epoch()).count();
+}
+
+uint32_t kind_of(GeomAbs_SurfaceType t)
+{
+    switch (t) {
+    case GeomAbs_Plane: return SW_SG_KIND_PLANE;
+    case GeomAbs_Cylinder: return SW_SG_KIND_CYLINDER;
+    case GeomAbs_Cone: return SW_SG_KIND_CONE;
+    case GeomAbs_Sphere: return SW_SG_KIND_SPHERE;
+    case GeomAbs_Torus: return SW_SG_KIND_TORUS;
+    case GeomAbs_BezierSurface: return SW_SG_KIND_BEZIER;
+    case GeomAbs_BSplineSurface: return SW_SG_KIND_BSPLINE;
+    case GeomAbs_SurfaceOfRevolution: return SW_SG_KIND_REVOLUTION;
+    case GeomAbs_SurfaceOfExtrusion: return SW_SG_KIND_EXTRUSION;
+    case GeomAbs_OffsetSurface: return SW_SG_KIND_OFFSET;
+    default: return SW_SG_KIND_OTHER;
+    }
+}
+
+void xform_of(const TopLoc_Location &loc, double x[12])
+{
+    const gp_Trsf t = loc.Transformation();
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 4; c++)
+            x[r * 4 + c] = t.Value(r + 1, c + 1);
+}
+
+std::string lower_ext(const std::string &path)
+{
+    size_t dot = path.find_last_of('.');
+    size_t slash = path.find_last_of('/');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+        return "";
+    std::string e = path.substr(dot + 1);
+    for (char &c : e)
+        c = (char)std::tolower((unsigned char)c);
+    return e;
+}
+
+std::string base_name(const std::string &path)
+{
+    size_t slash = path.find_last_of('/');
+    return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+/* ---- face conversion ------------------------------------------------------------------------ */
+
+Handle(Geom_BSplineSurface) nurbs_surface(const TopoDS_Face &cf, double period[2])
+{
+    Handle(Geom_Surface) s = BRep_Tool::Surface(cf);
+    if (s.IsNull())
+        throw face_error{"no surface"};
+    Handle(Geom_BSplineSurface) bs = Handle(Geom_BSplineSurface)::DownCast(s);
+    bs = bs.IsNull() ? GeomConvert::SurfaceToBSplineSurface(s)
+                     : Handle(Geom_BSplineSurface)::DownCast(bs->Copy());
+    if (bs.IsNull())
+        throw face_error{"surface is not convertible to a B-spline"};
+    period[0] = bs->IsUPeriodic() ? bs->UPeriod() : 0.0;
+    period[1] = bs->IsVPeriodic() ? bs->VPeriod() : 0.0;
+    if (bs->IsUPeriodic())
+        bs->SetUNotPeriodic();
+    if (bs->IsVPeriodic())
+        bs->SetVNotPeriodic();
+    return bs;
+}
+
+void surface_arrays(const Handle(Geom_BSplineSurface) & s, face_data &fd)
+{
+    const int nu = s->NbUPoles(), nv = s->NbVPoles(), du = s->UDegree(), dv = s->VDegree();
+    if (du > SW_SG_MAX_DEGREE || dv > SW_SG_MAX_DEGREE)
+        throw face_error{"surface degree above " + std::to_string(SW_SG_MAX_DEGREE)};
+    TColStd_Array1OfReal ku(1, nu + du + 1), kv(1, nv + dv + 1);
+    s->UKnotSequence(ku);
+    s->VKnotSequence(kv);
+    fd.knots_u.assign(ku.begin(), ku.end());
+    fd.knots_v.assign(kv.begin(), kv.end());
+    fd.cpw.resize((size_t)nu * nv * 4);
+    double *p = fd.cpw.data();
+    for (int j = 1; j <= nv; j++) /* OCCT's Pole(i, j): i along U, so U runs fastest here */
+        for (int i = 1; i <= nu; i++, p += 4) {
+            const gp_Pnt &q = s->Pole(i, j);
+            const double w = s->Weight(i, j);
+            p[0] = w * q.X(), p[1] = w * q.Y(), p[2] = w * q.Z(), p[3] = w;
+        }
+    fd.rec.deg_u = (uint32_t)du, fd.rec.deg_v = (uint32_t)dv;
+    fd.rec.n_u = (uint32_t)nu, fd.rec.n_v = (uint32_t)nv;
+}
+
+/* The edge's pcurve over its range, in the direction the wire runs along it. */
+curve_data pcurve(const TopoDS_Edge &e, const TopoDS_Face &cf)
+{
+    double f = 0.0, l = 0.0;
+    Handle(Geom2d_Curve) c = BRep_Tool::CurveOnSurface(e, cf, f, l);
+    if (c.IsNull())
+        throw face_error{"an edge has no pcurve"};
+    Handle(Geom2d_BSplineCurve) bs =
+        Geom2dConvert::CurveToBSplineCurve(new Geom2d_TrimmedCurve(c, f, l));
+    if (bs.IsNull())
+        throw face_error{"a pcurve is not convertible to a B-spline"};
+    if (bs->IsPeriodic())
+        bs->SetNotPeriodic();
+    if (e.Orientation() == TopAbs_REVERSED)
+        bs->Reverse();
+    if (bs->Degree() > SW_SG_MAX_DEGREE)
+        throw face_error{"pcurve degree above " + std::to_string(SW_SG_MAX_DEGREE)};
+    curve_data cd;
+    cd.degree = bs->Degree();
+    const int n = bs->NbPoles();
+    TColStd_Array1OfReal k(1, n + cd.degree + 1);
+    bs->KnotSequence(k);
+    cd.knots.assign(k.begin(), k.end());
+    cd.cpw.resize((size_t)n * 3);
+    for (int i = 1; i <= n; i++) {
+        const gp_Pnt2d &q = bs->Pole(i);
+        const double w = bs->Weight(i);
+        cd.cpw[(i - 1) * 3] = w * q.X(), cd.cpw[(i - 1) * 3 + 1] = w * q.Y();
+        cd.cpw[(i - 1) * 3 + 2] = w;
+    }
+    return cd;
+}
+
+struct uv_domain {
+    double u0, u1, v0, v1;
+    double diag() const { return std::hypot(u1 - u0, v1 - v0); }
+};
+
+/* Euclidean bounding box of a loop's control points: u0, u1, v0, v1. */
+void loop_box(const loop_data &ld, double box[4])
+{
+    box[0] = box[2] = HUGE_VAL, box[1] = box[3] = -HUGE_VAL;
+    for (const curve_data &c : ld.curves)
+        for (size_t i = 0; i < c.cpw.size(); i += 3) {
+            double u = c.cpw[i] / c.cpw[i + 2], v = c.cpw[i + 1] / c.cpw[i + 2];
+            box[0] = std::min(box[0], u), box[1] = std::max(box[1], u);
+            box[2] = std::min(box[2], v), box[3] = std::max(box[3], v);
+        }
+}
+
+/* Pcurves of a periodic surface may lie whole periods away from the non-periodic domain. */
+void shift_into_domain(loop_data &ld, const uv_domain &d, const double period[2])
+{
+    double box[4];
+    loop_box(ld, box);
+    double shift[2] = {0.0, 0.0};
+    const double lo[2] = {d.u0, d.v0}, hi[2] = {d.u1, d.v1};
+    for (int a = 0; a < 2; a++) {
+        double centre = 0.5 * (box[2 * a] + box[2 * a + 1]);
+        if (period[a] > 0.0 && (centre < lo[a] || centre > hi[a]))
+            shift[a] = -std::floor((centre - lo[a]) / period[a]) * period[a];
+    }
+    if (shift[0] == 0.0 && shift[1] == 0.0)
+        return;
+    for (curve_data &c : ld.curves)
+        for (size_t i = 0; i < c.cpw.size(); i += 3)
+            c.cpw[i] += shift[0] * c.cpw[i + 2], c.cpw[i + 1] += shift[1] * c.cpw[i + 2];
+}
+
+/* How far apart in (u, v) two points within 3D distance `tol3` of each other can be near (u, v):
+ * tol3 over the smallest singular value of the Jacobian [Su Sv]. */
+double uv_reach(const Handle(Geom_BSplineSurface) & s, const uv_domain &d, double u, double v,
+                double tol3)
+{
+    u = std::clamp(u, d.u0, d.u1), v = std::clamp(v, d.v0, d.v1);
+    gp_Pnt p;
+    gp_Vec su, sv;
+    s->D1(u, v, p, su, sv);
+    const double e = su.Dot(su), f = su.Dot(sv), g = sv.Dot(sv);
+    const double lmin = 0.5 * (e + g - std::sqrt((e - g) * (e - g) + 4.0 * f * f));
+    const double smin = std::sqrt(std::max(lmin, 0.0));
+    return smin > tol3 / d.diag() ? tol3 / smin : d.diag();
+}
+
+/* Snaps a loop closed. The allowed gap is generous: OCCT's loops have gaps up to the edge and
+ * vertex tolerances, which map to large parameter distances where the surface is nearly
+ * degenerate, so the largest mapping over the loop's joins is used. */
+void snap_loop(loop_data &ld, const Handle(Geom_BSplineSurface) & s, const uv_domain &d,
+               double tol3, const std::string &what)
+{
+    const size_t n = ld.curves.size();
+    double max_gap = 1e-9 * d.diag();
+    std::vector<double *> cpw(n);
+    std::vector<int32_t> np(n);
+    for (size_t k = 0; k < n; k++) {
+        curve_data &c = ld.curves[k];
+        cpw[k] = c.cpw.data();
+        np[k] = (int32_t)(c.cpw.size() / 3);
+        const double *end = c.cpw.data() + c.cpw.size() - 3;
+        max_gap =
+            std::max(max_gap, 4.0 * uv_reach(s, d, end[0] / end[2], end[1] / end[2], tol3));
+    }
+    sw_status st{};
+    if (sw_sg_trim_snap_loop((int32_t)n, cpw.data(), np.data(), max_gap, what.c_str(), &st) !=
+        SW_OK)
+        throw face_error{st.message};
+}
+
+/* A loop of curves each lying on one side of the domain rectangle, covering it. */
+bool is_domain_rectangle(const loop_data &ld, const uv_domain &d)
+{
+    const double eps = 1e-9 * d.diag();
+    double box[4];
+    loop_box(ld, box);
+    if (std::fabs(box[0] - d.u0) > eps || std::fabs(box[1] - d.u1) > eps ||
+        std::fabs(box[2] - d.v0) > eps || std::fabs(box[3] - d.v1) > eps)
+        return false;
+    for (const curve_data &c : ld.curves) {
+        bool side[4] = {true, true, true, true};
+        for (size_t i = 0; i < c.cpw.size(); i += 3) {
+            double u = c.cpw[i] / c.cpw[i + 2], v = c.cpw[i + 1] / c.cpw[i + 2];
+            side[0] &= std::fabs(u - d.u0) <= eps, side[1] &= std::fabs(u - d.u1) <= eps;
+            side[2] &= std::fabs(v - d.v0) <= eps, side[3] &= std::fabs(v - d.v1) <= eps;
+        }
+        if (!(side[0] || side[1] || side[2] || side[3]))
+            return false;
+    }
+    return true;
+}
+
+curve_data line_curve(double u0, double v0, double u1, double v1)
+{
+    curve_data c;
+    c.degree = 1;
+    c.knots = {0.0, 0.0, 1.0, 1.0};
+    c.cpw = {u0, v0, 1.0, u1, v1, 1.0};
+    return c;
+}
+
+void wire_loops(const TopoDS_Face &cf, face_data &fd)
+{
+    const TopoDS_Wire outer = BRepTools::OuterWire(cf);
+    for (TopoDS_Iterator it(cf); it.More(); it.Next()) {
+        if (it.Value().ShapeType() != TopAbs_WIRE)
+            continue;
+        const TopoDS_Wire &w = TopoDS::Wire(it.Value());
+        loop_data ld;
+        ld.flags = w.IsSame(outer) ? (uint32_t)SW_SG_LOOP_OUTER : 0u;
+        for (BRepTools_WireExplorer ex(w, cf); ex.More(); ex.Next())
+            ld.curves.push_back(pcurve(ex.Current(), cf));
+        if (!ld.curves.empty())
+            fd.loops.push_back(std::move(ld));
+    }
+}
+
+double max_tolerance(const TopoDS_Face &f, TopAbs_ShapeEnum type)
+{
+    double t = 0.0;
+    for (TopExp_Explorer ex(f, type); ex.More(); ex.Next())
+        t = std::max(t, type == TopAbs_EDGE ? BRep_Tool::Tolerance(TopoDS::Edge(ex.Current()))
+                                            : BRep_Tool::Tolerance(TopoDS::Vertex(ex.Current())));
+    return t;
+}
+
+/* Converts one face; throws face_error or Standard_Failure when it cannot. */
+face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what)
+{
+    face_data fd;
+    fd.rec.kind = kind_of(BRepAdaptor_Surface(f, Standard_False).GetType());
+    fd.rec.flags = f.Orientation() == TopAbs_REVERSED ? (uint32_t)SW_SG_FACE_REVERSED : 0u;
+    fd.rec.tolerance = max_tolerance(f, TopAbs_EDGE);
+
+    BRepBuilderAPI_NurbsConvert nc(f);
+    if (!nc.IsDone())
+        throw face_error{"BRepBuilderAPI_NurbsConvert failed"};
+    TopoDS_Shape cs = nc.ModifiedShape(f);
+    if (cs.IsNull() || cs.ShapeType() != TopAbs_FACE)
+        throw face_error{"BRepBuilderAPI_NurbsConvert gave no face"};
+    converted = TopoDS::Face(cs);
+
+    double period[2];
+    Handle(Geom_BSplineSurface) s = nurbs_surface(converted, period);
+    surface_arrays(s, fd);
+    uv_domain d{fd.knots_u[fd.rec.deg_u], fd.knots_u[fd.rec.n_u], fd.knots_v[fd.rec.deg_v],
+                fd.knots_v[fd.rec.n_v]};
+
+    wire_loops(converted, fd);
+    const double tol3 = std::max(fd.rec.tolerance, max_tolerance(converted, TopAbs_VERTEX));
+    for (loop_data &ld : fd.loops) {
+        shift_into_domain(ld, d, period);
+        snap_loop(ld, s, d, tol3, what);
+    }
+    if (fd.loops.empty()) { /* a face without wires is bounded by its surface's domain */
+        loop_data ld;
+        ld.flags = SW_SG_LOOP_OUTER;
+        ld.curves = {line_curve(d.u0, d.v0, d.u1, d.v0), line_curve(d.u1, d.v0, d.u1, d.v1),
+                     line_curve(d.u1, d.v1, d.u0, d.v1), line_curve(d.u0, d.v1, d.u0, d.v0)};
+        fd.loops.push_back(std::move(ld));
+    }
+    const bool untrimmed = fd.loops.size() == 1 && is_domain_rectangle(fd.loops[0], d);
+    if (!untrimmed)
+        fd.rec.flags |= SW_SG_FACE_TRIMMED;
+
+    double box[4] = {HUGE_VAL, -HUGE_VAL, HUGE_VAL, -HUGE_VAL};
+    for (const loop_data &ld : fd.loops) {
+        double lb[4];
+        loop_box(ld, lb);
+        box[0] = std::min(box[0], lb[0]), box[1] = std::max(box[1], lb[1]);
+        box[2] = std::min(box[2], lb[2]), box[3] = std::max(box[3], lb[3]);
+    }
+    fd.rec.uv_box[0] = std::clamp(box[0], d.u0, d.u1), fd.rec.uv_box[1] = std::clamp(box[1], d.u0, d.u1);
+    fd.rec.uv_box[2] = std::clamp(box[2], d.v0, d.v1), fd.rec.uv_box[3] = std::clamp(box[3], d.v0, d.v1);
+    if (untrimmed)
+        fd.rec.uv_box[0] = d.u0, fd.rec.uv_box[1] = d.u1, fd.rec.uv_box[2] = d.v0,
+        fd.rec.uv_box[3] = d.v1;
+    return fd;
+}
+
+/* ---- the importer --------------------------------------------------------------------------- */
+
+struct rgba {
+    float c[4];
+};
+
+class importer {
+public:
+    importer(sw_sg_builder *b, const sw_sg_import_desc *desc, sw__occt_face_observer *obs)
+        : b_(b), desc_(desc), obs_(obs), path_(desc->path), name_(base_name(desc->path))
+    {
+    }
+
+    sw_result run(uint32_t parent, const double xform[12], sw_sg_import_report *report,
+                  sw_status *status);
+
+private:
+    sw_sg_builder *b_;
+    const sw_sg_import_desc *desc_;
+    sw__occt_face_observer *obs_;
+    std::string path_, name_;
+    sw_sg_import_report rep_{};
+    uint32_t faces_estimate_ = 1;
+
+    NCollection_DataMap<TopoDS_Shape, uint32_t, TopTools_ShapeMapHasher> faces_;
+    std::set<std::pair<uint32_t, uint32_t>> adjacency_;
+    /* TopoDS sharing: occurrences of (TShape, orientation) among compound children. */
+    std::map<std::pair<const void *, int>, int> uses_;
+    std::map<std::pair<const void *, int>, uint32_t> protos_;
+    /* XCAF */
+    Handle(XCAFDoc_ShapeTool) st_;
+    Handle(XCAFDoc_ColorTool) ct_;
+    NCollection_DataMap<TDF_Label, int, TDF_LabelMapHasher> label_uses_;
+    NCollection_DataMap<TDF_Label, uint32_t, TDF_LabelMapHasher> label_protos_;
+    std::unordered_map<const void *, rgba> face_colors_;
+
+    void progress(double f, const char *stage)
+    {
+        if (desc_->progress)
+            desc_->progress(desc_->user_data, std::min(f, 1.0), stage);
+    }
+    void warn(const std::string &m)
+    {
+        if (desc_->warning)
+            desc_->warning(desc_->user_data, m.c_str());
+    }
+    uint32_t node(sw_sg_node_kind kind, uint32_t parent, uint32_t ref, const double *xf,
+                  const float *color, const char *name)
+    {
+        uint32_t n = sw_sg_builder_add_node(b_, kind, parent, ref, xf, color, name);
+        if (n == SW_SG_NONE)
+            throw oom_error{};
+        return n;
+    }
+
+    sw_result read_brep(TopoDS_Shape &shape, sw_status *status);
+    sw_result read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape, bool step,
+                       sw_status *status);
+    void estimate_faces(const TopoDS_Shape &shape);
+
+    void count_uses(const TopoDS_Shape &s, std::unordered_set<const void *> &seen);
+    void add_shape(const TopoDS_Shape &s, uint32_t parent);
+    void fill_shape(const TopoDS_Shape &local, uint32_t n);
+    void add_part(const TopoDS_Shape &part, uint32_t n);
+    uint32_t face_index(const TopoDS_Face &f);
+    uint32_t push_face(face_data &fd);
+
+    void count_label_uses(const TDF_Label &l);
+    void add_label(const TDF_Label &ref, const TDF_Label &occurrence, uint32_t parent,
+                   const TopLoc_Location &loc);
+    void fill_label(const TDF_Label &l, uint32_t n);
+    bool label_color(const TDF_Label &l, rgba &out) const;
+    std::string label_name(const TDF_Label &l) const;
+};
+
+sw_result importer::read_brep(TopoDS_Shape &shape, sw_status *status)
+{
+    BRep_Builder bb;
+    if (!BRepTools::Read(shape, path_.c_str(), bb) || shape.IsNull())
+        return sw__fail(status, SW_ERR_FORMAT, "%s: not a readable OCCT BREP file",
+                        path_.c_str());
+    return SW_OK;
+}
+
+/* STEP and IGES through XCAF (assemblies, names, colours); plain readers as the fall-back. */
+sw_result importer::read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape, bool step,
+                             sw_status *status)
+{
+    const char *fmt = step ? "STEP" : "IGES";
+    IFSelect_ReturnStatus rs;
+    bool ok;
+    if (step) {
+        STEPCAFControl_Reader r;
+        r.SetColorMode(true), r.SetNameMode(true), r.SetLayerMode(false);
+        rs = r.ReadFile(path_.c_str());
+        ok = rs == IFSelect_RetDone && r.Transfer(doc);
+    } else {
+        IGESCAFControl_Reader r;
+        r.SetColorMode(true), r.SetNameMode(true), r.SetLayerMode(false);
+        rs = r.ReadFile(path_.c_str());
+        ok = rs == IFSelect_RetDone && r.Transfer(doc);
+    }
+    if (rs != IFSelect_RetDone)
+        return sw__fail(status, SW_ERR_FORMAT, "%s: not a readable %s file (reader status %d)",
+                        path_.c_str(), fmt, (int)rs);
+    if (ok) {
+        st_ = XCAFDoc_DocumentTool::ShapeTool(doc->Main());
+        ct_ = XCAFDoc_DocumentTool::ColorTool(doc->Main());
+        TDF_LabelSequence free;
+        st_->GetFreeShapes(free);
+        if (free.Length() > 0)
+            return SW_OK;
+        st_.Nullify(), ct_.Nullify();
+    }
+    /* XCAF gave nothing: the plain reader, with the shape tree only. */
+    if (step) {
+        STEPControl_Reader r;
+        if (r.ReadFile(path_.c_str()) == IFSelect_RetDone && r.TransferRoots() > 0)
+            shape = r.OneShape();
+    } else {
+        IGESControl_Reader r;
+        if (r.ReadFile(path_.c_str()) == IFSelect_RetDone && r.TransferRoots() > 0)
+            shape = r.OneShape();
+    }
+    if (shape.IsNull())
+        return sw__fail(status, SW_ERR_FORMAT, "%s: the %s file holds no shape", path_.c_str(),
+                        fmt);
+    return SW_OK;
+}
+
+void importer::estimate_faces(const TopoDS_Shape &shape)
+{
+    std::unordered_set<const void *> tshapes;
+    for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next())
+        tshapes.insert(ex.Current().TShape().get());
+    faces_estimate_ = std::max<uint32_t>(1, (uint32_t)tshapes.size());
+}
+
+void importer::count_uses(const TopoDS_Shape &s, std::unordered_set<const void *> &seen)
+{
+    if (!seen.insert(s.TShape().get()).second || s.ShapeType() != TopAbs_COMPOUND)
+        return;
+    for (TopoDS_Iterator it(s, Standard_True, Standard_False); it.More(); it.Next()) {
+        uses_[{it.Value().TShape().get(), (int)it.Value().Orientation()}]++;
+        count_uses(it.Value(), seen);
+    }
+}
+
+/* `s` is located in its parent's frame; a shape used more than once becomes a prototype. */
+void importer::add_shape(const TopoDS_Shape &s, uint32_t parent)
+{
+    if (s.IsNull())
+        return;
+    double xf[12];
+    xform_of(s.Location(), xf);
+    const TopoDS_Shape local = s.Located(TopLoc_Location());
+    const std::pair<const void *, int> key{s.TShape().get(), (int)s.Orientation()};
+    auto u = uses_.find(key);
+    if (u != uses_.end() && u->second > 1) {
+        auto p = protos_.find(key);
+        uint32_t proto;
+        if (p == protos_.end()) {
+            proto = node(SW_SG_NODE_GROUP, SW_SG_NONE, 0, nullptr, nullptr, nullptr);
+            protos_[key] = proto;
+            fill_shape(local, proto);
+        } else {
+            proto = p->second;
+        }
+        node(SW_SG_NODE_INSTANCE, parent, proto, xf, nullptr, nullptr);
+        return;
+    }
+    uint32_t n = s.Location().IsIdentity()
+                     ? parent
+                     : node(SW_SG_NODE_TRANSFORM, parent, 0, xf, nullptr, nullptr);
+    fill_shape(local, n);
+}
+
+void importer::fill_shape(const TopoDS_Shape &local, uint32_t n)
+{
+    if (local.ShapeType() == TopAbs_COMPOUND) {
+        for (TopoDS_Iterator it(local, Standard_True, Standard_False); it.More(); it.Next())
+            add_shape(it.Value(), n);
+    } else {
+        add_part(local, n);
+    }
+}
+
+/* A solid, shell or face: its faces as SURFACE nodes under `n`, and their adjacency. */
+void importer::add_part(const TopoDS_Shape &part, uint32_t n)
+{
+    TopTools_IndexedMapOfShape faces;
+    TopExp::MapShapes(part, TopAbs_FACE, faces);
+    for (int i = 1; i <= faces.Extent(); i++) {
+        const TopoDS_Face &f = TopoDS::Face(faces(i));
+        uint32_t idx = face_index(f);
+        if (idx == SW_SG_NONE)
+            continue;
+        auto c = face_colors_.find(f.TShape().get());
+        node(SW_SG_NODE_SURFACE, n, idx, nullptr, c == face_colors_.end() ? nullptr : c->second.c,
+             nullptr);
+    }
+    TopTools_IndexedDataMapOfShapeListOfShape edge_faces;
+    TopExp::MapShapesAndAncestors(part, TopAbs_EDGE, TopAbs_FACE, edge_faces);
+    for (int i = 1; i <= edge_faces.Extent(); i++) {
+        std::vector<uint32_t> idx;
+        for (const TopoDS_Shape &f : edge_faces(i)) {
+            const uint32_t *k = faces_.Seek(f);
+            if (k && *k != SW_SG_NONE)
+                idx.push_back(*k);
+        }
+        for (size_t a = 0; a < idx.size(); a++)
+            for (size_t c = a + 1; c < idx.size(); c++)
+                if (idx[a] != idx[c])
+                    adjacency_.insert({std::min(idx[a], idx[c]), std::max(idx[a], idx[c])});
+    }
+}
+
+/* The scene face of `f`, converting it the first time; SW_SG_NONE when it failed. */
+uint32_t importer::face_index(const TopoDS_Face &f)
+{
+    if (const uint32_t *k = faces_.Seek(f))
+        return *k;
+    const uint32_t ordinal = rep_.faces_read++;
+    const std::string what = name_ + ": face " + std::to_string(ordinal);
+    uint32_t idx = SW_SG_NONE;
+    std::string why;
+    TopoDS_Face converted;
+    try {
+        face_data fd = convert_face(f, converted, what);
+        idx = push_face(fd);
+    } catch (const face_error &e) {
+        why = e.why;
+    } catch (const Standard_Failure &e) {
+        why = std::string(e.DynamicType()->Name()) + ": " + e.GetMessageString();
+    }
+    if (idx == SW_SG_NONE) {
+        rep_.faces_failed++;
+        warn(path_ + ": face " + std::to_string(ordinal) + " could not be converted: " + why);
+    } else {
+        rep_.faces_converted++;
+        if (obs_)
+            obs_->on_face(idx, f, converted);
+    }
+    faces_.Bind(f, idx);
+    progress(0.1 + 0.9 * rep_.faces_read / faces_estimate_, "convert");
+    return idx;
+}
+
+uint32_t importer::push_face(face_data &fd)
+{
+    auto push = [this](const std::vector<double> &v) {
+        uint64_t off = sw_sg_builder_push_doubles(b_, v.data(), v.size());
+        if (off == UINT64_MAX)
+            throw oom_error{};
+        return off;
+    };
+    fd.rec.knots_u = push(fd.knots_u);
+    fd.rec.knots_v = push(fd.knots_v);
+    fd.rec.cpw = push(fd.cpw);
+    fd.rec.first_loop = SW_SG_NONE;
+    for (const loop_data &ld : fd.loops) {
+        sw_sg_loop_rec lr{SW_SG_NONE, (uint32_t)ld.curves.size(), ld.flags, 0};
+        for (const curve_data &c : ld.curves) {
+            sw_sg_curve_rec cr{};
+            cr.degree = (uint32_t)c.degree;
+            cr.n = (uint32_t)(c.cpw.size() / 3);
+            cr.knots = push(c.knots);
+            cr.cpw = push(c.cpw);
+            uint32_t ci = sw_sg_builder_add_curve(b_, &cr);
+            if (ci == SW_SG_NONE)
+                throw oom_error{};
+            if (lr.first_curve == SW_SG_NONE)
+                lr.first_curve = ci;
+        }
+        uint32_t li = sw_sg_builder_add_loop(b_, &lr);
+        if (li == SW_SG_NONE)
+            throw oom_error{};
+        if (fd.rec.first_loop == SW_SG_NONE)
+            fd.rec.first_loop = li;
+    }
+    fd.rec.n_loops = (uint32_t)fd.loops.size();
+    uint32_t fi = sw_sg_builder_add_face(b_, &fd.rec);
+    if (fi == SW_SG_NONE)
+        throw oom_error{};
+    return fi;
+}
+
+/* ---- XCAF assembly tree ----------------------------------------------------------------------- */
+
+bool importer::label_color(const TDF_Label &l, rgba &out) const
+{
+    Quantity_ColorRGBA c;
+    if (ct_.IsNull() || !(ct_->GetColor(l, XCAFDoc_ColorSurf, c) ||
+                          ct_->GetColor(l, XCAFDoc_ColorGen, c)))
+        return false;
+    const Quantity_Color &rgb = c.GetRGB(); /* OCCT keeps linear RGB */
+    out = {{(float)rgb.Red(), (float)rgb.Green(), (float)rgb.Blue(), c.Alpha()}};
+    return true;
+}
+
+std::string importer::label_name(const TDF_Label &l) const
+{
+    Handle(TDataStd_Name) n;
+    if (!l.FindAttribute(TDataStd_Name::GetID(), n))
+        return "";
+    return TCollection_AsciiString(n->Get()).ToCString();
+}
+
+void importer::count_label_uses(const TDF_Label &l)
+{
+    if (!st_->IsAssembly(l))
+        return;
+    TDF_LabelSequence comps;
+    st_->GetComponents(l, comps);
+    for (const TDF_Label &c : comps) {
+        TDF_Label ref;
+        if (!st_->GetReferredShape(c, ref))
+            continue;
+        if (int *k = label_uses_.ChangeSeek(ref)) {
+            ++*k;
+        } else {
+            label_uses_.Bind(ref, 1);
+            count_label_uses(ref);
+        }
+    }
+}
+
+/* An occurrence of shape label `ref` (through component `occurrence`, or a free shape). */
+void importer::add_label(const TDF_Label &ref, const TDF_Label &occurrence, uint32_t parent,
+                         const TopLoc_Location &loc)
+{
+    rgba col;
+    bool has_col = label_color(occurrence, col);
+    std::string nm = label_name(occurrence);
+    if (nm.empty())
+        nm = label_name(ref);
+    double xf[12];
+    xform_of(loc, xf);
+    const int *uses = label_uses_.Seek(ref);
+    if (uses && *uses > 1) {
+        const uint32_t *p = label_protos_.Seek(ref);
+        uint32_t proto;
+        if (p) {
+            proto = *p;
+        } else {
+            rgba pc;
+            bool has_pc = label_color(ref, pc);
+            proto = node(SW_SG_NODE_GROUP, SW_SG_NONE, 0, nullptr, has_pc ? pc.c : nullptr,
+                         label_name(ref).c_str());
+            label_protos_.Bind(ref, proto);
+            fill_label(ref, proto);
+        }
+        node(SW_SG_NODE_INSTANCE, parent, proto, xf, has_col ? col.c : nullptr, nm.c_str());
+        return;
+    }
+    if (!has_col)
+        has_col = label_color(ref, col);
+    uint32_t n = node(loc.IsIdentity() ? SW_SG_NODE_GROUP : SW_SG_NODE_TRANSFORM, parent, 0,
+                      loc.IsIdentity() ? nullptr : xf, has_col ? col.c : nullptr,
+                      nm.empty() ? nullptr : nm.c_str());
+    fill_label(ref, n);
+}
+
+void importer::fill_label(const TDF_Label &l, uint32_t n)
+{
+    if (st_->IsAssembly(l)) {
+        TDF_LabelSequence comps;
+        st_->GetComponents(l, comps);
+        for (const TDF_Label &c : comps) {
+            TDF_Label ref;
+            if (st_->GetReferredShape(c, ref))
+                add_label(ref, c, n, st_->GetLocation(c));
+        }
+        return;
+    }
+    /* Colours of sub-shapes (faces, shells, solids) of a part, by the faces' TShape. */
+    TDF_LabelSequence subs;
+    st_->GetSubShapes(l, subs);
+    for (const TDF_Label &sub : subs) {
+        rgba col;
+        if (!label_color(sub, col))
+            continue;
+        for (TopExp_Explorer ex(st_->GetShape(sub), TopAbs_FACE); ex.More(); ex.Next())
+            face_colors_[ex.Current().TShape().get()] = col;
+    }
+    add_shape(st_->GetShape(l), n);
+}
+
+sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_report *report,
+                        sw_status *status)
+{
+    struct stat sb;
+    if (stat(path_.c_str(), &sb) != 0 || !S_ISREG(sb.st_mode))
+        return sw__fail(status, SW_ERR_NOT_FOUND, "%s: no such file", path_.c_str());
+    const std::string ext = lower_ext(path_);
+    const bool step = ext == "step" || ext == "stp", iges = ext == "iges" || ext == "igs";
+    if (!step && !iges && ext != "brep")
+        return sw__fail(status, SW_ERR_UNSUPPORTED,
+                        "%s: unknown extension (expected .step, .stp, .iges, .igs or .brep)",
+                        path_.c_str());
+
+    progress(0.0, "read");
+    double t0 = now_ms();
+    TopoDS_Shape shape;
+    struct doc_guard { /* the XCAF document is closed on every way out */
+        Handle(TDocStd_Document) doc;
+        ~doc_guard()
+        {
+            if (!doc.IsNull())
+                XCAFApp_Application::GetApplication()->Close(doc);
+        }
+    } guard;
+    Handle(TDocStd_Document) &doc = guard.doc;
+    sw_result r;
+    try {
+        if (step || iges) {
+            XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
+            r = read_cad(doc, shape, step, status);
+        } else {
+            r = read_brep(shape, status);
+        }
+    } catch (const Standard_Failure &e) {
+        r = sw__fail(status, SW_ERR_FORMAT, "%s: the reader failed: %s: %s", path_.c_str(),
+                     e.DynamicType()->Name(), e.GetMessageString());
+    }
+    rep_.ms_read = now_ms() - t0;
+    if (r == SW_OK) {
+        progress(0.1, "convert");
+        t0 = now_ms();
+        TDF_LabelSequence free;
+        if (!st_.IsNull()) {
+            st_->GetFreeShapes(free);
+            TopoDS_Compound all;
+            BRep_Builder bb;
+            bb.MakeCompound(all);
+            for (const TDF_Label &l : free) {
+                bb.Add(all, st_->GetShape(l));
+                count_label_uses(l);
+            }
+            estimate_faces(all);
+        } else {
+            std::unordered_set<const void *> seen;
+            count_uses(shape, seen);
+            estimate_faces(shape);
+        }
+        uint32_t top = node(xform ? SW_SG_NODE_TRANSFORM : SW_SG_NODE_GROUP, parent, 0, xform,
+                            nullptr, name_.c_str());
+        if (!st_.IsNull()) {
+            for (const TDF_Label &l : free)
+                add_label(l, l, top, st_->GetLocation(l));
+        } else {
+            add_shape(shape, top);
+        }
+        for (const auto &a : adjacency_)
+            if (sw_sg_builder_add_adjacency(b_, a.first, a.second) == SW_SG_NONE)
+                throw oom_error{};
+        rep_.ms_convert = now_ms() - t0;
+        if (rep_.faces_converted == 0)
+            r = sw__fail(status, SW_ERR_FORMAT, "%s: no face could be imported (%u read)",
+                         path_.c_str(), rep_.faces_read);
+    }
+    if (report)
+        *report = rep_;
+    if (r == SW_OK) {
+        progress(1.0, "done");
+        sw__status_ok(status);
+    }
+    return r;
+}
+
+} // namespace
+
+sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
+                               const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                               sw_status *status, sw__occt_face_observer *observer)
+{
+    if (!b || !desc || !desc->path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "import: no builder or no path");
+    const char *path = desc->path;
+    try {
+        importer imp(b, desc, observer);
+        return imp.run(parent, xform, report, status);
+    } catch (const oom_error &) {
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory while importing", path);
+    } catch (const std::bad_alloc &) {
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory while importing", path);
+    } catch (const Standard_Failure &e) {
+        return sw__fail(status, SW_ERR_INTERNAL, "%s: OCCT failed: %s: %s", path,
+                        e.DynamicType()->Name(), e.GetMessageString());
+    } catch (const std::exception &e) {
+        return sw__fail(status, SW_ERR_INTERNAL, "%s: %s", path, e.what());
+    } catch (...) {
+        return sw__fail(status, SW_ERR_INTERNAL, "%s: unknown exception while importing", path);
+    }
+}
+
+sw_result sw__occt_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
+                               sw_sg_import_report *report, sw_status *status,
+                               sw__occt_face_observer *observer)
+{
+    if (!out)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "import: no output scene");
+    *out = nullptr;
+    sw_sg_builder *b = sw_sg_builder_create();
+    if (!b)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "import: out of memory");
+    sw_result r = sw__occt_import_into(b, 0, nullptr, desc, report, status, observer);
+    if (r != SW_OK) {
+        sw_sg_builder_free(b);
+        return r;
+    }
+    return sw_sg_builder_finish(b, out, status);
+}
+
+extern "C" sw_result sw_sg_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
+                                       sw_sg_import_report *report, sw_status *status)
+{
+    return sw__occt_import_file(desc, out, report, status, nullptr);
+}
+
+extern "C" sw_result sw_sg_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
+                                       const sw_sg_import_desc *desc,
+                                       sw_sg_import_report *report, sw_status *status)
+{
+    return sw__occt_import_into(b, parent, xform, desc, report, status, nullptr);
+}

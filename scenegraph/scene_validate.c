@@ -1,0 +1,327 @@
+/* Validation of a scene's arrays before anything dereferences them: every index, pool offset and
+ * count against the array sizes (in 64-bit arithmetic that cannot overflow), the node graph for
+ * cycles (child links and instance references together), and each face's and curve's geometry
+ * through sw_sg_surface_validate / sw_sg_curve_validate. Mapped .sws files are hostile input
+ * (CONVENTIONS.md, Errors): this is the "validate" step after sws_file.c's "parse". */
+#include "sw_sg_scene_internal.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct vctx {
+    const sw_sg_scene_view *v;
+    const char *what;
+    const sw__sg_section_info *sec; /* may be NULL */
+    sw_status *status;
+} vctx;
+
+/* " at offset N" for record i of section s of a mapped file, "" in memory. */
+static const char *where(const vctx *c, int s, uint64_t i, char buf[48])
+{
+    buf[0] = '\0';
+    if (c->sec)
+        snprintf(buf, 48, " at offset %llu",
+                 (unsigned long long)(c->sec[s].offset + i * sw__sg_section_record_size[s]));
+    return buf;
+}
+
+/* [off, off + count) lies inside the pool; count is at most 2^64 - 1 by construction. */
+static int pool_range_ok(const sw_sg_scene_view *v, uint64_t off, uint64_t count)
+{
+    return off <= v->n_pool && count <= v->n_pool - off;
+}
+
+static int all_finite(const double *x, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!isfinite(x[i]))
+            return 0;
+    return 1;
+}
+
+static sw_result check_face_record(const vctx *c, uint32_t i, const sw_sg_face_rec *f)
+{
+    char at[48];
+    const sw_sg_scene_view *v = c->v;
+    where(c, SW__SG_SEC_FACES, i, at);
+    if (f->deg_u < 1 || f->deg_u > SW_SG_MAX_DEGREE || f->deg_v < 1 ||
+        f->deg_v > SW_SG_MAX_DEGREE)
+        return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY, "%s: face %u%s: degree %ux%u",
+                        c->what, i, at, f->deg_u, f->deg_v);
+    if (f->n_u <= f->deg_u || f->n_v <= f->deg_v || f->n_u > INT32_MAX || f->n_v > INT32_MAX)
+        return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
+                        "%s: face %u%s: %ux%u control points for degree %ux%u", c->what, i, at,
+                        f->n_u, f->n_v, f->deg_u, f->deg_v);
+    /* n < 2^31 and deg < 32: the sums fit; n_u * n_v * 4 < 2^64. */
+    uint64_t nku = (uint64_t)f->n_u + f->deg_u + 1, nkv = (uint64_t)f->n_v + f->deg_v + 1;
+    uint64_t ncp = (uint64_t)f->n_u * f->n_v * 4u;
+    if (!pool_range_ok(v, f->knots_u, nku) || !pool_range_ok(v, f->knots_v, nkv) ||
+        !pool_range_ok(v, f->cpw, ncp))
+        return sw__fail(c->status, SW_ERR_FORMAT,
+                        "%s: face %u%s: knots/control points (pool offsets %llu, %llu, %llu) "
+                        "outside the pool of %llu doubles",
+                        c->what, i, at, (unsigned long long)f->knots_u,
+                        (unsigned long long)f->knots_v, (unsigned long long)f->cpw,
+                        (unsigned long long)v->n_pool);
+    if (f->first_loop > v->n_loops || f->n_loops > v->n_loops - f->first_loop)
+        return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: loops [%u, +%u) of %u", c->what,
+                        i, at, f->first_loop, f->n_loops, v->n_loops);
+    if (f->kind >= SW_SG_KIND_COUNT || (f->flags & ~(uint32_t)3u))
+        return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: kind %u, flags 0x%x", c->what,
+                        i, at, f->kind, f->flags);
+    if (!all_finite(f->uv_box, 4) || f->uv_box[0] > f->uv_box[1] || f->uv_box[2] > f->uv_box[3] ||
+        !isfinite(f->tolerance) || f->tolerance < 0.0)
+        return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
+                        "%s: face %u%s: bad uv box or tolerance", c->what, i, at);
+    return SW_OK;
+}
+
+static sw_result check_faces(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    for (uint32_t i = 0; i < v->n_faces; i++) {
+        const sw_sg_face_rec *f = &v->faces[i];
+        sw_result r = check_face_record(c, i, f);
+        if (r != SW_OK)
+            return r;
+        sw_sg_surface s = {(int32_t)f->deg_u, (int32_t)f->deg_v, (int32_t)f->n_u,
+                           (int32_t)f->n_v,   v->pool + f->knots_u, v->pool + f->knots_v,
+                           v->pool + f->cpw};
+        char what[300], at[48];
+        snprintf(what, sizeof what, "%s: face %u%s", c->what, i,
+                 where(c, SW__SG_SEC_FACES, i, at));
+        r = sw_sg_surface_validate(&s, what, c->status);
+        if (r != SW_OK)
+            return r;
+    }
+    return SW_OK;
+}
+
+static sw_result check_loops(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    for (uint32_t i = 0; i < v->n_loops; i++) {
+        const sw_sg_loop_rec *l = &v->loops[i];
+        char at[48];
+        if (l->n_curves == 0 || l->first_curve > v->n_curves ||
+            l->n_curves > v->n_curves - l->first_curve || (l->flags & ~(uint32_t)SW_SG_LOOP_OUTER) ||
+            l->reserved != 0)
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: loop %u%s: curves [%u, +%u) of %u, flags 0x%x, reserved %u",
+                            c->what, i, where(c, SW__SG_SEC_LOOPS, i, at), l->first_curve,
+                            l->n_curves, v->n_curves, l->flags, l->reserved);
+    }
+    return SW_OK;
+}
+
+static sw_result check_curves(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    for (uint32_t i = 0; i < v->n_curves; i++) {
+        const sw_sg_curve_rec *k = &v->curves[i];
+        char what[300], at[48];
+        snprintf(what, sizeof what, "%s: curve %u%s", c->what, i,
+                 where(c, SW__SG_SEC_CURVES, i, at));
+        if (k->degree < 1 || k->degree > SW_SG_MAX_DEGREE || k->n <= k->degree ||
+            k->n > INT32_MAX)
+            return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
+                            "%s: degree %u with %u control points", what, k->degree, k->n);
+        if (!pool_range_ok(v, k->knots, (uint64_t)k->n + k->degree + 1) ||
+            !pool_range_ok(v, k->cpw, (uint64_t)k->n * 3u))
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: pool offsets %llu, %llu outside the pool of %llu doubles", what,
+                            (unsigned long long)k->knots, (unsigned long long)k->cpw,
+                            (unsigned long long)v->n_pool);
+        sw_sg_curve cv = {(int32_t)k->degree, (int32_t)k->n, 3, v->pool + k->knots,
+                          v->pool + k->cpw};
+        sw_result r = sw_sg_curve_validate(&cv, what, c->status);
+        if (r != SW_OK)
+            return r;
+    }
+    return SW_OK;
+}
+
+static int node_link_ok(uint32_t link, uint32_t n)
+{
+    return link == SW_SG_NONE || link < n;
+}
+
+static sw_result check_node_records(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    for (uint32_t i = 0; i < v->n_nodes; i++) {
+        const sw_sg_node_rec *nd = &v->nodes[i];
+        char at[48];
+        where(c, SW__SG_SEC_NODES, i, at);
+        int ref_ok = nd->kind == SW_SG_NODE_SURFACE    ? nd->ref < v->n_faces
+                     : nd->kind == SW_SG_NODE_INSTANCE ? nd->ref < v->n_nodes
+                                                       : 1;
+        if (nd->kind > SW_SG_NODE_SURFACE || !ref_ok)
+            return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: kind %u, ref %u", c->what,
+                            i, at, nd->kind, nd->ref);
+        if (!node_link_ok(nd->parent, v->n_nodes) || !node_link_ok(nd->first_child, v->n_nodes) ||
+            !node_link_ok(nd->next_sibling, v->n_nodes))
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: node %u%s: parent %u, first child %u, next sibling %u of %u "
+                            "nodes",
+                            c->what, i, at, nd->parent, nd->first_child, nd->next_sibling,
+                            v->n_nodes);
+        if (nd->name != SW_SG_NONE && nd->name >= v->n_strings)
+            return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: name offset %u of %llu",
+                            c->what, i, at, nd->name, (unsigned long long)v->n_strings);
+        int color_ok = 1;
+        for (int k = 0; k < 4; k++)
+            color_ok &= isfinite(nd->color[k]) != 0;
+        if (!color_ok || !all_finite(nd->xform, 12))
+            return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: non-finite colour or "
+                            "transform", c->what, i, at);
+    }
+    return SW_OK;
+}
+
+/* Every child chain is consistent with the parent links and visits each node at most once, so
+ * walking a chain terminates; together with the DFS below the node graph is a DAG. */
+static sw_result check_child_chains(const vctx *c, unsigned char *seen)
+{
+    const sw_sg_scene_view *v = c->v;
+    uint64_t in_chains = 0, with_parent = 0;
+    for (uint32_t p = 0; p < v->n_nodes; p++) {
+        if (v->nodes[p].parent != SW_SG_NONE)
+            with_parent++;
+        for (uint32_t k = v->nodes[p].first_child; k != SW_SG_NONE; k = v->nodes[k].next_sibling) {
+            char at[48];
+            if (seen[k] || v->nodes[k].parent != p)
+                return sw__fail(c->status, SW_ERR_FORMAT,
+                                "%s: node %u%s: listed as a child of node %u (parent %u)%s",
+                                c->what, k, where(c, SW__SG_SEC_NODES, k, at), p,
+                                v->nodes[k].parent, seen[k] ? " twice" : "");
+            seen[k] = 1;
+            in_chains++;
+        }
+    }
+    if (in_chains != with_parent)
+        return sw__fail(c->status, SW_ERR_FORMAT,
+                        "%s: %llu nodes have a parent but %llu are in their parents' child lists",
+                        c->what, (unsigned long long)with_parent, (unsigned long long)in_chains);
+    return SW_OK;
+}
+
+/* Iterative three-colour DFS over child and instance edges. The stack holds each grey node and
+ * where its edge iteration stands: the next child to visit, then (once) the instance reference. */
+typedef struct dfs_frame {
+    uint32_t node, next_child;
+    int ref_done;
+} dfs_frame;
+
+static sw_result check_cycles(const vctx *c, unsigned char *color, dfs_frame *stack)
+{
+    const sw_sg_scene_view *v = c->v;
+    memset(color, 0, v->n_nodes);
+    for (uint32_t start = 0; start < v->n_nodes; start++) {
+        if (color[start])
+            continue;
+        size_t n = 0;
+        stack[n++] = (dfs_frame){start, v->nodes[start].first_child, 0};
+        color[start] = 1;
+        while (n) {
+            dfs_frame *f = &stack[n - 1];
+            const sw_sg_node_rec *nd = &v->nodes[f->node];
+            uint32_t next = SW_SG_NONE;
+            if (f->next_child != SW_SG_NONE) {
+                next = f->next_child;
+                f->next_child = v->nodes[next].next_sibling;
+            } else if (!f->ref_done && nd->kind == SW_SG_NODE_INSTANCE) {
+                f->ref_done = 1;
+                next = nd->ref;
+            }
+            if (next == SW_SG_NONE) {
+                color[f->node] = 2;
+                n--;
+                continue;
+            }
+            if (color[next] == 1) {
+                char at[48];
+                return sw__fail(c->status, SW_ERR_FORMAT,
+                                "%s: node %u%s: cycle in the node graph (through node %u)",
+                                c->what, f->node, where(c, SW__SG_SEC_NODES, f->node, at), next);
+            }
+            if (color[next] == 0) {
+                color[next] = 1;
+                stack[n++] = (dfs_frame){next, v->nodes[next].first_child, 0};
+            }
+        }
+    }
+    return SW_OK;
+}
+
+static sw_result check_nodes(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    char at[48];
+    if (v->root >= v->n_nodes)
+        return sw__fail(c->status, SW_ERR_FORMAT, "%s: META%s: root node %u of %u nodes", c->what,
+                        where(c, SW__SG_SEC_META, 0, at), v->root, v->n_nodes);
+    sw_result r = check_node_records(c);
+    if (r != SW_OK)
+        return r;
+    unsigned char *marks = calloc(v->n_nodes, 1);
+    dfs_frame *stack = malloc((size_t)v->n_nodes * sizeof *stack);
+    if (!marks || !stack) {
+        free(marks);
+        free(stack);
+        return sw__fail(c->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory validating %u nodes",
+                        c->what, v->n_nodes);
+    }
+    r = check_child_chains(c, marks);
+    if (r == SW_OK)
+        r = check_cycles(c, marks, stack);
+    free(marks);
+    free(stack);
+    return r;
+}
+
+static sw_result check_misc(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    for (uint32_t i = 0; i < v->n_adjacency; i++) {
+        char at[48];
+        if (v->adjacency[i].face_a >= v->n_faces || v->adjacency[i].face_b >= v->n_faces)
+            return sw__fail(c->status, SW_ERR_FORMAT, "%s: adjacency %u%s: faces %u, %u of %u",
+                            c->what, i, where(c, SW__SG_SEC_ADJACENCY, i, at),
+                            v->adjacency[i].face_a, v->adjacency[i].face_b, v->n_faces);
+    }
+    /* A terminating NUL at the end makes every name offset below n_strings a valid C string. */
+    if (v->n_strings && v->strings[v->n_strings - 1] != '\0') {
+        char at[48];
+        return sw__fail(c->status, SW_ERR_FORMAT, "%s: strings%s: not NUL-terminated", c->what,
+                        where(c, SW__SG_SEC_STRINGS, v->n_strings - 1, at));
+    }
+    return SW_OK;
+}
+
+sw_result sw__sg_scene_validate_at(const sw_sg_scene_view *view, const char *what,
+                                   const sw__sg_section_info *sec, sw_status *status)
+{
+    vctx c = {view, what ? what : "scene", sec, status};
+    /* Cheap structural checks first, geometry last: a bad index is reported as such. */
+    sw_result r = check_misc(&c);
+    if (r == SW_OK)
+        r = check_nodes(&c);
+    if (r == SW_OK)
+        r = check_loops(&c);
+    if (r == SW_OK)
+        r = check_faces(&c);
+    if (r == SW_OK)
+        r = check_curves(&c);
+    if (r == SW_OK)
+        sw__status_ok(status);
+    return r;
+}
+
+sw_result sw_sg_scene_validate(const sw_sg_scene_view *view, const char *what, sw_status *status)
+{
+    return sw__sg_scene_validate_at(view, what, NULL, status);
+}

@@ -1,0 +1,27 @@
+/* C++-only entry points of the OCCT importer (import_occt.cpp) with a per-face observer, so tests
+ * can compare each imported face with OCCT's own geometry of the same face. Never included from C.
+ */
+#ifndef SW_SG_IMPORT_OCCT_HPP
+#define SW_SG_IMPORT_OCCT_HPP
+
+#include "sw_sg_import.h"
+
+#include <TopoDS_Face.hxx>
+
+struct sw__occt_face_observer {
+    virtual ~sw__occt_face_observer() = default;
+    /* Scene face `face` was made from `source` (as located in its part's frame) through
+     * `converted`, its NURBS conversion: the surface and the pcurves the loops come from. */
+    virtual void on_face(uint32_t face, const TopoDS_Face &source,
+                         const TopoDS_Face &converted) = 0;
+};
+
+/* sw_sg_import_into / sw_sg_import_file with an observer (may be NULL). */
+sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
+                               const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                               sw_status *status, sw__occt_face_observer *observer);
+sw_result sw__occt_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
+                               sw_sg_import_report *report, sw_status *status,
+                               sw__occt_face_observer *observer);
+
+#endif

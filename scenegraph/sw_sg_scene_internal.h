@@ -1,0 +1,55 @@
+/* The scene object shared by scene.c (builder, accessors, traversal), scene_validate.c and
+ * sws_file.c (mapped scenes). Internal to scenegraph/, never installed. */
+#ifndef SW_SG_SCENE_INTERNAL_H
+#define SW_SG_SCENE_INTERNAL_H
+
+#include "sw_sg_scene.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* Sections in .sws order; index i is bit (1 << i) of sw_sg_section, META has no bit. */
+enum {
+    SW__SG_SEC_FACES,
+    SW__SG_SEC_LOOPS,
+    SW__SG_SEC_CURVES,
+    SW__SG_SEC_NODES,
+    SW__SG_SEC_ADJACENCY,
+    SW__SG_SEC_POOL,
+    SW__SG_SEC_STRINGS,
+    SW__SG_SEC_META,
+    SW__SG_SEC_COUNT
+};
+
+/* Names and record sizes of the sections, indexed as above. */
+extern const char *const sw__sg_section_names[SW__SG_SEC_COUNT];
+extern const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT];
+
+typedef struct sw__sg_section_info {
+    uint64_t offset, size, count;
+    uint32_t checksum;
+} sw__sg_section_info;
+
+struct sw_sg_scene {
+    sw_sg_scene_view view;
+    char *path;                      /* "" for a scene built in memory; always owned */
+    void *owned[SW__SG_SEC_COUNT];   /* in-memory arrays (malloc), NULL when mapped */
+    size_t owned_bytes;
+    void *map;                       /* mapped file, NULL in memory */
+    size_t map_size;
+    sw__sg_section_info sec[SW__SG_SEC_COUNT]; /* mapped only */
+    uint32_t verified;               /* sections whose checksum matched (sw_sg_section bits) */
+    int validated;                   /* 1 once sw_sg_scene_validate passed, -1 once it failed */
+    sw_status validate_status;       /* the failure, repeated to later callers */
+};
+
+/* sw_sg_scene_validate with byte offsets of each record in the messages: when `sec` is not NULL,
+ * record i of section s is reported at sec[s].offset + i * record size. */
+sw_result sw__sg_scene_validate_at(const sw_sg_scene_view *view, const char *what,
+                                   const sw__sg_section_info *sec, sw_status *status);
+
+/* Pointer and byte size of section s of a view (s < SW__SG_SEC_META). */
+const void *sw__sg_view_section(const sw_sg_scene_view *view, int s, uint64_t *bytes,
+                                uint64_t *count);
+
+#endif

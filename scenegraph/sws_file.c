@@ -1,0 +1,535 @@
+/* The native scene file, .sws: the scene's record arrays written as they are in memory, so that
+ * opening one is an mmap plus a check of the header and section table, and each section is
+ * checksummed on first use (ARCHITECTURE.md, "Rules that keep the pipeline sane").
+ *
+ * Layout, version 1 (all integers little-endian; docs/sws-format.md says the same at length):
+ *
+ *   offset  size  field
+ *   0       8     magic "SWSCENE\0"
+ *   8       4     version = 1
+ *   12      4     flags = 0
+ *   16      4     section count = 8
+ *   20      4     header size = 64
+ *   24      8     total file size in bytes
+ *   32      8     offset of the section table (16-byte aligned, >= 64)
+ *   40      4     size of a section-table entry = 40
+ *   44      16    reserved, zero
+ *   60      4     header checksum: CRC-32C of bytes [0, 60) followed by the whole section table
+ *
+ *   section table entry (40 bytes):
+ *   0  u32 id (0 FACES, 1 LOOPS, 2 CURVES, 3 NODES, 4 ADJACENCY, 5 POOL, 6 STRINGS, 7 META)
+ *   4  u32 reserved, zero
+ *   8  u64 offset of the section (16-byte aligned, after the table, sections do not overlap)
+ *   16 u64 size in bytes = element count * record size
+ *   24 u64 element count
+ *   32 u32 CRC-32C of the section's bytes
+ *   36 u32 reserved, zero
+ *
+ *   record sizes: FACES 96 (sw_sg_face_rec), LOOPS 16, CURVES 24, NODES 136, ADJACENCY 8,
+ *   POOL 8 (double), STRINGS 1 (char; the last one NUL), META 16 (u32 root node, 12 zero bytes).
+ *   Padding between sections is zero. The file ends where its last section ends.
+ *
+ * Open checks everything up to the section table (and META, 16 bytes) and that the file is as
+ * long as the header says, before any section body is read: a mapping shorter than that would
+ * raise SIGBUS. sw_sg_scene_require() then verifies section checksums once each and, when all
+ * are verified, validates the records (scene_validate.c). Save writes PATH.tmp-<pid>, fsyncs it
+ * and renames it over PATH, so a reader sees either the old file or the new one. */
+#include "sw_crc32c.h"
+#include "sw_sg_scene_internal.h"
+#include "sw_status_util.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+_Static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, ".sws records are little-endian");
+_Static_assert(sizeof(sw_sg_face_rec) == 96 && offsetof(sw_sg_face_rec, uv_box) == 56,
+               "face record layout is part of the .sws format");
+_Static_assert(sizeof(sw_sg_loop_rec) == 16, "loop record layout is part of the .sws format");
+_Static_assert(sizeof(sw_sg_curve_rec) == 24, "curve record layout is part of the .sws format");
+_Static_assert(sizeof(sw_sg_node_rec) == 136 && offsetof(sw_sg_node_rec, xform) == 40,
+               "node record layout is part of the .sws format");
+_Static_assert(sizeof(sw_sg_adjacency_rec) == 8, "adjacency layout is part of the .sws format");
+_Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/binary32");
+
+#define SWS_MAGIC "SWSCENE"
+#define SWS_VERSION 1u
+#define SWS_HEADER_SIZE 64u
+#define SWS_ENTRY_SIZE 40u
+#define SWS_ALIGN 16u
+#define SWS_HEADER_CRC_AT 60u
+
+typedef struct sws_header {
+    uint32_t version, flags, section_count, header_size;
+    uint64_t file_size, table_offset;
+    uint32_t entry_size, header_crc;
+    int reserved_zero;
+} sws_header;
+
+static uint32_t rd32(const unsigned char *p)
+{
+    uint32_t x;
+    memcpy(&x, p, 4);
+    return x;
+}
+
+static uint64_t rd64(const unsigned char *p)
+{
+    uint64_t x;
+    memcpy(&x, p, 8);
+    return x;
+}
+
+static void wr32(unsigned char *p, uint32_t x)
+{
+    memcpy(p, &x, 4);
+}
+
+static void wr64(unsigned char *p, uint64_t x)
+{
+    memcpy(p, &x, 8);
+}
+
+static uint64_t align16(uint64_t x)
+{
+    return (x + (SWS_ALIGN - 1)) & ~(uint64_t)(SWS_ALIGN - 1);
+}
+
+/* ---- require --------------------------------------------------------------------------------- */
+
+sw_result sw_sg_scene_require(sw_sg_scene *scene, uint32_t sections, sw_status *status)
+{
+    if (!scene->map) {
+        sw__status_ok(status);
+        return SW_OK;
+    }
+    for (int s = 0; s < SW__SG_SEC_META; s++) {
+        uint32_t bit = 1u << s;
+        if (!(sections & bit) || (scene->verified & bit))
+            continue;
+        const sw__sg_section_info *e = &scene->sec[s];
+        uint32_t crc = sw__crc32c(0, (const unsigned char *)scene->map + e->offset, e->size);
+        if (crc != e->checksum)
+            return sw__fail(status, SW_ERR_CHECKSUM,
+                            "%s: section %s at offset %llu: checksum mismatch (stored 0x%08x, "
+                            "computed 0x%08x)",
+                            scene->path, sw__sg_section_names[s], (unsigned long long)e->offset,
+                            e->checksum, crc);
+        scene->verified |= bit;
+    }
+    if (scene->verified == SW_SG_SEC_ALL && scene->validated == 0) {
+        sw_status st = {0};
+        sw_result r = sw__sg_scene_validate_at(&scene->view, scene->path, scene->sec, &st);
+        scene->validated = r == SW_OK ? 1 : -1;
+        scene->validate_status = st;
+    }
+    if (scene->validated < 0) {
+        if (status)
+            *status = scene->validate_status;
+        return scene->validate_status.result;
+    }
+    sw__status_ok(status);
+    return SW_OK;
+}
+
+/* ---- open ------------------------------------------------------------------------------------ */
+
+/* Magic and version, reading no byte past `size`. */
+static sw_result check_ident(const char *path, const unsigned char *p, uint64_t size,
+                             sw_status *status)
+{
+    size_t have = size < 8 ? (size_t)size : 8;
+    if (memcmp(p, SWS_MAGIC, have) != 0)
+        return sw__fail(status, SW_ERR_FORMAT, "%s: offset 0: not a .sws file (bad magic)", path);
+    if (size < 12)
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: header at offset 0: file is %llu bytes, the header %u", path,
+                        (unsigned long long)size, SWS_HEADER_SIZE);
+    if (rd32(p + 8) != SWS_VERSION)
+        return sw__fail(status, SW_ERR_VERSION,
+                        "%s: offset 8: format version %u, this program reads version %u", path,
+                        rd32(p + 8), SWS_VERSION);
+    if (size < SWS_HEADER_SIZE)
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: header at offset 0: file is %llu bytes, the header %u", path,
+                        (unsigned long long)size, SWS_HEADER_SIZE);
+    return SW_OK;
+}
+
+static void read_header(const unsigned char *p, sws_header *h)
+{
+    h->version = rd32(p + 8);
+    h->flags = rd32(p + 12);
+    h->section_count = rd32(p + 16);
+    h->header_size = rd32(p + 20);
+    h->file_size = rd64(p + 24);
+    h->table_offset = rd64(p + 32);
+    h->entry_size = rd32(p + 40);
+    h->header_crc = rd32(p + SWS_HEADER_CRC_AT);
+    h->reserved_zero = rd32(p + 44) == 0 && rd64(p + 48) == 0 && rd32(p + 56) == 0;
+}
+
+/* The table's place in the file, the header checksum (before the other fields, so a flipped
+ * header byte reads as corruption), the fields, then the file size. */
+static sw_result check_header(const char *path, const unsigned char *p, uint64_t size,
+                              const sws_header *h, sw_status *status)
+{
+    const uint64_t table_bytes = (uint64_t)SW__SG_SEC_COUNT * SWS_ENTRY_SIZE;
+    if (h->table_offset < SWS_HEADER_SIZE || h->table_offset % SWS_ALIGN ||
+        h->table_offset > h->file_size || table_bytes > h->file_size - h->table_offset)
+        return sw__fail(status, SW_ERR_FORMAT,
+                        "%s: offset 32: section table at offset %llu does not fit in the %llu "
+                        "bytes the header declares",
+                        path, (unsigned long long)h->table_offset,
+                        (unsigned long long)h->file_size);
+    if (h->table_offset > size || table_bytes > size - h->table_offset)
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: section table at offset %llu: file is %llu bytes, header says %llu",
+                        path, (unsigned long long)h->table_offset, (unsigned long long)size,
+                        (unsigned long long)h->file_size);
+    uint32_t crc = sw__crc32c(0, p, SWS_HEADER_CRC_AT);
+    crc = sw__crc32c(crc, p + h->table_offset, table_bytes);
+    if (crc != h->header_crc)
+        return sw__fail(status, SW_ERR_CHECKSUM,
+                        "%s: header at offset 0: checksum mismatch (stored 0x%08x, computed "
+                        "0x%08x)",
+                        path, h->header_crc, crc);
+    if (h->flags != 0 || h->header_size != SWS_HEADER_SIZE || h->entry_size != SWS_ENTRY_SIZE ||
+        h->section_count != SW__SG_SEC_COUNT || !h->reserved_zero)
+        return sw__fail(status, SW_ERR_FORMAT,
+                        "%s: header at offset 12: flags 0x%x, %u sections, header size %u, entry "
+                        "size %u (expected 0, %u, %u, %u, reserved zero)",
+                        path, h->flags, h->section_count, h->header_size, h->entry_size,
+                        SW__SG_SEC_COUNT, SWS_HEADER_SIZE, SWS_ENTRY_SIZE);
+    if (h->file_size > size)
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: offset %llu: file is %llu bytes, its section table says %llu", path,
+                        (unsigned long long)size, (unsigned long long)size,
+                        (unsigned long long)h->file_size);
+    if (h->file_size < size)
+        return sw__fail(status, SW_ERR_FORMAT,
+                        "%s: offset %llu: %llu bytes after the end the header declares", path,
+                        (unsigned long long)h->file_size,
+                        (unsigned long long)(size - h->file_size));
+    return SW_OK;
+}
+
+/* One table entry: known id, not seen before, aligned, inside the file, after the table, and
+ * count * record size == size (all without overflow). */
+static sw_result check_entry(const char *path, const unsigned char *ent, uint64_t ent_off,
+                             uint64_t data_start, uint64_t file_size, sw__sg_section_info *sec,
+                             uint32_t *seen, sw_status *status)
+{
+    uint32_t id = rd32(ent);
+    uint64_t off = rd64(ent + 8), sz = rd64(ent + 16), count = rd64(ent + 24);
+    if (id >= SW__SG_SEC_COUNT || (*seen & (1u << id)) || rd32(ent + 4) || rd32(ent + 36))
+        return sw__fail(status, SW_ERR_FORMAT,
+                        "%s: section table entry at offset %llu: unknown or repeated id %u", path,
+                        (unsigned long long)ent_off, id);
+    const char *name = sw__sg_section_names[id];
+    const uint64_t rec = sw__sg_section_record_size[id];
+    if (off % SWS_ALIGN || off < data_start || off > file_size || sz > file_size - off)
+        return sw__fail(status, SW_ERR_FORMAT,
+                        "%s: section %s (table entry at offset %llu): offset %llu, size %llu "
+                        "outside the data area [%llu, %llu) or not 16-byte aligned",
+                        path, name, (unsigned long long)ent_off, (unsigned long long)off,
+                        (unsigned long long)sz, (unsigned long long)data_start,
+                        (unsigned long long)file_size);
+    uint64_t max_count = id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS ? UINT64_MAX
+                         : id == SW__SG_SEC_META                           ? 1
+                                                                           : SW_SG_NONE - 1;
+    if (count > max_count || count > UINT64_MAX / rec || count * rec != sz ||
+        (id == SW__SG_SEC_META && count != 1))
+        return sw__fail(status, SW_ERR_FORMAT,
+                        "%s: section %s at offset %llu: %llu elements of %llu bytes do not make "
+                        "its size %llu",
+                        path, name, (unsigned long long)off, (unsigned long long)count,
+                        (unsigned long long)rec, (unsigned long long)sz);
+    *seen |= 1u << id;
+    sec[id] = (sw__sg_section_info){off, sz, count, rd32(ent + 32)};
+    return SW_OK;
+}
+
+static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec,
+                                sw_status *status)
+{
+    for (int a = 0; a < SW__SG_SEC_COUNT; a++)
+        for (int b = a + 1; b < SW__SG_SEC_COUNT; b++) {
+            const sw__sg_section_info *x = &sec[a], *y = &sec[b];
+            if (x->size && y->size && x->offset < y->offset + y->size &&
+                y->offset < x->offset + x->size)
+                return sw__fail(status, SW_ERR_FORMAT,
+                                "%s: section %s at offset %llu overlaps section %s at offset %llu",
+                                path, sw__sg_section_names[a], (unsigned long long)x->offset,
+                                sw__sg_section_names[b], (unsigned long long)y->offset);
+        }
+    return SW_OK;
+}
+
+static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status *status)
+{
+    const unsigned char *p = scene->map;
+    const uint64_t data_start = h->table_offset + (uint64_t)SW__SG_SEC_COUNT * SWS_ENTRY_SIZE;
+    uint32_t seen = 0;
+    for (uint32_t i = 0; i < SW__SG_SEC_COUNT; i++) {
+        uint64_t ent_off = h->table_offset + (uint64_t)i * SWS_ENTRY_SIZE;
+        sw_result r = check_entry(scene->path, p + ent_off, ent_off, data_start, h->file_size,
+                                  scene->sec, &seen, status);
+        if (r != SW_OK)
+            return r;
+    }
+    sw_result r = check_overlaps(scene->path, scene->sec, status);
+    if (r != SW_OK)
+        return r;
+    /* META is 16 bytes: verified here, as the root is part of the view. */
+    const sw__sg_section_info *m = &scene->sec[SW__SG_SEC_META];
+    uint32_t crc = sw__crc32c(0, p + m->offset, m->size);
+    if (crc != m->checksum)
+        return sw__fail(status, SW_ERR_CHECKSUM,
+                        "%s: section META at offset %llu: checksum mismatch (stored 0x%08x, "
+                        "computed 0x%08x)",
+                        scene->path, (unsigned long long)m->offset, m->checksum, crc);
+    if (rd32(p + m->offset + 4) || rd64(p + m->offset + 8))
+        return sw__fail(status, SW_ERR_FORMAT, "%s: section META at offset %llu: reserved bytes",
+                        scene->path, (unsigned long long)m->offset);
+    scene->view.root = rd32(p + m->offset);
+    return SW_OK;
+}
+
+static void map_view(sw_sg_scene *scene)
+{
+    const unsigned char *p = scene->map;
+    const sw__sg_section_info *s = scene->sec;
+    sw_sg_scene_view *v = &scene->view;
+    v->faces = (const sw_sg_face_rec *)(const void *)(p + s[SW__SG_SEC_FACES].offset);
+    v->loops = (const sw_sg_loop_rec *)(const void *)(p + s[SW__SG_SEC_LOOPS].offset);
+    v->curves = (const sw_sg_curve_rec *)(const void *)(p + s[SW__SG_SEC_CURVES].offset);
+    v->nodes = (const sw_sg_node_rec *)(const void *)(p + s[SW__SG_SEC_NODES].offset);
+    v->adjacency =
+        (const sw_sg_adjacency_rec *)(const void *)(p + s[SW__SG_SEC_ADJACENCY].offset);
+    v->pool = (const double *)(const void *)(p + s[SW__SG_SEC_POOL].offset);
+    v->strings = (const char *)(p + s[SW__SG_SEC_STRINGS].offset);
+    v->n_faces = (uint32_t)s[SW__SG_SEC_FACES].count;
+    v->n_loops = (uint32_t)s[SW__SG_SEC_LOOPS].count;
+    v->n_curves = (uint32_t)s[SW__SG_SEC_CURVES].count;
+    v->n_nodes = (uint32_t)s[SW__SG_SEC_NODES].count;
+    v->n_adjacency = (uint32_t)s[SW__SG_SEC_ADJACENCY].count;
+    v->n_pool = s[SW__SG_SEC_POOL].count;
+    v->n_strings = s[SW__SG_SEC_STRINGS].count;
+}
+
+/* open + fstat + mmap; the descriptor is closed before returning. */
+static sw_result map_file(sw_sg_scene *scene, sw_status *status)
+{
+    const char *path = scene->path;
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (fd < 0)
+        return sw__fail(status, errno == ENOENT || errno == ENOTDIR ? SW_ERR_NOT_FOUND : SW_ERR_IO,
+                        "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    sw_result r = SW_OK;
+    if (fstat(fd, &st) != 0)
+        r = sw__fail(status, SW_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    else if (!S_ISREG(st.st_mode))
+        r = sw__fail(status, SW_ERR_IO, "%s: not a regular file", path);
+    else if (st.st_size == 0)
+        r = sw__fail(status, SW_ERR_TRUNCATED, "%s: offset 0: empty file", path);
+    else if ((uint64_t)st.st_size > SIZE_MAX)
+        r = sw__fail(status, SW_ERR_LIMIT, "%s: %lld bytes do not fit in the address space", path,
+                     (long long)st.st_size);
+    if (r == SW_OK) {
+        void *m = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
+        if (m == MAP_FAILED)
+            r = sw__fail(status, errno == ENOMEM ? SW_ERR_OUT_OF_MEMORY : SW_ERR_IO,
+                         "%s: cannot map %lld bytes: %s", path, (long long)st.st_size,
+                         strerror(errno));
+        else {
+            scene->map = m;
+            scene->map_size = (size_t)st.st_size;
+        }
+    }
+    close(fd);
+    return r;
+}
+
+sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status)
+{
+    *out = NULL;
+    sw_sg_scene *scene = calloc(1, sizeof *scene);
+    char *copy = malloc(strlen(path) + 1);
+    if (!scene || !copy) {
+        free(scene);
+        free(copy);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    }
+    scene->path = strcpy(copy, path);
+    sw_result r = map_file(scene, status);
+    if (r == SW_OK)
+        r = check_ident(path, scene->map, scene->map_size, status);
+    sws_header h;
+    if (r == SW_OK) {
+        read_header(scene->map, &h);
+        r = check_header(path, scene->map, scene->map_size, &h, status);
+    }
+    if (r == SW_OK)
+        r = parse_table(scene, &h, status);
+    if (r != SW_OK) {
+        sw_sg_scene_free(scene);
+        return r;
+    }
+    map_view(scene);
+    *out = scene;
+    sw__status_ok(status);
+    return SW_OK;
+}
+
+/* ---- save ------------------------------------------------------------------------------------ */
+
+static int write_all(int fd, const void *data, uint64_t n)
+{
+    const unsigned char *p = data;
+    while (n) {
+        size_t chunk = n > (1u << 30) ? (1u << 30) : (size_t)n;
+        ssize_t w = write(fd, p, chunk);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            return 0;
+        p += w;
+        n -= (uint64_t)w;
+    }
+    return 1;
+}
+
+/* Header, table and META for a scene's view; fills the section offsets and the file size. */
+static void build_header(const sw_sg_scene_view *v, const void *ptr[SW__SG_SEC_COUNT],
+                         unsigned char meta[16], unsigned char *head, uint64_t head_bytes,
+                         uint64_t *file_size)
+{
+    memset(head, 0, head_bytes);
+    memset(meta, 0, 16);
+    wr32(meta, v->root);
+    uint64_t off = head_bytes;
+    unsigned char *table = head + SWS_HEADER_SIZE;
+    for (int s = 0; s < SW__SG_SEC_COUNT; s++) {
+        uint64_t bytes = 16, count = 1;
+        if (s == SW__SG_SEC_META)
+            ptr[s] = meta;
+        else
+            ptr[s] = sw__sg_view_section(v, s, &bytes, &count);
+        off = align16(off);
+        unsigned char *e = table + (size_t)s * SWS_ENTRY_SIZE;
+        wr32(e, (uint32_t)s);
+        wr64(e + 8, off);
+        wr64(e + 16, bytes);
+        wr64(e + 24, count);
+        wr32(e + 32, sw__crc32c(0, ptr[s], bytes));
+        off += bytes;
+    }
+    *file_size = off;
+    memcpy(head, SWS_MAGIC, 8);
+    wr32(head + 8, SWS_VERSION);
+    wr32(head + 16, SW__SG_SEC_COUNT);
+    wr32(head + 20, SWS_HEADER_SIZE);
+    wr64(head + 24, off);
+    wr64(head + 32, SWS_HEADER_SIZE);
+    wr32(head + 40, SWS_ENTRY_SIZE);
+    uint32_t crc = sw__crc32c(0, head, SWS_HEADER_CRC_AT);
+    crc = sw__crc32c(crc, table, (size_t)SW__SG_SEC_COUNT * SWS_ENTRY_SIZE);
+    wr32(head + SWS_HEADER_CRC_AT, crc);
+}
+
+/* Writes the sections in table order with zero padding up to each 16-byte boundary. */
+static int write_body(int fd, const unsigned char *head, uint64_t head_bytes,
+                      const void *const ptr[SW__SG_SEC_COUNT])
+{
+    static const unsigned char zeros[SWS_ALIGN];
+    if (!write_all(fd, head, head_bytes))
+        return 0;
+    uint64_t pos = head_bytes;
+    for (int s = 0; s < SW__SG_SEC_COUNT; s++) {
+        const unsigned char *e = head + SWS_HEADER_SIZE + (size_t)s * SWS_ENTRY_SIZE;
+        uint64_t off = rd64(e + 8), bytes = rd64(e + 16);
+        if (!write_all(fd, zeros, off - pos) || !write_all(fd, ptr[s], bytes))
+            return 0;
+        pos = off + bytes;
+    }
+    return 1;
+}
+
+/* Makes the rename durable; a failure here is not reported, the file itself is complete. */
+static void sync_parent_dir(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if ((size_t)(slash - path) < sizeof dir)
+        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
+    else
+        return;
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) {
+        fsync(fd);
+        close(fd);
+    }
+}
+
+sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *status)
+{
+    /* A mapped scene is verified first: a corrupted section must not be rewritten with a fresh,
+     * matching checksum. */
+    sw_result r = sw_sg_scene_require(scene, SW_SG_SEC_ALL, status);
+    if (r != SW_OK)
+        return r;
+    enum { HEAD = SWS_HEADER_SIZE + SW__SG_SEC_COUNT * SWS_ENTRY_SIZE };
+    unsigned char head[HEAD], meta[16];
+    const void *ptr[SW__SG_SEC_COUNT];
+    uint64_t file_size;
+    build_header(&scene->view, ptr, meta, head, HEAD, &file_size);
+
+    size_t tlen = strlen(path) + 32;
+    char *tmp = malloc(tlen);
+    if (!tmp)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    snprintf(tmp, tlen, "%s.tmp-%ld", path, (long)getpid());
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        r = sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO,
+                     "%s: cannot create %s: %s", path, tmp, strerror(errno));
+        free(tmp);
+        return r;
+    }
+    const char *step = NULL;
+    if (!write_body(fd, head, HEAD, ptr))
+        step = "write";
+    else if (fsync(fd) != 0)
+        step = "fsync";
+    int err = errno;
+    if (close(fd) != 0 && !step) {
+        step = "close";
+        err = errno;
+    }
+    if (!step && rename(tmp, path) != 0) {
+        step = "rename";
+        err = errno;
+    }
+    if (step) {
+        unlink(tmp);
+        r = sw__fail(status, SW_ERR_IO,
+                     "%s: %s of %llu bytes through %s failed: %s", path, step,
+                     (unsigned long long)file_size, tmp, strerror(err));
+        free(tmp);
+        return r;
+    }
+    free(tmp);
+    sync_parent_dir(path);
+    sw__status_ok(status);
+    return SW_OK;
+}

@@ -1,0 +1,251 @@
+/* Rendering, analytic (issue 2): a planar NURBS square with a circular hole (an exact rational
+ * quadratic circle as trim curve) and a star-shaped hole (a degree-1 loop), rendered at 512x512
+ * looking straight at it. Every pixel whose centre is more than 1 pixel from a boundary (computed
+ * here by projecting the analytic shape) must be covered exactly when the analytic shape says so,
+ * and covered pixels must carry the plane's depth. Also writes the frame as PNG and EXR.
+ *
+ * Usage: test_gpu_analytic OUTDIR
+ */
+#include "sw_gpu.h"
+#include "sw_sg_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#define W 512
+#define H 512
+static const double k_dist = 3.0, k_fovy = 40.0;
+static const double k_circle_c[2] = {0.3, 0.62}, k_circle_r = 0.17;
+static const double k_star_c[2] = {0.64, 0.34}, k_star_ro = 0.22, k_star_ri = 0.09;
+#define STAR_N 5
+
+static int fail(const char *what, const sw_status *st)
+{
+    fprintf(stderr, "FAIL: %s: %s\n", what, st ? st->message : "");
+    return 1;
+}
+
+static void star_vertex(int k, double out[2])
+{
+    double r = (k % 2) ? k_star_ri : k_star_ro, a = M_PI / 2.0 + M_PI * k / STAR_N;
+    out[0] = k_star_c[0] + r * cos(a);
+    out[1] = k_star_c[1] + r * sin(a);
+}
+
+static uint32_t add_curve(sw_sg_builder *b, int32_t degree, const double *knots, int32_t n,
+                          const double *cpw)
+{
+    sw_sg_curve_rec c = {(uint32_t)degree, (uint32_t)n, 0, 0};
+    c.knots = sw_sg_builder_push_doubles(b, knots, (size_t)(n + degree + 1));
+    c.cpw = sw_sg_builder_push_doubles(b, cpw, (size_t)n * 3);
+    return sw_sg_builder_add_curve(b, &c);
+}
+
+/* Degree-1 closed loop through pts (count points; the closing point is appended). */
+static uint32_t add_polygon_loop(sw_sg_builder *b, const double *pts, int count, uint32_t flags)
+{
+    double knots[64], cpw[3 * 32];
+    int n = count + 1;
+    knots[0] = 0.0;
+    for (int i = 0; i < n; ++i)
+        knots[i + 1] = (double)i / (double)(n - 1);
+    knots[n + 1] = 1.0;
+    for (int i = 0; i < n; ++i) {
+        cpw[3 * i] = pts[2 * (i % count)];
+        cpw[3 * i + 1] = pts[2 * (i % count) + 1];
+        cpw[3 * i + 2] = 1.0;
+    }
+    uint32_t c = add_curve(b, 1, knots, n, cpw);
+    sw_sg_loop_rec l = {c, 1, flags, 0};
+    return sw_sg_builder_add_loop(b, &l);
+}
+
+static uint32_t add_circle_loop(sw_sg_builder *b)
+{
+    static const double knots[12] = {0, 0, 0, .25, .25, .5, .5, .75, .75, 1, 1, 1};
+    static const double dir[9][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1}, {-1, 0},
+                                     {-1, -1}, {0, -1}, {1, -1}, {1, 0}};
+    double cpw[27];
+    for (int i = 0; i < 9; ++i) {
+        double w = (i % 2) ? sqrt(0.5) : 1.0;
+        cpw[3 * i] = w * (k_circle_c[0] + k_circle_r * dir[i][0]);
+        cpw[3 * i + 1] = w * (k_circle_c[1] + k_circle_r * dir[i][1]);
+        cpw[3 * i + 2] = w;
+    }
+    uint32_t c = add_curve(b, 2, knots, 9, cpw);
+    sw_sg_loop_rec l = {c, 1, 0, 0};
+    return sw_sg_builder_add_loop(b, &l);
+}
+
+/* The square [-1,1]^2 (z = 0) over the domain [0,1]^2: biquadratic with two spans each way. */
+static int build_scene(sw_sg_scene **out, sw_status *st)
+{
+    sw_sg_builder *b = sw_sg_builder_create();
+    if (!b)
+        return 0;
+    static const double knots[7] = {0, 0, 0, 0.5, 1, 1, 1};
+    static const double greville[4] = {0.0, 0.25, 0.75, 1.0};
+    double cpw[4 * 4 * 4];
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 4; ++i) {
+            double *p = cpw + (j * 4 + i) * 4;
+            p[0] = -1.0 + 2.0 * greville[i];
+            p[1] = -1.0 + 2.0 * greville[j];
+            p[2] = 0.0;
+            p[3] = 1.0;
+        }
+    sw_sg_face_rec f;
+    memset(&f, 0, sizeof f);
+    f.deg_u = f.deg_v = 2;
+    f.n_u = f.n_v = 4;
+    f.knots_u = sw_sg_builder_push_doubles(b, knots, 7);
+    f.knots_v = sw_sg_builder_push_doubles(b, knots, 7);
+    f.cpw = sw_sg_builder_push_doubles(b, cpw, 64);
+    static const double square[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+    double star[2 * 2 * STAR_N];
+    for (int k = 0; k < 2 * STAR_N; ++k)
+        star_vertex(k, star + 2 * k);
+    f.first_loop = add_polygon_loop(b, square, 4, SW_SG_LOOP_OUTER);
+    add_circle_loop(b);
+    add_polygon_loop(b, star, 2 * STAR_N, 0);
+    f.n_loops = 3;
+    f.kind = SW_SG_KIND_PLANE;
+    f.flags = SW_SG_FACE_TRIMMED;
+    f.uv_box[0] = f.uv_box[2] = 0.0;
+    f.uv_box[1] = f.uv_box[3] = 1.0;
+    f.tolerance = 1e-7;
+    uint32_t face = sw_sg_builder_add_face(b, &f);
+    static const float white[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    sw_sg_builder_add_node(b, SW_SG_NODE_SURFACE, 0, face, NULL, white, "square");
+    return sw_sg_builder_finish(b, out, st) == SW_OK;
+}
+
+static double seg_dist(const double p[2], const double a[2], const double b[2])
+{
+    double d[2] = {b[0] - a[0], b[1] - a[1]}, e[2] = {p[0] - a[0], p[1] - a[1]};
+    double t = (d[0] * e[0] + d[1] * e[1]) / (d[0] * d[0] + d[1] * d[1]);
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    return hypot(e[0] - t * d[0], e[1] - t * d[1]);
+}
+
+/* Inside the trimmed face (1/0) and the distance in uv to the nearest boundary. */
+static int analytic(const double uv[2], double *dist)
+{
+    double sq[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}}, star[2 * STAR_N][2];
+    double d = INFINITY;
+    for (int k = 0; k < 4; ++k)
+        d = fmin(d, seg_dist(uv, sq[k], sq[(k + 1) % 4]));
+    double rc = hypot(uv[0] - k_circle_c[0], uv[1] - k_circle_c[1]);
+    d = fmin(d, fabs(rc - k_circle_r));
+    int in_star = 0;
+    for (int k = 0; k < 2 * STAR_N; ++k)
+        star_vertex(k, star[k]);
+    for (int k = 0, j = 2 * STAR_N - 1; k < 2 * STAR_N; j = k++) {
+        d = fmin(d, seg_dist(uv, star[k], star[j]));
+        if ((star[k][1] > uv[1]) != (star[j][1] > uv[1]) &&
+            uv[0] < (star[j][0] - star[k][0]) * (uv[1] - star[k][1]) /
+                            (star[j][1] - star[k][1]) +
+                        star[k][0])
+            in_star = !in_star;
+    }
+    *dist = d;
+    int in_square = uv[0] >= 0 && uv[0] <= 1 && uv[1] >= 0 && uv[1] <= 1;
+    return in_square && rc > k_circle_r && !in_star;
+}
+
+static int check_frame(const sw_gpu_image *img)
+{
+    double tan_y = tan(k_fovy * M_PI / 360.0), half = k_dist * tan_y; /* world half-height */
+    double px_per_uv = 2.0 * (H / 2.0) / half; /* the square spans 2 world units per uv unit */
+    long checked = 0, wrong = 0, covered = 0, band = 0, bad_depth = 0;
+    for (int y = 0; y < H; ++y) {
+        for (int x = 0; x < W; ++x) {
+            double wx = ((x + 0.5) / (W / 2.0) - 1.0) * half;
+            double wy = (1.0 - (y + 0.5) / (H / 2.0)) * half;
+            double uv[2] = {(wx + 1.0) / 2.0, (wy + 1.0) / 2.0}, d;
+            int want = analytic(uv, &d);
+            size_t i = (size_t)y * W + (size_t)x;
+            int got = img->rgba[4 * i + 3] != 0;
+            covered += got;
+            if (got && fabs(img->depth[i] - k_dist) > 1e-5 * k_dist)
+                ++bad_depth;
+            if (d * px_per_uv <= 1.0) {
+                ++band;
+                continue;
+            }
+            ++checked;
+            if (got != want) {
+                if (wrong < 10)
+                    fprintf(stderr, "pixel (%d,%d) uv (%.4f,%.4f) %.2f px from a boundary: "
+                                    "covered %d, expected %d\n",
+                            x, y, uv[0], uv[1], d * px_per_uv, got, want);
+                ++wrong;
+            }
+        }
+    }
+    printf("analytic: %ld pixels checked (%ld within 1 px of a boundary skipped), %ld covered, "
+           "%ld misclassified, %ld with wrong depth\n",
+           checked, band, covered, wrong, bad_depth);
+    return wrong == 0 && bad_depth == 0 && covered > W * H / 4;
+}
+
+static int check_writes(const sw_gpu_image *img, const char *dir)
+{
+    char png[1024], exr[1024], bad[1024];
+    snprintf(png, sizeof png, "%s/analytic.png", dir);
+    snprintf(exr, sizeof exr, "%s/analytic.exr", dir);
+    snprintf(bad, sizeof bad, "%s/analytic.bmpx", dir);
+    sw_status st = {0};
+    if (sw_gpu_image_write(img, png, &st) != SW_OK)
+        return fail("png write", &st);
+    if (sw_gpu_image_write(img, exr, &st) != SW_OK)
+        return fail("exr write", &st);
+    if (sw_gpu_image_write(img, bad, &st) != SW_ERR_UNSUPPORTED)
+        return fail("unsupported extension accepted", &st);
+    struct stat sb;
+    if (stat(png, &sb) != 0 || sb.st_size < 100 || stat(exr, &sb) != 0 || sb.st_size < 100)
+        return fail("image files missing", NULL);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *dir = argc > 1 ? argv[1] : ".";
+    sw_status st = {0};
+    sw_sg_scene *scene = NULL;
+    if (!build_scene(&scene, &st))
+        return fail("scene build", &st);
+    sw_gpu_context *ctx = NULL;
+    if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK)
+        return fail("context", &st);
+    printf("context: %s\n", sw_gpu_context_description_ptr(ctx));
+    sw_gpu_frame_desc desc;
+    memset(&desc, 0, sizeof desc);
+    desc.width = W;
+    desc.height = H;
+    desc.want_depth = 1;
+    desc.camera = (sw_gpu_camera){{0, 0, k_dist}, {0, 0, 0}, {0, 1, 0}, k_fovy};
+    sw_gpu_image img;
+    sw_gpu_frame_stats fs;
+    if (sw_gpu_render_scene(ctx, scene, &desc, &img, &fs, &st) != SW_OK)
+        return fail("render", &st);
+    printf("stats: faces %llu drawn / %llu culled, patches %llu trimmed / %llu untrimmed / %llu "
+           "culled, %llu triangles, %llu trim textures (%llu texels); ms: tessellate %.2f trim "
+           "%.2f draw %.2f readback %.2f\n",
+           (unsigned long long)fs.faces_drawn, (unsigned long long)fs.faces_culled,
+           (unsigned long long)fs.patches_trimmed, (unsigned long long)fs.patches_untrimmed,
+           (unsigned long long)fs.patches_culled, (unsigned long long)fs.triangles,
+           (unsigned long long)fs.trim_textures, (unsigned long long)fs.trim_texels,
+           fs.ms_tessellate, fs.ms_trim, fs.ms_draw, fs.ms_readback);
+    int ok = check_frame(&img) && fs.patches_trimmed == 4 && fs.trim_textures == 1;
+    if (check_writes(&img, dir))
+        ok = 0;
+    sw_gpu_image_free(&img);
+    sw_gpu_context_free(ctx);
+    sw_sg_scene_free(scene);
+    puts(ok ? "PASS" : "FAIL");
+    return ok ? 0 : 1;
+}
