@@ -15,9 +15,14 @@ const char *const sw__sg_section_names[SW__SG_SEC_COUNT] = {
     "FACES", "LOOPS", "CURVES", "NODES", "ADJACENCY", "POOL", "STRINGS", "META",
 };
 const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT] = {
-    sizeof(sw_sg_face_rec), sizeof(sw_sg_loop_rec),      sizeof(sw_sg_curve_rec),
-    sizeof(sw_sg_node_rec), sizeof(sw_sg_adjacency_rec), sizeof(double),
-    1,                      16,
+    sizeof(sw_sg_face_rec),
+    sizeof(sw_sg_loop_rec),
+    sizeof(sw_sg_curve_rec),
+    sizeof(sw_sg_node_rec),
+    sizeof(sw_sg_adjacency_rec),
+    sizeof(double),
+    1,
+    16,
 };
 
 static const double identity12[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -302,14 +307,29 @@ const void *sw__sg_view_section(const sw_sg_scene_view *view, int s, uint64_t *b
     const void *p = NULL;
     uint64_t n = 0;
     switch (s) {
-    case SW__SG_SEC_FACES: p = view->faces, n = view->n_faces; break;
-    case SW__SG_SEC_LOOPS: p = view->loops, n = view->n_loops; break;
-    case SW__SG_SEC_CURVES: p = view->curves, n = view->n_curves; break;
-    case SW__SG_SEC_NODES: p = view->nodes, n = view->n_nodes; break;
-    case SW__SG_SEC_ADJACENCY: p = view->adjacency, n = view->n_adjacency; break;
-    case SW__SG_SEC_POOL: p = view->pool, n = view->n_pool; break;
-    case SW__SG_SEC_STRINGS: p = view->strings, n = view->n_strings; break;
-    default: assert(!"not an array section");
+    case SW__SG_SEC_FACES:
+        p = view->faces, n = view->n_faces;
+        break;
+    case SW__SG_SEC_LOOPS:
+        p = view->loops, n = view->n_loops;
+        break;
+    case SW__SG_SEC_CURVES:
+        p = view->curves, n = view->n_curves;
+        break;
+    case SW__SG_SEC_NODES:
+        p = view->nodes, n = view->n_nodes;
+        break;
+    case SW__SG_SEC_ADJACENCY:
+        p = view->adjacency, n = view->n_adjacency;
+        break;
+    case SW__SG_SEC_POOL:
+        p = view->pool, n = view->n_pool;
+        break;
+    case SW__SG_SEC_STRINGS:
+        p = view->strings, n = view->n_strings;
+        break;
+    default:
+        assert(!"not an array section");
     }
     *count = n;
     *bytes = n * sw__sg_section_record_size[s];
@@ -391,8 +411,8 @@ static int trav_push(trav_stack *st, uint32_t node, uint32_t depth, int follow,
 {
     if (st->n == st->cap) {
         size_t cap = st->cap * 2;
-        trav_entry *e = st->e == st->local ? malloc(cap * sizeof *e)
-                                           : realloc(st->e, cap * sizeof *e);
+        trav_entry *e =
+            st->e == st->local ? malloc(cap * sizeof *e) : realloc(st->e, cap * sizeof *e);
         if (!e)
             return 0;
         if (st->e == st->local)

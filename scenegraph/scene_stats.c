@@ -49,10 +49,10 @@ static void face_stats(const sw_sg_scene_view *v, sw_sg_scene_stats *out)
         if (f->deg_v > out->max_deg_v)
             out->max_deg_v = f->deg_v;
         out->control_points += (uint64_t)f->n_u * f->n_v;
-        int32_t su = sw_sg_knots_segment_count(v->pool + f->knots_u, (int32_t)f->deg_u,
-                                               (int32_t)f->n_u);
-        int32_t sv = sw_sg_knots_segment_count(v->pool + f->knots_v, (int32_t)f->deg_v,
-                                               (int32_t)f->n_v);
+        int32_t su =
+            sw_sg_knots_segment_count(v->pool + f->knots_u, (int32_t)f->deg_u, (int32_t)f->n_u);
+        int32_t sv =
+            sw_sg_knots_segment_count(v->pool + f->knots_v, (int32_t)f->deg_v, (int32_t)f->n_v);
         out->bezier_patches += (uint64_t)su * (uint64_t)sv;
     }
 }

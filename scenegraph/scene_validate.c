@@ -47,10 +47,9 @@ static sw_result check_face_record(const vctx *c, uint32_t i, const sw_sg_face_r
     char at[48];
     const sw_sg_scene_view *v = c->v;
     where(c, SW__SG_SEC_FACES, i, at);
-    if (f->deg_u < 1 || f->deg_u > SW_SG_MAX_DEGREE || f->deg_v < 1 ||
-        f->deg_v > SW_SG_MAX_DEGREE)
-        return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY, "%s: face %u%s: degree %ux%u",
-                        c->what, i, at, f->deg_u, f->deg_v);
+    if (f->deg_u < 1 || f->deg_u > SW_SG_MAX_DEGREE || f->deg_v < 1 || f->deg_v > SW_SG_MAX_DEGREE)
+        return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY, "%s: face %u%s: degree %ux%u", c->what,
+                        i, at, f->deg_u, f->deg_v);
     if (f->n_u <= f->deg_u || f->n_v <= f->deg_v || f->n_u > INT32_MAX || f->n_v > INT32_MAX)
         return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
                         "%s: face %u%s: %ux%u control points for degree %ux%u", c->what, i, at,
@@ -70,8 +69,8 @@ static sw_result check_face_record(const vctx *c, uint32_t i, const sw_sg_face_r
         return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: loops [%u, +%u) of %u", c->what,
                         i, at, f->first_loop, f->n_loops, v->n_loops);
     if (f->kind >= SW_SG_KIND_COUNT || (f->flags & ~(uint32_t)3u))
-        return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: kind %u, flags 0x%x", c->what,
-                        i, at, f->kind, f->flags);
+        return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: kind %u, flags 0x%x", c->what, i,
+                        at, f->kind, f->flags);
     if (!all_finite(f->uv_box, 4) || f->uv_box[0] > f->uv_box[1] || f->uv_box[2] > f->uv_box[3] ||
         !isfinite(f->tolerance) || f->tolerance < 0.0)
         return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
@@ -87,15 +86,16 @@ static sw_result check_faces(const vctx *c)
         sw_result r = check_face_record(c, i, f);
         if (r != SW_OK)
             return r;
-        sw_sg_surface s = {(int32_t)f->deg_u, (int32_t)f->deg_v, (int32_t)f->n_u,
+        sw_sg_surface s = {(int32_t)f->deg_u, (int32_t)f->deg_v,    (int32_t)f->n_u,
                            (int32_t)f->n_v,   v->pool + f->knots_u, v->pool + f->knots_v,
                            v->pool + f->cpw};
-        char what[300], at[48];
-        snprintf(what, sizeof what, "%s: face %u%s", c->what, i,
-                 where(c, SW__SG_SEC_FACES, i, at));
-        r = sw_sg_surface_validate(&s, what, c->status);
-        if (r != SW_OK)
-            return r;
+        /* The face's name is only formatted when it is needed, for the message. */
+        if (sw_sg_surface_validate(&s, c->what, NULL) != SW_OK) {
+            char what[300], at[48];
+            snprintf(what, sizeof what, "%s: face %u%s", c->what, i,
+                     where(c, SW__SG_SEC_FACES, i, at));
+            return sw_sg_surface_validate(&s, what, c->status);
+        }
     }
     return SW_OK;
 }
@@ -107,8 +107,8 @@ static sw_result check_loops(const vctx *c)
         const sw_sg_loop_rec *l = &v->loops[i];
         char at[48];
         if (l->n_curves == 0 || l->first_curve > v->n_curves ||
-            l->n_curves > v->n_curves - l->first_curve || (l->flags & ~(uint32_t)SW_SG_LOOP_OUTER) ||
-            l->reserved != 0)
+            l->n_curves > v->n_curves - l->first_curve ||
+            (l->flags & ~(uint32_t)SW_SG_LOOP_OUTER) || l->reserved != 0)
             return sw__fail(c->status, SW_ERR_FORMAT,
                             "%s: loop %u%s: curves [%u, +%u) of %u, flags 0x%x, reserved %u",
                             c->what, i, where(c, SW__SG_SEC_LOOPS, i, at), l->first_curve,
@@ -117,29 +117,45 @@ static sw_result check_loops(const vctx *c)
     return SW_OK;
 }
 
+/* Index checks of one curve record; `what` is formatted by the caller only on failure. */
+static int curve_record_ok(const sw_sg_scene_view *v, const sw_sg_curve_rec *k, sw_result *r)
+{
+    if (k->degree < 1 || k->degree > SW_SG_MAX_DEGREE || k->n <= k->degree || k->n > INT32_MAX) {
+        *r = SW_ERR_INVALID_GEOMETRY;
+        return 0;
+    }
+    if (!pool_range_ok(v, k->knots, (uint64_t)k->n + k->degree + 1) ||
+        !pool_range_ok(v, k->cpw, (uint64_t)k->n * 3u)) {
+        *r = SW_ERR_FORMAT;
+        return 0;
+    }
+    return 1;
+}
+
 static sw_result check_curves(const vctx *c)
 {
     const sw_sg_scene_view *v = c->v;
     for (uint32_t i = 0; i < v->n_curves; i++) {
         const sw_sg_curve_rec *k = &v->curves[i];
+        sw_result r = SW_OK;
+        int record_ok = curve_record_ok(v, k, &r);
+        sw_sg_curve cv = {(int32_t)k->degree, (int32_t)k->n, 3, NULL, NULL};
+        if (record_ok) {
+            cv.knots = v->pool + k->knots;
+            cv.cpw = v->pool + k->cpw;
+            if (sw_sg_curve_validate(&cv, c->what, NULL) == SW_OK)
+                continue;
+        }
         char what[300], at[48];
         snprintf(what, sizeof what, "%s: curve %u%s", c->what, i,
                  where(c, SW__SG_SEC_CURVES, i, at));
-        if (k->degree < 1 || k->degree > SW_SG_MAX_DEGREE || k->n <= k->degree ||
-            k->n > INT32_MAX)
-            return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
-                            "%s: degree %u with %u control points", what, k->degree, k->n);
-        if (!pool_range_ok(v, k->knots, (uint64_t)k->n + k->degree + 1) ||
-            !pool_range_ok(v, k->cpw, (uint64_t)k->n * 3u))
-            return sw__fail(c->status, SW_ERR_FORMAT,
-                            "%s: pool offsets %llu, %llu outside the pool of %llu doubles", what,
-                            (unsigned long long)k->knots, (unsigned long long)k->cpw,
-                            (unsigned long long)v->n_pool);
-        sw_sg_curve cv = {(int32_t)k->degree, (int32_t)k->n, 3, v->pool + k->knots,
-                          v->pool + k->cpw};
-        sw_result r = sw_sg_curve_validate(&cv, what, c->status);
-        if (r != SW_OK)
-            return r;
+        if (record_ok)
+            return sw_sg_curve_validate(&cv, what, c->status);
+        return sw__fail(c->status, r,
+                        "%s: degree %u with %u control points at pool offsets %llu, %llu (pool "
+                        "of %llu doubles)",
+                        what, k->degree, k->n, (unsigned long long)k->knots,
+                        (unsigned long long)k->cpw, (unsigned long long)v->n_pool);
     }
     return SW_OK;
 }
@@ -160,8 +176,8 @@ static sw_result check_node_records(const vctx *c)
                      : nd->kind == SW_SG_NODE_INSTANCE ? nd->ref < v->n_nodes
                                                        : 1;
         if (nd->kind > SW_SG_NODE_SURFACE || !ref_ok)
-            return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: kind %u, ref %u", c->what,
-                            i, at, nd->kind, nd->ref);
+            return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: kind %u, ref %u", c->what, i,
+                            at, nd->kind, nd->ref);
         if (!node_link_ok(nd->parent, v->n_nodes) || !node_link_ok(nd->first_child, v->n_nodes) ||
             !node_link_ok(nd->next_sibling, v->n_nodes))
             return sw__fail(c->status, SW_ERR_FORMAT,
@@ -176,8 +192,10 @@ static sw_result check_node_records(const vctx *c)
         for (int k = 0; k < 4; k++)
             color_ok &= isfinite(nd->color[k]) != 0;
         if (!color_ok || !all_finite(nd->xform, 12))
-            return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: non-finite colour or "
-                            "transform", c->what, i, at);
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: node %u%s: non-finite colour or "
+                            "transform",
+                            c->what, i, at);
     }
     return SW_OK;
 }
@@ -245,8 +263,8 @@ static sw_result check_cycles(const vctx *c, unsigned char *color, dfs_frame *st
             if (color[next] == 1) {
                 char at[48];
                 return sw__fail(c->status, SW_ERR_FORMAT,
-                                "%s: node %u%s: cycle in the node graph (through node %u)",
-                                c->what, f->node, where(c, SW__SG_SEC_NODES, f->node, at), next);
+                                "%s: node %u%s: cycle in the node graph (through node %u)", c->what,
+                                f->node, where(c, SW__SG_SEC_NODES, f->node, at), next);
             }
             if (color[next] == 0) {
                 color[next] = 1;

@@ -16,6 +16,18 @@ const char *sw_result_str(sw_result result)
     return names[result];
 }
 
+const char *sw_result_id_str(sw_result result)
+{
+    static const char *const ids[] = {
+#define SW__RESULT_ID(id, text) #id,
+        SW_RESULT_XMACRO(SW__RESULT_ID)
+#undef SW__RESULT_ID
+    };
+    if ((unsigned)result >= (unsigned)SW_RESULT_COUNT)
+        return "SW_RESULT_UNKNOWN";
+    return ids[result];
+}
+
 sw_result sw__fail(sw_status *status, sw_result result, const char *fmt, ...)
 {
     if (status) {

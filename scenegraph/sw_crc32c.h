@@ -11,7 +11,8 @@ extern "C" {
 #endif
 
 /* Continues a CRC-32C: start with crc = 0; sw__crc32c(sw__crc32c(0, a, n), b, m) equals the CRC of
- * a followed by b. CRC-32C("123456789") = 0xE3069283. `data` may be NULL when n == 0. Thread-safe. */
+ * a followed by b. CRC-32C("123456789") = 0xE3069283. `data` may be NULL when n == 0. Thread-safe.
+ */
 uint32_t sw__crc32c(uint32_t crc, const void *data, size_t n);
 /* The same through the portable table path only (tests compare it with the hardware path). */
 uint32_t sw__crc32c_portable(uint32_t crc, const void *data, size_t n);

@@ -32,15 +32,15 @@ typedef struct sw__sg_section_info {
 
 struct sw_sg_scene {
     sw_sg_scene_view view;
-    char *path;                      /* "" for a scene built in memory; always owned */
-    void *owned[SW__SG_SEC_COUNT];   /* in-memory arrays (malloc), NULL when mapped */
+    char *path;                    /* "" for a scene built in memory; always owned */
+    void *owned[SW__SG_SEC_COUNT]; /* in-memory arrays (malloc), NULL when mapped */
     size_t owned_bytes;
-    void *map;                       /* mapped file, NULL in memory */
+    void *map; /* mapped file, NULL in memory */
     size_t map_size;
     sw__sg_section_info sec[SW__SG_SEC_COUNT]; /* mapped only */
-    uint32_t verified;               /* sections whose checksum matched (sw_sg_section bits) */
-    int validated;                   /* 1 once sw_sg_scene_validate passed, -1 once it failed */
-    sw_status validate_status;       /* the failure, repeated to later callers */
+    uint32_t verified;         /* sections whose checksum matched (sw_sg_section bits) */
+    int validated;             /* 1 once sw_sg_scene_validate passed, -1 once it failed */
+    sw_status validate_status; /* the failure, repeated to later callers */
 };
 
 /* sw_sg_scene_validate with byte offsets of each record in the messages: when `sec` is not NULL,

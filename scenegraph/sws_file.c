@@ -126,6 +126,8 @@ sw_result sw_sg_scene_require(sw_sg_scene *scene, uint32_t sections, sw_status *
     if (scene->verified == SW_SG_SEC_ALL && scene->validated == 0) {
         sw_status st = {0};
         sw_result r = sw__sg_scene_validate_at(&scene->view, scene->path, scene->sec, &st);
+        if (r == SW_ERR_OUT_OF_MEMORY) /* not a property of the file: may pass next time */
+            return sw__fail(status, r, "%s", st.message);
         scene->validated = r == SW_OK ? 1 : -1;
         scene->validate_status = st;
     }
@@ -213,10 +215,9 @@ static sw_result check_header(const char *path, const unsigned char *p, uint64_t
                         (unsigned long long)size, (unsigned long long)size,
                         (unsigned long long)h->file_size);
     if (h->file_size < size)
-        return sw__fail(status, SW_ERR_FORMAT,
-                        "%s: offset %llu: %llu bytes after the end the header declares", path,
-                        (unsigned long long)h->file_size,
-                        (unsigned long long)(size - h->file_size));
+        return sw__fail(
+            status, SW_ERR_FORMAT, "%s: offset %llu: %llu bytes after the end the header declares",
+            path, (unsigned long long)h->file_size, (unsigned long long)(size - h->file_size));
     return SW_OK;
 }
 
@@ -256,8 +257,7 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
     return SW_OK;
 }
 
-static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec,
-                                sw_status *status)
+static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec, sw_status *status)
 {
     for (int a = 0; a < SW__SG_SEC_COUNT; a++)
         for (int b = a + 1; b < SW__SG_SEC_COUNT; b++) {
@@ -311,8 +311,7 @@ static void map_view(sw_sg_scene *scene)
     v->loops = (const sw_sg_loop_rec *)(const void *)(p + s[SW__SG_SEC_LOOPS].offset);
     v->curves = (const sw_sg_curve_rec *)(const void *)(p + s[SW__SG_SEC_CURVES].offset);
     v->nodes = (const sw_sg_node_rec *)(const void *)(p + s[SW__SG_SEC_NODES].offset);
-    v->adjacency =
-        (const sw_sg_adjacency_rec *)(const void *)(p + s[SW__SG_SEC_ADJACENCY].offset);
+    v->adjacency = (const sw_sg_adjacency_rec *)(const void *)(p + s[SW__SG_SEC_ADJACENCY].offset);
     v->pool = (const double *)(const void *)(p + s[SW__SG_SEC_POOL].offset);
     v->strings = (const char *)(p + s[SW__SG_SEC_STRINGS].offset);
     v->n_faces = (uint32_t)s[SW__SG_SEC_FACES].count;
@@ -522,8 +521,7 @@ sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *stat
     }
     if (step) {
         unlink(tmp);
-        r = sw__fail(status, SW_ERR_IO,
-                     "%s: %s of %llu bytes through %s failed: %s", path, step,
+        r = sw__fail(status, SW_ERR_IO, "%s: %s of %llu bytes through %s failed: %s", path, step,
                      (unsigned long long)file_size, tmp, strerror(err));
         free(tmp);
         return r;

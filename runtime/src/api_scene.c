@@ -57,18 +57,24 @@ sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status
 }
 
 /* The default scene: OCCT's "modern kitchen" sample models are already placed in Room.brep's
- * coordinates; a second chair is an instance of the first, and the motor stands on the table. */
+ * coordinates; a second chair is an instance of the first, and the motor stands on the table.
+ * BREP files carry no colours, so each part gets one (linear RGB). */
 typedef struct default_part {
     const char *file;
     int instanced; /* 1: imported once as a prototype, drawn by the instances below */
+    float color[4];
 } default_part;
 
 static const default_part k_default_parts[] = {
-    {"occ/Room.brep", 0},           {"occ/MODERN_Table_1.brep", 0},
-    {"occ/MODERN_Chair_1.brep", 1}, {"occ/MODERN_Cooker_1.brep", 0},
-    {"occ/MODERN_Exhaust_1.brep", 0}, {"occ/MODERN_MVCooker_1.brep", 0},
-    {"occ/MODERN_Refrigerator_1.brep", 0}, {"occ/MODERN_Sink_1.brep", 0},
-    {"occ/Motor-c.brep", 0},
+    {"occ/Room.brep", 0, {0.80f, 0.78f, 0.74f, 1}},
+    {"occ/MODERN_Table_1.brep", 0, {0.55f, 0.36f, 0.20f, 1}},
+    {"occ/MODERN_Chair_1.brep", 1, {0.20f, 0.35f, 0.60f, 1}},
+    {"occ/MODERN_Cooker_1.brep", 0, {0.85f, 0.85f, 0.88f, 1}},
+    {"occ/MODERN_Exhaust_1.brep", 0, {0.60f, 0.62f, 0.66f, 1}},
+    {"occ/MODERN_MVCooker_1.brep", 0, {0.30f, 0.30f, 0.32f, 1}},
+    {"occ/MODERN_Refrigerator_1.brep", 0, {0.92f, 0.92f, 0.95f, 1}},
+    {"occ/MODERN_Sink_1.brep", 0, {0.70f, 0.72f, 0.75f, 1}},
+    {"occ/Motor-c.brep", 0, {0.75f, 0.30f, 0.15f, 1}},
 };
 
 /* Row-major 3x4 transforms. The chair's twin is turned by 180° about the table's vertical axis
@@ -99,17 +105,17 @@ static sw_result build_default(sw_sg_builder *b, const char *data_dir,
         if (desc && desc->progress)
             desc->progress(desc->user_data, (double)i / (double)count, part->file);
         int is_motor = strstr(part->file, "Motor-c") != NULL;
-        uint32_t parent = 0;
-        if (part->instanced) {
-            parent = sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, SW_SG_NONE, 0, NULL, NULL,
-                                            part->file);
-            if (parent == SW_SG_NONE ||
-                sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_identity, NULL,
-                                       "chair") == SW_SG_NONE ||
-                sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_chair_twin, NULL,
-                                       "chair twin") == SW_SG_NONE)
-                return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
-        }
+        uint32_t parent = sw_sg_builder_add_node(b, SW_SG_NODE_GROUP,
+                                                 part->instanced ? SW_SG_NONE : 0, 0, NULL,
+                                                 part->color, part->file);
+        if (parent == SW_SG_NONE)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+        if (part->instanced &&
+            (sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_identity, NULL,
+                                    "chair") == SW_SG_NONE ||
+             sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_chair_twin, NULL,
+                                    "chair twin") == SW_SG_NONE))
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
         sw_result r = import_part(b, parent, is_motor ? k_motor_on_table : NULL, data_dir,
                                   part->file, desc, status);
         if (r != SW_OK)

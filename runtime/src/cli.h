@@ -14,7 +14,7 @@ int sw_cli_demo(int argc, char **argv);
 int sw_cli_is_help(const char *arg);
 /* Prints "splinewalk <cmd>: <result>: <message>" to stderr; returns 1. */
 int sw_cli_report(const char *cmd, const sw_status *status);
-/* A progress bar on stderr (redrawn in place on a terminal, a line per 10 % otherwise). */
+/* A progress bar on stderr: redrawn in place on a terminal, else a line per quarter and stage. */
 void sw_cli_progress(void *user_data, double fraction, const char *stage);
 void sw_cli_progress_end(void);
 void sw_cli_warning(void *user_data, const char *message);

@@ -16,14 +16,14 @@ int sw_cli_is_help(const char *arg)
 
 int sw_cli_report(const char *cmd, const sw_status *status)
 {
-    fprintf(stderr, "splinewalk %s: %s: %s\n", cmd, sw_result_str(status->result),
-            status->message[0] ? status->message : "(no details)");
+    fprintf(stderr, "splinewalk %s: %s (%s): %s\n", cmd, sw_result_str(status->result),
+            sw_result_id_str(status->result), status->message[0] ? status->message : "(no details)");
     return 1;
 }
 
 static struct {
     int active;
-    int last_decile;
+    int last_quarter;
     char stage[64];
 } g_progress;
 
@@ -41,11 +41,11 @@ void sw_cli_progress(void *user_data, double fraction, const char *stage)
         g_progress.active = 1;
         return;
     }
-    int decile = (int)(fraction * 10.0);
-    if (!g_progress.active || decile > g_progress.last_decile ||
+    int quarter = (int)(fraction * 4.0); /* logs stay short */
+    if (!g_progress.active || quarter > g_progress.last_quarter ||
         (stage && strncmp(stage, g_progress.stage, sizeof g_progress.stage - 1) != 0)) {
         fprintf(stderr, "  %3d%% %s\n", (int)(fraction * 100.0), stage ? stage : "");
-        g_progress.last_decile = decile;
+        g_progress.last_quarter = quarter;
         snprintf(g_progress.stage, sizeof g_progress.stage, "%s", stage ? stage : "");
         g_progress.active = 1;
     }

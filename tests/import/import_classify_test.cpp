@@ -20,6 +20,7 @@
 
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepClass_FaceClassifier.hxx>
+#include <BRepClass_FaceExplorer.hxx>
 #include <BRepTools_WireExplorer.hxx>
 #include <BRep_Tool.hxx>
 #include <Geom2d_Curve.hxx>
@@ -81,11 +82,11 @@ double nearest(const std::vector<sw_sg_polyline> &pl, double u, double v, double
             double dx = b[0] - a[0], dy = b[1] - a[1], l2 = dx * dx + dy * dy;
             double t = l2 > 0 ? ((u - a[0]) * dx + (v - a[1]) * dy) / l2 : 0.0;
             t = std::clamp(t, 0.0, 1.0);
-            double x = a[0] + t * dx, y = a[1] + t * dy, d = std::hypot(u - x, v - y);
-            if (d < best)
-                best = d, q[0] = x, q[1] = y;
+            double x = a[0] + t * dx - u, y = a[1] + t * dy - v, d2 = x * x + y * y;
+            if (d2 < best)
+                best = d2, q[0] = x + u, q[1] = y + v;
         }
-    return best;
+    return std::sqrt(best);
 }
 
 /* tol3 mapped to parameter distance at (u, v). */
@@ -120,6 +121,7 @@ bool classify_face(const sw_sg_scene *scene, uint32_t fi, const TopoDS_Face &cf,
     }
     const double tol3 = face_tolerance(cf), gap = closure_gap(cf);
     BRepAdaptor_Surface surf(cf, Standard_False);
+    BRepClass_FaceExplorer fx(cf);
     BRepClass_FaceClassifier fc;
     long in_band[2] = {0, 0}, dis = 0;
     for (int k = 0; k < kSamples; k++) {
@@ -130,7 +132,7 @@ bool classify_face(const sw_sg_scene *scene, uint32_t fi, const TopoDS_Face &cf,
         in_band[0] += d <= band[0], in_band[1] += d <= band[1];
         if (d <= std::min(band[0], band[1]))
             continue;
-        fc.Perform(cf, gp_Pnt2d(u, w), 1e-9);
+        fc.BRepClass_FClassifier::Perform(fx, gp_Pnt2d(u, w), 1e-9);
         TopAbs_State s = fc.State();
         if (mine != (s == TopAbs_IN)) {
             if (dis < 3)

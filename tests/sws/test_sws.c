@@ -23,15 +23,16 @@
 
 /* Format constants, from docs/sws-format.md (not from the implementation). */
 enum { HDR_FILE_SIZE = 24, HDR_TABLE = 32, HDR_CRC = 60, ENTRY = 40, N_SEC = 8 };
-static const char *const sec_names[N_SEC] = {"FACES", "LOOPS", "CURVES", "NODES",
-                                             "ADJACENCY", "POOL", "STRINGS", "META"};
+static const char *const sec_names[N_SEC] = {"FACES",     "LOOPS", "CURVES",  "NODES",
+                                             "ADJACENCY", "POOL",  "STRINGS", "META"};
 
 static char g_dir[256];
 static char g_path[300];
 static unsigned char *g_file;
 static size_t g_len;
 
-/* ---- helpers ---------------------------------------------------------------------------------- */
+/* ---- helpers ----------------------------------------------------------------------------------
+ */
 
 static uint32_t rd32(const unsigned char *p)
 {
@@ -110,8 +111,8 @@ static void reseal(unsigned char *file, size_t len)
 }
 
 /* Writes `img` to a scratch file and opens it; returns the open result. */
-static sw_result open_image(const unsigned char *img, size_t len, sw_sg_scene **out,
-                            sw_status *st, char *path_out)
+static sw_result open_image(const unsigned char *img, size_t len, sw_sg_scene **out, sw_status *st,
+                            char *path_out)
 {
     snprintf(path_out, 300, "%s/bad.sws", g_dir);
     write_bytes(path_out, img, len);
@@ -205,7 +206,8 @@ static int group_teardown(void **state)
     return remove_dir(g_dir) == 0 ? 0 : -1;
 }
 
-/* ---- checksum --------------------------------------------------------------------------------- */
+/* ---- checksum ---------------------------------------------------------------------------------
+ */
 
 static void test_crc32c(void **state)
 {
@@ -224,13 +226,14 @@ static void test_crc32c(void **state)
         for (size_t n = 0; n + start <= sizeof buf; n += 97) {
             uint32_t a = sw__crc32c(0, buf + start, n);
             assert_int_equal(a, sw__crc32c_portable(0, buf + start, n));
-            uint32_t split = sw__crc32c(sw__crc32c(0, buf + start, n / 3), buf + start + n / 3,
-                                        n - n / 3);
+            uint32_t split =
+                sw__crc32c(sw__crc32c(0, buf + start, n / 3), buf + start + n / 3, n - n / 3);
             assert_int_equal(a, split);
         }
 }
 
-/* ---- round trip and traversal ----------------------------------------------------------------- */
+/* ---- round trip and traversal -----------------------------------------------------------------
+ */
 
 typedef struct occ {
     uint32_t face;
@@ -497,7 +500,8 @@ static void test_stats(void **state)
     sw_sg_scene_free(s);
 }
 
-/* ---- hostile files ---------------------------------------------------------------------------- */
+/* ---- hostile files ----------------------------------------------------------------------------
+ */
 
 static void expect_open(const unsigned char *img, size_t len, sw_result want)
 {
@@ -518,8 +522,19 @@ static void test_truncated(void **state)
     (void)state;
     uint64_t table = rd64(g_file + HDR_TABLE);
     uint64_t faces = rd64(entry_of(g_file, 0) + 8), pool = rd64(entry_of(g_file, 5) + 8);
-    const size_t cuts[] = {0, 3, 8, 11, 20, 63, 64, (size_t)table + 7, (size_t)table + 319,
-                           (size_t)table + 320, (size_t)faces + 50, (size_t)pool + 8, g_len - 1};
+    const size_t cuts[] = {0,
+                           3,
+                           8,
+                           11,
+                           20,
+                           63,
+                           64,
+                           (size_t)table + 7,
+                           (size_t)table + 319,
+                           (size_t)table + 320,
+                           (size_t)faces + 50,
+                           (size_t)pool + 8,
+                           g_len - 1};
     for (size_t i = 0; i < sizeof cuts / sizeof cuts[0]; i++)
         expect_open(g_file, cuts[i], SW_ERR_TRUNCATED);
     /* The header claims more bytes than the file has: the cut is after the table. */
@@ -596,8 +611,8 @@ static void test_header(void **state)
 static void test_overflowing_table(void **state)
 {
     (void)state;
-    const uint64_t huge[] = {UINT64_MAX, UINT64_MAX - 15, UINT64_MAX / 8 + 1, 1ull << 63,
-                             (1ull << 61) + 1, 0xFFFFFFF0ull};
+    const uint64_t huge[] = {UINT64_MAX, UINT64_MAX - 15,  UINT64_MAX / 8 + 1,
+                             1ull << 63, (1ull << 61) + 1, 0xFFFFFFF0ull};
     unsigned char *img = malloc(g_len);
     for (size_t h = 0; h < sizeof huge / sizeof huge[0]; h++) {
         for (uint32_t id = 0; id < N_SEC; id++)
@@ -688,6 +703,20 @@ static void test_bad_records(void **state)
     nd.name = 1u << 30;
     memcpy(record(img, 3, NODE, 1), &nd, NODE);
     expect_require(img, SW_ERR_FORMAT);
+    /* curve 5's control points past the pool; curve 0 of degree 0 */
+    memcpy(img, g_file, g_len);
+    sw_sg_curve_rec cr;
+    memcpy(&cr, record(img, 2, sizeof cr, 5), sizeof cr);
+    cr.cpw = rd64(entry_of(img, 5) + 24) - 8;
+    memcpy(record(img, 2, sizeof cr, 5), &cr, sizeof cr);
+    expect_require(img, SW_ERR_FORMAT);
+    memcpy(img, g_file, g_len);
+    wr32(record(img, 2, sizeof cr, 0), 0);
+    expect_require(img, SW_ERR_INVALID_GEOMETRY);
+    /* the adjacency names a face that does not exist */
+    memcpy(img, g_file, g_len);
+    wr32(record(img, 4, 8, 1) + 4, 3);
+    expect_require(img, SW_ERR_FORMAT);
     /* the root out of range (META) */
     memcpy(img, g_file, g_len);
     wr32(img + rd64(entry_of(img, 7) + 8), 9);
@@ -737,8 +766,8 @@ static void test_cycles(void **state)
 
     /* the builder refuses an instance cycle too */
     sw_sg_builder *b = sw_sg_builder_create();
-    uint32_t p = sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, SW_SG_NONE, SW_SG_NONE, NULL, NULL,
-                                        NULL);
+    uint32_t p =
+        sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, SW_SG_NONE, SW_SG_NONE, NULL, NULL, NULL);
     uint32_t q = sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, p, SW_SG_NONE, NULL, NULL, NULL);
     sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, q, p, NULL, NULL, NULL);
     sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, p, NULL, NULL, NULL);

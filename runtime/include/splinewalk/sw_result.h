@@ -53,6 +53,8 @@ typedef struct sw_status {
 
 /* Short English name of a result; never NULL, also for out-of-range values. */
 SW_API const char *sw_result_str(sw_result result);
+/* The identifier of a result ("SW_ERR_TRUNCATED"): stable, for scripts and tests. */
+SW_API const char *sw_result_id_str(sw_result result);
 
 #ifdef __cplusplus
 }
