@@ -15,10 +15,11 @@
 #include <string.h>
 #include <time.h>
 
-/* eglTerminate ends a display for every context of the process, so displays are counted. */
+/* The process's display is initialised once and never terminated: eglTerminate would end it for
+ * every context of the process (several threads may own contexts), and it unloads Mesa's driver,
+ * whose exit-time allocations LeakSanitizer could then no longer attribute to it. */
 static pthread_mutex_t g_display_lock = PTHREAD_MUTEX_INITIALIZER;
 static EGLDisplay g_display = EGL_NO_DISPLAY;
-static int g_display_users;
 static char g_display_platform[64];
 
 double sw__gpu_now_ms(void)
@@ -79,13 +80,11 @@ static EGLDisplay open_device_display(void)
     return EGL_NO_DISPLAY;
 }
 
-/* Opens (or shares) the process's display. Caller holds g_display_lock. */
+/* Opens the process's display once. Caller holds g_display_lock. */
 static EGLDisplay acquire_display(void)
 {
-    if (g_display_users > 0) {
-        ++g_display_users;
+    if (g_display != EGL_NO_DISPLAY)
         return g_display;
-    }
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     EGLDisplay d = EGL_NO_DISPLAY;
     if (has_extension(client, "EGL_MESA_platform_surfaceless")) {
@@ -101,21 +100,8 @@ static EGLDisplay acquire_display(void)
         d = try_initialize(eglGetDisplay(EGL_DEFAULT_DISPLAY));
         snprintf(g_display_platform, sizeof g_display_platform, "default");
     }
-    if (d != EGL_NO_DISPLAY) {
-        g_display = d;
-        g_display_users = 1;
-    }
+    g_display = d;
     return d;
-}
-
-static void release_display(void)
-{
-    pthread_mutex_lock(&g_display_lock);
-    if (g_display_users > 0 && --g_display_users == 0) {
-        eglTerminate(g_display);
-        g_display = EGL_NO_DISPLAY;
-    }
-    pthread_mutex_unlock(&g_display_lock);
 }
 
 static EGLContext create_gl_context(EGLDisplay dpy, int minor)
@@ -242,8 +228,6 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         eglMakeCurrent(ctx->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(ctx->egl_display, ctx->egl_context);
     }
-    if (ctx->egl_display)
-        release_display();
     free(ctx);
 }
 

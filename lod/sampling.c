@@ -17,6 +17,14 @@
  *    For a polynomial patch (equal weights) the B terms vanish and the bounds are the classical
  *    p(p-1) max|D^2 P| etc.
  *
+ * A second bound, used for degrees <= 7 (taking the smaller of the two, both being rigorous),
+ * follows §5.1 literally but for surfaces: with N_s = H_s W - H W_s (so S_s = N_s / W^2) the
+ * second derivatives are S_ss = (d_s N_s W - 2 N_s W_s) / W^3, S_st = (d_s N_t W - 2 N_t W_s) / W^3,
+ * S_tt likewise; numerators and W^3 are multiplied out in Bernstein form, and
+ * |S_xy| <= max |numerator coefficient| / min (W^3 coefficient) (convex hull; W^3's coefficients
+ * are positive). Its numerators cancel exactly where the first bound's triangle inequalities
+ * cannot: a cylinder's S_st = 0 gets a zero bound, so its straight direction needs one segment.
+ *
  * Where the paper is loose: (a) §5.1 bounds |C''| by max|P_i| / min w_i of the rational
  * derivative's numerator and denominator in absolute coordinates; that numerator is not
  * translation-invariant, so for a patch far from the origin (CAD parts placed at 10^3 mm) the bound
@@ -36,6 +44,8 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 
 static double norm3(const double v[3])
 {
@@ -125,6 +135,151 @@ static void net_centre_radius_wmin(const double *cpw, int32_t count, double c[3]
     }
 }
 
+/* ---- the Bernstein-product bound ---------------------------------------------------------- */
+enum { PRODUCT_MAX_DEGREE = 7, BMAX = 3 * PRODUCT_MAX_DEGREE };
+
+/* A tensor-product polynomial in Bernstein form: (m+1) x (n+1) coefficients of `dim` doubles,
+ * s fastest. */
+typedef struct bpoly {
+    int32_t m, n, dim;
+    double *c;
+} bpoly;
+
+typedef struct arena {
+    double *mem;
+    size_t used, cap;
+    double binom[BMAX + 1][BMAX + 1];
+} arena;
+
+static bpoly bp_new(arena *a, int32_t m, int32_t n, int32_t dim)
+{
+    bpoly p = {m, n, dim, a->mem + a->used};
+    size_t need = (size_t)(m + 1) * (size_t)(n + 1) * (size_t)dim;
+    a->used += need;
+    memset(p.c, 0, need * sizeof *p.c);
+    return p;
+}
+
+static double *bp_at(const bpoly *p, int32_t i, int32_t j)
+{
+    return p->c + ((size_t)j * (size_t)(p->m + 1) + (size_t)i) * (size_t)p->dim;
+}
+
+/* Partial derivative along s (dir 0) or t (dir 1); of a constant direction: zero of degree 0. */
+static bpoly bp_deriv(arena *a, const bpoly *p, int dir)
+{
+    int32_t deg = dir ? p->n : p->m;
+    int32_t m = dir ? p->m : (deg > 0 ? deg - 1 : 0), n = dir ? (deg > 0 ? deg - 1 : 0) : p->n;
+    bpoly d = bp_new(a, m, n, p->dim);
+    if (deg == 0)
+        return d;
+    for (int32_t j = 0; j <= n; ++j)
+        for (int32_t i = 0; i <= m; ++i) {
+            const double *lo = bp_at(p, i, j), *hi = bp_at(p, i + !dir, j + dir);
+            double *o = bp_at(&d, i, j);
+            for (int32_t k = 0; k < p->dim; ++k)
+                o[k] = deg * (hi[k] - lo[k]);
+        }
+    return d;
+}
+
+/* Product of a scalar polynomial `w` and a polynomial `p`, times `scale`, added to `out` (which
+ * must have degree (w.m + p.m, w.n + p.n) and p's dim). */
+static void bp_mul_add(const arena *a, const bpoly *w, const bpoly *p, double scale, bpoly *out)
+{
+    const double(*b)[BMAX + 1] = a->binom;
+    for (int32_t j1 = 0; j1 <= w->n; ++j1)
+        for (int32_t i1 = 0; i1 <= w->m; ++i1) {
+            double wc = *bp_at(w, i1, j1) * scale * b[w->m][i1] * b[w->n][j1];
+            for (int32_t j2 = 0; j2 <= p->n; ++j2)
+                for (int32_t i2 = 0; i2 <= p->m; ++i2) {
+                    int32_t i = i1 + i2, j = j1 + j2;
+                    double f = wc * b[p->m][i2] * b[p->n][j2] / (b[out->m][i] * b[out->n][j]);
+                    const double *pc = bp_at(p, i2, j2);
+                    double *o = bp_at(out, i, j);
+                    for (int32_t k = 0; k < p->dim; ++k)
+                        o[k] += f * pc[k];
+                }
+        }
+}
+
+/* x * w - y * v (x, y vector; w, v scalar), both products of the same degree. */
+static bpoly bp_cross_diff(arena *a, const bpoly *x, const bpoly *w, double ky, const bpoly *y,
+                           const bpoly *v)
+{
+    bpoly r = bp_new(a, x->m + w->m, x->n + w->n, x->dim);
+    bp_mul_add(a, w, x, 1.0, &r);
+    bp_mul_add(a, v, y, -ky, &r);
+    return r;
+}
+
+static double bp_max_norm(const bpoly *p)
+{
+    double m = 0.0;
+    size_t n = (size_t)(p->m + 1) * (size_t)(p->n + 1);
+    for (size_t i = 0; i < n; ++i)
+        m = fmax(m, norm3(p->c + 3 * i));
+    return m;
+}
+
+static double bp_min(const bpoly *p)
+{
+    double m = INFINITY;
+    size_t n = (size_t)(p->m + 1) * (size_t)(p->n + 1);
+    for (size_t i = 0; i < n; ++i)
+        m = fmin(m, p->c[i]);
+    return m;
+}
+
+/* The Bernstein-product bounds (see the top of the file); 0 when out of memory or too high a
+ * degree (the caller keeps the other bound then). */
+static int product_bounds(int32_t p, int32_t q, const double *cpw, const double c[3],
+                          sw_lod_patch_bounds *out)
+{
+    if (p > PRODUCT_MAX_DEGREE || q > PRODUCT_MAX_DEGREE)
+        return 0;
+    arena a;
+    /* 17 polynomials, none of degree above (3p, 3q), at most 3 doubles per coefficient */
+    a.cap = 17 * (size_t)(3 * p + 1) * (size_t)(3 * q + 1) * 3;
+    a.used = 0;
+    a.mem = malloc(a.cap * sizeof *a.mem);
+    if (!a.mem)
+        return 0;
+    for (int n = 0; n <= BMAX; ++n) {
+        a.binom[n][0] = 1.0;
+        for (int k = 1; k <= n; ++k)
+            a.binom[n][k] = a.binom[n][k - 1] * (double)(n - k + 1) / (double)k;
+    }
+    bpoly h = bp_new(&a, p, q, 3), w = bp_new(&a, p, q, 1);
+    for (int32_t j = 0; j <= q; ++j)
+        for (int32_t i = 0; i <= p; ++i) {
+            const double *src = cpw + ((size_t)j * (size_t)(p + 1) + (size_t)i) * 4;
+            for (int k = 0; k < 3; ++k)
+                bp_at(&h, i, j)[k] = src[k] - src[3] * c[k];
+            *bp_at(&w, i, j) = src[3];
+        }
+    bpoly hs = bp_deriv(&a, &h, 0), ht = bp_deriv(&a, &h, 1);
+    bpoly ws = bp_deriv(&a, &w, 0), wt = bp_deriv(&a, &w, 1);
+    bpoly ns = bp_cross_diff(&a, &hs, &w, 1.0, &h, &ws);
+    bpoly nt = bp_cross_diff(&a, &ht, &w, 1.0, &h, &wt);
+    bpoly w2 = bp_new(&a, 2 * p, 2 * q, 1);
+    bp_mul_add(&a, &w, &w, 1.0, &w2);
+    bpoly w3 = bp_new(&a, 3 * p, 3 * q, 1);
+    bp_mul_add(&a, &w2, &w, 1.0, &w3);
+    bpoly nss = bp_deriv(&a, &ns, 0), nts = bp_deriv(&a, &nt, 0), ntt = bp_deriv(&a, &nt, 1);
+    bpoly kss = bp_cross_diff(&a, &nss, &w, 2.0, &ns, &ws);
+    bpoly kst = bp_cross_diff(&a, &nts, &w, 2.0, &nt, &ws);
+    bpoly ktt = bp_cross_diff(&a, &ntt, &w, 2.0, &nt, &wt);
+    double m2 = bp_min(&w2), m3 = bp_min(&w3);
+    out->d1[0] = bp_max_norm(&ns) / m2;
+    out->d1[1] = bp_max_norm(&nt) / m2;
+    out->d2[0] = bp_max_norm(&kss) / m3;
+    out->d2[1] = bp_max_norm(&kst) / m3;
+    out->d2[2] = bp_max_norm(&ktt) / m3;
+    free(a.mem);
+    return 1;
+}
+
 void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *cpw,
                                    sw_lod_patch_bounds *out)
 {
@@ -153,6 +308,14 @@ void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *c
     out->d2[0] = (a_ss + 2.0 * b_s * g_s + b_ss * r) / wmin;
     out->d2[1] = (a_st + b_s * g_t + b_t * g_s + b_st * r) / wmin;
     out->d2[2] = (a_tt + 2.0 * b_t * g_t + b_tt * r) / wmin;
+
+    sw_lod_patch_bounds pb;
+    if (product_bounds(deg_u, deg_v, cpw, c, &pb)) {
+        for (int k = 0; k < 2; ++k)
+            out->d1[k] = fmin(out->d1[k], pb.d1[k]);
+        for (int k = 0; k < 3; ++k)
+            out->d2[k] = fmin(out->d2[k], pb.d2[k]);
+    }
 }
 
 int32_t sw_lod_filip_segments(double m_dir, double m_mixed, double len, double eps,

@@ -62,9 +62,11 @@
 #include <unordered_set>
 #include <vector>
 
-namespace {
+namespace
+{
 
-struct oom_error {};
+struct oom_error {
+};
 
 /* A face converted but not yet in the builder: nothing is added unless all of it succeeded. */
 struct curve_data {
@@ -95,17 +97,28 @@ double now_ms()
 uint32_t kind_of(GeomAbs_SurfaceType t)
 {
     switch (t) {
-    case GeomAbs_Plane: return SW_SG_KIND_PLANE;
-    case GeomAbs_Cylinder: return SW_SG_KIND_CYLINDER;
-    case GeomAbs_Cone: return SW_SG_KIND_CONE;
-    case GeomAbs_Sphere: return SW_SG_KIND_SPHERE;
-    case GeomAbs_Torus: return SW_SG_KIND_TORUS;
-    case GeomAbs_BezierSurface: return SW_SG_KIND_BEZIER;
-    case GeomAbs_BSplineSurface: return SW_SG_KIND_BSPLINE;
-    case GeomAbs_SurfaceOfRevolution: return SW_SG_KIND_REVOLUTION;
-    case GeomAbs_SurfaceOfExtrusion: return SW_SG_KIND_EXTRUSION;
-    case GeomAbs_OffsetSurface: return SW_SG_KIND_OFFSET;
-    default: return SW_SG_KIND_OTHER;
+    case GeomAbs_Plane:
+        return SW_SG_KIND_PLANE;
+    case GeomAbs_Cylinder:
+        return SW_SG_KIND_CYLINDER;
+    case GeomAbs_Cone:
+        return SW_SG_KIND_CONE;
+    case GeomAbs_Sphere:
+        return SW_SG_KIND_SPHERE;
+    case GeomAbs_Torus:
+        return SW_SG_KIND_TORUS;
+    case GeomAbs_BezierSurface:
+        return SW_SG_KIND_BEZIER;
+    case GeomAbs_BSplineSurface:
+        return SW_SG_KIND_BSPLINE;
+    case GeomAbs_SurfaceOfRevolution:
+        return SW_SG_KIND_REVOLUTION;
+    case GeomAbs_SurfaceOfExtrusion:
+        return SW_SG_KIND_EXTRUSION;
+    case GeomAbs_OffsetSurface:
+        return SW_SG_KIND_OFFSET;
+    default:
+        return SW_SG_KIND_OTHER;
     }
 }
 
@@ -115,6 +128,12 @@ void xform_of(const TopLoc_Location &loc, double x[12])
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 4; c++)
             x[r * 4 + c] = t.Value(r + 1, c + 1);
+}
+
+/* A location chain can compose to the identity (Room.brep's walls). */
+bool is_identity(const TopLoc_Location &loc)
+{
+    return loc.IsIdentity() || loc.Transformation().Form() == gp_Identity;
 }
 
 std::string lower_ext(const std::string &path)
@@ -213,7 +232,10 @@ curve_data pcurve(const TopoDS_Edge &e, const TopoDS_Face &cf)
 
 struct uv_domain {
     double u0, u1, v0, v1;
-    double diag() const { return std::hypot(u1 - u0, v1 - v0); }
+    double diag() const
+    {
+        return std::hypot(u1 - u0, v1 - v0);
+    }
 };
 
 /* Euclidean bounding box of a loop's control points: u0, u1, v0, v1. */
@@ -277,8 +299,7 @@ void snap_loop(loop_data &ld, const Handle(Geom_BSplineSurface) & s, const uv_do
         cpw[k] = c.cpw.data();
         np[k] = (int32_t)(c.cpw.size() / 3);
         const double *end = c.cpw.data() + c.cpw.size() - 3;
-        max_gap =
-            std::max(max_gap, 4.0 * uv_reach(s, d, end[0] / end[2], end[1] / end[2], tol3));
+        max_gap = std::max(max_gap, 4.0 * uv_reach(s, d, end[0] / end[2], end[1] / end[2], tol3));
     }
     sw_status st{};
     if (sw_sg_trim_snap_loop((int32_t)n, cpw.data(), np.data(), max_gap, what.c_str(), &st) !=
@@ -388,8 +409,10 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
         box[0] = std::min(box[0], lb[0]), box[1] = std::max(box[1], lb[1]);
         box[2] = std::min(box[2], lb[2]), box[3] = std::max(box[3], lb[3]);
     }
-    fd.rec.uv_box[0] = std::clamp(box[0], d.u0, d.u1), fd.rec.uv_box[1] = std::clamp(box[1], d.u0, d.u1);
-    fd.rec.uv_box[2] = std::clamp(box[2], d.v0, d.v1), fd.rec.uv_box[3] = std::clamp(box[3], d.v0, d.v1);
+    fd.rec.uv_box[0] = std::clamp(box[0], d.u0, d.u1),
+    fd.rec.uv_box[1] = std::clamp(box[1], d.u0, d.u1);
+    fd.rec.uv_box[2] = std::clamp(box[2], d.v0, d.v1),
+    fd.rec.uv_box[3] = std::clamp(box[3], d.v0, d.v1);
     if (untrimmed)
         fd.rec.uv_box[0] = d.u0, fd.rec.uv_box[1] = d.u1, fd.rec.uv_box[2] = d.v0,
         fd.rec.uv_box[3] = d.v1;
@@ -402,8 +425,9 @@ struct rgba {
     float c[4];
 };
 
-class importer {
-public:
+class importer
+{
+  public:
     importer(sw_sg_builder *b, const sw_sg_import_desc *desc, sw__occt_face_observer *obs)
         : b_(b), desc_(desc), obs_(obs), path_(desc->path), name_(base_name(desc->path))
     {
@@ -412,7 +436,7 @@ public:
     sw_result run(uint32_t parent, const double xform[12], sw_sg_import_report *report,
                   sw_status *status);
 
-private:
+  private:
     sw_sg_builder *b_;
     const sw_sg_import_desc *desc_;
     sw__occt_face_observer *obs_;
@@ -475,8 +499,7 @@ sw_result importer::read_brep(TopoDS_Shape &shape, sw_status *status)
 {
     BRep_Builder bb;
     if (!BRepTools::Read(shape, path_.c_str(), bb) || shape.IsNull())
-        return sw__fail(status, SW_ERR_FORMAT, "%s: not a readable OCCT BREP file",
-                        path_.c_str());
+        return sw__fail(status, SW_ERR_FORMAT, "%s: not a readable OCCT BREP file", path_.c_str());
     return SW_OK;
 }
 
@@ -567,7 +590,7 @@ void importer::add_shape(const TopoDS_Shape &s, uint32_t parent)
         node(SW_SG_NODE_INSTANCE, parent, proto, xf, nullptr, nullptr);
         return;
     }
-    uint32_t n = s.Location().IsIdentity()
+    uint32_t n = is_identity(s.Location())
                      ? parent
                      : node(SW_SG_NODE_TRANSFORM, parent, 0, xf, nullptr, nullptr);
     fill_shape(local, n);
@@ -683,13 +706,14 @@ uint32_t importer::push_face(face_data &fd)
     return fi;
 }
 
-/* ---- XCAF assembly tree ----------------------------------------------------------------------- */
+/* ---- XCAF assembly tree -----------------------------------------------------------------------
+ */
 
 bool importer::label_color(const TDF_Label &l, rgba &out) const
 {
     Quantity_ColorRGBA c;
-    if (ct_.IsNull() || !(ct_->GetColor(l, XCAFDoc_ColorSurf, c) ||
-                          ct_->GetColor(l, XCAFDoc_ColorGen, c)))
+    if (ct_.IsNull() ||
+        !(ct_->GetColor(l, XCAFDoc_ColorSurf, c) || ct_->GetColor(l, XCAFDoc_ColorGen, c)))
         return false;
     const Quantity_Color &rgb = c.GetRGB(); /* OCCT keeps linear RGB */
     out = {{(float)rgb.Red(), (float)rgb.Green(), (float)rgb.Blue(), c.Alpha()}};
@@ -753,9 +777,10 @@ void importer::add_label(const TDF_Label &ref, const TDF_Label &occurrence, uint
     }
     if (!has_col)
         has_col = label_color(ref, col);
-    uint32_t n = node(loc.IsIdentity() ? SW_SG_NODE_GROUP : SW_SG_NODE_TRANSFORM, parent, 0,
-                      loc.IsIdentity() ? nullptr : xf, has_col ? col.c : nullptr,
-                      nm.empty() ? nullptr : nm.c_str());
+    const bool ident = is_identity(loc);
+    uint32_t n =
+        node(ident ? SW_SG_NODE_GROUP : SW_SG_NODE_TRANSFORM, parent, 0, ident ? nullptr : xf,
+             has_col ? col.c : nullptr, nm.empty() ? nullptr : nm.c_str());
     fill_label(ref, n);
 }
 
@@ -787,6 +812,8 @@ void importer::fill_label(const TDF_Label &l, uint32_t n)
 sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_report *report,
                         sw_status *status)
 {
+    if (report)
+        *report = rep_;
     struct stat sb;
     if (stat(path_.c_str(), &sb) != 0 || !S_ISREG(sb.st_mode))
         return sw__fail(status, SW_ERR_NOT_FOUND, "%s: no such file", path_.c_str());
@@ -917,8 +944,8 @@ extern "C" sw_result sw_sg_import_file(const sw_sg_import_desc *desc, sw_sg_scen
 }
 
 extern "C" sw_result sw_sg_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
-                                       const sw_sg_import_desc *desc,
-                                       sw_sg_import_report *report, sw_status *status)
+                                       const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                                       sw_status *status)
 {
     return sw__occt_import_into(b, parent, xform, desc, report, status, nullptr);
 }

@@ -431,12 +431,12 @@ static int trav_push(trav_stack *st, uint32_t node, uint32_t depth, int follow,
 
 /* Iterative depth-first walk (no recursion: CAD assemblies nest deeply). The depth guard only
  * matters for an unvalidated scene: a validated one has no cycle, so no path is longer than
- * n_nodes. Stops quietly if the stack cannot grow. */
-void sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx)
+ * n_nodes. */
+sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx)
 {
     const sw_sg_scene_view *v = &scene->view;
     if (v->root >= v->n_nodes)
-        return;
+        return SW_OK;
     trav_stack st = {.n = 0, .cap = 32};
     st.e = st.local;
     int ok = trav_push(&st, v->root, 0, 0, identity12, default_color);
@@ -461,4 +461,5 @@ void sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *
     }
     if (st.e != st.local)
         free(st.e);
+    return ok ? SW_OK : SW_ERR_OUT_OF_MEMORY;
 }

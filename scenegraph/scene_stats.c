@@ -57,7 +57,7 @@ static void face_stats(const sw_sg_scene_view *v, sw_sg_scene_stats *out)
     }
 }
 
-void sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out)
+sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out)
 {
     const sw_sg_scene_view *v = &scene->view;
     memset(out, 0, sizeof *out);
@@ -78,8 +78,9 @@ void sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out)
         out->bbox[3 + r] = -DBL_MAX;
     }
     stats_ctx c = {scene, out};
-    sw_sg_scene_traverse(scene, stats_visit, &c);
+    sw_result r = sw_sg_scene_traverse(scene, stats_visit, &c);
     if (out->face_occurrences == 0)
         memset(out->bbox, 0, sizeof out->bbox); /* nothing drawn: an empty box at the origin */
     out->memory_bytes = sw_sg_scene_memory(scene);
+    return r;
 }

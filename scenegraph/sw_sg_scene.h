@@ -155,8 +155,10 @@ void sw_sg_scene_free(sw_sg_scene *scene); /* NULL allowed */
  * resolved colour. Instances are expanded. Returning non-zero stops the traversal. */
 typedef int (*sw_sg_visit_fn)(void *ctx, uint32_t face, const double world[12],
                               const float color[4]);
-/* Walks the tree from the root. Precondition: SW_SG_SEC_NODES required and validated. */
-void sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx);
+/* Walks the tree from the root. Precondition: SW_SG_SEC_NODES required and validated. Returns
+ * SW_OK (also when the visitor stopped it) or SW_ERR_OUT_OF_MEMORY when its stack could not grow,
+ * in which case some occurrences were not visited. */
+sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx);
 
 /* ---- building -------------------------------------------------------------------------------- */
 typedef struct sw_sg_builder sw_sg_builder;
@@ -193,7 +195,8 @@ sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *stat
 /* Maps a .sws file. Checks the header, version, the section table and that the file is as long as
  * the table says (a short mapping would raise SIGBUS); checksums are verified per section by
  * sw_sg_scene_require. Errors: SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_VERSION,
- * SW_ERR_TRUNCATED; the message names the file and the byte offset. */
+ * SW_ERR_TRUNCATED, SW_ERR_CHECKSUM (the header's own CRC over itself and the section table, or the
+ * 16-byte META section, both checked at open); the message names the file and the byte offset. */
 sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status);
 
 /* ---- statistics (scene_stats.c) -------------------------------------------------------------- */
@@ -209,8 +212,8 @@ typedef struct sw_sg_scene_stats {
     double bbox[6];            /* world box of the control nets (min xyz, max xyz) */
     size_t memory_bytes;
 } sw_sg_scene_stats;
-/* Precondition: SW_SG_SEC_ALL required. */
-void sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out);
+/* Precondition: SW_SG_SEC_ALL required. Returns SW_OK or SW_ERR_OUT_OF_MEMORY (traversal). */
+sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out);
 
 #ifdef __cplusplus
 }

@@ -30,7 +30,8 @@ typedef struct sw_sg_polyline {
 /* Flattens loop `loop` so that every chord is within `tol` (parameter units) of the curve, using a
  * bound from the control polygon (a subdivided segment is emitted when its control points lie
  * within tol of its chord). Allocates out->uv (free with sw_sg_polyline_free).
- * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than `max_vertices`). */
+ * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than `max_vertices`), SW_ERR_INVALID_GEOMETRY
+ * (a curve that is not a clamped 2D curve: its first vertex would not be its first control point). */
 sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, double tol,
                                   uint32_t max_vertices, sw_sg_polyline *out, sw_status *status);
 void sw_sg_polyline_free(sw_sg_polyline *p);

@@ -130,8 +130,8 @@ static void flatten_bezier(double *q, int32_t p, double tol, int depth, vertex_b
         return;
     }
     double right[(SW_SG_MAX_DEGREE + 1) * TRIM_DIM];
-    /* de Casteljau: after pass r, q[0..p-r] holds level r; its last point belongs to the right half.
-     * q[0] is never modified, so the first vertex stays bit-identical to the input. */
+    /* de Casteljau: after pass r, q[0..p-r] holds level r; its last point belongs to the right
+     * half. q[0] is never modified, so the first vertex stays bit-identical to the input. */
     memcpy(right + (size_t)p * TRIM_DIM, q + (size_t)p * TRIM_DIM, TRIM_DIM * sizeof(double));
     for (int32_t r = 1; r <= p; r++) {
         for (int32_t i = p; i >= r; i--)

@@ -160,9 +160,13 @@ sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *sta
     if (!scene->ready) {
         sw_status local = {0};
         scene->ready_result = sw_sg_scene_require(scene->sg, SW_SG_SEC_ALL, &local);
-        if (scene->ready_result == SW_OK)
-            sw_sg_scene_compute_stats(scene->sg, &scene->stats);
-        else if (status)
+        if (scene->ready_result == SW_OK) {
+            scene->ready_result = sw_sg_scene_compute_stats(scene->sg, &scene->stats);
+            if (scene->ready_result != SW_OK)
+                sw__fail(&local, scene->ready_result, "%s: out of memory walking the scene",
+                         sw_sg_scene_path_ptr(scene->sg));
+        }
+        if (scene->ready_result != SW_OK && status)
             *status = local;
         scene->ready = 1;
     } else if (scene->ready_result != SW_OK) {

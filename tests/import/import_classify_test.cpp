@@ -31,14 +31,18 @@
 #include <algorithm>
 #include <cmath>
 
-namespace {
+namespace
+{
 
 const int kSamples = 2000;
 const double kFlatRel = 1e-6; /* flattening tolerance, relative to the uv_box diagonal */
 
 struct totals {
     long faces = 0, samples = 0, outside[2] = {0, 0}, disagree = 0;
-    double pct(int b) const { return samples ? 100.0 * outside[b] / samples : 100.0; }
+    double pct(int b) const
+    {
+        return samples ? 100.0 * outside[b] / samples : 100.0;
+    }
 };
 
 /* Largest parameter-space gap between consecutive pcurves of the face's wires (OCCT's loops are
@@ -114,7 +118,8 @@ bool classify_face(const sw_sg_scene *scene, uint32_t fi, const TopoDS_Face &cf,
     std::vector<sw_sg_polyline> pl(f.n_loops);
     for (uint32_t l = 0; l < f.n_loops; l++) {
         sw_status st{};
-        if (sw_sg_trim_flatten_loop(scene, f.first_loop + l, flat, 1u << 22, &pl[l], &st) != SW_OK) {
+        if (sw_sg_trim_flatten_loop(scene, f.first_loop + l, flat, 1u << 22, &pl[l], &st) !=
+            SW_OK) {
             std::printf("FAIL face %u loop %u: %s\n", fi, l, st.message);
             return false;
         }
@@ -137,7 +142,8 @@ bool classify_face(const sw_sg_scene *scene, uint32_t fi, const TopoDS_Face &cf,
         if (mine != (s == TopAbs_IN)) {
             if (dis < 3)
                 std::printf("  face %u: (%.17g, %.17g) parity %d, OCCT state %d, distance %.3g, "
-                            "bands %.3g %.3g\n", fi, u, w, mine, (int)s, d, band[0], band[1]);
+                            "bands %.3g %.3g\n",
+                            fi, u, w, mine, (int)s, d, band[0], band[1]);
             dis++;
         }
     }
@@ -145,8 +151,8 @@ bool classify_face(const sw_sg_scene *scene, uint32_t fi, const TopoDS_Face &cf,
         sw_sg_polyline_free(&p);
     if (in_band[0] > kSamples / 20)
         std::printf("  face %u (%s): %ld samples in the tolerance band, %ld in the gap band; "
-                    "edge tolerance %.3g, closure gap %.3g, uv_box diagonal %.3g\n", fi,
-                    sw_sg_surface_kind_str(f.kind), in_band[0], in_band[1], tol3, gap, diag);
+                    "edge tolerance %.3g, closure gap %.3g, uv_box diagonal %.3g\n",
+                    fi, sw_sg_surface_kind_str(f.kind), in_band[0], in_band[1], tol3, gap, diag);
     tot.faces++, tot.samples += kSamples, tot.disagree += dis;
     tot.outside[0] += kSamples - in_band[0], tot.outside[1] += kSamples - in_band[1];
     return true;
@@ -176,8 +182,8 @@ bool run_file(const std::string &path, ot::rng &rng, totals &all)
         if (v->faces[fi].flags & SW_SG_FACE_TRIMMED)
             ok &= classify_face(im.scene, fi, im.faces.converted.at(fi), rng, t);
     std::printf("  %ld trimmed faces, %ld samples, outside the tolerance band %.2f %%, outside the "
-                "gap band %.2f %%, %ld disagreements\n", t.faces, t.samples, t.pct(0), t.pct(1),
-                t.disagree);
+                "gap band %.2f %%, %ld disagreements\n",
+                t.faces, t.samples, t.pct(0), t.pct(1), t.disagree);
     if (t.disagree > 0 || t.pct(1) < 98.0) {
         std::printf("FAIL %s\n", path.c_str());
         ok = false;
@@ -200,9 +206,10 @@ int main(int argc, char **argv)
     bool ok = true;
     for (int i = 1; i < argc; i++)
         ok &= run_file(argv[i], rng, all);
-    std::printf("total: %ld trimmed faces, %ld samples, outside the tolerance band %.2f %%, outside "
-                "the gap band %.2f %%, %ld disagreements\n", all.faces, all.samples, all.pct(0),
-                all.pct(1), all.disagree);
+    std::printf(
+        "total: %ld trimmed faces, %ld samples, outside the tolerance band %.2f %%, outside "
+        "the gap band %.2f %%, %ld disagreements\n",
+        all.faces, all.samples, all.pct(0), all.pct(1), all.disagree);
     if (all.pct(0) < 98.0)
         ok = false;
     std::printf(ok ? "PASS\n" : "FAIL\n");

@@ -12,7 +12,8 @@
 #include <string>
 #include <vector>
 
-namespace ot {
+namespace ot
+{
 
 /* splitmix64, seeded from SW_TEST_SEED (printed) so a failure can be replayed. */
 struct rng {
@@ -25,7 +26,10 @@ struct rng {
         z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
         return z ^ (z >> 31);
     }
-    double uniform(double lo, double hi) { return lo + (hi - lo) * (double)(next() >> 11) * 0x1.0p-53; }
+    double uniform(double lo, double hi)
+    {
+        return lo + (hi - lo) * (double)(next() >> 11) * 0x1.0p-53;
+    }
 };
 
 inline uint64_t seed()
@@ -52,7 +56,10 @@ struct imported {
     keep_faces faces;
     sw_sg_import_report report{};
     std::vector<std::string> warnings;
-    ~imported() { sw_sg_scene_free(scene); }
+    ~imported()
+    {
+        sw_sg_scene_free(scene);
+    }
 };
 
 inline void collect_warning(void *ctx, const char *msg)
@@ -61,7 +68,7 @@ inline void collect_warning(void *ctx, const char *msg)
 }
 
 /* Imports `path`; prints the failure and returns false when it does not succeed. */
-inline bool import(const std::string &path, imported &out)
+inline bool import(const std::string &path, imported &out, sw_result *result = nullptr)
 {
     sw_sg_import_desc desc{};
     desc.path = path.c_str();
@@ -69,10 +76,13 @@ inline bool import(const std::string &path, imported &out)
     desc.user_data = &out;
     sw_status st{};
     sw_result r = sw__occt_import_file(&desc, &out.scene, &out.report, &st, &out.faces);
+    if (result)
+        *result = r;
     for (const std::string &w : out.warnings)
         std::printf("  warning: %s\n", w.c_str());
     if (r != SW_OK) {
-        std::printf("FAIL import %s: %s: %s\n", path.c_str(), sw_result_str(r), st.message);
+        std::printf("%s import %s: %s: %s\n", result ? "no" : "FAIL", path.c_str(),
+                    sw_result_str(r), st.message);
         return false;
     }
     return true;
