@@ -9,6 +9,7 @@ int sw_cli_import(int argc, char **argv);
 int sw_cli_info(int argc, char **argv);
 int sw_cli_render(int argc, char **argv);
 int sw_cli_demo(int argc, char **argv);
+int sw_cli_check_osd(int argc, char **argv);
 
 /* ---- shared helpers (cli_common.c) ---------------------------------------------------------- */
 int sw_cli_is_help(const char *arg);
@@ -24,6 +25,8 @@ sw_result sw_cli_load_scene(const char *path, sw_scene *out, sw_status *status);
 int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h);
 /* "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy" → camera. Returns 0 on success. */
 int sw_cli_parse_camera(const char *text, sw_camera *out);
+/* An integer in [lo, hi]. Returns 0 on success. */
+int sw_cli_parse_count(const char *text, int lo, int hi, int *out);
 /* A positive finite number. Returns 0 on success. */
 int sw_cli_parse_positive(const char *text, double *out);
 double sw_cli_now_ms(void);

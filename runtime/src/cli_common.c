@@ -122,6 +122,17 @@ int sw_cli_parse_camera(const char *text, sw_camera *out)
     return d2 > 0.0 && u2 > 0.0 ? 0 : -1;
 }
 
+int sw_cli_parse_count(const char *text, int lo, int hi, int *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(text, &end, 10);
+    if (errno || end == text || *end != '\0' || v < lo || v > hi)
+        return -1;
+    *out = (int)v;
+    return 0;
+}
+
 int sw_cli_parse_positive(const char *text, double *out)
 {
     char *end;

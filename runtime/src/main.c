@@ -15,6 +15,7 @@ static const command k_commands[] = {
     {"info", sw_cli_info, "describe a scene (surfaces, trims, patches, memory)"},
     {"render", sw_cli_render, "render one converged frame headlessly to PNG / EXR"},
     {"demo", sw_cli_demo, "build and render the built-in default scene"},
+    {"check-osd", sw_cli_check_osd, "cross-check uniform bicubic regions against OpenSubdiv"},
 };
 
 static void usage(FILE *out)
@@ -22,7 +23,7 @@ static void usage(FILE *out)
     fprintf(out, "usage: splinewalk COMMAND [ARGS]   (splinewalk COMMAND --help for details)\n\n"
                  "commands:\n");
     for (size_t i = 0; i < sizeof k_commands / sizeof k_commands[0]; i++)
-        fprintf(out, "  %-8s %s\n", k_commands[i].name, k_commands[i].summary);
+        fprintf(out, "  %-10s %s\n", k_commands[i].name, k_commands[i].summary);
     fprintf(out, "\nsplinewalk %s — walk through huge trimmed-NURBS CAD models\n",
             SW_VERSION_STRING);
 }
