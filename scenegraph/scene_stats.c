@@ -1,37 +1,68 @@
 /* Scene statistics for `splinewalk info`: counts by surface kind, trims, Bézier patches after
  * extraction (Guthe et al. 2005 §3 starts from those patches), degrees, instances, face
- * occurrences after instance expansion, and the world bounding box of the control nets. */
+ * occurrences after instance expansion, and the world bounding box of the surfaces. */
 #include "sw_sg_scene_internal.h"
 
 #include <float.h>
+#include <stdlib.h>
 #include <string.h>
+
+#define SW__STATS_GRID 17 /* samples per direction of each face's trim box */
 
 typedef struct stats_ctx {
     const sw_sg_scene *scene;
     sw_sg_scene_stats *out;
+    double *face_boxes; /* per face: local box of its samples (min xyz, max xyz), or NULL */
 } stats_ctx;
 
-/* Grows the box by every control point of the face (projected by its weight) placed in the
- * world: the convex hull property makes this a bound of the surface. */
+static void box_add(double box[6], const double p[3])
+{
+    for (int r = 0; r < 3; r++) {
+        if (p[r] < box[r])
+            box[r] = p[r];
+        if (p[r] > box[3 + r])
+            box[3 + r] = p[r];
+    }
+}
+
+/* The box of the face sampled on a grid over its trim box (uv_box), not of its control net: a
+ * converted cylinder's net can reach far beyond the trimmed face (linkrods.step's box grew 7x),
+ * which made camera presets frame a speck. A sampled box may miss a bulge between samples by a
+ * little; the presets' 10 % margin covers that, and culling uses its own rigorous boxes. */
+static void face_sample_box(const sw_sg_scene *scene, uint32_t face, double box[6])
+{
+    const sw_sg_face_rec *f = &scene->view.faces[face];
+    sw_sg_surface s;
+    sw_sg_scene_face_surface(scene, face, &s);
+    for (int r = 0; r < 3; r++) {
+        box[r] = DBL_MAX;
+        box[3 + r] = -DBL_MAX;
+    }
+    for (int j = 0; j < SW__STATS_GRID; j++) {
+        double v = f->uv_box[2] + (f->uv_box[3] - f->uv_box[2]) * j / (SW__STATS_GRID - 1);
+        for (int i = 0; i < SW__STATS_GRID; i++) {
+            double u = f->uv_box[0] + (f->uv_box[1] - f->uv_box[0]) * i / (SW__STATS_GRID - 1);
+            double p[3];
+            sw_sg_surface_eval(&s, u, v, p);
+            box_add(box, p);
+        }
+    }
+}
+
+/* Grows the world box by the face's local box, its eight corners placed in the world. */
 static int stats_visit(void *ctx, uint32_t face, const double world[12], const float color[4])
 {
     (void)color;
     stats_ctx *c = ctx;
-    const sw_sg_scene_view *v = &c->scene->view;
-    const sw_sg_face_rec *f = &v->faces[face];
-    const double *cp = v->pool + f->cpw;
-    uint64_t n = (uint64_t)f->n_u * f->n_v;
-    double *box = c->out->bbox;
-    for (uint64_t i = 0; i < n; i++, cp += 4) {
-        double x = cp[0] / cp[3], y = cp[1] / cp[3], z = cp[2] / cp[3];
+    const double *local = c->face_boxes + (size_t)face * 6;
+    for (int k = 0; k < 8; k++) {
+        double q[3] = {local[(k & 1) ? 3 : 0], local[(k & 2) ? 4 : 1], local[(k & 4) ? 5 : 2]};
+        double p[3];
         for (int r = 0; r < 3; r++) {
             const double *m = world + 4 * r;
-            double w = m[0] * x + m[1] * y + m[2] * z + m[3];
-            if (w < box[r])
-                box[r] = w;
-            if (w > box[3 + r])
-                box[3 + r] = w;
+            p[r] = m[0] * q[0] + m[1] * q[1] + m[2] * q[2] + m[3];
         }
+        box_add(c->out->bbox, p);
     }
     c->out->face_occurrences++;
     return 0;
@@ -77,8 +108,13 @@ sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats 
         out->bbox[r] = DBL_MAX;
         out->bbox[3 + r] = -DBL_MAX;
     }
-    stats_ctx c = {scene, out};
+    stats_ctx c = {scene, out, malloc(((size_t)v->n_faces + 1) * 6 * sizeof(double))};
+    if (!c.face_boxes)
+        return SW_ERR_OUT_OF_MEMORY;
+    for (uint32_t i = 0; i < v->n_faces; i++)
+        face_sample_box(scene, i, c.face_boxes + (size_t)i * 6);
     sw_result r = sw_sg_scene_traverse(scene, stats_visit, &c);
+    free(c.face_boxes);
     if (out->face_occurrences == 0)
         memset(out->bbox, 0, sizeof out->bbox); /* nothing drawn: an empty box at the origin */
     out->memory_bytes = sw_sg_scene_memory(scene);

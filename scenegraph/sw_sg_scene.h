@@ -209,7 +209,7 @@ typedef struct sw_sg_scene_stats {
     uint32_t nodes, instances;
     uint64_t face_occurrences; /* faces drawn after instance expansion */
     uint32_t adjacency;
-    double bbox[6];            /* world box of the control nets (min xyz, max xyz) */
+    double bbox[6];            /* world box of the faces sampled over their trim boxes */
     size_t memory_bytes;
 } sw_sg_scene_stats;
 /* Precondition: SW_SG_SEC_ALL required. Returns SW_OK or SW_ERR_OUT_OF_MEMORY (traversal). */
