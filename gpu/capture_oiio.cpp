@@ -12,7 +12,8 @@
 #include <unistd.h>
 #include <vector>
 
-namespace {
+namespace
+{
 
 using OIIO::ImageOutput;
 using OIIO::ImageSpec;
@@ -99,8 +100,8 @@ extern "C" sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *pat
         std::string tmp = p + ".tmp-" + std::to_string((long)getpid());
         sw_result r = png ? write_png(img, tmp, path, status) : write_exr(img, tmp, path, status);
         if (r == SW_OK && std::rename(tmp.c_str(), p.c_str()) != 0)
-            r = sw__fail(status, SW_ERR_IO, "%s: cannot rename %s over it: %s", path,
-                         tmp.c_str(), std::strerror(errno));
+            r = sw__fail(status, SW_ERR_IO, "%s: cannot rename %s over it: %s", path, tmp.c_str(),
+                         std::strerror(errno));
         if (r != SW_OK)
             std::remove(tmp.c_str());
         else

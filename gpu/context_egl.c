@@ -253,10 +253,8 @@ sw_result sw__gpu_target_ensure(sw_gpu_context *ctx, int32_t w, int32_t h, sw_st
     glBindRenderbuffer(GL_RENDERBUFFER, ctx->rb_depth);
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
     glBindFramebuffer(GL_FRAMEBUFFER, ctx->fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
-                              ctx->rb_color);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER,
-                              ctx->rb_depth);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ctx->rb_color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ctx->rb_depth);
     GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (fs != GL_FRAMEBUFFER_COMPLETE)
         return sw__fail(status, SW_ERR_GL, "render target %dx%d incomplete (0x%04x)", (int)w,

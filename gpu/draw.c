@@ -46,8 +46,8 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_v * sizeof *mesh->v), mesh->v,
                  GL_STREAM_DRAW);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_idx * sizeof *mesh->idx),
-                 mesh->idx, GL_STREAM_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_idx * sizeof *mesh->idx), mesh->idx,
+                 GL_STREAM_DRAW);
     GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,

@@ -19,12 +19,12 @@
 #include <string.h>
 
 enum {
-    MAX_SEGMENTS = 256,           /* grid segments per patch and direction */
-    MAX_TRIM_SIDE = 4096,         /* texels per side of one trim texture */
+    MAX_SEGMENTS = 256,   /* grid segments per patch and direction */
+    MAX_TRIM_SIDE = 4096, /* texels per side of one trim texture */
     MAX_TRIM_LOOP_VERTICES = 1u << 22,
 };
-static const double k_max_frame_vertices = 48e6;  /* ~1.5 GB of grid vertices */
-static const double k_max_frame_texels = 256e6;   /* R8 trim texels per frame */
+static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
+static const double k_max_frame_texels = 256e6;  /* R8 trim texels per frame */
 
 typedef struct occurrence {
     uint32_t face;
@@ -168,8 +168,8 @@ static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch 
         xform_h(o->world, f->view.eye, bp->cpw + 4 * i, cpw + 4 * i);
         box_add(box, cpw + 4 * i);
     }
-    *pt = (sw__gpu_patch){bp->deg_u, bp->deg_v, cpw, 0, 1, 0, 1, bp->u0, bp->u1, bp->v0, bp->v1,
-                          0, 0, 0, 1, 1};
+    *pt = (sw__gpu_patch){bp->deg_u, bp->deg_v, cpw,    0, 1, 0, 1, bp->u0,
+                          bp->u1,    bp->v0,    bp->v1, 0, 0, 0, 1, 1};
     double du = bp->u1 - bp->u0, dv = bp->v1 - bp->v0;
     pt->s0 = fmax(0.0, (ub[0] - bp->u0) / du);
     pt->s1 = fmin(1.0, (ub[1] - bp->u0) / du);
@@ -303,8 +303,8 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     }
     static const double k_origin[3] = {0.0, 0.0, 0.0};
     double near_plane = f->n_occ ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
-    sw_result r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height,
-                                    near_plane, status);
+    sw_result r =
+        sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane, status);
     for (size_t i = 0; i < f->n_occ && r == SW_OK; ++i) {
         if (!sw__gpu_view_box_visible(&f->view, boxes + 6 * i)) {
             f->st.faces_culled++;
@@ -403,8 +403,7 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
         r = make_trims(&f, status);
     double t2 = sw__gpu_now_ms();
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws,
-                               status);
+        r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws, status);
     double t3 = sw__gpu_now_ms();
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &f.view, desc.want_depth, out, status);

@@ -34,8 +34,7 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     return 1;
 }
 
-sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx,
-                               sw_status *status)
+sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, sw_status *status)
 {
     if (m->n_v + more_v > UINT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "frame needs more than 2^32 grid vertices");
@@ -63,7 +62,8 @@ static void bernstein(int32_t p, double s, double *b, double *db)
     }
 }
 
-/* Homogeneous value and first partials of a patch at (s, t): h[0..3], h[4..7] d/ds, h[8..11] d/dt. */
+/* Homogeneous value and first partials of a patch at (s, t): h[0..3], h[4..7] d/ds, h[8..11] d/dt.
+ */
 static void eval_h1(const sw__gpu_patch *pt, double s, double t, double h[12])
 {
     double bu[SW_SG_MAX_DEGREE + 1], dbu[SW_SG_MAX_DEGREE + 1];

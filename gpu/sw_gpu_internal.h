@@ -82,18 +82,17 @@ typedef struct sw__gpu_mesh {
 } sw__gpu_mesh;
 
 void sw__gpu_mesh_free(sw__gpu_mesh *m);
-sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx,
-                               sw_status *status);
+sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, sw_status *status);
 
 /* One Bézier patch of a face occurrence, its control points in eye-relative world space. */
 typedef struct sw__gpu_patch {
     int32_t deg_u, deg_v;
-    double *cpw;            /* (deg_u+1)(deg_v+1)*4, eye-relative world, homogeneous */
-    double s0, s1, t0, t1;  /* the part of the local domain inside the face's uv_box */
-    double u0, u1, v0, v1;  /* its parameter rectangle in the face's domain */
-    int32_t col, row;       /* position in the face's patch grid */
-    int32_t visible;        /* survived frustum culling */
-    int32_t nu, nv;         /* grid segments (after the column/row maxima) */
+    double *cpw;           /* (deg_u+1)(deg_v+1)*4, eye-relative world, homogeneous */
+    double s0, s1, t0, t1; /* the part of the local domain inside the face's uv_box */
+    double u0, u1, v0, v1; /* its parameter rectangle in the face's domain */
+    int32_t col, row;      /* position in the face's patch grid */
+    int32_t visible;       /* survived frustum culling */
+    int32_t nu, nv;        /* grid segments (after the column/row maxima) */
 } sw__gpu_patch;
 
 /* Evaluates the visible patches of one face occurrence (grids of nu x nv cells each, neighbours

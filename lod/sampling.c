@@ -11,19 +11,24 @@
  *    same for W with B_s, B_ss, B_st (max |differences of w|);
  *  - W >= w_min = min w_ij, and |S - c| <= R = max |P_ij - c| (convex hull; weights positive);
  *  - differentiating H_c = W (S - c):
- *      S_s  = (d_s H_c - W_s (S - c)) / W                        -> |S_s|  <= (A_s + B_s R) / w_min = G_s
- *      S_ss = (d_ss H_c - 2 W_s S_s - W_ss (S - c)) / W          -> |S_ss| <= (A_ss + 2 B_s G_s + B_ss R) / w_min
- *      S_st = (d_st H_c - W_s S_t - W_t S_s - W_st (S - c)) / W  -> |S_st| <= (A_st + B_s G_t + B_t G_s + B_st R) / w_min
+ *      S_s  = (d_s H_c - W_s (S - c)) / W
+ *      S_ss = (d_ss H_c - 2 W_s S_s - W_ss (S - c)) / W
+ *      S_st = (d_st H_c - W_s S_t - W_t S_s - W_st (S - c)) / W
+ *    hence
+ *      |S_s|  <= G_s = (A_s + B_s R) / w_min
+ *      |S_ss| <= (A_ss + 2 B_s G_s + B_ss R) / w_min
+ *      |S_st| <= (A_st + B_s G_t + B_t G_s + B_st R) / w_min
  *    For a polynomial patch (equal weights) the B terms vanish and the bounds are the classical
  *    p(p-1) max|D^2 P| etc.
  *
  * A second bound, used for degrees <= 7 (taking the smaller of the two, both being rigorous),
  * follows §5.1 literally but for surfaces: with N_s = H_s W - H W_s (so S_s = N_s / W^2) the
- * second derivatives are S_ss = (d_s N_s W - 2 N_s W_s) / W^3, S_st = (d_s N_t W - 2 N_t W_s) / W^3,
- * S_tt likewise; numerators and W^3 are multiplied out in Bernstein form, and
- * |S_xy| <= max |numerator coefficient| / min (W^3 coefficient) (convex hull; W^3's coefficients
- * are positive). Its numerators cancel exactly where the first bound's triangle inequalities
- * cannot: a cylinder's S_st = 0 gets a zero bound, so its straight direction needs one segment.
+ * second derivatives are S_ss = (d_s N_s W - 2 N_s W_s) / W^3, S_st = (d_s N_t W - 2 N_t W_s) /
+ * W^3, S_tt likewise; numerators and W^3 are multiplied out in Bernstein form, and |S_xy| <= max
+ * |numerator coefficient| / min (W^3 coefficient) (convex hull; W^3's coefficients are positive).
+ * The first derivatives likewise: |S_s| <= max |N_s coefficient| / min (W^2 coefficient).
+ * Its numerators cancel exactly where the first bound's triangle inequalities cannot: a cylinder's
+ * S_st = 0 gets a zero bound, so its straight direction needs one segment.
  *
  * Where the paper is loose: (a) §5.1 bounds |C''| by max|P_i| / min w_i of the rational
  * derivative's numerator and denominator in absolute coordinates; that numerator is not
@@ -37,8 +42,9 @@
  * and we use the box's depth along the view axis (<= its distance), which is the stricter choice.
  *
  * Filip's bound (Guthe §5.2): on a cell of size (ds, dt) the two triangles deviate from the patch
- * by at most (ds^2 M_ss + 2 ds dt M_st + dt^2 M_tt) / 8 <= (ds^2 (M_ss + M_st) + dt^2 (M_tt + M_st)) / 8
- * (from 2ab <= a^2 + b^2), so each direction gets eps/2: ds <= sqrt(4 eps / (M_ss + M_st)).
+ * by at most (ds^2 M_ss + 2 ds dt M_st + dt^2 M_tt) / 8 <= (ds^2 (M_ss + M_st) + dt^2 (M_tt +
+ * M_st)) / 8 (from 2ab <= a^2 + b^2), so each direction gets eps/2: ds <= sqrt(4 eps / (M_ss +
+ * M_st)).
  */
 #include "sw_lod_sampling.h"
 

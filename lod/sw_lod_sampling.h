@@ -1,9 +1,9 @@
 /* splinewalk lod/ sampling bounds: how densely a rational Bézier patch must be sampled so that its
  * piecewise-linear grid stays within an object-space tolerance (the Filip et al. 1986 bound as used
- * by Guthe et al. 2005 §5.2), the object-space tolerance that a screen-space error ε_img allows at a
- * given depth (§7), and the trim-texture resolution that keeps a texel below that tolerance on the
- * surface (§5.3). The derivative bounds are rigorous for any degree and any positive weights; the
- * derivation is in sampling.c.
+ * by Guthe et al. 2005 §5.2), the object-space tolerance that a screen-space error ε_img allows at
+ * a given depth (§7), and the trim-texture resolution that keeps a texel below that tolerance on
+ * the surface (§5.3). The derivative bounds are rigorous for any degree and any positive weights;
+ * the derivation is in sampling.c.
  *
  * All functions are pure and thread-safe.
  */

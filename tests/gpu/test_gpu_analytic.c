@@ -66,7 +66,7 @@ static uint32_t add_polygon_loop(sw_sg_builder *b, const double *pts, int count,
 static uint32_t add_circle_loop(sw_sg_builder *b)
 {
     static const double knots[12] = {0, 0, 0, .25, .25, .5, .5, .75, .75, 1, 1, 1};
-    static const double dir[9][2] = {{1, 0},  {1, 1},   {0, 1},  {-1, 1}, {-1, 0},
+    static const double dir[9][2] = {{1, 0},   {1, 1},  {0, 1},  {-1, 1}, {-1, 0},
                                      {-1, -1}, {0, -1}, {1, -1}, {1, 0}};
     double cpw[27];
     for (int i = 0; i < 9; ++i) {
@@ -146,8 +146,7 @@ static int analytic(const double uv[2], double *dist)
     for (int k = 0, j = 2 * STAR_N - 1; k < 2 * STAR_N; j = k++) {
         d = fmin(d, seg_dist(uv, star[k], star[j]));
         if ((star[k][1] > uv[1]) != (star[j][1] > uv[1]) &&
-            uv[0] < (star[j][0] - star[k][0]) * (uv[1] - star[k][1]) /
-                            (star[j][1] - star[k][1]) +
+            uv[0] < (star[j][0] - star[k][0]) * (uv[1] - star[k][1]) / (star[j][1] - star[k][1]) +
                         star[k][0])
             in_star = !in_star;
     }
@@ -179,8 +178,9 @@ static int check_frame(const sw_gpu_image *img)
             ++checked;
             if (got != want) {
                 if (wrong < 10)
-                    fprintf(stderr, "pixel (%d,%d) uv (%.4f,%.4f) %.2f px from a boundary: "
-                                    "covered %d, expected %d\n",
+                    fprintf(stderr,
+                            "pixel (%d,%d) uv (%.4f,%.4f) %.2f px from a boundary: "
+                            "covered %d, expected %d\n",
                             x, y, uv[0], uv[1], d * px_per_uv, got, want);
                 ++wrong;
             }

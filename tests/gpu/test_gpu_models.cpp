@@ -33,7 +33,8 @@
 #include <string>
 #include <vector>
 
-namespace {
+namespace
+{
 
 struct ref_mesh {
     std::vector<double> pos;
@@ -80,8 +81,8 @@ bool reference_mesh(const std::string &path, double deflection, ref_mesh &m)
         for (Standard_Integer i = 1; i <= tri->NbTriangles(); ++i) {
             Standard_Integer a, b, c;
             tri->Triangle(i).Get(a, b, c);
-            m.idx.insert(m.idx.end(), {base + (uint32_t)a - 1, base + (uint32_t)b - 1,
-                                       base + (uint32_t)c - 1});
+            m.idx.insert(m.idx.end(),
+                         {base + (uint32_t)a - 1, base + (uint32_t)b - 1, base + (uint32_t)c - 1});
         }
     }
     return !m.idx.empty();
@@ -162,9 +163,8 @@ bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const ref_mesh &ref
         std::fprintf(stderr, "render: %s\n", st.message);
         return false;
     }
-    if (sw_gpu_render_triangles(ctx, ref.pos.data(), (uint32_t)(ref.pos.size() / 3),
-                                ref.idx.data(), (uint32_t)ref.idx.size(), &desc, &theirs,
-                                &st) != SW_OK) {
+    if (sw_gpu_render_triangles(ctx, ref.pos.data(), (uint32_t)(ref.pos.size() / 3), ref.idx.data(),
+                                (uint32_t)ref.idx.size(), &desc, &theirs, &st) != SW_OK) {
         std::fprintf(stderr, "reference render: %s\n", st.message);
         sw_gpu_image_free(&ours);
         return false;
@@ -193,8 +193,7 @@ bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const ref_mesh &ref
     return ok;
 }
 
-bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &outdir, int w,
-              int h)
+bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &outdir, int w, int h)
 {
     sw_sg_import_desc id{};
     id.path = path.c_str();
@@ -206,9 +205,9 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
     }
     sw_sg_scene_stats ss{};
     sw_sg_scene_compute_stats(scene, &ss);
-    double diag = std::sqrt(std::pow(ss.bbox[3] - ss.bbox[0], 2) +
-                            std::pow(ss.bbox[4] - ss.bbox[1], 2) +
-                            std::pow(ss.bbox[5] - ss.bbox[2], 2));
+    double diag =
+        std::sqrt(std::pow(ss.bbox[3] - ss.bbox[0], 2) + std::pow(ss.bbox[4] - ss.bbox[1], 2) +
+                  std::pow(ss.bbox[5] - ss.bbox[2], 2));
     ref_mesh ref;
     double deflection = 1e-4 * diag;
     auto t0 = std::chrono::steady_clock::now();
@@ -217,8 +216,8 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
         sw_sg_scene_free(scene);
         return false;
     }
-    double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                    .count();
+    double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     /* The views frame the geometry's box (the mesh's), not the control nets' box: a plane's
      * control net may extend far beyond its trimmed face. */
     double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
