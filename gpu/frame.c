@@ -286,8 +286,7 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
 /* Collects occurrences, sets the view (near plane from the scene's box) and tessellates. */
 static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *status)
 {
-    sw_sg_scene_traverse(f->scene, collect, f);
-    if (f->oom)
+    if (sw_sg_scene_traverse(f->scene, collect, f) != SW_OK || f->oom)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
     double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes), scene_box[6];
     if (!boxes)
