@@ -37,7 +37,8 @@ extern "C" {
     X(SW_SG_KIND_BSPLINE, "bspline")                                                               \
     X(SW_SG_KIND_BEZIER, "bezier")                                                                 \
     X(SW_SG_KIND_OFFSET, "offset")                                                                 \
-    X(SW_SG_KIND_OTHER, "other")
+    X(SW_SG_KIND_OTHER, "other")                                                                   \
+    X(SW_SG_KIND_TSPLINE, "tspline") /* a Bézier patch extracted from a T-spline (.tsm) */
 
 typedef enum sw_sg_surface_kind {
 #define SW__KIND_ENUM(id, text) id,

@@ -2,6 +2,7 @@
 #include "sw_rt.h"
 
 #include "sw_sg_import.h"
+#include "sw_sg_tspline.h"
 #include "sw_status_util.h"
 
 #include <stdio.h>
@@ -15,6 +16,16 @@ static int has_extension(const char *path, const char *ext)
 {
     size_t n = strlen(path), e = strlen(ext);
     return n > e && strcasecmp(path + n - e, ext) == 0;
+}
+
+static int is_cad_file(const char *path)
+{
+    static const char *const exts[] = {".step", ".stp", ".iges", ".igs", ".brep"};
+    for (size_t i = 0; i < sizeof exts / sizeof exts[0]; i++) {
+        if (has_extension(path, exts[i]))
+            return 1;
+    }
+    return 0;
 }
 
 static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
@@ -47,6 +58,13 @@ sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status
     sw_result r;
     if (has_extension(desc->path, ".sws")) {
         r = sw_sg_scene_open(desc->path, &sg, status);
+    } else if (has_extension(desc->path, ".tsm")) {
+        r = sw_sg_tspline_import_file(desc->path, &sg, status);
+    } else if (!is_cad_file(desc->path)) {
+        return sw__fail(status, SW_ERR_UNSUPPORTED,
+                        "%s: unknown extension (expected .sws, .step, .stp, .iges, .igs, .brep "
+                        "or .tsm)",
+                        desc->path);
     } else {
         sw_sg_import_desc import = {desc->path, desc->progress, desc->warning, desc->user_data};
         r = sw_sg_import_file(&import, &sg, NULL, status);

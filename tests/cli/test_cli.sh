@@ -54,6 +54,13 @@ trimmed=$(sed -n 's/.*trimmed by trim textures \([0-9]*\).*/\1/p' render.txt)
 [ -s motor.exr ] || fail "no EXR written"
 pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 
+# A T-spline sample: its rational bicubic Bézier patches through the same pipeline.
+tsm=$(dirname "$0")/../../samples/tsplines/t_junctions.tsm
+"$sw" info "$tsm" --json >tsm.json || fail "info t_junctions.tsm"
+grep -q '"tspline": 32' tsm.json || fail "t_junctions.tsm should give 32 T-spline patches: $(cat tsm.json)"
+"$sw" render "$tsm" -o tsm.png --size 160x120 >/dev/null 2>&1 || fail "render t_junctions.tsm"
+pass "T-spline sample through info and render"
+
 # Bad input.
 size=$(stat -c %s motor.sws)
 expect_error "missing file" SW_ERR_NOT_FOUND no-such.sws -- "$sw" info no-such.sws

@@ -35,7 +35,7 @@ typedef void (*sw_progress_fn)(void *user_data, double fraction, const char *sta
 typedef void (*sw_warning_fn)(void *user_data, const char *message);
 
 typedef struct sw_scene_load_desc {
-    const char *path;         /* required: .sws, .step/.stp, .iges/.igs, .brep */
+    const char *path;         /* required: .sws, .step/.stp, .iges/.igs, .brep, .tsm (T-spline) */
     sw_progress_fn progress;  /* NULL: none; called on the loading thread */
     sw_warning_fn warning;    /* NULL: none; a face that cannot be converted is reported here */
     void *user_data;
@@ -58,7 +58,7 @@ SW_API sw_result sw_scene_save(sw_scene scene, const char *path, sw_status *stat
 /* Frees the scene; later use of the handle yields SW_ERR_STALE_HANDLE. */
 SW_API sw_result sw_scene_destroy(sw_scene scene);
 
-#define SW_SURFACE_KIND_COUNT 11
+#define SW_SURFACE_KIND_COUNT 12
 typedef struct sw_scene_info {
     uint32_t faces, trimmed_faces, loops, curves;
     uint32_t faces_by_kind[SW_SURFACE_KIND_COUNT]; /* names: sw_surface_kind_name(k) */
