@@ -1,0 +1,445 @@
+/* tests/threads: worker-pool behaviour (threads/sw_th_pool.h) — cancellation of stale requests,
+ * priorities, group waiters that help, fork-join from tasks, shutdown that drains, and idle
+ * workers that sleep instead of spinning. */
+#include "sw_th_pool.h"
+
+#include <sched.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <sys/resource.h>
+#include <time.h>
+#include <cmocka.h>
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+/* ---- a gate task that occupies a worker until opened ---------------------------------------- */
+
+typedef struct gate {
+    _Atomic int running;
+    _Atomic int open;
+} gate;
+
+static void gate_fn(void *ctx)
+{
+    gate *g = ctx;
+    atomic_store(&g->running, 1);
+    while (!atomic_load(&g->open))
+        sched_yield();
+}
+
+static sw_th_pool *pool_with(uint32_t workers)
+{
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc d = {.worker_count = workers};
+    assert_int_equal(sw_th_pool_create(&d, &pool), SW_OK);
+    assert_int_equal(sw_th_pool_worker_count(pool), workers);
+    return pool;
+}
+
+static void block_worker(sw_th_pool *pool, gate *g)
+{
+    sw_th_task t = {.fn = gate_fn, .ctx = g};
+    assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    while (!atomic_load(&g->running))
+        sched_yield();
+}
+
+/* ---- cancellation ---------------------------------------------------------------------------- */
+
+enum { MARKS = 4096 };
+
+typedef struct marks {
+    _Atomic int ran[MARKS];
+    _Atomic int order[MARKS];
+    _Atomic int seq;
+    _Atomic int done;
+} marks;
+
+typedef struct mark_ctx {
+    marks *m;
+    int id;
+} mark_ctx;
+
+static void mark_fn(void *ctx)
+{
+    mark_ctx *c = ctx;
+    atomic_fetch_add(&c->m->ran[c->id], 1);
+    atomic_store(&c->m->order[c->id], atomic_fetch_add(&c->m->seq, 1));
+    atomic_fetch_add(&c->m->done, 1);
+}
+
+/* One worker held by a gate: 1000 tasks of generation g0, cancel, 500 of g1. Only the 500 run;
+ * the 1000 are counted as cancelled and still release their group. */
+static void test_cancel_external(void **state)
+{
+    (void)state;
+    static marks m;
+    static mark_ctx ctx[1500];
+    sw_th_pool *pool = pool_with(1);
+    gate g = {0};
+    block_worker(pool, &g);
+    sw_th_token tok;
+    sw_th_token_init(&tok);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    uint64_t g0 = sw_th_token_current(&tok);
+    for (int i = 0; i < 1500; i++) {
+        if (i == 1000)
+            assert_int_equal(sw_th_token_cancel(&tok), g0 + 1);
+        ctx[i] = (mark_ctx){&m, i};
+        sw_th_task t = {.fn = mark_fn,
+                        .ctx = &ctx[i],
+                        .token = &tok,
+                        .generation = sw_th_token_current(&tok),
+                        .group = &grp,
+                        .priority = (sw_th_priority)(i % 2)};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    }
+    assert_int_equal(sw_th_group_pending(&grp), 1500);
+    atomic_store(&g.open, 1);
+    sw_th_group_wait(pool, &grp);
+    assert_int_equal(sw_th_group_pending(&grp), 0);
+    for (int i = 0; i < 1500; i++)
+        assert_int_equal(atomic_load(&m.ran[i]), i < 1000 ? 0 : 1);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    assert_int_equal(st.cancelled, 1000);
+    sw_th_pool_destroy(pool);
+}
+
+typedef struct spawner {
+    sw_th_pool *pool;
+    sw_th_token tok;
+    sw_th_group grp;
+    mark_ctx ctx[300];
+    marks m;
+} spawner;
+
+/* A running task spawns 100 children of the live generation, cancels its request, then spawns
+ * 100 of the old generation (all must be skipped) and 100 of the new one (all must run). */
+static void spawner_fn(void *arg)
+{
+    spawner *s = arg;
+    uint64_t g0 = sw_th_token_current(&s->tok);
+    for (int i = 0; i < 300; i++) {
+        if (i == 100)
+            sw_th_token_cancel(&s->tok);
+        s->ctx[i] = (mark_ctx){&s->m, i};
+        sw_th_task t = {.fn = mark_fn,
+                        .ctx = &s->ctx[i],
+                        .token = &s->tok,
+                        .generation = i < 200 ? g0 : g0 + 1,
+                        .group = &s->grp};
+        assert_int_equal(sw_th_pool_submit(s->pool, &t), SW_OK);
+    }
+}
+
+static void test_cancel_from_task(void **state)
+{
+    (void)state;
+    static spawner s;
+    s.pool = pool_with(4);
+    sw_th_token_init(&s.tok);
+    sw_th_group_init(&s.grp);
+    sw_th_task t = {.fn = spawner_fn, .ctx = &s, .group = &s.grp};
+    assert_int_equal(sw_th_pool_submit(s.pool, &t), SW_OK);
+    sw_th_group_wait(s.pool, &s.grp);
+    int early = 0;
+    for (int i = 0; i < 100; i++)
+        early += atomic_load(&s.m.ran[i]);
+    for (int i = 100; i < 200; i++)
+        assert_int_equal(atomic_load(&s.m.ran[i]), 0);
+    for (int i = 200; i < 300; i++)
+        assert_int_equal(atomic_load(&s.m.ran[i]), 1);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(s.pool, &st);
+    /* The first 100 raced with the cancel: each either ran or was counted, never both. */
+    assert_int_equal(early + (int)st.cancelled, 200);
+    sw_th_pool_destroy(s.pool);
+}
+
+/* ---- priorities ------------------------------------------------------------------------------ */
+
+static void check_frame_first(marks *m, int n)
+{
+    int last_frame = -1, first_background = 1 << 30;
+    for (int i = 0; i < 2 * n; i++) {
+        int o = atomic_load(&m->order[i]);
+        assert_int_equal(atomic_load(&m->ran[i]), 1);
+        if (i < n && o < first_background)
+            first_background = o; /* ids < n were submitted as BACKGROUND */
+        if (i >= n && o > last_frame)
+            last_frame = o;
+    }
+    assert_true(last_frame < first_background);
+}
+
+/* One worker held by a gate; 100 BACKGROUND tasks, then 100 FRAME ones: the FRAME ones run
+ * first. (The test polls instead of sw_th_group_wait, whose help would add a second runner.) */
+static void test_priority_external(void **state)
+{
+    (void)state;
+    static marks m;
+    static mark_ctx ctx[200];
+    sw_th_pool *pool = pool_with(1);
+    gate g = {0};
+    block_worker(pool, &g);
+    for (int i = 0; i < 200; i++) {
+        ctx[i] = (mark_ctx){&m, i};
+        sw_th_task t = {.fn = mark_fn,
+                        .ctx = &ctx[i],
+                        .priority = i < 100 ? SW_TH_PRIORITY_BACKGROUND : SW_TH_PRIORITY_FRAME};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    }
+    atomic_store(&g.open, 1);
+    while (atomic_load(&m.done) < 200)
+        sleep_ms(1);
+    check_frame_first(&m, 100);
+    sw_th_pool_destroy(pool);
+}
+
+typedef struct prio_parent {
+    sw_th_pool *pool;
+    marks m;
+    mark_ctx ctx[100];
+} prio_parent;
+
+static void prio_parent_fn(void *arg)
+{
+    prio_parent *p = arg;
+    for (int i = 0; i < 100; i++) {
+        p->ctx[i] = (mark_ctx){&p->m, i};
+        sw_th_task t = {.fn = mark_fn,
+                        .ctx = &p->ctx[i],
+                        .priority = i < 50 ? SW_TH_PRIORITY_BACKGROUND : SW_TH_PRIORITY_FRAME};
+        assert_int_equal(sw_th_pool_submit(p->pool, &t), SW_OK);
+    }
+}
+
+/* The same from inside a task: children go to the worker's own deques, FRAME popped first. */
+static void test_priority_local(void **state)
+{
+    (void)state;
+    static prio_parent p;
+    p.pool = pool_with(1);
+    sw_th_task t = {.fn = prio_parent_fn, .ctx = &p};
+    assert_int_equal(sw_th_pool_submit(p.pool, &t), SW_OK);
+    while (atomic_load(&p.m.done) < 100)
+        sleep_ms(1);
+    check_frame_first(&p.m, 50);
+    sw_th_pool_destroy(p.pool);
+}
+
+/* ---- groups ---------------------------------------------------------------------------------- */
+
+typedef struct helper_probe {
+    sw_th_pool *pool;
+    _Atomic int ran_by_caller;
+    _Atomic int ran;
+} helper_probe;
+
+static void probe_fn(void *arg)
+{
+    helper_probe *h = arg;
+    if (sw_th_pool_current_worker(h->pool) == -1)
+        atomic_fetch_add(&h->ran_by_caller, 1);
+    atomic_fetch_add(&h->ran, 1);
+}
+
+/* The only worker is held until all 100 tasks ran: sw_th_group_wait must run them itself (a
+ * waiter that only blocked would hang here until the test's timeout). */
+static void test_group_wait_helps(void **state)
+{
+    (void)state;
+    helper_probe h = {0};
+    h.pool = pool_with(1);
+    gate g = {0};
+    block_worker(h.pool, &g);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    for (int i = 0; i < 100; i++) {
+        sw_th_task t = {.fn = probe_fn, .ctx = &h, .group = &grp};
+        assert_int_equal(sw_th_pool_submit(h.pool, &t), SW_OK);
+    }
+    sw_th_group_wait(h.pool, &grp);
+    assert_int_equal(atomic_load(&h.ran), 100);
+    assert_int_equal(atomic_load(&h.ran_by_caller), 100);
+    atomic_store(&g.open, 1);
+    sw_th_pool_destroy(h.pool);
+}
+
+typedef struct fib_ctx {
+    sw_th_pool *pool;
+    int n;
+    long result;
+} fib_ctx;
+
+static void fib_fn(void *arg)
+{
+    fib_ctx *f = arg;
+    if (f->n < 2) {
+        f->result = f->n;
+        return;
+    }
+    fib_ctx a = {f->pool, f->n - 1, 0}, b = {f->pool, f->n - 2, 0};
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    sw_th_task ta = {.fn = fib_fn, .ctx = &a, .group = &grp};
+    sw_th_task tb = {.fn = fib_fn, .ctx = &b, .group = &grp};
+    assert_int_equal(sw_th_pool_submit(f->pool, &ta), SW_OK);
+    assert_int_equal(sw_th_pool_submit(f->pool, &tb), SW_OK);
+    sw_th_group_wait(f->pool, &grp);
+    f->result = a.result + b.result;
+}
+
+static long fib_serial(int n)
+{
+    long a = 0, b = 1;
+    for (int i = 0; i < n; i++) {
+        long c = a + b;
+        a = b;
+        b = c;
+    }
+    return a;
+}
+
+/* Fork-join with waits nested in tasks on every worker (each waiter keeps running tasks). */
+static void test_fork_join(void **state)
+{
+    (void)state;
+    for (uint32_t workers = 1; workers <= 4; workers += 3) {
+        sw_th_pool *pool = pool_with(workers);
+        fib_ctx f = {pool, 18, -1};
+        sw_th_group grp;
+        sw_th_group_init(&grp);
+        sw_th_task t = {.fn = fib_fn, .ctx = &f, .group = &grp};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+        sw_th_group_wait(pool, &grp);
+        assert_int_equal(f.result, fib_serial(18));
+        sw_th_pool_destroy(pool);
+    }
+}
+
+/* ---- shutdown and sleeping ------------------------------------------------------------------- */
+
+typedef struct tree_ctx {
+    sw_th_pool *pool;
+    _Atomic int64_t count;
+} tree_ctx;
+
+static void tree_fn(void *arg);
+
+static void tree_spawn(tree_ctx *c, int depth)
+{
+    sw_th_task t = {.fn = tree_fn, .ctx = (void *)((uintptr_t)c | (uintptr_t)depth)};
+    assert_int_equal(sw_th_pool_submit(c->pool, &t), SW_OK);
+}
+
+/* ctx carries the depth in its low bits (tree_ctx is 8-aligned, depth < 8). */
+static void tree_fn(void *arg)
+{
+    tree_ctx *c = (tree_ctx *)((uintptr_t)arg & ~(uintptr_t)7);
+    int depth = (int)((uintptr_t)arg & 7);
+    atomic_fetch_add(&c->count, 1);
+    if (depth > 0) {
+        tree_spawn(c, depth - 1);
+        tree_spawn(c, depth - 1);
+    }
+}
+
+/* Destroy right after submitting: every task submitted, and every child spawned by them,
+ * still runs (2000 binary trees of depth 5 = 2000 * 63 tasks). */
+static void test_shutdown_drains(void **state)
+{
+    (void)state;
+    static tree_ctx c;
+    c.pool = pool_with(3);
+    for (int i = 0; i < 2000; i++)
+        tree_spawn(&c, 5);
+    sw_th_pool_destroy(c.pool);
+    assert_int_equal(atomic_load(&c.count), 2000 * 63);
+}
+
+/* Lost wake-ups: workers that spin only twice before sleeping get a small burst of tasks from
+ * outside, then the caller waits WITHOUT helping (polling), so a task left with every worker
+ * asleep would never run. 3000 bursts, with pauses that let the pool fall asleep in between. */
+static void test_no_lost_wakeup(void **state)
+{
+    (void)state;
+    static tree_ctx c;
+    sw_th_pool_desc d = {.worker_count = 3, .spin_rounds = 2};
+    assert_int_equal(sw_th_pool_create(&d, &c.pool), SW_OK);
+    atomic_store(&c.count, 0);
+    int64_t expected = 0;
+    for (int i = 0; i < 3000; i++) {
+        int depth = i % 3;
+        tree_spawn(&c, depth);
+        expected += (2 << depth) - 1;
+        time_t deadline = time(NULL) + 20;
+        while (atomic_load(&c.count) < expected) {
+            assert_true(time(NULL) < deadline);
+            sched_yield();
+        }
+        if (i % 7 == 0)
+            sleep_ms(1);
+    }
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(c.pool, &st);
+    print_message("3000 bursts: %llu sleeps\n", (unsigned long long)st.sleeps);
+    assert_true(st.sleeps > 100);
+    sw_th_pool_destroy(c.pool);
+}
+
+static double cpu_seconds(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return (double)(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
+           1e-6 * (double)(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec);
+}
+
+/* Idle workers block: 4 idle workers for 400 ms burn well under 400 ms of CPU (spinning ones
+ * would burn ~4 × 400 ms), and a task submitted afterwards still wakes one and runs. */
+static void test_idle_workers_sleep(void **state)
+{
+    (void)state;
+    helper_probe h = {0};
+    h.pool = pool_with(4);
+    sleep_ms(50);
+    double c0 = cpu_seconds();
+    sleep_ms(400);
+    double burnt = cpu_seconds() - c0;
+    print_message("4 idle workers used %.1f ms of CPU in 400 ms\n", 1e3 * burnt);
+    assert_true(burnt < 0.1);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(h.pool, &st);
+    assert_true(st.sleeps >= 4);
+    for (int i = 0; i < 10; i++) {
+        sw_th_task t = {.fn = probe_fn, .ctx = &h};
+        assert_int_equal(sw_th_pool_submit(h.pool, &t), SW_OK);
+        while (atomic_load(&h.ran) < i + 1)
+            sched_yield();
+        sleep_ms(5); /* let the pool fall asleep again */
+    }
+    assert_int_equal(atomic_load(&h.ran_by_caller), 0);
+    sw_th_pool_destroy(h.pool);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_cancel_external),    cmocka_unit_test(test_cancel_from_task),
+        cmocka_unit_test(test_priority_external),  cmocka_unit_test(test_priority_local),
+        cmocka_unit_test(test_group_wait_helps),   cmocka_unit_test(test_fork_join),
+        cmocka_unit_test(test_shutdown_drains),    cmocka_unit_test(test_no_lost_wakeup),
+        cmocka_unit_test(test_idle_workers_sleep),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
