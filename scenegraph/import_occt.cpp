@@ -307,21 +307,22 @@ void snap_loop(loop_data &ld, const Handle(Geom_BSplineSurface) & s, const uv_do
         throw face_error{st.message};
 }
 
-/* A loop of curves each lying on one side of the domain rectangle, covering it. */
-bool is_domain_rectangle(const loop_data &ld, const uv_domain &d)
+/* A loop of curves each lying on one side of its own parameter box: an axis-aligned rectangle,
+ * the domain's or a part of it. Such a trim needs no texture (Guthe §4.4): restricting the patches
+ * to the box — which the renderer does for every face — is the whole trim. */
+bool is_axis_rectangle(const loop_data &ld, const uv_domain &d)
 {
     const double eps = 1e-9 * d.diag();
     double box[4];
     loop_box(ld, box);
-    if (std::fabs(box[0] - d.u0) > eps || std::fabs(box[1] - d.u1) > eps ||
-        std::fabs(box[2] - d.v0) > eps || std::fabs(box[3] - d.v1) > eps)
+    if (!(box[1] - box[0] > eps) || !(box[3] - box[2] > eps))
         return false;
     for (const curve_data &c : ld.curves) {
         bool side[4] = {true, true, true, true};
         for (size_t i = 0; i < c.cpw.size(); i += 3) {
             double u = c.cpw[i] / c.cpw[i + 2], v = c.cpw[i + 1] / c.cpw[i + 2];
-            side[0] &= std::fabs(u - d.u0) <= eps, side[1] &= std::fabs(u - d.u1) <= eps;
-            side[2] &= std::fabs(v - d.v0) <= eps, side[3] &= std::fabs(v - d.v1) <= eps;
+            side[0] &= std::fabs(u - box[0]) <= eps, side[1] &= std::fabs(u - box[1]) <= eps;
+            side[2] &= std::fabs(v - box[2]) <= eps, side[3] &= std::fabs(v - box[3]) <= eps;
         }
         if (!(side[0] || side[1] || side[2] || side[3]))
             return false;
@@ -398,7 +399,7 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
                      line_curve(d.u1, d.v1, d.u0, d.v1), line_curve(d.u0, d.v1, d.u0, d.v0)};
         fd.loops.push_back(std::move(ld));
     }
-    const bool untrimmed = fd.loops.size() == 1 && is_domain_rectangle(fd.loops[0], d);
+    const bool untrimmed = fd.loops.size() == 1 && is_axis_rectangle(fd.loops[0], d);
     if (!untrimmed)
         fd.rec.flags |= SW_SG_FACE_TRIMMED;
 
@@ -413,9 +414,6 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     fd.rec.uv_box[1] = std::clamp(box[1], d.u0, d.u1);
     fd.rec.uv_box[2] = std::clamp(box[2], d.v0, d.v1),
     fd.rec.uv_box[3] = std::clamp(box[3], d.v0, d.v1);
-    if (untrimmed)
-        fd.rec.uv_box[0] = d.u0, fd.rec.uv_box[1] = d.u1, fd.rec.uv_box[2] = d.v0,
-        fd.rec.uv_box[3] = d.v1;
     return fd;
 }
 
