@@ -199,6 +199,8 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
     sw_result r = make_context(ctx, status);
     if (r == SW_OK)
         r = sw__gpu_programs_create(ctx, status);
+    if (r == SW_OK)
+        r = sw__gpu_grids_create(ctx, status);
     if (r == SW_OK) {
         glGenVertexArrays(1, &ctx->vao);
         glGenFramebuffers(1, &ctx->trim_fbo);
@@ -220,6 +222,8 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         return;
     if (ctx->egl_context) {
         sw__gpu_programs_free(ctx);
+        sw__gpu_atlas_free(ctx);
+        sw__gpu_grids_free(ctx);
         glDeleteVertexArrays(1, &ctx->vao);
         glDeleteFramebuffers(1, &ctx->trim_fbo);
         glDeleteFramebuffers(1, &ctx->fbo);

@@ -60,9 +60,42 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
                           (const void *)offsetof(sw__gpu_vertex, st));
 }
 
+/* The frame's GPU-evaluated patches (§4.2): records and control points into two shader storage
+ * buffers, then one instanced draw per non-empty grid class, attribute-less. */
+static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
+                         const sw__gpu_patch_batch *batch)
+{
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->patch_ssbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(batch->n_recs * sizeof *batch->recs),
+                 batch->recs, GL_STREAM_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->cp_ssbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(batch->n_cps * 4 * sizeof *batch->cps),
+                 batch->cps, GL_STREAM_DRAW);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ctx->patch_ssbo);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx->cp_ssbo);
+    glBindVertexArray(ctx->vao);
+    for (GLuint a = 0; a < 3; ++a)
+        glDisableVertexAttribArray(a);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->grid_ibo);
+    glUseProgram(ctx->prog_eval);
+    glUniformMatrix4fv(ctx->loc_eval_view_proj, 1, GL_FALSE, view->view_proj);
+    glUniform1i(ctx->loc_eval_trim, 0);
+    for (int b = 0; b < SW__GPU_GRID_CLASSES; ++b) {
+        for (int a = 0; a < SW__GPU_GRID_CLASSES; ++a) {
+            if (batch->count[b][a] == 0)
+                continue;
+            glUniform2i(ctx->loc_eval_grid, sw__gpu_grid_segments[a], sw__gpu_grid_segments[b]);
+            glUniform1i(ctx->loc_eval_base, (GLint)batch->first[b][a]);
+            glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)ctx->grid_count[b][a], GL_UNSIGNED_INT,
+                                    (const void *)(ctx->grid_first[b][a] * sizeof(uint32_t)),
+                                    (GLsizei)batch->count[b][a]);
+        }
+    }
+}
+
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, const float bg[4],
                              const sw__gpu_mesh *mesh, const sw__gpu_draw *draws, size_t n_draws,
-                             sw_status *status)
+                             const sw__gpu_patch_batch *batch, sw_status *status)
 {
     sw_result r = sw__gpu_target_ensure(ctx, view->width, view->height, status);
     if (r != SW_OK)
@@ -83,15 +116,21 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, cons
     glUniformMatrix4fv(ctx->loc_view_proj, 1, GL_FALSE, view->view_proj);
     glUniform1i(ctx->loc_trim, 0);
     glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, sw__gpu_atlas_texture(ctx));
     for (size_t d = 0; d < n_draws; ++d) {
         if (draws[d].n_idx == 0)
             continue;
         glUniform4fv(ctx->loc_color, 1, draws[d].color);
-        glUniform1i(ctx->loc_trimmed, draws[d].trim_tex != 0);
-        glBindTexture(GL_TEXTURE_2D, draws[d].trim_tex);
+        sw__gpu_trim_rect tr = {0, 0, 0, 0, 0};
+        if (draws[d].trim_entry >= 0)
+            sw__gpu_atlas_rect(ctx, draws[d].trim_entry, &tr);
+        glUniform4f(ctx->loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
+        glUniform1f(ctx->loc_trim_layer, (float)tr.layer);
         glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
                        (const void *)(draws[d].first_idx * sizeof(uint32_t)));
     }
+    if (batch && batch->n_recs > 0)
+        draw_patches(ctx, view, batch);
     glFinish();
     return sw__gpu_check(status, "frame draw");
 }
@@ -216,9 +255,9 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
     sw__gpu_mesh mesh = {0};
     if (r == SW_OK)
         r = triangles_to_mesh(positions, n_vertices, indices, n_indices, view.eye, &mesh, status);
-    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, 0};
+    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1};
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &view, desc.background, &mesh, &draw, 1, status);
+        r = sw__gpu_draw_frame(ctx, &view, desc.background, &mesh, &draw, 1, NULL, status);
     sw__gpu_mesh_free(&mesh);
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &view, desc.want_depth, out, status);

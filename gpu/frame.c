@@ -2,8 +2,9 @@
  * slice): traverse the scene, cull face occurrences and then their rational Bézier patches against
  * the view frustum by their control-net boxes, choose each patch's grid density from the Filip
  * bound at the object-space tolerance its depth allows (§5.2), evaluate the grids on the CPU, make
- * one trim texture per trimmed face occurrence at a resolution from its on-screen size (§5.3) by
- * fan parity on the GPU (§4), draw, read back.
+ * one trim texture per trimmed face occurrence at a resolution from its on-screen size (§5.3),
+ * rounded up to a power-of-two class, in the context's trim atlas (§4.4) by fan parity on the GPU
+ * (§4), draw, read back.
  *
  * Phases are timed separately: tessellate (extraction, bounds, grids), trim (flattening and
  * texture generation, waited for), draw (upload and draw until glFinish), readback.
@@ -19,8 +20,7 @@
 #include <string.h>
 
 enum {
-    MAX_SEGMENTS = 256,   /* grid segments per patch and direction */
-    MAX_TRIM_SIDE = 4096, /* texels per side of one trim texture */
+    MAX_SEGMENTS = 256, /* grid segments per patch and direction */
     MAX_TRIM_LOOP_VERTICES = 1u << 22,
 };
 static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
@@ -54,6 +54,9 @@ typedef struct frame {
     size_t n_draws, cap_draws;
     pending_trim *trims;
     size_t n_trims, cap_trims;
+    size_t n_recs, n_cps; /* GPU-evaluated patches in ctx->recs, control points in ctx->cps */
+    double gpu_vertices;  /* grid vertices the vertex shader will evaluate */
+    sw__gpu_patch_batch batch;
 } frame;
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -219,11 +222,95 @@ static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int t
     d->first_idx = first_idx;
     d->n_idx = f->mesh.n_idx - first_idx;
     memcpy(d->color, o->color, sizeof d->color);
-    d->trim_tex = 0;
+    d->trim_entry = -1;
     if (trimmed)
         f->trims[f->n_trims++] = (pending_trim){f->n_draws, o->face, need->u, need->v};
     f->n_draws++;
     return SW_OK;
+}
+
+/* Smallest grid class with at least n segments (n <= SW__GPU_GRID_MAX). */
+static int32_t level_for(int32_t n)
+{
+    int32_t l = 0;
+    while (sw__gpu_grid_segments[l] < n)
+        ++l;
+    return l;
+}
+
+/* Pieces a direction of n segments is cut into so that each fits the largest grid class, and the
+ * class of a piece: at least n / pieces segments each, so the Filip bound still holds (§5.2). */
+static void split_class(int32_t n, int32_t *pieces, int32_t *level)
+{
+    *pieces = (n + SW__GPU_GRID_MAX - 1) / SW__GPU_GRID_MAX;
+    *level = level_for((n + *pieces - 1) / *pieces);
+}
+
+/* Appends the control points of a visible patch (float, eye-relative homogeneous) and one record
+ * per piece of its sampled domain (§4.2). Pieces share their edge parameters bit for bit. */
+static sw_result gpu_patch(frame *f, const sw__gpu_patch *pt, const double ub[4], double sign,
+                           int32_t draw, sw_status *status)
+{
+    sw_gpu_context *ctx = f->ctx;
+    size_t n_cp = (size_t)(pt->deg_u + 1) * (size_t)(pt->deg_v + 1);
+    int32_t ku, kv, lu, lv;
+    split_class(pt->nu, &ku, &lu);
+    split_class(pt->nv, &kv, &lv);
+    size_t n_rec = (size_t)ku * (size_t)kv;
+    if (!grow((void **)&ctx->cps, &ctx->cap_cps, 4 * (f->n_cps + n_cp), sizeof *ctx->cps) ||
+        !grow((void **)&ctx->recs, &ctx->cap_recs, f->n_recs + n_rec, sizeof *ctx->recs))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
+    for (size_t i = 0; i < 4 * n_cp; ++i)
+        ctx->cps[4 * f->n_cps + i] = (float)pt->cpw[i];
+    double bw = ub[1] - ub[0], bh = ub[3] - ub[2];
+    float map[4] = {(float)((pt->u0 - ub[0]) / bw), (float)((pt->u1 - pt->u0) / bw),
+                    (float)((pt->v0 - ub[2]) / bh), (float)((pt->v1 - pt->v0) / bh)};
+    for (int32_t b = 0; b < kv; ++b) {
+        for (int32_t a = 0; a < ku; ++a) {
+            sw__gpu_patch_rec *rec = &ctx->recs[f->n_recs++];
+            memset(rec, 0, sizeof *rec);
+            rec->st[0] = (float)(pt->s0 + (pt->s1 - pt->s0) * a / ku);
+            rec->st[1] = (float)(a + 1 == ku ? pt->s1 : pt->s0 + (pt->s1 - pt->s0) * (a + 1) / ku);
+            rec->st[2] = (float)(pt->t0 + (pt->t1 - pt->t0) * b / kv);
+            rec->st[3] = (float)(b + 1 == kv ? pt->t1 : pt->t0 + (pt->t1 - pt->t0) * (b + 1) / kv);
+            memcpy(rec->trim_map, map, sizeof map);
+            rec->cp = (uint32_t)f->n_cps;
+            rec->deg_u = pt->deg_u;
+            rec->deg_v = pt->deg_v;
+            rec->normal_sign = (float)sign;
+            rec->draw = draw;
+            rec->level_u = lu;
+            rec->level_v = lv;
+        }
+    }
+    f->n_cps += n_cp;
+    int32_t su = sw__gpu_grid_segments[lu], sv = sw__gpu_grid_segments[lv];
+    f->gpu_vertices += (double)n_rec * (double)(su + 1) * (double)(sv + 1);
+    f->st.triangles += (uint64_t)n_rec * 2u * (uint64_t)su * (uint64_t)sv;
+    return SW_OK;
+}
+
+/* GPU evaluation of a face's patches: one draw record for its colour and trim texture, one
+ * patch record per visible patch (or piece). */
+static sw_result gpu_face(frame *f, const occurrence *o, const sw__gpu_patch *pt, size_t n,
+                          double sign, int trimmed, const trim_need *need, sw_status *status)
+{
+    int32_t d = (int32_t)f->n_draws;
+    sw_result r = add_draw(f, o, f->mesh.n_idx, trimmed, need, status);
+    const double *ub = f->sv->faces[o->face].uv_box;
+    for (size_t p = 0; p < n && r == SW_OK; ++p)
+        if (pt[p].visible)
+            r = gpu_patch(f, &pt[p], ub, sign, d, status);
+    return r;
+}
+
+/* Which path draws a face: the vertex shader takes rational Bézier patches of degree <= 3 x 3
+ * (§4.2); higher degrees stay CPU grids (patch_grid.c) until the bicubic hierarchy feeds them. */
+static int face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
+{
+    if (f->ctx->eval_mode != SW__GPU_EVAL_AUTO || set->n_u * set->n_v == 0)
+        return 0;
+    return set->patches[0].deg_u <= 3 && set->patches[0].deg_v <= 3;
 }
 
 static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
@@ -262,9 +349,14 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
         if (det3(o->world) < 0.0)
             sign = -sign;
         size_t first = f->mesh.n_idx;
-        r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->mesh, status);
-        if (r == SW_OK)
-            r = add_draw(f, o, first, trimmed, &need, status);
+        if (face_on_gpu(f, set)) {
+            r = gpu_face(f, o, pt, n, sign, trimmed, &need, status);
+            f->st.patches_gpu_evaluated += drawn;
+        } else {
+            r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->mesh, status);
+            if (r == SW_OK)
+                r = add_draw(f, o, first, trimmed, &need, status);
+        }
         f->st.faces_drawn++;
         if (trimmed)
             f->st.patches_trimmed += drawn;
@@ -275,7 +367,7 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
     }
     free(pt);
     free(cpw);
-    if (r == SW_OK && (double)f->mesh.n_v > k_max_frame_vertices)
+    if (r == SW_OK && (double)f->mesh.n_v + f->gpu_vertices > k_max_frame_vertices)
         r = sw__fail(status, SW_ERR_LIMIT,
                      "frame needs more than %.0f grid vertices (error %g px too small for this "
                      "view?)",
@@ -315,13 +407,31 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     return r;
 }
 
+/* Texels of a resolution class: footprints (texture plus gutters) are powers of two, so that a
+ * class changes only when the wanted resolution doubles or halves, and pages pack them tightly. */
+static int32_t class_texels(double want, int32_t max_entry)
+{
+    int32_t foot = 16;
+    while (foot - 2 * SW__GPU_ATLAS_GUTTER < want && foot - 2 * SW__GPU_ATLAS_GUTTER < max_entry)
+        foot *= 2;
+    int32_t n = foot - 2 * SW__GPU_ATLAS_GUTTER;
+    return n < max_entry ? n : max_entry;
+}
+
 static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_status *status)
 {
     const sw_sg_face_rec *rec = &f->sv->faces[t->face];
-    double cap = fmin((double)MAX_TRIM_SIDE, (double)f->ctx->max_texture_size);
-    int32_t w = (int32_t)fmin(cap, fmax(8.0, ceil(t->width * scale)));
-    int32_t h = (int32_t)fmin(cap, fmax(8.0, ceil(t->height * scale)));
+    int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
+    int32_t w = class_texels(t->width * scale, max_entry);
+    int32_t h = class_texels(t->height * scale, max_entry);
     const double *ub = rec->uv_box;
+    sw__gpu_trim_key key = {
+        f->scene, t->face, rec->first_loop, rec->n_loops, {ub[0], ub[1], ub[2], ub[3]}};
+    int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
+    if (id >= 0) {
+        f->draws[t->draw].trim_entry = id;
+        return SW_OK;
+    }
     double tol = 0.5 * fmin((ub[1] - ub[0]) / w, (ub[3] - ub[2]) / h);
     sw_sg_polyline *loops = calloc(rec->n_loops, sizeof *loops);
     if (!loops)
@@ -330,39 +440,91 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k)
         r = sw_sg_trim_flatten_loop(f->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
                                     &loops[k], status);
-    GLuint tex = 0;
     if (r == SW_OK)
-        r = sw__gpu_trim_texture_make(f->ctx, loops, rec->n_loops, ub, w, h, &tex, status);
+        r = sw__gpu_atlas_add(f->ctx, &key, w, h, loops, rec->n_loops, &id, status);
     for (uint32_t k = 0; k < rec->n_loops; ++k)
         sw_sg_polyline_free(&loops[k]);
     free(loops);
-    if (r != SW_OK)
-        return r;
-    f->draws[t->draw].trim_tex = tex;
-    f->st.trim_textures++;
-    f->st.trim_texels += (uint64_t)w * (uint64_t)h;
-    return SW_OK;
+    f->draws[t->draw].trim_entry = id;
+    return r;
 }
 
-/* Trim textures for every drawn trimmed face, scaled down together if over the frame budget. */
+/* Trim textures for every drawn trimmed face through the atlas (§4.4), scaled down together if
+ * over the frame budget. */
 static sw_result make_trims(frame *f, sw_status *status)
 {
     double total = 0.0;
     for (size_t i = 0; i < f->n_trims; ++i)
         total += f->trims[i].width * f->trims[i].height;
     double scale = total > k_max_frame_texels ? sqrt(k_max_frame_texels / total) : 1.0;
-    sw_result r = SW_OK;
+    sw_result r = sw__gpu_atlas_begin(f->ctx, status);
     for (size_t i = 0; i < f->n_trims && r == SW_OK; ++i)
         r = make_trim(f, &f->trims[i], scale, status);
+    sw__gpu_atlas_stats as;
+    memset(&as, 0, sizeof as);
+    if (r == SW_OK)
+        r = sw__gpu_atlas_commit(f->ctx, &as, status);
+    f->st.trim_textures = as.entries;
+    f->st.trim_texels = as.entry_texels;
+    f->st.trim_reused = as.reused;
+    f->st.atlas_pages = as.pages;
+    f->st.atlas_texels = (uint64_t)as.pages * (uint64_t)as.side * (uint64_t)as.side;
+    f->st.atlas_switches = as.switches;
     glFinish();
     return r;
 }
 
+/* Fills the records' colour and trim rectangle from their draws (trim entries are known after the
+ * atlas commit) and sorts them by grid class into ctx->recs_sorted (counting sort). */
+static sw_result build_batch(frame *f, sw_status *status)
+{
+    sw_gpu_context *ctx = f->ctx;
+    sw__gpu_patch_batch *b = &f->batch;
+    memset(b, 0, sizeof *b);
+    if (f->n_recs == 0)
+        return SW_OK;
+    if (!grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, f->n_recs,
+              sizeof *ctx->recs_sorted))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
+    for (size_t i = 0; i < f->n_recs; ++i) {
+        sw__gpu_patch_rec *rec = &ctx->recs[i];
+        const sw__gpu_draw *d = &f->draws[rec->draw];
+        memcpy(rec->color, d->color, sizeof rec->color);
+        if (d->trim_entry >= 0) {
+            sw__gpu_trim_rect tr;
+            sw__gpu_atlas_rect(ctx, d->trim_entry, &tr);
+            rec->trim_rect[0] = (float)tr.x0;
+            rec->trim_rect[1] = (float)tr.y0;
+            rec->trim_rect[2] = (float)tr.w;
+            rec->trim_rect[3] = (float)tr.h;
+            rec->layer = (float)tr.layer;
+        }
+        b->count[rec->level_v][rec->level_u]++;
+    }
+    uint32_t at = 0, next[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    for (int v = 0; v < SW__GPU_GRID_CLASSES; ++v)
+        for (int u = 0; u < SW__GPU_GRID_CLASSES; ++u) {
+            b->first[v][u] = next[v][u] = at;
+            at += b->count[v][u];
+        }
+    for (size_t i = 0; i < f->n_recs; ++i) {
+        const sw__gpu_patch_rec *rec = &ctx->recs[i];
+        ctx->recs_sorted[next[rec->level_v][rec->level_u]++] = *rec;
+    }
+    b->recs = ctx->recs_sorted;
+    b->n_recs = f->n_recs;
+    b->cps = ctx->cps;
+    b->n_cps = f->n_cps;
+    return SW_OK;
+}
+
+void sw__gpu_set_eval_mode(sw_gpu_context *ctx, sw__gpu_eval_mode mode)
+{
+    ctx->eval_mode = (int32_t)mode;
+}
+
 static void frame_free(frame *f)
 {
-    for (size_t d = 0; d < f->n_draws; ++d)
-        if (f->draws[d].trim_tex)
-            glDeleteTextures(1, &f->draws[d].trim_tex);
     if (f->bez) {
         for (uint32_t i = 0; i < f->sv->n_faces; ++i) {
             if (f->bez[i]) {
@@ -402,13 +564,16 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
         r = make_trims(&f, status);
     double t2 = sw__gpu_now_ms();
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws, status);
+        r = build_batch(&f, status);
+    if (r == SW_OK)
+        r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws, &f.batch,
+                               status);
     double t3 = sw__gpu_now_ms();
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &f.view, desc.want_depth, out, status);
     double t4 = sw__gpu_now_ms();
 
-    f.st.triangles = f.mesh.n_idx / 3;
+    f.st.triangles += f.mesh.n_idx / 3;
     f.st.ms_tessellate = t1 - t0;
     f.st.ms_trim = t2 - t1;
     f.st.ms_draw = t3 - t2;

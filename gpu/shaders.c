@@ -1,7 +1,8 @@
 /* GLSL programs, embedded as C strings: the mesh program (grids of Bézier patches and plain
  * triangles: reversed-Z projection of camera-relative positions, Lambert + headlight shading, and
  * the trim-texture lookup of Guthe et al. 2005 §4.3 that discards fragments outside the trim
- * region), and the trim program that draws fans and crack-filling lines into a trim texture (§4).
+ * region, read from the trim atlas of §4.4), and the trim program that draws fans and crack-filling
+ * lines into a trim texture (§4).
  */
 #include "sw_gpu_internal.h"
 #include "sw_status_util.h"
@@ -14,40 +15,142 @@ static const char *const k_mesh_vs =
     "layout(location = 1) in vec3 a_nrm;\n"
     "layout(location = 2) in vec2 a_st;\n"
     "uniform mat4 u_view_proj;\n"
+    "uniform vec4 u_color;\n"
+    "uniform vec4 u_trim_rect;\n"
+    "uniform float u_trim_layer;\n"
     "out vec3 v_rel;\n"
     "out vec3 v_nrm;\n"
     "out vec2 v_st;\n"
+    "flat out vec4 v_color;\n"
+    "flat out vec4 v_trim_rect;\n"
+    "flat out float v_trim_layer;\n"
     "void main() {\n"
     "  v_rel = a_pos;\n"
     "  v_nrm = a_nrm;\n"
     "  v_st = a_st;\n"
+    "  v_color = u_color;\n"
+    "  v_trim_rect = u_trim_rect;\n"
+    "  v_trim_layer = u_trim_layer;\n"
     "  gl_Position = u_view_proj * vec4(a_pos, 1.0);\n"
     "}\n";
 
-/* The lookup is clamped half a texel inside the texture so that texelFetch never leaves it and a
- * parameter on the box's edge reads the edge texel (PLATFORM.md: trim parity exactness). Shading
- * is two-sided: the headlight lights whichever side faces the eye. Output is gamma-encoded. */
-static const char *const k_mesh_fs =
+/* Shared by every surface program. The trim lookup (§4.3) reads the face's rectangle of the atlas
+ * (§4.4; rect = x0, y0, w, h in texels, w = 0 untrimmed), clamped half a texel inside the
+ * rectangle so that a parameter on the box's edge reads the edge texel and never the gutter
+ * (PLATFORM.md: trim parity exactness). Shading is two-sided: the headlight lights whichever side
+ * faces the eye. Output is gamma-encoded. */
+static const char *const k_surface_fs =
     "#version 430 core\n"
     "in vec3 v_rel;\n"
     "in vec3 v_nrm;\n"
     "in vec2 v_st;\n"
-    "uniform vec4 u_color;\n"
-    "uniform int u_trimmed;\n"
-    "uniform sampler2D u_trim;\n"
+    "flat in vec4 v_color;\n"
+    "flat in vec4 v_trim_rect;\n"
+    "flat in float v_trim_layer;\n"
+    "uniform sampler2DArray u_trim;\n"
     "layout(location = 0) out vec4 o_color;\n"
     "void main() {\n"
-    "  if (u_trimmed != 0) {\n"
-    "    vec2 size = vec2(textureSize(u_trim, 0));\n"
-    "    vec2 t = clamp(v_st * size, vec2(0.5), size - vec2(0.5));\n"
-    "    if (texelFetch(u_trim, ivec2(t), 0).r < 0.5) discard;\n"
+    "  if (v_trim_rect.z > 0.0) {\n"
+    "    vec2 size = v_trim_rect.zw;\n"
+    "    vec2 t = v_trim_rect.xy + clamp(v_st * size, vec2(0.5), size - vec2(0.5));\n"
+    "    if (texelFetch(u_trim, ivec3(ivec2(t), int(v_trim_layer)), 0).r < 0.5) discard;\n"
     "  }\n"
     "  vec3 n = v_nrm;\n"
     "  float ln = length(n);\n"
     "  float lambert = 1.0;\n"
     "  if (ln > 0.0) lambert = abs(dot(n / ln, normalize(-v_rel)));\n"
-    "  vec3 c = u_color.rgb * (0.2 + 0.8 * lambert);\n"
-    "  o_color = vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)), u_color.a);\n"
+    "  vec3 c = v_color.rgb * (0.2 + 0.8 * lambert);\n"
+    "  o_color = vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)), v_color.a);\n"
+    "}\n";
+
+/* Vertex-shader evaluation of rational Bézier patches of degree <= 3 x 3 on a predefined grid
+ * (§4.2): gl_VertexID gives the grid point, gl_InstanceID (plus the class's first record) the patch
+ * record. Direct evaluation in the Bernstein basis of the homogeneous control points (eye-relative
+ * world, so float keeps sub-pixel accuracy close up) with both first partials, then the division
+ * by w; the normal is the cross product of the rational partials (their w^2-scaled forms). A
+ * collapsed edge (pole) has no normal there: it is taken just inside the patch, like patch_grid.c.
+ * Grid points on a patch's edges get exactly the edge parameter, so patches sharing an edge (and
+ * its control points) produce bit-identical positions along it. */
+static const char *const k_eval_vs =
+    "#version 430 core\n"
+    "struct PatchRec {\n"
+    "  vec4 st; vec4 trim_map; vec4 trim_rect; vec4 color;\n"
+    "  uint cp; int deg_u; int deg_v; float layer;\n"
+    "  float nsign; int draw; int level_u; int level_v;\n"
+    "};\n"
+    "layout(std430, binding = 0) readonly buffer Patches { PatchRec recs[]; };\n"
+    "layout(std430, binding = 1) readonly buffer ControlPoints { vec4 cps[]; };\n"
+    "uniform mat4 u_view_proj;\n"
+    "uniform ivec2 u_grid;\n" /* segments in u, v of this draw's class */
+    "uniform int u_base;\n"   /* first record of this draw */
+    "out vec3 v_rel;\n"
+    "out vec3 v_nrm;\n"
+    "out vec2 v_st;\n"
+    "flat out vec4 v_color;\n"
+    "flat out vec4 v_trim_rect;\n"
+    "flat out float v_trim_layer;\n"
+    "void bern(int p, float s, out float b[4], out float db[4]) {\n"
+    "  float r = 1.0 - s;\n"
+    "  b[0] = 1.0; b[1] = 0.0; b[2] = 0.0; b[3] = 0.0;\n"
+    "  db[0] = 0.0; db[1] = 0.0; db[2] = 0.0; db[3] = 0.0;\n"
+    "  if (p == 1) {\n"
+    "    b[0] = r; b[1] = s; db[0] = -1.0; db[1] = 1.0;\n"
+    "  } else if (p == 2) {\n"
+    "    b[0] = r * r; b[1] = 2.0 * r * s; b[2] = s * s;\n"
+    "    db[0] = -2.0 * r; db[1] = 2.0 * (r - s); db[2] = 2.0 * s;\n"
+    "  } else if (p == 3) {\n"
+    "    b[0] = r * r * r; b[1] = 3.0 * r * r * s; b[2] = 3.0 * r * s * s; b[3] = s * s * s;\n"
+    "    db[0] = -3.0 * r * r; db[1] = 3.0 * r * (r - 2.0 * s);\n"
+    "    db[2] = 3.0 * s * (2.0 * r - s); db[3] = 3.0 * s * s;\n"
+    "  }\n"
+    "}\n"
+    "void eval(PatchRec p, float s, float t, out vec4 h, out vec4 hs, out vec4 ht) {\n"
+    "  float bu[4], dbu[4], bv[4], dbv[4];\n"
+    "  bern(p.deg_u, s, bu, dbu);\n"
+    "  bern(p.deg_v, t, bv, dbv);\n"
+    "  h = vec4(0.0); hs = vec4(0.0); ht = vec4(0.0);\n"
+    "  uint at = p.cp;\n"
+    "  for (int j = 0; j <= p.deg_v; ++j) {\n"
+    "    vec4 row = vec4(0.0), rows = vec4(0.0);\n"
+    "    for (int i = 0; i <= p.deg_u; ++i, ++at) {\n"
+    "      vec4 c = cps[at];\n"
+    "      row += bu[i] * c;\n"
+    "      rows += dbu[i] * c;\n"
+    "    }\n"
+    "    h += bv[j] * row; hs += bv[j] * rows; ht += dbv[j] * row;\n"
+    "  }\n"
+    "}\n"
+    "vec3 normal_of(vec4 h, vec4 hs, vec4 ht, out float ok) {\n"
+    "  vec3 ds = hs.xyz * h.w - h.xyz * hs.w, dt = ht.xyz * h.w - h.xyz * ht.w;\n"
+    "  vec3 n = cross(ds, dt);\n"
+    "  ok = length(n) > 1e-6 * length(ds) * length(dt) ? 1.0 : 0.0;\n"
+    "  return n;\n"
+    "}\n"
+    "void main() {\n"
+    "  PatchRec p = recs[u_base + gl_InstanceID];\n"
+    "  int i = gl_VertexID % (u_grid.x + 1), j = gl_VertexID / (u_grid.x + 1);\n"
+    "  float s = i == u_grid.x ? p.st.y : p.st.x + (p.st.y - p.st.x) * float(i) / "
+    "float(u_grid.x);\n"
+    "  float t = j == u_grid.y ? p.st.w : p.st.z + (p.st.w - p.st.z) * float(j) / "
+    "float(u_grid.y);\n"
+    "  vec4 h, hs, ht;\n"
+    "  eval(p, s, t, h, hs, ht);\n"
+    "  float ok;\n"
+    "  vec3 n = normal_of(h, hs, ht, ok);\n"
+    "  if (ok == 0.0) {\n"
+    "    vec4 h2, hs2, ht2;\n"
+    "    eval(p, s + 1e-3 * (0.5 - s), t + 1e-3 * (0.5 - t), h2, hs2, ht2);\n"
+    "    n = normal_of(h2, hs2, ht2, ok);\n"
+    "  }\n"
+    "  vec3 pos = h.xyz / h.w;\n"
+    "  float ln = length(n);\n"
+    "  v_nrm = ln > 0.0 ? p.nsign * n / ln : vec3(0.0);\n"
+    "  v_rel = pos;\n"
+    "  v_st = vec2(p.trim_map.x + s * p.trim_map.y, p.trim_map.z + t * p.trim_map.w);\n"
+    "  v_color = p.color;\n"
+    "  v_trim_rect = p.trim_rect;\n"
+    "  v_trim_layer = p.layer;\n"
+    "  gl_Position = u_view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
 static const char *const k_trim_vs = "#version 430 core\n"
@@ -108,15 +211,23 @@ static sw_result link(const char *vs, const char *fs, const char *what, GLuint *
 
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
 {
-    sw_result r = link(k_mesh_vs, k_mesh_fs, "mesh", &ctx->prog_mesh, status);
+    sw_result r = link(k_mesh_vs, k_surface_fs, "mesh", &ctx->prog_mesh, status);
     if (r != SW_OK)
         return r;
     r = link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
     if (r != SW_OK)
         return r;
+    r = link(k_eval_vs, k_surface_fs, "patch evaluation", &ctx->prog_eval, status);
+    if (r != SW_OK)
+        return r;
+    ctx->loc_eval_view_proj = glGetUniformLocation(ctx->prog_eval, "u_view_proj");
+    ctx->loc_eval_grid = glGetUniformLocation(ctx->prog_eval, "u_grid");
+    ctx->loc_eval_base = glGetUniformLocation(ctx->prog_eval, "u_base");
+    ctx->loc_eval_trim = glGetUniformLocation(ctx->prog_eval, "u_trim");
     ctx->loc_view_proj = glGetUniformLocation(ctx->prog_mesh, "u_view_proj");
     ctx->loc_color = glGetUniformLocation(ctx->prog_mesh, "u_color");
-    ctx->loc_trimmed = glGetUniformLocation(ctx->prog_mesh, "u_trimmed");
+    ctx->loc_trim_rect = glGetUniformLocation(ctx->prog_mesh, "u_trim_rect");
+    ctx->loc_trim_layer = glGetUniformLocation(ctx->prog_mesh, "u_trim_layer");
     ctx->loc_trim = glGetUniformLocation(ctx->prog_mesh, "u_trim");
     return sw__gpu_check(status, "program set-up");
 }
@@ -125,5 +236,6 @@ void sw__gpu_programs_free(sw_gpu_context *ctx)
 {
     glDeleteProgram(ctx->prog_mesh);
     glDeleteProgram(ctx->prog_trim);
-    ctx->prog_mesh = ctx->prog_trim = 0;
+    glDeleteProgram(ctx->prog_eval);
+    ctx->prog_mesh = ctx->prog_trim = ctx->prog_eval = 0;
 }

@@ -54,6 +54,13 @@ typedef struct sw_gpu_frame_stats {
     double ms_trim;       /* trim-texture generation */
     double ms_draw;       /* draw submission until glFinish */
     double ms_readback;
+    /* trim-texture atlas (Guthe §4.4), kept in the context across frames */
+    uint64_t atlas_pages;         /* pages (layers) after this frame */
+    uint64_t atlas_texels;        /* texels of those pages */
+    uint64_t trim_reused;         /* trim textures kept from an earlier frame (of trim_textures) */
+    uint64_t atlas_switches;      /* render-target switches for trim generation in this frame */
+    uint64_t patches_gpu_evaluated; /* drawn patches evaluated in the vertex shader (§4.2); the
+                                       others are CPU grids */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

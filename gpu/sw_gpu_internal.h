@@ -17,13 +17,42 @@
 extern "C" {
 #endif
 
+/* Grid classes (§4.2): base grids of 1 and 3 segments subdivided by powers of two, per direction
+ * independently: sw__gpu_grid_segments[c] = 1, 2, 3, 4, 6, 8, ..., 48, 64 (grid_set.c). */
+enum { SW__GPU_GRID_CLASSES = 12, SW__GPU_GRID_MAX = 64 };
+extern const int32_t sw__gpu_grid_segments[SW__GPU_GRID_CLASSES];
+
+/* How patches are tessellated. AUTO: rational Bézier patches of degree <= 3 x 3 evaluated in the
+ * vertex shader on predefined grids, others as CPU grids. CPU_GRIDS: every patch as a CPU grid
+ * (the reference the GPU path is compared with in tests). */
+typedef enum sw__gpu_eval_mode {
+    SW__GPU_EVAL_AUTO = 0,
+    SW__GPU_EVAL_CPU_GRIDS = 1
+} sw__gpu_eval_mode;
+void sw__gpu_set_eval_mode(sw_gpu_context *ctx, sw__gpu_eval_mode mode);
+
+/* One instance of a predefined grid: a rational Bézier patch (or a piece of its domain) evaluated
+ * by the vertex shader. std430 layout, mirrored by the GLSL struct in shaders.c (96 bytes). */
+typedef struct sw__gpu_patch_rec {
+    float st[4];        /* s0, s1, t0, t1: the part of the local domain [0,1]^2 sampled */
+    float trim_map[4];  /* trim lookup: (m0 + s m1, m2 + t m3) in the face's uv box's [0,1]^2 */
+    float trim_rect[4]; /* atlas rectangle x0, y0, w, h in texels; w = 0 untrimmed */
+    float color[4];
+    uint32_t cp; /* first control point (vec4 index into the control-point buffer) */
+    int32_t deg_u, deg_v;
+    float layer; /* atlas layer */
+    float normal_sign;
+    int32_t draw;             /* CPU side: the frame draw holding the colour and the trim entry */
+    int32_t level_u, level_v; /* grid class: sw__gpu_grid_segments[level] segments */
+} sw__gpu_patch_rec;
+
 struct sw_gpu_context {
     void *egl_display, *egl_context; /* EGLDisplay, EGLContext */
     char description[256];
     GLint max_texture_size;
     /* grid / triangle program */
     GLuint prog_mesh;
-    GLint loc_view_proj, loc_color, loc_trimmed, loc_trim;
+    GLint loc_view_proj, loc_color, loc_trim;
     /* trim-texture program: 2D positions in clip space, constant colour */
     GLuint prog_trim;
     GLuint vao;
@@ -32,6 +61,24 @@ struct sw_gpu_context {
     int32_t fbo_w, fbo_h;
     GLuint trim_fbo, trim_vbo;
     GLuint mesh_vbo, mesh_ibo; /* per-frame streaming buffers */
+    GLint loc_trim_rect;       /* mesh program: atlas rectangle (x0, y0, w, h), w = 0 untrimmed */
+    GLint loc_trim_layer;
+    struct sw__gpu_atlas *atlas; /* trim-texture atlas kept across frames (trim_atlas.c) */
+    /* vertex-shader evaluation of rational Bézier patches (§4.2; shaders.c, grid_set.c) */
+    GLuint prog_eval;
+    GLint loc_eval_view_proj, loc_eval_grid, loc_eval_base, loc_eval_trim;
+    GLuint grid_ibo; /* every grid class's triangles, one after another */
+    uint32_t grid_first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* [level v][level u] */
+    uint32_t grid_count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    GLuint patch_ssbo, cp_ssbo; /* per-frame patch records and control points */
+    int32_t eval_mode;          /* sw__gpu_eval_mode */
+    /* per-frame scratch kept between frames (no per-frame allocation once grown) */
+    struct sw__gpu_patch_rec *recs;
+    size_t cap_recs;
+    float *cps;
+    size_t cap_cps;
+    struct sw__gpu_patch_rec *recs_sorted;
+    size_t cap_recs_sorted;
 };
 
 /* Last GL error as SW_ERR_GL naming `what`, or SW_OK. */
@@ -104,35 +151,107 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
                                   sw_status *status);
 
 /* ---- trim textures (trim_texture.c) --------------------------------------------------------- */
-/* Renders loops (polylines in face parameters) into a new R8 texture of w x h texels spanning
- * uv_box: fans from each loop's first vertex toggle texels (even-odd parity, §4), then the loops
- * drawn as 1-pixel line loops SET their texels (§7.1 crack filling: boundary texels are inside).
- * The texture is returned in *tex (GL name, owned by the caller). */
-sw_result sw__gpu_trim_texture_make(sw_gpu_context *ctx, const sw_sg_polyline *loops,
-                                    uint32_t n_loops, const double uv_box[4], int32_t w, int32_t h,
-                                    GLuint *tex, sw_status *status);
-/* Reads a trim texture back (w*h bytes, row 0 = v0 side). */
-sw_result sw__gpu_trim_texture_read(sw_gpu_context *ctx, GLuint tex, int32_t w, int32_t h,
-                                    uint8_t *out, sw_status *status);
+/* Renders loops already in the clip space of one atlas page into layer `layer` of the R8 array
+ * texture `tex` (side x side texels per layer): fans from each loop's first vertex toggle texels
+ * (even-odd parity, §4), then every loop drawn as a 1-pixel line loop SETS its texels (§7.1 crack
+ * filling: boundary texels are inside). One render-target switch; two multi-draw calls.
+ * Loops with fewer than 3 (fans) or 2 (lines) vertices are skipped. */
+void sw__gpu_trim_page_draw(sw_gpu_context *ctx, GLuint tex, int32_t layer, int32_t side,
+                            const float *xy, size_t n_xy, const GLint *first, const GLsizei *count,
+                            GLsizei n_loops);
+
+/* ---- trim-texture atlas (trim_atlas.c, §4.4) ------------------------------------------------- */
+/* Identity of a trim texture: the scene, the face and what its loops are (checked on reuse). */
+typedef struct sw__gpu_trim_key {
+    const void *scene;
+    uint32_t face, first_loop, n_loops;
+    double uv_box[4];
+} sw__gpu_trim_key;
+
+/* Where an entry's texels are: layer of the atlas array texture, rectangle in texels. */
+typedef struct sw__gpu_trim_rect {
+    int32_t layer, x0, y0, w, h;
+} sw__gpu_trim_rect;
+
+typedef struct sw__gpu_atlas_stats {
+    uint32_t pages;        /* layers of the atlas */
+    int32_t side;          /* texels per page side */
+    uint32_t entries;      /* used this frame */
+    uint32_t reused;       /* used this frame, rendered in an earlier one */
+    uint32_t rendered;     /* rendered this frame */
+    uint32_t switches;     /* render-target switches this frame */
+    uint32_t repacks;      /* full repacks this frame (0 or 1) */
+    uint64_t entry_texels; /* texels of the entries used this frame */
+} sw__gpu_atlas_stats;
+
+enum { SW__GPU_ATLAS_GUTTER = 2 }; /* texels around every entry */
+
+/* Frame protocol, GL thread only: begin; per trimmed face find, and on a miss add; commit
+ * (placement and rendering); then rect / texture for the draws. Entry ids are valid from find/add
+ * until the next begin. */
+sw_result sw__gpu_atlas_begin(sw_gpu_context *ctx, sw_status *status);
+/* Largest page side (power of two) the atlas may use; 0 = min(4096, GL_MAX_TEXTURE_SIZE).
+ * Takes effect at the next repack. For tests. */
+void sw__gpu_atlas_set_max_side(sw_gpu_context *ctx, int32_t side);
+/* Largest entry (w, h) that fits a page: side - 2 gutters. */
+int32_t sw__gpu_atlas_max_entry(const sw_gpu_context *ctx);
+/* Entry id of a cached (or already added this frame) texture of w x h texels for key, marking it
+ * used; -1 when absent. */
+int32_t sw__gpu_atlas_find(sw_gpu_context *ctx, const sw__gpu_trim_key *key, int32_t w, int32_t h);
+/* Adds a texture of w x h texels for key whose loops (face parameters) span key->uv_box; copies
+ * the loops. Errors: SW_ERR_LIMIT (w or h above sw__gpu_atlas_max_entry), SW_ERR_OUT_OF_MEMORY,
+ * SW_ERR_INVALID_GEOMETRY (empty uv box). */
+sw_result sw__gpu_atlas_add(sw_gpu_context *ctx, const sw__gpu_trim_key *key, int32_t w, int32_t h,
+                            const sw_sg_polyline *loops, uint32_t n_loops, int32_t *entry,
+                            sw_status *status);
+/* Places the entries added since begin (shelf packing by height into free space, or a repack of
+ * every entry used this frame when they do not fit) and renders them, one render-target switch per
+ * page. Errors: SW_ERR_GL, SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+sw_result sw__gpu_atlas_commit(sw_gpu_context *ctx, sw__gpu_atlas_stats *stats, sw_status *status);
+void sw__gpu_atlas_rect(const sw_gpu_context *ctx, int32_t entry, sw__gpu_trim_rect *out);
+/* Forgets every entry but keeps the pages: the next frame regenerates every trim texture, as the
+ * paper does each frame (benchmarks). */
+void sw__gpu_atlas_invalidate(sw_gpu_context *ctx);
+/* Reads layer `layer` of the atlas back (side*side bytes, row 0 at y = 0); side in *side. */
+sw_result sw__gpu_atlas_read_page(sw_gpu_context *ctx, int32_t layer, uint8_t *out, size_t size,
+                                  int32_t *side, sw_status *status);
+/* The atlas's GL_TEXTURE_2D_ARRAY (0 before the first commit with entries). */
+GLuint sw__gpu_atlas_texture(const sw_gpu_context *ctx);
+void sw__gpu_atlas_free(sw_gpu_context *ctx);
 
 /* ---- drawing and readback (draw.c) ----------------------------------------------------------- */
 /* A range of the frame's index buffer drawn with one colour and trim texture (0 = untrimmed). */
 typedef struct sw__gpu_draw {
     size_t first_idx, n_idx;
     float color[4];
-    GLuint trim_tex;
+    int32_t trim_entry; /* atlas entry, -1 = untrimmed */
 } sw__gpu_draw;
+
+/* The frame's GPU-evaluated patches: records sorted by grid class, control points. */
+typedef struct sw__gpu_patch_batch {
+    const sw__gpu_patch_rec *recs;
+    size_t n_recs;
+    const float *cps; /* 4 floats per control point */
+    size_t n_cps;
+    uint32_t first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* records of each class */
+    uint32_t count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+} sw__gpu_patch_batch;
+
+/* Creates the grid classes' index buffer (grid_set.c). */
+sw_result sw__gpu_grids_create(sw_gpu_context *ctx, sw_status *status);
+void sw__gpu_grids_free(sw_gpu_context *ctx);
 
 /* Fills the defaults of a frame description (size 1280 x 720, error 0.5 px). */
 void sw__gpu_desc_defaults(const sw_gpu_frame_desc *in, sw_gpu_frame_desc *out);
 /* Near plane for a scene box in world coordinates seen from eye: max(1e-4 x diagonal, half the
  * eye's distance to the box), never 0. */
 double sw__gpu_near_plane(const double eye[3], const double world_box[6]);
-/* Clears the render target, uploads `mesh` and draws every range with reversed-Z depth; waits for
- * the GPU (glFinish) so that the caller's timing is the real draw time. */
+/* Clears the render target, uploads `mesh` and draws every range with reversed-Z depth, then the
+ * batch's patches (NULL = none) with one instanced draw per grid class; waits for the GPU
+ * (glFinish) so that the caller's timing is the real draw time. */
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, const float bg[4],
                              const sw__gpu_mesh *mesh, const sw__gpu_draw *draws, size_t n_draws,
-                             sw_status *status);
+                             const sw__gpu_patch_batch *batch, sw_status *status);
 /* Reads the frame back into `out` (rows top first; depth as eye-space depth, +INF background). */
 sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int want_depth,
                            sw_gpu_image *out, sw_status *status);
