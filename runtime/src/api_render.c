@@ -96,6 +96,9 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->triangles = g->triangles;
     out->trim_textures = g->trim_textures;
     out->trim_texels = g->trim_texels;
+    out->patches_gpu_evaluated = g->patches_gpu_evaluated;
+    out->atlas_pages = g->atlas_pages;
+    out->trim_reused = g->trim_reused;
     out->ms_tessellate = g->ms_tessellate;
     out->ms_trim = g->ms_trim;
     out->ms_draw = g->ms_draw;

@@ -118,6 +118,8 @@ typedef struct sw_frame_stats {
     uint64_t faces_drawn, faces_culled;
     uint64_t patches_trimmed, patches_untrimmed, patches_culled;
     uint64_t triangles, trim_textures, trim_texels;
+    uint64_t patches_gpu_evaluated; /* evaluated in the vertex shader; the rest are CPU grids */
+    uint64_t atlas_pages, trim_reused; /* trim-texture atlas pages; textures kept from before */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
 } sw_frame_stats;
 
