@@ -4,6 +4,9 @@
  * functions and their derivatives are A2.2/A2.3 (Cox-de Boor triangle, then derivatives from its
  * lower half). Everything lives in fixed stack arrays sized by SW_SG_MAX_DEGREE + 1, so evaluation
  * never allocates. Guthe et al. 2005 §3 and §4.2 start from surfaces evaluated this way.
+ * The derivative rows are ~ (degree / knot span)^k large and cancel when contracted with poles, so
+ * in short spans they lose accuracy to the poles' magnitude: nurbs_eval.c differences the poles
+ * instead and keeps only the Cox-de Boor triangle; this function serves callers that need N^(k).
  */
 #include "sw_sg_geom.h"
 

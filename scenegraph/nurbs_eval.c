@@ -1,12 +1,24 @@
 /* Evaluation of rational B-spline curves and surfaces in homogeneous form (double precision).
  *
- * Points and derivatives are first computed for the homogeneous form S^w = (w*x, w*y, w*z, w)
- * (The NURBS Book A3.2/A3.6), then projected; the Euclidean derivatives follow from the quotient
- * rule (A4.4): with A = w*S,
+ * Derivatives are not taken from derivatives of the basis functions (The NURBS Book A2.3), whose
+ * terms are ~ degree / knot-span large and cancel: in a span of width h next to spans of width 1
+ * (hammer.brep, Top.brep: h = 1e-3 .. 4e-8) that loses a factor (1/h)^order of accuracy to the
+ * magnitude of the poles. Instead the poles of the span are differenced first, into the control
+ * points of the derivative (A3.3, A3.7: P^(k)_i = (p-k+1) (P^(k-1)_i+1 - P^(k-1)_i) /
+ * (t_i+p+1 - t_i+k)), which are then contracted with the basis values of degree p-k (A2.2, all
+ * degrees come from one Cox-de Boor triangle, A3.4/A3.8). Differences of neighbouring poles are
+ * exact or rounded relative to themselves, and the contraction is a convex combination, so each
+ * derivative is accurate relative to its own control points. Differencing happens on the poles in
+ * both directions before any contraction: a v-derivative never differences u-contracted values.
+ *
+ * The Euclidean derivatives follow from the quotient rule (A4.4) on the homogeneous form A = w*S:
  *   S_u  = (A_u - w_u S) / w,
  *   S_uu = (A_uu - 2 w_u S_u - w_uu S) / w,  S_uv = (A_uv - w_u S_v - w_v S_u - w_uv S) / w.
+ * What is left is the conditioning of the homogeneous form itself: w*P is rounded when stored,
+ * and A_uv holds w_uv S at the poles' absolute magnitude (moving to a local origin would need
+ * exact products, i.e. FMA, to gain anything); both stay ~1e-12 relative on the sample models.
  * Guthe et al. 2005 §4.2 evaluates the same rational form (on the GPU, per Bézier patch).
- * No heap allocation: basis rows live in stack arrays sized by SW_SG_MAX_DEGREE + 1.
+ * No heap allocation: every buffer is a stack array sized by SW_SG_MAX_DEGREE + 1.
  */
 #include "sw_sg_geom.h"
 
@@ -14,86 +26,179 @@
 #include <string.h>
 
 #define SW__P1 (SW_SG_MAX_DEGREE + 1)
+#define SW__ND 2       /* highest derivative order evaluated */
+#define SW__MAX_DIM 16 /* sw_sg_curve_validate's bound on the homogeneous dimension */
+
+/* One parameter's span: basis values of degrees p, p-1, p-2 and the factors that turn pole
+ * differences into derivative control points. */
+typedef struct span_basis {
+    int32_t span, p;
+    int32_t nd; /* derivative orders kept: min(requested, p); higher ones vanish */
+    double n[SW__ND + 1][SW__P1]; /* n[k][r] = N_{span-p+k+r, p-k}(t), r = 0..p-k */
+    double s[SW__ND][SW__P1];     /* s[k-1][i] = (p-k+1) / (t_{span+i+1} - t_{span-p+i+k}) */
+} span_basis;
+
+static void span_basis_init(span_basis *b, const double *knots, int32_t p, int32_t n, double t,
+                            int32_t nd)
+{
+    assert(p >= 0 && p <= SW_SG_MAX_DEGREE && nd >= 0 && nd <= SW__ND);
+    const int32_t span = sw_sg_knots_find_span(knots, p, n, t);
+    double left[SW__P1], right[SW__P1], nb[SW__P1];
+    b->span = span;
+    b->p = p;
+    b->nd = nd < p ? nd : p;
+    nb[0] = 1.0;
+    if (p <= b->nd)
+        b->n[p][0] = 1.0;
+    /* A2.2; the degree-j row is kept once p - j is an order we need. */
+    for (int32_t j = 1; j <= p; j++) {
+        left[j] = t - knots[span + 1 - j];
+        right[j] = knots[span + j] - t;
+        double saved = 0.0;
+        for (int32_t r = 0; r < j; r++) {
+            /* Within a non-empty span these knot differences are never zero. */
+            const double temp = nb[r] / (right[r + 1] + left[j - r]);
+            nb[r] = saved + right[r + 1] * temp;
+            saved = left[j - r] * temp;
+        }
+        nb[j] = saved;
+        if (p - j <= b->nd)
+            memcpy(b->n[p - j], nb, sizeof(double) * (size_t)(j + 1));
+    }
+    /* The denominators hold the span itself, so they are never zero either. */
+    for (int32_t k = 1; k <= b->nd; k++)
+        for (int32_t i = 0; i <= p - k; i++)
+            b->s[k - 1][i] = (double)(p - k + 1) / (knots[span + i + 1] - knots[span - p + i + k]);
+}
+
+/* The control points of derivative k (count - 1 points) from those of derivative k - 1 (count
+ * points), `dim` doubles each: the step of A3.3. */
+static void diff_points(const double *in, int32_t count, int32_t dim, const double *scale,
+                        double *out)
+{
+    for (int32_t i = 0; i + 1 < count; i++)
+        for (int32_t d = 0; d < dim; d++)
+            out[i * dim + d] = scale[i] * (in[(i + 1) * dim + d] - in[i * dim + d]);
+}
+
+/* out[d] = sum_r basis[r] * pts[r * dim + d], r < count. */
+static void contract(const double *basis, const double *pts, int32_t count, int32_t dim,
+                     double *out)
+{
+    for (int32_t d = 0; d < dim; d++)
+        out[d] = 0.0;
+    for (int32_t r = 0; r < count; r++)
+        for (int32_t d = 0; d < dim; d++)
+            out[d] += basis[r] * pts[r * dim + d];
+}
+
+/* Derivatives 0..b->nd of a curve whose local control points (p + 1 of them, `dim` doubles
+ * each, p = b->p) are `pts`: out[k * dim + d]. */
+static void curve_ders_local(const span_basis *b, const double *pts, int32_t dim, double *out)
+{
+    double d1[SW__P1 * SW__MAX_DIM], d2[SW__P1 * SW__MAX_DIM];
+    const int32_t p = b->p;
+    contract(b->n[0], pts, p + 1, dim, out);
+    if (b->nd >= 1) {
+        diff_points(pts, p + 1, dim, b->s[0], d1);
+        contract(b->n[1], d1, p, dim, out + dim);
+    }
+    if (b->nd >= 2) {
+        diff_points(d1, p, dim, b->s[1], d2);
+        contract(b->n[2], d2, p - 1, dim, out + 2 * dim);
+    }
+}
 
 void sw_sg_curve_eval_h(const sw_sg_curve *c, double t, int32_t nd, double *out)
 {
-    assert(c && out && nd >= 0 && nd <= 2 && c->degree <= SW_SG_MAX_DEGREE);
-    const int32_t p = c->degree, dim = c->dim;
-    double ders[3 * SW__P1];
-    const int32_t span = sw_sg_knots_find_span(c->knots, p, c->n, t);
-    sw_sg_basis_ders(c->knots, p, span, t, nd, ders);
-
-    memset(out, 0, sizeof(double) * (size_t)((nd + 1) * dim));
-    for (int32_t r = 0; r <= p; r++) {
-        const double *pw = c->cpw + (size_t)(span - p + r) * (size_t)dim;
-        for (int32_t k = 0; k <= nd; k++) {
-            const double b = ders[k * (p + 1) + r];
-            for (int32_t d = 0; d < dim; d++)
-                out[k * dim + d] += b * pw[d];
-        }
-    }
+    assert(c && out && nd >= 0 && nd <= SW__ND && c->dim >= 1 && c->dim <= SW__MAX_DIM);
+    span_basis b;
+    span_basis_init(&b, c->knots, c->degree, c->n, t, nd);
+    const double *pts = c->cpw + (size_t)(b.span - c->degree) * (size_t)c->dim;
+    curve_ders_local(&b, pts, c->dim, out);
+    for (int32_t k = b.nd + 1; k <= nd; k++)
+        memset(out + k * c->dim, 0, sizeof(double) * (size_t)c->dim);
 }
 
 void sw_sg_curve_eval(const sw_sg_curve *c, double t, double *out)
 {
-    assert(c && out && c->dim >= 2);
-    const int32_t p = c->degree, dim = c->dim;
-    double n0[SW__P1];
-    const int32_t span = sw_sg_knots_find_span(c->knots, p, c->n, t);
-    sw_sg_basis_ders(c->knots, p, span, t, 0, n0);
-
-    double w = 0.0;
-    for (int32_t d = 0; d < dim - 1; d++)
-        out[d] = 0.0;
-    for (int32_t r = 0; r <= p; r++) {
-        const double *pw = c->cpw + (size_t)(span - p + r) * (size_t)dim;
-        for (int32_t d = 0; d < dim - 1; d++)
-            out[d] += n0[r] * pw[d];
-        w += n0[r] * pw[dim - 1];
-    }
-    for (int32_t d = 0; d < dim - 1; d++)
-        out[d] /= w;
+    assert(c && out && c->dim >= 2 && c->dim <= SW__MAX_DIM);
+    double h[SW__MAX_DIM];
+    sw_sg_curve_eval_h(c, t, 0, h);
+    for (int32_t d = 0; d < c->dim - 1; d++)
+        out[d] = h[d] / h[c->dim - 1];
 }
 
-/* Homogeneous partial derivatives A[k][l] = d^{k+l} S^w / du^k dv^l for k, l <= nd (A3.6). */
-static void surface_eval_h(const sw_sg_surface *s, double u, double v, int32_t nd,
-                           double a[3][3][4])
-{
-    assert(s && nd >= 0 && nd <= 2);
-    assert(s->deg_u <= SW_SG_MAX_DEGREE && s->deg_v <= SW_SG_MAX_DEGREE);
-    const int32_t p = s->deg_u, q = s->deg_v;
-    double nu[3 * SW__P1], nv[3 * SW__P1];
-    const int32_t su = sw_sg_knots_find_span(s->knots_u, p, s->n_u, u);
-    const int32_t sv = sw_sg_knots_find_span(s->knots_v, q, s->n_v, v);
-    sw_sg_basis_ders(s->knots_u, p, su, u, nd, nu);
-    sw_sg_basis_ders(s->knots_v, q, sv, v, nd, nv);
+/* The homogeneous partials a[k][l] = d^{k+l} S^w / du^k dv^l, k + l <= nd, of a surface at the
+ * spans of bu and bv. Each row of the (p+1) x (q+1) local net is differenced in v (up to the
+ * order still needed) from the raw poles, then in u, then contracted in u and accumulated in v:
+ * rows of v-order l arrive with a lag of l rows, so three raw rows suffice. */
+typedef struct surface_acc {
+    const span_basis *bu, *bv;
+    int32_t nd;
+    double a[SW__ND + 1][SW__ND + 1][4];
+} surface_acc;
 
-    memset(a, 0, sizeof(double) * 3 * 3 * 4);
+/* One row (local v index j) of the net differenced l times in v: adds its contribution to every
+ * a[k][l] with k + l <= nd. */
+static void surface_add_row(surface_acc *acc, int32_t l, int32_t j, const double *row)
+{
+    const span_basis *bu = acc->bu;
+    const int32_t p = bu->p;
+    const int32_t kmax = acc->nd - l < bu->nd ? acc->nd - l : bu->nd;
+    double d1[SW__P1 * 4], d2[SW__P1 * 4], r[4];
+    const double *net = row;
+    for (int32_t k = 0; k <= kmax; k++) {
+        if (k == 1) {
+            diff_points(row, p + 1, 4, bu->s[0], d1);
+            net = d1;
+        } else if (k == 2) {
+            diff_points(d1, p, 4, bu->s[1], d2);
+            net = d2;
+        }
+        contract(bu->n[k], net, p + 1 - k, 4, r);
+        const double nv = acc->bv->n[l][j];
+        for (int32_t d = 0; d < 4; d++)
+            acc->a[k][l][d] += nv * r[d];
+    }
+}
+
+static void surface_eval_h(const sw_sg_surface *s, double u, double v, int32_t nd,
+                           double a[SW__ND + 1][SW__ND + 1][4])
+{
+    assert(s && nd >= 0 && nd <= SW__ND);
+    span_basis bu, bv;
+    span_basis_init(&bu, s->knots_u, s->deg_u, s->n_u, u, nd);
+    span_basis_init(&bv, s->knots_v, s->deg_v, s->n_v, v, nd);
+    const int32_t p = bu.p, q = bv.p;
+    surface_acc acc = {.bu = &bu, .bv = &bv, .nd = nd};
+    double e1[2][SW__P1 * 4], e2[SW__P1 * 4];
+    const double *base =
+        s->cpw + ((size_t)(bv.span - q) * (size_t)s->n_u + (size_t)(bu.span - p)) * 4;
     for (int32_t j = 0; j <= q; j++) {
-        /* Row j of the net contracted with the u-basis, for each u-derivative order. */
-        double row[3][4] = {{0}};
-        const double *base =
-            s->cpw + ((size_t)(sv - q + j) * (size_t)s->n_u + (size_t)(su - p)) * 4;
-        for (int32_t i = 0; i <= p; i++) {
-            const double *pw = base + (size_t)i * 4;
-            for (int32_t k = 0; k <= nd; k++) {
-                const double b = nu[k * (p + 1) + i];
-                for (int32_t d = 0; d < 4; d++)
-                    row[k][d] += b * pw[d];
+        const double *row = base + (size_t)j * (size_t)s->n_u * 4;
+        surface_add_row(&acc, 0, j, row);
+        if (bv.nd >= 1 && j >= 1) {
+            /* e1[j & 1]: row j - 1 of the first v-differences */
+            const double *prev = row - (size_t)s->n_u * 4;
+            double *cur = e1[j & 1];
+            for (int32_t i = 0; i < (p + 1) * 4; i++)
+                cur[i] = bv.s[0][j - 1] * (row[i] - prev[i]);
+            surface_add_row(&acc, 1, j - 1, cur);
+            if (bv.nd >= 2 && j >= 2) {
+                const double *old = e1[(j - 1) & 1];
+                for (int32_t i = 0; i < (p + 1) * 4; i++)
+                    e2[i] = bv.s[1][j - 2] * (cur[i] - old[i]);
+                surface_add_row(&acc, 2, j - 2, e2);
             }
         }
-        for (int32_t k = 0; k <= nd; k++)
-            for (int32_t l = 0; k + l <= nd; l++) {
-                const double b = nv[l * (q + 1) + j];
-                for (int32_t d = 0; d < 4; d++)
-                    a[k][l][d] += b * row[k][d];
-            }
     }
+    memcpy(a, acc.a, sizeof(acc.a));
 }
 
 void sw_sg_surface_eval(const sw_sg_surface *s, double u, double v, double p[3])
 {
-    double a[3][3][4];
+    double a[SW__ND + 1][SW__ND + 1][4];
     surface_eval_h(s, u, v, 0, a);
     for (int d = 0; d < 3; d++)
         p[d] = a[0][0][d] / a[0][0][3];
@@ -101,7 +206,7 @@ void sw_sg_surface_eval(const sw_sg_surface *s, double u, double v, double p[3])
 
 void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[12])
 {
-    double a[3][3][4];
+    double a[SW__ND + 1][SW__ND + 1][4];
     surface_eval_h(s, u, v, 1, a);
     for (int d = 0; d < 4; d++) {
         h[d] = a[0][0][d];
@@ -113,7 +218,7 @@ void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[
 void sw_sg_surface_eval_d2(const sw_sg_surface *s, double u, double v, sw_sg_surface_d2 *out)
 {
     assert(out);
-    double a[3][3][4];
+    double a[SW__ND + 1][SW__ND + 1][4];
     surface_eval_h(s, u, v, 2, a);
     const double w = a[0][0][3], wu = a[1][0][3], wv = a[0][1][3];
     const double wuu = a[2][0][3], wuv = a[1][1][3], wvv = a[0][2][3];

@@ -2,9 +2,12 @@
  * degree and dimension, evaluated in homogeneous form in double precision; knot insertion and
  * extraction into rational Bézier patches.
  *
- * Algorithms: de Boor / Cox basis functions with derivatives (Piegpl & Tiller, The NURBS Book,
- * A2.2-A2.3), rational derivatives by the quotient rule on the homogeneous form (A4.4), Boehm knot
- * insertion (A5.1) and Bézier extraction by knot refinement (A5.6). Guthe et al. 2005 §3 starts the
+ * Algorithms: Cox-de Boor basis functions (Piegl & Tiller, The NURBS Book, A2.2); derivatives
+ * from differences of the span's poles times lower-degree basis values (derivative control points,
+ * A3.3/A3.7), which stay accurate where knot spans of 1e-8 sit next to spans of 1 — the basis-
+ * derivative form (A2.3) loses digits there (nurbs_eval.c); rational derivatives by the quotient
+ * rule on the homogeneous form (A4.4), Boehm knot insertion (A5.1) and Bézier extraction by knot
+ * refinement (A5.6). Guthe et al. 2005 §3 starts the
  * GPU pipeline from exactly these rational Bézier patches.
  *
  * Conventions shared by all functions below:
