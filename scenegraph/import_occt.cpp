@@ -26,6 +26,9 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Reader.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_Printer.hxx>
 #include <NCollection_DataMap.hxx>
 #include <Quantity_ColorRGBA.hxx>
 #include <STEPCAFControl_Reader.hxx>
@@ -493,6 +496,54 @@ class importer
     std::string label_name(const TDF_Label &l) const;
 };
 
+/* OCCT's readers report through the process-wide default messenger, whose printer writes to
+ * stdout ("Total number of loaded entities ..." in colour) — which would corrupt `info --json` and
+ * any host's output. While a file is read, the default printers are set aside and replaced by one
+ * that forwards warnings and failures to the import's warning callback and drops the chatter.
+ * The messenger is global: concurrent imports share the swap (each restores what it saw). */
+class forward_printer : public Message_Printer
+{
+  public:
+    forward_printer(sw_sg_warning_fn fn, void *user, std::string prefix)
+        : fn_(fn), user_(user), prefix_(std::move(prefix))
+    {
+        myTraceLevel = Message_Warning;
+    }
+
+  protected:
+    void send(const TCollection_AsciiString &text, const Message_Gravity gravity) const override
+    {
+        if (fn_ && gravity >= Message_Warning)
+            fn_(user_, (prefix_ + ": OCCT: " + text.ToCString()).c_str());
+    }
+
+  private:
+    sw_sg_warning_fn fn_;
+    void *user_;
+    std::string prefix_;
+};
+
+class quiet_messenger
+{
+  public:
+    quiet_messenger(sw_sg_warning_fn fn, void *user, const std::string &path)
+        : messenger_(Message::DefaultMessenger()), saved_(messenger_->Printers())
+    {
+        messenger_->ChangePrinters().Clear();
+        messenger_->AddPrinter(new forward_printer(fn, user, path));
+    }
+    ~quiet_messenger()
+    {
+        messenger_->ChangePrinters() = saved_;
+    }
+    quiet_messenger(const quiet_messenger &) = delete;
+    quiet_messenger &operator=(const quiet_messenger &) = delete;
+
+  private:
+    Handle(Message_Messenger) messenger_;
+    Message_SequenceOfPrinters saved_;
+};
+
 sw_result importer::read_brep(TopoDS_Shape &shape, sw_status *status)
 {
     BRep_Builder bb;
@@ -836,6 +887,7 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
     Handle(TDocStd_Document) &doc = guard.doc;
     sw_result r;
     try {
+        quiet_messenger quiet(desc_->warning, desc_->user_data, path_);
         if (step || iges) {
             XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
             r = read_cad(doc, shape, step, status);

@@ -54,6 +54,12 @@ trimmed=$(sed -n 's/.*trimmed by trim textures \([0-9]*\).*/\1/p' render.txt)
 [ -s motor.exr ] || fail "no EXR written"
 pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 
+# OCCT's IGES reader prints to stdout by default: `info --json` must still print one JSON line.
+"$sw" info --json "$data/iges/bearing.iges" >iges.json 2>/dev/null || fail "info bearing.iges"
+[ "$(head -c 1 iges.json)" = "{" ] && [ "$(wc -l <iges.json)" -eq 1 ] ||
+  fail "info --json of an IGES file is not one JSON line: $(head -c 300 iges.json)"
+pass "info --json of an IGES file is clean"
+
 # A T-spline sample: its rational bicubic Bézier patches through the same pipeline.
 tsm=$(dirname "$0")/../../samples/tsplines/t_junctions.tsm
 "$sw" info "$tsm" --json >tsm.json || fail "info t_junctions.tsm"
