@@ -1,8 +1,10 @@
 /* One converged frame of a scene (Guthe et al. 2005 §7, without the bicubic hierarchy in this
  * slice): traverse the scene, cull face occurrences and then their rational Bézier patches against
- * the view frustum by their control-net boxes, choose each patch's grid density from the Filip
- * bound at the object-space tolerance its depth allows (§5.2), evaluate the grids on the CPU, make
- * one trim texture per trimmed face occurrence at a resolution from its on-screen size (§5.3),
+ * the view frustum by their control-net boxes, choose each patch's grid density so that its
+ * triangles stay within ε_img on screen (§5.2 and §7 in one rigorous bound, lod/sampling.c's
+ * sw_lod_screen_segments, over the grid classes' segment counts), evaluate the grids, add fat
+ * borders along every drawn face's boundary to close cracks between faces (§7.1, crack_fill.c),
+ * make one trim texture per trimmed face occurrence at a resolution from its on-screen size (§5.3),
  * rounded up to a power-of-two class, in the context's trim atlas (§4.4) by fan parity on the GPU
  * (§4), draw, read back.
  *
@@ -22,7 +24,15 @@
 enum {
     MAX_SEGMENTS = 256, /* grid segments per patch and direction */
     MAX_TRIM_LOOP_VERTICES = 1u << 22,
+    MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
 };
+
+/* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
+ * for predefined grids (§4.2) the counts a grid class, or pieces of one class, can draw. */
+typedef struct segment_set {
+    int32_t n[MAX_SEGMENTS];
+    int32_t count;
+} segment_set;
 static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
 static const double k_max_frame_texels = 256e6;  /* R8 trim texels per frame */
 
@@ -36,6 +46,8 @@ typedef struct pending_trim {
     size_t draw;
     uint32_t face;
     double width, height; /* wanted resolution before the frame budget */
+    size_t occ;           /* occurrence, for its fat border */
+    double cell[2];       /* smallest grid cell of the face in u, v (fat-border sampling) */
 } pending_trim;
 
 typedef struct frame {
@@ -57,6 +69,10 @@ typedef struct frame {
     size_t n_recs, n_cps; /* GPU-evaluated patches in ctx->recs, control points in ctx->cps */
     double gpu_vertices;  /* grid vertices the vertex shader will evaluate */
     sw__gpu_patch_batch batch;
+    sw_lod_screen_view screen; /* the view as the density bound needs it */
+    segment_set gpu_segments, cpu_segments;
+    uint64_t border_triangles; /* fat-border triangles (counted in st.triangles, which also
+                                  counts the mesh at the end: subtracted there) */
 } frame;
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -162,7 +178,8 @@ typedef struct trim_need {
 
 /* Sets up one patch: eye-relative control points, clipping to the uv box, culling, density. */
 static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch *bp,
-                        const double ub[4], double *cpw, sw__gpu_patch *pt, trim_need *need)
+                        const double ub[4], int class_grids, double *cpw, sw__gpu_patch *pt,
+                        trim_need *need)
 {
     size_t n = (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1);
     double box[6];
@@ -171,8 +188,15 @@ static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch 
         xform_h(o->world, f->view.eye, bp->cpw + 4 * i, cpw + 4 * i);
         box_add(box, cpw + 4 * i);
     }
-    *pt = (sw__gpu_patch){bp->deg_u, bp->deg_v, cpw,    0, 1, 0, 1, bp->u0,
-                          bp->u1,    bp->v0,    bp->v1, 0, 0, 0, 1, 1};
+    memset(pt, 0, sizeof *pt);
+    pt->deg_u = bp->deg_u;
+    pt->deg_v = bp->deg_v;
+    pt->cpw = cpw;
+    pt->u0 = bp->u0;
+    pt->u1 = bp->u1;
+    pt->v0 = bp->v0;
+    pt->v1 = bp->v1;
+    pt->nu = pt->nv = 1;
     double du = bp->u1 - bp->u0, dv = bp->v1 - bp->v0;
     pt->s0 = fmax(0.0, (ub[0] - bp->u0) / du);
     pt->s1 = fmin(1.0, (ub[1] - bp->u0) / du);
@@ -181,14 +205,16 @@ static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch 
     if (!(pt->s1 > pt->s0) || !(pt->t1 > pt->t0) || !sw__gpu_view_box_visible(&f->view, box))
         return;
     pt->visible = 1;
-    sw_lod_patch_bounds b;
-    sw_lod_rational_bezier_bounds(bp->deg_u, bp->deg_v, cpw, &b);
-    double eps = sw_lod_object_tolerance(f->eps_px, sw__gpu_view_box_depth(&f->view, box),
-                                         f->view.focal_px, f->view.tan_x, f->view.tan_y);
-    pt->nu = sw_lod_filip_segments(b.d2[0], b.d2[1], pt->s1 - pt->s0, eps, MAX_SEGMENTS);
-    pt->nv = sw_lod_filip_segments(b.d2[2], b.d2[1], pt->t1 - pt->t0, eps, MAX_SEGMENTS);
-    need->u = fmax(need->u, sw_lod_trim_texels(ub[1] - ub[0], b.d1[0], du, eps));
-    need->v = fmax(need->v, sw_lod_trim_texels(ub[3] - ub[2], b.d1[1], dv, eps));
+    const double range[4] = {pt->s0, pt->s1, pt->t0, pt->t1};
+    const segment_set *set = class_grids ? &f->gpu_segments : &f->cpu_segments;
+    sw_lod_screen_density d;
+    sw_lod_screen_segments(bp->deg_u, bp->deg_v, cpw, range, &f->screen, set->n, set->count,
+                           MAX_BOUND_SUBDIVISION, &d);
+    pt->eps = d.eps_obj;
+    pt->nu = d.nu;
+    pt->nv = d.nv;
+    need->u = fmax(need->u, sw_lod_trim_texels(ub[1] - ub[0], d.d1[0], du, d.eps_obj));
+    need->v = fmax(need->v, sw_lod_trim_texels(ub[3] - ub[2], d.d1[1], dv, d.eps_obj));
 }
 
 /* One u-density per patch column and one v-density per row: grids meet vertex to vertex. */
@@ -213,7 +239,7 @@ static void unify_densities(sw__gpu_patch *pt, int32_t n_cols, int32_t n_rows)
 }
 
 static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int trimmed,
-                          const trim_need *need, sw_status *status)
+                          const trim_need *need, const double cell[2], sw_status *status)
 {
     if (!grow((void **)&f->draws, &f->cap_draws, f->n_draws + 1, sizeof *f->draws) ||
         (trimmed && !grow((void **)&f->trims, &f->cap_trims, f->n_trims + 1, sizeof *f->trims)))
@@ -224,9 +250,27 @@ static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int t
     memcpy(d->color, o->color, sizeof d->color);
     d->trim_entry = -1;
     if (trimmed)
-        f->trims[f->n_trims++] = (pending_trim){f->n_draws, o->face, need->u, need->v};
+        f->trims[f->n_trims++] = (pending_trim){
+            f->n_draws, o->face, need->u, need->v, (size_t)(o - f->occ), {cell[0], cell[1]}};
     f->n_draws++;
     return SW_OK;
+}
+
+/* Hands one drawn patch piece to the context's debug hook. */
+static void report_patch(const frame *f, const occurrence *o, const sw__gpu_patch *pt, double s0,
+                         double s1, double t0, double t1, int32_t nu, int32_t nv, int gpu,
+                         int trimmed)
+{
+    sw__gpu_drawn_patch d = {&f->view, o->face, o->world, pt->deg_u, pt->deg_v, pt->cpw, pt->u0,
+                             pt->u1,   pt->v0,  pt->v1,   s0,        s1,        t0,      t1,
+                             nu,       nv,      gpu,      trimmed,   pt->eps};
+    f->ctx->patch_hook(f->ctx->patch_hook_user, &d);
+}
+
+void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *user)
+{
+    ctx->patch_hook = fn;
+    ctx->patch_hook_user = user;
 }
 
 /* Smallest grid class with at least n segments (n <= SW__GPU_GRID_MAX). */
@@ -248,8 +292,9 @@ static void split_class(int32_t n, int32_t *pieces, int32_t *level)
 
 /* Appends the control points of a visible patch (float, eye-relative homogeneous) and one record
  * per piece of its sampled domain (§4.2). Pieces share their edge parameters bit for bit. */
-static sw_result gpu_patch(frame *f, const sw__gpu_patch *pt, const double ub[4], double sign,
-                           int32_t draw, sw_status *status)
+static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *pt,
+                           const double ub[4], double sign, int32_t draw, int trimmed,
+                           sw_status *status)
 {
     sw_gpu_context *ctx = f->ctx;
     size_t n_cp = (size_t)(pt->deg_u + 1) * (size_t)(pt->deg_v + 1);
@@ -281,6 +326,9 @@ static sw_result gpu_patch(frame *f, const sw__gpu_patch *pt, const double ub[4]
             rec->draw = draw;
             rec->level_u = lu;
             rec->level_v = lv;
+            if (ctx->patch_hook)
+                report_patch(f, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
+                             sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1, trimmed);
         }
     }
     f->n_cps += n_cp;
@@ -293,24 +341,65 @@ static sw_result gpu_patch(frame *f, const sw__gpu_patch *pt, const double ub[4]
 /* GPU evaluation of a face's patches: one draw record for its colour and trim texture, one
  * patch record per visible patch (or piece). */
 static sw_result gpu_face(frame *f, const occurrence *o, const sw__gpu_patch *pt, size_t n,
-                          double sign, int trimmed, const trim_need *need, sw_status *status)
+                          double sign, int trimmed, const trim_need *need, const double cell[2],
+                          sw_status *status)
 {
     int32_t d = (int32_t)f->n_draws;
-    sw_result r = add_draw(f, o, f->mesh.n_idx, trimmed, need, status);
+    sw_result r = add_draw(f, o, f->mesh.n_idx, trimmed, need, cell, status);
     const double *ub = f->sv->faces[o->face].uv_box;
     for (size_t p = 0; p < n && r == SW_OK; ++p)
         if (pt[p].visible)
-            r = gpu_patch(f, &pt[p], ub, sign, d, status);
+            r = gpu_patch(f, o, &pt[p], ub, sign, d, trimmed, status);
     return r;
 }
 
 /* Which path draws a face: the vertex shader takes rational Bézier patches of degree <= 3 x 3
  * (§4.2); higher degrees stay CPU grids (patch_grid.c) until the bicubic hierarchy feeds them. */
-static int face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
+static int face_gpu_eligible(const sw_sg_bezier_set *set)
 {
-    if (f->ctx->eval_mode != SW__GPU_EVAL_AUTO || set->n_u * set->n_v == 0)
+    if (set->n_u * set->n_v == 0)
         return 0;
     return set->patches[0].deg_u <= 3 && set->patches[0].deg_v <= 3;
+}
+
+static int face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
+{
+    return f->ctx->eval_mode == SW__GPU_EVAL_AUTO && face_gpu_eligible(set);
+}
+
+/* Smallest cell of the face's visible grids, in face parameters. */
+static void grid_cell(const sw__gpu_patch *pt, size_t n, double cell[2])
+{
+    cell[0] = cell[1] = INFINITY;
+    for (size_t p = 0; p < n; ++p) {
+        if (!pt[p].visible)
+            continue;
+        cell[0] = fmin(cell[0], (pt[p].u1 - pt[p].u0) * (pt[p].s1 - pt[p].s0) / pt[p].nu);
+        cell[1] = fmin(cell[1], (pt[p].v1 - pt[p].v0) * (pt[p].t1 - pt[p].t0) / pt[p].nv);
+    }
+}
+
+/* §7.1: a fat border along one closed uv loop of a drawn face, as its own untrimmed draw. */
+static sw_result fat_border(frame *f, const occurrence *o, const double *uv, size_t n,
+                            int left_inside, const double cell[2], sw_status *status)
+{
+    sw_sg_surface srf;
+    sw_sg_scene_face_surface(f->scene, o->face, &srf);
+    size_t first = f->mesh.n_idx;
+    sw_result r = sw__gpu_fat_border(&f->view, &srf, o->world, uv, n, left_inside, cell[0], cell[1],
+                                     2.0 * f->eps_px, &f->mesh, status);
+    if (r == SW_OK && f->mesh.n_idx > first) {
+        trim_need none = {0.0, 0.0};
+        r = add_draw(f, o, first, 0, &none, cell, status);
+        f->st.triangles += (f->mesh.n_idx - first) / 3;
+        f->border_triangles += (f->mesh.n_idx - first) / 3;
+    }
+    return r;
+}
+
+void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on)
+{
+    ctx->crack_fill_off = !on;
 }
 
 static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
@@ -333,9 +422,12 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
     }
     trim_need need = {1.0, 1.0};
     size_t at = 0, drawn = 0;
+    int on_gpu = face_on_gpu(f, set);
+    /* CPU_GRIDS mode draws the grids the vertex shader would (the reference of §4.2's path). */
+    int class_grids = face_gpu_eligible(set);
     for (size_t p = 0; p < n; ++p) {
         const sw_sg_bezier_patch *bp = &set->patches[p];
-        patch_setup(f, o, bp, rec->uv_box, cpw + at, &pt[p], &need);
+        patch_setup(f, o, bp, rec->uv_box, class_grids, cpw + at, &pt[p], &need);
         pt[p].col = (int32_t)(p % (size_t)n_cols);
         pt[p].row = (int32_t)(p / (size_t)n_cols);
         at += (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1) * 4;
@@ -349,13 +441,24 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
         if (det3(o->world) < 0.0)
             sign = -sign;
         size_t first = f->mesh.n_idx;
-        if (face_on_gpu(f, set)) {
-            r = gpu_face(f, o, pt, n, sign, trimmed, &need, status);
+        double cell[2];
+        grid_cell(pt, n, cell);
+        if (on_gpu) {
+            r = gpu_face(f, o, pt, n, sign, trimmed, &need, cell, status);
             f->st.patches_gpu_evaluated += drawn;
         } else {
             r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->mesh, status);
+            for (size_t p = 0; p < n && f->ctx->patch_hook; ++p)
+                if (pt[p].visible)
+                    report_patch(f, o, &pt[p], pt[p].s0, pt[p].s1, pt[p].t0, pt[p].t1, pt[p].nu,
+                                 pt[p].nv, 0, trimmed);
             if (r == SW_OK)
-                r = add_draw(f, o, first, trimmed, &need, status);
+                r = add_draw(f, o, first, trimmed, &need, cell, status);
+        }
+        if (r == SW_OK && !trimmed && !f->ctx->crack_fill_off) {
+            const double *b = rec->uv_box;
+            const double box_loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
+            r = fat_border(f, o, box_loop, 4, 1, cell, status); /* counter-clockwise */
         }
         f->st.faces_drawn++;
         if (trimmed)
@@ -373,6 +476,35 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
                      "view?)",
                      k_max_frame_vertices, f->eps_px);
     return r;
+}
+
+/* Effective segments of a direction of n segments drawn by split_class's pieces. */
+static int32_t class_segments(int32_t n)
+{
+    int32_t pieces, level;
+    split_class(n, &pieces, &level);
+    return pieces * sw__gpu_grid_segments[level];
+}
+
+static void screen_view_init(frame *f)
+{
+    const sw__gpu_view *v = &f->view;
+    sw_lod_screen_view *s = &f->screen;
+    memcpy(s->right, v->right, sizeof s->right);
+    memcpy(s->up, v->up, sizeof s->up);
+    memcpy(s->fwd, v->fwd, sizeof s->fwd);
+    s->focal_px = v->focal_px;
+    s->tan_corner = hypot(v->tan_x, v->tan_y);
+    s->near_plane = v->near_plane;
+    s->eps_px = f->eps_px;
+    f->cpu_segments.count = f->gpu_segments.count = 0;
+    for (int32_t n = 1; n <= MAX_SEGMENTS; ++n) {
+        f->cpu_segments.n[f->cpu_segments.count++] = n;
+        int32_t c = class_segments(n);
+        segment_set *g = &f->gpu_segments;
+        if (c <= MAX_SEGMENTS && (g->count == 0 || g->n[g->count - 1] < c))
+            g->n[g->count++] = c;
+    }
 }
 
 /* Collects occurrences, sets the view (near plane from the scene's box) and tessellates. */
@@ -396,6 +528,7 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     double near_plane = f->n_occ ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
     sw_result r =
         sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane, status);
+    screen_view_init(f);
     for (size_t i = 0; i < f->n_occ && r == SW_OK; ++i) {
         if (!sw__gpu_view_box_visible(&f->view, boxes + 6 * i)) {
             f->st.faces_culled++;
@@ -418,6 +551,29 @@ static int32_t class_texels(double want, int32_t max_entry)
     return n < max_entry ? n : max_entry;
 }
 
+/* Whether the trimmed region lies to the left of loop k's direction: classified just left of
+ * the middle of its longest edge (loops are simple, so one point decides for the whole loop). */
+static int left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k)
+{
+    const sw_sg_polyline *l = &loops[k];
+    uint32_t best = 0;
+    double best_len = -1.0;
+    for (uint32_t i = 0; i < l->count; ++i) {
+        const double *a = l->uv + 2 * i, *b = l->uv + 2 * ((i + 1) % l->count);
+        double len = hypot(b[0] - a[0], b[1] - a[1]);
+        if (len > best_len) {
+            best_len = len;
+            best = i;
+        }
+    }
+    if (l->count < 2 || !(best_len > 0.0))
+        return 1;
+    const double *a = l->uv + 2 * best, *b = l->uv + 2 * ((best + 1) % l->count);
+    double t[2] = {(b[0] - a[0]) / best_len, (b[1] - a[1]) / best_len}, step = 1e-3 * best_len;
+    double u = 0.5 * (a[0] + b[0]) - t[1] * step, v = 0.5 * (a[1] + b[1]) + t[0] * step;
+    return sw_sg_trim_classify(loops, n_loops, u, v);
+}
+
 static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_status *status)
 {
     const sw_sg_face_rec *rec = &f->sv->faces[t->face];
@@ -428,10 +584,10 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     sw__gpu_trim_key key = {
         f->scene, t->face, rec->first_loop, rec->n_loops, {ub[0], ub[1], ub[2], ub[3]}};
     int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
-    if (id >= 0) {
-        f->draws[t->draw].trim_entry = id;
+    f->draws[t->draw].trim_entry = id;
+    int border = !f->ctx->crack_fill_off;
+    if (id >= 0 && !border)
         return SW_OK;
-    }
     double tol = 0.5 * fmin((ub[1] - ub[0]) / w, (ub[3] - ub[2]) / h);
     sw_sg_polyline *loops = calloc(rec->n_loops, sizeof *loops);
     if (!loops)
@@ -440,12 +596,16 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k)
         r = sw_sg_trim_flatten_loop(f->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
                                     &loops[k], status);
-    if (r == SW_OK)
+    if (r == SW_OK && id < 0) {
         r = sw__gpu_atlas_add(f->ctx, &key, w, h, loops, rec->n_loops, &id, status);
+        f->draws[t->draw].trim_entry = id;
+    }
+    for (uint32_t k = 0; k < rec->n_loops && r == SW_OK && border; ++k)
+        r = fat_border(f, &f->occ[t->occ], loops[k].uv, loops[k].count,
+                       left_is_inside(loops, rec->n_loops, k), t->cell, status);
     for (uint32_t k = 0; k < rec->n_loops; ++k)
         sw_sg_polyline_free(&loops[k]);
     free(loops);
-    f->draws[t->draw].trim_entry = id;
     return r;
 }
 
@@ -573,7 +733,7 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
         r = sw__gpu_readback(ctx, &f.view, desc.want_depth, out, status);
     double t4 = sw__gpu_now_ms();
 
-    f.st.triangles += f.mesh.n_idx / 3;
+    f.st.triangles += f.mesh.n_idx / 3 - f.border_triangles;
     f.st.ms_tessellate = t1 - t0;
     f.st.ms_trim = t2 - t1;
     f.st.ms_draw = t3 - t2;

@@ -46,6 +46,26 @@ typedef struct sw__gpu_patch_rec {
     int32_t level_u, level_v; /* grid class: sw__gpu_grid_segments[level] segments */
 } sw__gpu_patch_rec;
 
+/* Debug hook (frame.c): every drawn patch piece of a frame, as the frame built it, for tests that
+ * check the drawn geometry against the exact surface on the CPU. */
+typedef struct sw__gpu_drawn_patch {
+    const struct sw__gpu_view *view; /* the frame's view (eye, basis, projection) */
+    uint32_t face;                   /* face record of the occurrence */
+    const double *world;             /* occurrence transform, 3 x 4 row-major */
+    int32_t deg_u, deg_v;
+    const double *cpw;     /* eye-relative world, homogeneous, (deg_u+1)(deg_v+1)*4 */
+    double u0, u1, v0, v1; /* the Bézier patch's rectangle in the face's parameters */
+    double s0, s1, t0, t1; /* the sampled part of its local domain [0,1]^2 */
+    int32_t nu, nv;        /* grid segments drawn over [s0,s1] x [t0,t1] */
+    int32_t gpu;           /* 1: a vertex-shader record (float st: grid parameters are
+                              computed in float as the shader does); 0: a CPU grid */
+    int32_t trimmed;       /* drawn with a trim-texture lookup */
+    double eps_obj;        /* object-space tolerance the density was chosen for */
+} sw__gpu_drawn_patch;
+typedef void (*sw__gpu_patch_hook)(void *user, const sw__gpu_drawn_patch *p);
+/* Installs (fn != NULL) or removes the hook; called on the GL thread during sw_gpu_render_scene. */
+void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *user);
+
 struct sw_gpu_context {
     void *egl_display, *egl_context; /* EGLDisplay, EGLContext */
     char description[256];
@@ -79,6 +99,9 @@ struct sw_gpu_context {
     size_t cap_cps;
     struct sw__gpu_patch_rec *recs_sorted;
     size_t cap_recs_sorted;
+    int32_t crack_fill_off;        /* 1: no fat borders (§7.1) */
+    sw__gpu_patch_hook patch_hook; /* debug hook, NULL = none */
+    void *patch_hook_user;
 };
 
 /* Last GL error as SW_ERR_GL naming `what`, or SW_OK. */
@@ -140,6 +163,7 @@ typedef struct sw__gpu_patch {
     int32_t col, row;      /* position in the face's patch grid */
     int32_t visible;       /* survived frustum culling */
     int32_t nu, nv;        /* grid segments (after the column/row maxima) */
+    double eps;            /* object-space tolerance of its density (§7) */
 } sw__gpu_patch;
 
 /* Evaluates the visible patches of one face occurrence (grids of nu x nv cells each, neighbours
@@ -149,6 +173,18 @@ typedef struct sw__gpu_patch {
 sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, int32_t n_rows,
                                   double normal_sign, const double uv_box[4], sw__gpu_mesh *mesh,
                                   sw_status *status);
+
+/* ---- crack filling (crack_fill.c, §7.1) ------------------------------------------------------ */
+/* Appends a screen-facing ribbon (fat border), width_px pixels wide on the face's inner side, along
+ * a closed polyline uv[2n] in the parameters of surface srf placed by `world` (3 x 4), sampled on
+ * the exact surface with steps no longer than (du, dv). left_inside: the face lies to the left of
+ * the polyline's direction in (u, v). Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
+                             const double world[12], const double *uv, size_t n, int left_inside,
+                             double du, double dv, double width_px, sw__gpu_mesh *mesh,
+                             sw_status *status);
+/* Crack filling on (default) or off, for tests that measure what it closes. */
+void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 
 /* ---- trim textures (trim_texture.c) --------------------------------------------------------- */
 /* Renders loops already in the clip space of one atlas page into layer `layer` of the R8 array

@@ -53,9 +53,17 @@
 #include <stdlib.h>
 #include <string.h>
 
-static double norm3(const double v[3])
+/* Norm of the components of v selected by mask (bit k = component k): the bounds of a linear
+ * image L(S) of the patch (a rational patch with control points L P_ij and the same weights) are
+ * the bounds with the norm taken over L's components, which is how the screen-space bounds split
+ * an error into its lateral and depth parts. */
+static double norm_mask(const double v[3], unsigned mask)
 {
-    return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    double s = 0.0;
+    for (int k = 0; k < 3; ++k)
+        if (mask & (1u << k))
+            s += v[k] * v[k];
+    return sqrt(s);
 }
 
 /* Differences of a control net, 4 doubles per point (Q_xyz, w). */
@@ -63,9 +71,9 @@ typedef struct diff_max {
     double q, w; /* max norm of the xyz part, max |w part| */
 } diff_max;
 
-static void diff_update(diff_max *m, const double d[4])
+static void diff_update(diff_max *m, const double d[4], unsigned mask)
 {
-    double qn = norm3(d);
+    double qn = norm_mask(d, mask);
     if (qn > m->q)
         m->q = qn;
     if (fabs(d[3]) > m->w)
@@ -84,7 +92,7 @@ static void centred(const double *cpw, int32_t nu, int32_t i, int32_t j, const d
 
 /* max over the net of the norm of a difference given by stencil offsets and coefficients. */
 static diff_max net_diff(const double *cpw, int32_t nu, int32_t nv, const double c[3], int di,
-                         int dj, int order_s, int order_t)
+                         int dj, int order_s, int order_t, unsigned mask)
 {
     diff_max m = {0.0, 0.0};
     for (int32_t j = 0; j + dj < nv; ++j) {
@@ -111,14 +119,14 @@ static diff_max net_diff(const double *cpw, int32_t nu, int32_t nv, const double
                 for (int k = 0; k < 4; ++k)
                     d[k] = b[k] - a[k];
             }
-            diff_update(&m, d);
+            diff_update(&m, d, mask);
         }
     }
     return m;
 }
 
-static void net_centre_radius_wmin(const double *cpw, int32_t count, double c[3], double *radius,
-                                   double *wmin)
+static void net_centre_radius_wmin(const double *cpw, int32_t count, unsigned mask, double c[3],
+                                   double *radius, double *wmin)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     *wmin = INFINITY;
@@ -137,15 +145,16 @@ static void net_centre_radius_wmin(const double *cpw, int32_t count, double c[3]
     for (int32_t k = 0; k < count; ++k) {
         const double *p = cpw + (size_t)k * 4;
         double d[3] = {p[0] / p[3] - c[0], p[1] / p[3] - c[1], p[2] / p[3] - c[2]};
-        *radius = fmax(*radius, norm3(d));
+        *radius = fmax(*radius, norm_mask(d, mask));
     }
 }
 
 /* ---- the Bernstein-product bound ---------------------------------------------------------- */
 enum { PRODUCT_MAX_DEGREE = 7, BMAX = 3 * PRODUCT_MAX_DEGREE };
 
-/* A tensor-product polynomial in Bernstein form: (m+1) x (n+1) coefficients of `dim` doubles,
- * s fastest. */
+/* A tensor-product polynomial in scaled Bernstein form: coefficient (i, j) is the Bernstein
+ * coefficient times C(m, i) C(n, j), so that products are plain convolutions and derivatives need
+ * no division; (m+1) x (n+1) coefficients of `dim` doubles, s fastest. */
 typedef struct bpoly {
     int32_t m, n, dim;
     double *c;
@@ -154,8 +163,9 @@ typedef struct bpoly {
 typedef struct arena {
     double *mem;
     size_t used, cap;
-    double binom[BMAX + 1][BMAX + 1];
 } arena;
+
+enum { ARENA_STACK = 17 * 10 * 10 * 3 }; /* bicubic patches need no allocation */
 
 static bpoly bp_new(arena *a, int32_t m, int32_t n, int32_t dim)
 {
@@ -171,7 +181,8 @@ static double *bp_at(const bpoly *p, int32_t i, int32_t j)
     return p->c + ((size_t)j * (size_t)(p->m + 1) + (size_t)i) * (size_t)p->dim;
 }
 
-/* Partial derivative along s (dir 0) or t (dir 1); of a constant direction: zero of degree 0. */
+/* Partial derivative along s (dir 0) or t (dir 1); of a constant direction: zero of degree 0.
+ * Scaled form: d_i = (i + 1) c_{i+1} - (deg - i) c_i. */
 static bpoly bp_deriv(arena *a, const bpoly *p, int dir)
 {
     int32_t deg = dir ? p->n : p->m;
@@ -183,29 +194,27 @@ static bpoly bp_deriv(arena *a, const bpoly *p, int dir)
         for (int32_t i = 0; i <= m; ++i) {
             const double *lo = bp_at(p, i, j), *hi = bp_at(p, i + !dir, j + dir);
             double *o = bp_at(&d, i, j);
+            double kh = (double)((dir ? j : i) + 1), kl = (double)(deg - (dir ? j : i));
             for (int32_t k = 0; k < p->dim; ++k)
-                o[k] = deg * (hi[k] - lo[k]);
+                o[k] = kh * hi[k] - kl * lo[k];
         }
     return d;
 }
 
 /* Product of a scalar polynomial `w` and a polynomial `p`, times `scale`, added to `out` (which
  * must have degree (w.m + p.m, w.n + p.n) and p's dim). */
-static void bp_mul_add(const arena *a, const bpoly *w, const bpoly *p, double scale, bpoly *out)
+static void bp_mul_add(const bpoly *w, const bpoly *p, double scale, bpoly *out)
 {
-    const double(*b)[BMAX + 1] = a->binom;
     for (int32_t j1 = 0; j1 <= w->n; ++j1)
         for (int32_t i1 = 0; i1 <= w->m; ++i1) {
-            double wc = *bp_at(w, i1, j1) * scale * b[w->m][i1] * b[w->n][j1];
-            for (int32_t j2 = 0; j2 <= p->n; ++j2)
-                for (int32_t i2 = 0; i2 <= p->m; ++i2) {
-                    int32_t i = i1 + i2, j = j1 + j2;
-                    double f = wc * b[p->m][i2] * b[p->n][j2] / (b[out->m][i] * b[out->n][j]);
-                    const double *pc = bp_at(p, i2, j2);
-                    double *o = bp_at(out, i, j);
-                    for (int32_t k = 0; k < p->dim; ++k)
-                        o[k] += f * pc[k];
-                }
+            double wc = *bp_at(w, i1, j1) * scale;
+            for (int32_t j2 = 0; j2 <= p->n; ++j2) {
+                const double *pc = bp_at(p, 0, j2);
+                double *o = bp_at(out, i1, j1 + j2);
+                size_t len = (size_t)(p->m + 1) * (size_t)p->dim;
+                for (size_t k = 0; k < len; ++k)
+                    o[k] += wc * pc[k];
+            }
         }
 }
 
@@ -214,94 +223,111 @@ static bpoly bp_cross_diff(arena *a, const bpoly *x, const bpoly *w, double ky, 
                            const bpoly *v)
 {
     bpoly r = bp_new(a, x->m + w->m, x->n + w->n, x->dim);
-    bp_mul_add(a, w, x, 1.0, &r);
-    bp_mul_add(a, v, y, -ky, &r);
+    bp_mul_add(w, x, 1.0, &r);
+    bp_mul_add(v, y, -ky, &r);
     return r;
 }
 
-static double bp_max_norm(const bpoly *p)
+static void binomials(int32_t n, double *b)
 {
-    double m = 0.0;
-    size_t n = (size_t)(p->m + 1) * (size_t)(p->n + 1);
-    for (size_t i = 0; i < n; ++i)
-        m = fmax(m, norm3(p->c + 3 * i));
+    b[0] = 1.0;
+    for (int32_t k = 1; k <= n; ++k)
+        b[k] = b[k - 1] * (double)(n - k + 1) / (double)k;
+}
+
+/* Largest norm (components in mask) of the Bernstein coefficients. */
+static double bp_max_norm(const bpoly *p, unsigned mask)
+{
+    double bm[BMAX + 1], bn[BMAX + 1], m = 0.0;
+    binomials(p->m, bm);
+    binomials(p->n, bn);
+    for (int32_t j = 0; j <= p->n; ++j)
+        for (int32_t i = 0; i <= p->m; ++i)
+            m = fmax(m, norm_mask(bp_at(p, i, j), mask) / (bm[i] * bn[j]));
     return m;
 }
 
+/* Smallest Bernstein coefficient of a scalar polynomial. */
 static double bp_min(const bpoly *p)
 {
-    double m = INFINITY;
-    size_t n = (size_t)(p->m + 1) * (size_t)(p->n + 1);
-    for (size_t i = 0; i < n; ++i)
-        m = fmin(m, p->c[i]);
+    double bm[BMAX + 1], bn[BMAX + 1], m = INFINITY;
+    binomials(p->m, bm);
+    binomials(p->n, bn);
+    for (int32_t j = 0; j <= p->n; ++j)
+        for (int32_t i = 0; i <= p->m; ++i)
+            m = fmin(m, *bp_at(p, i, j) / (bm[i] * bn[j]));
     return m;
 }
 
-/* The Bernstein-product bounds (see the top of the file); 0 when out of memory or too high a
- * degree (the caller keeps the other bound then). */
+/* The Bernstein-product bounds (see the top of the file), one set per mask; 0 when out of memory
+ * or too high a degree (the caller keeps the other bound then). */
 static int product_bounds(int32_t p, int32_t q, const double *cpw, const double c[3],
-                          sw_lod_patch_bounds *out)
+                          const unsigned *masks, int n_masks, sw_lod_patch_bounds *out)
 {
     if (p > PRODUCT_MAX_DEGREE || q > PRODUCT_MAX_DEGREE)
         return 0;
     arena a;
+    double stack_mem[ARENA_STACK];
     /* 17 polynomials, none of degree above (3p, 3q), at most 3 doubles per coefficient */
     a.cap = 17 * (size_t)(3 * p + 1) * (size_t)(3 * q + 1) * 3;
     a.used = 0;
-    a.mem = malloc(a.cap * sizeof *a.mem);
+    a.mem = a.cap <= ARENA_STACK ? stack_mem : malloc(a.cap * sizeof *a.mem);
     if (!a.mem)
         return 0;
-    for (int n = 0; n <= BMAX; ++n) {
-        a.binom[n][0] = 1.0;
-        for (int k = 1; k <= n; ++k)
-            a.binom[n][k] = a.binom[n][k - 1] * (double)(n - k + 1) / (double)k;
-    }
+    double bp[PRODUCT_MAX_DEGREE + 1], bq[PRODUCT_MAX_DEGREE + 1];
+    binomials(p, bp);
+    binomials(q, bq);
     bpoly h = bp_new(&a, p, q, 3), w = bp_new(&a, p, q, 1);
     for (int32_t j = 0; j <= q; ++j)
         for (int32_t i = 0; i <= p; ++i) {
             const double *src = cpw + ((size_t)j * (size_t)(p + 1) + (size_t)i) * 4;
+            double sc = bp[i] * bq[j];
             for (int k = 0; k < 3; ++k)
-                bp_at(&h, i, j)[k] = src[k] - src[3] * c[k];
-            *bp_at(&w, i, j) = src[3];
+                bp_at(&h, i, j)[k] = (src[k] - src[3] * c[k]) * sc;
+            *bp_at(&w, i, j) = src[3] * sc;
         }
     bpoly hs = bp_deriv(&a, &h, 0), ht = bp_deriv(&a, &h, 1);
     bpoly ws = bp_deriv(&a, &w, 0), wt = bp_deriv(&a, &w, 1);
     bpoly ns = bp_cross_diff(&a, &hs, &w, 1.0, &h, &ws);
     bpoly nt = bp_cross_diff(&a, &ht, &w, 1.0, &h, &wt);
     bpoly w2 = bp_new(&a, 2 * p, 2 * q, 1);
-    bp_mul_add(&a, &w, &w, 1.0, &w2);
+    bp_mul_add(&w, &w, 1.0, &w2);
     bpoly w3 = bp_new(&a, 3 * p, 3 * q, 1);
-    bp_mul_add(&a, &w2, &w, 1.0, &w3);
+    bp_mul_add(&w2, &w, 1.0, &w3);
     bpoly nss = bp_deriv(&a, &ns, 0), nts = bp_deriv(&a, &nt, 0), ntt = bp_deriv(&a, &nt, 1);
     bpoly kss = bp_cross_diff(&a, &nss, &w, 2.0, &ns, &ws);
     bpoly kst = bp_cross_diff(&a, &nts, &w, 2.0, &nt, &ws);
     bpoly ktt = bp_cross_diff(&a, &ntt, &w, 2.0, &nt, &wt);
     double m2 = bp_min(&w2), m3 = bp_min(&w3);
-    out->d1[0] = bp_max_norm(&ns) / m2;
-    out->d1[1] = bp_max_norm(&nt) / m2;
-    out->d2[0] = bp_max_norm(&kss) / m3;
-    out->d2[1] = bp_max_norm(&kst) / m3;
-    out->d2[2] = bp_max_norm(&ktt) / m3;
-    free(a.mem);
+    for (int k = 0; k < n_masks; ++k) {
+        out[k].d1[0] = bp_max_norm(&ns, masks[k]) / m2;
+        out[k].d1[1] = bp_max_norm(&nt, masks[k]) / m2;
+        out[k].d2[0] = bp_max_norm(&kss, masks[k]) / m3;
+        out[k].d2[1] = bp_max_norm(&kst, masks[k]) / m3;
+        out[k].d2[2] = bp_max_norm(&ktt, masks[k]) / m3;
+    }
+    if (a.mem != stack_mem)
+        free(a.mem);
     return 1;
 }
 
-void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *cpw,
-                                   sw_lod_patch_bounds *out)
+/* The difference bounds of the linear image selected by `mask` (see the top of the file). */
+static void difference_bounds(int32_t deg_u, int32_t deg_v, const double *cpw, unsigned mask,
+                              double c[3], sw_lod_patch_bounds *out)
 {
     int32_t nu = deg_u + 1, nv = deg_v + 1;
-    double c[3], r, wmin;
-    net_centre_radius_wmin(cpw, nu * nv, c, &r, &wmin);
+    double r, wmin;
+    net_centre_radius_wmin(cpw, nu * nv, mask, c, &r, &wmin);
     double p = deg_u, q = deg_v;
 
-    diff_max ds = net_diff(cpw, nu, nv, c, 1, 0, 1, 0);
-    diff_max dt = net_diff(cpw, nu, nv, c, 0, 1, 0, 1);
-    diff_max dst = net_diff(cpw, nu, nv, c, 1, 1, 1, 1);
+    diff_max ds = net_diff(cpw, nu, nv, c, 1, 0, 1, 0, mask);
+    diff_max dt = net_diff(cpw, nu, nv, c, 0, 1, 0, 1, mask);
+    diff_max dst = net_diff(cpw, nu, nv, c, 1, 1, 1, 1, mask);
     diff_max dss = {0.0, 0.0}, dtt = {0.0, 0.0};
     if (deg_u >= 2)
-        dss = net_diff(cpw, nu, nv, c, 2, 0, 2, 0);
+        dss = net_diff(cpw, nu, nv, c, 2, 0, 2, 0, mask);
     if (deg_v >= 2)
-        dtt = net_diff(cpw, nu, nv, c, 0, 2, 0, 2);
+        dtt = net_diff(cpw, nu, nv, c, 0, 2, 0, 2, mask);
 
     double a_s = p * ds.q, b_s = p * ds.w, a_t = q * dt.q, b_t = q * dt.w;
     double g_s = (a_s + b_s * r) / wmin, g_t = (a_t + b_t * r) / wmin;
@@ -314,14 +340,31 @@ void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *c
     out->d2[0] = (a_ss + 2.0 * b_s * g_s + b_ss * r) / wmin;
     out->d2[1] = (a_st + b_s * g_t + b_t * g_s + b_st * r) / wmin;
     out->d2[2] = (a_tt + 2.0 * b_t * g_t + b_tt * r) / wmin;
+}
 
-    sw_lod_patch_bounds pb;
-    if (product_bounds(deg_u, deg_v, cpw, c, &pb)) {
-        for (int k = 0; k < 2; ++k)
-            out->d1[k] = fmin(out->d1[k], pb.d1[k]);
-        for (int k = 0; k < 3; ++k)
-            out->d2[k] = fmin(out->d2[k], pb.d2[k]);
+/* Both bounds, the smaller kept, for each mask (at most 3). */
+static void bounds_masked(int32_t deg_u, int32_t deg_v, const double *cpw, const unsigned *masks,
+                          int n_masks, sw_lod_patch_bounds *out)
+{
+    double c[3];
+    for (int k = 0; k < n_masks; ++k)
+        difference_bounds(deg_u, deg_v, cpw, masks[k], c, &out[k]);
+    sw_lod_patch_bounds pb[3];
+    if (n_masks <= 3 && product_bounds(deg_u, deg_v, cpw, c, masks, n_masks, pb)) {
+        for (int m = 0; m < n_masks; ++m) {
+            for (int k = 0; k < 2; ++k)
+                out[m].d1[k] = fmin(out[m].d1[k], pb[m].d1[k]);
+            for (int k = 0; k < 3; ++k)
+                out[m].d2[k] = fmin(out[m].d2[k], pb[m].d2[k]);
+        }
     }
+}
+
+void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *cpw,
+                                   sw_lod_patch_bounds *out)
+{
+    static const unsigned all = 7u;
+    bounds_masked(deg_u, deg_v, cpw, &all, 1, out);
 }
 
 int32_t sw_lod_filip_segments(double m_dir, double m_mixed, double len, double eps,
@@ -355,4 +398,218 @@ double sw_lod_trim_texels(double span, double d1, double patch_len, double eps)
         return INFINITY;
     double t = span * d1 / (patch_len * eps);
     return t >= 1.0 ? t : 1.0;
+}
+
+/* ---- screen-space grid segments ----------------------------------------------------------------
+ * Why the bound below holds. Write points in the camera frame (right, up, fwd) relative to the
+ * eye, x = (x_lat, x_f). A drawn point x = T(b) of a grid triangle (barycentric b over surface
+ * vertices) and the surface point y = S(s, t) at the same parameters b interpolates project to
+ * f x_lat / x_f and f y_lat / y_f, and exactly
+ *     pi(x) - pi(y) = (f / x_f) (e_lat - e_f p_y),   e = x - y,  p_y = y_lat / y_f,
+ * so |pi(x) - pi(y)| <= (f / z_min) (|e_lat| + P |e_f|) with z_min <= x_f and P >= |p_y|. x lies
+ * in the convex hull of the surface over the cell, hence of the control points of any sub-patches
+ * covering the cell: z_min and P are taken over those control points (P is also capped by the
+ * frustum's corner tangent plus 2 eps/f: only visible x matter, and there |p_x - p_y| <= eps/f).
+ * e_lat and e_f are the grid errors of the linear images S_lat and S_f of the patch, each bounded
+ * by Filip's bound with its own second-derivative bounds (the bounds above, normed over those
+ * components). So a cell of size (ds, dt) is within eps_px when
+ *     A ds^2 + 2 B ds dt + C dt^2 <= 8 eps_px z_min / f,   A = M_ss^lat + P M_ss^f, B, C alike.
+ * This replaces the isotropic |e| sqrt(1 + tan^2) (the Jacobian's norm) by the split above, which
+ * is never larger (Cauchy-Schwarz), and is much smaller where the error lies along the view.
+ *
+ * Sub-patches: the range [s0,s1] x [t0,t1] is cut into K x K sub-patches (for bounding only);
+ * a cell of a grid with n_u >= 1 segments touches at most m_u = min(K, ceil(K / n_u) + 1)
+ * consecutive sub-columns (and m_v sub-rows), so the condition above with maxima (of M, P) and
+ * minima (of z) over every m_u x m_v window of sub-patches covers every cell. The whole range
+ * (K = 1) is checked too; a grid passes when either analysis proves it.
+ * Among the allowed segment counts the pair with the fewest cells is taken (for a single window
+ * the optimum has A ds^2 = C dt^2, not the even split of eps per direction of §5.2). */
+enum { SUB_MAX = 4, SMALL_NET = 64 };
+
+typedef struct sub_info {
+    double ml[3], mf[3]; /* second-derivative bounds (range parameters): lateral, depth */
+    double zmin, pmax;
+} sub_info;
+
+/* The part [a, b] of a Bézier curve of degree p given by p+1 points of 4 doubles, `stride`
+ * doubles apart, in place (two de Casteljau splits). */
+static void curve_part(double *pts, int32_t p, size_t stride, double a, double b)
+{
+    if (b < 1.0)
+        for (int32_t r = 1; r <= p; ++r)
+            for (int32_t i = p; i >= r; --i)
+                for (int k = 0; k < 4; ++k)
+                    pts[i * stride + k] =
+                        (1.0 - b) * pts[(i - 1) * stride + k] + b * pts[i * stride + k];
+    double tau = b > 0.0 ? a / b : 0.0;
+    if (tau > 0.0)
+        for (int32_t r = 1; r <= p; ++r)
+            for (int32_t i = 0; i <= p - r; ++i)
+                for (int k = 0; k < 4; ++k)
+                    pts[i * stride + k] =
+                        (1.0 - tau) * pts[i * stride + k] + tau * pts[(i + 1) * stride + k];
+}
+
+/* out = the sub-patch over [s0,s1] x [t0,t1] of the net `in`. */
+static void patch_part(int32_t p, int32_t q, const double *in, const double r[4], double *out)
+{
+    size_t n = (size_t)(p + 1) * (size_t)(q + 1) * 4;
+    memcpy(out, in, n * sizeof *out);
+    for (int32_t j = 0; j <= q; ++j)
+        curve_part(out + (size_t)j * (size_t)(p + 1) * 4, p, 4, r[0], r[1]);
+    for (int32_t i = 0; i <= p; ++i)
+        curve_part(out + (size_t)i * 4, q, (size_t)(p + 1) * 4, r[2], r[3]);
+}
+
+static void sub_measure(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
+                        double ku, double kv, sub_info *o)
+{
+    static const unsigned masks[2] = {3u, 4u};
+    sw_lod_patch_bounds b[2];
+    bounds_masked(p, q, net, masks, 2, b);
+    double scale[3] = {ku * ku, ku * kv, kv * kv};
+    for (int k = 0; k < 3; ++k) {
+        o->ml[k] = b[0].d2[k] * scale[k];
+        o->mf[k] = b[1].d2[k] * scale[k];
+    }
+    o->zmin = INFINITY;
+    o->pmax = 0.0;
+    size_t n = (size_t)(p + 1) * (size_t)(q + 1);
+    for (size_t i = 0; i < n; ++i) {
+        const double *c = net + 4 * i;
+        double z = c[2] / c[3], lat = hypot(c[0], c[1]) / c[3];
+        o->zmin = fmin(o->zmin, z);
+        o->pmax = z > 0.0 ? fmax(o->pmax, lat / z) : INFINITY;
+    }
+    o->pmax = fmin(o->pmax, v->tan_corner + 2.0 * v->eps_px / v->focal_px);
+    o->zmin = fmax(o->zmin, v->near_plane);
+}
+
+/* 1 when every cell of an nu x nv grid passes, from the k x k sub-patch measures. */
+static int grid_passes(const sub_info *sub, int32_t k, int32_t nu, int32_t nv,
+                       const sw_lod_screen_view *v)
+{
+    int32_t mu = k, mv = k;
+    if (k > 1) {
+        mu = (k + nu - 1) / nu + 1;
+        mv = (k + nv - 1) / nv + 1;
+        mu = mu < k ? mu : k;
+        mv = mv < k ? mv : k;
+    }
+    double ds = 1.0 / nu, dt = 1.0 / nv;
+    for (int32_t b = 0; b + mv <= k; ++b)
+        for (int32_t a = 0; a + mu <= k; ++a) {
+            sub_info w = sub[b * k + a];
+            for (int32_t y = b; y < b + mv; ++y)
+                for (int32_t x = a; x < a + mu; ++x) {
+                    const sub_info *o = &sub[y * k + x];
+                    for (int c = 0; c < 3; ++c) {
+                        w.ml[c] = fmax(w.ml[c], o->ml[c]);
+                        w.mf[c] = fmax(w.mf[c], o->mf[c]);
+                    }
+                    w.zmin = fmin(w.zmin, o->zmin);
+                    w.pmax = fmax(w.pmax, o->pmax);
+                }
+            double m[3];
+            for (int c = 0; c < 3; ++c)
+                m[c] = w.ml[c] + w.pmax * w.mf[c];
+            double lhs = m[0] * ds * ds + 2.0 * m[1] * ds * dt + m[2] * dt * dt;
+            if (!(lhs <= 8.0 * v->eps_px * w.zmin / v->focal_px))
+                return 0;
+        }
+    return 1;
+}
+
+static int pair_passes(const sub_info *whole, const sub_info *subs, int32_t k, int32_t nu,
+                       int32_t nv, const sw_lod_screen_view *v)
+{
+    return grid_passes(whole, 1, nu, nv, v) || (k > 1 && grid_passes(subs, k, nu, nv, v));
+}
+
+/* Fewest cells among allowed pairs passing for either analysis (whole, subs). Passing is
+ * monotone in nu and nv, so the smallest passing nv never grows with nu. */
+static int choose_segments(const sub_info *whole, const sub_info *subs, int32_t k,
+                           const sw_lod_screen_view *v, const int32_t *allowed, int32_t n_allowed,
+                           int32_t out[2])
+{
+    double best = INFINITY;
+    int32_t known = n_allowed; /* index of an nv known to pass for the current nu, or none */
+    for (int32_t i = 0; i < n_allowed; ++i) {
+        int32_t nu = allowed[i];
+        if ((double)nu * allowed[0] >= best)
+            break;
+        int32_t lo = 0, hi = known; /* first passing nv in [lo, hi]; hi passes unless == n */
+        while (lo < hi) {
+            int32_t mid = (lo + hi) / 2;
+            if (pair_passes(whole, subs, k, nu, allowed[mid], v))
+                hi = mid;
+            else
+                lo = mid + 1;
+        }
+        if (lo == n_allowed)
+            continue;
+        known = lo;
+        double cells = (double)nu * (double)allowed[lo];
+        if (cells < best) {
+            best = cells;
+            out[0] = nu;
+            out[1] = allowed[lo];
+        }
+    }
+    return best < INFINITY;
+}
+
+int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, const double range[4],
+                           const sw_lod_screen_view *v, const int32_t *allowed, int32_t n_allowed,
+                           int32_t max_sub, sw_lod_screen_density *out)
+{
+    size_t n = (size_t)(deg_u + 1) * (size_t)(deg_v + 1);
+    double small[3 * 4 * SMALL_NET],
+        *mem = n <= SMALL_NET ? small : malloc(3 * 4 * n * sizeof *mem);
+    out->nu = out->nv = allowed[n_allowed - 1];
+    out->eps_obj = 0.0;
+    if (!mem)
+        return 0;
+    double *view = mem, *part = mem + 4 * n, *sub = mem + 8 * n;
+    for (size_t i = 0; i < n; ++i) {
+        const double *c = cpw + 4 * i;
+        double *o = view + 4 * i;
+        o[0] = v->right[0] * c[0] + v->right[1] * c[1] + v->right[2] * c[2];
+        o[1] = v->up[0] * c[0] + v->up[1] * c[1] + v->up[2] * c[2];
+        o[2] = v->fwd[0] * c[0] + v->fwd[1] * c[1] + v->fwd[2] * c[2];
+        o[3] = c[3];
+    }
+    patch_part(deg_u, deg_v, view, range, part);
+    sub_info whole, subs[SUB_MAX * SUB_MAX];
+    sub_measure(deg_u, deg_v, part, v, 1.0, 1.0, &whole);
+    static const unsigned all = 7u;
+    sw_lod_patch_bounds rb;
+    bounds_masked(deg_u, deg_v, part, &all, 1, &rb);
+    out->d1[0] = rb.d1[0] / (range[1] - range[0]);
+    out->d1[1] = rb.d1[1] / (range[3] - range[2]);
+    out->eps_obj = v->eps_px * whole.zmin / (v->focal_px * sqrt(1.0 + whole.pmax * whole.pmax));
+    int32_t guess[2];
+    int found = choose_segments(&whole, NULL, 1, v, allowed, n_allowed, guess);
+    /* Sub-patch bounds pay for themselves only on grids of many cells: a bound costs ~10 us,
+     * about what drawing 50 triangles costs on llvmpipe. */
+    double cells = found ? (double)guess[0] * guess[1] : INFINITY;
+    int32_t k = cells <= 32.0 ? 1 : cells <= 1024.0 ? 2 : SUB_MAX;
+    k = k < max_sub ? k : (max_sub > 1 ? max_sub : 1);
+    if (k > 1) {
+        for (int32_t b = 0; b < k; ++b)
+            for (int32_t a = 0; a < k; ++a) {
+                double r[4] = {(double)a / k, (double)(a + 1) / k, (double)b / k,
+                               (double)(b + 1) / k};
+                patch_part(deg_u, deg_v, part, r, sub);
+                sub_measure(deg_u, deg_v, sub, v, k, k, &subs[b * k + a]);
+            }
+        found = choose_segments(&whole, subs, k, v, allowed, n_allowed, guess);
+    }
+    if (found) {
+        out->nu = guess[0];
+        out->nv = guess[1];
+    }
+    if (mem != small)
+        free(mem);
+    return found;
 }

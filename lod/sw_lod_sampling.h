@@ -52,6 +52,35 @@ double sw_lod_object_tolerance(double eps_px, double depth, double focal_px, dou
  * Returns a value >= 1 (not capped; may be +INF when eps <= 0). */
 double sw_lod_trim_texels(double span, double d1, double patch_len, double eps);
 
+/* ---- screen-space grid density (Guthe §5.2 and §7 in one bound; derivation in sampling.c) ---- */
+/* The camera as the screen-space bound needs it. Control points are given relative to the eye. */
+typedef struct sw_lod_screen_view {
+    double right[3], up[3], fwd[3]; /* orthonormal camera basis, fwd = viewing direction */
+    double focal_px;                /* pixels per unit of tangent: height / (2 tan(fovy/2)) */
+    double tan_corner;              /* sqrt(tan_x^2 + tan_y^2): the frustum's corner tangent */
+    double near_plane;              /* smallest depth drawn (> 0) */
+    double eps_px;                  /* ε_img */
+} sw_lod_screen_view;
+
+typedef struct sw_lod_screen_density {
+    int32_t nu, nv; /* grid segments over the range */
+    double eps_obj; /* object-space tolerance at the range's nearest depth (isotropic §7 form,
+                       for the trim-texture resolution) */
+    double d1[2];   /* bounds of |S_s|, |S_t| over the range, local patch parameters */
+} sw_lod_screen_density;
+
+/* Grid segments (nu, nv), both from `allowed` (ascending, n_allowed >= 1), over the part
+ * range = [s0,s1] x [t0,t1] of the local domain of a rational Bézier patch (homogeneous control
+ * points relative to the eye, as in sw_lod_rational_bezier_bounds), with the fewest cells such
+ * that every point of the grid's triangles (each cell split along a diagonal) projects within
+ * eps_px of the patch point at the same parameters. Rigorous: Filip's bound per screen axis with
+ * derivative bounds of the range (and of up to max_sub x max_sub sub-patches of it, max_sub
+ * <= 4), nearest depth and largest off-axis tangent from control points. Returns 1, or 0 when no
+ * allowed pair suffices (out->nu, nv = the largest allowed) or out of memory. */
+int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, const double range[4],
+                           const sw_lod_screen_view *v, const int32_t *allowed, int32_t n_allowed,
+                           int32_t max_sub, sw_lod_screen_density *out);
+
 #ifdef __cplusplus
 }
 #endif

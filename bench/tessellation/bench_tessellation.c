@@ -14,6 +14,7 @@
  */
 #include "glu_nurbs.h"
 #include "vbo_draw.h"
+#include "wavy_patch.h"
 #include "sw_gpu_internal.h"
 #include "sw_sg_scene.h"
 
@@ -29,17 +30,8 @@
 #define N_SIZES 6
 static const int k_sizes[N_SIZES] = {32, 64, 128, 256, 512, 1024};
 static const int32_t k_width = 1280, k_height = 1024;
-static const double k_fovy = 40.0;
 
 /* ---- the patch and its trim loops ----------------------------------------------------------- */
-/* A wavy rational bicubic over [-1,1]^2, one Bézier patch (clamped knots, 4 x 4 points). */
-static const double k_knots[8] = {0, 0, 0, 0, 1, 1, 1, 1};
-static const double k_z[4][4] = {{0.0, 0.3, -0.2, 0.1},
-                                 {0.25, -0.35, 0.4, -0.1},
-                                 {-0.2, 0.45, -0.3, 0.2},
-                                 {0.1, -0.15, 0.25, 0.0}};
-static const double k_w[4][4] = {
-    {1.0, 1.0, 1.0, 1.0}, {1.0, 2.0, 1.5, 1.0}, {1.0, 0.7, 0.5, 1.0}, {1.0, 1.0, 1.0, 1.0}};
 static const double k_star_c[2] = {0.5, 0.5}, k_star_ro = 0.48, k_star_ri = 0.3;
 static const double k_hole_c[2] = {0.46, 0.53}, k_hole_r = 0.15;
 
@@ -55,14 +47,7 @@ static const double k_circle_knots[12] = {0, 0, 0, .25, .25, .5, .5, .75, .75, 1
 
 static void make_shape(shape *s)
 {
-    for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) {
-            double w = k_w[j][i], *p = s->cpw + 4 * (4 * j + i);
-            p[0] = w * (-1.0 + 2.0 * i / 3.0);
-            p[1] = w * (-1.0 + 2.0 * j / 3.0);
-            p[2] = w * k_z[j][i];
-            p[3] = w;
-        }
+    bt_wavy_cpw(s->cpw);
     s->star_box[0] = s->star_box[2] = INFINITY;
     s->star_box[1] = s->star_box[3] = -INFINITY;
     for (int k = 0; k <= 2 * STAR_N; ++k) {
@@ -92,7 +77,7 @@ static void make_shape(shape *s)
 
 static sw_sg_surface shape_surface(const shape *s)
 {
-    return (sw_sg_surface){3, 3, 4, 4, k_knots, k_knots, s->cpw};
+    return bt_wavy_surface(s->cpw);
 }
 
 /* ---- the splinewalk scene -------------------------------------------------------------------- */
@@ -115,8 +100,8 @@ static sw_result build_scene(const shape *s, int trimmed, sw_sg_scene **out, sw_
     memset(&f, 0, sizeof f);
     f.deg_u = f.deg_v = 3;
     f.n_u = f.n_v = 4;
-    f.knots_u = sw_sg_builder_push_doubles(b, k_knots, 8);
-    f.knots_v = sw_sg_builder_push_doubles(b, k_knots, 8);
+    f.knots_u = sw_sg_builder_push_doubles(b, bt_wavy_knots, 8);
+    f.knots_v = sw_sg_builder_push_doubles(b, bt_wavy_knots, 8);
     f.cpw = sw_sg_builder_push_doubles(b, s->cpw, 64);
     f.kind = SW_SG_KIND_BSPLINE;
     f.uv_box[1] = f.uv_box[3] = 1.0;
@@ -138,53 +123,6 @@ static sw_result build_scene(const shape *s, int trimmed, sw_sg_scene **out, sw_
     static const float white[4] = {0.8f, 0.8f, 0.8f, 1.0f};
     sw_sg_builder_add_node(b, SW_SG_NODE_SURFACE, 0, face, NULL, white, "patch");
     return sw_sg_builder_finish(b, out, st);
-}
-
-/* ---- camera ---------------------------------------------------------------------------------- */
-static sw_gpu_camera camera_at(double dist)
-{
-    sw_gpu_camera c = {{0.3, -0.55, 1.0}, {0, 0, 0}, {0, 1, 0}, k_fovy};
-    double n = sqrt(c.eye[0] * c.eye[0] + c.eye[1] * c.eye[1] + c.eye[2] * c.eye[2]);
-    for (int k = 0; k < 3; ++k)
-        c.eye[k] *= dist / n;
-    return c;
-}
-
-/* Horizontal extent in pixels of the untrimmed patch, sampled on a 33 x 33 grid. */
-static double width_px(const shape *s, const sw_gpu_camera *cam)
-{
-    sw__gpu_view v;
-    if (sw__gpu_view_init(&v, cam, k_width, k_height, 1e-3, NULL) != SW_OK)
-        return 0.0;
-    sw_sg_surface srf = shape_surface(s);
-    double lo = INFINITY, hi = -INFINITY;
-    for (int j = 0; j <= 32; ++j)
-        for (int i = 0; i <= 32; ++i) {
-            double p[3], x = 0.0, w = 0.0;
-            sw_sg_surface_eval(&srf, i / 32.0, j / 32.0, p);
-            for (int k = 0; k < 3; ++k) {
-                x += v.right[k] * (p[k] - v.eye[k]);
-                w += v.fwd[k] * (p[k] - v.eye[k]);
-            }
-            double px = (x / (w * v.tan_x) + 1.0) * 0.5 * k_width;
-            lo = fmin(lo, px);
-            hi = fmax(hi, px);
-        }
-    return hi - lo;
-}
-
-/* Camera distance at which the patch is `px` pixels across (fixed-point iteration: the width is
- * nearly inversely proportional to the distance). */
-static double fit_distance(const shape *s, double px, double *got)
-{
-    double d = 10.0;
-    for (int it = 0; it < 12; ++it) {
-        sw_gpu_camera c = camera_at(d);
-        d *= width_px(s, &c) / px;
-    }
-    sw_gpu_camera c = camera_at(d);
-    *got = width_px(s, &c);
-    return d;
 }
 
 /* ---- measurements ---------------------------------------------------------------------------- */
@@ -251,7 +189,7 @@ static sw_gpu_frame_desc frame_desc(const bench *b, double dist)
     d.width = k_width;
     d.height = k_height;
     d.error_px = b->error_px;
-    d.camera = camera_at(dist);
+    d.camera = bt_wavy_camera_at(dist);
     return d;
 }
 
@@ -322,7 +260,7 @@ static int32_t star_polyline(const shape *sh, int split, float *out)
 static void glu_input_init(glu_input *in, const shape *sh, int trimmed, int split)
 {
     for (int i = 0; i < 8; ++i)
-        in->knots[i] = (float)k_knots[i];
+        in->knots[i] = (float)bt_wavy_knots[i];
     int32_t n_star = star_polyline(sh, split, in->star);
     for (int i = 0; i < 27; ++i)
         in->hole[i] = (float)sh->hole[i];
@@ -456,7 +394,7 @@ static int run_glu(bench *b, int trimmed, double dist, series *s)
 {
     static glu_input in;
     glu_input_init(&in, b->shape, trimmed, b->glu_trim_split);
-    sw_gpu_camera cam = camera_at(dist);
+    sw_gpu_camera cam = bt_wavy_camera_at(dist);
     sw__gpu_view v;
     if (glu_view(b, &cam, &v) != SW_OK)
         return 0;
@@ -551,7 +489,8 @@ static int run_scene(bench *b, int trimmed)
     int worst_size = 0;
     int ok = 1;
     for (int k = 0; k < N_SIZES && ok; ++k) {
-        double across, dist = fit_distance(b->shape, k_sizes[k], &across);
+        double across,
+            dist = bt_wavy_fit_distance(b->shape->cpw, k_sizes[k], k_width, k_height, &across);
         if (fabs(across - k_sizes[k]) > 0.5)
             printf("  warning: the patch is %.1f px across, not %d\n", across, k_sizes[k]);
         ok = run_splinewalk(b, scene, dist, &sw_s) && run_glu(b, trimmed, dist, &gl_s);

@@ -1,8 +1,10 @@
 /* Rendering, real (issue 2): imported CAD models rendered by sw_gpu_render_scene (trim textures,
  * Filip grids) against an independent reference — OCCT's BRepMesh_IncrementalMesh of the same
  * file at a deflection of 1e-4 x the box diagonal, drawn through sw_gpu_render_triangles with the
- * same camera. From the iso and front views: coverage masks differ in <= 0.5 % of the covered
- * pixels, where both cover a pixel the depths agree within the surface error (2 pixels' worth of
+ * same camera. From the iso and front views: coverage masks differ in <= 0.1 % of the covered
+ * pixels, not counting pixels within 1 px of the other image's coverage (an edge may move by
+ * ε_img = 0.5 px, which flips a whole row of pixels along a silhouette that runs near pixel
+ * centres), where both cover a pixel the depths agree within the surface error (2 pixels' worth of
  * object size at that depth plus the reference's deflection) for >= 99 % of them, and trim
  * textures were used (patches_trimmed > 0).
  *
@@ -10,20 +12,10 @@
  */
 #include "sw_gpu.h"
 #include "sw_sg_import.h"
+#include "occt_reference.hpp"
 
 #include <BRepBndLib.hxx>
-#include <BRepMesh_IncrementalMesh.hxx>
-#include <BRepTools.hxx>
-#include <BRep_Builder.hxx>
-#include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
-#include <IFSelect_ReturnStatus.hxx>
-#include <Poly_Triangulation.hxx>
-#include <STEPControl_Reader.hxx>
-#include <TopExp_Explorer.hxx>
-#include <TopoDS.hxx>
-#include <TopoDS_Face.hxx>
-#include <TopoDS_Shape.hxx>
 
 #include <algorithm>
 #include <chrono>
@@ -35,58 +27,6 @@
 
 namespace
 {
-
-struct ref_mesh {
-    std::vector<double> pos;
-    std::vector<uint32_t> idx;
-};
-
-bool ends_with(const std::string &s, const char *e)
-{
-    size_t n = std::strlen(e);
-    return s.size() >= n && s.compare(s.size() - n, n, e) == 0;
-}
-
-bool read_shape(const std::string &path, TopoDS_Shape &shape)
-{
-    if (ends_with(path, ".brep")) {
-        BRep_Builder b;
-        return BRepTools::Read(shape, path.c_str(), b);
-    }
-    STEPControl_Reader r;
-    if (r.ReadFile(path.c_str()) != IFSelect_RetDone)
-        return false;
-    r.TransferRoots();
-    shape = r.OneShape();
-    return !shape.IsNull();
-}
-
-bool reference_mesh(const std::string &path, double deflection, ref_mesh &m)
-{
-    TopoDS_Shape shape;
-    if (!read_shape(path, shape))
-        return false;
-    BRepMesh_IncrementalMesh mesher(shape, deflection, Standard_False, 0.5, Standard_True);
-    for (TopExp_Explorer ex(shape, TopAbs_FACE); ex.More(); ex.Next()) {
-        TopLoc_Location loc;
-        const TopoDS_Face &f = TopoDS::Face(ex.Current());
-        Handle(Poly_Triangulation) tri = BRep_Tool::Triangulation(f, loc);
-        if (tri.IsNull())
-            continue;
-        uint32_t base = (uint32_t)(m.pos.size() / 3);
-        for (Standard_Integer i = 1; i <= tri->NbNodes(); ++i) {
-            gp_Pnt p = tri->Node(i).Transformed(loc.Transformation());
-            m.pos.insert(m.pos.end(), {p.X(), p.Y(), p.Z()});
-        }
-        for (Standard_Integer i = 1; i <= tri->NbTriangles(); ++i) {
-            Standard_Integer a, b, c;
-            tri->Triangle(i).Get(a, b, c);
-            m.idx.insert(m.idx.end(),
-                         {base + (uint32_t)a - 1, base + (uint32_t)b - 1, base + (uint32_t)c - 1});
-        }
-    }
-    return !m.idx.empty();
-}
 
 sw_gpu_camera preset(const double bbox[6], bool iso)
 {
@@ -108,7 +48,20 @@ sw_gpu_camera preset(const double bbox[6], bool iso)
 
 struct compare_result {
     long covered_a = 0, covered_b = 0, differ = 0, both = 0, depth_bad = 0;
+    long far = 0; /* differing pixels with no pixel of the other image's coverage within 1 px */
 };
+
+bool covered_near(const sw_gpu_image &img, int x, int y)
+{
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < img.width && yy < img.height &&
+                img.rgba[4 * ((size_t)yy * (size_t)img.width + (size_t)xx) + 3] != 0)
+                return true;
+        }
+    return false;
+}
 
 compare_result compare(const sw_gpu_image &a, const sw_gpu_image &b, double focal_px,
                        double deflection)
@@ -120,6 +73,10 @@ compare_result compare(const sw_gpu_image &a, const sw_gpu_image &b, double foca
         r.covered_a += ca;
         r.covered_b += cb;
         r.differ += ca != cb;
+        if (ca != cb) {
+            int x = (int)(i % (size_t)a.width), y = (int)(i / (size_t)a.width);
+            r.far += !covered_near(ca ? b : a, x, y);
+        }
         if (ca && cb) {
             ++r.both;
             double z = std::min(a.depth[i], b.depth[i]);
@@ -171,7 +128,7 @@ bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const ref_mesh &ref
     }
     double focal = h / (2.0 * std::tan(20.0 * M_PI / 180.0));
     compare_result c = compare(ours, theirs, focal, deflection);
-    double cover_frac = (double)c.differ / (double)std::max(1L, c.covered_b);
+    double cover_frac = (double)c.far / (double)std::max(1L, c.covered_b);
     double depth_frac = (double)c.depth_bad / (double)std::max(1L, c.both);
     std::printf("%s %s %dx%d: patches %llu trimmed / %llu untrimmed / %llu culled, %llu "
                 "triangles (reference %zu), %llu trim textures; ms tessellate %.1f trim %.1f "
@@ -181,13 +138,14 @@ bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const ref_mesh &ref
                 (unsigned long long)fs.patches_culled, (unsigned long long)fs.triangles,
                 ref.idx.size() / 3, (unsigned long long)fs.trim_textures, fs.ms_tessellate,
                 fs.ms_trim, fs.ms_draw, fs.ms_readback);
-    std::printf("  coverage: ours %ld, reference %ld, differ %ld (%.3f %% of covered); depth "
-                "outside tolerance at %ld of %ld common pixels (%.3f %%)\n",
-                c.covered_a, c.covered_b, c.differ, 100.0 * cover_frac, c.depth_bad, c.both,
+    std::printf("  coverage: ours %ld, reference %ld, differ %ld, of which %ld (%.3f %% of "
+                "covered) farther than 1 px from the other's coverage; depth outside tolerance at "
+                "%ld of %ld common pixels (%.3f %%)\n",
+                c.covered_a, c.covered_b, c.differ, c.far, 100.0 * cover_frac, c.depth_bad, c.both,
                 100.0 * depth_frac);
     std::string tag = out_prefix + (iso ? "_iso" : "_front");
     bool ok = write(ours, tag + ".png") && write(theirs, tag + "_brepmesh.png");
-    ok = ok && cover_frac <= 0.005 && depth_frac <= 0.01 && fs.patches_trimmed > 0;
+    ok = ok && cover_frac <= 0.001 && depth_frac <= 0.01 && fs.patches_trimmed > 0;
     sw_gpu_image_free(&ours);
     sw_gpu_image_free(&theirs);
     return ok;
