@@ -13,7 +13,9 @@
  *
  * Usage: test_gpu_cracks OUTDIR FILE...   (.brep / .step / .tsm)
  */
-#include "occt_reference.hpp"
+#include "occt_reference.hpp" /* tests/support */
+
+#include <cstring>
 #include "sw_gpu_internal.h"
 #include "sw_sg_import.h"
 #include "sw_sg_tspline.h"
@@ -137,7 +139,7 @@ bool render(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_gpu_frame_de
 
 const double k_dirs[4][3] = {{1, 1, 1}, {0, -1, 0.2}, {-1, 0.6, 0.5}, {0.7, -0.4, -0.8}};
 
-bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const ref_mesh *ref, double deflection,
+bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_test::occt_triangles *ref, double deflection,
               const double box[6], int view, const std::string &prefix)
 {
     sw_gpu_frame_desc desc{};
@@ -184,7 +186,7 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
 {
     sw_sg_scene *scene = nullptr;
     sw_status st{};
-    bool tsm = ends_with(path, ".tsm");
+    bool tsm = path.size() >= 4 && path.compare(path.size() - 4, 4, ".tsm") == 0;
     sw_result r;
     if (tsm) {
         r = sw_sg_tspline_import_file(path.c_str(), &scene, &st);
@@ -201,13 +203,13 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
     sw_sg_scene_compute_stats(scene, &ss);
     double box[6];
     std::memcpy(box, ss.bbox, sizeof box);
-    ref_mesh ref;
+    sw_test::occt_triangles ref;
     double deflection = 0.0;
     if (!tsm) {
         double diag = std::sqrt(std::pow(box[3] - box[0], 2) + std::pow(box[4] - box[1], 2) +
                                 std::pow(box[5] - box[2], 2));
         deflection = 1e-4 * diag;
-        if (!reference_mesh(path, deflection, ref)) {
+        if (!sw_test::occt_reference_mesh(path, deflection, ref)) {
             std::fprintf(stderr, "reference mesh of %s failed\n", path.c_str());
             sw_sg_scene_free(scene);
             return false;

@@ -12,7 +12,7 @@
  */
 #include "sw_gpu.h"
 #include "sw_sg_import.h"
-#include "occt_reference.hpp"
+#include "occt_reference.hpp" /* tests/support */
 
 #include <BRepBndLib.hxx>
 #include <Bnd_Box.hxx>
@@ -104,7 +104,7 @@ std::string base_name(const std::string &p)
     return b.substr(0, b.find_last_of('.'));
 }
 
-bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const ref_mesh &ref,
+bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_test::occt_triangles &ref,
               const double bbox[6], double deflection, bool iso, int w, int h,
               const std::string &out_prefix)
 {
@@ -166,10 +166,10 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
     double diag =
         std::sqrt(std::pow(ss.bbox[3] - ss.bbox[0], 2) + std::pow(ss.bbox[4] - ss.bbox[1], 2) +
                   std::pow(ss.bbox[5] - ss.bbox[2], 2));
-    ref_mesh ref;
+    sw_test::occt_triangles ref;
     double deflection = 1e-4 * diag;
     auto t0 = std::chrono::steady_clock::now();
-    if (!reference_mesh(path, deflection, ref)) {
+    if (!sw_test::occt_reference_mesh(path, deflection, ref)) {
         std::fprintf(stderr, "reference mesh of %s failed\n", path.c_str());
         sw_sg_scene_free(scene);
         return false;

@@ -1,0 +1,228 @@
+/* Test support: OCCT BRepMesh_IncrementalMesh of a model file as world-space triangles, the
+ * independent reference the image tests draw through sw_gpu_render_triangles (see
+ * occt_reference.hpp). Reading and meshing follow tests/gpu/test_gpu_models.cpp: absolute
+ * deflection, angular deflection 0.5 rad, parallel meshing.
+ */
+#include "occt_reference.hpp"
+
+#include <BRepBndLib.hxx>
+#include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <IGESControl_Reader.hxx>
+#include <Poly_Triangulation.hxx>
+#include <STEPControl_Reader.hxx>
+#include <Standard_Failure.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <TopoDS_Compound.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cmath>
+
+namespace sw_test
+{
+
+namespace
+{
+
+std::string lower_extension(const std::string &path)
+{
+    size_t dot = path.find_last_of('.');
+    std::string e = dot == std::string::npos ? std::string() : path.substr(dot + 1);
+    for (char &c : e)
+        c = (char)std::tolower((unsigned char)c);
+    return e;
+}
+
+bool read_shape(const std::string &path, TopoDS_Shape &shape, std::string &error)
+{
+    std::string ext = lower_extension(path);
+    if (ext == "brep") {
+        BRep_Builder b;
+        if (!BRepTools::Read(shape, path.c_str(), b))
+            error = "BRepTools::Read failed";
+    } else if (ext == "step" || ext == "stp") {
+        STEPControl_Reader r;
+        if (r.ReadFile(path.c_str()) != IFSelect_RetDone) {
+            error = "STEPControl_Reader::ReadFile failed";
+            return false;
+        }
+        r.TransferRoots();
+        shape = r.OneShape();
+    } else if (ext == "iges" || ext == "igs") {
+        IGESControl_Reader r;
+        if (r.ReadFile(path.c_str()) != IFSelect_RetDone) {
+            error = "IGESControl_Reader::ReadFile failed";
+            return false;
+        }
+        r.TransferRoots();
+        shape = r.OneShape();
+    } else {
+        error = "unsupported extension '" + ext + "'";
+        return false;
+    }
+    if (error.empty() && shape.IsNull())
+        error = "the file holds no shape";
+    return error.empty();
+}
+
+std::array<double, 6> empty_box()
+{
+    return {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+}
+
+void grow(std::array<double, 6> &b, const double p[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        b[k] = std::min(b[k], p[k]);
+        b[3 + k] = std::max(b[3 + k], p[k]);
+    }
+}
+
+std::array<double, 6> zero_if_empty(const std::array<double, 6> &b)
+{
+    return b[0] <= b[3] ? b : std::array<double, 6>{};
+}
+
+/* Appends one meshed face occurrence, its location applied. */
+void append_face(const TopoDS_Face &f, occt_triangles &out)
+{
+    TopLoc_Location loc;
+    Handle(Poly_Triangulation) tri = BRep_Tool::Triangulation(f, loc);
+    if (tri.IsNull())
+        return;
+    uint32_t base = (uint32_t)out.n_vertices();
+    for (Standard_Integer i = 1; i <= tri->NbNodes(); ++i) {
+        gp_Pnt p = tri->Node(i).Transformed(loc.Transformation());
+        out.pos.insert(out.pos.end(), {p.X(), p.Y(), p.Z()});
+    }
+    for (Standard_Integer i = 1; i <= tri->NbTriangles(); ++i) {
+        Standard_Integer a, b, c;
+        tri->Triangle(i).Get(a, b, c);
+        out.idx.insert(out.idx.end(),
+                       {base + (uint32_t)a - 1, base + (uint32_t)b - 1, base + (uint32_t)c - 1});
+    }
+    ++out.faces_meshed;
+}
+
+} // namespace
+
+std::array<double, 6> occt_triangles::box() const
+{
+    std::array<double, 6> b = empty_box();
+    for (size_t i = 0; i + 2 < pos.size(); i += 3)
+        grow(b, &pos[i]);
+    return zero_if_empty(b);
+}
+
+struct occt_model::impl {
+    TopoDS_Shape shape;
+    std::vector<TopoDS_Face> faces; /* occurrences, with their locations */
+    std::vector<std::array<double, 6>> boxes;
+};
+
+occt_model::occt_model() : p_(new impl) {}
+occt_model::~occt_model() = default;
+
+bool occt_model::read(const std::string &path, std::string *error)
+{
+    std::string err;
+    p_->faces.clear();
+    p_->boxes.clear();
+    try {
+        if (read_shape(path, p_->shape, err)) {
+            for (TopExp_Explorer ex(p_->shape, TopAbs_FACE); ex.More(); ex.Next()) {
+                const TopoDS_Face &f = TopoDS::Face(ex.Current());
+                Bnd_Box bb;
+                BRepBndLib::Add(f, bb, Standard_False);
+                if (bb.IsVoid())
+                    continue;
+                double b[6];
+                bb.Get(b[0], b[1], b[2], b[3], b[4], b[5]);
+                p_->faces.push_back(f);
+                p_->boxes.push_back({b[0], b[1], b[2], b[3], b[4], b[5]});
+            }
+            if (p_->faces.empty())
+                err = "no faces";
+        }
+    } catch (const Standard_Failure &e) {
+        err = std::string("OCCT exception: ") + e.GetMessageString();
+    }
+    if (!err.empty() && error)
+        *error = path + ": " + err;
+    return err.empty();
+}
+
+size_t occt_model::n_faces() const { return p_->faces.size(); }
+
+const std::vector<std::array<double, 6>> &occt_model::face_boxes() const { return p_->boxes; }
+
+std::array<double, 6> occt_model::box() const
+{
+    std::array<double, 6> b = empty_box();
+    for (const auto &fb : p_->boxes) {
+        grow(b, &fb[0]);
+        grow(b, &fb[3]);
+    }
+    return zero_if_empty(b);
+}
+
+bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_filter &keep,
+                      double angle_rad)
+{
+    out = occt_triangles{};
+    if (!(deflection > 0.0) || p_->faces.empty())
+        return false;
+    try {
+        /* A finer triangulation left from an earlier call would be kept by BRepMesh. */
+        BRepTools::Clean(p_->shape, Standard_True);
+        BRep_Builder b;
+        TopoDS_Compound sel;
+        b.MakeCompound(sel);
+        std::vector<size_t> chosen;
+        for (size_t i = 0; i < p_->faces.size(); ++i)
+            if (!keep || keep(p_->boxes[i])) {
+                b.Add(sel, p_->faces[i]);
+                chosen.push_back(i);
+            }
+        if (chosen.empty())
+            return false;
+        auto t0 = std::chrono::steady_clock::now();
+        BRepMesh_IncrementalMesh mesher(sel, deflection, Standard_False, angle_rad, Standard_True);
+        out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                     .count();
+        out.triangles_per_face.assign(p_->faces.size(), 0);
+        for (size_t i : chosen) {
+            size_t before = out.n_triangles();
+            append_face(p_->faces[i], out);
+            out.triangles_per_face[i] = (uint32_t)(out.n_triangles() - before);
+        }
+    } catch (const Standard_Failure &) {
+        out = occt_triangles{};
+        return false;
+    }
+    return !out.idx.empty();
+}
+
+bool occt_reference_mesh(const std::string &path, double deflection, occt_triangles &out,
+                         std::string *error)
+{
+    occt_model m;
+    if (!m.read(path, error))
+        return false;
+    if (m.mesh(deflection, out))
+        return true;
+    if (error)
+        *error = path + ": BRepMesh produced no triangles";
+    return false;
+}
+
+} // namespace sw_test
