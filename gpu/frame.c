@@ -12,6 +12,7 @@
  * texture generation, waited for), draw (upload and draw until glFinish), readback.
  */
 #include "sw_gpu_internal.h"
+#include "sw_lod_bezier.h"
 #include "sw_lod_sampling.h"
 #include "sw_sg_trim.h"
 #include "sw_status_util.h"
@@ -25,6 +26,8 @@ enum {
     MAX_SEGMENTS = 256, /* grid segments per patch and direction */
     MAX_TRIM_LOOP_VERTICES = 1u << 22,
     MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
+    MAX_TILES_PER_DIR = 4096,  /* trim tiles of a face per direction */
+    MAX_TILES_PER_FACE = 16384, /* visible trim tiles of one face occurrence (else coarser) */
 };
 
 /* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
@@ -35,6 +38,8 @@ typedef struct segment_set {
 } segment_set;
 static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
 static const double k_max_frame_texels = 256e6;  /* R8 trim texels per frame */
+static const double k_tile_texels = 1024.0; /* wanted trim texels per direction above which a
+                                               face's trim box is split into tiles */
 
 typedef struct occurrence {
     uint32_t face;
@@ -48,7 +53,15 @@ typedef struct pending_trim {
     double width, height; /* wanted resolution before the frame budget */
     size_t occ;           /* occurrence, for its fat border */
     double cell[2];       /* smallest grid cell of the face in u, v (fat-border sampling) */
+    int64_t loops;        /* tiled face: its flattened loops in frame.loops; -1: whole trim box */
+    double rect[4];       /* tiled face: the tile (face parameters) */
 } pending_trim;
+
+/* A tiled face occurrence's loops, flattened once for all its tiles. */
+typedef struct face_loops {
+    sw_sg_polyline *loops;
+    uint32_t n;
+} face_loops;
 
 typedef struct frame {
     sw_gpu_context *ctx;
@@ -73,6 +86,8 @@ typedef struct frame {
     segment_set gpu_segments, cpu_segments;
     uint64_t border_triangles; /* fat-border triangles (counted in st.triangles, which also
                                   counts the mesh at the end: subtracted there) */
+    face_loops *loops;         /* of tiled faces */
+    size_t n_loops, cap_loops;
 } frame;
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -218,6 +233,9 @@ static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch 
 }
 
 /* One u-density per patch column and one v-density per row: grids meet vertex to vertex. */
+static int32_t class_texels(double want, int32_t max_entry);
+static int left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k);
+
 static void unify_densities(sw__gpu_patch *pt, int32_t n_cols, int32_t n_rows)
 {
     for (int32_t a = 0; a < n_cols; ++a) {
@@ -250,8 +268,14 @@ static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int t
     memcpy(d->color, o->color, sizeof d->color);
     d->trim_entry = -1;
     if (trimmed)
-        f->trims[f->n_trims++] = (pending_trim){
-            f->n_draws, o->face, need->u, need->v, (size_t)(o - f->occ), {cell[0], cell[1]}};
+        f->trims[f->n_trims++] = (pending_trim){f->n_draws,
+                                                o->face,
+                                                need->u,
+                                                need->v,
+                                                (size_t)(o - f->occ),
+                                                {cell[0], cell[1]},
+                                                -1,
+                                                {0.0, 0.0, 0.0, 0.0}};
     f->n_draws++;
     return SW_OK;
 }
@@ -402,6 +426,338 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on)
     ctx->crack_fill_off = !on;
 }
 
+/* ---- tiled trim boxes (§5.3, §7: trim textures finer than one texture per face can hold) ----
+ * A face whose trim texture would need more than k_tile_texels per direction has its trim box
+ * cut into ku x kv equal tiles (powers of two). Only tiles whose part of the surface meets the
+ * frustum are kept (found by bisection on the sub-patch control-net boxes); each kept tile is
+ * one draw with its own trim texture over the tile's rectangle, at the resolution its own part
+ * of the surface needs; tiles no loop crosses need no texture (inside) or are dropped (outside).
+ * The patches are cut at the tile boundaries into cells; cell densities are unified per column
+ * and row of the refined grid (every tile of a column shares its u breaks), so neighbouring
+ * cells meet vertex to vertex as whole patches do. */
+typedef struct tile {
+    double rect[4];
+    int32_t i, j;         /* tile indices */
+    int32_t a0, a1, b0, b1; /* patch columns and rows it overlaps (inclusive) */
+    size_t first_cell;    /* (a1 - a0 + 1) x (b1 - b0 + 1) cells, column fastest */
+    trim_need need;
+    int cls; /* sw__gpu_trim_rect_class */
+} tile;
+
+typedef struct tiling {
+    frame *f;
+    const occurrence *o;
+    const sw_sg_bezier_set *set;
+    const sw__gpu_patch *pt;
+    const double *ub;
+    int32_t ku, kv, class_grids;
+    tile *tiles;
+    size_t n_tiles, cap_tiles;
+    sw__gpu_patch *cells;
+    size_t n_cells, cap_cells;
+    double *scratch; /* restricted control net */
+} tiling;
+
+static double tile_edge(const double *ub, int lo, int32_t i, int32_t k)
+{
+    return i == k ? ub[lo + 1] : ub[lo] + (ub[lo + 1] - ub[lo]) * (double)i / (double)k;
+}
+
+static void tile_rect(const tiling *t, int32_t i0, int32_t i1, int32_t j0, int32_t j1, double r[4])
+{
+    r[0] = tile_edge(t->ub, 0, i0, t->ku);
+    r[1] = tile_edge(t->ub, 0, i1, t->ku);
+    r[2] = tile_edge(t->ub, 2, j0, t->kv);
+    r[3] = tile_edge(t->ub, 2, j1, t->kv);
+}
+
+/* Patch columns (dir 0) or rows (dir 1) overlapping [lo, hi]; *first > *last when none. */
+static void patch_span(const sw_sg_bezier_set *set, int dir, double lo, double hi, int32_t *first,
+                       int32_t *last)
+{
+    int32_t n = dir ? set->n_v : set->n_u;
+    *first = n;
+    *last = -1;
+    for (int32_t a = 0; a < n; ++a) {
+        const sw_sg_bezier_patch *bp = &set->patches[dir ? (size_t)a * (size_t)set->n_u : (size_t)a];
+        double p0 = dir ? bp->v0 : bp->u0, p1 = dir ? bp->v1 : bp->u1;
+        if (p1 > lo && p0 < hi) {
+            *first = a < *first ? a : *first;
+            *last = a;
+        }
+    }
+}
+
+/* The cell of patch p inside rect r (local range restricted); visible when its sub-net's box
+ * meets the frustum. */
+static void make_cell(const tiling *t, size_t p, const double r[4], sw__gpu_patch *c)
+{
+    *c = t->pt[p];
+    if (!c->visible)
+        return;
+    double du = c->u1 - c->u0, dv = c->v1 - c->v0;
+    c->s0 = fmax(c->s0, (r[0] - c->u0) / du);
+    c->s1 = fmin(c->s1, (r[1] - c->u0) / du);
+    c->t0 = fmax(c->t0, (r[2] - c->v0) / dv);
+    c->t1 = fmin(c->t1, (r[3] - c->v0) / dv);
+    c->visible = 0;
+    if (!(c->s1 > c->s0) || !(c->t1 > c->t0))
+        return;
+    const double range[4] = {c->s0, c->s1, c->t0, c->t1};
+    sw_lod_bez_restrict(c->deg_u, c->deg_v, 4, c->cpw, range, t->scratch);
+    double box[6];
+    box_empty(box);
+    size_t n = (size_t)(c->deg_u + 1) * (size_t)(c->deg_v + 1);
+    for (size_t i = 0; i < n; ++i)
+        box_add(box, t->scratch + 4 * i);
+    c->visible = sw__gpu_view_box_visible(&t->f->view, box);
+}
+
+static int rect_visible(const tiling *t, const double r[4])
+{
+    int32_t a0, a1, b0, b1;
+    patch_span(t->set, 0, r[0], r[1], &a0, &a1);
+    patch_span(t->set, 1, r[2], r[3], &b0, &b1);
+    for (int32_t b = b0; b <= b1; ++b)
+        for (int32_t a = a0; a <= a1; ++a) {
+            sw__gpu_patch c;
+            make_cell(t, (size_t)b * (size_t)t->set->n_u + (size_t)a, r, &c);
+            if (c.visible)
+                return 1;
+        }
+    return 0;
+}
+
+/* Bisection over tile index ranges: keeps the visible tiles (at most MAX_TILES_PER_FACE). */
+static int find_tiles(tiling *t, int32_t i0, int32_t i1, int32_t j0, int32_t j1)
+{
+    double r[4];
+    tile_rect(t, i0, i1, j0, j1, r);
+    if (!rect_visible(t, r))
+        return 1;
+    if (i1 - i0 > 1 || j1 - j0 > 1) {
+        if (i1 - i0 >= j1 - j0)
+            return find_tiles(t, i0, (i0 + i1) / 2, j0, j1) &&
+                   find_tiles(t, (i0 + i1) / 2, i1, j0, j1);
+        return find_tiles(t, i0, i1, j0, (j0 + j1) / 2) && find_tiles(t, i0, i1, (j0 + j1) / 2, j1);
+    }
+    if (t->n_tiles >= MAX_TILES_PER_FACE ||
+        !grow((void **)&t->tiles, &t->cap_tiles, t->n_tiles + 1, sizeof *t->tiles))
+        return 0;
+    tile *tl = &t->tiles[t->n_tiles++];
+    memset(tl, 0, sizeof *tl);
+    memcpy(tl->rect, r, sizeof r);
+    tl->i = i0;
+    tl->j = j0;
+    return 1;
+}
+
+/* Cells of one tile with their densities and the tile's wanted texels. */
+static int tile_cells(tiling *t, tile *tl)
+{
+    frame *f = t->f;
+    patch_span(t->set, 0, tl->rect[0], tl->rect[1], &tl->a0, &tl->a1);
+    patch_span(t->set, 1, tl->rect[2], tl->rect[3], &tl->b0, &tl->b1);
+    size_t n = (size_t)(tl->a1 - tl->a0 + 1) * (size_t)(tl->b1 - tl->b0 + 1);
+    if (!grow((void **)&t->cells, &t->cap_cells, t->n_cells + n, sizeof *t->cells))
+        return 0;
+    tl->first_cell = t->n_cells;
+    tl->need = (trim_need){1.0, 1.0};
+    const segment_set *set = t->class_grids ? &f->gpu_segments : &f->cpu_segments;
+    for (int32_t b = tl->b0; b <= tl->b1; ++b)
+        for (int32_t a = tl->a0; a <= tl->a1; ++a) {
+            sw__gpu_patch *c = &t->cells[t->n_cells++];
+            make_cell(t, (size_t)b * (size_t)t->set->n_u + (size_t)a, tl->rect, c);
+            c->col = a;
+            c->row = b;
+            if (!c->visible)
+                continue;
+            const double range[4] = {c->s0, c->s1, c->t0, c->t1};
+            sw_lod_screen_density d;
+            sw_lod_screen_segments(c->deg_u, c->deg_v, c->cpw, range, &f->screen, set->n,
+                                   set->count, MAX_BOUND_SUBDIVISION, &d);
+            c->eps = d.eps_obj;
+            c->nu = d.nu;
+            c->nv = d.nv;
+            tl->need.u = fmax(tl->need.u, sw_lod_trim_texels(tl->rect[1] - tl->rect[0], d.d1[0],
+                                                             c->u1 - c->u0, d.eps_obj));
+            tl->need.v = fmax(tl->need.v, sw_lod_trim_texels(tl->rect[3] - tl->rect[2], d.d1[1],
+                                                             c->v1 - c->v0, d.eps_obj));
+        }
+    return 1;
+}
+
+typedef struct cell_key {
+    int64_t key;
+    size_t cell;
+} cell_key;
+
+static int cell_key_cmp(const void *a, const void *b)
+{
+    int64_t x = ((const cell_key *)a)->key, y = ((const cell_key *)b)->key;
+    return x < y ? -1 : x > y;
+}
+
+/* Unifies nu over every cell of a refined column (dir 0) or nv over a row (dir 1). */
+static int unify_cells(tiling *t, int dir)
+{
+    cell_key *k = malloc((t->n_cells ? t->n_cells : 1) * sizeof *k);
+    if (!k)
+        return 0;
+    size_t m = 0;
+    for (size_t ti = 0; ti < t->n_tiles; ++ti) {
+        const tile *tl = &t->tiles[ti];
+        size_t n = (size_t)(tl->a1 - tl->a0 + 1) * (size_t)(tl->b1 - tl->b0 + 1);
+        for (size_t c = tl->first_cell; c < tl->first_cell + n; ++c) {
+            const sw__gpu_patch *p = &t->cells[c];
+            int64_t key = dir ? (int64_t)tl->j * t->set->n_v + p->row
+                              : (int64_t)tl->i * t->set->n_u + p->col;
+            if (p->visible)
+                k[m++] = (cell_key){key, c};
+        }
+    }
+    qsort(k, m, sizeof *k, cell_key_cmp);
+    for (size_t a = 0; a < m;) {
+        size_t b = a;
+        int32_t mx = 1;
+        for (; b < m && k[b].key == k[a].key; ++b)
+            mx = dir ? (t->cells[k[b].cell].nv > mx ? t->cells[k[b].cell].nv : mx)
+                     : (t->cells[k[b].cell].nu > mx ? t->cells[k[b].cell].nu : mx);
+        for (; a < b; ++a)
+            *(dir ? &t->cells[k[a].cell].nv : &t->cells[k[a].cell].nu) = mx;
+    }
+    free(k);
+    return 1;
+}
+
+/* Flattens the face's loops once, finely enough for its finest tile texture, and classifies
+ * the tiles against them (a margin of 1 % of a tile so that a loop on a tile's edge counts). */
+static sw_result tile_loops(tiling *t, int64_t *index, sw_status *status)
+{
+    frame *f = t->f;
+    const sw_sg_face_rec *rec = &f->sv->faces[t->o->face];
+    int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
+    double tol = INFINITY;
+    for (size_t i = 0; i < t->n_tiles; ++i) {
+        const tile *tl = &t->tiles[i];
+        tol = fmin(tol, 0.5 * (tl->rect[1] - tl->rect[0]) / class_texels(tl->need.u, max_entry));
+        tol = fmin(tol, 0.5 * (tl->rect[3] - tl->rect[2]) / class_texels(tl->need.v, max_entry));
+    }
+    if (!grow((void **)&f->loops, &f->cap_loops, f->n_loops + 1, sizeof *f->loops))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->o->face);
+    face_loops *fl = &f->loops[f->n_loops];
+    fl->n = 0;
+    fl->loops = calloc(rec->n_loops, sizeof *fl->loops);
+    if (!fl->loops)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->o->face);
+    *index = (int64_t)f->n_loops++;
+    sw_result r = SW_OK;
+    for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k, ++fl->n)
+        r = sw_sg_trim_flatten_loop(f->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
+                                    &fl->loops[k], status);
+    for (size_t i = 0; i < t->n_tiles && r == SW_OK; ++i) {
+        tile *tl = &t->tiles[i];
+        double mu = 0.01 * (tl->rect[1] - tl->rect[0]), mv = 0.01 * (tl->rect[3] - tl->rect[2]);
+        double g[4] = {tl->rect[0] - mu, tl->rect[1] + mu, tl->rect[2] - mv, tl->rect[3] + mv};
+        tl->cls = sw__gpu_trim_rect_class(fl->loops, fl->n, g);
+    }
+    return r;
+}
+
+/* One tile's draw: its cells as vertex-shader records or one CPU grid. */
+static sw_result tile_draw(tiling *t, const tile *tl, int64_t loops, double sign, int on_gpu,
+                           const double cell[2], sw_status *status)
+{
+    frame *f = t->f;
+    int trimmed = tl->cls == 0;
+    int32_t n_cols = tl->a1 - tl->a0 + 1, n_rows = tl->b1 - tl->b0 + 1;
+    size_t n = (size_t)n_cols * (size_t)n_rows, first = f->mesh.n_idx;
+    const sw__gpu_patch *c = t->cells + tl->first_cell;
+    int32_t d = (int32_t)f->n_draws;
+    sw_result r = SW_OK;
+    if (on_gpu) {
+        r = add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
+        for (size_t p = 0; p < n && r == SW_OK; ++p)
+            if (c[p].visible)
+                r = gpu_patch(f, t->o, &c[p], tl->rect, sign, d, trimmed, status);
+    } else {
+        r = sw__gpu_tessellate_face(c, n_cols, n_rows, sign, tl->rect, &f->mesh, status);
+        for (size_t p = 0; p < n && f->ctx->patch_hook; ++p)
+            if (c[p].visible)
+                report_patch(f, t->o, &c[p], c[p].s0, c[p].s1, c[p].t0, c[p].t1, c[p].nu, c[p].nv,
+                             0, trimmed);
+        if (r == SW_OK)
+            r = add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
+    }
+    if (r == SW_OK && trimmed) {
+        pending_trim *pt = &f->trims[f->n_trims - 1];
+        pt->loops = loops;
+        memcpy(pt->rect, tl->rect, sizeof pt->rect);
+    }
+    return r;
+}
+
+static sw_result tiled_draws(tiling *t, double sign, int on_gpu, sw_status *status)
+{
+    frame *f = t->f;
+    int64_t loops = -1;
+    sw_result r = tile_loops(t, &loops, status);
+    double cell[2] = {INFINITY, INFINITY};
+    for (size_t i = 0; i < t->n_cells; ++i)
+        if (t->cells[i].visible) {
+            const sw__gpu_patch *c = &t->cells[i];
+            cell[0] = fmin(cell[0], (c->u1 - c->u0) * (c->s1 - c->s0) / c->nu);
+            cell[1] = fmin(cell[1], (c->v1 - c->v0) * (c->t1 - c->t0) / c->nv);
+        }
+    for (size_t i = 0; i < t->n_tiles && r == SW_OK; ++i)
+        if (t->tiles[i].cls >= 0)
+            r = tile_draw(t, &t->tiles[i], loops, sign, on_gpu, cell, status);
+    const face_loops *fl = loops >= 0 ? &f->loops[loops] : NULL;
+    for (uint32_t k = 0; r == SW_OK && fl && !f->ctx->crack_fill_off && k < fl->n; ++k)
+        r = fat_border(f, t->o, fl->loops[k].uv, fl->loops[k].count,
+                       left_is_inside(fl->loops, fl->n, k), cell, status);
+    return r;
+}
+
+static int32_t tiles_for(double need)
+{
+    int32_t k = 1;
+    while (k < MAX_TILES_PER_DIR && need / k > k_tile_texels)
+        k *= 2;
+    return k;
+}
+
+static sw_result tiled_face(frame *f, const occurrence *o, const sw_sg_bezier_set *set,
+                            const sw__gpu_patch *pt, const trim_need *need, double sign,
+                            int on_gpu, int class_grids, sw_status *status)
+{
+    tiling t = {f, o, set, pt, f->sv->faces[o->face].uv_box, tiles_for(need->u), tiles_for(need->v),
+                class_grids, NULL, 0, 0, NULL, 0, 0, NULL};
+    int32_t md = 0;
+    for (size_t p = 0; p < (size_t)set->n_u * (size_t)set->n_v; ++p)
+        md = md > (set->patches[p].deg_u + 1) * (set->patches[p].deg_v + 1)
+                 ? md
+                 : (set->patches[p].deg_u + 1) * (set->patches[p].deg_v + 1);
+    t.scratch = malloc((size_t)md * 4 * sizeof *t.scratch);
+    int ok = t.scratch != NULL;
+    while (ok && !find_tiles(&t, 0, t.ku, 0, t.kv) && t.n_tiles >= MAX_TILES_PER_FACE) {
+        t.n_tiles = 0; /* too many visible tiles: coarser ones */
+        t.ku = t.ku > 1 ? t.ku / 2 : 1;
+        t.kv = t.kv > 1 ? t.kv / 2 : 1;
+    }
+    ok = ok && t.n_tiles < MAX_TILES_PER_FACE;
+    for (size_t i = 0; i < t.n_tiles && ok; ++i)
+        ok = tile_cells(&t, &t.tiles[i]);
+    ok = ok && unify_cells(&t, 0) && unify_cells(&t, 1);
+    sw_result r = ok ? tiled_draws(&t, sign, on_gpu, status)
+                     : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u tiles: out of memory",
+                                o->face);
+    free(t.scratch);
+    free(t.tiles);
+    free(t.cells);
+    return r;
+}
+
 static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
 {
     const sw_sg_face_rec *rec = &f->sv->faces[o->face];
@@ -443,7 +799,11 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
         size_t first = f->mesh.n_idx;
         double cell[2];
         grid_cell(pt, n, cell);
-        if (on_gpu) {
+        if (trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)) {
+            r = tiled_face(f, o, set, pt, &need, sign, on_gpu, class_grids, status);
+            if (on_gpu)
+                f->st.patches_gpu_evaluated += drawn;
+        } else if (on_gpu) {
             r = gpu_face(f, o, pt, n, sign, trimmed, &need, cell, status);
             f->st.patches_gpu_evaluated += drawn;
         } else {
@@ -574,8 +934,41 @@ static int left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_
     return sw_sg_trim_classify(loops, n_loops, u, v);
 }
 
+/* A tile's trim texture: the face's loops clipped to the tile grown by one texel (the clipped
+ * border then falls in the entry's gutter), keyed by the tile's rectangle. */
+static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, sw_status *status)
+{
+    const sw_sg_face_rec *rec = &f->sv->faces[t->face];
+    int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
+    int32_t w = class_texels(t->width * scale, max_entry);
+    int32_t h = class_texels(t->height * scale, max_entry);
+    const double *r = t->rect;
+    sw__gpu_trim_key key = {f->scene, t->face, rec->first_loop, rec->n_loops, {r[0], r[1], r[2], r[3]}};
+    int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
+    f->draws[t->draw].trim_entry = id;
+    if (id >= 0)
+        return SW_OK;
+    const face_loops *fl = &f->loops[t->loops];
+    double mu = (r[1] - r[0]) / w, mv = (r[3] - r[2]) / h;
+    const double g[4] = {r[0] - mu, r[1] + mu, r[2] - mv, r[3] + mv};
+    sw_sg_polyline *clipped = calloc(fl->n ? fl->n : 1, sizeof *clipped);
+    if (!clipped)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->face);
+    sw_result res = sw__gpu_trim_clip_loops(fl->loops, fl->n, g, clipped, status);
+    if (res == SW_OK) {
+        res = sw__gpu_atlas_add(f->ctx, &key, w, h, clipped, fl->n, &id, status);
+        f->draws[t->draw].trim_entry = id;
+        for (uint32_t k = 0; k < fl->n; ++k)
+            sw_sg_polyline_free(&clipped[k]);
+    }
+    free(clipped);
+    return res;
+}
+
 static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_status *status)
 {
+    if (t->loops >= 0)
+        return make_tile_trim(f, t, scale, status);
     const sw_sg_face_rec *rec = &f->sv->faces[t->face];
     int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
     int32_t w = class_texels(t->width * scale, max_entry);
@@ -697,6 +1090,12 @@ static void frame_free(frame *f)
     free(f->occ);
     free(f->draws);
     free(f->trims);
+    for (size_t i = 0; i < f->n_loops; ++i) {
+        for (uint32_t k = 0; k < f->loops[i].n; ++k)
+            sw_sg_polyline_free(&f->loops[i].loops[k]);
+        free(f->loops[i].loops);
+    }
+    free(f->loops);
     sw__gpu_mesh_free(&f->mesh);
 }
 

@@ -255,6 +255,15 @@ sw_result sw__gpu_atlas_read_page(sw_gpu_context *ctx, int32_t layer, uint8_t *o
 GLuint sw__gpu_atlas_texture(const sw_gpu_context *ctx);
 void sw__gpu_atlas_free(sw_gpu_context *ctx);
 
+/* ---- trim tiles (trim_tiles.c): loops restricted to a tile of a face's trim box -------------- */
+/* Class of rect = {u0, u1, v0, v1} against closed polylines: 0 when a loop meets it, else 1 when
+ * it lies inside the trimmed region (even-odd), -1 outside. */
+int sw__gpu_trim_rect_class(const sw_sg_polyline *loops, uint32_t n_loops, const double rect[4]);
+/* Sutherland–Hodgman clip of every loop to rect (same even-odd parity inside rect); out[n_loops]
+ * is allocated (free each with sw_sg_polyline_free). Errors: SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__gpu_trim_clip_loops(const sw_sg_polyline *loops, uint32_t n_loops,
+                                  const double rect[4], sw_sg_polyline *out, sw_status *status);
+
 /* ---- drawing and readback (draw.c) ----------------------------------------------------------- */
 /* A range of the frame's index buffer drawn with one colour and trim texture (0 = untrimmed). */
 typedef struct sw__gpu_draw {
