@@ -60,6 +60,77 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
                           (const void *)offsetof(sw__gpu_vertex, st));
 }
 
+/* Exact path: pieces, knots and double control points into storage buffers 2, 3, 4. */
+static void upload_ssbo(GLuint buf, GLuint binding, size_t bytes, const void *data)
+{
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(bytes ? bytes : 16), bytes ? data : NULL,
+                 GL_STREAM_DRAW);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buf);
+}
+
+static void upload_exact(sw_gpu_context *ctx, const sw__gpu_patch_batch *batch)
+{
+    upload_ssbo(ctx->piece_ssbo, 2, batch->n_pieces * sizeof *batch->pieces, batch->pieces);
+    upload_ssbo(ctx->knot_ssbo, 3, batch->n_knots * sizeof *batch->knots, batch->knots);
+    upload_ssbo(ctx->dcp_ssbo, 4, batch->n_dcps * 4 * sizeof *batch->dcps, batch->dcps);
+}
+
+/* Debug capture: a zeroed counter plus room for capture_max vertices (two vec4 each). */
+static void capture_begin(sw_gpu_context *ctx)
+{
+    glUniform1i(ctx->loc_eval_capture, (GLint)ctx->capture_max);
+    if (ctx->capture_max == 0)
+        return;
+    if (!ctx->capture_ssbo)
+        glGenBuffers(1, &ctx->capture_ssbo);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->capture_ssbo);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(16 + (size_t)ctx->capture_max * 32), NULL,
+                 GL_STREAM_READ);
+    static const uint32_t zero[4] = {0, 0, 0, 0};
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zero, zero);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, ctx->capture_ssbo);
+}
+
+void sw__gpu_set_capture(sw_gpu_context *ctx, uint32_t max_vertices)
+{
+    ctx->capture_max = max_vertices;
+}
+
+sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out, size_t *n,
+                               size_t *total, sw_status *status)
+{
+    *out = NULL;
+    *n = *total = 0;
+    if (!ctx->capture_ssbo || ctx->capture_max == 0)
+        return SW_OK;
+    uint32_t count = 0;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->capture_ssbo);
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof count, &count);
+    size_t m = count < ctx->capture_max ? count : ctx->capture_max;
+    float *raw = malloc((m ? m : 1) * 8 * sizeof *raw);
+    sw__gpu_capture_vertex *v = malloc((m ? m : 1) * sizeof *v);
+    if (!raw || !v) {
+        free(raw);
+        free(v);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "capture: out of memory");
+    }
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 16, (GLsizeiptr)(m * 32), raw);
+    for (size_t i = 0; i < m; ++i) {
+        uint32_t sorted;
+        memcpy(&sorted, &raw[8 * i], sizeof sorted);
+        v[i].piece = sorted < ctx->cap_rec_source ? ctx->rec_source[sorted] : UINT32_MAX;
+        v[i].s = raw[8 * i + 1];
+        v[i].t = raw[8 * i + 2];
+        memcpy(v[i].pos, &raw[8 * i + 4], sizeof v[i].pos);
+    }
+    free(raw);
+    *out = v;
+    *n = m;
+    *total = count;
+    return sw__gpu_check(status, "capture read");
+}
+
 /* The frame's GPU-evaluated patches (§4.2): records and control points into two shader storage
  * buffers, then one instanced draw per non-empty grid class, attribute-less. */
 static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
@@ -73,19 +144,28 @@ static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                  batch->cps, GL_STREAM_DRAW);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ctx->patch_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx->cp_ssbo);
+    GLint loc_grid = ctx->loc_eval_grid, loc_base = ctx->loc_eval_base;
+    if (batch->exact) {
+        upload_exact(ctx, batch);
+        loc_grid = ctx->loc_exact_grid;
+        loc_base = ctx->loc_exact_base;
+    }
     glBindVertexArray(ctx->vao);
     for (GLuint a = 0; a < 3; ++a)
         glDisableVertexAttribArray(a);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->grid_ibo);
-    glUseProgram(ctx->prog_eval);
-    glUniformMatrix4fv(ctx->loc_eval_view_proj, 1, GL_FALSE, view->view_proj);
-    glUniform1i(ctx->loc_eval_trim, 0);
+    glUseProgram(batch->exact ? ctx->prog_exact : ctx->prog_eval);
+    glUniformMatrix4fv(batch->exact ? ctx->loc_exact_view_proj : ctx->loc_eval_view_proj, 1,
+                       GL_FALSE, view->view_proj);
+    glUniform1i(batch->exact ? ctx->loc_exact_trim : ctx->loc_eval_trim, 0);
+    if (!batch->exact)
+        capture_begin(ctx);
     for (int b = 0; b < SW__GPU_GRID_CLASSES; ++b) {
         for (int a = 0; a < SW__GPU_GRID_CLASSES; ++a) {
             if (batch->count[b][a] == 0)
                 continue;
-            glUniform2i(ctx->loc_eval_grid, sw__gpu_grid_segments[a], sw__gpu_grid_segments[b]);
-            glUniform1i(ctx->loc_eval_base, (GLint)batch->first[b][a]);
+            glUniform2i(loc_grid, sw__gpu_grid_segments[a], sw__gpu_grid_segments[b]);
+            glUniform1i(loc_base, (GLint)batch->first[b][a]);
             glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)ctx->grid_count[b][a], GL_UNSIGNED_INT,
                                     (const void *)(ctx->grid_first[b][a] * sizeof(uint32_t)),
                                     (GLsizei)batch->count[b][a]);

@@ -88,6 +88,15 @@ typedef struct frame {
                                   counts the mesh at the end: subtracted there) */
     face_loops *loops;         /* of tiled faces */
     size_t n_loops, cap_loops;
+    /* exact path (eval_exact): pieces, knots and eye-relative control points in double */
+    int exact;
+    sw__gpu_exact_piece *pieces;
+    size_t n_pieces, cap_pieces;
+    double *knots, *dcps;
+    size_t n_knots, cap_knots, n_dcps, cap_dcps;
+    const occurrence *ex_occ; /* the occurrence whose net is at ex_base (NULL: none yet) */
+    sw__gpu_exact_piece ex_base; /* its knots, control points, stride and degrees */
+    sw_sg_surface ex_srf;
 } frame;
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -314,6 +323,65 @@ static void split_class(int32_t n, int32_t *pieces, int32_t *level)
     *level = level_for((n + *pieces - 1) / *pieces);
 }
 
+/* Exact path: the face occurrence's knot vectors and eye-relative homogeneous control points
+ * (double), appended once per occurrence. */
+static sw_result exact_net(frame *f, const occurrence *o, sw_status *status)
+{
+    if (f->ex_occ == o)
+        return SW_OK;
+    sw_sg_surface s;
+    sw_sg_scene_face_surface(f->scene, o->face, &s);
+    size_t nku = (size_t)s.n_u + (size_t)s.deg_u + 1, nkv = (size_t)s.n_v + (size_t)s.deg_v + 1;
+    size_t ncp = (size_t)s.n_u * (size_t)s.n_v;
+    if (f->n_knots + nku + nkv > UINT32_MAX || f->n_dcps + ncp > UINT32_MAX)
+        return sw__fail(status, SW_ERR_LIMIT, "face %u: exact evaluation buffers over 2^32",
+                        o->face);
+    if (!grow((void **)&f->knots, &f->cap_knots, f->n_knots + nku + nkv, sizeof *f->knots) ||
+        !grow((void **)&f->dcps, &f->cap_dcps, 4 * (f->n_dcps + ncp), sizeof *f->dcps))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
+    sw__gpu_exact_piece *b = &f->ex_base;
+    memset(b, 0, sizeof *b);
+    b->ku = (uint32_t)f->n_knots;
+    b->kv = (uint32_t)(f->n_knots + nku);
+    b->cp = (uint32_t)f->n_dcps;
+    b->stride = s.n_u;
+    b->deg_u = s.deg_u;
+    b->deg_v = s.deg_v;
+    memcpy(f->knots + f->n_knots, s.knots_u, nku * sizeof *f->knots);
+    memcpy(f->knots + f->n_knots + nku, s.knots_v, nkv * sizeof *f->knots);
+    f->n_knots += nku + nkv;
+    for (size_t i = 0; i < ncp; ++i)
+        xform_h(o->world, f->view.eye, s.cpw + 4 * i, f->dcps + 4 * (f->n_dcps + i));
+    f->n_dcps += ncp;
+    f->ex_srf = s;
+    f->ex_occ = o;
+    return SW_OK;
+}
+
+/* Exact path: the piece (knot spans) of one Bézier patch of the current occurrence; its index
+ * goes into the records' cp. */
+static sw_result exact_piece(frame *f, const occurrence *o, const sw__gpu_patch *pt,
+                             uint32_t *index, sw_status *status)
+{
+    sw_result r = exact_net(f, o, status);
+    if (r != SW_OK)
+        return r;
+    if (!grow((void **)&f->pieces, &f->cap_pieces, f->n_pieces + 1, sizeof *f->pieces))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
+    const sw_sg_surface *s = &f->ex_srf;
+    sw__gpu_exact_piece *q = &f->pieces[f->n_pieces];
+    *q = f->ex_base;
+    q->u0 = pt->u0;
+    q->u1 = pt->u1;
+    q->v0 = pt->v0;
+    q->v1 = pt->v1;
+    /* the midpoint lies inside the patch's span whatever the half-open convention */
+    q->span_u = sw_sg_knots_find_span(s->knots_u, s->deg_u, s->n_u, 0.5 * (pt->u0 + pt->u1));
+    q->span_v = sw_sg_knots_find_span(s->knots_v, s->deg_v, s->n_v, 0.5 * (pt->v0 + pt->v1));
+    *index = (uint32_t)f->n_pieces++;
+    return SW_OK;
+}
+
 /* Appends the control points of a visible patch (float, eye-relative homogeneous) and one record
  * per piece of its sampled domain (§4.2). Pieces share their edge parameters bit for bit. */
 static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *pt,
@@ -321,7 +389,13 @@ static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
                            sw_status *status)
 {
     sw_gpu_context *ctx = f->ctx;
-    size_t n_cp = (size_t)(pt->deg_u + 1) * (size_t)(pt->deg_v + 1);
+    size_t n_cp = f->exact ? 0 : (size_t)(pt->deg_u + 1) * (size_t)(pt->deg_v + 1);
+    uint32_t cp_index = (uint32_t)f->n_cps;
+    if (f->exact) {
+        sw_result r = exact_piece(f, o, pt, &cp_index, status);
+        if (r != SW_OK)
+            return r;
+    }
     int32_t ku, kv, lu, lv;
     split_class(pt->nu, &ku, &lu);
     split_class(pt->nv, &kv, &lv);
@@ -343,7 +417,7 @@ static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
             rec->st[2] = (float)(pt->t0 + (pt->t1 - pt->t0) * b / kv);
             rec->st[3] = (float)(b + 1 == kv ? pt->t1 : pt->t0 + (pt->t1 - pt->t0) * (b + 1) / kv);
             memcpy(rec->trim_map, map, sizeof map);
-            rec->cp = (uint32_t)f->n_cps;
+            rec->cp = cp_index;
             rec->deg_u = pt->deg_u;
             rec->deg_v = pt->deg_v;
             rec->normal_sign = (float)sign;
@@ -388,6 +462,8 @@ static int face_gpu_eligible(const sw_sg_bezier_set *set)
 
 static int face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
 {
+    if (f->exact)
+        return 1;
     return f->ctx->eval_mode == SW__GPU_EVAL_AUTO && face_gpu_eligible(set);
 }
 
@@ -765,6 +841,14 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
     sw_result r = face_bezier(f, o->face, &set, status);
     if (r != SW_OK)
         return r;
+    if (f->exact) {
+        sw_sg_surface s;
+        sw_sg_scene_face_surface(f->scene, o->face, &s);
+        if (s.deg_u > SW_GPU_EXACT_MAX_DEGREE || s.deg_v > SW_GPU_EXACT_MAX_DEGREE)
+            return sw__fail(status, SW_ERR_LIMIT,
+                            "face %u: degree %d x %d above %d, the exact evaluator's limit",
+                            o->face, s.deg_u, s.deg_v, SW_GPU_EXACT_MAX_DEGREE);
+    }
     int32_t n_cols = set->n_u, n_rows = set->n_v;
     size_t n = (size_t)n_cols * (size_t)n_rows, n_cp = 0;
     for (size_t p = 0; p < n; ++p)
@@ -780,7 +864,7 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
     size_t at = 0, drawn = 0;
     int on_gpu = face_on_gpu(f, set);
     /* CPU_GRIDS mode draws the grids the vertex shader would (the reference of §4.2's path). */
-    int class_grids = face_gpu_eligible(set);
+    int class_grids = f->exact || face_gpu_eligible(set);
     for (size_t p = 0; p < n; ++p) {
         const sw_sg_bezier_patch *bp = &set->patches[p];
         patch_setup(f, o, bp, rec->uv_box, class_grids, cpw + at, &pt[p], &need);
@@ -815,6 +899,8 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
             if (r == SW_OK)
                 r = add_draw(f, o, first, trimmed, &need, cell, status);
         }
+        if (f->exact)
+            f->st.patches_exact += drawn;
         if (r == SW_OK && !trimmed && !f->ctx->crack_fill_off) {
             const double *b = rec->uv_box;
             const double box_loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
@@ -1060,14 +1146,28 @@ static sw_result build_batch(frame *f, sw_status *status)
             b->first[v][u] = next[v][u] = at;
             at += b->count[v][u];
         }
+    int keep = ctx->capture_max > 0;
+    if (keep && !grow((void **)&ctx->rec_source, &ctx->cap_rec_source, f->n_recs,
+                      sizeof *ctx->rec_source))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < f->n_recs; ++i) {
         const sw__gpu_patch_rec *rec = &ctx->recs[i];
-        ctx->recs_sorted[next[rec->level_v][rec->level_u]++] = *rec;
+        uint32_t slot = next[rec->level_v][rec->level_u]++;
+        ctx->recs_sorted[slot] = *rec;
+        if (keep)
+            ctx->rec_source[slot] = (uint32_t)i;
     }
     b->recs = ctx->recs_sorted;
     b->n_recs = f->n_recs;
     b->cps = ctx->cps;
     b->n_cps = f->n_cps;
+    b->exact = f->exact;
+    b->pieces = f->pieces;
+    b->n_pieces = f->n_pieces;
+    b->knots = f->knots;
+    b->n_knots = f->n_knots;
+    b->dcps = f->dcps;
+    b->n_dcps = f->n_dcps;
     return SW_OK;
 }
 
@@ -1096,6 +1196,9 @@ static void frame_free(frame *f)
         free(f->loops[i].loops);
     }
     free(f->loops);
+    free(f->pieces);
+    free(f->knots);
+    free(f->dcps);
     sw__gpu_mesh_free(&f->mesh);
 }
 
@@ -1112,6 +1215,7 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
     f.scene = scene;
     f.sv = sw_sg_scene_view_ptr(scene);
     f.eps_px = desc.error_px;
+    f.exact = desc.eval_exact != 0;
     f.bez = calloc(f.sv->n_faces ? f.sv->n_faces : 1, sizeof *f.bez);
     if (!f.bez)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");

@@ -52,6 +52,9 @@ sw_result sw__gpu_grids_create(sw_gpu_context *ctx, sw_status *status)
     free(idx);
     glGenBuffers(1, &ctx->patch_ssbo);
     glGenBuffers(1, &ctx->cp_ssbo);
+    glGenBuffers(1, &ctx->piece_ssbo);
+    glGenBuffers(1, &ctx->knot_ssbo);
+    glGenBuffers(1, &ctx->dcp_ssbo);
     return sw__gpu_check(status, "grid set");
 }
 
@@ -60,6 +63,15 @@ void sw__gpu_grids_free(sw_gpu_context *ctx)
     glDeleteBuffers(1, &ctx->grid_ibo);
     glDeleteBuffers(1, &ctx->patch_ssbo);
     glDeleteBuffers(1, &ctx->cp_ssbo);
+    glDeleteBuffers(1, &ctx->piece_ssbo);
+    glDeleteBuffers(1, &ctx->knot_ssbo);
+    glDeleteBuffers(1, &ctx->dcp_ssbo);
+    ctx->piece_ssbo = ctx->knot_ssbo = ctx->dcp_ssbo = 0;
+    glDeleteBuffers(1, &ctx->capture_ssbo);
+    ctx->capture_ssbo = 0;
+    free(ctx->rec_source);
+    ctx->rec_source = NULL;
+    ctx->cap_rec_source = 0;
     ctx->grid_ibo = ctx->patch_ssbo = ctx->cp_ssbo = 0;
     free(ctx->recs);
     free(ctx->cps);

@@ -2,7 +2,8 @@
  * triangles: reversed-Z projection of camera-relative positions, Lambert + headlight shading, and
  * the trim-texture lookup of Guthe et al. 2005 §4.3 that discards fragments outside the trim
  * region, read from the trim atlas of §4.4), and the trim program that draws fans and crack-filling
- * lines into a trim texture (§4).
+ * lines into a trim texture (§4), and the exact program that evaluates NURBS of any degree from
+ * knot vectors in the vertex shader (eval_exact).
  */
 #include "sw_gpu_internal.h"
 #include "sw_status_util.h"
@@ -83,6 +84,8 @@ static const char *const k_eval_vs =
     "uniform mat4 u_view_proj;\n"
     "uniform ivec2 u_grid;\n" /* segments in u, v of this draw's class */
     "uniform int u_base;\n"   /* first record of this draw */
+    "uniform int u_capture;\n" /* debug: > 0 writes every evaluated vertex to Capture */
+    "layout(std430, binding = 5) buffer Capture { uint n_capture; uint pad[3]; vec4 cap[]; };\n"
     "out vec3 v_rel;\n"
     "out vec3 v_nrm;\n"
     "out vec2 v_st;\n"
@@ -145,6 +148,126 @@ static const char *const k_eval_vs =
     "  vec3 pos = h.xyz / h.w;\n"
     "  float ln = length(n);\n"
     "  v_nrm = ln > 0.0 ? p.nsign * n / ln : vec3(0.0);\n"
+    "  v_rel = pos;\n"
+    "  v_st = vec2(p.trim_map.x + s * p.trim_map.y, p.trim_map.z + t * p.trim_map.w);\n"
+    "  v_color = p.color;\n"
+    "  v_trim_rect = p.trim_rect;\n"
+    "  v_trim_layer = p.layer;\n"
+    "  if (u_capture > 0) {\n"
+    "    uint k = atomicAdd(n_capture, 1u);\n"
+    "    if (k < uint(u_capture)) {\n"
+    "      cap[2u * k] = vec4(uintBitsToFloat(uint(u_base + gl_InstanceID)), s, t, 0.0);\n"
+    "      cap[2u * k + 1u] = vec4(pos, 0.0);\n"
+    "    }\n"
+    "  }\n"
+    "  gl_Position = u_view_proj * vec4(pos, 1.0);\n"
+    "}\n";
+
+/* Exact evaluation (eval_exact): the same predefined grids and patch records, but a record's cp
+ * names one knot span of a face occurrence (sw__gpu_exact_piece) and the vertex shader evaluates
+ * the NURBS there from its knot vectors and homogeneous control points (eye-relative world): the
+ * p + 1 non-zero B-spline basis functions by the Cox–de Boor triangle (Piegl & Tiller A2.2), their
+ * first derivatives from the degree p - 1 functions (A2.3 with n = 1), the homogeneous point and
+ * both partials (A4.3), all in double (ARB_gpu_shader_fp64, core since GL 4.0); the rational point
+ * and the normal are converted to float only at the end. Degrees up to 15 per direction. */
+static const char *const k_exact_vs =
+    "#version 430 core\n"
+    "struct PatchRec {\n"
+    "  vec4 st; vec4 trim_map; vec4 trim_rect; vec4 color;\n"
+    "  uint cp; int deg_u; int deg_v; float layer;\n"
+    "  float nsign; int draw; int level_u; int level_v;\n"
+    "};\n"
+    "struct Piece {\n"
+    "  double u0, u1, v0, v1;\n"
+    "  uint ku, kv, cp; int stride; int deg_u, deg_v, span_u, span_v;\n"
+    "};\n"
+    "layout(std430, binding = 0) readonly buffer Patches { PatchRec recs[]; };\n"
+    "layout(std430, binding = 2) readonly buffer Pieces { Piece pieces[]; };\n"
+    "layout(std430, binding = 3) readonly buffer Knots { double knots[]; };\n"
+    "layout(std430, binding = 4) readonly buffer ControlPoints { dvec4 cps[]; };\n"
+    "uniform mat4 u_view_proj;\n"
+    "uniform ivec2 u_grid;\n"
+    "uniform int u_base;\n"
+    "out vec3 v_rel;\n"
+    "out vec3 v_nrm;\n"
+    "out vec2 v_st;\n"
+    "flat out vec4 v_color;\n"
+    "flat out vec4 v_trim_rect;\n"
+    "flat out float v_trim_layer;\n"
+    "void basis(uint kb, int p, int span, double t, out double N[16], out double dN[16]) {\n"
+    "  double left[16], right[16], Nm[16];\n"
+    "  for (int r = 0; r < 16; ++r) { N[r] = 0.0LF; dN[r] = 0.0LF; Nm[r] = 0.0LF; }\n"
+    "  N[0] = 1.0LF;\n"
+    "  for (int j = 1; j <= p; ++j) {\n"
+    "    left[j] = t - knots[kb + uint(span + 1 - j)];\n"
+    "    right[j] = knots[kb + uint(span + j)] - t;\n"
+    "    if (j == p) Nm = N;\n"
+    "    double saved = 0.0LF;\n"
+    "    for (int r = 0; r < j; ++r) {\n"
+    "      double temp = N[r] / (right[r + 1] + left[j - r]);\n"
+    "      N[r] = saved + right[r + 1] * temp;\n"
+    "      saved = left[j - r] * temp;\n"
+    "    }\n"
+    "    N[j] = saved;\n"
+    "  }\n"
+    "  for (int r = 0; r <= p; ++r) {\n"
+    "    double d = 0.0LF;\n"
+    "    if (r >= 1)\n"
+    "      d += Nm[r - 1] / (knots[kb + uint(span + r)] - knots[kb + uint(span - p + r)]);\n"
+    "    if (r < p)\n"
+    "      d -= Nm[r] / (knots[kb + uint(span + r + 1)] - knots[kb + uint(span - p + r + 1)]);\n"
+    "    dN[r] = double(p) * d;\n"
+    "  }\n"
+    "}\n"
+    "void eval(Piece q, double u, double v, out dvec4 h, out dvec4 hs, out dvec4 ht) {\n"
+    "  double Nu[16], dNu[16], Nv[16], dNv[16];\n"
+    "  basis(q.ku, q.deg_u, q.span_u, u, Nu, dNu);\n"
+    "  basis(q.kv, q.deg_v, q.span_v, v, Nv, dNv);\n"
+    "  h = dvec4(0.0LF); hs = dvec4(0.0LF); ht = dvec4(0.0LF);\n"
+    "  for (int l = 0; l <= q.deg_v; ++l) {\n"
+    "    uint at = q.cp + uint((q.span_v - q.deg_v + l) * q.stride + q.span_u - q.deg_u);\n"
+    "    dvec4 row = dvec4(0.0LF), rows = dvec4(0.0LF);\n"
+    "    for (int k = 0; k <= q.deg_u; ++k) {\n"
+    "      dvec4 c = cps[at + uint(k)];\n"
+    "      row += Nu[k] * c;\n"
+    "      rows += dNu[k] * c;\n"
+    "    }\n"
+    "    h += Nv[l] * row; hs += Nv[l] * rows; ht += dNv[l] * row;\n"
+    "  }\n"
+    "}\n"
+    "dvec3 normal_of(dvec4 h, dvec4 hs, dvec4 ht, out bool ok) {\n"
+    "  dvec3 ds = hs.xyz * h.w - h.xyz * hs.w, dt = ht.xyz * h.w - h.xyz * ht.w;\n"
+    "  dvec3 n = cross(ds, dt);\n"
+    "  ok = length(n) > 1e-9LF * length(ds) * length(dt);\n"
+    "  return n;\n"
+    "}\n"
+    "double param(float s, float s0, float s1, double a, double b) {\n"
+    "  if (s == 0.0) return a;\n"
+    "  if (s == 1.0) return b;\n"
+    "  return a + (b - a) * double(s);\n"
+    "}\n"
+    "void main() {\n"
+    "  PatchRec p = recs[u_base + gl_InstanceID];\n"
+    "  Piece q = pieces[p.cp];\n"
+    "  int i = gl_VertexID % (u_grid.x + 1), j = gl_VertexID / (u_grid.x + 1);\n"
+    "  float s = i == u_grid.x ? p.st.y : p.st.x + (p.st.y - p.st.x) * float(i) / "
+    "float(u_grid.x);\n"
+    "  float t = j == u_grid.y ? p.st.w : p.st.z + (p.st.w - p.st.z) * float(j) / "
+    "float(u_grid.y);\n"
+    "  double u = param(s, p.st.x, p.st.y, q.u0, q.u1), v = param(t, p.st.z, p.st.w, q.v0, q.v1);\n"
+    "  dvec4 h, hs, ht;\n"
+    "  eval(q, u, v, h, hs, ht);\n"
+    "  bool ok;\n"
+    "  dvec3 n = normal_of(h, hs, ht, ok);\n"
+    "  if (!ok) {\n"
+    "    dvec4 h2, hs2, ht2;\n"
+    "    double su = 1e-3LF * (q.u1 - q.u0), sv = 1e-3LF * (q.v1 - q.v0);\n"
+    "    eval(q, u + (s < 0.5 ? su : -su), v + (t < 0.5 ? sv : -sv), h2, hs2, ht2);\n"
+    "    n = normal_of(h2, hs2, ht2, ok);\n"
+    "  }\n"
+    "  vec3 pos = vec3(h.xyz / h.w);\n"
+    "  double ln = length(n);\n"
+    "  v_nrm = ln > 0.0LF ? p.nsign * vec3(n / ln) : vec3(0.0);\n"
     "  v_rel = pos;\n"
     "  v_st = vec2(p.trim_map.x + s * p.trim_map.y, p.trim_map.z + t * p.trim_map.w);\n"
     "  v_color = p.color;\n"
@@ -224,6 +347,14 @@ sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
     ctx->loc_eval_grid = glGetUniformLocation(ctx->prog_eval, "u_grid");
     ctx->loc_eval_base = glGetUniformLocation(ctx->prog_eval, "u_base");
     ctx->loc_eval_trim = glGetUniformLocation(ctx->prog_eval, "u_trim");
+    ctx->loc_eval_capture = glGetUniformLocation(ctx->prog_eval, "u_capture");
+    r = link(k_exact_vs, k_surface_fs, "exact evaluation", &ctx->prog_exact, status);
+    if (r != SW_OK)
+        return r;
+    ctx->loc_exact_view_proj = glGetUniformLocation(ctx->prog_exact, "u_view_proj");
+    ctx->loc_exact_grid = glGetUniformLocation(ctx->prog_exact, "u_grid");
+    ctx->loc_exact_base = glGetUniformLocation(ctx->prog_exact, "u_base");
+    ctx->loc_exact_trim = glGetUniformLocation(ctx->prog_exact, "u_trim");
     ctx->loc_view_proj = glGetUniformLocation(ctx->prog_mesh, "u_view_proj");
     ctx->loc_color = glGetUniformLocation(ctx->prog_mesh, "u_color");
     ctx->loc_trim_rect = glGetUniformLocation(ctx->prog_mesh, "u_trim_rect");
@@ -237,5 +368,6 @@ void sw__gpu_programs_free(sw_gpu_context *ctx)
     glDeleteProgram(ctx->prog_mesh);
     glDeleteProgram(ctx->prog_trim);
     glDeleteProgram(ctx->prog_eval);
-    ctx->prog_mesh = ctx->prog_trim = ctx->prog_eval = 0;
+    glDeleteProgram(ctx->prog_exact);
+    ctx->prog_mesh = ctx->prog_trim = ctx->prog_eval = ctx->prog_exact = 0;
 }

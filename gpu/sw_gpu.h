@@ -41,7 +41,12 @@ typedef struct sw_gpu_frame_desc {
     sw_gpu_camera camera;
     float background[4];   /* RGBA */
     int32_t want_depth;    /* also read back depth */
+    int32_t eval_exact;    /* 1: every drawn patch piece evaluated in the vertex shader from the
+                              face's knot vectors and control points (B-spline basis in double,
+                              any degree up to SW_GPU_EXACT_MAX_DEGREE); 0: Bézier path */
 } sw_gpu_frame_desc;
+
+enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
 
 typedef struct sw_gpu_frame_stats {
     uint64_t faces_drawn, faces_culled;          /* face occurrences */
@@ -61,6 +66,7 @@ typedef struct sw_gpu_frame_stats {
     uint64_t atlas_switches;      /* render-target switches for trim generation in this frame */
     uint64_t patches_gpu_evaluated; /* drawn patches evaluated in the vertex shader (§4.2); the
                                        others are CPU grids */
+    uint64_t patches_exact; /* of those, evaluated from knots and control points (eval_exact) */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -46,6 +46,35 @@ typedef struct sw__gpu_patch_rec {
     int32_t level_u, level_v; /* grid class: sw__gpu_grid_segments[level] segments */
 } sw__gpu_patch_rec;
 
+/* Exact evaluation (eval_exact): what a record's cp indexes instead of Bézier control points —
+ * one B-spline span of a face occurrence. std430, mirrored by the GLSL struct in shaders.c
+ * (64 bytes). The record's st maps to u = u0 + s (u1 - u0), v likewise. */
+typedef struct sw__gpu_exact_piece {
+    double u0, u1, v0, v1;    /* the Bézier patch's rectangle in the face's parameters */
+    uint32_t ku, kv;          /* first knot of the face's u and v knot vectors (double index) */
+    uint32_t cp;              /* first control point of the face occurrence (dvec4 index) */
+    int32_t stride;           /* control points per row (n_u) */
+    int32_t deg_u, deg_v;
+    int32_t span_u, span_v;   /* knot span of [u0, u1) and [v0, v1) */
+} sw__gpu_exact_piece;
+
+/* Debug capture (tests): while max_vertices > 0, every vertex the Bézier vertex shader evaluates
+ * (§4.2 path; not the exact path) is written, up to max_vertices per frame, to a buffer read
+ * back with sw__gpu_capture_read after sw_gpu_render_scene. `piece` is the index of the drawn
+ * GPU piece among the patch hook's gpu = 1 reports of that frame (in order); (s, t) are the
+ * float local parameters the shader used; pos the eye-relative float position. A vertex shared
+ * by triangles may appear more than once. */
+typedef struct sw__gpu_capture_vertex {
+    uint32_t piece;
+    float s, t;
+    float pos[3];
+} sw__gpu_capture_vertex;
+void sw__gpu_set_capture(sw_gpu_context *ctx, uint32_t max_vertices);
+/* *out (caller frees) receives *n captured vertices of the last frame (at most max_vertices;
+ * *total is how many the shader tried to write). Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_GL. */
+sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out, size_t *n,
+                               size_t *total, sw_status *status);
+
 /* Debug hook (frame.c): every drawn patch piece of a frame, as the frame built it, for tests that
  * check the drawn geometry against the exact surface on the CPU. */
 typedef struct sw__gpu_drawn_patch {
@@ -102,6 +131,16 @@ struct sw_gpu_context {
     int32_t crack_fill_off;        /* 1: no fat borders (§7.1) */
     sw__gpu_patch_hook patch_hook; /* debug hook, NULL = none */
     void *patch_hook_user;
+    /* exact evaluation from knots and control points (eval_exact; shaders.c) */
+    GLuint prog_exact;
+    GLint loc_exact_view_proj, loc_exact_grid, loc_exact_base, loc_exact_trim;
+    GLuint piece_ssbo, knot_ssbo, dcp_ssbo; /* per-frame pieces, knots, control points */
+    /* debug capture of the Bézier vertex shader's output (sw__gpu_set_capture) */
+    GLint loc_eval_capture;
+    GLuint capture_ssbo;
+    uint32_t capture_max;   /* vertices; 0 = off */
+    uint32_t *rec_source;   /* sorted record -> record in append (patch hook) order */
+    size_t cap_rec_source;
 };
 
 /* Last GL error as SW_ERR_GL naming `what`, or SW_OK. */
@@ -278,6 +317,14 @@ typedef struct sw__gpu_patch_batch {
     size_t n_recs;
     const float *cps; /* 4 floats per control point */
     size_t n_cps;
+    /* exact path: records' cp index pieces; knots and eye-relative control points in double */
+    int32_t exact;
+    const sw__gpu_exact_piece *pieces;
+    size_t n_pieces;
+    const double *knots;
+    size_t n_knots;
+    const double *dcps; /* 4 doubles per control point */
+    size_t n_dcps;
     uint32_t first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* records of each class */
     uint32_t count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
 } sw__gpu_patch_batch;

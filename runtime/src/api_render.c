@@ -97,6 +97,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->trim_textures = g->trim_textures;
     out->trim_texels = g->trim_texels;
     out->patches_gpu_evaluated = g->patches_gpu_evaluated;
+    out->patches_exact = g->patches_exact;
     out->atlas_pages = g->atlas_pages;
     out->trim_reused = g->trim_reused;
     out->ms_tessellate = g->ms_tessellate;
@@ -138,6 +139,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     frame.camera.fovy_deg = desc->camera.fovy_deg > 0.0 ? desc->camera.fovy_deg : 40.0;
     frame.background[0] = frame.background[1] = frame.background[2] = 1.0f;
     frame.background[3] = 1.0f;
+    frame.eval_exact = desc->eval_exact != 0;
     frame.want_depth = 0;
     if (desc->output_path) {
         size_t n = strlen(desc->output_path);

@@ -154,10 +154,11 @@ double sw_cli_now_ms(void)
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
 {
     printf("%s: patches drawn trimmed by trim textures %llu, untrimmed %llu, culled %llu "
-           "(%llu evaluated on the GPU); faces drawn %llu, culled %llu; %llu triangles; "
+           "(%llu evaluated on the GPU, %llu by the exact path); faces drawn %llu, culled %llu; %llu triangles; "
            "%llu trim textures (%llu texels, %llu kept from earlier frames, %llu atlas pages)\n",
            label, (unsigned long long)s->patches_trimmed, (unsigned long long)s->patches_untrimmed,
            (unsigned long long)s->patches_culled, (unsigned long long)s->patches_gpu_evaluated,
+           (unsigned long long)s->patches_exact,
            (unsigned long long)s->faces_drawn, (unsigned long long)s->faces_culled,
            (unsigned long long)s->triangles, (unsigned long long)s->trim_textures,
            (unsigned long long)s->trim_texels, (unsigned long long)s->trim_reused,

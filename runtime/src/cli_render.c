@@ -9,6 +9,7 @@
 static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
+    "                         [--eval bezier|exact]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as EXR\n"
@@ -24,6 +25,10 @@ static const char k_usage[] =
     "                      right from +X up +Z\n"
     "  --camera LIST       eye, target, up and vertical field of view in degrees (overrides --view)\n"
     "  --error PX          screen-space error bound in pixels (default 0.5)\n"
+    "  --eval MODE         bezier (default): rational Bézier patches, degree <= 3 evaluated in\n"
+    "                      the vertex shader, higher degrees on the CPU; exact: every patch\n"
+    "                      evaluated in the vertex shader from its knot vectors and control\n"
+    "                      points (Krishnamurthy & Yasui), degree <= 15\n"
     "  -h, --help          this text\n";
 
 typedef struct render_args {
@@ -48,6 +53,9 @@ static int parse_args(int argc, char **argv, render_args *a)
         } else if (!strcmp(arg, "--camera") && val) {
             bad = sw_cli_parse_camera(val, &a->frame.camera);
             a->has_camera = 1;
+        } else if (!strcmp(arg, "--eval") && val) {
+            bad = strcmp(val, "bezier") != 0 && strcmp(val, "exact") != 0;
+            a->frame.eval_exact = strcmp(val, "exact") == 0;
         } else if (!strcmp(arg, "--error") && val) {
             bad = sw_cli_parse_positive(val, &a->frame.error_px);
         } else if (arg[0] != '-' && !a->scene) {

@@ -25,7 +25,7 @@ for c in import info render demo; do
   "$sw" $c --help >help.txt || fail "$c --help exit status"
 done
 "$sw" render --help >help.txt
-for opt in -o --size --view --camera --error iso front top right; do
+for opt in -o --size --view --camera --error --eval iso front top right bezier exact; do
   grep -q -- "$opt" help.txt || fail "render --help does not mention $opt"
 done
 "$sw" info --help | grep -q -- --json || fail "info --help does not mention --json"
@@ -51,6 +51,10 @@ trimmed=$(sed -n 's/.*trimmed by trim textures \([0-9]*\).*/\1/p' render.txt)
 [ -n "$trimmed" ] && [ "$trimmed" -gt 0 ] || fail "render: no trim-textured patches: $(cat render.txt)"
 [ -s motor.png ] || fail "render wrote no image"
 "$sw" render "$model" -o motor.exr --size 160x120 >/dev/null 2>&1 || fail "render to EXR"
+"$sw" render motor.sws -o exact.png --size 320x240 --eval exact >exact.txt 2>&1 || fail "render --eval exact"
+exact=$(sed -n 's/.*, \([0-9]*\) by the exact path.*/\1/p' exact.txt)
+[ -n "$exact" ] && [ "$exact" -gt 0 ] || fail "--eval exact drew no patch by the exact path: $(cat exact.txt)"
+"$sw" render motor.sws -o x.png --eval fast >/dev/null 2>&1; [ $? -eq 2 ] || fail "--eval fast accepted"
 [ -s motor.exr ] || fail "no EXR written"
 pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 

@@ -112,6 +112,9 @@ typedef struct sw_frame_desc {
     int32_t width, height; /* 0 = 1280 x 720 */
     double error_px;       /* screen-space error ε_img in pixels; 0 = 0.5 */
     const char *output_path; /* .png or .exr (with depth); NULL = render only */
+    int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
+                                vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
+                                Bézier patches (degree <= 3 in the shader, higher on the CPU) */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -119,6 +122,7 @@ typedef struct sw_frame_stats {
     uint64_t patches_trimmed, patches_untrimmed, patches_culled;
     uint64_t triangles, trim_textures, trim_texels;
     uint64_t patches_gpu_evaluated; /* evaluated in the vertex shader; the rest are CPU grids */
+    uint64_t patches_exact;         /* of those, by the exact NURBS path (eval_exact) */
     uint64_t atlas_pages, trim_reused; /* trim-texture atlas pages; textures kept from before */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
 } sw_frame_stats;
