@@ -13,7 +13,8 @@
  * through sw_sg_surface_eval and the camera (perspective as gpu/camera.c builds it). For each
  * sample inside the frame and not hidden (rendered depth not in front of the sample's depth), the
  * nearest coverage-boundary pixel centre (covered with an uncovered 4-neighbour or vice versa;
- * coverage = finite depth) must be within 1 px, Chebyshev distance.
+ * coverage = finite depth) must be within 1 px, Chebyshev distance. Samples within 1.5 px of the
+ * frame's edge are skipped: the boundary outside the image is not seen.
  *
  * Per-entry size: the frame stats do not list entry sizes; sw__gpu_atlas_add refuses an entry
  * above sw__gpu_atlas_max_entry with SW_ERR_LIMIT, so SW_OK implies the bound; the test also
@@ -162,7 +163,11 @@ static void check_point(frame_check *fc, const double p[3])
     if (!project(&fc->cam, fc->fwd, fc->right, fc->up, p, q, &z))
         return;
     q[0] += g_shift_px;
-    if (!(q[0] >= 0.0 && q[0] < W && q[1] >= 0.0 && q[1] < H))
+    /* Only points whose whole tolerance neighbourhood lies in the frame: the coverage boundary
+     * beyond the image edge is not seen, so a curve leaving the frame steeply would have its
+     * nearest visible boundary pixel up to 2 px away with a correctly drawn edge. */
+    const double m = k_tol_px + 0.5;
+    if (!(q[0] >= m && q[0] < W - m && q[1] >= m && q[1] < H - m))
         return;
     int ix = (int)q[0], iy = (int)q[1];
     float d = fc->img->depth[(size_t)iy * W + (size_t)ix];
