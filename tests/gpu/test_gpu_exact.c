@@ -9,6 +9,7 @@
  *
  * Usage: test_gpu_exact OUTDIR WIDTHxHEIGHT FILE...
  */
+#include "gpu_test_compare.h"
 #include "sw_gpu_internal.h"
 #include "sw_sg_import.h"
 
@@ -18,24 +19,6 @@
 #include <string.h>
 
 static const int k_color_tol = 8;
-
-static sw_gpu_camera view_camera(const double b[6], int iso)
-{
-    sw_gpu_camera c;
-    memset(&c, 0, sizeof c);
-    double diag = sqrt(pow(b[3] - b[0], 2) + pow(b[4] - b[1], 2) + pow(b[5] - b[2], 2));
-    double dist = diag / (2.0 * tan(20.0 * M_PI / 180.0)) * 1.1;
-    double dir[3] = {0.0, -1.0, 0.0};
-    if (iso)
-        dir[0] = dir[1] = dir[2] = 1.0 / sqrt(3.0);
-    for (int k = 0; k < 3; ++k) {
-        c.target[k] = 0.5 * (b[k] + b[3 + k]);
-        c.eye[k] = c.target[k] + dir[k] * dist;
-    }
-    c.up[2] = 1.0;
-    c.fovy_deg = 40.0;
-    return c;
-}
 
 static int render(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_gpu_frame_desc *desc,
                   int exact, sw_gpu_image *img, sw_gpu_frame_stats *fs)
@@ -56,7 +39,7 @@ static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const double 
     memset(&desc, 0, sizeof desc);
     desc.width = w;
     desc.height = h;
-    desc.camera = view_camera(box, iso);
+    desc.camera = sw_test_view_camera(box, iso);
     sw_gpu_image bez, ex;
     sw_gpu_frame_stats fb, fe;
     if (!render(ctx, scene, &desc, 0, &bez, &fb))
@@ -66,17 +49,8 @@ static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const double 
         return 0;
     }
     size_t n = (size_t)w * (size_t)h;
-    long covered = 0, differ = 0, cover_differ = 0;
-    for (size_t i = 0; i < n; ++i) {
-        int ca = bez.rgba[4 * i + 3] != 0, cb = ex.rgba[4 * i + 3] != 0, dmax = 0;
-        covered += ca || cb;
-        for (int k = 0; k < 3; ++k) {
-            int d = abs((int)bez.rgba[4 * i + k] - (int)ex.rgba[4 * i + k]);
-            dmax = d > dmax ? d : dmax;
-        }
-        cover_differ += ca != cb;
-        differ += ca != cb || dmax > k_color_tol;
-    }
+    sw_test_image_diff df = sw_test_compare_images(&bez, &ex, k_color_tol);
+    long covered = df.covered, differ = df.differ, cover_differ = df.cover_differ;
     unsigned long long drawn = fe.patches_trimmed + fe.patches_untrimmed;
     double frac = (double)differ / (double)(covered ? covered : 1);
     printf("%s %s %dx%d: %llu patches drawn, %llu exact (bezier path: %llu in the vertex shader); "
