@@ -44,6 +44,10 @@ typedef struct sw_gpu_frame_desc {
     int32_t eval_exact;    /* 1: every drawn patch piece evaluated in the vertex shader from the
                               face's knot vectors and control points (B-spline basis in double,
                               any degree up to SW_GPU_EXACT_MAX_DEGREE); 0: Bézier path */
+    struct sw_lod_cache *hierarchies; /* NULL: every face drawn by its own Bézier patches;
+                              else the cache of `scene`'s bicubic hierarchies (Guthe §6), traversed
+                              per frame (§7); the frame waits for the builds and refinements it
+                              asks for in the cache's pool (converged). Ignored with eval_exact. */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -67,6 +71,13 @@ typedef struct sw_gpu_frame_stats {
     uint64_t patches_gpu_evaluated; /* drawn patches evaluated in the vertex shader (§4.2); the
                                        others are CPU grids */
     uint64_t patches_exact; /* of those, evaluated from knots and control points (eval_exact) */
+    /* hierarchy traversal (desc.hierarchies) */
+    uint64_t hlod_nodes;          /* hierarchy nodes (or parts of one) drawn */
+    uint64_t hlod_fallback_faces; /* occurrences drawn by their Bézier patches: no hierarchy */
+    uint64_t hlod_refine_rounds;  /* rounds of refinement below the leaves the frame waited for */
+    uint64_t hlod_over_budget;    /* nodes drawn although their error exceeds their share of
+                                     ε_img (refinement stopped at its depth limit) */
+    double ms_hierarchy;          /* waiting for hierarchy builds and refinements */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

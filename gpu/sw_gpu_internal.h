@@ -190,6 +190,9 @@ typedef struct sw__gpu_mesh {
     size_t n_v, cap_v, n_idx, cap_idx;
 } sw__gpu_mesh;
 
+/* Grows *p (capacity *cap elements of elem bytes) to hold `need`, doubling; 0 when out of memory
+ * (*p and *cap unchanged). */
+int sw__gpu_grow(void **p, size_t *cap, size_t need, size_t elem);
 void sw__gpu_mesh_free(sw__gpu_mesh *m);
 sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, sw_status *status);
 
@@ -217,11 +220,13 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
 /* Appends a screen-facing ribbon (fat border), width_px pixels wide on the face's inner side, along
  * a closed polyline uv[2n] in the parameters of surface srf placed by `world` (3 x 4), sampled on
  * the exact surface with steps no longer than (du, dv). left_inside: the face lies to the left of
- * the polyline's direction in (u, v). Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+ * the polyline's direction in (u, v). st_box (u0, u1, v0, v1) or NULL: the rectangle the trim
+ * lookup of the ribbon's draw spans (vertices then carry st over it), else st = 0 (untrimmed).
+ * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
-                             double du, double dv, double width_px, sw__gpu_mesh *mesh,
-                             sw_status *status);
+                             double du, double dv, double width_px, const double *st_box,
+                             sw__gpu_mesh *mesh, sw_status *status);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 

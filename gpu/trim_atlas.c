@@ -77,25 +77,10 @@ struct sw__gpu_atlas {
 
 static sw_result compact(struct sw__gpu_atlas *a, sw_status *status);
 
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap * 2 : 64;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*p, c * elem);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
-
 static int grow32(void **p, int32_t *cap, size_t need, size_t elem)
 {
     size_t c = (size_t)*cap;
-    int ok = grow(p, &c, need, elem);
+    int ok = sw__gpu_grow(p, &c, need, elem);
     *cap = (int32_t)c;
     return ok;
 }
@@ -478,13 +463,13 @@ static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int
 static sw_result scratch_for_page(struct sw__gpu_atlas *a, size_t n_xy, size_t n_loops,
                                   sw_status *status)
 {
-    if (!grow((void **)&a->clip, &a->cap_clip, 2 * n_xy + 2, sizeof *a->clip))
+    if (!sw__gpu_grow((void **)&a->clip, &a->cap_clip, 2 * n_xy + 2, sizeof *a->clip))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     size_t cap = a->cap_loops;
-    if (!grow((void **)&a->first, &cap, n_loops + 1, sizeof *a->first))
+    if (!sw__gpu_grow((void **)&a->first, &cap, n_loops + 1, sizeof *a->first))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     cap = a->cap_loops;
-    if (!grow((void **)&a->count, &cap, n_loops + 1, sizeof *a->count))
+    if (!sw__gpu_grow((void **)&a->count, &cap, n_loops + 1, sizeof *a->count))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     a->cap_loops = cap;
     return SW_OK;

@@ -343,6 +343,16 @@ uint32_t sw_lod_cache_face_count(const sw_lod_cache *c)
     return c->n_faces;
 }
 
+sw_th_pool *sw_lod_cache_pool(const sw_lod_cache *c)
+{
+    return c->pool;
+}
+
+const sw_sg_scene *sw_lod_cache_scene(const sw_lod_cache *c)
+{
+    return c->scene;
+}
+
 /* ---- epochs and reclamation ------------------------------------------------------------------ */
 int32_t sw_lod_cache_reader_add(sw_lod_cache *c)
 {

@@ -112,6 +112,10 @@ sw_result sw_lod_cache_create(const sw_sg_scene *scene, sw_th_pool *pool,
 void sw_lod_cache_destroy(sw_lod_cache *cache);
 
 uint32_t sw_lod_cache_face_count(const sw_lod_cache *cache);
+/* The pool and scene the cache was created with (borrowed): a converged frame waits for its
+ * requests with sw_th_group_wait on this pool. */
+sw_th_pool *sw_lod_cache_pool(const sw_lod_cache *cache);
+const sw_sg_scene *sw_lod_cache_scene(const sw_lod_cache *cache);
 
 /* Any thread. Submits the face's build unless it is READY, FAILED, RUNNING, or QUEUED by a
  * request that covers this one (same token and generation, or no token, and at least this
