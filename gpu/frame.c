@@ -1181,7 +1181,7 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
     double t4 = sw__gpu_now_ms();
 
     f.st.triangles += f.mesh.n_idx / 3 - f.border_triangles;
-    f.st.ms_tessellate = t1 - t0;
+    f.st.ms_tessellate = t1 - t0 - f.st.ms_hierarchy; /* the waits are counted apart */
     f.st.ms_trim = t2 - t1;
     f.st.ms_draw = t3 - t2;
     f.st.ms_readback = t4 - t3;

@@ -59,7 +59,7 @@ typedef struct sw_gpu_frame_stats {
     uint64_t patches_culled;    /* outside the view frustum, or outside their face's trim box */
     uint64_t triangles;
     uint64_t trim_textures, trim_texels;
-    double ms_tessellate; /* CPU grid evaluation */
+    double ms_tessellate; /* traversal, bounds, CPU grids (without ms_hierarchy) */
     double ms_trim;       /* trim-texture generation */
     double ms_draw;       /* draw submission until glFinish */
     double ms_readback;
