@@ -356,6 +356,11 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     pt->eps = d.eps_obj;
     pt->nu = d.nu;
     pt->nv = d.nv;
+    if (hf->trimmed) { /* tighter than the node's constants: bounds of this range, at full ε_img */
+        double eps_t = d.eps_obj * f->eps_px / scr.eps_px;
+        c->need.u = sw_lod_trim_texels(1.0, d.d1[0], 1.0, eps_t); /* over the item */
+        c->need.v = sw_lod_trim_texels(1.0, d.d1[1], 1.0, eps_t);
+    }
 }
 
 static void item_cell(const sw__gpu_patch *pt, double cell[2])
@@ -373,32 +378,47 @@ static int item_class(const face_loops *fl, const double r[4])
     return sw__gpu_trim_rect_class(fl->loops, fl->n, g);
 }
 
-static sw_result draw_item(hl_face *hf, hl_choice *c, int64_t loops, double sign, int on_gpu,
-                           double cell_min[2], sw_status *status)
+static void count_item(hl_face *hf, const sw__gpu_patch *pt, int on_gpu, int trimmed)
 {
     frame *f = hf->f;
-    sw__gpu_patch pt;
-    item_patch(hf, c, &pt);
-    int cls = loops >= 0 ? item_class(&f->loops[loops], c->rect) : 1;
-    if (!pt.visible || cls < 0)
+    if (!on_gpu && f->ctx->patch_hook)
+        sw__fr_report_patch(f, hf->o, pt, pt->s0, pt->s1, pt->t0, pt->t1, pt->nu, pt->nv, 0,
+                            trimmed);
+    f->st.hlod_nodes++;
+    f->st.patches_gpu_evaluated += (uint64_t)on_gpu;
+    *(trimmed ? &f->st.patches_trimmed : &f->st.patches_untrimmed) += 1;
+}
+
+/* §7.1 between nodes of one face: a fat border along the item's rectangle (counter-clockwise),
+ * trimmed by the texture of draw `share` over st_box when given. */
+static sw_result item_border(hl_face *hf, const hl_choice *c, const double cell[2],
+                             const double *st_box, size_t share, sw_status *status)
+{
+    const double *b = c->rect;
+    const double loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
+    return sw__fr_fat_border(hf->f, hf->o, loop, 4, 1, cell, st_box, share, status);
+}
+
+/* Per-item trim textures (a face whose one texture would be too large): the item's own draw,
+ * trimmed over its rectangle when a loop crosses it, untrimmed when inside, nothing when outside. */
+static sw_result draw_item_own(hl_face *hf, hl_choice *c, const sw__gpu_patch *pt, int64_t loops,
+                               double sign, int on_gpu, sw_status *status)
+{
+    frame *f = hf->f;
+    int cls = item_class(&f->loops[loops], c->rect);
+    if (cls < 0)
         return SW_OK;
     int trimmed = cls == 0;
     double cell[2];
-    item_cell(&pt, cell);
-    cell_min[0] = fmin(cell_min[0], cell[0]);
-    cell_min[1] = fmin(cell_min[1], cell[1]);
+    item_cell(pt, cell);
     size_t draw = f->n_draws, first = f->mesh.n_idx;
     sw_result r;
     if (on_gpu) {
         r = sw__fr_add_draw(f, hf->o, first, trimmed, &c->need, cell, status);
         if (r == SW_OK)
-            r = sw__fr_gpu_patch(f, hf->o, &pt, c->rect, sign, (int32_t)draw, trimmed, status);
-        f->st.patches_gpu_evaluated++;
+            r = sw__fr_gpu_patch(f, hf->o, pt, c->rect, sign, (int32_t)draw, trimmed, status);
     } else {
-        r = sw__gpu_tessellate_face(&pt, 1, 1, sign, c->rect, &f->mesh, status);
-        if (f->ctx->patch_hook)
-            sw__fr_report_patch(f, hf->o, &pt, pt.s0, pt.s1, pt.t0, pt.t1, pt.nu, pt.nv, 0,
-                                trimmed);
+        r = sw__gpu_tessellate_face(pt, 1, 1, sign, c->rect, &f->mesh, status);
         if (r == SW_OK)
             r = sw__fr_add_draw(f, hf->o, first, trimmed, &c->need, cell, status);
     }
@@ -407,13 +427,9 @@ static sw_result draw_item(hl_face *hf, hl_choice *c, int64_t loops, double sign
         t->loops = loops;
         memcpy(t->rect, c->rect, sizeof t->rect);
     }
-    f->st.hlod_nodes++;
-    *(trimmed ? &f->st.patches_trimmed : &f->st.patches_untrimmed) += 1;
-    if (r == SW_OK && hf->n_chosen > 1 && !f->ctx->crack_fill_off) {
-        const double *b = c->rect; /* counter-clockwise */
-        const double loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
-        r = sw__fr_fat_border(f, hf->o, loop, 4, 1, cell, trimmed ? c->rect : NULL, draw, status);
-    }
+    count_item(hf, pt, on_gpu, trimmed);
+    if (r == SW_OK && hf->n_chosen > 1 && !f->ctx->crack_fill_off)
+        r = item_border(hf, c, cell, trimmed ? c->rect : NULL, draw, status);
     return r;
 }
 
@@ -432,23 +448,70 @@ static double loop_tolerance(const hl_face *hf)
     return tol;
 }
 
-/* The face's own border: its trim loops, or its parameter box when untrimmed. */
-static sw_result face_border(hl_face *hf, int64_t loops, const double cell[2], sw_status *status)
+static sw_result draw_own_textures(hl_face *hf, sw__gpu_patch *pts, double sign, int on_gpu,
+                                   const double cell_min[2], sw_status *status)
 {
     frame *f = hf->f;
-    if (f->ctx->crack_fill_off || !(cell[0] < INFINITY))
-        return SW_OK;
-    if (loops < 0) {
-        const double *b = f->sv->faces[hf->o->face].uv_box;
-        const double box_loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
-        return sw__fr_fat_border(f, hf->o, box_loop, 4, 1, cell, NULL, 0, status);
-    }
-    const face_loops *fl = &f->loops[loops];
-    sw_result r = SW_OK;
-    for (uint32_t k = 0; k < fl->n && r == SW_OK; ++k)
+    int64_t loops = -1;
+    sw_result r = sw__fr_face_loops(f, hf->o->face, loop_tolerance(hf), &loops, status);
+    for (size_t i = 0; i < hf->n_chosen && r == SW_OK; ++i)
+        if (pts[i].visible)
+            r = draw_item_own(hf, &hf->chosen[i], &pts[i], loops, sign, on_gpu, status);
+    const face_loops *fl = r == SW_OK ? &f->loops[loops] : NULL;
+    for (uint32_t k = 0; fl && !f->ctx->crack_fill_off && k < fl->n && r == SW_OK; ++k)
         r = sw__fr_fat_border(f, hf->o, fl->loops[k].uv, fl->loops[k].count,
-                              sw__fr_left_is_inside(fl->loops, fl->n, k), cell, NULL, 0, status);
+                              sw__fr_left_is_inside(fl->loops, fl->n, k), cell_min, NULL, 0,
+                              status);
     return r;
+}
+
+/* One draw for the whole face (one trim texture over its trim box, as the direct path). */
+static sw_result draw_one_texture(hl_face *hf, sw__gpu_patch *pts, double sign, int on_gpu,
+                                  const trim_need *need, const double cell_min[2],
+                                  sw_status *status)
+{
+    frame *f = hf->f;
+    const double *ub = f->sv->faces[hf->o->face].uv_box;
+    size_t draw = f->n_draws, first = f->mesh.n_idx;
+    sw_result r = on_gpu ? sw__fr_add_draw(f, hf->o, first, hf->trimmed, need, cell_min, status)
+                         : SW_OK;
+    for (size_t i = 0; i < hf->n_chosen && r == SW_OK; ++i) {
+        if (!pts[i].visible)
+            continue;
+        r = on_gpu ? sw__fr_gpu_patch(f, hf->o, &pts[i], ub, sign, (int32_t)draw, hf->trimmed,
+                                      status)
+                   : sw__gpu_tessellate_face(&pts[i], 1, 1, sign, ub, &f->mesh, status);
+        count_item(hf, &pts[i], on_gpu, hf->trimmed);
+    }
+    if (r == SW_OK && !on_gpu)
+        r = sw__fr_add_draw(f, hf->o, first, hf->trimmed, need, cell_min, status);
+    for (size_t i = 0; i < hf->n_chosen && r == SW_OK && hf->n_chosen > 1; ++i) {
+        double cell[2];
+        item_cell(&pts[i], cell);
+        if (pts[i].visible && !f->ctx->crack_fill_off)
+            r = item_border(hf, &hf->chosen[i], cell, hf->trimmed ? ub : NULL, draw, status);
+    }
+    if (r == SW_OK && !hf->trimmed && !f->ctx->crack_fill_off) {
+        /* a trimmed face's loops get theirs with its trim texture (frame.c make_trim) */
+        const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
+        r = sw__fr_fat_border(f, hf->o, box_loop, 4, 1, cell_min, NULL, 0, status);
+    }
+    return r;
+}
+
+/* Texels of one texture over the face's trim box that serve every chosen item. */
+static trim_need face_need(const hl_face *hf, const sw__gpu_patch *pts)
+{
+    const double *ub = hf->f->sv->faces[hf->o->face].uv_box;
+    trim_need n = {1.0, 1.0};
+    for (size_t i = 0; i < hf->n_chosen; ++i) {
+        const hl_choice *c = &hf->chosen[i];
+        if (!pts[i].visible)
+            continue;
+        n.u = fmax(n.u, c->need.u * (ub[1] - ub[0]) / (c->rect[1] - c->rect[0]));
+        n.v = fmax(n.v, c->need.v * (ub[3] - ub[2]) / (c->rect[3] - c->rect[2]));
+    }
+    return n;
 }
 
 static sw_result draw_chosen(hl_face *hf, sw_status *status)
@@ -460,18 +523,30 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
     if (sw__fr_det3(o->world) < 0.0)
         sign = -sign;
     int on_gpu = f->ctx->eval_mode == SW__GPU_EVAL_AUTO;
-    int64_t loops = -1;
-    sw_result r = hf->trimmed ? sw__fr_face_loops(f, o->face, loop_tolerance(hf), &loops, status)
-                              : SW_OK;
+    sw__gpu_patch *pts = malloc((hf->n_chosen ? hf->n_chosen : 1) * sizeof *pts);
+    if (!pts)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     double cell[2] = {INFINITY, INFINITY};
-    for (size_t i = 0; i < hf->n_chosen && r == SW_OK; ++i)
-        r = draw_item(hf, &hf->chosen[i], loops, sign, on_gpu, cell, status);
-    if (r == SW_OK)
-        r = face_border(hf, loops, cell, status);
-    if (cell[0] < INFINITY)
+    for (size_t i = 0; i < hf->n_chosen; ++i) {
+        item_patch(hf, &hf->chosen[i], &pts[i]);
+        double c[2];
+        item_cell(&pts[i], c);
+        if (pts[i].visible) {
+            cell[0] = fmin(cell[0], c[0]);
+            cell[1] = fmin(cell[1], c[1]);
+        }
+    }
+    sw_result r = SW_OK;
+    if (cell[0] < INFINITY) {
+        trim_need need = face_need(hf, pts);
+        r = hf->trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)
+                ? draw_own_textures(hf, pts, sign, on_gpu, cell, status)
+                : draw_one_texture(hf, pts, sign, on_gpu, &need, cell, status);
         f->st.faces_drawn++;
-    else
+    } else {
         f->st.faces_culled++;
+    }
+    free(pts);
     return r;
 }
 

@@ -2,7 +2,9 @@
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
 #include "sw_rt.h"
 
+#include "sw_lod_cache.h"
 #include "sw_status_util.h"
+#include "sw_th_pool.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,9 +12,14 @@
 #include <strings.h>
 #include <time.h>
 
+/* The hierarchies live with the renderer, for the scene it last drew: a walkthrough keeps drawing
+ * one scene, and the pool's workers then stay busy with that scene only. */
 typedef struct sw_rt_renderer {
     sw_gpu_context *gpu;
     pthread_t owner;
+    sw_th_pool *pool;        /* created on the first frame that needs it */
+    sw_lod_cache *cache;     /* of cache_scene */
+    uint32_t cache_scene;    /* scene handle id; 0 = none */
 } sw_rt_renderer;
 
 static sw_rt_pool g_renderers = SW_RT_POOL_INIT;
@@ -56,6 +63,8 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     if (!pthread_equal(r->owner, pthread_self()))
         return SW_ERR_INVALID_ARGUMENT; /* its GL context is current on another thread */
     sw_rt_pool_remove(&g_renderers, renderer.id);
+    sw_lod_cache_destroy(r->cache);
+    sw_th_pool_destroy(r->pool);
     sw_gpu_context_free(r->gpu);
     free(r);
     return SW_OK;
@@ -86,6 +95,29 @@ static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
     return SW_OK;
 }
 
+/* The renderer's hierarchy cache for `scene` (a cache of another scene is dropped first). */
+static sw_result renderer_cache(sw_rt_renderer *r, sw_scene handle, sw_rt_scene *scene,
+                                sw_lod_cache **out, sw_status *status)
+{
+    if (r->cache && r->cache_scene == handle.id) {
+        *out = r->cache;
+        return SW_OK;
+    }
+    sw_lod_cache_destroy(r->cache);
+    r->cache = NULL;
+    r->cache_scene = 0;
+    if (!r->pool) {
+        sw_th_pool_desc pd = {0};
+        if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
+    }
+    sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
+    if (res == SW_OK)
+        r->cache_scene = handle.id;
+    *out = r->cache;
+    return res;
+}
+
 static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
 {
     out->faces_drawn = g->faces_drawn;
@@ -100,6 +132,9 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->patches_exact = g->patches_exact;
     out->atlas_pages = g->atlas_pages;
     out->trim_reused = g->trim_reused;
+    out->hierarchy_nodes = g->hlod_nodes;
+    out->refine_rounds = g->hlod_refine_rounds;
+    out->ms_hierarchy = g->ms_hierarchy;
     out->ms_tessellate = g->ms_tessellate;
     out->ms_trim = g->ms_trim;
     out->ms_draw = g->ms_draw;
@@ -144,6 +179,12 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     if (desc->output_path) {
         size_t n = strlen(desc->output_path);
         frame.want_depth = n > 4 && strcasecmp(desc->output_path + n - 4, ".exr") == 0;
+    }
+
+    if (!frame.eval_exact && !desc->no_hierarchy) {
+        res = renderer_cache(r, desc->scene, scene, &frame.hierarchies, status);
+        if (res != SW_OK)
+            return res;
     }
 
     sw_gpu_image image = {0};

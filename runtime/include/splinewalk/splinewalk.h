@@ -115,6 +115,10 @@ typedef struct sw_frame_desc {
     int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
                                 vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
                                 Bézier patches (degree <= 3 in the shader, higher on the CPU) */
+    int32_t no_hierarchy;    /* 0: each face drawn from its bicubic hierarchy (Guthe et al. 2005
+                                §6-§7: nodes as coarse as the view allows, built and refined in the
+                                renderer's worker pool and kept for later frames); 1: every face
+                                drawn by its own Bézier patches. Ignored with eval_exact. */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -124,6 +128,9 @@ typedef struct sw_frame_stats {
     uint64_t patches_gpu_evaluated; /* evaluated in the vertex shader; the rest are CPU grids */
     uint64_t patches_exact;         /* of those, by the exact NURBS path (eval_exact) */
     uint64_t atlas_pages, trim_reused; /* trim-texture atlas pages; textures kept from before */
+    uint64_t hierarchy_nodes;  /* hierarchy nodes drawn (0 with no_hierarchy) */
+    uint64_t refine_rounds;    /* rounds of refinement below the hierarchies' leaves waited for */
+    double ms_hierarchy;       /* waiting for hierarchy builds and refinements */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
 } sw_frame_stats;
 
