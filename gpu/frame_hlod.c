@@ -31,7 +31,7 @@
 
 enum {
     MAX_ITEMS_PER_FACE = 16384, /* nodes (or parts) drawn for one face occurrence */
-    MAX_PART_DEPTH = 20,        /* halvings of a leaf's domain for its trim texture */
+    MAX_PART_DEPTH = 48,        /* halvings of a leaf's domain for its trim texture (2^-24 per direction) */
     MAX_REFINE_ROUNDS = 8,
 };
 
