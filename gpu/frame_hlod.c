@@ -308,6 +308,8 @@ sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, sw_status *status)
     f->planning = 1;
     for (int round = 0; round < MAX_REFINE_ROUNDS; ++round) {
         f->refine_asked = 0;
+        sw_lod_cache_stats before, after;
+        sw_lod_cache_stats_get(f->cache, &before);
         int ok = plan_round(f, boxes);
         sw_th_group_wait(pool, &f->group);
         if (!ok) {
@@ -317,6 +319,9 @@ sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, sw_status *status)
         if (f->refine_asked == 0)
             break;
         f->st.hlod_refine_rounds++;
+        sw_lod_cache_stats_get(f->cache, &after);
+        if (after.refinements == before.refinements)
+            break; /* nothing could be refined further (depth limits): drawn over budget */
     }
     f->planning = 0;
     f->st.ms_hierarchy = sw__gpu_now_ms() - t0;
