@@ -899,7 +899,7 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     screen_view_init(f);
     int hierarchy = f->cache && !f->exact;
     if (r == SW_OK && hierarchy)
-        r = sw__fr_hlod_prepare(f, boxes, status);
+        r = sw__fr_hlod_prepare(f, boxes, desc->walkthrough, status);
     for (size_t i = 0; i < f->n_occ && r == SW_OK; ++i) {
         if (!sw__gpu_view_box_visible(&f->view, boxes + 6 * i)) {
             f->st.faces_culled++;

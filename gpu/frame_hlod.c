@@ -171,9 +171,12 @@ static void ask_refine(hl_face *hf, int32_t node, double eps_obj)
     if (!(tol > 0.0) || !isfinite(tol))
         return;
     sw_lod_refine_outcome out = SW_LOD_REFINE_DONE;
-    if (sw_lod_cache_refine(f->cache, hf->o->face, node, tol, NULL, &f->group, &out) == SW_OK &&
-        (out == SW_LOD_REFINE_SUBMITTED || out == SW_LOD_REFINE_BUSY))
+    if (sw_lod_cache_refine(f->cache, hf->o->face, node, tol, f->walkthrough ? &f->req : NULL,
+                            f->walkthrough ? NULL : &f->group, &out) == SW_OK &&
+        (out == SW_LOD_REFINE_SUBMITTED || out == SW_LOD_REFINE_BUSY)) {
         f->refine_asked++;
+        f->st.hlod_refine_requests += (uint64_t)f->walkthrough;
+    }
 }
 
 /* Visits one item: culls it, draws it, or goes below it. */
@@ -225,7 +228,7 @@ static void visit(hl_face *hf, const hl_item *it)
         push(hf, n->child[1], k_full, 0);
         return;
     }
-    if (!approx_ok && f->planning && it->part_depth == 0)
+    if (!approx_ok && (f->planning || f->walkthrough) && it->part_depth == 0)
         ask_refine(hf, it->node, eps_obj);
     if (!texture_ok && it->part_depth < MAX_PART_DEPTH) {
         split_part(hf, it, &need);
@@ -295,23 +298,45 @@ static int plan_round(frame *f, const double *boxes)
     return ok;
 }
 
-sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, sw_status *status)
+/* Walkthrough: asks for the visible faces' hierarchies and returns at once. */
+static sw_result request_walkthrough(frame *f, const double *boxes, sw_status *status)
 {
+    f->walkthrough = 1;
+    f->req.priority = SW_TH_PRIORITY_FRAME;
+    f->req.token = f->ctx->walk_token;
+    f->req.generation = sw_th_token_cancel(f->ctx->walk_token);
+    for (size_t i = 0; i < f->n_occ; ++i)
+        if (sw__gpu_view_box_visible(&f->view, boxes + 6 * i) &&
+            sw_lod_cache_request(f->cache, f->occ[i].face, &f->req) == SW_ERR_OUT_OF_MEMORY)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "hierarchy requests: out of memory");
+    return SW_OK;
+}
+
+static void wait_group(frame *f, sw_th_pool *pool)
+{
+    sw_th_group_wait(pool, &f->group);
+    f->st.hlod_waits++;
+}
+
+sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, int walkthrough, sw_status *status)
+{
+    if (walkthrough)
+        return request_walkthrough(f, boxes, status);
     double t0 = sw__gpu_now_ms();
     sw_th_pool *pool = sw_lod_cache_pool(f->cache);
     sw_th_group_init(&f->group);
     if (request_builds(f, boxes) != SW_OK) {
-        sw_th_group_wait(pool, &f->group);
+        wait_group(f, pool);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "hierarchy builds: out of memory");
     }
-    sw_th_group_wait(pool, &f->group);
+    wait_group(f, pool);
     f->planning = 1;
     for (int round = 0; round < MAX_REFINE_ROUNDS; ++round) {
         f->refine_asked = 0;
         sw_lod_cache_stats before, after;
         sw_lod_cache_stats_get(f->cache, &before);
         int ok = plan_round(f, boxes);
-        sw_th_group_wait(pool, &f->group);
+        wait_group(f, pool);
         if (!ok) {
             f->planning = 0;
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "hierarchy traversal: out of memory");

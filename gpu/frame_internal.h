@@ -92,6 +92,8 @@ typedef struct frame {
     int32_t reader;         /* the frame's reader slot in the cache (epochs), -1 when none */
     sw_th_group group;      /* converged mode: builds and refinements the frame waits for */
     int planning;           /* 1: traversal only asks for refinements; 0: it draws */
+    int walkthrough;        /* never wait: requests carry `req` and are not waited for */
+    sw_lod_cache_req req;
     uint64_t refine_asked;  /* refinements submitted (or in flight) in this planning round */
     size_t *shares;         /* pairs (draw, source draw): draw uses the source's trim entry */
     size_t n_shares, cap_shares;
@@ -133,9 +135,9 @@ sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index,
                             sw_status *status);
 
 /* ---- frame_hlod.c ---- */
-/* Converged mode: builds the hierarchies of the visible occurrences' faces (boxes: eye-relative,
+/* Walkthrough: only requests the visible faces' hierarchies (never waits). Converged mode: builds the hierarchies of the visible occurrences' faces (boxes: eye-relative,
  * 6 per occurrence) and refines them until the frame's cut needs no more, waiting for the pool. */
-sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, sw_status *status);
+sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, int walkthrough, sw_status *status);
 /* Draws one occurrence from its face's hierarchy (§7), or by the direct path when it has none. */
 sw_result sw__fr_hlod_draw_face(frame *f, const occurrence *o, sw_status *status);
 

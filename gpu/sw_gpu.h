@@ -48,6 +48,11 @@ typedef struct sw_gpu_frame_desc {
                               else the cache of `scene`'s bicubic hierarchies (Guthe §6), traversed
                               per frame (§7); the frame waits for the builds and refinements it
                               asks for in the cache's pool (converged). Ignored with eval_exact. */
+    int32_t walkthrough;   /* with hierarchies: 1 = never wait for the pool (ARCHITECTURE.md
+                              walkthrough mode): faces without a hierarchy yet are drawn by their
+                              Bézier patches, leaves too coarse are drawn as they are, and both
+                              are requested from the pool for later frames; the requests of earlier
+                              frames that have not started are cancelled */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -77,6 +82,8 @@ typedef struct sw_gpu_frame_stats {
     uint64_t hlod_refine_rounds;  /* rounds of refinement below the leaves the frame waited for */
     uint64_t hlod_over_budget;    /* nodes drawn although their error exceeds their share of
                                      ε_img (refinement stopped at its depth limit) */
+    uint64_t hlod_waits;          /* times the frame waited for the pool (0 in walkthrough) */
+    uint64_t hlod_refine_requests; /* walkthrough: refinements asked for, not waited for */
     double ms_hierarchy;          /* waiting for hierarchy builds and refinements */
 } sw_gpu_frame_stats;
 

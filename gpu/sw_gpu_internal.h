@@ -97,6 +97,9 @@ void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *us
 
 struct sw_gpu_context {
     void *egl_display, *egl_context; /* EGLDisplay, EGLContext */
+    struct sw_th_token *walk_token; /* walkthrough frames' hierarchy requests; bumped every frame,
+                               so the requests of frames gone by are cancelled (a pointer: C++
+                               tests include this header, and the token is a C11 atomic) */
     char description[256];
     GLint max_texture_size;
     /* grid / triangle program */

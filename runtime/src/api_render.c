@@ -134,6 +134,8 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->trim_reused = g->trim_reused;
     out->hierarchy_nodes = g->hlod_nodes;
     out->refine_rounds = g->hlod_refine_rounds;
+    out->fallback_draws = g->hlod_fallback_faces + g->hlod_refine_requests;
+    out->pool_waits = g->hlod_waits;
     out->ms_hierarchy = g->ms_hierarchy;
     out->ms_tessellate = g->ms_tessellate;
     out->ms_trim = g->ms_trim;
@@ -175,6 +177,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     frame.background[0] = frame.background[1] = frame.background[2] = 1.0f;
     frame.background[3] = 1.0f;
     frame.eval_exact = desc->eval_exact != 0;
+    frame.walkthrough = desc->walkthrough != 0;
     frame.want_depth = 0;
     if (desc->output_path) {
         size_t n = strlen(desc->output_path);

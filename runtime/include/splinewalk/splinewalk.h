@@ -119,6 +119,10 @@ typedef struct sw_frame_desc {
                                 §6-§7: nodes as coarse as the view allows, built and refined in the
                                 renderer's worker pool and kept for later frames); 1: every face
                                 drawn by its own Bézier patches. Ignored with eval_exact. */
+    int32_t walkthrough;     /* 0: converged — the frame waits for every hierarchy build and
+                                refinement it asks for (deterministic images); 1: walkthrough — it
+                                never waits: what is not ready is drawn from what is at hand
+                                (Bézier patches, coarser nodes) and asked for, for later frames */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -130,6 +134,9 @@ typedef struct sw_frame_stats {
     uint64_t atlas_pages, trim_reused; /* trim-texture atlas pages; textures kept from before */
     uint64_t hierarchy_nodes;  /* hierarchy nodes drawn (0 with no_hierarchy) */
     uint64_t refine_rounds;    /* rounds of refinement below the hierarchies' leaves waited for */
+    uint64_t fallback_draws;   /* walkthrough: faces drawn without their hierarchy, plus leaves
+                                  drawn coarser than the error asks, both requested from the pool */
+    uint64_t pool_waits;       /* times the frame waited for the pool (0 in walkthrough) */
     double ms_hierarchy;       /* waiting for hierarchy builds and refinements */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
 } sw_frame_stats;
