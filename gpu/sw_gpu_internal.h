@@ -238,7 +238,8 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
  * texture `tex` (side x side texels per layer): fans from each loop's first vertex toggle texels
  * (even-odd parity, §4), then every loop drawn as a 1-pixel line loop SETS its texels (§7.1 crack
  * filling: boundary texels are inside). One render-target switch; two multi-draw calls.
- * Loops with fewer than 3 (fans) or 2 (lines) vertices are skipped. */
+ * Loops with fewer than 3 (fans) or 2 (lines) vertices draw nothing; empty loops (count 0) are
+ * allowed anywhere, first included (trim_texture.c works around llvmpipe dropping the rest). */
 void sw__gpu_trim_page_draw(sw_gpu_context *ctx, GLuint tex, int32_t layer, int32_t side,
                             const float *xy, size_t n_xy, const GLint *first, const GLsizei *count,
                             GLsizei n_loops);
