@@ -17,8 +17,9 @@
  * frame's entries need: growing would then copy pages of mostly dead texels, and with a new set
  * of textures every frame (an animated surface, a new scene per frame) add a page per frame up to
  * the texel limit. A repack keeps the array texture when its page size is right and it has at most
- * twice the pages needed (no copy), else allocates one of the size needed. Entries unused for k_max_idle_frames frames are dropped
- * at the next begin (their loops freed; their texels stay dead space until a repack).
+ * twice the pages needed (no copy), else allocates one of the size needed. Entries unused for
+ * k_max_idle_frames frames are dropped at the next begin (their loops freed; their texels stay dead
+ * space until a repack).
  *
  * Loops are stored in entry-local texel coordinates, clamped to the entry's rectangle grown by one
  * texel: a loop straying outside its uv box (flattening tolerance, a box from rounded data) can
