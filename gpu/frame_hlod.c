@@ -60,6 +60,9 @@ typedef struct hl_face {
     size_t n_stack, cap_stack;
     hl_choice *chosen;
     size_t n_chosen, cap_chosen;
+    int32_t *refine_nodes; /* leaves to refine below (planning and walkthrough) */
+    double *refine_tol;
+    size_t n_refine, cap_refine, cap_refine_tol;
     int oom;
 } hl_face;
 
@@ -171,16 +174,34 @@ static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double 
         hf->f->st.hlod_over_budget++;
 }
 
-/* In planning rounds: asks the pool for a finer hierarchy below a leaf. */
+/* In planning rounds and walkthrough frames: a leaf to refine below, to a tolerance in the
+ * surface's units (asked for together after the traversal, submit_refines). */
 static void ask_refine(hl_face *hf, int32_t node, double eps_obj)
 {
-    frame *f = hf->f;
     double tol = 0.5 * eps_obj / hf->scale;
     if (!(tol > 0.0) || !isfinite(tol))
         return;
+    if (!sw__gpu_grow((void **)&hf->refine_nodes, &hf->cap_refine, hf->n_refine + 1,
+                      sizeof *hf->refine_nodes) ||
+        !sw__gpu_grow((void **)&hf->refine_tol, &hf->cap_refine_tol, hf->n_refine + 1,
+                      sizeof *hf->refine_tol)) {
+        hf->oom = 1;
+        return;
+    }
+    hf->refine_nodes[hf->n_refine] = node;
+    hf->refine_tol[hf->n_refine++] = tol;
+}
+
+/* All of the face's leaves in one refinement task (one new version of its hierarchy). */
+static void submit_refines(hl_face *hf)
+{
+    frame *f = hf->f;
+    if (hf->n_refine == 0)
+        return;
     sw_lod_refine_outcome out = SW_LOD_REFINE_DONE;
-    if (sw_lod_cache_refine(f->cache, hf->o->face, node, tol, f->walkthrough ? &f->req : NULL,
-                            f->walkthrough ? NULL : &f->group, &out) == SW_OK &&
+    if (sw_lod_cache_refine_leaves(f->cache, hf->o->face, hf->refine_nodes, hf->refine_tol,
+                                   (uint32_t)hf->n_refine, f->walkthrough ? &f->req : NULL,
+                                   f->walkthrough ? NULL : &f->group, &out) == SW_OK &&
         (out == SW_LOD_REFINE_SUBMITTED || out == SW_LOD_REFINE_BUSY)) {
         f->refine_asked++;
         f->st.hlod_refine_requests += (uint64_t)f->walkthrough;
@@ -250,11 +271,14 @@ static void traverse(hl_face *hf)
 {
     static const double k_full[4] = {0.0, 1.0, 0.0, 1.0};
     hf->n_stack = hf->n_chosen = 0;
+    hf->n_refine = 0;
     push(hf, hf->h->root, k_full, 0);
     while (hf->n_stack > 0 && !hf->oom) {
         hl_item it = hf->stack[--hf->n_stack];
         visit(hf, &it);
     }
+    if (!hf->oom)
+        submit_refines(hf);
 }
 
 static void hl_face_init(hl_face *hf, frame *f, const occurrence *o, const sw_lod_hierarchy *h)
@@ -272,6 +296,8 @@ static void hl_face_free(hl_face *hf)
 {
     free(hf->stack);
     free(hf->chosen);
+    free(hf->refine_nodes);
+    free(hf->refine_tol);
 }
 
 /* ---- converged mode: build and refine before drawing ------------------------------------------ */

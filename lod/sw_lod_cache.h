@@ -155,6 +155,14 @@ sw_result sw_lod_cache_refine(sw_lod_cache *cache, uint32_t face, int32_t node, 
                               const sw_lod_cache_req *req, sw_th_group *group,
                               sw_lod_refine_outcome *outcome);
 
+/* As sw_lod_cache_refine for n leaves of one face at once (one task, one new version holding every
+ * refined subtree): SUBMITTED when at least one of them is a leaf above its tolerance. Errors as
+ * sw_lod_cache_refine (any node out of range or tolerance <= 0: SW_ERR_INVALID_ARGUMENT). */
+sw_result sw_lod_cache_refine_leaves(sw_lod_cache *cache, uint32_t face, const int32_t *nodes,
+                                     const double *tolerances, uint32_t n,
+                                     const sw_lod_cache_req *req, sw_th_group *group,
+                                     sw_lod_refine_outcome *outcome);
+
 /* ---- readers (epoch-based reclamation; the rule is at the top of this file) ------------------ */
 /* Claims a reader slot for the calling thread; returns its index, or -1 when all are taken. */
 int32_t sw_lod_cache_reader_add(sw_lod_cache *cache);
