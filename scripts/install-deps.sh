@@ -11,6 +11,7 @@ packages=(
   libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev
   libocct-foundation-dev libtbb-dev occt-misc
   xvfb xauth libcmocka-dev
+  libxml2-utils jq  # tests/profile: xmllint checks the SVG and HTML, jq the JSON
 )
 if [ "${SW_WITH_CLANG:-0}" = 1 ]; then
   packages+=(clang libclang-rt-14-dev)

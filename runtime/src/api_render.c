@@ -20,6 +20,7 @@ typedef struct sw_rt_renderer {
     sw_th_pool *pool;        /* created on the first frame that needs it */
     sw_lod_cache *cache;     /* of cache_scene */
     uint32_t cache_scene;    /* scene handle id; 0 = none */
+    uint32_t worker_threads; /* the pool's size; 0 = one per online processor */
 } sw_rt_renderer;
 
 static sw_rt_pool g_renderers = SW_RT_POOL_INIT;
@@ -33,13 +34,16 @@ static double now_ms(void)
 
 sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_status *status)
 {
-    (void)desc; /* no options yet; zero means default */
     if (!out)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_create: NULL out");
     out->id = 0;
+    const uint32_t workers = desc ? desc->worker_threads : 0;
+    if (workers > 1024)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "worker_threads %u above 1024", workers);
     sw_rt_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+    r->worker_threads = workers;
     sw_result res = sw_gpu_context_create_headless(&r->gpu, status);
     if (res != SW_OK) {
         free(r);
@@ -108,6 +112,7 @@ static sw_result renderer_cache(sw_rt_renderer *r, sw_scene handle, sw_rt_scene 
     r->cache_scene = 0;
     if (!r->pool) {
         sw_th_pool_desc pd = {0};
+        pd.worker_count = r->worker_threads;
         if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
     }

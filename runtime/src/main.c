@@ -14,6 +14,8 @@ static const command k_commands[] = {
     {"import", sw_cli_import, "import STEP / IGES / BREP into a .sws scene file"},
     {"info", sw_cli_info, "describe a scene (surfaces, trims, patches, memory)"},
     {"render", sw_cli_render, "render one converged frame headlessly to PNG / EXR"},
+    {"path", sw_cli_path, "write a camera path (orbit or fly-through) fitted to a scene"},
+    {"profile", sw_cli_profile, "time frames along a camera path: CSV, JSON, SVG, HTML report"},
     {"demo", sw_cli_demo, "build and render the built-in default scene"},
     {"check-osd", sw_cli_check_osd, "cross-check uniform bicubic regions against OpenSubdiv"},
 };

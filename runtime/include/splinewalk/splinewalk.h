@@ -95,11 +95,14 @@ SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *o
 
 /* ---- rendering ------------------------------------------------------------------------------- */
 typedef struct sw_renderer_desc {
-    int32_t reserved; /* zero; the embedding issue adds host-context options */
+    uint32_t worker_threads; /* threads of the worker pool that builds and refines hierarchies;
+                                0 = one per online processor. A converged frame's thread also
+                                runs pool tasks while it waits for them. At most 1024. */
 } sw_renderer_desc;
 
 /* Creates a headless renderer (EGL; llvmpipe when there is no GPU) owned by the calling thread.
- * desc may be NULL. Errors: SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY. */
+ * desc may be NULL. Errors: SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY,
+ * SW_ERR_INVALID_ARGUMENT (worker_threads above 1024). */
 SW_API sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out,
                                     sw_status *status);
 SW_API sw_result sw_renderer_destroy(sw_renderer renderer);

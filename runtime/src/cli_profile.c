@@ -1,0 +1,417 @@
+/* splinewalk profile SCENE --path PATH --out DIR [...]: frames along a camera path through the
+ * public renderer API, timed stage by stage (issue 5, first slice: one thread submits). */
+#include "cli.h"
+
+#include "sw_camera_path.h"
+#include "sw_profile_report.h"
+#include "sw_status_util.h"
+#include "sw_th_pool.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char k_usage[] =
+    "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
+    "                          [--converged] [--sequential | --threads N]\n"
+    "                          [--eval hierarchy|bezier|exact]\n"
+    "\n"
+    "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
+    "by `splinewalk path orbit|fly`) through the public renderer API and times each frame call\n"
+    "(frame_ms) and its stages: hierarchy (waiting for the pool), tessellate, trim, draw,\n"
+    "readback, write (the PNG of a captured frame) and other = frame_ms minus those. Writes into\n"
+    "DIR: profile.csv and profile.json (one row per frame with the stage times, patches,\n"
+    "triangles, trim textures and texels, atlas pages, fallback draws, pool waits and resident\n"
+    "memory; the JSON adds the run and a summary: median, p90, p99, max, mean per column),\n"
+    "frametime.svg (frame time and the stage stack along the path), report.html, and PNGs of\n"
+    "the first, middle and last frame. Everything is written aside and renamed into DIR at the\n"
+    "end: a failed run leaves DIR as it was. Prints the summary; a progress bar on a terminal.\n"
+    "\n"
+    "options:\n"
+    "  --path PATH       camera path file (required)\n"
+    "  -o, --out DIR     output directory, created if missing (required)\n"
+    "  --frames N        frames spread evenly over the path (default: the path's 'frames', else\n"
+    "                    100)\n"
+    "  --size WxH        frame size (default 1280x720)\n"
+    "  --error PX        screen-space error bound in pixels (default 0.5)\n"
+    "  --converged       every frame waits for the hierarchy builds and refinements it asks for\n"
+    "                    (default: walkthrough mode, frames never wait; what is not ready is\n"
+    "                    drawn coarser and queued)\n"
+    "  --threads N       worker-pool threads (default: one per online processor)\n"
+    "  --sequential      converged, with a pool of one worker: builds run only while the frame\n"
+    "                    waits for them, on that worker and the frame's own thread (the pool\n"
+    "                    cannot be emptied; nothing overlaps the frames)\n"
+    "  --eval MODE       hierarchy (default), bezier or exact, as for `render`\n"
+    "  -h, --help        this text\n";
+
+typedef struct profile_args {
+    const char *scene, *path, *out, *eval;
+    int frames; /* 0 = the path's, else 100 */
+    int threads;
+    int converged, sequential;
+    sw_frame_desc frame;
+} profile_args;
+
+static int parse_option(profile_args *a, const char *arg, const char *val)
+{
+    if (!strcmp(arg, "--path"))
+        a->path = val;
+    else if (!strcmp(arg, "-o") || !strcmp(arg, "--out") || !strcmp(arg, "--output"))
+        a->out = val;
+    else if (!strcmp(arg, "--frames"))
+        return sw_cli_parse_count(val, 1, (int)SW_RT_PATH_MAX_FRAMES, &a->frames);
+    else if (!strcmp(arg, "--size"))
+        return sw_cli_parse_size(val, &a->frame.width, &a->frame.height);
+    else if (!strcmp(arg, "--error"))
+        return sw_cli_parse_positive(val, &a->frame.error_px);
+    else if (!strcmp(arg, "--threads"))
+        return sw_cli_parse_count(val, 1, 1024, &a->threads);
+    else if (!strcmp(arg, "--eval")) {
+        a->eval = val;
+        a->frame.eval_exact = strcmp(val, "exact") == 0;
+        a->frame.no_hierarchy = strcmp(val, "bezier") == 0;
+        return strcmp(val, "hierarchy") != 0 && strcmp(val, "bezier") != 0 &&
+               strcmp(val, "exact") != 0;
+    } else
+        return 2;
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, profile_args *a)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(arg, "--converged") || !strcmp(arg, "--sequential")) {
+            a->converged = 1; /* --sequential implies it */
+            if (!strcmp(arg, "--sequential"))
+                a->sequential = 1;
+            continue;
+        }
+        if (arg[0] != '-' && !a->scene) {
+            a->scene = arg;
+            continue;
+        }
+        const int bad = val ? parse_option(a, arg, val) : 2;
+        if (bad == 2) {
+            fprintf(stderr, "splinewalk profile: unexpected argument '%s'\n%s", arg, k_usage);
+            return 2;
+        }
+        if (bad) {
+            fprintf(stderr, "splinewalk profile: bad value '%s' for %s\n%s", val, arg, k_usage);
+            return 2;
+        }
+        i++;
+    }
+    if (!a->scene || !a->path || !a->out) {
+        fprintf(stderr, "splinewalk profile: need SCENE, --path PATH and --out DIR\n%s", k_usage);
+        return 2;
+    }
+    if (a->sequential && a->threads) {
+        fprintf(stderr, "splinewalk profile: --sequential and --threads exclude each other\n");
+        return 2;
+    }
+    return 0;
+}
+
+/* ---- output directory: written aside, renamed in at the end ---------------------------------- */
+typedef struct staging {
+    char dir[4096]; /* DIR/.profile-XXXXXX */
+    char names[8][64];
+    int n_names;
+} staging;
+
+static sw_result make_staging(const char *out, staging *st, sw_status *status)
+{
+    struct stat sb;
+    if (stat(out, &sb) != 0) {
+        if (errno != ENOENT || mkdir(out, 0777) != 0)
+            return sw__fail(status, SW_ERR_IO, "%s: %s", out, strerror(errno));
+    } else if (!S_ISDIR(sb.st_mode)) {
+        return sw__fail(status, SW_ERR_IO, "%s: exists and is not a directory", out);
+    }
+    if (snprintf(st->dir, sizeof st->dir, "%s/.profile-XXXXXX", out) >= (int)sizeof st->dir)
+        return sw__fail(status, SW_ERR_IO, "%s: path too long", out);
+    if (!mkdtemp(st->dir))
+        return sw__fail(status, SW_ERR_IO, "%s: %s", st->dir, strerror(errno));
+    return SW_OK;
+}
+
+static void staged_path(const staging *st, const char *name, char *buf, size_t size)
+{
+    snprintf(buf, size, "%s/%s", st->dir, name);
+}
+
+static void staging_remember(staging *st, const char *name)
+{
+    if (st->n_names < (int)(sizeof st->names / sizeof st->names[0]))
+        snprintf(st->names[st->n_names++], sizeof st->names[0], "%s", name);
+}
+
+static void staging_abandon(staging *st)
+{
+    char p[4200];
+    for (int i = 0; i < st->n_names; i++) {
+        staged_path(st, st->names[i], p, sizeof p);
+        remove(p);
+    }
+    rmdir(st->dir);
+}
+
+/* Moves every staged file into `out`, then removes the staging directory. */
+static sw_result staging_commit(staging *st, const char *out, sw_status *status)
+{
+    for (int i = 0; i < st->n_names; i++) {
+        char from[4200], to[4200];
+        staged_path(st, st->names[i], from, sizeof from);
+        snprintf(to, sizeof to, "%s/%s", out, st->names[i]);
+        if (rename(from, to) != 0)
+            return sw__fail(status, SW_ERR_IO, "%s: %s", to, strerror(errno));
+    }
+    rmdir(st->dir);
+    return SW_OK;
+}
+
+typedef int (*report_fn)(FILE *f, const sw_rt_profile *p, const char *svg);
+
+static int csv_fn(FILE *f, const sw_rt_profile *p, const char *svg)
+{
+    (void)svg;
+    return sw_rt_profile_write_csv(f, p);
+}
+
+static int json_fn(FILE *f, const sw_rt_profile *p, const char *svg)
+{
+    (void)svg;
+    return sw_rt_profile_write_json(f, p);
+}
+
+static int text_fn(FILE *f, const sw_rt_profile *p, const char *svg)
+{
+    (void)p;
+    return fputs(svg, f) < 0 ? -1 : 0;
+}
+
+static int html_fn(FILE *f, const sw_rt_profile *p, const char *svg)
+{
+    return sw_rt_profile_write_html(f, p, svg);
+}
+
+static sw_result write_staged(staging *st, const char *name, report_fn fn, const sw_rt_profile *p,
+                              const char *svg, sw_status *status)
+{
+    char path[4200];
+    staged_path(st, name, path, sizeof path);
+    staging_remember(st, name);
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return sw__fail(status, SW_ERR_IO, "%s: %s", path, strerror(errno));
+    int bad = fn(f, p, svg);
+    bad |= fclose(f) != 0;
+    return bad ? sw__fail(status, SW_ERR_IO, "%s: write failed", path) : SW_OK;
+}
+
+static sw_result write_reports(staging *st, const sw_rt_profile *p, sw_status *status)
+{
+    char *svg = NULL;
+    size_t svg_len = 0;
+    FILE *mem = open_memstream(&svg, &svg_len);
+    if (!mem)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frametime.svg: out of memory");
+    int bad = sw_rt_profile_write_svg(mem, p);
+    bad |= fclose(mem) != 0;
+    sw_result r =
+        bad ? sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frametime.svg: out of memory") : SW_OK;
+    if (r == SW_OK)
+        r = write_staged(st, "profile.csv", csv_fn, p, NULL, status);
+    if (r == SW_OK)
+        r = write_staged(st, "profile.json", json_fn, p, NULL, status);
+    if (r == SW_OK)
+        r = write_staged(st, "frametime.svg", text_fn, p, svg, status);
+    if (r == SW_OK)
+        r = write_staged(st, "report.html", html_fn, p, svg, status);
+    free(svg);
+    return r;
+}
+
+/* ---- the run --------------------------------------------------------------------------------- */
+static double resident_bytes(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long size = 0, resident = 0;
+    if (!f)
+        return 0.0;
+    const int got = fscanf(f, "%lu %lu", &size, &resident);
+    fclose(f);
+    return got == 2 ? (double)resident * (double)sysconf(_SC_PAGESIZE) : 0.0;
+}
+
+static void choose_captures(sw_rt_profile *p, uint32_t n)
+{
+    const uint32_t want[3] = {0, n / 2, n - 1};
+    p->n_captures = 0;
+    for (int k = 0; k < 3; k++)
+        if (p->n_captures == 0 || p->captures[p->n_captures - 1] != want[k])
+            p->captures[p->n_captures++] = want[k];
+}
+
+static int is_capture(const sw_rt_profile *p, uint32_t i)
+{
+    for (uint32_t k = 0; k < p->n_captures; k++)
+        if (p->captures[k] == i)
+            return 1;
+    return 0;
+}
+
+static void show_progress(uint32_t done, uint32_t n, double last_ms)
+{
+    char stage[64];
+    snprintf(stage, sizeof stage, "frame %u/%u  %.1f ms", done, n, last_ms);
+    sw_cli_progress(NULL, (double)done / n, stage);
+}
+
+/* Draws the n frames; each row's frame_ms is the wall time of sw_renderer_draw alone. */
+static sw_result run_frames(sw_renderer renderer, const sw_rt_camera_path *path, uint32_t n,
+                            sw_frame_desc *frame, staging *st, sw_rt_profile *p, sw_status *status)
+{
+    const int tty = isatty(STDERR_FILENO);
+    for (uint32_t i = 0; i < n; i++) {
+        const double t = sw_rt_path_frame_time(path, i, n);
+        sw_rt_path_eval(path, t, &frame->camera);
+        char name[64], file[4200];
+        const int captured = is_capture(p, i);
+        if (captured) {
+            sw_rt_profile_capture_name(i, name, sizeof name);
+            staged_path(st, name, file, sizeof file);
+            staging_remember(st, name);
+        }
+        frame->output_path = captured ? file : NULL;
+        sw_frame_stats stats = {0};
+        const double t0 = sw_cli_now_ms();
+        sw_result r = sw_renderer_draw(renderer, frame, &stats, status);
+        const double ms = sw_cli_now_ms() - t0;
+        if (r != SW_OK) {
+            if (tty)
+                sw_cli_progress_end();
+            char msg[sizeof status->message];
+            snprintf(msg, sizeof msg, "%s", status->message);
+            return sw__fail(status, r, "frame %u (t = %g s): %s", i, t, msg);
+        }
+        sw_rt_prof_row row;
+        sw_rt_profile_row(&stats, i, t, ms, resident_bytes(), captured, &row);
+        if (sw_rt_profile_push(p, &row) != 0)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
+        if (tty)
+            show_progress(i + 1, n, ms);
+    }
+    if (tty)
+        sw_cli_progress_end();
+    return SW_OK;
+}
+
+/* The pool size the renderer is asked for; 0 = one per online processor. */
+static uint32_t requested_workers(const profile_args *a)
+{
+    return a->sequential ? 1u : (uint32_t)a->threads;
+}
+
+static void fill_meta(const profile_args *a, sw_renderer renderer, sw_rt_profile *p)
+{
+    sw_th_pool_desc want = {0}, pool; /* resolves the default as the renderer's pool will */
+    want.worker_count = requested_workers(a);
+    sw_th_pool_desc_defaults(&pool, &want);
+    sw_rt_prof_meta *m = &p->meta;
+    m->scene = a->scene;
+    m->path = a->path;
+    m->renderer = sw_renderer_description_ptr(renderer);
+    m->mode = a->converged ? "converged" : "walkthrough";
+    m->eval = a->eval ? a->eval : "hierarchy";
+    m->lp_num_threads = getenv("LP_NUM_THREADS");
+    m->width = a->frame.width ? a->frame.width : 1280;
+    m->height = a->frame.height ? a->frame.height : 720;
+    m->error_px = a->frame.error_px > 0.0 ? a->frame.error_px : 0.5;
+    m->worker_threads = pool.worker_count;
+    m->sequential = a->sequential;
+}
+
+/* Renderer, frames, files; the scene and path are loaded. */
+static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera_path *path,
+                             uint32_t n, sw_rt_profile *p, sw_status *status)
+{
+    sw_renderer_desc rd = {0};
+    rd.worker_threads = requested_workers(a);
+    sw_renderer renderer = {0};
+    sw_result r = sw_renderer_create(&rd, &renderer, status);
+    if (r != SW_OK)
+        return r;
+    fill_meta(a, renderer, p);
+    staging st = {0};
+    r = make_staging(a->out, &st, status);
+    if (r == SW_OK) {
+        a->frame.scene = scene;
+        a->frame.walkthrough = !a->converged;
+        choose_captures(p, n);
+        const double t0 = sw_cli_now_ms();
+        r = run_frames(renderer, path, n, &a->frame, &st, p, status);
+        p->meta.wall_s = (sw_cli_now_ms() - t0) / 1e3;
+        if (r == SW_OK && sw_rt_profile_summarize(p) != 0)
+            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
+        if (r == SW_OK)
+            r = write_reports(&st, p, status);
+        if (r == SW_OK)
+            r = staging_commit(&st, a->out, status);
+        if (r != SW_OK)
+            staging_abandon(&st);
+    }
+    sw_renderer_destroy(renderer);
+    return r;
+}
+
+int sw_cli_profile(int argc, char **argv)
+{
+    for (int i = 1; i < argc; i++) {
+        if (sw_cli_is_help(argv[i])) {
+            fputs(k_usage, stdout);
+            return 0;
+        }
+    }
+    profile_args a = {0};
+    int rc = parse_args(argc, argv, &a);
+    if (rc)
+        return rc;
+
+    sw_status status = {0};
+    sw_rt_camera_path path; /* first: a bad path fails before any work or output */
+    if (sw_rt_path_load(a.path, &path, &status) != SW_OK)
+        return sw_cli_report("profile", &status);
+    const uint32_t n = a.frames ? (uint32_t)a.frames : path.frames ? path.frames : 100;
+    sw_scene scene;
+    if (sw_cli_load_scene(a.scene, &scene, &status) != SW_OK) {
+        sw_rt_path_free(&path);
+        return sw_cli_report("profile", &status);
+    }
+    sw_rt_profile prof = {0};
+    sw_result r = profile_run(&a, scene, &path, n, &prof, &status);
+    sw_scene_destroy(scene);
+    sw_rt_path_free(&path);
+    if (r != SW_OK) {
+        sw_rt_profile_free(&prof);
+        return sw_cli_report("profile", &status);
+    }
+    printf("%s along %s: %u frames at %dx%d, error %g px, %s, %u pool worker%s%s, "
+           "LP_NUM_THREADS=%s, %.2f s\n",
+           a.scene, a.path, n, prof.meta.width, prof.meta.height, prof.meta.error_px,
+           prof.meta.mode, prof.meta.worker_threads, prof.meta.worker_threads == 1 ? "" : "s",
+           a.sequential ? " (sequential)" : "",
+           prof.meta.lp_num_threads ? prof.meta.lp_num_threads : "(unset)", prof.meta.wall_s);
+    sw_rt_profile_print_summary(stdout, &prof);
+    printf("wrote %s/profile.csv, profile.json, frametime.svg, report.html and %u frames\n", a.out,
+           prof.n_captures);
+    if (!isatty(STDERR_FILENO))
+        fprintf(stderr, "splinewalk profile: %u/%u frames in %.2f s\n", n, n, prof.meta.wall_s);
+    sw_rt_profile_free(&prof);
+    return 0;
+}

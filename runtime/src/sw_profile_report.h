@@ -1,0 +1,117 @@
+/* Frame-time profiles (never installed): one row of numbers per frame of a `splinewalk profile`
+ * run, their summary (median, p90, p99, max, mean), and the files a run leaves: profile.csv,
+ * profile.json, frametime.svg and report.html (hand-written SVG; the HTML is also well-formed XML).
+ *
+ * The stages are the renderer's own timers (sw_frame_stats) plus "other" = frame_ms - sum of the
+ * measured stages: whatever the frame call spent outside them (setup, bookkeeping, the first
+ * frame's pool and cache creation). Keeping "other" small is what shows that the stages account
+ * for the frame (issue 5).
+ */
+#ifndef SW_PROFILE_REPORT_H
+#define SW_PROFILE_REPORT_H
+
+#include <splinewalk/splinewalk.h>
+
+#include <stdint.h>
+#include <stdio.h>
+
+/* Every per-frame column: enum, name (CSV header and JSON key), kind, what it is. */
+#define SW_RT_PROFILE_COLUMNS(X)                                                                   \
+    X(FRAME, "frame", INDEX, "frame index along the path")                                         \
+    X(T, "t_s", SECONDS, "path time of the frame (s)")                                             \
+    X(FRAME_MS, "frame_ms", FRAME, "wall time of the frame call (sw_renderer_draw)")               \
+    X(HIERARCHY_MS, "hierarchy_ms", STAGE, "waiting for hierarchy builds and refinements")         \
+    X(TESSELLATE_MS, "tessellate_ms", STAGE, "traversal, bounds, CPU grids, requests")             \
+    X(TRIM_MS, "trim_ms", STAGE, "trim-texture generation into the atlas")                         \
+    X(DRAW_MS, "draw_ms", STAGE, "draw submission until glFinish")                                 \
+    X(READBACK_MS, "readback_ms", STAGE, "glReadPixels of the frame")                              \
+    X(WRITE_MS, "write_ms", STAGE, "PNG write (captured frames only)")                             \
+    X(OTHER_MS, "other_ms", STAGE, "frame_ms minus the stages above")                              \
+    X(PATCHES, "patches", COUNT, "patches drawn (trimmed + untrimmed)")                            \
+    X(PATCHES_TRIMMED, "patches_trimmed", COUNT, "patches drawn with a trim texture")              \
+    X(PATCHES_CULLED, "patches_culled", COUNT, "patches culled")                                   \
+    X(FACES_DRAWN, "faces_drawn", COUNT, "face occurrences drawn")                                 \
+    X(FACES_CULLED, "faces_culled", COUNT, "face occurrences culled")                              \
+    X(HIERARCHY_NODES, "hierarchy_nodes", COUNT, "hierarchy nodes drawn")                          \
+    X(REFINE_ROUNDS, "refine_rounds", COUNT, "refinement rounds waited for")                       \
+    X(TRIANGLES, "triangles", COUNT, "triangles drawn (fat borders excluded)")                     \
+    X(TRIM_TEXTURES, "trim_textures", COUNT, "trim textures used")                                 \
+    X(TRIM_TEXELS, "trim_texels", COUNT, "texels of those trim textures")                          \
+    X(TRIM_REUSED, "trim_reused", COUNT, "trim textures kept from earlier frames")                 \
+    X(ATLAS_PAGES, "atlas_pages", COUNT, "trim-atlas pages after the frame")                       \
+    X(FALLBACK_DRAWS, "fallback_draws", COUNT, "walkthrough: drawn coarser than asked, queued")    \
+    X(POOL_WAITS, "pool_waits", COUNT, "times the frame waited for the worker pool")               \
+    X(RESIDENT_BYTES, "resident_bytes", COUNT,                                                     \
+      "resident memory after the frame (/proc/self/statm)")                                        \
+    X(CAPTURED, "captured", INDEX, "1 if the frame was written as PNG")
+
+typedef enum sw_rt_prof_col {
+#define SW_RT__COL_ENUM(id, name, kind, what) SW_RT_COL_##id,
+    SW_RT_PROFILE_COLUMNS(SW_RT__COL_ENUM)
+#undef SW_RT__COL_ENUM
+        SW_RT_COL_COUNT
+} sw_rt_prof_col;
+
+typedef enum sw_rt_prof_kind {
+    SW_RT_KIND_INDEX,
+    SW_RT_KIND_SECONDS,
+    SW_RT_KIND_FRAME,
+    SW_RT_KIND_STAGE,
+    SW_RT_KIND_COUNT
+} sw_rt_prof_kind;
+
+const char *sw_rt_prof_col_name(sw_rt_prof_col col);
+const char *sw_rt_prof_col_what(sw_rt_prof_col col);
+sw_rt_prof_kind sw_rt_prof_col_kind(sw_rt_prof_col col);
+
+typedef struct sw_rt_prof_row {
+    double v[SW_RT_COL_COUNT];
+} sw_rt_prof_row;
+
+/* What the run was; strings are borrowed and must outlive the profile. */
+typedef struct sw_rt_prof_meta {
+    const char *scene, *path, *renderer, *mode, *eval, *lp_num_threads; /* lp: NULL = unset */
+    int32_t width, height;
+    double error_px;
+    uint32_t worker_threads; /* the pool's size (the default resolved) */
+    int sequential;
+    double wall_s; /* the whole run, frames only */
+} sw_rt_prof_meta;
+
+typedef struct sw_rt_prof_stat {
+    double median, p90, p99, max, mean;
+} sw_rt_prof_stat;
+
+typedef struct sw_rt_profile {
+    sw_rt_prof_meta meta;
+    sw_rt_prof_row *rows;
+    uint32_t n_rows, cap_rows;
+    uint32_t captures[3]; /* frame indices written as PNG */
+    uint32_t n_captures;
+    sw_rt_prof_stat summary[SW_RT_COL_COUNT]; /* after sw_rt_profile_summarize */
+} sw_rt_profile;
+
+/* A frame's row from the renderer's stats, the frame call's wall time and resident memory;
+ * OTHER_MS is frame_ms minus the measured stages. */
+void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, double frame_ms,
+                       double resident_bytes, int captured, sw_rt_prof_row *out);
+/* Appends a row. Returns 0, or -1 when out of memory. */
+int sw_rt_profile_push(sw_rt_profile *p, const sw_rt_prof_row *row);
+void sw_rt_profile_free(sw_rt_profile *p);
+
+/* Percentiles by linear interpolation between the closest ranks (numpy's default), over every
+ * frame. Returns 0, or -1 when out of memory. */
+int sw_rt_profile_summarize(sw_rt_profile *p);
+
+/* The files; each returns 0, or -1 on a write error (ferror). `svg` is frametime.svg's text,
+ * inlined into the HTML. The PNG file of capture i is sw_rt_profile_capture_name(). */
+int sw_rt_profile_write_csv(FILE *f, const sw_rt_profile *p);
+int sw_rt_profile_write_json(FILE *f, const sw_rt_profile *p);
+int sw_rt_profile_write_svg(FILE *f, const sw_rt_profile *p);
+int sw_rt_profile_write_html(FILE *f, const sw_rt_profile *p, const char *svg);
+/* The summary table on stdout-like streams. */
+void sw_rt_profile_print_summary(FILE *f, const sw_rt_profile *p);
+/* "frame-0042.png" into buf. */
+void sw_rt_profile_capture_name(uint32_t frame, char *buf, size_t size);
+
+#endif

@@ -1,0 +1,178 @@
+#!/usr/bin/env bash
+# splinewalk path and profile, end to end on the default scene (issue 5, first slice):
+# - `path orbit|fly` write paths that `profile` reads back;
+# - `profile` writes profile.csv with the documented columns and one row per frame, all numbers;
+#   profile.json agrees with the CSV (its median recomputed here); other_ms = frame_ms - stages;
+# - converged: on the median frame the stages add up to frame_ms within 5 % (other <= 5 %);
+#   walkthrough: no frame waits for the pool; converged: no fallback draws;
+# - frametime.svg and report.html are well-formed XML; 3 frames captured, nothing left staged;
+# - bad path files: exit 1, file:line and the result id on stderr, no output written.
+# usage: test_profile.sh SPLINEWALK DATA_DIR WORKDIR SOURCE_DIR
+set -u
+sw=$1 data=$2 work=$3 src=$4
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+pass() { echo "ok:   $*"; }
+for tool in xmllint jq awk; do
+  command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
+done
+
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,resident_bytes,captured"
+
+# ---- help and usage ---------------------------------------------------------------------------
+"$sw" --help | grep -q '^  profile' || fail "splinewalk --help does not list profile"
+"$sw" --help | grep -q '^  path' || fail "splinewalk --help does not list path"
+"$sw" profile --help >help.txt || fail "profile --help exit status"
+for opt in --path --out --frames --size --error --converged --sequential --threads --eval; do
+  grep -q -- "$opt" help.txt || fail "profile --help does not mention $opt"
+done
+"$sw" path --help | grep -q -- --seconds || fail "path --help does not mention --seconds"
+"$sw" path spiral x.sws -o p.path >/dev/null 2>&1; [ $? -eq 2 ] || fail "path spiral: not a usage error"
+"$sw" profile x.sws --path p.path >/dev/null 2>&1; [ $? -eq 2 ] || fail "profile without --out: not a usage error"
+"$sw" profile x.sws --path p.path --out o --sequential --threads 2 >/dev/null 2>&1
+[ $? -eq 2 ] || fail "--sequential with --threads: not a usage error"
+for c in ${columns//,/ }; do
+  grep -q "\`$c\`" "$src/docs/camera-path.md" || fail "column $c is not documented in docs/camera-path.md"
+done
+pass "help texts, usage errors, documented columns"
+
+# ---- paths on the default scene -----------------------------------------------------------------
+"$sw" demo -o demo --data "$data" --size 64x48 >demo.txt 2>&1 || { fail "demo"; cat demo.txt; exit 1; }
+scene=demo/default.sws
+"$sw" path orbit $scene -o orbit.path --frames 40 --seconds 8 >path.txt 2>&1 || { fail "path orbit"; cat path.txt; }
+"$sw" path fly $scene -o fly.path --frames 8 >>path.txt 2>&1 || { fail "path fly"; cat path.txt; }
+head -1 orbit.path | grep -qx 'splinewalk-path 1' || fail "orbit.path header: $(head -1 orbit.path)"
+grep -qx closed orbit.path || fail "orbit.path is not closed"
+grep -qx 'frames 40' orbit.path || fail "orbit.path does not suggest 40 frames"
+[ "$(grep -c '^key ' orbit.path)" -eq 17 ] || fail "orbit.path: expected 16 keys + the closing one"
+ls orbit.path.tmp-* >/dev/null 2>&1 && fail "path left a temporary file"
+pass "path orbit / fly"
+
+# ---- checks on one run's files ------------------------------------------------------------------
+# check_run DIR N: columns, N numeric rows, other = frame - stages, JSON = CSV, XML, captures.
+check_run() {
+  local dir=$1 n=$2
+  [ "$(head -1 "$dir/profile.csv")" = "$columns" ] || fail "$dir: CSV header: $(head -1 "$dir/profile.csv")"
+  [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
+  awk -F, -v n=26 'NR > 1 {
+      if (NF != n) { print "row " NR ": " NF " fields"; bad = 1 }
+      for (i = 1; i <= NF; i++) if ($i !~ /^-?[0-9]+(\.[0-9]+)?$/) { print "row " NR " field " i ": " $i; bad = 1 }
+      if ($1 != NR - 2) { print "row " NR ": frame " $1; bad = 1 }
+      stages = $4 + $5 + $6 + $7 + $8 + $9
+      if (($3 - stages - $10) > 0.002 || ($3 - stages - $10) < -0.002) { print "row " NR ": other " $10 " != " $3 - stages; bad = 1 }
+      if (NR > 2 && $2 <= prev_t) { print "row " NR ": t_s not increasing"; bad = 1 }
+      prev_t = $2
+    } END { exit bad }' "$dir/profile.csv" >awk.txt || { fail "$dir: CSV rows"; head -5 awk.txt; }
+  jq -e ".frame_count == $n and (.frames | length) == $n" "$dir/profile.json" >/dev/null ||
+    fail "$dir: profile.json is not valid JSON or has not $n frames"
+  local med_csv med_json
+  med_csv=$(tail -n +2 "$dir/profile.csv" | cut -d, -f3 | sort -g |
+            awk '{ v[NR] = $1 } END { print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2 }')
+  med_json=$(jq '.summary.frame_ms.median' "$dir/profile.json")
+  awk -v a="$med_csv" -v b="$med_json" 'BEGIN { exit !(a - b < 0.001 && b - a < 0.001) }' ||
+    fail "$dir: JSON median frame_ms $med_json, CSV gives $med_csv"
+  for s in hierarchy tessellate trim draw readback write other; do
+    jq -e ".summary.${s}_ms | has(\"median\") and has(\"p90\") and has(\"p99\") and has(\"max\")" \
+      "$dir/profile.json" >/dev/null || fail "$dir: summary lacks ${s}_ms"
+  done
+  xmllint --noout "$dir/frametime.svg" 2>xml.txt || { fail "$dir: frametime.svg not well-formed"; cat xml.txt; }
+  xmllint --noout "$dir/report.html" 2>xml.txt || { fail "$dir: report.html not well-formed"; cat xml.txt; }
+  grep -q '<svg' "$dir/report.html" || fail "$dir: report.html holds no SVG"
+  local caps
+  caps=$(awk -F, 'NR > 1 && $26 == 1 { printf "%s ", $1 }' "$dir/profile.csv")
+  [ "$caps" = "0 $((n / 2)) $((n - 1)) " ] || fail "$dir: captured frames '$caps'"
+  for f in $caps; do
+    local png
+    png=$(printf 'frame-%04d.png' "$f")
+    [ -s "$dir/$png" ] || fail "$dir: $png missing"
+    grep -q "$png" "$dir/report.html" || fail "$dir: report.html does not show $png"
+  done
+  [ "$(ls "$dir"/*.png | wc -l)" -eq 3 ] || fail "$dir: more PNGs than captures"
+  ls -a "$dir" | grep -q '^\.profile-' && fail "$dir: staging directory left behind"
+}
+
+# column VALUE of DIR: every row's value of a column, one a line.
+column() { awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == c) k = i; next } { print $k }' "$1/profile.csv"; }
+
+# ---- walkthrough (the default mode) -------------------------------------------------------------
+"$sw" profile $scene --path orbit.path --size 320x240 --out walk >walk.txt 2>walk.err ||
+  { fail "profile (walkthrough)"; cat walk.txt walk.err; }
+check_run walk 40
+[ "$(column walk pool_waits | sort -u)" = 0 ] || fail "walkthrough: a frame waited for the pool"
+[ "$(column walk hierarchy_ms | sort -u)" = 0.0000 ] || fail "walkthrough: hierarchy waits"
+jq -e '.mode == "walkthrough" and .lp_num_threads == "2"' walk/profile.json >/dev/null ||
+  fail "walkthrough: run description in profile.json"
+grep -q 'frames in' walk.err || fail "no final progress line on a non-terminal stderr"
+pass "walkthrough: 40 frames, $(sed -n 's/^frame *\([0-9.]*\).*/\1/p' walk.txt) ms median"
+
+# ---- converged: the stages account for the frame ------------------------------------------------
+"$sw" profile $scene --path orbit.path --frames 40 --size 320x240 --out conv --converged \
+  >conv.txt 2>&1 || { fail "profile --converged"; cat conv.txt; }
+check_run conv 40
+[ "$(column conv fallback_draws | sort -u)" = 0 ] || fail "converged: fallback draws"
+tail -n +2 conv/profile.csv | sort -t, -k3 -g | sed -n 20p | awk -F, '{
+    stages = $4 + $5 + $6 + $7 + $8 + $9
+    printf "median frame %d: frame %.3f ms, stages %.3f ms, other %.3f ms (%.2f %%)\n", $1, $3, stages, $10, 100 * $10 / $3
+    exit !($3 > 0 && stages >= 0.95 * $3 && stages <= 1.05 * $3 && $10 <= 0.05 * $3) }' >median.txt ||
+  fail "converged: stages do not add up on the median frame: $(cat median.txt)"
+pass "converged: $(cat median.txt)"
+
+# ---- sequential and the fly-through -------------------------------------------------------------
+"$sw" profile $scene --path orbit.path --frames 6 --size 160x120 --out seq --sequential >seq.txt 2>&1 ||
+  { fail "profile --sequential"; cat seq.txt; }
+check_run seq 6
+jq -e '.worker_threads == 1 and .sequential == true and .mode == "converged"' seq/profile.json \
+  >/dev/null || fail "--sequential: not one worker, converged: $(jq -c '[.worker_threads, .sequential, .mode]' seq/profile.json)"
+"$sw" profile $scene --path fly.path --size 160x120 --out fly --threads 1 >fly.txt 2>&1 ||
+  { fail "profile along fly.path"; cat fly.txt; }
+check_run fly 8
+jq -e '.worker_threads == 1' fly/profile.json >/dev/null || fail "--threads 1 not passed through"
+pass "sequential and fly-through runs"
+
+# ---- bad path files -----------------------------------------------------------------------------
+key='key 0  10 0 0  0 0 0  0 0 1  40'
+key2='key 1  0 10 0  0 0 0  0 0 1  40'
+# bad NAME LINE ID CONTENT: profile fails with NAME.path:LINE and ID, exit 1, writes nothing.
+bad() {
+  local name=$1 line=$2 id=$3
+  printf '%b' "$4" >"$name.path"
+  "$sw" profile $scene --path "$name.path" --out "out-$name" >out.txt 2>err.txt; local rc=$?
+  if [ $rc -ne 1 ]; then fail "$name: exit status $rc, expected 1"; cat err.txt; return; fi
+  grep -qF -- "$name.path:$line:" err.txt || { fail "$name: stderr lacks $name.path:$line:"; cat err.txt; return; }
+  grep -q -- "$id" err.txt || { fail "$name: stderr lacks $id"; cat err.txt; return; }
+  [ ! -e "out-$name" ] || fail "$name: output directory written"
+  echo "      $name: $(head -c 160 err.txt)"
+}
+bad empty 1 SW_ERR_FORMAT ''
+bad no_header 1 SW_ERR_FORMAT "$key\n"
+bad version 2 SW_ERR_VERSION "# comment\nsplinewalk-path 2\n$key\n"
+bad no_keys 3 SW_ERR_FORMAT "splinewalk-path 1\nframes 10\n\n"
+bad short_key 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0 1 2 3\n$key2\n"
+bad long_key 3 SW_ERR_FORMAT "splinewalk-path 1\n$key\n$key2 7\n"
+bad not_number 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0 10 zero 0 0 0 0 0 0 1 40\n"
+bad nan 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0 10 nan 0 0 0 0 0 0 1 40\n"
+bad time_order 3 SW_ERR_FORMAT "splinewalk-path 1\nkey 1  10 0 0  0 0 0  0 0 1  40\n$key2\n"
+bad eye_is_target 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  1 2 3  1 2 3  0 0 1  40\n"
+bad up_along_view 3 SW_ERR_FORMAT "splinewalk-path 1\n$key\nkey 1  0 0 10  0 0 0  0 0 1  40\n"
+bad fovy 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  10 0 0  0 0 0  0 0 1  180\n"
+bad flipped_up 3 SW_ERR_FORMAT "splinewalk-path 1\n$key\nkey 1  0 10 0  0 0 0  0 0 -1  40\n"
+bad not_closed 4 SW_ERR_FORMAT "splinewalk-path 1\nclosed\n$key\n$key2\n"
+bad unknown 3 SW_ERR_FORMAT "splinewalk-path 1\n$key\nspeed 3\n"
+bad frames_zero 2 SW_ERR_FORMAT "splinewalk-path 1\nframes 0\n$key\n"
+bad twice_closed 3 SW_ERR_FORMAT "splinewalk-path 1\nclosed\nclosed\n$key\n"
+bad truncated 3 SW_ERR_TRUNCATED "splinewalk-path 1\n$key\nkey 1  0 10 0  0 0"
+bad binary 1 SW_ERR_FORMAT "\x01\x02\xff\xfe\x00garbage\n"
+# Each key is fine, but the eye passes through the target half way between them.
+bad through_target 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  0 0 0  10 0 0  0 0 1  40\nkey 1  20 0 0  10 0 0  0 0 1  40\n"
+# An existing output directory is left as it was.
+mkdir -p keep && echo old >keep/marker
+printf 'splinewalk-path 1\nkey 0 1\n' >cut.path
+"$sw" profile $scene --path cut.path --out keep >/dev/null 2>&1; [ $? -eq 1 ] || fail "cut.path accepted"
+[ "$(ls -A keep)" = marker ] || fail "a failed run changed its output directory: $(ls -A keep)"
+"$sw" profile $scene --path no-such.path --out nothing >/dev/null 2>err.txt; [ $? -eq 1 ] &&
+  grep -q SW_ERR_NOT_FOUND err.txt || fail "missing path file: $(cat err.txt)"
+pass "bad path files: file:line errors, exit 1, nothing written"
+
+[ $failures -eq 0 ] && echo "all profile tests passed" || echo "$failures failure(s)"
+exit $((failures > 0))
