@@ -2,11 +2,10 @@
  * borders of Balázs et al. 2004). Core-profile GL has no wide lines, so each boundary loop of a
  * drawn face (its trim loops, or its parameter box when untrimmed) becomes a ribbon of triangles:
  * the loop is sampled on the exact surface (NURBS evaluation in double), and every sample is
- * joined to a copy of itself moved in the surface's tangent plane towards the face's inside, so
- * far that its image lies width_px pixels from the loop's image. The ribbon follows the surface
- * (on a plane it lies in the plane: depths stay exact), covers the face's own side of its exact
- * border, and reaches beyond it only by k_outer x width_px: silhouettes and open boundaries grow
- * by a fraction of a pixel, not by the ribbon's width.
+ * joined to a point of the face inside it, so far that its image lies width_px pixels from the
+ * loop's image. The ribbon covers the face's own side of its exact border and reaches beyond it
+ * only by k_outer x width_px: silhouettes and open boundaries grow by a fraction of a pixel, not
+ * by the ribbon's width.
  * Why it closes the cracks: where faces A and B meet along a curve C, each is drawn within ε_img
  * of the exact surface, so an uncovered pixel between them lies on A's or B's side of C's image
  * within ε_img of it, and that face's ribbon covers its side of C to width_px = 2 ε_img; the
@@ -14,10 +13,20 @@
  * most one grid cell apart in u and v, where the Filip bound of the face's grid holds; trim loops
  * are flattened to half a trim texel, one texel moving the surface by at most the object
  * tolerance; samples are dropped only where the kept chord stays within width_px / 4 of them on
- * screen). Not rigorous between samples (the surface is not bounded there), and the ribbon is
- * flat in the tangent plane: over one cell both are second-order small. A sliver k_outer x
+ * screen). Not rigorous between samples (the surface is not bounded there). A sliver k_outer x
  * width_px wide beyond C makes two ribbons meeting exactly on C overlap, so that no pixel centre
  * on C falls between them by rounding (without it, single-pixel holes remain at joins).
+ * The inner point: the step in (u, v) perpendicular to the loop whose tangent-plane image is
+ * width_px pixels from the loop's image (first order), then
+ *  - cut where the step leaves the face across its own loop (a ray cast in (u, v); none at a
+ *    corner it leaves at once): at an acute corner or across a face narrower than the step, the
+ *    ribbon would otherwise cover what lies beyond the face (a silhouette grew by up to 1.4 px);
+ *  - evaluated on the surface, and halved while the surface bulges more than width_px / 4 on
+ *    screen from the chord to it: a face seen edge-on needs a long step (capped at 4 x width_px
+ *    in object size), which on a curved face leaves the surface (fins of a motor: 1 px and more).
+ * Only the sample's own loop cuts the step: where another loop of the face comes closer than the
+ * step (a thin bridge between a hole and the outer boundary), the ribbon may still reach up to
+ * width_px beyond the face.
  */
 #include "sw_gpu_internal.h"
 #include "sw_status_util.h"
@@ -31,10 +40,15 @@ static const double k_outer = 0.125; /* of the width: overlap on the far side, s
                                        meeting exactly on C leave no pixel centre between them */
 
 typedef struct border_point {
-    double p[3];  /* eye-relative world position */
-    double n[3];  /* world normal (unnormalised) */
-    double in[3]; /* world tangent vector pointing into the face (unnormalised) */
-    double uv[2], in_uv[2]; /* the loop point and `in` in face parameters (trim lookups) */
+    double p[3];                 /* eye-relative world position */
+    double n[3];                 /* world normal (unnormalised) */
+    double in[3];                /* world tangent vector pointing into the face (unnormalised) */
+    double uv[2];                /* the loop point in face parameters */
+    double in_uv[2];             /* the step in (u, v) whose image is `in` (trim lookups too) */
+    double d_prev[2], d_next[2]; /* loop directions before and after the sample (equal inside a
+                                    segment; at a vertex, its two segments) */
+    double scr[2];               /* screen position (thinning), valid when in_front */
+    int in_front;
 } border_point;
 
 /* in_uv: a direction in (u, v) pointing into the face at this point. */
@@ -67,6 +81,17 @@ static void eval_point(const sw_sg_surface *srf, const double world[12], const d
     }
 }
 
+/* Eye-relative world position of the surface point at (u, v). */
+static void surface_point(const sw_sg_surface *srf, const double world[12], const double eye[3],
+                          const double uv[2], double out[3])
+{
+    double p[3];
+    sw_sg_surface_eval(srf, uv[0], uv[1], p);
+    for (int r = 0; r < 3; ++r)
+        out[r] = world[4 * r] * p[0] + world[4 * r + 1] * p[1] + world[4 * r + 2] * p[2] +
+                 world[4 * r + 3] - eye[r];
+}
+
 /* Samples of a closed uv polyline, each segment cut into pieces no longer than (du, dv). */
 static size_t count_samples(const double *uv, size_t n, double du, double dv)
 {
@@ -91,12 +116,13 @@ static int screen_of(const sw__gpu_view *v, const double p[3], double out[2])
     return 1;
 }
 
-static double dist_to_segment(const double p[2], const double a[2], const double b[2])
+static double dist2_to_segment(const double p[2], const double a[2], const double b[2])
 {
     double d[2] = {b[0] - a[0], b[1] - a[1]}, l2 = d[0] * d[0] + d[1] * d[1];
     double t = l2 > 0.0 ? ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2 : 0.0;
     t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
-    return hypot(p[0] - a[0] - t * d[0], p[1] - a[1] - t * d[1]);
+    double x = p[0] - a[0] - t * d[0], y = p[1] - a[1] - t * d[1];
+    return x * x + y * y;
 }
 
 /* Drops samples (in place) whose screen image stays within tol_px of the chord between the
@@ -105,16 +131,18 @@ static double dist_to_segment(const double p[2], const double a[2], const double
 static size_t thin_samples(const sw__gpu_view *v, border_point *bp, size_t n, double tol_px)
 {
     enum { MAX_RUN = 64 };
+    for (size_t k = 0; k < n; ++k)
+        bp[k].in_front = screen_of(v, bp[k].p, bp[k].scr);
     size_t kept = 1, i = 1;
     while (i < n) {
-        double a[2], q[2], b[2];
-        size_t end = i; /* extend the run [last kept, end] while every sample fits the chord */
-        if (screen_of(v, bp[kept - 1].p, a)) {
-            while (end + 1 < n && end + 1 - (kept - 1) <= MAX_RUN &&
-                   screen_of(v, bp[end + 1].p, b)) {
+        size_t end = i; /* extend the run [last kept = input i - 1, end] while every sample fits */
+        if (bp[kept - 1].in_front) {
+            const double *a = bp[kept - 1].scr;
+            while (end + 1 < n && end + 1 - (i - 1) <= MAX_RUN && bp[end + 1].in_front) {
+                const double *b = bp[end + 1].scr;
                 int fits = 1;
                 for (size_t k = i; k <= end && fits; ++k)
-                    fits = screen_of(v, bp[k].p, q) && dist_to_segment(q, a, b) <= tol_px;
+                    fits = bp[k].in_front && dist2_to_segment(bp[k].scr, a, b) <= tol_px * tol_px;
                 if (!fits)
                     break;
                 ++end;
@@ -163,12 +191,169 @@ static double inward_length(const sw__gpu_view *v, const double p[3], const doub
     return perp > width_px / cap ? width_px / perp : cap;
 }
 
-/* One quad per loop segment, lying in the surface's tangent plane at the segment's start (on a
- * plane, in the plane), from k_outer x width_px outside the loop to width_px inside. Quads of
- * consecutive segments share their points on the loop; their inner edges are not joined, which
- * keeps a sharp corner of the loop from folding a quad across it. */
-static void emit_ribbon(const sw__gpu_view *v, const border_point *bp, size_t n, double width_px,
-                        const double *st_box, sw__gpu_mesh *mesh)
+/* ---- the loop's segments in a uniform grid over its (u, v) box, for ray casts ---------------- */
+typedef struct loop_grid {
+    const double *uv;
+    size_t n;
+    double lo[2], cell[2];
+    int32_t g[2];
+    uint32_t *start; /* g[0] g[1] + 1 offsets into items */
+    uint32_t *items; /* segment indices, cell by cell */
+} loop_grid;
+
+static int32_t grid_cell(const loop_grid *gr, int k, double x)
+{
+    double c = floor((x - gr->lo[k]) / gr->cell[k]);
+    return c < 0.0 ? 0 : (c >= gr->g[k] ? gr->g[k] - 1 : (int32_t)c);
+}
+
+/* Loops over every cell (cx, cy) of the box spanned by points a and b. */
+#define FOR_CELLS(gr, a, b, cx, cy)                                                                \
+    for (int32_t cy = grid_cell(gr, 1, fmin(a[1], b[1]));                                          \
+         cy <= grid_cell(gr, 1, fmax(a[1], b[1])); ++cy)                                           \
+        for (int32_t cx = grid_cell(gr, 0, fmin(a[0], b[0]));                                      \
+             cx <= grid_cell(gr, 0, fmax(a[0], b[0])); ++cx)
+
+/* About one segment per cell; segments are filed under every cell their box meets. */
+static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
+{
+    memset(gr, 0, sizeof *gr);
+    gr->uv = uv;
+    gr->n = n;
+    double hi[2] = {uv[0], uv[1]};
+    gr->lo[0] = uv[0];
+    gr->lo[1] = uv[1];
+    for (size_t i = 1; i < n; ++i)
+        for (int k = 0; k < 2; ++k) {
+            gr->lo[k] = fmin(gr->lo[k], uv[2 * i + k]);
+            hi[k] = fmax(hi[k], uv[2 * i + k]);
+        }
+    int32_t side = (int32_t)ceil(sqrt((double)n));
+    side = side < 1 ? 1 : (side > 256 ? 256 : side);
+    for (int k = 0; k < 2; ++k) {
+        gr->g[k] = hi[k] > gr->lo[k] ? side : 1;
+        gr->cell[k] = hi[k] > gr->lo[k] ? (hi[k] - gr->lo[k]) / side : 1.0;
+    }
+    size_t cells = (size_t)gr->g[0] * (size_t)gr->g[1];
+    gr->start = calloc(cells + 1, sizeof *gr->start);
+    if (!gr->start)
+        return 0;
+    size_t total = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        for (size_t i = 0; i < n; ++i) {
+            const double *a = uv + 2 * i, *b = uv + 2 * ((i + 1) % n);
+            FOR_CELLS(gr, a, b, cx, cy)
+            {
+                size_t c = (size_t)cy * (size_t)gr->g[0] + (size_t)cx;
+                if (pass == 0)
+                    gr->start[c + 1]++, total++;
+                else
+                    gr->items[gr->start[c]++] = (uint32_t)i;
+            }
+        }
+        if (pass == 0) {
+            if (total > UINT32_MAX ||
+                !(gr->items = malloc((total ? total : 1) * sizeof *gr->items)))
+                return 0;
+            for (size_t c = 0; c < cells; ++c)
+                gr->start[c + 1] += gr->start[c];
+        } else { /* the fill pass advanced each start to the next cell's: shift back */
+            memmove(gr->start + 1, gr->start, cells * sizeof *gr->start);
+            gr->start[0] = 0;
+        }
+    }
+    return 1;
+}
+
+static void loop_grid_free(loop_grid *gr)
+{
+    free(gr->start);
+    free(gr->items);
+}
+
+/* Smallest s in (0, s_max] at which p + s r crosses a loop segment; s_max if none. Crossings at
+ * s <= 1e-9 s_max are the segments p lies on. Segments parallel to r are skipped: a ray along
+ * the loop stays on the face's border. */
+static double ray_exit(const loop_grid *gr, const double p[2], const double r[2], double s_max)
+{
+    double q[2] = {p[0] + s_max * r[0], p[1] + s_max * r[1]}, best = s_max;
+    double rr = r[0] * r[0] + r[1] * r[1];
+    FOR_CELLS(gr, p, q, cx, cy)
+    {
+        size_t c = (size_t)cy * (size_t)gr->g[0] + (size_t)cx;
+        for (uint32_t k = gr->start[c]; k < gr->start[c + 1]; ++k) {
+            size_t i = gr->items[k];
+            const double *a = gr->uv + 2 * i, *b = gr->uv + 2 * ((i + 1) % gr->n);
+            double e[2] = {b[0] - a[0], b[1] - a[1]}, w[2] = {a[0] - p[0], a[1] - p[1]};
+            double den = r[0] * e[1] - r[1] * e[0];
+            if (!(den * den > 1e-24 * rr * (e[0] * e[0] + e[1] * e[1])))
+                continue;
+            double s = (w[0] * e[1] - w[1] * e[0]) / den, t = (w[0] * r[1] - w[1] * r[0]) / den;
+            if (s > 1e-9 * s_max && s < best && t >= 0.0 && t <= 1.0)
+                best = s;
+        }
+    }
+    return best;
+}
+
+/* side x (a x b) >= 0, with a relative tolerance: b lies on the face's side of direction a. */
+static int on_inner_side(const double a[2], const double b[2], double side)
+{
+    double c = side * (a[0] * b[1] - a[1] * b[0]);
+    return c >= 0.0 || c * c <= 1e-24 * (a[0] * a[0] + a[1] * a[1]) * (b[0] * b[0] + b[1] * b[1]);
+}
+
+/* Does the step r from sample e start into the face (side: +1 when it lies left of the loop)?
+ * At a vertex, into the wedge between its two segments (both sides at a convex corner, either
+ * at a reflex one). */
+static int starts_inside(const border_point *e, const double r[2], double side)
+{
+    int a = on_inner_side(e->d_prev, r, side), b = on_inner_side(e->d_next, r, side);
+    int convex = side * (e->d_prev[0] * e->d_next[1] - e->d_prev[1] * e->d_next[0]) > 0.0;
+    return convex ? a && b : a || b;
+}
+
+typedef struct ribbon_ctx {
+    const sw__gpu_view *v;
+    const sw_sg_surface *srf;
+    const double *world;
+    const loop_grid *grid;
+    double side, width_px;
+    const double *st_box; /* trim lookup's rectangle, or NULL (st = 0) */
+} ribbon_ctx;
+
+/* The inner point of sample e for the step direction r_uv (first-order length h along r_uv):
+ * cut at the loop, on the surface, halved while the surface bulges from the chord to it.
+ * Returns the step taken along r_uv (0: the inner point is e itself). */
+static double inner_point(const ribbon_ctx *c, const border_point *e, const double r_uv[2],
+                          double h, double out[3])
+{
+    enum { MAX_HALVINGS = 12 };
+    memcpy(out, e->p, 3 * sizeof *out);
+    if (!(h > 0.0) || !starts_inside(e, r_uv, c->side))
+        return 0.0;
+    double s = ray_exit(c->grid, e->uv, r_uv, h), tol = 0.25 * c->width_px;
+    for (int k = 0; k < MAX_HALVINGS; ++k, s *= 0.5) {
+        double uq[2] = {e->uv[0] + s * r_uv[0], e->uv[1] + s * r_uv[1]};
+        double um[2] = {e->uv[0] + 0.5 * s * r_uv[0], e->uv[1] + 0.5 * s * r_uv[1]};
+        double q[3], m[3], chord[3], sq[2], sm[2], sc[2];
+        surface_point(c->srf, c->world, c->v->eye, uq, q);
+        surface_point(c->srf, c->world, c->v->eye, um, m);
+        for (int i = 0; i < 3; ++i)
+            chord[i] = 0.5 * (e->p[i] + q[i]);
+        if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm) && screen_of(c->v, chord, sc) &&
+            hypot(sm[0] - sc[0], sm[1] - sc[1]) <= tol) {
+            memcpy(out, q, sizeof q);
+            return s;
+        }
+    }
+    return 0.0;
+}
+
+/* One quad per loop segment, from k_outer x width_px outside the loop (in the tangent plane) to
+ * the inner points. Quads of consecutive segments share their points on the loop; their inner
+ * edges are not joined, which keeps a sharp corner of the loop from folding a quad across it. */
+static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, sw__gpu_mesh *mesh)
 {
     for (size_t i = 0; i < n; ++i) {
         const border_point *e[2] = {&bp[i], &bp[(i + 1) % n]};
@@ -176,20 +361,24 @@ static void emit_ribbon(const sw__gpu_view *v, const border_point *bp, size_t n,
         double t[3] = {e[1]->p[0] - e[0]->p[0], e[1]->p[1] - e[0]->p[1], e[1]->p[2] - e[0]->p[2]};
         uint32_t base = (uint32_t)mesh->n_v;
         for (int end = 0; end < 2; ++end) {
-            double h = inward_length(v, e[end]->p, t, in, width_px);
+            double h = inward_length(c->v, e[end]->p, t, in, c->width_px), q[2][3], step[2];
+            step[0] = -k_outer * h;
+            for (int k = 0; k < 3; ++k)
+                q[0][k] = e[end]->p[k] + step[0] * in[k];
+            step[1] = inner_point(c, e[end], e[0]->in_uv, h, q[1]);
             for (int side = 0; side < 2; ++side) {
                 sw__gpu_vertex *o = &mesh->v[mesh->n_v++];
-                double sgn = side ? h : -k_outer * h;
                 for (int k = 0; k < 3; ++k) {
-                    o->pos[k] = (float)(e[end]->p[k] + sgn * in[k]);
+                    o->pos[k] = (float)q[side][k];
                     o->nrm[k] = (float)e[end]->n[k];
                 }
                 o->st[0] = o->st[1] = 0.0f;
-                if (st_box) { /* `in` moves uv by in_uv, to first order */
-                    o->st[0] = (float)((e[end]->uv[0] + sgn * e[0]->in_uv[0] - st_box[0]) /
-                                       (st_box[1] - st_box[0]));
-                    o->st[1] = (float)((e[end]->uv[1] + sgn * e[0]->in_uv[1] - st_box[2]) /
-                                       (st_box[3] - st_box[2]));
+                if (c->st_box) { /* inner point: its exact (u, v); outer: to first order */
+                    const double *b = c->st_box;
+                    o->st[0] = (float)((e[end]->uv[0] + step[side] * e[0]->in_uv[0] - b[0]) /
+                                       (b[1] - b[0]));
+                    o->st[1] = (float)((e[end]->uv[1] + step[side] * e[0]->in_uv[1] - b[2]) /
+                                       (b[3] - b[2]));
                 }
             }
         }
@@ -197,6 +386,18 @@ static void emit_ribbon(const sw__gpu_view *v, const border_point *bp, size_t n,
         o[0] = base, o[1] = base + 1, o[2] = base + 3, o[3] = base, o[4] = base + 3,
         o[5] = base + 2;
         mesh->n_idx += 6;
+    }
+}
+
+/* Direction of the last segment of length > 0 ending at vertex i (zero if the loop has none). */
+static void prev_direction(const double *uv, size_t n, size_t i, double out[2])
+{
+    out[0] = out[1] = 0.0;
+    for (size_t k = 1; k <= n && out[0] == 0.0 && out[1] == 0.0; ++k) {
+        size_t j = (i + n - k) % n;
+        const double *a = uv + 2 * j, *b = uv + 2 * ((j + 1) % n);
+        out[0] = b[0] - a[0];
+        out[1] = b[1] - a[1];
     }
 }
 
@@ -212,21 +413,30 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
     if (r != SW_OK)
         return r;
     border_point *bp = malloc(m * sizeof *bp);
-    if (!bp)
+    loop_grid grid = {0};
+    if (!bp || !loop_grid_build(&grid, uv, n)) {
+        free(bp);
+        loop_grid_free(&grid);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "fat border: out of memory");
+    }
     size_t at = 0;
     for (size_t i = 0; i < n; ++i) {
         const double *a = uv + 2 * i, *b = uv + 2 * ((i + 1) % n);
         double k = fmax(fabs(b[0] - a[0]) / du, fabs(b[1] - a[1]) / dv);
         int32_t pieces = (int32_t)ceil(fmin(fmax(k, 1.0), (double)MAX_PIECES_PER_SEGMENT));
-        double t[2] = {b[0] - a[0], b[1] - a[1]};
+        double t[2] = {b[0] - a[0], b[1] - a[1]}, before[2];
         double in_uv[2] = {left_inside ? -t[1] : t[1], left_inside ? t[0] : -t[0]};
-        for (int32_t j = 0; j < pieces; ++j) {
+        prev_direction(uv, n, i, before);
+        for (int32_t j = 0; j < pieces; ++j, ++at) {
             double f = (double)j / pieces;
-            eval_point(srf, world, v->eye, a[0] + f * t[0], a[1] + f * t[1], in_uv, &bp[at++]);
+            eval_point(srf, world, v->eye, a[0] + f * t[0], a[1] + f * t[1], in_uv, &bp[at]);
+            memcpy(bp[at].d_prev, j == 0 ? before : t, sizeof before);
+            memcpy(bp[at].d_next, t, sizeof t);
         }
     }
-    emit_ribbon(v, bp, thin_samples(v, bp, m, 0.25 * width_px), width_px, st_box, mesh);
+    ribbon_ctx c = {v, srf, world, &grid, left_inside ? 1.0 : -1.0, width_px, st_box};
+    emit_ribbon(&c, bp, thin_samples(v, bp, m, 0.25 * width_px), mesh);
+    loop_grid_free(&grid);
     free(bp);
     return SW_OK;
 }

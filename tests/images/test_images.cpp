@@ -15,8 +15,9 @@
  * measured side uses the thresholds and the side searched uses half of them (hysteresis); the
  * coverage boundary has no threshold. Required in both directions: <= 1 px at >= 99.9 % of the
  * edge pixels and <= 2 px everywhere. Crack pixels (ours sees through a thin gap in a surface the
- * reference covers) are tested elsewhere: they and splinewalk's edge pixels next to them are left
- * out here, and counted. Failed views leave their frames and an edge diff in OUTDIR.
+ * reference covers, except on the reference's own edge pixels) are tested elsewhere: they and
+ * splinewalk's edge pixels next to them are left out here, and counted. Failed views leave their
+ * frames and an edge diff in OUTDIR.
  *
  * Usage: test_images OUTDIR WIDTHxHEIGHT VIEWS FILE...   VIEWS: comma list of whole,mid,close
  * Env: SW_IMAGES_MAX_TRIANGLES caps the reference mesh (default 1500000); SW_IMAGES_DEBUG=1
@@ -415,6 +416,13 @@ bool compare_edges(const model_ctx &m, const view &v, const image_pair &ip)
     auto our_s = sw_test::edge_pixels(ip.ours.depth, m.w, m.h, strong);
     auto our_w = sw_test::edge_pixels(ip.ours.depth, m.w, m.h, weak);
     auto cracks = sw_test::crack_pixels(ip.ours.depth, ip.ref.depth, m.w, m.h, strong.rel);
+    /* A crack is a gap in a surface the reference shows whole. On an edge pixel of the reference,
+     * ours seeing farther is that edge drawn on the other side of the pixel centre (Motor-c whole:
+     * exact edges 0.05 px from two such centres, each image within its tolerance), not a gap;
+     * counting it would drop splinewalk's edge pixels next to it, so that the reference's edge
+     * pixel found splinewalk's edge 2 px away instead of 1. */
+    for (size_t i = 0; i < cracks.size(); ++i)
+        cracks[i] = cracks[i] && !ref_s[i];
     sw_test::clear_near(our_s, cracks, m.w, m.h);
     sw_test::clear_near(our_w, cracks, m.w, m.h);
     long n_cracks = 0;
