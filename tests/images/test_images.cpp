@@ -24,6 +24,7 @@
  * prints the depths around the first splinewalk edge pixels farther than 1 px.
  */
 #include "edge_metric.hpp"
+#include "hierarchy_support.h"
 #include "occt_reference.hpp"
 
 #include "sw_gpu.h"
@@ -342,10 +343,15 @@ reference_plan plan_reference(const model_ctx &m, const basis &b, const sw_gpu_i
     return p;
 }
 
-bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d, sw_gpu_image &out, double &ms,
+bool g_hierarchy = false;             /* --hierarchy: ours through the bicubic hierarchies */
+struct sw_lod_cache *g_cache = nullptr; /* of the file being tested */
+
+bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d_in, sw_gpu_image &out, double &ms,
                  sw_gpu_frame_stats &fs)
 {
     sw_status st{};
+    sw_gpu_frame_desc d = d_in;
+    d.hierarchies = g_cache;
     auto t0 = std::chrono::steady_clock::now();
     sw_result r = sw_gpu_render_scene(m.gpu, m.scene, &d, &out, &fs, &st);
     ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -549,7 +555,11 @@ bool run_file(sw_gpu_context *gpu, const std::string &path, const std::string &o
     } else {
         std::fprintf(stderr, "%s\n", err.c_str());
     }
-    ok = ok && run_model(m, path, list);
+    sw_test_hierarchies *hier = g_hierarchy ? sw_test_hierarchies_create(scene) : nullptr;
+    g_cache = sw_test_hierarchies_cache(hier);
+    ok = ok && (!g_hierarchy || hier) && run_model(m, path, list);
+    sw_test_hierarchies_free(hier);
+    g_cache = nullptr;
     sw_sg_scene_free(scene);
     return ok;
 }
@@ -558,8 +568,12 @@ bool run_file(sw_gpu_context *gpu, const std::string &path, const std::string &o
 
 int main(int argc, char **argv)
 {
+    g_hierarchy = argc > 1 && std::strcmp(argv[1], "--hierarchy") == 0;
+    argc -= g_hierarchy;
+    argv += g_hierarchy;
     if (argc < 5) {
-        std::fprintf(stderr, "usage: %s OUTDIR WIDTHxHEIGHT whole,mid,close FILE...\n", argv[0]);
+        std::fprintf(stderr, "usage: %s [--hierarchy] OUTDIR WIDTHxHEIGHT whole,mid,close FILE...\n",
+                     argv[0]);
         return 2;
     }
     int w = 0, h = 0;
