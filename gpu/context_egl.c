@@ -4,6 +4,7 @@
  * into an FBO with RGBA8 colour and 32-bit float depth for reversed-Z.
  */
 #include "sw_gpu_internal.h"
+#include "sw_th_pool.h"
 #include "sw_status_util.h"
 
 #include <EGL/egl.h>
@@ -194,8 +195,13 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
 {
     *out = NULL;
     sw_gpu_context *ctx = calloc(1, sizeof *ctx);
-    if (!ctx)
+    if (ctx)
+        ctx->walk_token = calloc(1, sizeof *ctx->walk_token);
+    if (!ctx || !ctx->walk_token) {
+        free(ctx);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
+    }
+    sw_th_token_init(ctx->walk_token);
     sw_result r = make_context(ctx, status);
     if (r == SW_OK)
         r = sw__gpu_programs_create(ctx, status);
@@ -232,6 +238,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         eglMakeCurrent(ctx->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(ctx->egl_display, ctx->egl_context);
     }
+    free(ctx->walk_token);
     free(ctx);
 }
 

@@ -34,6 +34,7 @@ typedef struct border_point {
     double p[3];  /* eye-relative world position */
     double n[3];  /* world normal (unnormalised) */
     double in[3]; /* world tangent vector pointing into the face (unnormalised) */
+    double uv[2], in_uv[2]; /* the loop point and `in` in face parameters (trim lookups) */
 } border_point;
 
 /* in_uv: a direction in (u, v) pointing into the face at this point. */
@@ -54,6 +55,10 @@ static void eval_point(const sw_sg_surface *srf, const double world[12], const d
     double in[3];
     for (int k = 0; k < 3; ++k)
         in[k] = du[k] * in_uv[0] + dv[k] * in_uv[1];
+    out->uv[0] = u;
+    out->uv[1] = v;
+    out->in_uv[0] = in_uv[0];
+    out->in_uv[1] = in_uv[1];
     for (int r = 0; r < 3; ++r) {
         out->p[r] = world[4 * r] * p[0] + world[4 * r + 1] * p[1] + world[4 * r + 2] * p[2] +
                     world[4 * r + 3] - eye[r];
@@ -163,7 +168,7 @@ static double inward_length(const sw__gpu_view *v, const double p[3], const doub
  * consecutive segments share their points on the loop; their inner edges are not joined, which
  * keeps a sharp corner of the loop from folding a quad across it. */
 static void emit_ribbon(const sw__gpu_view *v, const border_point *bp, size_t n, double width_px,
-                        sw__gpu_mesh *mesh)
+                        const double *st_box, sw__gpu_mesh *mesh)
 {
     for (size_t i = 0; i < n; ++i) {
         const border_point *e[2] = {&bp[i], &bp[(i + 1) % n]};
@@ -180,6 +185,12 @@ static void emit_ribbon(const sw__gpu_view *v, const border_point *bp, size_t n,
                     o->nrm[k] = (float)e[end]->n[k];
                 }
                 o->st[0] = o->st[1] = 0.0f;
+                if (st_box) { /* `in` moves uv by in_uv, to first order */
+                    o->st[0] = (float)((e[end]->uv[0] + sgn * e[0]->in_uv[0] - st_box[0]) /
+                                       (st_box[1] - st_box[0]));
+                    o->st[1] = (float)((e[end]->uv[1] + sgn * e[0]->in_uv[1] - st_box[2]) /
+                                       (st_box[3] - st_box[2]));
+                }
             }
         }
         uint32_t *o = mesh->idx + mesh->n_idx;
@@ -191,8 +202,8 @@ static void emit_ribbon(const sw__gpu_view *v, const border_point *bp, size_t n,
 
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
-                             double du, double dv, double width_px, sw__gpu_mesh *mesh,
-                             sw_status *status)
+                             double du, double dv, double width_px, const double *st_box,
+                             sw__gpu_mesh *mesh, sw_status *status)
 {
     if (n < 2 || !(du > 0.0) || !(dv > 0.0))
         return SW_OK;
@@ -215,7 +226,7 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
             eval_point(srf, world, v->eye, a[0] + f * t[0], a[1] + f * t[1], in_uv, &bp[at++]);
         }
     }
-    emit_ribbon(v, bp, thin_samples(v, bp, m, 0.25 * width_px), width_px, mesh);
+    emit_ribbon(v, bp, thin_samples(v, bp, m, 0.25 * width_px), width_px, st_box, mesh);
     free(bp);
     return SW_OK;
 }

@@ -22,102 +22,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum {
-    MAX_SEGMENTS = 256, /* grid segments per patch and direction */
-    MAX_TRIM_LOOP_VERTICES = 1u << 22,
-    MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
-    MAX_TILES_PER_DIR = 4096,  /* trim tiles of a face per direction */
-    MAX_TILES_PER_FACE = 16384, /* visible trim tiles of one face occurrence (else coarser) */
-};
-
-/* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
- * for predefined grids (§4.2) the counts a grid class, or pieces of one class, can draw. */
-typedef struct segment_set {
-    int32_t n[MAX_SEGMENTS];
-    int32_t count;
-} segment_set;
-static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
-static const double k_max_frame_texels = 256e6;  /* R8 trim texels per frame */
-static const double k_tile_texels = 1024.0; /* wanted trim texels per direction above which a
-                                               face's trim box is split into tiles */
-
-typedef struct occurrence {
-    uint32_t face;
-    double world[12];
-    float color[4];
-} occurrence;
-
-typedef struct pending_trim {
-    size_t draw;
-    uint32_t face;
-    double width, height; /* wanted resolution before the frame budget */
-    size_t occ;           /* occurrence, for its fat border */
-    double cell[2];       /* smallest grid cell of the face in u, v (fat-border sampling) */
-    int64_t loops;        /* tiled face: its flattened loops in frame.loops; -1: whole trim box */
-    double rect[4];       /* tiled face: the tile (face parameters) */
-} pending_trim;
-
-/* A tiled face occurrence's loops, flattened once for all its tiles. */
-typedef struct face_loops {
-    sw_sg_polyline *loops;
-    uint32_t n;
-} face_loops;
-
-typedef struct frame {
-    sw_gpu_context *ctx;
-    const sw_sg_scene *scene;
-    const sw_sg_scene_view *sv;
-    sw__gpu_view view;
-    double eps_px;
-    sw_gpu_frame_stats st;
-    occurrence *occ;
-    size_t n_occ, cap_occ;
-    int oom;
-    sw_sg_bezier_set **bez; /* per face, extracted on first use in this frame */
-    sw__gpu_mesh mesh;
-    sw__gpu_draw *draws;
-    size_t n_draws, cap_draws;
-    pending_trim *trims;
-    size_t n_trims, cap_trims;
-    size_t n_recs, n_cps; /* GPU-evaluated patches in ctx->recs, control points in ctx->cps */
-    double gpu_vertices;  /* grid vertices the vertex shader will evaluate */
-    sw__gpu_patch_batch batch;
-    sw_lod_screen_view screen; /* the view as the density bound needs it */
-    segment_set gpu_segments, cpu_segments;
-    uint64_t border_triangles; /* fat-border triangles (counted in st.triangles, which also
-                                  counts the mesh at the end: subtracted there) */
-    face_loops *loops;         /* of tiled faces */
-    size_t n_loops, cap_loops;
-    /* exact path (eval_exact): pieces, knots and eye-relative control points in double */
-    int exact;
-    sw__gpu_exact_piece *pieces;
-    size_t n_pieces, cap_pieces;
-    double *knots, *dcps;
-    size_t n_knots, cap_knots, n_dcps, cap_dcps;
-    const occurrence *ex_occ; /* the occurrence whose net is at ex_base (NULL: none yet) */
-    sw__gpu_exact_piece ex_base; /* its knots, control points, stride and degrees */
-    sw_sg_surface ex_srf;
-} frame;
-
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap * 2 : 64;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*p, c * elem);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
+#include "frame_internal.h"
 
 static int collect(void *user, uint32_t face, const double world[12], const float color[4])
 {
     frame *f = user;
-    if (!grow((void **)&f->occ, &f->cap_occ, f->n_occ + 1, sizeof *f->occ)) {
+    if (!sw__gpu_grow((void **)&f->occ, &f->cap_occ, f->n_occ + 1, sizeof *f->occ)) {
         f->oom = 1;
         return 1;
     }
@@ -130,7 +40,7 @@ static int collect(void *user, uint32_t face, const double world[12], const floa
 }
 
 /* Homogeneous control point mapped to eye-relative world space: w x' = R (w x) + w (t - eye). */
-static void xform_h(const double m[12], const double eye[3], const double in[4], double out[4])
+void sw__fr_xform_h(const double m[12], const double eye[3], const double in[4], double out[4])
 {
     for (int r = 0; r < 3; ++r)
         out[r] = m[4 * r] * in[0] + m[4 * r + 1] * in[1] + m[4 * r + 2] * in[2] +
@@ -138,7 +48,7 @@ static void xform_h(const double m[12], const double eye[3], const double in[4],
     out[3] = in[3];
 }
 
-static void box_empty(double box[6])
+void sw__fr_box_empty(double box[6])
 {
     for (int k = 0; k < 3; ++k) {
         box[k] = INFINITY;
@@ -146,7 +56,7 @@ static void box_empty(double box[6])
     }
 }
 
-static void box_add(double box[6], const double h[4])
+void sw__fr_box_add(double box[6], const double h[4])
 {
     for (int k = 0; k < 3; ++k) {
         double x = h[k] / h[3];
@@ -159,16 +69,16 @@ static void occurrence_box(const frame *f, const occurrence *o, double box[6])
 {
     sw_sg_surface s;
     sw_sg_scene_face_surface(f->scene, o->face, &s);
-    box_empty(box);
+    sw__fr_box_empty(box);
     size_t n = (size_t)s.n_u * (size_t)s.n_v;
     for (size_t i = 0; i < n; ++i) {
         double h[4];
-        xform_h(o->world, f->view.eye, s.cpw + 4 * i, h);
-        box_add(box, h);
+        sw__fr_xform_h(o->world, f->view.eye, s.cpw + 4 * i, h);
+        sw__fr_box_add(box, h);
     }
 }
 
-static double det3(const double m[12])
+double sw__fr_det3(const double m[12])
 {
     return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
            m[2] * (m[4] * m[9] - m[5] * m[8]);
@@ -195,10 +105,6 @@ static sw_result face_bezier(frame *f, uint32_t face, const sw_sg_bezier_set **o
     return SW_OK;
 }
 
-/* Texels wanted per direction of a face's trim texture (max over its drawn patches). */
-typedef struct trim_need {
-    double u, v;
-} trim_need;
 
 /* Sets up one patch: eye-relative control points, clipping to the uv box, culling, density. */
 static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch *bp,
@@ -207,10 +113,10 @@ static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch 
 {
     size_t n = (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1);
     double box[6];
-    box_empty(box);
+    sw__fr_box_empty(box);
     for (size_t i = 0; i < n; ++i) {
-        xform_h(o->world, f->view.eye, bp->cpw + 4 * i, cpw + 4 * i);
-        box_add(box, cpw + 4 * i);
+        sw__fr_xform_h(o->world, f->view.eye, bp->cpw + 4 * i, cpw + 4 * i);
+        sw__fr_box_add(box, cpw + 4 * i);
     }
     memset(pt, 0, sizeof *pt);
     pt->deg_u = bp->deg_u;
@@ -242,8 +148,6 @@ static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch 
 }
 
 /* One u-density per patch column and one v-density per row: grids meet vertex to vertex. */
-static int32_t class_texels(double want, int32_t max_entry);
-static int left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k);
 
 static void unify_densities(sw__gpu_patch *pt, int32_t n_cols, int32_t n_rows)
 {
@@ -265,11 +169,11 @@ static void unify_densities(sw__gpu_patch *pt, int32_t n_cols, int32_t n_rows)
     }
 }
 
-static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int trimmed,
+sw_result sw__fr_add_draw(frame *f, const occurrence *o, size_t first_idx, int trimmed,
                           const trim_need *need, const double cell[2], sw_status *status)
 {
-    if (!grow((void **)&f->draws, &f->cap_draws, f->n_draws + 1, sizeof *f->draws) ||
-        (trimmed && !grow((void **)&f->trims, &f->cap_trims, f->n_trims + 1, sizeof *f->trims)))
+    if (!sw__gpu_grow((void **)&f->draws, &f->cap_draws, f->n_draws + 1, sizeof *f->draws) ||
+        (trimmed && !sw__gpu_grow((void **)&f->trims, &f->cap_trims, f->n_trims + 1, sizeof *f->trims)))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame draws: out of memory");
     sw__gpu_draw *d = &f->draws[f->n_draws];
     d->first_idx = first_idx;
@@ -290,7 +194,7 @@ static sw_result add_draw(frame *f, const occurrence *o, size_t first_idx, int t
 }
 
 /* Hands one drawn patch piece to the context's debug hook. */
-static void report_patch(const frame *f, const occurrence *o, const sw__gpu_patch *pt, double s0,
+void sw__fr_report_patch(const frame *f, const occurrence *o, const sw__gpu_patch *pt, double s0,
                          double s1, double t0, double t1, int32_t nu, int32_t nv, int gpu,
                          int trimmed)
 {
@@ -336,8 +240,8 @@ static sw_result exact_net(frame *f, const occurrence *o, sw_status *status)
     if (f->n_knots + nku + nkv > UINT32_MAX || f->n_dcps + ncp > UINT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "face %u: exact evaluation buffers over 2^32",
                         o->face);
-    if (!grow((void **)&f->knots, &f->cap_knots, f->n_knots + nku + nkv, sizeof *f->knots) ||
-        !grow((void **)&f->dcps, &f->cap_dcps, 4 * (f->n_dcps + ncp), sizeof *f->dcps))
+    if (!sw__gpu_grow((void **)&f->knots, &f->cap_knots, f->n_knots + nku + nkv, sizeof *f->knots) ||
+        !sw__gpu_grow((void **)&f->dcps, &f->cap_dcps, 4 * (f->n_dcps + ncp), sizeof *f->dcps))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     sw__gpu_exact_piece *b = &f->ex_base;
     memset(b, 0, sizeof *b);
@@ -351,7 +255,7 @@ static sw_result exact_net(frame *f, const occurrence *o, sw_status *status)
     memcpy(f->knots + f->n_knots + nku, s.knots_v, nkv * sizeof *f->knots);
     f->n_knots += nku + nkv;
     for (size_t i = 0; i < ncp; ++i)
-        xform_h(o->world, f->view.eye, s.cpw + 4 * i, f->dcps + 4 * (f->n_dcps + i));
+        sw__fr_xform_h(o->world, f->view.eye, s.cpw + 4 * i, f->dcps + 4 * (f->n_dcps + i));
     f->n_dcps += ncp;
     f->ex_srf = s;
     f->ex_occ = o;
@@ -366,7 +270,7 @@ static sw_result exact_piece(frame *f, const occurrence *o, const sw__gpu_patch 
     sw_result r = exact_net(f, o, status);
     if (r != SW_OK)
         return r;
-    if (!grow((void **)&f->pieces, &f->cap_pieces, f->n_pieces + 1, sizeof *f->pieces))
+    if (!sw__gpu_grow((void **)&f->pieces, &f->cap_pieces, f->n_pieces + 1, sizeof *f->pieces))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     const sw_sg_surface *s = &f->ex_srf;
     sw__gpu_exact_piece *q = &f->pieces[f->n_pieces];
@@ -384,7 +288,7 @@ static sw_result exact_piece(frame *f, const occurrence *o, const sw__gpu_patch 
 
 /* Appends the control points of a visible patch (float, eye-relative homogeneous) and one record
  * per piece of its sampled domain (§4.2). Pieces share their edge parameters bit for bit. */
-static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *pt,
+sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *pt,
                            const double ub[4], double sign, int32_t draw, int trimmed,
                            sw_status *status)
 {
@@ -400,8 +304,8 @@ static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
     split_class(pt->nu, &ku, &lu);
     split_class(pt->nv, &kv, &lv);
     size_t n_rec = (size_t)ku * (size_t)kv;
-    if (!grow((void **)&ctx->cps, &ctx->cap_cps, 4 * (f->n_cps + n_cp), sizeof *ctx->cps) ||
-        !grow((void **)&ctx->recs, &ctx->cap_recs, f->n_recs + n_rec, sizeof *ctx->recs))
+    if (!sw__gpu_grow((void **)&ctx->cps, &ctx->cap_cps, 4 * (f->n_cps + n_cp), sizeof *ctx->cps) ||
+        !sw__gpu_grow((void **)&ctx->recs, &ctx->cap_recs, f->n_recs + n_rec, sizeof *ctx->recs))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < 4 * n_cp; ++i)
         ctx->cps[4 * f->n_cps + i] = (float)pt->cpw[i];
@@ -425,7 +329,7 @@ static sw_result gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
             rec->level_u = lu;
             rec->level_v = lv;
             if (ctx->patch_hook)
-                report_patch(f, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
+                sw__fr_report_patch(f, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
                              sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1, trimmed);
         }
     }
@@ -443,28 +347,28 @@ static sw_result gpu_face(frame *f, const occurrence *o, const sw__gpu_patch *pt
                           sw_status *status)
 {
     int32_t d = (int32_t)f->n_draws;
-    sw_result r = add_draw(f, o, f->mesh.n_idx, trimmed, need, cell, status);
+    sw_result r = sw__fr_add_draw(f, o, f->mesh.n_idx, trimmed, need, cell, status);
     const double *ub = f->sv->faces[o->face].uv_box;
     for (size_t p = 0; p < n && r == SW_OK; ++p)
         if (pt[p].visible)
-            r = gpu_patch(f, o, &pt[p], ub, sign, d, trimmed, status);
+            r = sw__fr_gpu_patch(f, o, &pt[p], ub, sign, d, trimmed, status);
     return r;
 }
 
 /* Which path draws a face: the vertex shader takes rational Bézier patches of degree <= 3 x 3
  * (§4.2); higher degrees stay CPU grids (patch_grid.c) until the bicubic hierarchy feeds them. */
-static int face_gpu_eligible(const sw_sg_bezier_set *set)
+int sw__fr_face_gpu_eligible(const sw_sg_bezier_set *set)
 {
     if (set->n_u * set->n_v == 0)
         return 0;
     return set->patches[0].deg_u <= 3 && set->patches[0].deg_v <= 3;
 }
 
-static int face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
+int sw__fr_face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
 {
     if (f->exact)
         return 1;
-    return f->ctx->eval_mode == SW__GPU_EVAL_AUTO && face_gpu_eligible(set);
+    return f->ctx->eval_mode == SW__GPU_EVAL_AUTO && sw__fr_face_gpu_eligible(set);
 }
 
 /* Smallest cell of the face's visible grids, in face parameters. */
@@ -479,20 +383,30 @@ static void grid_cell(const sw__gpu_patch *pt, size_t n, double cell[2])
     }
 }
 
-/* §7.1: a fat border along one closed uv loop of a drawn face, as its own untrimmed draw. */
-static sw_result fat_border(frame *f, const occurrence *o, const double *uv, size_t n,
-                            int left_inside, const double cell[2], sw_status *status)
+/* §7.1: a fat border along one closed uv loop of a drawn face, as its own draw. */
+sw_result sw__fr_fat_border(frame *f, const occurrence *o, const double *uv, size_t n,
+                            int left_inside, const double cell[2], const double *st_box,
+                            size_t share, sw_status *status)
 {
     sw_sg_surface srf;
     sw_sg_scene_face_surface(f->scene, o->face, &srf);
     size_t first = f->mesh.n_idx;
     sw_result r = sw__gpu_fat_border(&f->view, &srf, o->world, uv, n, left_inside, cell[0], cell[1],
-                                     2.0 * f->eps_px, &f->mesh, status);
+                                     2.0 * f->eps_px, st_box, &f->mesh, status);
     if (r == SW_OK && f->mesh.n_idx > first) {
         trim_need none = {0.0, 0.0};
-        r = add_draw(f, o, first, 0, &none, cell, status);
+        size_t draw = f->n_draws;
+        r = sw__fr_add_draw(f, o, first, 0, &none, cell, status);
         f->st.triangles += (f->mesh.n_idx - first) / 3;
         f->border_triangles += (f->mesh.n_idx - first) / 3;
+        if (r == SW_OK && st_box) {
+            if (!sw__gpu_grow((void **)&f->shares, &f->cap_shares, 2 * (f->n_shares + 1),
+                              sizeof *f->shares))
+                return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame draws: out of memory");
+            f->shares[2 * f->n_shares] = draw;
+            f->shares[2 * f->n_shares + 1] = share;
+            f->n_shares++;
+        }
     }
     return r;
 }
@@ -582,10 +496,10 @@ static void make_cell(const tiling *t, size_t p, const double r[4], sw__gpu_patc
     const double range[4] = {c->s0, c->s1, c->t0, c->t1};
     sw_lod_bez_restrict(c->deg_u, c->deg_v, 4, c->cpw, range, t->scratch);
     double box[6];
-    box_empty(box);
+    sw__fr_box_empty(box);
     size_t n = (size_t)(c->deg_u + 1) * (size_t)(c->deg_v + 1);
     for (size_t i = 0; i < n; ++i)
-        box_add(box, t->scratch + 4 * i);
+        sw__fr_box_add(box, t->scratch + 4 * i);
     c->visible = sw__gpu_view_box_visible(&t->f->view, box);
 }
 
@@ -618,7 +532,7 @@ static int find_tiles(tiling *t, int32_t i0, int32_t i1, int32_t j0, int32_t j1)
         return find_tiles(t, i0, i1, j0, (j0 + j1) / 2) && find_tiles(t, i0, i1, (j0 + j1) / 2, j1);
     }
     if (t->n_tiles >= MAX_TILES_PER_FACE ||
-        !grow((void **)&t->tiles, &t->cap_tiles, t->n_tiles + 1, sizeof *t->tiles))
+        !sw__gpu_grow((void **)&t->tiles, &t->cap_tiles, t->n_tiles + 1, sizeof *t->tiles))
         return 0;
     tile *tl = &t->tiles[t->n_tiles++];
     memset(tl, 0, sizeof *tl);
@@ -635,7 +549,7 @@ static int tile_cells(tiling *t, tile *tl)
     patch_span(t->set, 0, tl->rect[0], tl->rect[1], &tl->a0, &tl->a1);
     patch_span(t->set, 1, tl->rect[2], tl->rect[3], &tl->b0, &tl->b1);
     size_t n = (size_t)(tl->a1 - tl->a0 + 1) * (size_t)(tl->b1 - tl->b0 + 1);
-    if (!grow((void **)&t->cells, &t->cap_cells, t->n_cells + n, sizeof *t->cells))
+    if (!sw__gpu_grow((void **)&t->cells, &t->cap_cells, t->n_cells + n, sizeof *t->cells))
         return 0;
     tl->first_cell = t->n_cells;
     tl->need = (trim_need){1.0, 1.0};
@@ -708,29 +622,37 @@ static int unify_cells(tiling *t, int dir)
 
 /* Flattens the face's loops once, finely enough for its finest tile texture, and classifies
  * the tiles against them (a margin of 1 % of a tile so that a loop on a tile's edge counts). */
-static sw_result tile_loops(tiling *t, int64_t *index, sw_status *status)
+sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index,
+                            sw_status *status)
 {
-    frame *f = t->f;
-    const sw_sg_face_rec *rec = &f->sv->faces[t->o->face];
-    int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
-    double tol = INFINITY;
-    for (size_t i = 0; i < t->n_tiles; ++i) {
-        const tile *tl = &t->tiles[i];
-        tol = fmin(tol, 0.5 * (tl->rect[1] - tl->rect[0]) / class_texels(tl->need.u, max_entry));
-        tol = fmin(tol, 0.5 * (tl->rect[3] - tl->rect[2]) / class_texels(tl->need.v, max_entry));
-    }
-    if (!grow((void **)&f->loops, &f->cap_loops, f->n_loops + 1, sizeof *f->loops))
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->o->face);
+    const sw_sg_face_rec *rec = &f->sv->faces[face];
+    if (!sw__gpu_grow((void **)&f->loops, &f->cap_loops, f->n_loops + 1, sizeof *f->loops))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     face_loops *fl = &f->loops[f->n_loops];
     fl->n = 0;
-    fl->loops = calloc(rec->n_loops, sizeof *fl->loops);
+    fl->loops = calloc(rec->n_loops ? rec->n_loops : 1, sizeof *fl->loops);
     if (!fl->loops)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->o->face);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     *index = (int64_t)f->n_loops++;
     sw_result r = SW_OK;
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k, ++fl->n)
         r = sw_sg_trim_flatten_loop(f->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
                                     &fl->loops[k], status);
+    return r;
+}
+
+static sw_result tile_loops(tiling *t, int64_t *index, sw_status *status)
+{
+    frame *f = t->f;
+    int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
+    double tol = INFINITY;
+    for (size_t i = 0; i < t->n_tiles; ++i) {
+        const tile *tl = &t->tiles[i];
+        tol = fmin(tol, 0.5 * (tl->rect[1] - tl->rect[0]) / sw__fr_class_texels(tl->need.u, max_entry));
+        tol = fmin(tol, 0.5 * (tl->rect[3] - tl->rect[2]) / sw__fr_class_texels(tl->need.v, max_entry));
+    }
+    sw_result r = sw__fr_face_loops(f, t->o->face, tol, index, status);
+    const face_loops *fl = r == SW_OK ? &f->loops[*index] : NULL;
     for (size_t i = 0; i < t->n_tiles && r == SW_OK; ++i) {
         tile *tl = &t->tiles[i];
         double mu = 0.01 * (tl->rect[1] - tl->rect[0]), mv = 0.01 * (tl->rect[3] - tl->rect[2]);
@@ -752,18 +674,18 @@ static sw_result tile_draw(tiling *t, const tile *tl, int64_t loops, double sign
     int32_t d = (int32_t)f->n_draws;
     sw_result r = SW_OK;
     if (on_gpu) {
-        r = add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
+        r = sw__fr_add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
         for (size_t p = 0; p < n && r == SW_OK; ++p)
             if (c[p].visible)
-                r = gpu_patch(f, t->o, &c[p], tl->rect, sign, d, trimmed, status);
+                r = sw__fr_gpu_patch(f, t->o, &c[p], tl->rect, sign, d, trimmed, status);
     } else {
         r = sw__gpu_tessellate_face(c, n_cols, n_rows, sign, tl->rect, &f->mesh, status);
         for (size_t p = 0; p < n && f->ctx->patch_hook; ++p)
             if (c[p].visible)
-                report_patch(f, t->o, &c[p], c[p].s0, c[p].s1, c[p].t0, c[p].t1, c[p].nu, c[p].nv,
+                sw__fr_report_patch(f, t->o, &c[p], c[p].s0, c[p].s1, c[p].t0, c[p].t1, c[p].nu, c[p].nv,
                              0, trimmed);
         if (r == SW_OK)
-            r = add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
+            r = sw__fr_add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
     }
     if (r == SW_OK && trimmed) {
         pending_trim *pt = &f->trims[f->n_trims - 1];
@@ -790,8 +712,8 @@ static sw_result tiled_draws(tiling *t, double sign, int on_gpu, sw_status *stat
             r = tile_draw(t, &t->tiles[i], loops, sign, on_gpu, cell, status);
     const face_loops *fl = loops >= 0 ? &f->loops[loops] : NULL;
     for (uint32_t k = 0; r == SW_OK && fl && !f->ctx->crack_fill_off && k < fl->n; ++k)
-        r = fat_border(f, t->o, fl->loops[k].uv, fl->loops[k].count,
-                       left_is_inside(fl->loops, fl->n, k), cell, status);
+        r = sw__fr_fat_border(f, t->o, fl->loops[k].uv, fl->loops[k].count,
+                       sw__fr_left_is_inside(fl->loops, fl->n, k), cell, NULL, 0, status);
     return r;
 }
 
@@ -834,7 +756,7 @@ static sw_result tiled_face(frame *f, const occurrence *o, const sw_sg_bezier_se
     return r;
 }
 
-static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
+sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status)
 {
     const sw_sg_face_rec *rec = &f->sv->faces[o->face];
     const sw_sg_bezier_set *set = NULL;
@@ -862,9 +784,9 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
     }
     trim_need need = {1.0, 1.0};
     size_t at = 0, drawn = 0;
-    int on_gpu = face_on_gpu(f, set);
+    int on_gpu = sw__fr_face_on_gpu(f, set);
     /* CPU_GRIDS mode draws the grids the vertex shader would (the reference of §4.2's path). */
-    int class_grids = f->exact || face_gpu_eligible(set);
+    int class_grids = f->exact || sw__fr_face_gpu_eligible(set);
     for (size_t p = 0; p < n; ++p) {
         const sw_sg_bezier_patch *bp = &set->patches[p];
         patch_setup(f, o, bp, rec->uv_box, class_grids, cpw + at, &pt[p], &need);
@@ -878,7 +800,7 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
     if (drawn > 0) {
         unify_densities(pt, n_cols, n_rows);
         double sign = (rec->flags & SW_SG_FACE_REVERSED) ? -1.0 : 1.0;
-        if (det3(o->world) < 0.0)
+        if (sw__fr_det3(o->world) < 0.0)
             sign = -sign;
         size_t first = f->mesh.n_idx;
         double cell[2];
@@ -894,17 +816,17 @@ static sw_result draw_face(frame *f, const occurrence *o, sw_status *status)
             r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->mesh, status);
             for (size_t p = 0; p < n && f->ctx->patch_hook; ++p)
                 if (pt[p].visible)
-                    report_patch(f, o, &pt[p], pt[p].s0, pt[p].s1, pt[p].t0, pt[p].t1, pt[p].nu,
+                    sw__fr_report_patch(f, o, &pt[p], pt[p].s0, pt[p].s1, pt[p].t0, pt[p].t1, pt[p].nu,
                                  pt[p].nv, 0, trimmed);
             if (r == SW_OK)
-                r = add_draw(f, o, first, trimmed, &need, cell, status);
+                r = sw__fr_add_draw(f, o, first, trimmed, &need, cell, status);
         }
         if (f->exact)
             f->st.patches_exact += drawn;
         if (r == SW_OK && !trimmed && !f->ctx->crack_fill_off) {
             const double *b = rec->uv_box;
             const double box_loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
-            r = fat_border(f, o, box_loop, 4, 1, cell, status); /* counter-clockwise */
+            r = sw__fr_fat_border(f, o, box_loop, 4, 1, cell, NULL, 0, status); /* counter-clockwise */
         }
         f->st.faces_drawn++;
         if (trimmed)
@@ -962,7 +884,7 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     if (!boxes)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
     memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
-    box_empty(scene_box);
+    sw__fr_box_empty(scene_box);
     for (size_t i = 0; i < f->n_occ; ++i) {
         occurrence_box(f, &f->occ[i], boxes + 6 * i);
         for (int k = 0; k < 3; ++k) {
@@ -975,12 +897,16 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     sw_result r =
         sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane, status);
     screen_view_init(f);
+    int hierarchy = f->cache && !f->exact;
+    if (r == SW_OK && hierarchy)
+        r = sw__fr_hlod_prepare(f, boxes, desc->walkthrough, status);
     for (size_t i = 0; i < f->n_occ && r == SW_OK; ++i) {
         if (!sw__gpu_view_box_visible(&f->view, boxes + 6 * i)) {
             f->st.faces_culled++;
             continue;
         }
-        r = draw_face(f, &f->occ[i], status);
+        r = hierarchy ? sw__fr_hlod_draw_face(f, &f->occ[i], status)
+                      : sw__fr_draw_face(f, &f->occ[i], status);
     }
     free(boxes);
     return r;
@@ -988,7 +914,7 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
 
 /* Texels of a resolution class: footprints (texture plus gutters) are powers of two, so that a
  * class changes only when the wanted resolution doubles or halves, and pages pack them tightly. */
-static int32_t class_texels(double want, int32_t max_entry)
+int32_t sw__fr_class_texels(double want, int32_t max_entry)
 {
     int32_t foot = 16;
     while (foot - 2 * SW__GPU_ATLAS_GUTTER < want && foot - 2 * SW__GPU_ATLAS_GUTTER < max_entry)
@@ -999,7 +925,7 @@ static int32_t class_texels(double want, int32_t max_entry)
 
 /* Whether the trimmed region lies to the left of loop k's direction: classified just left of
  * the middle of its longest edge (loops are simple, so one point decides for the whole loop). */
-static int left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k)
+int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k)
 {
     const sw_sg_polyline *l = &loops[k];
     uint32_t best = 0;
@@ -1026,8 +952,8 @@ static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, s
 {
     const sw_sg_face_rec *rec = &f->sv->faces[t->face];
     int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
-    int32_t w = class_texels(t->width * scale, max_entry);
-    int32_t h = class_texels(t->height * scale, max_entry);
+    int32_t w = sw__fr_class_texels(t->width * scale, max_entry);
+    int32_t h = sw__fr_class_texels(t->height * scale, max_entry);
     const double *r = t->rect;
     sw__gpu_trim_key key = {f->scene, t->face, rec->first_loop, rec->n_loops, {r[0], r[1], r[2], r[3]}};
     int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
@@ -1057,8 +983,8 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
         return make_tile_trim(f, t, scale, status);
     const sw_sg_face_rec *rec = &f->sv->faces[t->face];
     int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx);
-    int32_t w = class_texels(t->width * scale, max_entry);
-    int32_t h = class_texels(t->height * scale, max_entry);
+    int32_t w = sw__fr_class_texels(t->width * scale, max_entry);
+    int32_t h = sw__fr_class_texels(t->height * scale, max_entry);
     const double *ub = rec->uv_box;
     sw__gpu_trim_key key = {
         f->scene, t->face, rec->first_loop, rec->n_loops, {ub[0], ub[1], ub[2], ub[3]}};
@@ -1080,8 +1006,8 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
         f->draws[t->draw].trim_entry = id;
     }
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK && border; ++k)
-        r = fat_border(f, &f->occ[t->occ], loops[k].uv, loops[k].count,
-                       left_is_inside(loops, rec->n_loops, k), t->cell, status);
+        r = sw__fr_fat_border(f, &f->occ[t->occ], loops[k].uv, loops[k].count,
+                       sw__fr_left_is_inside(loops, rec->n_loops, k), t->cell, NULL, 0, status);
     for (uint32_t k = 0; k < rec->n_loops; ++k)
         sw_sg_polyline_free(&loops[k]);
     free(loops);
@@ -1103,6 +1029,8 @@ static sw_result make_trims(frame *f, sw_status *status)
     memset(&as, 0, sizeof as);
     if (r == SW_OK)
         r = sw__gpu_atlas_commit(f->ctx, &as, status);
+    for (size_t i = 0; i < f->n_shares; ++i)
+        f->draws[f->shares[2 * i]].trim_entry = f->draws[f->shares[2 * i + 1]].trim_entry;
     f->st.trim_textures = as.entries;
     f->st.trim_texels = as.entry_texels;
     f->st.trim_reused = as.reused;
@@ -1122,7 +1050,7 @@ static sw_result build_batch(frame *f, sw_status *status)
     memset(b, 0, sizeof *b);
     if (f->n_recs == 0)
         return SW_OK;
-    if (!grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, f->n_recs,
+    if (!sw__gpu_grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, f->n_recs,
               sizeof *ctx->recs_sorted))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < f->n_recs; ++i) {
@@ -1147,7 +1075,7 @@ static sw_result build_batch(frame *f, sw_status *status)
             at += b->count[v][u];
         }
     int keep = ctx->capture_max > 0;
-    if (keep && !grow((void **)&ctx->rec_source, &ctx->cap_rec_source, f->n_recs,
+    if (keep && !sw__gpu_grow((void **)&ctx->rec_source, &ctx->cap_rec_source, f->n_recs,
                       sizeof *ctx->rec_source))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < f->n_recs; ++i) {
@@ -1199,6 +1127,7 @@ static void frame_free(frame *f)
     free(f->pieces);
     free(f->knots);
     free(f->dcps);
+    free(f->shares);
     sw__gpu_mesh_free(&f->mesh);
 }
 
@@ -1219,6 +1148,21 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
     f.bez = calloc(f.sv->n_faces ? f.sv->n_faces : 1, sizeof *f.bez);
     if (!f.bez)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
+    f.reader = -1;
+    if (desc.hierarchies) {
+        if (sw_lod_cache_scene(desc.hierarchies) != scene) {
+            frame_free(&f);
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                            "frame: the hierarchy cache belongs to another scene");
+        }
+        f.cache = desc.hierarchies;
+        f.reader = sw_lod_cache_reader_add(f.cache);
+        if (f.reader < 0) {
+            frame_free(&f);
+            return sw__fail(status, SW_ERR_LIMIT, "frame: no free reader slot in the cache");
+        }
+        sw_lod_cache_reader_enter(f.cache, f.reader);
+    }
 
     double t0 = sw__gpu_now_ms();
     sw_result r = tessellate(&f, &desc, status);
@@ -1237,12 +1181,17 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
     double t4 = sw__gpu_now_ms();
 
     f.st.triangles += f.mesh.n_idx / 3 - f.border_triangles;
-    f.st.ms_tessellate = t1 - t0;
+    f.st.ms_tessellate = t1 - t0 - f.st.ms_hierarchy; /* the waits are counted apart */
     f.st.ms_trim = t2 - t1;
     f.st.ms_draw = t3 - t2;
     f.st.ms_readback = t4 - t3;
     if (stats)
         *stats = f.st;
+    if (f.cache) {
+        sw_lod_cache_reader_leave(f.cache, f.reader);
+        sw_lod_cache_reader_remove(f.cache, f.reader);
+        sw_lod_cache_collect(f.cache);
+    }
     frame_free(&f);
     if (r == SW_OK)
         sw__status_ok(status);

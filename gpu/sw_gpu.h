@@ -44,6 +44,15 @@ typedef struct sw_gpu_frame_desc {
     int32_t eval_exact;    /* 1: every drawn patch piece evaluated in the vertex shader from the
                               face's knot vectors and control points (B-spline basis in double,
                               any degree up to SW_GPU_EXACT_MAX_DEGREE); 0: Bézier path */
+    struct sw_lod_cache *hierarchies; /* NULL: every face drawn by its own Bézier patches;
+                              else the cache of `scene`'s bicubic hierarchies (Guthe §6), traversed
+                              per frame (§7); the frame waits for the builds and refinements it
+                              asks for in the cache's pool (converged). Ignored with eval_exact. */
+    int32_t walkthrough;   /* with hierarchies: 1 = never wait for the pool (ARCHITECTURE.md
+                              walkthrough mode): faces without a hierarchy yet are drawn by their
+                              Bézier patches, leaves too coarse are drawn as they are, and both
+                              are requested from the pool for later frames; the requests of earlier
+                              frames that have not started are cancelled */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -55,7 +64,7 @@ typedef struct sw_gpu_frame_stats {
     uint64_t patches_culled;    /* outside the view frustum, or outside their face's trim box */
     uint64_t triangles;
     uint64_t trim_textures, trim_texels;
-    double ms_tessellate; /* CPU grid evaluation */
+    double ms_tessellate; /* traversal, bounds, CPU grids (without ms_hierarchy) */
     double ms_trim;       /* trim-texture generation */
     double ms_draw;       /* draw submission until glFinish */
     double ms_readback;
@@ -67,6 +76,15 @@ typedef struct sw_gpu_frame_stats {
     uint64_t patches_gpu_evaluated; /* drawn patches evaluated in the vertex shader (§4.2); the
                                        others are CPU grids */
     uint64_t patches_exact; /* of those, evaluated from knots and control points (eval_exact) */
+    /* hierarchy traversal (desc.hierarchies) */
+    uint64_t hlod_nodes;          /* hierarchy nodes (or parts of one) drawn */
+    uint64_t hlod_fallback_faces; /* occurrences drawn by their Bézier patches: no hierarchy */
+    uint64_t hlod_refine_rounds;  /* rounds of refinement below the leaves the frame waited for */
+    uint64_t hlod_over_budget;    /* nodes drawn although their error exceeds their share of
+                                     ε_img (refinement stopped at its depth limit) */
+    uint64_t hlod_waits;          /* times the frame waited for the pool (0 in walkthrough) */
+    uint64_t hlod_refine_requests; /* walkthrough: refinements asked for, not waited for */
+    double ms_hierarchy;          /* waiting for hierarchy builds and refinements */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -97,6 +97,9 @@ void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *us
 
 struct sw_gpu_context {
     void *egl_display, *egl_context; /* EGLDisplay, EGLContext */
+    struct sw_th_token *walk_token; /* walkthrough frames' hierarchy requests; bumped every frame,
+                               so the requests of frames gone by are cancelled (a pointer: C++
+                               tests include this header, and the token is a C11 atomic) */
     char description[256];
     GLint max_texture_size;
     /* grid / triangle program */
@@ -190,6 +193,9 @@ typedef struct sw__gpu_mesh {
     size_t n_v, cap_v, n_idx, cap_idx;
 } sw__gpu_mesh;
 
+/* Grows *p (capacity *cap elements of elem bytes) to hold `need`, doubling; 0 when out of memory
+ * (*p and *cap unchanged). */
+int sw__gpu_grow(void **p, size_t *cap, size_t need, size_t elem);
 void sw__gpu_mesh_free(sw__gpu_mesh *m);
 sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, sw_status *status);
 
@@ -217,11 +223,13 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
 /* Appends a screen-facing ribbon (fat border), width_px pixels wide on the face's inner side, along
  * a closed polyline uv[2n] in the parameters of surface srf placed by `world` (3 x 4), sampled on
  * the exact surface with steps no longer than (du, dv). left_inside: the face lies to the left of
- * the polyline's direction in (u, v). Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+ * the polyline's direction in (u, v). st_box (u0, u1, v0, v1) or NULL: the rectangle the trim
+ * lookup of the ribbon's draw spans (vertices then carry st over it), else st = 0 (untrimmed).
+ * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
-                             double du, double dv, double width_px, sw__gpu_mesh *mesh,
-                             sw_status *status);
+                             double du, double dv, double width_px, const double *st_box,
+                             sw__gpu_mesh *mesh, sw_status *status);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 
@@ -230,7 +238,8 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
  * texture `tex` (side x side texels per layer): fans from each loop's first vertex toggle texels
  * (even-odd parity, §4), then every loop drawn as a 1-pixel line loop SETS its texels (§7.1 crack
  * filling: boundary texels are inside). One render-target switch; two multi-draw calls.
- * Loops with fewer than 3 (fans) or 2 (lines) vertices are skipped. */
+ * Loops with fewer than 3 (fans) or 2 (lines) vertices draw nothing; empty loops (count 0) are
+ * allowed anywhere, first included (trim_texture.c works around llvmpipe dropping the rest). */
 void sw__gpu_trim_page_draw(sw_gpu_context *ctx, GLuint tex, int32_t layer, int32_t side,
                             const float *xy, size_t n_xy, const GLint *first, const GLsizei *count,
                             GLsizei n_loops);

@@ -8,10 +8,18 @@
  * Unlike the paper, which regenerates the atlas every frame, textures are kept across frames:
  * an entry is identified by its face (sw__gpu_trim_key) and its size, which the caller rounds to a
  * resolution class (frame.c: a power of two per direction), so a walkthrough re-renders a trim
- * texture only when its class changes. Entries a frame does not use stay until the atlas is
- * repacked: new entries are placed in free space (never used since the last repack); only when
- * they do not fit are all entries of the current frame repacked from scratch (into a new array
- * texture when the page size or count must change) and re-rendered from the loops kept on the CPU.
+ * texture only when its class changes. New entries are placed in free space (never used since the
+ * last repack) of the pages already allocated. When they do not fit there, the atlas either grows
+ * (new pages, every old page copied into the new array texture) or repacks: every entry of the
+ * current frame packed from scratch and re-rendered from the loops kept on the CPU, the others
+ * dropped. It repacks when the space taken by anything but this frame's entries (entries this
+ * frame does not use, the height a shelf gives its shorter entries) is at least the space this
+ * frame's entries need: growing would then copy pages of mostly dead texels, and with a new set
+ * of textures every frame (an animated surface, a new scene per frame) add a page per frame up to
+ * the texel limit. A repack keeps the array texture when its page size is right and it has at most
+ * twice the pages needed (no copy), else allocates one of the size needed. Entries unused for
+ * k_max_idle_frames frames are dropped at the next begin (their loops freed; their texels stay dead
+ * space until a repack).
  *
  * Loops are stored in entry-local texel coordinates, clamped to the entry's rectangle grown by one
  * texel: a loop straying outside its uv box (flattening tolerance, a box from rounded data) can
@@ -27,6 +35,9 @@
 
 enum { MIN_SIDE = 256, DEFAULT_MAX_SIDE = 4096, MAX_PAGES = 64 };
 static const double k_max_atlas_texels = 512e6; /* R8 texels kept by the atlas at most */
+/* Frames an entry may go unused before begin drops it: a walkthrough coming back to a view within
+ * about a second (at 60 Hz) finds its textures. */
+static const uint64_t k_max_idle_frames = 64;
 
 typedef struct entry {
     sw__gpu_trim_key key;
@@ -76,26 +87,12 @@ struct sw__gpu_atlas {
 };
 
 static sw_result compact(struct sw__gpu_atlas *a, sw_status *status);
-
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap * 2 : 64;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*p, c * elem);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
+static void evict_idle(struct sw__gpu_atlas *a);
 
 static int grow32(void **p, int32_t *cap, size_t need, size_t elem)
 {
     size_t c = (size_t)*cap;
-    int ok = grow(p, &c, need, elem);
+    int ok = sw__gpu_grow(p, &c, need, elem);
     *cap = (int32_t)c;
     return ok;
 }
@@ -175,6 +172,7 @@ sw_result sw__gpu_atlas_begin(sw_gpu_context *ctx, sw_status *status)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     a->frame++;
     memset(&a->st, 0, sizeof a->st);
+    evict_idle(a);
     return compact(a, status);
 }
 
@@ -361,6 +359,18 @@ static void kill_unused(struct sw__gpu_atlas *a)
     }
 }
 
+/* Entries unused for more than k_max_idle_frames die (their space stays taken until a repack). */
+static void evict_idle(struct sw__gpu_atlas *a)
+{
+    for (int32_t i = 0; i < a->n_entries; ++i) {
+        entry *e = &a->entries[i];
+        if (!e->dead && a->frame - e->used_frame > k_max_idle_frames) {
+            free_entry(e);
+            e->dead = 1;
+        }
+    }
+}
+
 /* Removes dead entries (ids change: only between frames). */
 static sw_result compact(struct sw__gpu_atlas *a, sw_status *status)
 {
@@ -447,12 +457,58 @@ static sw_result repack(sw_gpu_context *ctx, struct sw__gpu_atlas *a, sw_status 
                             "trim textures of this frame exceed the atlas (%d pages of %d^2)",
                             (int)limit, (int)a->side);
     a->st.repacks++;
-    if (a->tex && a->side == a->tex_side && a->cap_layers >= a->n_pages)
-        return SW_OK; /* every footprint is cleared before it is rendered: no need for a new one */
+    /* every footprint is cleared before it is rendered: the old texture serves as it is unless
+     * its pages have the wrong size or are too few, or more than twice too many (after a frame
+     * that needed many, the memory is given back) */
+    if (a->tex && a->side == a->tex_side && a->cap_layers >= a->n_pages &&
+        a->cap_layers <= 2 * a->n_pages)
+        return SW_OK;
     return alloc_layers(ctx, a, a->n_pages, 0, status);
 }
 
-/* Places the pending entries in free space; 0 when one does not fit in the page limit. */
+/* Places the entries of order[0..n) not placed yet within the first max_pages pages; 1 when all
+ * of them fit. */
+static int place_all(struct sw__gpu_atlas *a, int32_t n, int32_t max_pages)
+{
+    int all = 1;
+    for (int32_t i = 0; i < n; ++i) {
+        entry *e = &a->entries[a->order[i].id];
+        if (e->layer < 0 && !place(a, e, max_pages))
+            all = 0;
+    }
+    return all;
+}
+
+static double footprint(const entry *e)
+{
+    const int32_t g = SW__GPU_ATLAS_GUTTER;
+    return (double)(e->w + 2 * g) * (double)(e->h + 2 * g);
+}
+
+/* 1 when the texels taken in the pages by anything but this frame's placed entries (entries
+ * unused this frame or dropped, a shelf's height above its shorter entries) are at least what all
+ * of this frame's entries need. Free space (a shelf's unused length, a page's unused top) is not
+ * counted: new entries can still go there. */
+static int dead_exceeds_live(const struct sw__gpu_atlas *a)
+{
+    double taken = 0.0, live = 0.0, live_placed = 0.0;
+    for (int32_t l = 0; l < a->n_pages; ++l)
+        for (int32_t k = 0; k < a->pages[l].n_shelves; ++k) {
+            const shelf *sh = &a->pages[l].shelves[k];
+            taken += (double)sh->x * (double)sh->h;
+        }
+    for (int32_t i = 0; i < a->n_entries; ++i) {
+        const entry *e = &a->entries[i];
+        if (e->dead || e->used_frame != a->frame)
+            continue;
+        live += footprint(e);
+        live_placed += e->layer >= 0 ? footprint(e) : 0.0;
+    }
+    return taken - live_placed >= live;
+}
+
+/* Places the pending entries in free space of the pages allocated, else in new pages unless a
+ * repack is the better use of the space (dead_exceeds_live); *fits = 0 asks for the repack. */
 static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int *fits,
                                sw_status *status)
 {
@@ -466,10 +522,12 @@ static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int
         return SW_OK;
     }
     int32_t limit = page_limit(a);
-    for (int32_t i = 0; i < n && *fits; ++i)
-        *fits = place(a, &a->entries[a->order[i].id], limit);
-    if (!*fits)
+    if (place_all(a, n, a->cap_layers < limit ? a->cap_layers : limit))
         return SW_OK;
+    if (dead_exceeds_live(a) || !place_all(a, n, limit)) {
+        *fits = 0;
+        return SW_OK;
+    }
     if (a->n_pages > a->cap_layers) /* pages are large: grow by what is needed only */
         r = alloc_layers(ctx, a, a->n_pages, 1, status);
     return r;
@@ -478,13 +536,13 @@ static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int
 static sw_result scratch_for_page(struct sw__gpu_atlas *a, size_t n_xy, size_t n_loops,
                                   sw_status *status)
 {
-    if (!grow((void **)&a->clip, &a->cap_clip, 2 * n_xy + 2, sizeof *a->clip))
+    if (!sw__gpu_grow((void **)&a->clip, &a->cap_clip, 2 * n_xy + 2, sizeof *a->clip))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     size_t cap = a->cap_loops;
-    if (!grow((void **)&a->first, &cap, n_loops + 1, sizeof *a->first))
+    if (!sw__gpu_grow((void **)&a->first, &cap, n_loops + 1, sizeof *a->first))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     cap = a->cap_loops;
-    if (!grow((void **)&a->count, &cap, n_loops + 1, sizeof *a->count))
+    if (!sw__gpu_grow((void **)&a->count, &cap, n_loops + 1, sizeof *a->count))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     a->cap_loops = cap;
     return SW_OK;

@@ -38,6 +38,14 @@ void sw__gpu_trim_page_draw(sw_gpu_context *ctx, GLuint tex, int32_t layer, int3
     glDisableVertexAttribArray(1);
     glDisableVertexAttribArray(2);
     glUseProgram(ctx->prog_trim);
+    /* llvmpipe (Mesa 22.3, llvmpipe_draw_vbo) returns from a multi-draw whose FIRST draw has no
+     * vertices without drawing any of the others; a loop clipped away by a trim tile (trim_tiles.c)
+     * is such a draw. Empty loops draw nothing anyway: start at the first non-empty one. */
+    while (n_loops > 0 && count[0] == 0) {
+        ++first;
+        ++count;
+        --n_loops;
+    }
 
     glEnable(GL_COLOR_LOGIC_OP);
     glLogicOp(GL_INVERT);

@@ -343,6 +343,16 @@ uint32_t sw_lod_cache_face_count(const sw_lod_cache *c)
     return c->n_faces;
 }
 
+sw_th_pool *sw_lod_cache_pool(const sw_lod_cache *c)
+{
+    return c->pool;
+}
+
+const sw_sg_scene *sw_lod_cache_scene(const sw_lod_cache *c)
+{
+    return c->scene;
+}
+
 /* ---- epochs and reclamation ------------------------------------------------------------------ */
 int32_t sw_lod_cache_reader_add(sw_lod_cache *c)
 {
@@ -453,8 +463,9 @@ static sw_result publish_version(sw_lod_cache *c, slot *s, sw_lod_hierarchy *h)
 typedef struct refine_job {
     sw_lod_cache *cache;
     uint32_t face;
-    int32_t node;
-    double tolerance;
+    uint32_t n;        /* leaves to refine */
+    int32_t *nodes;    /* n, in the same allocation as the job */
+    double *tolerance; /* n */
     sw_lod_cache_req req;
 } refine_job;
 
@@ -529,15 +540,17 @@ static sw_lod_hierarchy *replace_leaf(const sw_lod_hierarchy *old, int32_t leaf,
     return h;
 }
 
-/* The leaf's own finer hierarchy merged into a new version, or NULL (nothing to publish). */
-static sw_lod_hierarchy *refined_version(sw_lod_cache *c, const refine_job *j,
-                                         const sw_lod_hierarchy *old)
+/* The leaf's own finer hierarchy merged into a new version of cur, or NULL (nothing to publish). */
+static sw_lod_hierarchy *refine_leaf(sw_lod_cache *c, uint32_t face, const sw_lod_hierarchy *cur,
+                                     int32_t node, double tolerance)
 {
-    const sw_lod_hnode *leaf = &old->nodes[j->node];
+    const sw_lod_hnode *leaf = &cur->nodes[node];
+    if (leaf->child[0] >= 0 || leaf->error <= tolerance)
+        return NULL;
     sw_sg_surface surf;
-    sw_sg_scene_face_surface(c->scene, j->face, &surf);
+    sw_sg_scene_face_surface(c->scene, face, &surf);
     sw_lod_hierarchy_desc d = c->desc.hierarchy;
-    d.leaf_tolerance = j->tolerance;
+    d.leaf_tolerance = tolerance;
     d.use_box = 1;
     memcpy(d.uv_box, leaf->rect, sizeof d.uv_box);
     sw_lod_hierarchy *sub = NULL, *h = NULL;
@@ -545,11 +558,29 @@ static sw_lod_hierarchy *refined_version(sw_lod_cache *c, const refine_job *j,
         return NULL;
     const sw_lod_hnode *root = &sub->nodes[sub->root];
     if (root->child[0] >= 0 && root->child[1] >= 0)
-        h = merge_subtree(old, j->node, sub);
+        h = merge_subtree(cur, node, sub);
     else if ((root->flags & SW_LOD_HNODE_REPRESENTABLE) && root->error < leaf->error)
-        h = replace_leaf(old, j->node, root);
+        h = replace_leaf(cur, node, root);
     sw_lod_hierarchy_free(sub);
     return h;
+}
+
+/* Every leaf of the job refined into one new version (node indices of old stay valid in each
+ * intermediate version), or NULL when none could be. */
+static sw_lod_hierarchy *refined_version(sw_lod_cache *c, const refine_job *j,
+                                         const sw_lod_hierarchy *old)
+{
+    const sw_lod_hierarchy *cur = old;
+    sw_lod_hierarchy *own = NULL;
+    for (uint32_t k = 0; k < j->n; ++k) {
+        sw_lod_hierarchy *h = refine_leaf(c, j->face, cur, j->nodes[k], j->tolerance[k]);
+        if (!h)
+            continue;
+        sw_lod_hierarchy_free(own);
+        own = h;
+        cur = h;
+    }
+    return own;
 }
 
 static void release_refining(slot *s)
@@ -577,26 +608,50 @@ static void refine_task(void *ctx)
     sw_lod_cache_collect(c);
 }
 
-/* With the refining flag held: what to do about node of face's current version. */
-static sw_result refine_check(slot *s, int32_t node, double tolerance, sw_lod_refine_outcome *oc)
+/* With the refining flag held: whether any of the nodes of the face's current version is a leaf
+ * above its tolerance. */
+static sw_result refine_check(slot *s, const int32_t *nodes, const double *tolerance, uint32_t n,
+                              sw_lod_refine_outcome *oc)
 {
     const sw_lod_hierarchy *h = atomic_load_explicit(&s->current, memory_order_acquire);
-    if (node < 0 || node >= h->n_nodes)
-        return SW_ERR_INVALID_ARGUMENT;
-    const sw_lod_hnode *n = &h->nodes[node];
-    *oc = n->child[0] >= 0 || n->error <= tolerance ? SW_LOD_REFINE_DONE : SW_LOD_REFINE_SUBMITTED;
+    *oc = SW_LOD_REFINE_DONE;
+    for (uint32_t k = 0; k < n; ++k) {
+        if (nodes[k] < 0 || nodes[k] >= h->n_nodes || !(tolerance[k] > 0.0))
+            return SW_ERR_INVALID_ARGUMENT;
+        const sw_lod_hnode *l = &h->nodes[nodes[k]];
+        if (l->child[0] < 0 && l->error > tolerance[k])
+            *oc = SW_LOD_REFINE_SUBMITTED;
+    }
     return SW_OK;
 }
 
-sw_result sw_lod_cache_refine(sw_lod_cache *c, uint32_t face, int32_t node, double tolerance,
-                              const sw_lod_cache_req *req, sw_th_group *group,
-                              sw_lod_refine_outcome *outcome)
+static refine_job *refine_job_new(sw_lod_cache *c, uint32_t face, const int32_t *nodes,
+                                  const double *tolerance, uint32_t n, const sw_lod_cache_req *r)
+{
+    refine_job *j = malloc(sizeof *j + (size_t)n * (sizeof *j->tolerance + sizeof *j->nodes));
+    if (!j)
+        return NULL;
+    j->cache = c;
+    j->face = face;
+    j->n = n;
+    j->tolerance = (double *)(j + 1);
+    j->nodes = (int32_t *)(j->tolerance + n);
+    memcpy(j->tolerance, tolerance, (size_t)n * sizeof *tolerance);
+    memcpy(j->nodes, nodes, (size_t)n * sizeof *nodes);
+    j->req = *r;
+    return j;
+}
+
+sw_result sw_lod_cache_refine_leaves(sw_lod_cache *c, uint32_t face, const int32_t *nodes,
+                                     const double *tolerance, uint32_t n,
+                                     const sw_lod_cache_req *req, sw_th_group *group,
+                                     sw_lod_refine_outcome *outcome)
 {
     assert(c);
     sw_lod_refine_outcome oc_local, *oc = outcome ? outcome : &oc_local;
     const sw_lod_cache_req *r = req ? req : &default_req;
     *oc = SW_LOD_REFINE_DONE;
-    if (face >= c->n_faces || !(tolerance > 0.0) ||
+    if (face >= c->n_faces || n == 0 || !nodes || !tolerance ||
         sw_lod_cache_state_get(c, face) != SW_LOD_CACHE_READY)
         return SW_ERR_INVALID_ARGUMENT;
     if (req_stale(r)) {
@@ -606,19 +661,18 @@ sw_result sw_lod_cache_refine(sw_lod_cache *c, uint32_t face, int32_t node, doub
     slot *s = &c->slots[face];
     int32_t idle = -1;
     /* acquire: pairs with release_refining, so the version read next is the newest */
-    if (!atomic_compare_exchange_strong_explicit(&s->refining, &idle, node, memory_order_acquire,
-                                                 memory_order_relaxed)) {
+    if (!atomic_compare_exchange_strong_explicit(&s->refining, &idle, nodes[0],
+                                                 memory_order_acquire, memory_order_relaxed)) {
         *oc = SW_LOD_REFINE_BUSY;
         return SW_OK;
     }
-    sw_result res = refine_check(s, node, tolerance, oc);
+    sw_result res = refine_check(s, nodes, tolerance, n, oc);
     refine_job *j = NULL;
     if (res == SW_OK && *oc == SW_LOD_REFINE_SUBMITTED) {
-        j = malloc(sizeof *j);
+        j = refine_job_new(c, face, nodes, tolerance, n, r);
         res = j ? SW_OK : SW_ERR_OUT_OF_MEMORY;
     }
     if (j) {
-        *j = (refine_job){c, face, node, tolerance, *r};
         /* no token for the pool: the task must run to release the flag; it checks itself */
         const sw_th_task task = {refine_task, j, r->priority,
                                  NULL,        0, group ? group : &c->refine_group};
@@ -632,6 +686,18 @@ sw_result sw_lod_cache_refine(sw_lod_cache *c, uint32_t face, int32_t node, doub
         release_refining(s);
     }
     return res;
+}
+
+sw_result sw_lod_cache_refine(sw_lod_cache *c, uint32_t face, int32_t node, double tolerance,
+                              const sw_lod_cache_req *req, sw_th_group *group,
+                              sw_lod_refine_outcome *outcome)
+{
+    if (!(tolerance > 0.0)) {
+        if (outcome)
+            *outcome = SW_LOD_REFINE_DONE;
+        return SW_ERR_INVALID_ARGUMENT;
+    }
+    return sw_lod_cache_refine_leaves(c, face, &node, &tolerance, 1, req, group, outcome);
 }
 
 /* ---- life cycle and accounting --------------------------------------------------------------- */

@@ -112,6 +112,10 @@ sw_result sw_lod_cache_create(const sw_sg_scene *scene, sw_th_pool *pool,
 void sw_lod_cache_destroy(sw_lod_cache *cache);
 
 uint32_t sw_lod_cache_face_count(const sw_lod_cache *cache);
+/* The pool and scene the cache was created with (borrowed): a converged frame waits for its
+ * requests with sw_th_group_wait on this pool. */
+sw_th_pool *sw_lod_cache_pool(const sw_lod_cache *cache);
+const sw_sg_scene *sw_lod_cache_scene(const sw_lod_cache *cache);
 
 /* Any thread. Submits the face's build unless it is READY, FAILED, RUNNING, or QUEUED by a
  * request that covers this one (same token and generation, or no token, and at least this
@@ -150,6 +154,14 @@ sw_result sw_lod_cache_failure(const sw_lod_cache *cache, uint32_t face, sw_stat
 sw_result sw_lod_cache_refine(sw_lod_cache *cache, uint32_t face, int32_t node, double tolerance,
                               const sw_lod_cache_req *req, sw_th_group *group,
                               sw_lod_refine_outcome *outcome);
+
+/* As sw_lod_cache_refine for n leaves of one face at once (one task, one new version holding every
+ * refined subtree): SUBMITTED when at least one of them is a leaf above its tolerance. Errors as
+ * sw_lod_cache_refine (any node out of range or tolerance <= 0: SW_ERR_INVALID_ARGUMENT). */
+sw_result sw_lod_cache_refine_leaves(sw_lod_cache *cache, uint32_t face, const int32_t *nodes,
+                                     const double *tolerances, uint32_t n,
+                                     const sw_lod_cache_req *req, sw_th_group *group,
+                                     sw_lod_refine_outcome *outcome);
 
 /* ---- readers (epoch-based reclamation; the rule is at the top of this file) ------------------ */
 /* Claims a reader slot for the calling thread; returns its index, or -1 when all are taken. */

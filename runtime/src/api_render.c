@@ -2,7 +2,9 @@
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
 #include "sw_rt.h"
 
+#include "sw_lod_cache.h"
 #include "sw_status_util.h"
+#include "sw_th_pool.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -10,9 +12,16 @@
 #include <strings.h>
 #include <time.h>
 
+/* The hierarchies live with the renderer, for the scene it last drew: a walkthrough keeps drawing
+ * one scene, and the pool's workers then stay busy with that scene only. The renderer holds a
+ * reference to that scene: its workers may still build hierarchies from it after a walkthrough
+ * frame returned, and after the caller destroyed its handle. */
 typedef struct sw_rt_renderer {
     sw_gpu_context *gpu;
     pthread_t owner;
+    sw_th_pool *pool;          /* created on the first frame that needs it */
+    sw_lod_cache *cache;       /* of cache_scene */
+    sw_rt_scene *cache_scene;  /* retained while the cache lives; NULL = none */
 } sw_rt_renderer;
 
 static sw_rt_pool g_renderers = SW_RT_POOL_INIT;
@@ -76,6 +85,40 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
     return SW_OK;
 }
 
+/* Drops the hierarchy cache (waiting for its tasks), then the scene reference it needed. */
+static void drop_cache(sw_rt_renderer *r)
+{
+    sw_lod_cache_destroy(r->cache);
+    r->cache = NULL;
+    if (r->cache_scene)
+        sw_rt_scene_release(r->cache_scene);
+    r->cache_scene = NULL;
+}
+
+/* The renderer's hierarchy cache for `scene` (a cache of another scene is dropped first). The
+ * scene pointer identifies it: a retained scene cannot be freed, so its address is not reused. */
+static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_lod_cache **out,
+                                sw_status *status)
+{
+    if (r->cache && r->cache_scene == scene) {
+        *out = r->cache;
+        return SW_OK;
+    }
+    drop_cache(r);
+    if (!r->pool) {
+        sw_th_pool_desc pd = {0};
+        if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
+    }
+    sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
+    if (res == SW_OK) {
+        sw_rt_scene_retain(scene);
+        r->cache_scene = scene;
+    }
+    *out = r->cache;
+    return res;
+}
+
 sw_result sw_renderer_destroy(sw_renderer renderer)
 {
     void *item;
@@ -83,6 +126,8 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     if (r != SW_OK)
         return r; /* stale, or another thread's context: left untouched */
     sw_rt_renderer *rr = item;
+    drop_cache(rr);
+    sw_th_pool_destroy(rr->pool);
     sw_gpu_context_free(rr->gpu);
     free(rr);
     return SW_OK;
@@ -129,6 +174,11 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->patches_exact = g->patches_exact;
     out->atlas_pages = g->atlas_pages;
     out->trim_reused = g->trim_reused;
+    out->hierarchy_nodes = g->hlod_nodes;
+    out->refine_rounds = g->hlod_refine_rounds;
+    out->fallback_draws = g->hlod_fallback_faces + g->hlod_refine_requests;
+    out->pool_waits = g->hlod_waits;
+    out->ms_hierarchy = g->ms_hierarchy;
     out->ms_tessellate = g->ms_tessellate;
     out->ms_trim = g->ms_trim;
     out->ms_draw = g->ms_draw;
@@ -184,6 +234,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->background[0] = frame->background[1] = frame->background[2] = 1.0f;
     frame->background[3] = 1.0f;
     frame->eval_exact = desc->eval_exact != 0;
+    frame->walkthrough = desc->walkthrough != 0;
     frame->want_depth = 0;
     if (desc->output_path) {
         size_t n = strlen(desc->output_path);
@@ -192,7 +243,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
 }
 
 /* Renders and writes the frame of a checked desc on the renderer's thread. */
-static sw_result draw_frame(sw_rt_renderer *r, const sw_rt_scene *scene, const sw_frame_desc *desc,
+static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
                             sw_frame_stats *stats, sw_status *status)
 {
     double t0 = now_ms();
@@ -201,6 +252,11 @@ static sw_result draw_frame(sw_rt_renderer *r, const sw_rt_scene *scene, const s
     sw_result res = resolve_camera(&desc->camera, scene, &frame.camera, status);
     if (res != SW_OK)
         return res;
+    if (!frame.eval_exact && !desc->no_hierarchy) {
+        res = renderer_cache(r, scene, &frame.hierarchies, status);
+        if (res != SW_OK)
+            return res;
+    }
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
     res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);

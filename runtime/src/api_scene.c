@@ -179,6 +179,12 @@ static sw_result retain_scene(void *item, void *ctx)
     return SW_OK;
 }
 
+void sw_rt_scene_retain(sw_rt_scene *scene)
+{
+    /* Relaxed: the caller already holds a reference, so the count cannot reach 0 meanwhile. */
+    atomic_fetch_add_explicit(&scene->refs, 1u, memory_order_relaxed);
+}
+
 void sw_rt_scene_release(sw_rt_scene *scene)
 {
     /* acq_rel: every use of the scene by other holders happens before the last one frees it. */

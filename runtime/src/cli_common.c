@@ -163,8 +163,11 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
            (unsigned long long)s->triangles, (unsigned long long)s->trim_textures,
            (unsigned long long)s->trim_texels, (unsigned long long)s->trim_reused,
            (unsigned long long)s->atlas_pages);
-    printf("%*s  time: tessellate %.1f ms, trim textures %.1f ms, draw %.1f ms, readback %.1f ms, "
-           "write %.1f ms, total %.1f ms\n",
-           (int)strlen(label), "", s->ms_tessellate, s->ms_trim, s->ms_draw, s->ms_readback,
-           s->ms_write, s->ms_total);
+    if (s->hierarchy_nodes > 0)
+        printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
+               (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);
+    printf("%*s  time: hierarchy builds %.1f ms, tessellate %.1f ms, trim textures %.1f ms, draw "
+           "%.1f ms, readback %.1f ms, write %.1f ms, total %.1f ms\n",
+           (int)strlen(label), "", s->ms_hierarchy, s->ms_tessellate, s->ms_trim, s->ms_draw,
+           s->ms_readback, s->ms_write, s->ms_total);
 }

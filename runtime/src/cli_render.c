@@ -9,12 +9,12 @@
 static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
-    "                         [--eval bezier|exact]\n"
+    "                         [--eval hierarchy|bezier|exact]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as EXR\n"
-    "with a depth channel when FRAME ends in .exr. Prints how many Bézier patches were drawn\n"
-    "trimmed by trim textures, untrimmed, and culled, and how long each step took.\n"
+    "with a depth channel when FRAME ends in .exr. Prints how many patches were drawn trimmed by\n"
+    "trim textures, untrimmed, and culled, and how long each step took.\n"
     "\n"
     "options:\n"
     "  -o, --output FILE   image to write (.png or .exr; required)\n"
@@ -25,8 +25,11 @@ static const char k_usage[] =
     "                      right from +X up +Z\n"
     "  --camera LIST       eye, target, up and vertical field of view in degrees (overrides --view)\n"
     "  --error PX          screen-space error bound in pixels (default 0.5)\n"
-    "  --eval MODE         bezier (default): rational Bézier patches, degree <= 3 evaluated in\n"
-    "                      the vertex shader, higher degrees on the CPU; exact: every patch\n"
+    "  --eval MODE         hierarchy (default): each face drawn from its hierarchy of rational\n"
+    "                      bicubic patches (Guthe et al. 2005), nodes as coarse as the error\n"
+    "                      allows, built in a worker pool and evaluated in the vertex shader;\n"
+    "                      bezier: each face by its own rational Bézier patches, degree <= 3\n"
+    "                      in the vertex shader, higher degrees on the CPU; exact: every patch\n"
     "                      evaluated in the vertex shader from its knot vectors and control\n"
     "                      points (Krishnamurthy & Yasui), degree <= 15\n"
     "  -h, --help          this text\n";
@@ -54,8 +57,10 @@ static int parse_args(int argc, char **argv, render_args *a)
             bad = sw_cli_parse_camera(val, &a->frame.camera);
             a->has_camera = 1;
         } else if (!strcmp(arg, "--eval") && val) {
-            bad = strcmp(val, "bezier") != 0 && strcmp(val, "exact") != 0;
+            bad = strcmp(val, "hierarchy") != 0 && strcmp(val, "bezier") != 0 &&
+                  strcmp(val, "exact") != 0;
             a->frame.eval_exact = strcmp(val, "exact") == 0;
+            a->frame.no_hierarchy = strcmp(val, "bezier") == 0;
         } else if (!strcmp(arg, "--error") && val) {
             bad = sw_cli_parse_positive(val, &a->frame.error_px);
         } else if (arg[0] != '-' && !a->scene) {

@@ -57,6 +57,9 @@ typedef struct sw_rt_scene {
  * reference is held). */
 sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status);
 void sw_rt_scene_release(sw_rt_scene *scene); /* frees it when it was the last reference */
+/* One more reference, for a caller that already holds one (acquire) and keeps the scene beyond
+ * its call (a renderer's hierarchy cache). */
+void sw_rt_scene_retain(sw_rt_scene *scene);
 
 /* ---- cameras (camera.c) ---------------------------------------------------------------------- */
 /* Fits a preset to a world box (min xyz, max xyz) as sw_camera_fit documents. */

@@ -5,9 +5,11 @@
  *   test_api handles  SCENE.tsm WORKDIR   NULL descs and outs, stale and forged handles, double
  *                                         destroy, slot reuse, a scene destroyed while another
  *                                         thread saves it (no GL)
- *   test_api renderer SCENE.tsm WORKDIR   the renderer: bad frame descs, calls from a thread that
+ *   test_api renderer SCENE.tsm WORKDIR BIG_SCENE
+ *                                         the renderer: bad frame descs, calls from a thread that
  *                                         does not own the GL context, stale renderers and scenes,
- *                                         a scene destroyed while its owner draws it (EGL) */
+ *                                         a scene destroyed while its owner draws it, and
+ *                                         BIG_SCENE destroyed after a walkthrough frame (EGL) */
 #include <splinewalk/splinewalk.h>
 
 #include <math.h>
@@ -19,7 +21,7 @@
 #include <unistd.h>
 
 static int g_failures;
-static const char *g_scene_path, *g_work;
+static const char *g_scene_path, *g_work, *g_big_scene_path;
 
 static void expect_result(sw_result got, sw_result want, const char *call, int line)
 {
@@ -398,6 +400,30 @@ static void test_destroy_while_drawing(sw_renderer r)
            ROUNDS, draws);
 }
 
+/* A walkthrough frame returns while the renderer's workers may still build hierarchies from the
+ * scene (a model of a few hundred faces keeps them busy for tens of milliseconds); destroying the
+ * scene right after must not free it under them (ASan), and the next frame, of another scene,
+ * lets it go. */
+static void test_destroy_after_walkthrough(sw_renderer r)
+{
+    sw_scene_load_desc desc = {g_big_scene_path, NULL, NULL, NULL};
+    sw_scene big;
+    sw_status status = {0};
+    EXPECT_RESULT(sw_scene_load(&desc, &big, &status), SW_OK);
+    sw_frame_desc frame = small_frame(big);
+    frame.walkthrough = 1;
+    sw_frame_stats stats;
+    EXPECT_RESULT(sw_renderer_draw(r, &frame, &stats, NULL), SW_OK);
+    EXPECT_RESULT(sw_scene_destroy(big), SW_OK);
+    EXPECT_RESULT(sw_renderer_draw(r, &frame, NULL, NULL), SW_ERR_STALE_HANDLE);
+    printf("walkthrough frame: %llu fallback draws requested from the pool\n",
+           (unsigned long long)stats.fallback_draws);
+    sw_scene small = load_scene();
+    sw_frame_desc next = small_frame(small);
+    EXPECT_RESULT(sw_renderer_draw(r, &next, NULL, NULL), SW_OK);
+    EXPECT_RESULT(sw_scene_destroy(small), SW_OK);
+}
+
 static void test_renderer(void)
 {
     sw_renderer r = {77};
@@ -418,6 +444,7 @@ static void test_renderer(void)
     test_wrong_thread(r, scene);
     test_second_thread_renderer(scene);
     test_destroy_while_drawing(r);
+    test_destroy_after_walkthrough(r);
 
     sw_frame_desc frame = small_frame(scene);
     EXPECT_RESULT(sw_renderer_destroy(r), SW_OK);
@@ -436,12 +463,16 @@ static void test_renderer(void)
 
 int main(int argc, char **argv)
 {
-    if (argc != 4 || (strcmp(argv[1], "handles") != 0 && strcmp(argv[1], "renderer") != 0)) {
-        fprintf(stderr, "usage: test_api handles|renderer SCENE WORKDIR\n");
+    int handles = argc == 4 && !strcmp(argv[1], "handles");
+    int renderer = argc == 5 && !strcmp(argv[1], "renderer");
+    if (!handles && !renderer) {
+        fprintf(stderr, "usage: test_api handles SCENE WORKDIR\n"
+                        "       test_api renderer SCENE WORKDIR BIG_SCENE\n");
         return 2;
     }
     g_scene_path = argv[2];
     g_work = argv[3];
+    g_big_scene_path = renderer ? argv[4] : NULL;
     if (!strcmp(argv[1], "handles")) {
         test_null_arguments();
         test_stale_and_double_destroy();

@@ -11,11 +11,16 @@
  * Each view is rendered with crack filling off (the count is reported: it shows what the fat
  * borders close) and on (the count must be 0).
  *
- * Usage: test_gpu_cracks OUTDIR FILE...   (.brep / .step / .tsm)
+ * With --hierarchy faces are drawn from their bicubic hierarchies (§6-§7): neighbouring nodes of
+ * one face are then different bicubics at different densities, and their own fat borders must
+ * close those cracks too.
+ *
+ * Usage: test_gpu_cracks [--hierarchy] OUTDIR FILE...   (.brep / .step / .tsm)
  */
 #include "occt_reference.hpp" /* tests/support */
 
 #include <cstring>
+#include "hierarchy_support.h"
 #include "sw_gpu_internal.h"
 #include "sw_sg_import.h"
 #include "sw_sg_tspline.h"
@@ -28,6 +33,8 @@ namespace
 {
 
 const int k_width = 1280, k_height = 720;
+bool g_hierarchy = false; /* --hierarchy */
+sw_lod_cache *g_cache = nullptr;
 
 sw_gpu_camera view_camera(const double b[6], const double dir_in[3])
 {
@@ -147,6 +154,7 @@ bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_test::occt
     desc.height = k_height;
     desc.want_depth = 1;
     desc.camera = view_camera(box, k_dirs[view]);
+    desc.hierarchies = g_cache;
     sw_gpu_image off{}, on{}, theirs{};
     sw_gpu_frame_stats fs_off{}, fs_on{};
     if (!render(ctx, scene, desc, 0, off, fs_off) || !render(ctx, scene, desc, 1, on, fs_on))
@@ -227,8 +235,13 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
     std::string prefix =
         outdir + "/cracks_" + (slash == std::string::npos ? path : path.substr(slash + 1));
     bool ok = true;
-    for (int v = 0; v < 4; ++v)
+    sw_test_hierarchies *hier = g_hierarchy ? sw_test_hierarchies_create(scene) : nullptr;
+    g_cache = sw_test_hierarchies_cache(hier);
+    ok = !g_hierarchy || hier;
+    for (int v = 0; v < 4 && ok; ++v)
         ok = run_view(ctx, scene, tsm ? nullptr : &ref, deflection, box, v, prefix) && ok;
+    sw_test_hierarchies_free(hier);
+    g_cache = nullptr;
     sw_sg_scene_free(scene);
     return ok;
 }
@@ -237,10 +250,14 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
 
 int main(int argc, char **argv)
 {
+    bool hierarchy = argc > 1 && std::strcmp(argv[1], "--hierarchy") == 0;
+    argc -= hierarchy;
+    argv += hierarchy;
     if (argc < 3) {
-        std::fprintf(stderr, "usage: %s OUTDIR FILE...\n", argv[0]);
+        std::fprintf(stderr, "usage: %s [--hierarchy] OUTDIR FILE...\n", argv[0]);
         return 2;
     }
+    g_hierarchy = hierarchy;
     sw_gpu_context *ctx = nullptr;
     sw_status st{};
     if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK) {

@@ -14,9 +14,14 @@
  * Views: whole model (iso, fitted to the box), then mid (0.4 x that distance) and close-up
  * (0.15 x) looking at the middle of the piece with the most cells in the whole view.
  *
- * Usage: test_gpu_screen_error OUTDIR FILE...
+ * With --hierarchy the frame traverses the faces' bicubic hierarchies (§6-§7, a lod/ cache built in
+ * a worker pool): the drawn pieces are then hierarchy nodes whose bicubics only approximate the
+ * face, and the check against the exact NURBS covers their approximation error too.
+ *
+ * Usage: test_gpu_screen_error [--hierarchy] OUTDIR FILE...
  */
 #include "sw_gpu_internal.h"
+#include "sw_lod_cache.h"
 #include "sw_sg_import.h"
 #include "sw_sg_trim.h"
 
@@ -26,6 +31,7 @@
 #include <string.h>
 
 static const double k_eps_px = 0.5;
+static sw_th_pool *g_pool; /* --hierarchy: builds the hierarchies */
 static const int32_t k_width = 1280, k_height = 720;
 
 typedef struct piece {
@@ -276,9 +282,9 @@ static void busiest_point(const collector *c, double out[3])
         out[k] += c->view.eye[k];
 }
 
-static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, face_loops *fl,
-                    const double box[6], double fraction, const double *target, const char *name,
-                    const char *prefix, collector *c)
+static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *cache,
+                    face_loops *fl, const double box[6], double fraction, const double *target,
+                    const char *name, const char *prefix, collector *c)
 {
     sw_gpu_frame_desc desc;
     memset(&desc, 0, sizeof desc);
@@ -286,6 +292,7 @@ static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, face_loops *f
     desc.height = k_height;
     desc.error_px = k_eps_px;
     desc.camera = view_camera(box, fraction, target);
+    desc.hierarchies = cache;
     collector_clear(c);
     sw__gpu_set_patch_hook(ctx, hook, c);
     sw_gpu_image img;
@@ -320,11 +327,17 @@ static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, face_loops *f
         median = s.err[s.n / 2];
     }
     int ok = s.worst <= k_eps_px && s.n > 1000;
-    printf("%s %s: %zu pieces (%llu shader-evaluated patches), %llu triangles; %zu points "
-           "checked, max %.4f px, median %.4f px; skipped %llu outside the trim loops, %llu off "
-           "screen%s\n",
-           prefix, name, c->n, (unsigned long long)fs.patches_gpu_evaluated, s.triangles, s.n,
-           s.worst, median, s.skipped_trim, s.skipped_off, ok ? "" : "  <-- FAIL");
+    printf("%s %s: %zu pieces (%llu shader-evaluated patches, %llu hierarchy nodes, %llu over "
+           "budget, %llu refinement rounds), %llu triangles; %zu points checked, max %.4f px, "
+           "median %.4f px; skipped %llu outside the trim loops, %llu off screen%s\n",
+           prefix, name, c->n, (unsigned long long)fs.patches_gpu_evaluated,
+           (unsigned long long)fs.hlod_nodes, (unsigned long long)fs.hlod_over_budget,
+           (unsigned long long)fs.hlod_refine_rounds, s.triangles, s.n, s.worst, median,
+           s.skipped_trim, s.skipped_off, ok ? "" : "  <-- FAIL");
+    if (cache && fs.hlod_nodes == 0) {
+        printf("  <-- FAIL: --hierarchy drew no hierarchy node\n");
+        ok = 0;
+    }
     free(s.err);
     return ok;
 }
@@ -343,6 +356,11 @@ static int run_file(sw_gpu_context *ctx, const char *outdir, const char *path, c
     uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     face_loops *fl = calloc(n_faces ? n_faces : 1, sizeof *fl);
     int ok = fl != NULL;
+    sw_lod_cache *cache = NULL;
+    if (ok && g_pool && sw_lod_cache_create(scene, g_pool, NULL, &cache, &st) != SW_OK) {
+        fprintf(stderr, "hierarchy cache: %s\n", st.message);
+        ok = 0;
+    }
     const char *base = strrchr(path, '/');
     char prefix[1024];
     snprintf(prefix, sizeof prefix, "%s/%s", outdir, base ? base + 1 : path);
@@ -350,8 +368,8 @@ static int run_file(sw_gpu_context *ctx, const char *outdir, const char *path, c
     static const char *const names[3] = {"whole", "mid", "close"};
     double target[3];
     for (int k = 0; k < 3 && ok; ++k) {
-        ok = run_view(ctx, scene, fl, ss.bbox, fractions[k], k ? target : NULL, names[k], prefix,
-                      c) &&
+        ok = run_view(ctx, scene, cache, fl, ss.bbox, fractions[k], k ? target : NULL, names[k],
+                      prefix, c) &&
              ok;
         if (k == 0 && c->n > 0)
             busiest_point(c, target);
@@ -362,14 +380,24 @@ static int run_file(sw_gpu_context *ctx, const char *outdir, const char *path, c
         free(fl[f].loops);
     }
     free(fl);
+    sw_lod_cache_destroy(cache);
     sw_sg_scene_free(scene);
     return ok;
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 3) {
-        fprintf(stderr, "usage: %s OUTDIR FILE...\n", argv[0]);
+    int first = 1;
+    if (argc > 1 && strcmp(argv[1], "--hierarchy") == 0) {
+        sw_th_pool_desc pd = {0};
+        if (sw_th_pool_create(&pd, &g_pool) != SW_OK) {
+            fprintf(stderr, "FAIL: worker pool\n");
+            return 1;
+        }
+        first = 2;
+    }
+    if (argc < first + 2) {
+        fprintf(stderr, "usage: %s [--hierarchy] OUTDIR FILE...\n", argv[0]);
         return 2;
     }
     sw_status st = {0};
@@ -381,11 +409,12 @@ int main(int argc, char **argv)
     collector c;
     memset(&c, 0, sizeof c);
     int ok = 1;
-    for (int a = 2; a < argc; ++a)
-        ok = run_file(ctx, argv[1], argv[a], &c) && ok;
+    for (int a = first + 1; a < argc; ++a)
+        ok = run_file(ctx, argv[first], argv[a], &c) && ok;
     collector_clear(&c);
     free(c.p);
     sw_gpu_context_free(ctx);
+    sw_th_pool_destroy(g_pool);
     puts(ok ? "PASS" : "FAIL");
     return ok ? 0 : 1;
 }

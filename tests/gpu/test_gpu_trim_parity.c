@@ -7,11 +7,13 @@
  * texel centre written here. Texels farther than one texel from every loop segment must agree
  * exactly; texels on the boundary band may only be set (boundary texels count as inside).
  *
- * Four frames exercise the cache: frame 2 finds every entry of frame 1 (nothing re-rendered)
+ * Five frames exercise the cache: frame 2 finds every entry of frame 1 (nothing re-rendered)
  * and appends new ones into free space beside them (whose fans must not disturb the old entries);
  * frame 3 keeps some and adds one that needs a new page (the array texture grows, old layers
  * copied); frame 4, with a larger page size allowed, adds one larger than a page, forcing a
- * repack of every entry it uses into fresh pages.
+ * repack of every entry it uses into fresh pages; frame 5 adds a page whose first loop is empty,
+ * as a loop clipped away by a trim tile is (llvmpipe skipped a whole multi-draw whose first draw
+ * had no vertices: the page stayed blank).
  */
 #include "sw_gpu_internal.h"
 
@@ -26,14 +28,17 @@
 
 typedef struct shape {
     double star[4 * STAR_POINTS], hole[2 * HOLE_N], island[8];
-    sw_sg_polyline loops[3];
+    sw_sg_polyline all[4]; /* an empty loop, then the star, the hole and the island */
+    const sw_sg_polyline *loops;
+    uint32_t n_loops;
     double box[4];
     int w, h;
     int32_t id;
     sw__gpu_trim_key key;
 } shape;
 
-static void make_shape(shape *s, const double box[4], int w, int h, double phase, uint32_t face)
+static void make_shape(shape *s, const double box[4], int w, int h, double phase, uint32_t face,
+                       int leading_empty)
 {
     memcpy(s->box, box, sizeof s->box);
     s->w = w;
@@ -55,11 +60,15 @@ static void make_shape(shape *s, const double box[4], int w, int h, double phase
         s->island[2 * k] = cu + su * isl[2 * k];
         s->island[2 * k + 1] = cv + sv * isl[2 * k + 1];
     }
-    s->loops[0] = (sw_sg_polyline){s->star, 2 * STAR_POINTS};
-    s->loops[1] = (sw_sg_polyline){s->hole, HOLE_N};
-    s->loops[2] = (sw_sg_polyline){s->island, 4};
+    s->all[0] = (sw_sg_polyline){s->star, 0};
+    s->all[1] = (sw_sg_polyline){s->star, 2 * STAR_POINTS};
+    s->all[2] = (sw_sg_polyline){s->hole, HOLE_N};
+    s->all[3] = (sw_sg_polyline){s->island, 4};
+    s->loops = leading_empty ? s->all : s->all + 1;
+    s->n_loops = leading_empty ? 4 : 3;
     static const int k_scene_tag = 0;
-    s->key = (sw__gpu_trim_key){&k_scene_tag, face, 3 * face, 3, {box[0], box[1], box[2], box[3]}};
+    s->key = (sw__gpu_trim_key){&k_scene_tag, face, 4 * face, s->n_loops,
+                                {box[0], box[1], box[2], box[3]}};
     s->id = -1;
 }
 
@@ -118,10 +127,10 @@ static int check_entry(sw_gpu_context *ctx, const shape *s, const uint8_t *page,
         for (int x = 0; x < w; ++x) {
             double u = box[0] + (x + 0.5) * (box[1] - box[0]) / w;
             double v = box[2] + (y + 0.5) * (box[3] - box[2]) / h;
-            int want = cpu_inside(s->loops, 3, u, v);
+            int want = cpu_inside(s->loops, (int)s->n_loops, u, v);
             int got = page[(size_t)(rc.y0 + y) * (size_t)side + (size_t)(rc.x0 + x)] >= 128;
             inside += want;
-            if (texel_dist(s->loops, 3, box, w, h, x + 0.5, y + 0.5) <= 1.0) {
+            if (texel_dist(s->loops, (int)s->n_loops, box, w, h, x + 0.5, y + 0.5) <= 1.0) {
                 ++band;
                 band_unset_inside += want && !got;
                 continue;
@@ -185,7 +194,7 @@ static int frame(sw_gpu_context *ctx, shape *const *list, int n, sw__gpu_atlas_s
         shape *s = list[i];
         s->id = sw__gpu_atlas_find(ctx, &s->key, s->w, s->h);
         if (s->id < 0 &&
-            sw__gpu_atlas_add(ctx, &s->key, s->w, s->h, s->loops, 3, &s->id, &st) != SW_OK)
+            sw__gpu_atlas_add(ctx, &s->key, s->w, s->h, s->loops, s->n_loops, &s->id, &st) != SW_OK)
             return fprintf(stderr, "FAIL: add: %s\n", st.message), 0;
     }
     if (sw__gpu_atlas_commit(ctx, as, &st) != SW_OK)
@@ -212,23 +221,27 @@ int main(void)
     static const double thin[4] = {-0.25, 0.75, 10.0, 10.125};
     shape s[MAX_ENTRIES];
     /* Frame 1: a full-width entry and a full-height one (page edges), and several per page. */
-    make_shape(&s[0], unit, cap, 100, 0.3, 0);
-    make_shape(&s[1], offset, 300, cap, 0.9, 1);
-    make_shape(&s[2], unit, 256, 256, 1.7, 2);
-    make_shape(&s[3], offset, 777, 301, 2.2, 3);
-    make_shape(&s[4], thin, 400, 60, 0.1, 4);
-    make_shape(&s[5], unit, 128, 512, 2.9, 5);
-    make_shape(&s[6], offset, 60, 60, 0.5, 6);
+    make_shape(&s[0], unit, cap, 100, 0.3, 0, 0);
+    make_shape(&s[1], offset, 300, cap, 0.9, 1, 0);
+    make_shape(&s[2], unit, 256, 256, 1.7, 2, 0);
+    make_shape(&s[3], offset, 777, 301, 2.2, 3, 0);
+    make_shape(&s[4], thin, 400, 60, 0.1, 4, 0);
+    make_shape(&s[5], unit, 128, 512, 2.9, 5, 0);
+    make_shape(&s[6], offset, 60, 60, 0.5, 6, 0);
     /* Frame 2 adds, frame 3 adds one that forces a repack. */
-    make_shape(&s[7], unit, 200, 90, 1.1, 7);
-    make_shape(&s[8], thin, 90, 200, 2.5, 8);
-    make_shape(&s[9], offset, cap, cap, 0.7, 9);
-    make_shape(&s[10], unit, 1500, 1100, 1.3, 10);
+    make_shape(&s[7], unit, 200, 90, 1.1, 7, 0);
+    make_shape(&s[8], thin, 90, 200, 2.5, 8, 0);
+    make_shape(&s[9], offset, cap, cap, 0.7, 9, 0);
+    make_shape(&s[10], unit, 1500, 1100, 1.3, 10, 0);
     shape *f1[] = {&s[0], &s[1], &s[2], &s[3], &s[4], &s[5], &s[6]};
     shape *f2[] = {&s[0], &s[1], &s[2], &s[3], &s[4], &s[5], &s[6], &s[7], &s[8]};
     shape *f3[] = {&s[2], &s[3], &s[7], &s[9], &s[5]};
     shape *f4[] = {&s[9], &s[10], &s[0], &s[3]};
-    sw__gpu_atlas_stats a1, a2, a3, a4;
+    /* Frame 5: one that fills a page of its own, its first loop empty, and one beside old ones. */
+    make_shape(&s[11], offset, 2048 - 2 * SW__GPU_ATLAS_GUTTER, 1100, 2.0, 11, 1);
+    make_shape(&s[12], thin, 64, 64, 0.4, 12, 1);
+    shape *f5[] = {&s[9], &s[10], &s[11], &s[12]};
+    sw__gpu_atlas_stats a1, a2, a3, a4, a5;
     int ok = frame(ctx, f1, 7, &a1, "frame 1");
     ok &= a1.rendered == 7 && a1.pages >= 2 && a1.switches == a1.pages;
     ok &= frame(ctx, f2, 9, &a2, "frame 2");
@@ -238,6 +251,8 @@ int main(void)
     sw__gpu_atlas_set_max_side(ctx, 2048);
     ok &= frame(ctx, f4, 4, &a4, "frame 4");
     ok &= a4.repacks == 1 && a4.rendered == 4 && a4.side == 2048 && a4.switches == a4.pages;
+    ok &= frame(ctx, f5, 4, &a5, "frame 5");
+    ok &= a5.repacks == 0 && a5.rendered == 2 && a5.pages > a4.pages;
     sw_gpu_context_free(ctx);
     puts(ok ? "PASS" : "FAIL");
     return ok ? 0 : 1;

@@ -20,11 +20,16 @@
  * above sw__gpu_atlas_max_entry with SW_ERR_LIMIT, so SW_OK implies the bound; the test also
  * checks atlas_texels / atlas_pages <= GL_MAX_TEXTURE_SIZE^2 and the mean entry size.
  *
- * Usage: test_gpu_zoom OUTDIR Motor-c.brep [SHIFT_PX]
+ * With --hierarchy the frames traverse the face's bicubic hierarchy (§6-§7): there the nodes
+ * (refined below the leaves, and leaves cut into parts) carry the trim textures, and every frame
+ * must draw hierarchy nodes.
+ *
+ * Usage: test_gpu_zoom [--hierarchy] OUTDIR Motor-c.brep [SHIFT_PX]
  * SHIFT_PX (default 0) moves the reference curve sideways on screen: a control showing that the
  * check fails for a displaced edge (e.g. 1.5).
  */
 #include "sw_gpu_internal.h"
+#include "sw_lod_cache.h"
 #include "sw_sg_import.h"
 #include "sw_status_util.h"
 
@@ -35,6 +40,7 @@
 
 enum { W = 640, H = 360, N_FRAMES = 9 };
 static double g_shift_px = 0.0;
+static sw_lod_cache *g_cache; /* --hierarchy */
 static const double k_fovy = 40.0, k_oblique_deg = 30.0, k_tol_px = 1.0;
 
 static double dot3(const double a[3], const double b[3])
@@ -342,6 +348,7 @@ static int run_frame(sw_gpu_context *ctx, const sw_sg_scene *one, uint32_t f0, c
     desc.error_px = 0.5;
     desc.camera = fc.cam;
     desc.want_depth = 1;
+    desc.hierarchies = g_cache;
     sw_gpu_image img;
     sw_gpu_frame_stats fs;
     sw_status st = {0};
@@ -370,7 +377,11 @@ static int run_frame(sw_gpu_context *ctx, const sw_sg_scene *one, uint32_t f0, c
     double page = fs.atlas_pages ? (double)fs.atlas_texels / (double)fs.atlas_pages : 0.0;
     double mean = fs.trim_textures ? (double)fs.trim_texels / (double)fs.trim_textures : 0.0;
     int ok = fc.failed == 0 && fc.checked > 100 && page <= (double)max_tex * (double)max_tex &&
-             mean <= (double)max_entry * (double)max_entry && fs.trim_textures > 0;
+             mean <= (double)max_entry * (double)max_entry && fs.trim_textures > 0 &&
+             (!g_cache || fs.hlod_nodes > 0);
+    if (g_cache)
+        printf("frame %d: %llu hierarchy nodes drawn, %llu refinement rounds\n", idx,
+               (unsigned long long)fs.hlod_nodes, (unsigned long long)fs.hlod_refine_rounds);
     printf("frame %d: visible height %.6g (diag / %.0f): %llu trim textures, %llu texels "
            "(atlas %llu pages of %.0f texels; max entry %lld^2, GL max %lld); %lu curve points "
            "checked, %lu hidden; max distance to the coverage boundary %.3f px Chebyshev "
@@ -408,8 +419,11 @@ static uint32_t pick_face(const sw_sg_scene *scene)
 
 int main(int argc, char **argv)
 {
+    int hierarchy = argc > 1 && strcmp(argv[1], "--hierarchy") == 0;
+    argc -= hierarchy;
+    argv += hierarchy;
     if (argc != 3 && argc != 4) {
-        fprintf(stderr, "usage: %s OUTDIR Motor-c.brep [SHIFT_PX]\n", argv[0]);
+        fprintf(stderr, "usage: %s [--hierarchy] OUTDIR Motor-c.brep [SHIFT_PX]\n", argv[0]);
         return 2;
     }
     if (argc == 4)
@@ -446,10 +460,19 @@ int main(int argc, char **argv)
         return 1;
     }
     int ok = 1;
-    for (int i = 0; i < N_FRAMES; ++i)
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc pd = {0};
+    if (hierarchy && (sw_th_pool_create(&pd, &pool) != SW_OK ||
+                      sw_lod_cache_create(one, pool, NULL, &g_cache, &st) != SW_OK)) {
+        fprintf(stderr, "FAIL: hierarchy cache: %s\n", st.message);
+        ok = 0;
+    }
+    for (int i = 0; i < N_FRAMES && ok; ++i)
         ok = run_frame(ctx, one, 0, &tg, diag * pow(10.0, -4.0 * i / (N_FRAMES - 1)), diag, i,
                        argv[1], boundary) &&
              ok;
+    sw_lod_cache_destroy(g_cache);
+    sw_th_pool_destroy(pool);
     sw_gpu_context_free(ctx);
     free(boundary);
     sw_sg_scene_free(one);

@@ -647,6 +647,46 @@ static void refine_one(const model *m, sw_lod_cache *c, sw_th_pool *pool, uint32
     free(copy);
 }
 
+/* Several leaves of one face in one task: one new version, every leaf refined in it. */
+static void refine_many(sw_lod_cache *c, sw_th_pool *pool, uint32_t face)
+{
+    enum { MANY = 4 };
+    const sw_lod_hierarchy *h = sw_lod_cache_get(c, face);
+    int32_t nodes[MANY];
+    double tol[MANY], err[MANY];
+    uint32_t n = 0;
+    for (int32_t i = 0; i < h->n_nodes && n < MANY; ++i)
+        if (h->nodes[i].child[0] < 0 && h->nodes[i].error > 0.0) {
+            nodes[n] = i;
+            err[n] = h->nodes[i].error;
+            tol[n++] = h->nodes[i].error / 4;
+        }
+    const int32_t n_before = h->n_nodes; /* h is freed once replaced: no reader slot here */
+    if (n < 2)
+        return; /* a face with fewer inexact leaves shows nothing here */
+    sw_lod_cache_stats before, after;
+    sw_lod_cache_stats_get(c, &before);
+    sw_th_group g;
+    sw_th_group_init(&g);
+    sw_lod_refine_outcome oc;
+    CHECK(sw_lod_cache_refine_leaves(c, face, nodes, tol, n, NULL, &g, &oc) == SW_OK &&
+              oc == SW_LOD_REFINE_SUBMITTED,
+          "refine_leaves: outcome %d", (int)oc);
+    sw_th_group_wait(pool, &g);
+    sw_lod_cache_stats_get(c, &after);
+    const sw_lod_hierarchy *h2 = sw_lod_cache_get(c, face);
+    CHECK(after.refinements == before.refinements + 1 && h2->n_nodes > n_before,
+          "%u leaves: %llu versions published", n,
+          (unsigned long long)(after.refinements - before.refinements));
+    for (uint32_t k = 0; k < n; ++k) {
+        const sw_lod_hnode *l = &h2->nodes[nodes[k]];
+        CHECK(l->child[0] >= 0 || l->error < err[k],
+              "leaf %d of the batch not refined", nodes[k]);
+    }
+    printf("refine_leaves: %u leaves of face %u in one version (%d -> %d nodes)\n", n, face,
+           n_before, h2->n_nodes);
+}
+
 static void test_refine(const model *m, int rounds)
 {
     enum { FACES = 4, READERS = 2 };
@@ -739,6 +779,7 @@ static void test_refine(const model *m, int rounds)
            "readers meanwhile, %llu versions retired and freed; memory %zu -> %zu bytes\n",
            refined, nf, sections, READERS, (unsigned long long)st.versions_freed, mem0,
            sw_lod_cache_memory(c));
+    refine_many(c, pool, faces[0]);
     sw_lod_cache_destroy(c);
     sw_th_pool_destroy(pool);
 }

@@ -80,7 +80,8 @@ SW_API sw_result sw_scene_save(sw_scene scene, const char *path, sw_status *stat
 
 /* Frees the scene; later use of the handle yields SW_ERR_STALE_HANDLE. Any thread: a call using
  * the scene on another thread at that moment completes first (the memory goes with the last of
- * them). Errors: SW_ERR_STALE_HANDLE (already destroyed, or never valid). */
+ * them), and a renderer that last drew the scene keeps its memory, with the hierarchies it built,
+ * until it draws another scene or is destroyed. Errors: SW_ERR_STALE_HANDLE (already destroyed, or never valid). */
 SW_API sw_result sw_scene_destroy(sw_scene scene);
 
 #define SW_SURFACE_KIND_COUNT 12
@@ -139,7 +140,8 @@ typedef struct sw_renderer_desc {
  * SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (65,535 renderers). */
 SW_API sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out,
                                     sw_status *status);
-/* Frees the renderer and its GL context. Owner thread only. Errors: SW_ERR_STALE_HANDLE (already
+/* Frees the renderer, its GL context, its worker pool and the hierarchies it keeps (waiting for
+ * the pool's tasks). Owner thread only. Errors: SW_ERR_STALE_HANDLE (already
  * destroyed, or never valid), SW_ERR_INVALID_ARGUMENT (called from another thread: the renderer
  * stays alive and usable by its owner). */
 SW_API sw_result sw_renderer_destroy(sw_renderer renderer);
@@ -156,6 +158,14 @@ typedef struct sw_frame_desc {
     int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
                                 vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
                                 Bézier patches (degree <= 3 in the shader, higher on the CPU) */
+    int32_t no_hierarchy;    /* 0: each face drawn from its bicubic hierarchy (Guthe et al. 2005
+                                §6-§7: nodes as coarse as the view allows, built and refined in the
+                                renderer's worker pool and kept for later frames); 1: every face
+                                drawn by its own Bézier patches. Ignored with eval_exact. */
+    int32_t walkthrough;     /* 0: converged — the frame waits for every hierarchy build and
+                                refinement it asks for (deterministic images); 1: walkthrough — it
+                                never waits: what is not ready is drawn from what is at hand
+                                (Bézier patches, coarser nodes) and asked for, for later frames */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -165,11 +175,18 @@ typedef struct sw_frame_stats {
     uint64_t patches_gpu_evaluated; /* evaluated in the vertex shader; the rest are CPU grids */
     uint64_t patches_exact;         /* of those, by the exact NURBS path (eval_exact) */
     uint64_t atlas_pages, trim_reused; /* trim-texture atlas pages; textures kept from before */
+    uint64_t hierarchy_nodes;  /* hierarchy nodes drawn (0 with no_hierarchy) */
+    uint64_t refine_rounds;    /* rounds of refinement below the hierarchies' leaves waited for */
+    uint64_t fallback_draws;   /* walkthrough: faces drawn without their hierarchy, plus leaves
+                                  drawn coarser than the error asks, both requested from the pool */
+    uint64_t pool_waits;       /* times the frame waited for the pool (0 in walkthrough) */
+    double ms_hierarchy;       /* waiting for hierarchy builds and refinements */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
 } sw_frame_stats;
 
-/* Renders one converged frame (every refinement done before the frame is drawn, so the image is
- * deterministic: the same scene, camera and size give the image `splinewalk render` gives) and
+/* Renders one frame: converged by default (every refinement done before the frame is drawn, so
+ * the image is deterministic: the same scene, camera and size give the image `splinewalk render`
+ * gives), or walkthrough (desc->walkthrough: never waits for the renderer's worker pool), and
  * writes it to desc->output_path when that is not NULL (temporary name, then rename). Owner
  * thread only; the scene may be used by other threads meanwhile. desc is read during the call
  * only. stats may be NULL; it is written on success only.
