@@ -13,14 +13,16 @@
 #include <time.h>
 
 /* The hierarchies live with the renderer, for the scene it last drew: a walkthrough keeps drawing
- * one scene, and the pool's workers then stay busy with that scene only. */
+ * one scene, and the pool's workers then stay busy with that scene only. The renderer holds a
+ * reference to that scene: its workers may still build hierarchies from it after a walkthrough
+ * frame returned, and after the caller destroyed its handle. */
 typedef struct sw_rt_renderer {
     sw_gpu_context *gpu;
     pthread_t owner;
-    sw_th_pool *pool;        /* created on the first frame that needs it */
-    sw_lod_cache *cache;     /* of cache_scene */
-    uint32_t cache_scene;    /* scene handle id; 0 = none */
-    uint32_t worker_threads; /* the pool's size; 0 = one per online processor */
+    sw_th_pool *pool;          /* created on the first frame that needs it */
+    sw_lod_cache *cache;       /* of cache_scene */
+    sw_rt_scene *cache_scene;  /* retained while the cache lives; NULL = none */
+    uint32_t worker_threads;   /* the pool's size; 0 = one per online processor */
 } sw_rt_renderer;
 
 static sw_rt_pool g_renderers = SW_RT_POOL_INIT;
@@ -59,25 +61,86 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
     return SW_OK;
 }
 
+/* Runs under the renderer pool's lock: a renderer is only ever used and destroyed by its owner
+ * thread, so a caller that passes this check cannot see it freed under its feet, and a caller on
+ * another thread never reads past the lock. */
+static sw_result check_owner(void *item, void *ctx)
+{
+    (void)ctx;
+    return pthread_equal(((sw_rt_renderer *)item)->owner, pthread_self()) ? SW_OK
+                                                                          : SW_ERR_INVALID_ARGUMENT;
+}
+
+/* The renderer behind a handle, if the calling thread owns it. */
+static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_renderer **out,
+                                sw_status *status)
+{
+    void *item;
+    sw_result r = sw_rt_pool_get_checked(&g_renderers, handle.id, check_owner, NULL, &item);
+    *out = item;
+    if (r == SW_ERR_STALE_HANDLE)
+        return sw__fail(status, r, "%s: renderer handle %#x is stale or invalid", fn, handle.id);
+    if (r != SW_OK)
+        return sw__fail(status, r, "%s: called from a thread that does not own the renderer",
+                        fn);
+    return SW_OK;
+}
+
+/* Drops the hierarchy cache (waiting for its tasks), then the scene reference it needed. */
+static void drop_cache(sw_rt_renderer *r)
+{
+    sw_lod_cache_destroy(r->cache);
+    r->cache = NULL;
+    if (r->cache_scene)
+        sw_rt_scene_release(r->cache_scene);
+    r->cache_scene = NULL;
+}
+
+/* The renderer's hierarchy cache for `scene` (a cache of another scene is dropped first). The
+ * scene pointer identifies it: a retained scene cannot be freed, so its address is not reused. */
+static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_lod_cache **out,
+                                sw_status *status)
+{
+    if (r->cache && r->cache_scene == scene) {
+        *out = r->cache;
+        return SW_OK;
+    }
+    drop_cache(r);
+    if (!r->pool) {
+        sw_th_pool_desc pd = {0};
+        pd.worker_count = r->worker_threads;
+        if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
+    }
+    sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
+    if (res == SW_OK) {
+        sw_rt_scene_retain(scene);
+        r->cache_scene = scene;
+    }
+    *out = r->cache;
+    return res;
+}
+
 sw_result sw_renderer_destroy(sw_renderer renderer)
 {
-    sw_rt_renderer *r = sw_rt_pool_get(&g_renderers, renderer.id);
-    if (!r)
-        return SW_ERR_STALE_HANDLE;
-    if (!pthread_equal(r->owner, pthread_self()))
-        return SW_ERR_INVALID_ARGUMENT; /* its GL context is current on another thread */
-    sw_rt_pool_remove(&g_renderers, renderer.id);
-    sw_lod_cache_destroy(r->cache);
-    sw_th_pool_destroy(r->pool);
-    sw_gpu_context_free(r->gpu);
-    free(r);
+    void *item;
+    sw_result r = sw_rt_pool_remove_checked(&g_renderers, renderer.id, check_owner, NULL, &item);
+    if (r != SW_OK)
+        return r; /* stale, or another thread's context: left untouched */
+    sw_rt_renderer *rr = item;
+    drop_cache(rr);
+    sw_th_pool_destroy(rr->pool);
+    sw_gpu_context_free(rr->gpu);
+    free(rr);
     return SW_OK;
 }
 
 const char *sw_renderer_description_ptr(sw_renderer renderer)
 {
-    sw_rt_renderer *r = sw_rt_pool_get(&g_renderers, renderer.id);
-    return r ? sw_gpu_context_description_ptr(r->gpu) : "";
+    sw_rt_renderer *r;
+    if (owned_renderer(renderer, "sw_renderer_description_ptr", &r, NULL) != SW_OK)
+        return "";
+    return sw_gpu_context_description_ptr(r->gpu);
 }
 
 static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
@@ -97,30 +160,6 @@ static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera has a non-finite coordinate");
     }
     return SW_OK;
-}
-
-/* The renderer's hierarchy cache for `scene` (a cache of another scene is dropped first). */
-static sw_result renderer_cache(sw_rt_renderer *r, sw_scene handle, sw_rt_scene *scene,
-                                sw_lod_cache **out, sw_status *status)
-{
-    if (r->cache && r->cache_scene == handle.id) {
-        *out = r->cache;
-        return SW_OK;
-    }
-    sw_lod_cache_destroy(r->cache);
-    r->cache = NULL;
-    r->cache_scene = 0;
-    if (!r->pool) {
-        sw_th_pool_desc pd = {0};
-        pd.worker_count = r->worker_threads;
-        if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
-            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
-    }
-    sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
-    if (res == SW_OK)
-        r->cache_scene = handle.id;
-    *out = r->cache;
-    return res;
 }
 
 static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
@@ -148,53 +187,78 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->ms_readback = g->ms_readback;
 }
 
-sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_frame_stats *stats,
-                           sw_status *status)
+static int camera_is_zero(const sw_camera *c)
 {
-    if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
-    sw_rt_renderer *r = sw_rt_pool_get(&g_renderers, renderer.id);
-    if (!r)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "renderer handle %#x is stale or invalid",
-                        renderer.id);
-    if (!pthread_equal(r->owner, pthread_self()))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "sw_renderer_draw called from a thread that does not own the GL context");
-    sw_result res = check_frame_desc(desc, status);
-    if (res != SW_OK)
-        return res;
-    sw_rt_scene *scene;
-    res = sw_rt_scene_acquire(desc->scene, &scene, status);
-    if (res != SW_OK)
-        return res;
-
-    double t0 = now_ms();
-    sw_gpu_frame_desc frame = {0};
-    frame.width = desc->width ? desc->width : 1280;
-    frame.height = desc->height ? desc->height : 720;
-    frame.error_px = desc->error_px > 0.0 ? desc->error_px : 0.5;
     for (int k = 0; k < 3; k++) {
-        frame.camera.eye[k] = desc->camera.eye[k];
-        frame.camera.target[k] = desc->camera.target[k];
-        frame.camera.up[k] = desc->camera.up[k];
+        if (c->eye[k] != 0.0 || c->target[k] != 0.0 || c->up[k] != 0.0)
+            return 0;
     }
-    frame.camera.fovy_deg = desc->camera.fovy_deg > 0.0 ? desc->camera.fovy_deg : 40.0;
-    frame.background[0] = frame.background[1] = frame.background[2] = 1.0f;
-    frame.background[3] = 1.0f;
-    frame.eval_exact = desc->eval_exact != 0;
-    frame.walkthrough = desc->walkthrough != 0;
-    frame.want_depth = 0;
+    return c->fovy_deg == 0.0;
+}
+
+/* The frame's camera: a zero camera means the iso preset fitted to the scene (zero = default);
+ * otherwise eye, target and up must span a view (a degenerate one would yield NaN matrices and an
+ * empty image instead of an error). */
+static sw_result resolve_camera(const sw_camera *in, const sw_rt_scene *scene, sw_gpu_camera *out,
+                                sw_status *status)
+{
+    sw_camera c = *in;
+    if (camera_is_zero(&c))
+        sw_rt_camera_fit_box(scene->stats.bbox, SW_VIEW_ISO, &c);
+    double d[3], cross[3], dd = 0.0, uu = 0.0, cc = 0.0;
+    for (int k = 0; k < 3; k++)
+        d[k] = c.target[k] - c.eye[k];
+    for (int k = 0; k < 3; k++) {
+        cross[k] = d[(k + 1) % 3] * c.up[(k + 2) % 3] - d[(k + 2) % 3] * c.up[(k + 1) % 3];
+        dd += d[k] * d[k];
+        uu += c.up[k] * c.up[k];
+        cc += cross[k] * cross[k];
+    }
+    if (!(dd > 0.0))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera: eye equals target");
+    if (!(cc > 1e-24 * dd * uu))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "camera: up is zero or parallel to the view direction");
+    for (int k = 0; k < 3; k++) {
+        out->eye[k] = c.eye[k];
+        out->target[k] = c.target[k];
+        out->up[k] = c.up[k];
+    }
+    out->fovy_deg = c.fovy_deg > 0.0 ? c.fovy_deg : 40.0;
+    return SW_OK;
+}
+
+static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
+{
+    frame->width = desc->width ? desc->width : 1280;
+    frame->height = desc->height ? desc->height : 720;
+    frame->error_px = desc->error_px > 0.0 ? desc->error_px : 0.5;
+    frame->background[0] = frame->background[1] = frame->background[2] = 1.0f;
+    frame->background[3] = 1.0f;
+    frame->eval_exact = desc->eval_exact != 0;
+    frame->walkthrough = desc->walkthrough != 0;
+    frame->want_depth = 0;
     if (desc->output_path) {
         size_t n = strlen(desc->output_path);
-        frame.want_depth = n > 4 && strcasecmp(desc->output_path + n - 4, ".exr") == 0;
+        frame->want_depth = n > 4 && strcasecmp(desc->output_path + n - 4, ".exr") == 0;
     }
+}
 
+/* Renders and writes the frame of a checked desc on the renderer's thread. */
+static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
+                            sw_frame_stats *stats, sw_status *status)
+{
+    double t0 = now_ms();
+    sw_gpu_frame_desc frame = {0};
+    frame_from_desc(desc, &frame);
+    sw_result res = resolve_camera(&desc->camera, scene, &frame.camera, status);
+    if (res != SW_OK)
+        return res;
     if (!frame.eval_exact && !desc->no_hierarchy) {
-        res = renderer_cache(r, desc->scene, scene, &frame.hierarchies, status);
+        res = renderer_cache(r, scene, &frame.hierarchies, status);
         if (res != SW_OK)
             return res;
     }
-
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
     res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);
@@ -208,5 +272,26 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
         stats->ms_write = t2 - t1;
         stats->ms_total = t2 - t0;
     }
+    return res;
+}
+
+sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_frame_stats *stats,
+                           sw_status *status)
+{
+    if (!desc)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
+    sw_rt_renderer *r;
+    sw_result res = owned_renderer(renderer, "sw_renderer_draw", &r, status);
+    if (res != SW_OK)
+        return res;
+    res = check_frame_desc(desc, status);
+    if (res != SW_OK)
+        return res;
+    sw_rt_scene *scene;
+    res = sw_rt_scene_acquire(desc->scene, &scene, status);
+    if (res != SW_OK)
+        return res;
+    res = draw_frame(r, scene, desc, stats, status);
+    sw_rt_scene_release(scene);
     return res;
 }

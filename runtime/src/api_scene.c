@@ -36,6 +36,7 @@ static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
     }
     scene->sg = sg;
+    atomic_init(&scene->refs, 1u); /* the pool's reference, dropped by sw_scene_destroy */
     pthread_mutex_init(&scene->once_lock, NULL);
     uint32_t id = sw_rt_pool_add(&g_scenes, scene);
     if (!id) {
@@ -51,9 +52,10 @@ static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
 
 sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status)
 {
+    if (out)
+        out->id = 0;
     if (!desc || !desc->path || !out)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load: NULL desc, path or out");
-    out->id = 0;
     sw_sg_scene *sg = NULL;
     sw_result r;
     if (has_extension(desc->path, ".sws")) {
@@ -167,13 +169,36 @@ sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *
     return wrap_scene(sg, out, status);
 }
 
-sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status)
+/* Runs under the scene pool's lock, so sw_scene_destroy cannot drop the pool's reference (and
+ * free the scene) between the lookup and this increment. Relaxed: the pool's lock orders it
+ * against the removal, and the count is already at least 1 here. */
+static sw_result retain_scene(void *item, void *ctx)
 {
-    sw_rt_scene *scene = sw_rt_pool_get(&g_scenes, handle.id);
-    if (!scene)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
-                        handle.id);
-    /* once_lock: the first use verifies every section and computes the stats exactly once. */
+    (void)ctx;
+    atomic_fetch_add_explicit(&((sw_rt_scene *)item)->refs, 1u, memory_order_relaxed);
+    return SW_OK;
+}
+
+void sw_rt_scene_retain(sw_rt_scene *scene)
+{
+    /* Relaxed: the caller already holds a reference, so the count cannot reach 0 meanwhile. */
+    atomic_fetch_add_explicit(&scene->refs, 1u, memory_order_relaxed);
+}
+
+void sw_rt_scene_release(sw_rt_scene *scene)
+{
+    /* acq_rel: every use of the scene by other holders happens before the last one frees it. */
+    if (atomic_fetch_sub_explicit(&scene->refs, 1u, memory_order_acq_rel) != 1u)
+        return;
+    sw_sg_scene_free(scene->sg);
+    pthread_mutex_destroy(&scene->once_lock);
+    free(scene);
+}
+
+/* Verifies every section and computes the stats, exactly once per scene. Locks once_lock, which
+ * guards `ready`, `ready_result` and `stats`. */
+static sw_result make_ready(sw_rt_scene *scene, sw_status *status)
+{
     pthread_mutex_lock(&scene->once_lock);
     if (!scene->ready) {
         sw_status local = {0};
@@ -193,8 +218,24 @@ sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *sta
     }
     sw_result r = scene->ready_result;
     pthread_mutex_unlock(&scene->once_lock);
-    *out = scene;
     return r;
+}
+
+sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status)
+{
+    void *item;
+    *out = NULL;
+    if (sw_rt_pool_get_checked(&g_scenes, handle.id, retain_scene, NULL, &item) != SW_OK)
+        return sw__fail(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
+                        handle.id);
+    sw_rt_scene *scene = item;
+    sw_result r = make_ready(scene, status);
+    if (r != SW_OK) {
+        sw_rt_scene_release(scene);
+        return r;
+    }
+    *out = scene;
+    return SW_OK;
 }
 
 sw_result sw_scene_save(sw_scene handle, const char *path, sw_status *status)
@@ -205,7 +246,9 @@ sw_result sw_scene_save(sw_scene handle, const char *path, sw_status *status)
     sw_result r = sw_rt_scene_acquire(handle, &scene, status);
     if (r != SW_OK)
         return r;
-    return sw_sg_scene_save(scene->sg, path, status);
+    r = sw_sg_scene_save(scene->sg, path, status);
+    sw_rt_scene_release(scene);
+    return r;
 }
 
 sw_result sw_scene_destroy(sw_scene handle)
@@ -213,9 +256,7 @@ sw_result sw_scene_destroy(sw_scene handle)
     sw_rt_scene *scene = sw_rt_pool_remove(&g_scenes, handle.id);
     if (!scene)
         return SW_ERR_STALE_HANDLE;
-    sw_sg_scene_free(scene->sg);
-    pthread_mutex_destroy(&scene->once_lock);
-    free(scene);
+    sw_rt_scene_release(scene); /* freed now, or by the last call still using it */
     return SW_OK;
 }
 
@@ -247,6 +288,7 @@ sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *stat
     memcpy(out->bbox_min, s->bbox, sizeof out->bbox_min);
     memcpy(out->bbox_max, s->bbox + 3, sizeof out->bbox_max);
     out->memory_bytes = sw_sg_scene_memory(scene->sg);
+    sw_rt_scene_release(scene);
     return SW_OK;
 }
 
@@ -264,5 +306,6 @@ sw_result sw_camera_fit(sw_scene handle, sw_view_preset view, sw_camera *out, sw
     if (r != SW_OK)
         return r;
     sw_rt_camera_fit_box(scene->stats.bbox, view, out);
+    sw_rt_scene_release(scene);
     return SW_OK;
 }

@@ -52,6 +52,8 @@ static int check_scene(const char *path, const osd_args *a)
     uint32_t n_faces = r == SW_OK ? sw_sg_scene_view_ptr(scene->sg)->n_faces : 0;
     for (uint32_t f = 0; f < n_faces && r == SW_OK; f++)
         r = sw_lod_osd_check_face(scene->sg, f, a->samples, 1000 + f, &rep, &status);
+    if (scene)
+        sw_rt_scene_release(scene);
     sw_scene_destroy(handle);
     if (r != SW_OK)
         return sw_cli_report("check-osd", &status);

@@ -60,31 +60,56 @@ static int slot_of(const sw_rt_pool *pool, uint32_t id, uint32_t *slot)
     return pool->items[*slot] && pool->generations[*slot] == (uint16_t)(id >> 16);
 }
 
-/* Locks pool->lock (see sw_rt_pool_add). */
-void *sw_rt_pool_get(sw_rt_pool *pool, uint32_t id)
+/* Locks pool->lock (see sw_rt_pool_add); `check` runs under it. */
+sw_result sw_rt_pool_get_checked(sw_rt_pool *pool, uint32_t id, sw_rt_pool_check_fn check,
+                                 void *ctx, void **out)
 {
-    void *item = NULL;
+    sw_result r = SW_ERR_STALE_HANDLE;
     uint32_t slot;
-    pthread_mutex_lock(&pool->lock);
-    if (slot_of(pool, id, &slot))
-        item = pool->items[slot];
-    pthread_mutex_unlock(&pool->lock);
-    return item;
-}
-
-/* Locks pool->lock (see sw_rt_pool_add). The slot's generation moves on (never to 0), so every
- * handle to the removed item goes stale. */
-void *sw_rt_pool_remove(sw_rt_pool *pool, uint32_t id)
-{
-    void *item = NULL;
-    uint32_t slot;
+    *out = NULL;
     pthread_mutex_lock(&pool->lock);
     if (slot_of(pool, id, &slot)) {
-        item = pool->items[slot];
-        pool->items[slot] = NULL;
-        uint16_t next = (uint16_t)(pool->generations[slot] + 1);
-        pool->generations[slot] = next ? next : 1;
+        r = check(pool->items[slot], ctx);
+        if (r == SW_OK)
+            *out = pool->items[slot];
     }
     pthread_mutex_unlock(&pool->lock);
+    return r;
+}
+
+/* Locks pool->lock (see sw_rt_pool_add); `check` runs under it, so no other thread can remove
+ * the item between the check and the removal. The slot's generation moves on (never to 0), so
+ * every handle to the removed item goes stale. */
+sw_result sw_rt_pool_remove_checked(sw_rt_pool *pool, uint32_t id, sw_rt_pool_check_fn check,
+                                    void *ctx, void **out)
+{
+    sw_result r = SW_ERR_STALE_HANDLE;
+    uint32_t slot;
+    *out = NULL;
+    pthread_mutex_lock(&pool->lock);
+    if (slot_of(pool, id, &slot)) {
+        r = check(pool->items[slot], ctx);
+        if (r == SW_OK) {
+            *out = pool->items[slot];
+            pool->items[slot] = NULL;
+            uint16_t next = (uint16_t)(pool->generations[slot] + 1);
+            pool->generations[slot] = next ? next : 1;
+        }
+    }
+    pthread_mutex_unlock(&pool->lock);
+    return r;
+}
+
+static sw_result accept_any(void *item, void *ctx)
+{
+    (void)item;
+    (void)ctx;
+    return SW_OK;
+}
+
+void *sw_rt_pool_remove(sw_rt_pool *pool, uint32_t id)
+{
+    void *item;
+    sw_rt_pool_remove_checked(pool, id, accept_any, NULL, &item);
     return item;
 }

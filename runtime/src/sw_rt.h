@@ -8,6 +8,7 @@
 #include "sw_sg_scene.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 
 /* ---- handle pools (handle_pool.c) -------------------------------------------------------------
@@ -23,13 +24,27 @@ typedef struct sw_rt_pool {
 #define SW_RT_POOL_INIT {PTHREAD_MUTEX_INITIALIZER, NULL, NULL, 0}
 #define SW_RT_POOL_MAX_SLOTS 65535u
 
-uint32_t sw_rt_pool_add(sw_rt_pool *pool, void *item);    /* 0 when full or out of memory */
-void *sw_rt_pool_get(sw_rt_pool *pool, uint32_t id);      /* NULL for stale or invalid ids */
-void *sw_rt_pool_remove(sw_rt_pool *pool, uint32_t id);   /* NULL for stale or invalid ids */
+uint32_t sw_rt_pool_add(sw_rt_pool *pool, void *item);  /* 0 when full or out of memory */
+void *sw_rt_pool_remove(sw_rt_pool *pool, uint32_t id); /* NULL for stale or invalid ids */
+
+/* A check (or a reference count increment) made while the pool's lock is held, so that the item
+ * cannot be removed and freed by another thread between its lookup and the check. It must be
+ * short and must not call into the pool. SW_OK accepts the item. */
+typedef sw_result (*sw_rt_pool_check_fn)(void *item, void *ctx);
+/* Looks `id` up and runs `check` on its item under the lock. Returns SW_ERR_STALE_HANDLE for a
+ * stale or invalid id, else check's result; *out = the item when that is SW_OK, else NULL. */
+sw_result sw_rt_pool_get_checked(sw_rt_pool *pool, uint32_t id, sw_rt_pool_check_fn check,
+                                 void *ctx, void **out);
+/* The same, and removes the item (the handle goes stale) when check accepts it. */
+sw_result sw_rt_pool_remove_checked(sw_rt_pool *pool, uint32_t id, sw_rt_pool_check_fn check,
+                                    void *ctx, void **out);
 
 /* ---- scenes (api_scene.c) -------------------------------------------------------------------- */
 typedef struct sw_rt_scene {
     sw_sg_scene *sg;
+    /* The pool's reference plus one per call using the scene: a scene destroyed while another
+     * thread saves or draws it is freed by the last of them, never under their feet. */
+    atomic_uint refs;
     pthread_mutex_t once_lock; /* guards `ready`, `ready_result` and `stats` (first use only) */
     int ready;
     sw_result ready_result;
@@ -37,8 +52,14 @@ typedef struct sw_rt_scene {
 } sw_rt_scene;
 
 /* The scene behind a handle, with every section verified and its stats computed (first call does
- * the work). Errors: SW_ERR_STALE_HANDLE, or whatever the first verification found. */
+ * the work), holding a reference that the caller gives back with sw_rt_scene_release. Errors:
+ * SW_ERR_STALE_HANDLE, or whatever the first verification found (then *out = NULL and no
+ * reference is held). */
 sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status);
+void sw_rt_scene_release(sw_rt_scene *scene); /* frees it when it was the last reference */
+/* One more reference, for a caller that already holds one (acquire) and keeps the scene beyond
+ * its call (a renderer's hierarchy cache). */
+void sw_rt_scene_retain(sw_rt_scene *scene);
 
 /* ---- cameras (camera.c) ---------------------------------------------------------------------- */
 /* Fits a preset to a world box (min xyz, max xyz) as sw_camera_fit documents. */

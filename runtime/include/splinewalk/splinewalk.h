@@ -10,9 +10,22 @@
  * sw_status with the file, position and what was expected; a failed call changes nothing and calls
  * no callback after reporting the failure.
  *
- * Threads: scene handles may be used from any thread (a loaded scene is immutable). A renderer owns
- * a GL context and must be used only on the thread that created it (SW_ERR_INVALID_ARGUMENT
- * otherwise).
+ * Threads: scene handles may be used from any thread (a loaded scene is immutable); a scene
+ * destroyed while another thread saves, describes or draws it stays alive until that call returns,
+ * and later calls with its handle return SW_ERR_STALE_HANDLE. A renderer owns a GL context and
+ * must be used and destroyed only on the thread that created it: a call from another thread
+ * returns SW_ERR_INVALID_ARGUMENT and changes nothing.
+ *
+ * Handles: a handle holds a slot index and a 16-bit generation; {0} is never valid. After destroy
+ * every copy of the handle is stale, also once the slot is reused, until its generation wraps
+ * after 65,535 reuses of the same slot. Destroying twice returns SW_ERR_STALE_HANDLE.
+ *
+ * Ownership: the library keeps no pointer into caller memory after a call returns, except the
+ * callbacks of a load while it runs. `*_ptr` functions return borrowed strings.
+ *
+ * Results: every function returning sw_result may also be given status == NULL; on failure the
+ * status (when given) holds the result and a message naming the file, position or argument.
+ * Outputs (`out`) are zeroed on failure where the documentation says so, untouched otherwise.
  */
 #ifndef SPLINEWALK_H
 #define SPLINEWALK_H
@@ -42,20 +55,33 @@ typedef struct sw_scene_load_desc {
 } sw_scene_load_desc;
 
 /* Loads or imports a scene. A .sws file is mapped and checked (header, section table, size;
- * checksums are verified before first use). Errors: SW_ERR_INVALID_ARGUMENT (NULL desc or path),
- * SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_TRUNCATED, SW_ERR_CHECKSUM, SW_ERR_VERSION,
- * SW_ERR_UNSUPPORTED, SW_ERR_INVALID_GEOMETRY, SW_ERR_OUT_OF_MEMORY, SW_ERR_INTERNAL. */
+ * checksums are verified before first use). Any thread; several loads may run at once. The
+ * scene is the caller's: free it with sw_scene_destroy. desc and desc->path are read during the
+ * call only; callbacks run on the calling thread before it returns, never after a failure is
+ * returned. *out = {0} on failure.
+ * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc, path or out), SW_ERR_UNSUPPORTED (unknown
+ * extension or input), SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_TRUNCATED,
+ * SW_ERR_CHECKSUM, SW_ERR_VERSION, SW_ERR_INVALID_GEOMETRY, SW_ERR_OUT_OF_MEMORY,
+ * SW_ERR_LIMIT (65,535 scenes alive), SW_ERR_INTERNAL. */
 SW_API sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status);
 
 /* Builds the built-in default scene (OCCT's sample furniture arranged in its room, plus a motor)
- * from the occt-misc data directory `data_dir` (NULL: /usr/share/opencascade/data). */
+ * from the occt-misc data directory `data_dir` (NULL: /usr/share/opencascade/data). desc may be
+ * NULL; only its callbacks and user_data are used (its path is ignored). Thread, ownership and
+ * *out as sw_scene_load. Errors: SW_ERR_INVALID_ARGUMENT (NULL out, data_dir too long), and those
+ * of importing a file (SW_ERR_NOT_FOUND when the occt-misc data is missing). */
 SW_API sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *desc,
                                        sw_scene *out, sw_status *status);
 
-/* Writes the scene as .sws (temporary name, then rename). Errors: SW_ERR_STALE_HANDLE, SW_ERR_IO. */
+/* Writes the scene as .sws (temporary name, then rename: a failure leaves `path` as it was). Any
+ * thread. Errors: SW_ERR_INVALID_ARGUMENT (NULL path), SW_ERR_STALE_HANDLE, SW_ERR_IO, and
+ * SW_ERR_CHECKSUM / SW_ERR_FORMAT for a mapped scene found corrupt on first use. */
 SW_API sw_result sw_scene_save(sw_scene scene, const char *path, sw_status *status);
 
-/* Frees the scene; later use of the handle yields SW_ERR_STALE_HANDLE. */
+/* Frees the scene; later use of the handle yields SW_ERR_STALE_HANDLE. Any thread: a call using
+ * the scene on another thread at that moment completes first (the memory goes with the last of
+ * them), and a renderer that last drew the scene keeps its memory, with the hierarchies it built,
+ * until it draws another scene or is destroyed. Errors: SW_ERR_STALE_HANDLE (already destroyed, or never valid). */
 SW_API sw_result sw_scene_destroy(sw_scene scene);
 
 #define SW_SURFACE_KIND_COUNT 12
@@ -72,10 +98,16 @@ typedef struct sw_scene_info {
     size_t memory_bytes;
 } sw_scene_info;
 
+/* Describes the scene (the first call on a scene verifies it and walks it once). Any thread.
+ * Errors: SW_ERR_INVALID_ARGUMENT (NULL out), SW_ERR_STALE_HANDLE, SW_ERR_CHECKSUM /
+ * SW_ERR_FORMAT (a corrupt mapped scene), SW_ERR_OUT_OF_MEMORY. */
 SW_API sw_result sw_scene_get_info(sw_scene scene, sw_scene_info *out, sw_status *status);
-SW_API const char *sw_surface_kind_name(uint32_t kind); /* "plane", "cylinder", ...; never NULL */
+/* "plane", "cylinder", ...; "unknown" out of range; never NULL. A static string; any thread. */
+SW_API const char *sw_surface_kind_name(uint32_t kind);
 
 /* ---- cameras --------------------------------------------------------------------------------- */
+/* Right-handed, world units. All zero: the iso preset fitted to the drawn scene. Otherwise eye and
+ * target must differ and up must not be parallel to target - eye. */
 typedef struct sw_camera {
     double eye[3], target[3], up[3];
     double fovy_deg; /* vertical field of view in degrees; 0 = 40 */
@@ -89,7 +121,9 @@ typedef enum sw_view_preset {
 } sw_view_preset;
 
 /* Fits a preset to the scene's bounding box: fovy 40°, target = box centre, distance =
- * diagonal / (2 tan(fovy/2)) × 1.1. Errors: SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT. */
+ * diagonal / (2 tan(fovy/2)) × 1.1 — the cameras of `splinewalk render --view`. Any thread.
+ * Errors: SW_ERR_INVALID_ARGUMENT (NULL out, view not a preset), SW_ERR_STALE_HANDLE,
+ * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene). */
 SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *out,
                                sw_status *status);
 
@@ -100,13 +134,20 @@ typedef struct sw_renderer_desc {
                                 runs pool tasks while it waits for them. At most 1024. */
 } sw_renderer_desc;
 
-/* Creates a headless renderer (EGL; llvmpipe when there is no GPU) owned by the calling thread.
- * desc may be NULL. Errors: SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY,
- * SW_ERR_INVALID_ARGUMENT (worker_threads above 1024). */
+/* Creates a headless renderer (EGL; llvmpipe when there is no GPU) owned by the calling thread,
+ * whose GL context stays current on that thread; destroy it there with sw_renderer_destroy.
+ * desc may be NULL (defaults). Several renderers may live on different threads. *out = {0} on
+ * failure. Errors: SW_ERR_INVALID_ARGUMENT (NULL out, worker_threads above 1024),
+ * SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (65,535 renderers). */
 SW_API sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out,
                                     sw_status *status);
+/* Frees the renderer, its GL context, its worker pool and the hierarchies it keeps (waiting for
+ * the pool's tasks). Owner thread only. Errors: SW_ERR_STALE_HANDLE (already
+ * destroyed, or never valid), SW_ERR_INVALID_ARGUMENT (called from another thread: the renderer
+ * stays alive and usable by its owner). */
 SW_API sw_result sw_renderer_destroy(sw_renderer renderer);
-/* "renderer / GL version" of the renderer's context; "" for a stale handle. */
+/* "renderer / GL version" of the renderer's context, borrowed until the renderer is destroyed;
+ * "" for a stale handle or a call from a thread other than the owner. Never NULL. */
 SW_API const char *sw_renderer_description_ptr(sw_renderer renderer);
 
 typedef struct sw_frame_desc {
@@ -144,10 +185,17 @@ typedef struct sw_frame_stats {
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
 } sw_frame_stats;
 
-/* Renders one converged frame (every refinement done before the frame is drawn) and writes it to
- * desc->output_path. stats may be NULL. Errors: SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT
- * (wrong thread, size out of 1..16384, error_px not positive and finite), SW_ERR_GL, SW_ERR_IO,
- * SW_ERR_LIMIT, SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */
+/* Renders one frame: converged by default (every refinement done before the frame is drawn, so
+ * the image is deterministic: the same scene, camera and size give the image `splinewalk render`
+ * gives), or walkthrough (desc->walkthrough: never waits for the renderer's worker pool), and
+ * writes it to desc->output_path when that is not NULL (temporary name, then rename). Owner
+ * thread only; the scene may be used by other threads meanwhile. desc is read during the call
+ * only. stats may be NULL; it is written on success only.
+ * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc; a thread other than the renderer's owner; size out
+ * of 0..16384; error_px negative or not finite; fovy out of (0, 180); a non-finite or degenerate
+ * camera), SW_ERR_STALE_HANDLE (renderer or desc->scene), SW_ERR_UNSUPPORTED (output extension
+ * not .png or .exr), SW_ERR_IO, SW_ERR_GL, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY,
+ * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */
 SW_API sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc,
                                   sw_frame_stats *stats, sw_status *status);
 

@@ -51,9 +51,11 @@ typedef struct sw_status {
     char message[512];
 } sw_status;
 
-/* Short English name of a result; never NULL, also for out-of-range values. */
+/* Short English name of a result; never NULL, also for out-of-range values ("unknown result").
+ * A static string; any thread. */
 SW_API const char *sw_result_str(sw_result result);
-/* The identifier of a result ("SW_ERR_TRUNCATED"): stable, for scripts and tests. */
+/* The identifier of a result ("SW_ERR_TRUNCATED"): stable, for scripts and tests;
+ * "SW_RESULT_UNKNOWN" out of range. A static string; any thread. */
 SW_API const char *sw_result_id_str(sw_result result);
 
 #ifdef __cplusplus

@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# The consumer test of issue 7: install splinewalk to a temporary prefix, build
+# samples/embed_headless.c against the installed package through find_package and through
+# pkg-config (a copy of the sample, so nothing but the installed headers can be seen), run both
+# headlessly, and compare their frames with `splinewalk render` of the same scene and camera:
+# at most 0.1 % of pixels may differ. Negative controls prove the comparison sees a different
+# camera (another preset, and the same camera with a 1 % narrower field of view).
+# usage: test_consumer.sh BUILD_DIR SOURCE_DIR PNG_DIFF DATA_DIR WORK_DIR [SANITIZE]
+set -euo pipefail
+build=$1 src=$2 png_diff=$3 data=$4 work=$5 sanitize=${6:-}
+export EGL_PLATFORM=surfaceless
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+step() { echo "== $*"; }
+
+rm -rf "$work"
+mkdir -p "$work"
+prefix=$work/prefix
+flags=(-Wall -Wextra -Wpedantic -Werror -std=c11)
+if [ -n "$sanitize" ]; then
+  # An instrumented library needs an instrumented program (the sanitizer runtime comes first).
+  flags+=("-fsanitize=$sanitize" -fno-omit-frame-pointer)
+fi
+
+step "install to $prefix"
+cmake --install "$build" --prefix "$prefix" >/dev/null
+for f in lib/libsplinewalk.so include/splinewalk/splinewalk.h include/splinewalk/sw_result.h \
+         lib/cmake/splinewalk/splinewalkConfig.cmake lib/cmake/splinewalk/splinewalkConfigVersion.cmake \
+         lib/pkgconfig/splinewalk.pc bin/splinewalk; do
+  [ -e "$prefix/$f" ] || fail "$f not installed"
+done
+
+step "the library exports exactly the functions the installed headers declare"
+exported=$(nm -D --defined-only "$prefix/lib/libsplinewalk.so" | awk '$2 ~ /^[TDBRVW]$/ {print $3}' |
+           grep -v -E '^(_edata|_end|__bss_start)$' | sort)
+declared=$(grep -h -o -E '^SW_API [^(]*\(' "$prefix"/include/splinewalk/*.h |
+           sed -E 's/.*[ *]([A-Za-z_0-9]+)\($/\1/' | sort)
+[ -n "$declared" ] || fail "no SW_API declarations found"
+diff <(echo "$exported") <(echo "$declared") || fail "exported symbols differ from the public API"
+echo "$(echo "$exported" | wc -l) functions"
+
+cp "$src/samples/embed_headless.c" "$work/embed_headless.c"
+
+step "build through find_package(splinewalk)"
+cmake -S "$src/tests/consumer/find_package" -B "$work/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" \
+      -DSW_SAMPLE="$work/embed_headless.c" -DCMAKE_BUILD_TYPE=Release \
+      -DCMAKE_C_FLAGS="${flags[*]}" >/dev/null
+cmake --build "$work/cmake-build" >/dev/null
+bin_cmake=$work/cmake-build/embed_headless
+
+step "build through pkg-config"
+export PKG_CONFIG_LIBDIR=$prefix/lib/pkgconfig   # this prefix only, never a system copy
+libdir=$(pkg-config --variable=libdir splinewalk)
+# shellcheck disable=SC2046  # pkg-config's output is a list of words
+cc "${flags[@]}" "$work/embed_headless.c" $(pkg-config --cflags --libs splinewalk) \
+   -Wl,-rpath,"$libdir" -o "$work/embed_pc"
+bin_pc=$work/embed_pc
+
+for b in "$bin_cmake" "$bin_pc"; do
+  deps=$(ldd "$b")
+  grep -q "libsplinewalk.so.0 => $prefix/" <<<"$deps" ||
+    fail "$b does not load the installed libsplinewalk: $(grep splinewalk <<<"$deps")"
+done
+
+step "help and usage"
+help=$("$bin_pc" --help)
+grep -q "usage: embed_headless" <<<"$help" || fail "--help"
+set +e
+"$bin_pc" --size 0x7 >/dev/null 2>&1; rc_usage=$?
+"$bin_pc" "$work/missing.sws" -o "$work/x.png" >/dev/null 2>&1; rc_missing=$?
+set -e
+[ $rc_usage -eq 2 ] || fail "bad --size: exit $rc_usage, expected 2"
+[ $rc_missing -eq 1 ] || fail "missing scene: exit $rc_missing, expected 1"
+
+cli=$prefix/bin/splinewalk
+size=640x480
+step "Motor-c: both builds against splinewalk render --view iso at $size"
+"$cli" import "$data/occ/Motor-c.brep" -o "$work/motor.sws" >/dev/null 2>&1
+"$bin_cmake" "$work/motor.sws" -o "$work/motor_cmake.png" --size $size > "$work/motor_cmake.log"
+"$bin_pc" "$work/motor.sws" -o "$work/motor_pc.png" --size $size > "$work/motor_pc.log"
+"$cli" render "$work/motor.sws" -o "$work/motor_ref.png" --size $size --view iso >/dev/null
+"$png_diff" "$work/motor_ref.png" "$work/motor_cmake.png" 0.1 || fail "find_package build differs"
+"$png_diff" "$work/motor_ref.png" "$work/motor_pc.png" 0.1 || fail "pkg-config build differs"
+
+step "negative controls: another camera must be seen as different"
+expect_different() {
+  set +e
+  "$png_diff" "$1" "$2" 0.1; local rc=$?
+  set -e
+  [ $rc -eq 1 ] || fail "$2 was not reported as different (exit $rc)"
+}
+"$cli" render "$work/motor.sws" -o "$work/motor_front.png" --size $size --view front >/dev/null
+expect_different "$work/motor_cmake.png" "$work/motor_front.png"
+# The sample prints its camera in --camera syntax: the same eye, target and up with a field of
+# view 1 % narrower (40° -> 39.6°) zooms the frame by 1 %.
+camera=$(sed -n 's/^camera: //p' "$work/motor_cmake.log")
+[ -n "$camera" ] || fail "the sample printed no camera"
+"$cli" render "$work/motor.sws" -o "$work/motor_same_camera.png" --size $size --camera "$camera" >/dev/null
+"$png_diff" "$work/motor_ref.png" "$work/motor_same_camera.png" 0.1 || fail "printed camera differs"
+zoomed=$(echo "$camera" | awk -F, -v OFS=, '{$10 = $10 * 0.99; print}')
+"$cli" render "$work/motor.sws" -o "$work/motor_zoom.png" --size $size --camera "$zoomed" >/dev/null
+expect_different "$work/motor_cmake.png" "$work/motor_zoom.png"
+
+size=640x360
+step "the built-in default scene (no SCENE argument) against render of demo's default.sws at $size"
+"$cli" demo -o "$work/demo" --size $size >/dev/null 2>&1
+"$bin_pc" -o "$work/default_pc.png" --size $size > "$work/default_pc.log" 2>/dev/null
+"$cli" render "$work/demo/default.sws" -o "$work/default_ref.png" --size $size --view iso >/dev/null
+"$png_diff" "$work/default_ref.png" "$work/default_pc.png" 0.1 || fail "default scene differs"
+echo "PASS"
