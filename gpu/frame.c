@@ -372,14 +372,27 @@ int sw__fr_face_on_gpu(const frame *f, const sw_sg_bezier_set *set)
 }
 
 /* Smallest cell of the face's visible grids, in face parameters. */
-static void grid_cell(const sw__gpu_patch *pt, size_t n, double cell[2])
+/* Smallest cell of the face's visible grids, in face parameters. Slivers (a patch column or row
+ * below 1e-9 of the trim box, left by knots a rounding apart) are skipped: their cells say
+ * nothing about how far apart the border may be sampled, and would cut every loop segment into
+ * thousands of pieces. */
+static void grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2])
 {
+    const double min_u = 1e-9 * (ub[1] - ub[0]), min_v = 1e-9 * (ub[3] - ub[2]);
     cell[0] = cell[1] = INFINITY;
     for (size_t p = 0; p < n; ++p) {
         if (!pt[p].visible)
             continue;
-        cell[0] = fmin(cell[0], (pt[p].u1 - pt[p].u0) * (pt[p].s1 - pt[p].s0) / pt[p].nu);
-        cell[1] = fmin(cell[1], (pt[p].v1 - pt[p].v0) * (pt[p].t1 - pt[p].t0) / pt[p].nv);
+        double wu = (pt[p].u1 - pt[p].u0) * (pt[p].s1 - pt[p].s0);
+        double wv = (pt[p].v1 - pt[p].v0) * (pt[p].t1 - pt[p].t0);
+        if (wu > min_u)
+            cell[0] = fmin(cell[0], wu / pt[p].nu);
+        if (wv > min_v)
+            cell[1] = fmin(cell[1], wv / pt[p].nv);
+    }
+    if (!(cell[0] < INFINITY) || !(cell[1] < INFINITY)) { /* slivers only */
+        cell[0] = fmin(cell[0], ub[1] - ub[0]);
+        cell[1] = fmin(cell[1], ub[3] - ub[2]);
     }
 }
 
@@ -804,7 +817,7 @@ sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status)
             sign = -sign;
         size_t first = f->mesh.n_idx;
         double cell[2];
-        grid_cell(pt, n, cell);
+        grid_cell(pt, n, rec->uv_box, cell);
         if (trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)) {
             r = tiled_face(f, o, set, pt, &need, sign, on_gpu, class_grids, status);
             if (on_gpu)
