@@ -15,6 +15,8 @@ int sw_cli_profile(int argc, char **argv);
 
 /* ---- shared helpers (cli_common.c) ---------------------------------------------------------- */
 int sw_cli_is_help(const char *arg);
+/* When any argument asks for help: prints usage on stdout and returns 1 (the command exits 0). */
+int sw_cli_print_help(int argc, char **argv, const char *usage);
 /* Prints "splinewalk <cmd>: <result>: <message>" to stderr; returns 1. */
 int sw_cli_report(const char *cmd, const sw_status *status);
 /* A progress bar on stderr: redrawn in place on a terminal, else a line per quarter and stage. */

@@ -14,6 +14,17 @@ int sw_cli_is_help(const char *arg)
     return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
 }
 
+int sw_cli_print_help(int argc, char **argv, const char *usage)
+{
+    for (int i = 1; i < argc; i++) {
+        if (sw_cli_is_help(argv[i])) {
+            fputs(usage, stdout);
+            return 1;
+        }
+    }
+    return 0;
+}
+
 int sw_cli_report(const char *cmd, const sw_status *status)
 {
     fprintf(stderr, "splinewalk %s: %s (%s): %s\n", cmd, sw_result_str(status->result),

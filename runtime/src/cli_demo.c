@@ -111,12 +111,8 @@ static int make_dir(const char *dir)
 
 int sw_cli_demo(int argc, char **argv)
 {
-    for (int i = 1; i < argc; i++) {
-        if (sw_cli_is_help(argv[i])) {
-            fputs(k_usage, stdout);
-            return 0;
-        }
-    }
+    if (sw_cli_print_help(argc, argv, k_usage))
+        return 0;
     demo_args a = {"demo-out", NULL, 1280, 720, 0.5};
     int rc = parse_args(argc, argv, &a);
     if (rc || make_dir(a.dir))

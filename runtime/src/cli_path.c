@@ -70,12 +70,8 @@ static int parse_args(int argc, char **argv, path_args *a)
 
 int sw_cli_path(int argc, char **argv)
 {
-    for (int i = 1; i < argc; i++) {
-        if (sw_cli_is_help(argv[i])) {
-            fputs(k_usage, stdout);
-            return 0;
-        }
-    }
+    if (sw_cli_print_help(argc, argv, k_usage))
+        return 0;
     path_args a = {0};
     a.frames = 120;
     a.seconds = 10.0;

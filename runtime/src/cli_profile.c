@@ -372,12 +372,8 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
 
 int sw_cli_profile(int argc, char **argv)
 {
-    for (int i = 1; i < argc; i++) {
-        if (sw_cli_is_help(argv[i])) {
-            fputs(k_usage, stdout);
-            return 0;
-        }
-    }
+    if (sw_cli_print_help(argc, argv, k_usage))
+        return 0;
     profile_args a = {0};
     int rc = parse_args(argc, argv, &a);
     if (rc)

@@ -85,12 +85,8 @@ static int parse_args(int argc, char **argv, render_args *a)
 
 int sw_cli_render(int argc, char **argv)
 {
-    for (int i = 1; i < argc; i++) {
-        if (sw_cli_is_help(argv[i])) {
-            fputs(k_usage, stdout);
-            return 0;
-        }
-    }
+    if (sw_cli_print_help(argc, argv, k_usage))
+        return 0;
     render_args a = {0};
     a.view = SW_VIEW_ISO;
     int rc = parse_args(argc, argv, &a);
