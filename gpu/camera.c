@@ -96,6 +96,19 @@ int sw__gpu_view_box_visible(const sw__gpu_view *v, const double box[6])
     return 1;
 }
 
+int sw__gpu_view_box_inside(const sw__gpu_view *v, const double box[6])
+{
+    for (int p = 0; p < 5; ++p) {
+        const double *pl = v->planes[p];
+        double s = pl[3];
+        for (int k = 0; k < 3; ++k)
+            s += pl[k] * (pl[k] >= 0.0 ? box[k] : box[3 + k]);
+        if (s < 0.0)
+            return 0;
+    }
+    return 1;
+}
+
 double sw__gpu_view_box_depth(const sw__gpu_view *v, const double box[6])
 {
     double d = 0.0;

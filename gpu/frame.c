@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "frame_internal.h"
+#include "sw_sg_bvh.h"
 
 static int collect(void *user, uint32_t face, const double world[12], const float color[4])
 {
@@ -889,14 +890,15 @@ static void screen_view_init(frame *f)
 }
 
 /* Collects occurrences, sets the view (near plane from the scene's box) and tessellates. */
-static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *status)
+/* Every occurrence, with its eye-relative control-net box (the scene traversal, all control points
+ * transformed: the path without a BVH). */
+static sw_result collect_all(frame *f, double **boxes_out, double scene_box[6], sw_status *status)
 {
     if (sw_sg_scene_traverse(f->scene, collect, f) != SW_OK || f->oom)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
-    double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes), scene_box[6];
+    double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes);
     if (!boxes)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
-    memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
     sw__fr_box_empty(scene_box);
     for (size_t i = 0; i < f->n_occ; ++i) {
         occurrence_box(f, &f->occ[i], boxes + 6 * i);
@@ -905,10 +907,85 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
             scene_box[3 + k] = fmax(scene_box[3 + k], boxes[6 * i + 3 + k]);
         }
     }
+    *boxes_out = boxes;
+    return SW_OK;
+}
+
+static void eye_box(const frame *f, const double world[6], double out[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        out[k] = world[k] - f->view.eye[k];
+        out[3 + k] = world[3 + k] - f->view.eye[k];
+    }
+}
+
+/* Appends one BVH item as an occurrence with its eye-relative box. */
+static int bvh_take(frame *f, const sw_sg_bvh_item *it, double **boxes, size_t *cap_boxes)
+{
+    size_t at = f->n_occ;
+    if (collect(f, it->face, it->world, it->color) != 0 ||
+        !sw__gpu_grow((void **)boxes, cap_boxes, 6 * (at + 1), sizeof **boxes))
+        return 0;
+    eye_box(f, it->box, *boxes + 6 * at);
+    return 1;
+}
+
+/* Kumar §4.4: the occurrences whose boxes may meet the frustum, by the BVH: a node outside is
+ * culled with its subtree, a node inside takes its subtree untested. */
+static sw_result collect_bvh(frame *f, const sw_sg_bvh *bvh, double **boxes, sw_status *status)
+{
+    size_t cap_boxes = 0;
+    uint32_t stack[128], n = bvh->n_nodes ? 1 : 0; /* depth <= log2(items) + 1 */
+    stack[0] = 0;
+    int ok = 1;
+    while (n > 0 && ok) {
+        const sw_sg_bvh_node *node = &bvh->nodes[stack[--n]];
+        double b[6];
+        eye_box(f, node->box, b);
+        if (!sw__gpu_view_box_visible(&f->view, b)) {
+            f->st.faces_culled += node->count;
+            continue;
+        }
+        int inside = sw__gpu_view_box_inside(&f->view, b);
+        if (node->child[0] >= 0 && !inside && n + 2 <= 128) {
+            stack[n++] = (uint32_t)node->child[1];
+            stack[n++] = (uint32_t)node->child[0];
+            continue;
+        }
+        for (uint32_t i = node->first; i < node->first + node->count && ok; ++i) {
+            double ib[6];
+            eye_box(f, bvh->items[i].box, ib);
+            if (inside || sw__gpu_view_box_visible(&f->view, ib))
+                ok = bvh_take(f, &bvh->items[i], boxes, &cap_boxes);
+            else
+                f->st.faces_culled++;
+        }
+    }
+    if (!ok)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    return SW_OK;
+}
+
+/* Sets the view (near plane from the scene's box), finds the visible occurrences and tessellates. */
+static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *status)
+{
+    memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
+    double *boxes = NULL, scene_box[6];
+    sw_result r = SW_OK;
+    if (desc->bvh) {
+        sw__fr_box_empty(scene_box);
+        if (desc->bvh->n_nodes)
+            eye_box(f, desc->bvh->nodes[0].box, scene_box);
+    } else {
+        r = collect_all(f, &boxes, scene_box, status);
+    }
     static const double k_origin[3] = {0.0, 0.0, 0.0};
-    double near_plane = f->n_occ ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
-    sw_result r =
-        sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane, status);
+    double near_plane = scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
+    if (r == SW_OK)
+        r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane,
+                              status);
+    if (r == SW_OK && desc->bvh)
+        r = collect_bvh(f, desc->bvh, &boxes, status);
     screen_view_init(f);
     int hierarchy = f->cache && !f->exact;
     if (r == SW_OK && hierarchy)

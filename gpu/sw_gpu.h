@@ -48,6 +48,9 @@ typedef struct sw_gpu_frame_desc {
                               else the cache of `scene`'s bicubic hierarchies (Guthe §6), traversed
                               per frame (§7); the frame waits for the builds and refinements it
                               asks for in the cache's pool (converged). Ignored with eval_exact. */
+    const struct sw_sg_bvh *bvh; /* NULL: every occurrence of the scene's traversal is boxed and
+                              culled each frame; else the scene's BVH (sw_sg_bvh.h): subtrees
+                              outside the frustum are culled, subtrees inside taken untested */
     int32_t walkthrough;   /* with hierarchies: 1 = never wait for the pool (ARCHITECTURE.md
                               walkthrough mode): faces without a hierarchy yet are drawn by their
                               Bézier patches, leaves too coarse are drawn as they are, and both

@@ -173,6 +173,8 @@ sw_result sw__gpu_view_init(sw__gpu_view *v, const sw_gpu_camera *cam, int32_t w
                             double near_plane, sw_status *status);
 /* 1 when the eye-relative box (min xyz, max xyz) may meet the frustum. */
 int sw__gpu_view_box_visible(const sw__gpu_view *v, const double box[6]);
+/* 1 when the whole eye-relative box is inside the frustum (its subtree needs no more tests). */
+int sw__gpu_view_box_inside(const sw__gpu_view *v, const double box[6]);
 /* Smallest depth along the view axis of an eye-relative box, clamped below by the near plane. */
 double sw__gpu_view_box_depth(const sw__gpu_view *v, const double box[6]);
 /* Euclidean distance from the eye (origin) to an eye-relative box; 0 when inside. */

@@ -1,0 +1,204 @@
+/* The BVH over face occurrences (sw_sg_bvh.h). */
+#include "sw_sg_bvh.h"
+
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct build {
+    const sw_sg_scene *scene;
+    double *face_box; /* 6 per face, local; NaN[0] until computed */
+    sw_sg_bvh_item *items;
+    size_t n_items, cap_items;
+    int oom;
+} build;
+
+static void local_box(const sw_sg_scene *scene, uint32_t face, double box[6])
+{
+    sw_sg_surface s;
+    sw_sg_scene_face_surface(scene, face, &s);
+    for (int k = 0; k < 3; ++k) {
+        box[k] = INFINITY;
+        box[3 + k] = -INFINITY;
+    }
+    const size_t n = (size_t)s.n_u * (size_t)s.n_v;
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            double x = s.cpw[4 * i + k] / s.cpw[4 * i + 3];
+            box[k] = fmin(box[k], x);
+            box[3 + k] = fmax(box[3 + k], x);
+        }
+}
+
+/* The world box of a local box under a 3 x 4 transform (its eight corners). */
+static void world_box(const double m[12], const double b[6], double out[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        out[k] = INFINITY;
+        out[3 + k] = -INFINITY;
+    }
+    for (int c = 0; c < 8; ++c) {
+        const double p[3] = {b[(c & 1) ? 3 : 0], b[(c & 2) ? 4 : 1], b[(c & 4) ? 5 : 2]};
+        for (int r = 0; r < 3; ++r) {
+            double x = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+            out[r] = fmin(out[r], x);
+            out[3 + r] = fmax(out[3 + r], x);
+        }
+    }
+}
+
+static int visit(void *ctx, uint32_t face, const double world[12], const float color[4])
+{
+    build *b = ctx;
+    if (b->n_items == b->cap_items) {
+        size_t cap = b->cap_items ? 2 * b->cap_items : 256;
+        sw_sg_bvh_item *p = cap <= INT32_MAX ? realloc(b->items, cap * sizeof *p) : NULL;
+        if (!p) {
+            b->oom = 1;
+            return 1;
+        }
+        b->items = p;
+        b->cap_items = cap;
+    }
+    double *lb = b->face_box + 6 * (size_t)face;
+    if (isnan(lb[0]))
+        local_box(b->scene, face, lb);
+    sw_sg_bvh_item *it = &b->items[b->n_items++];
+    memcpy(it->world, world, sizeof it->world);
+    world_box(world, lb, it->box);
+    static const float k_none[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+    memcpy(it->color, color ? color : k_none, sizeof it->color);
+    it->face = face;
+    return 0;
+}
+
+static void box_union(double out[6], const double b[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        out[k] = fmin(out[k], b[k]);
+        out[3 + k] = fmax(out[3 + k], b[3 + k]);
+    }
+}
+
+static double centre(const sw_sg_bvh_item *it, int axis)
+{
+    return 0.5 * (it->box[axis] + it->box[3 + axis]);
+}
+
+static void swap_items(sw_sg_bvh_item *a, sw_sg_bvh_item *b)
+{
+    sw_sg_bvh_item t = *a;
+    *a = *b;
+    *b = t;
+}
+
+/* Quickselect (Lomuto partition, middle pivot): afterwards the item at mid has its sorted place
+ * along axis among [lo, hi), smaller centres before it and larger after. */
+static void select_median(sw_sg_bvh_item *items, uint32_t lo, uint32_t hi, uint32_t mid, int axis)
+{
+    int64_t l = lo, h = (int64_t)hi - 1;
+    while (l < h) {
+        swap_items(&items[l + (h - l) / 2], &items[h]);
+        const double pivot = centre(&items[h], axis);
+        int64_t store = l;
+        for (int64_t i = l; i < h; ++i)
+            if (centre(&items[i], axis) < pivot)
+                swap_items(&items[i], &items[store++]);
+        swap_items(&items[store], &items[h]);
+        if (store == (int64_t)mid)
+            return;
+        if ((int64_t)mid < store)
+            h = store - 1;
+        else
+            l = store + 1;
+    }
+}
+
+/* Builds the subtree of items [lo, hi); returns its node index (nodes preallocated: 2n - 1 at
+ * most, so pointers into them stay valid). Recursion depth is O(log n): median splits. */
+static uint32_t build_node(sw_sg_bvh *t, uint32_t lo, uint32_t hi)
+{
+    const uint32_t id = t->n_nodes++;
+    sw_sg_bvh_node *n = &t->nodes[id];
+    double cb[6];
+    for (int k = 0; k < 3; ++k) {
+        n->box[k] = cb[k] = INFINITY;
+        n->box[3 + k] = cb[3 + k] = -INFINITY;
+    }
+    for (uint32_t i = lo; i < hi; ++i) {
+        box_union(n->box, t->items[i].box);
+        for (int k = 0; k < 3; ++k) {
+            cb[k] = fmin(cb[k], centre(&t->items[i], k));
+            cb[3 + k] = fmax(cb[3 + k], centre(&t->items[i], k));
+        }
+    }
+    n->child[0] = n->child[1] = -1;
+    n->first = lo;
+    n->count = hi - lo;
+    if (hi - lo <= SW_SG_BVH_LEAF)
+        return id;
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+        if (cb[3 + k] - cb[k] > cb[3 + axis] - cb[axis])
+            axis = k;
+    const uint32_t mid = lo + (hi - lo) / 2;
+    if (cb[3 + axis] > cb[axis]) /* all centres equal: any split is as good */
+        select_median(t->items, lo, hi, mid, axis);
+    const int32_t a = (int32_t)build_node(t, lo, mid);
+    const int32_t b = (int32_t)build_node(t, mid, hi);
+    n->child[0] = a;
+    n->child[1] = b;
+    return id;
+}
+
+sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *status)
+{
+    *out = NULL;
+    const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
+    build b = {scene, malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), NULL, 0, 0, 0};
+    sw_sg_bvh *t = calloc(1, sizeof *t);
+    if (!b.face_box || !t) {
+        free(b.face_box);
+        free(t);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
+    }
+    for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
+        b.face_box[i] = NAN;
+    sw_result r = sw_sg_scene_traverse(scene, visit, &b);
+    free(b.face_box);
+    if (r != SW_OK || b.oom) {
+        free(b.items);
+        free(t);
+        return sw__fail(status, b.cap_items >= INT32_MAX / 2 ? SW_ERR_LIMIT : SW_ERR_OUT_OF_MEMORY,
+                        "BVH: %zu occurrences: out of memory", b.n_items);
+    }
+    t->items = b.items;
+    t->n_items = (uint32_t)b.n_items;
+    t->nodes = malloc((t->n_items ? 2 * (size_t)t->n_items : 1) * sizeof *t->nodes);
+    if (!t->nodes) {
+        sw_sg_bvh_free(t);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
+    }
+    if (t->n_items)
+        build_node(t, 0, t->n_items);
+    *out = t;
+    return SW_OK;
+}
+
+void sw_sg_bvh_free(sw_sg_bvh *bvh)
+{
+    if (!bvh)
+        return;
+    free(bvh->items);
+    free(bvh->nodes);
+    free(bvh);
+}
+
+size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh)
+{
+    return bvh ? sizeof *bvh + bvh->n_items * sizeof *bvh->items +
+                     2 * (size_t)bvh->n_items * sizeof *bvh->nodes
+               : 0;
+}
