@@ -3,6 +3,7 @@
 #include "sw_rt.h"
 
 #include "sw_lod_cache.h"
+#include "sw_sg_bvh.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
@@ -21,6 +22,7 @@ typedef struct sw_rt_renderer {
     pthread_t owner;
     sw_th_pool *pool;          /* created on the first frame that needs it */
     sw_lod_cache *cache;       /* of cache_scene */
+    sw_sg_bvh *bvh;            /* of cache_scene */
     sw_rt_scene *cache_scene;  /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;   /* the pool's size; 0 = one per online processor */
 } sw_rt_renderer;
@@ -86,25 +88,26 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
     return SW_OK;
 }
 
-/* Drops the hierarchy cache (waiting for its tasks), then the scene reference it needed. */
+/* Drops the hierarchy cache (waiting for its tasks) and the BVH, then the scene reference they
+ * needed. */
 static void drop_cache(sw_rt_renderer *r)
 {
     sw_lod_cache_destroy(r->cache);
     r->cache = NULL;
+    sw_sg_bvh_free(r->bvh);
+    r->bvh = NULL;
     if (r->cache_scene)
         sw_rt_scene_release(r->cache_scene);
     r->cache_scene = NULL;
 }
 
-/* The renderer's hierarchy cache for `scene` (a cache of another scene is dropped first). The
- * scene pointer identifies it: a retained scene cannot be freed, so its address is not reused. */
-static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_lod_cache **out,
-                                sw_status *status)
+/* The renderer's hierarchy cache and BVH for `scene` (those of another scene are dropped first).
+ * The scene pointer identifies them: a retained scene cannot be freed, so its address is not
+ * reused. */
+static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_status *status)
 {
-    if (r->cache && r->cache_scene == scene) {
-        *out = r->cache;
+    if (r->cache && r->cache_scene == scene)
         return SW_OK;
-    }
     drop_cache(r);
     if (!r->pool) {
         sw_th_pool_desc pd = {0};
@@ -113,12 +116,15 @@ static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_lod_ca
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
     }
     sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
-    if (res == SW_OK) {
-        sw_rt_scene_retain(scene);
-        r->cache_scene = scene;
+    if (res == SW_OK)
+        res = sw_sg_bvh_build(scene->sg, &r->bvh, status);
+    if (res != SW_OK) {
+        drop_cache(r);
+        return res;
     }
-    *out = r->cache;
-    return res;
+    sw_rt_scene_retain(scene);
+    r->cache_scene = scene;
+    return SW_OK;
 }
 
 sw_result sw_renderer_destroy(sw_renderer renderer)
@@ -254,11 +260,12 @@ static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_fram
     sw_result res = resolve_camera(&desc->camera, scene, &frame.camera, status);
     if (res != SW_OK)
         return res;
-    if (!frame.eval_exact && !desc->no_hierarchy) {
-        res = renderer_cache(r, scene, &frame.hierarchies, status);
-        if (res != SW_OK)
-            return res;
-    }
+    res = renderer_cache(r, scene, status);
+    if (res != SW_OK)
+        return res;
+    frame.bvh = r->bvh;
+    if (!frame.eval_exact && !desc->no_hierarchy)
+        frame.hierarchies = r->cache;
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
     res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);
