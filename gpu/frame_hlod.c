@@ -387,6 +387,87 @@ sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, int walkthrough, sw
     return SW_OK;
 }
 
+/* ---- exact degree of a node's bicubic ----------------------------------------------------------
+ * Planes, cylinders and cones reach the hierarchy as degree-elevated bicubics. Their derivative
+ * bounds (lod/sampling.c, products of degree 3p x 3q) cost ~6x more at degree 3 than at the true
+ * degree, and the bound is the same surface's: so the density is computed at the lowest degree
+ * that reproduces the net exactly (up to rounding). */
+static int near(const double *a, const double *b, double tol)
+{
+    for (int k = 0; k < 4; ++k)
+        if (!(fabs(a[k] - b[k]) <= tol))
+            return 0;
+    return 1;
+}
+
+/* The cubic row (4 homogeneous points, stride `st` doubles) as a row of degree d (1 or 2) when it
+ * is one exactly (within tol): out gets d + 1 points; returns 0 when it is not. Elevation from
+ * degree 2: P0 = Q0, P1 = (Q0 + 2 Q1) / 3, P2 = (2 Q1 + Q2) / 3, P3 = Q2; from degree 1 the inner
+ * points sit at the thirds. */
+static int row_at_degree(const double *p, size_t st, int d, double tol, double *out)
+{
+    const double *p0 = p, *p1 = p + st, *p2 = p + 2 * st, *p3 = p + 3 * st;
+    double a[4], b[4], q1[4];
+    for (int k = 0; k < 4; ++k) {
+        q1[k] = 0.5 * (3.0 * p1[k] - p0[k]);
+        a[k] = d == 1 ? (2.0 * p0[k] + p3[k]) / 3.0 : p1[k];
+        b[k] = d == 1 ? (p0[k] + 2.0 * p3[k]) / 3.0 : (2.0 * q1[k] + p3[k]) / 3.0;
+    }
+    if (!near(a, p1, tol) || !near(b, p2, tol))
+        return 0;
+    memcpy(out, p0, 4 * sizeof *out);
+    if (d == 2)
+        memcpy(out + 4, q1, sizeof q1);
+    memcpy(out + 4 * d, p3, 4 * sizeof *out);
+    return 1;
+}
+
+/* The lowest d in {1, 2} at which every one of n rows (start i * row_st, point stride st) is
+ * exact, or 3. */
+static int rows_degree(const double *p, int n, size_t row_st, size_t st, double tol)
+{
+    double scratch[12];
+    for (int d = 1; d <= 2; ++d) {
+        int all = 1;
+        for (int i = 0; i < n && all; ++i)
+            all = row_at_degree(p + (size_t)i * row_st, st, d, tol, scratch);
+        if (all)
+            return d;
+    }
+    return 3;
+}
+
+/* The net at its lowest exact degrees (*du, *dv <= 3) into low ((du+1)(dv+1) points, u fastest). */
+static void lowest_degree(const double cpw[64], double low[64], int32_t *du, int32_t *dv)
+{
+    double scale = 0.0;
+    for (int i = 0; i < 64; ++i)
+        scale = fmax(scale, fabs(cpw[i]));
+    const double tol = 1e-12 * scale;
+    const int d = rows_degree(cpw, 4, 16, 4, tol); /* u: the 4 rows */
+    double tmp[64];
+    for (int j = 0; j < 4; ++j) {
+        if (d == 3)
+            memcpy(tmp + 16 * j, cpw + 16 * j, 16 * sizeof *tmp);
+        else
+            row_at_degree(cpw + 16 * j, 4, d, tol, tmp + 4 * (d + 1) * j);
+    }
+    const size_t row = 4 * (size_t)(d + 1); /* doubles per row of tmp */
+    const int e = rows_degree(tmp, d + 1, 4, row, tol); /* v: the d + 1 columns */
+    for (int i = 0; i <= d; ++i) {
+        double col[16];
+        if (e == 3)
+            for (int j = 0; j < 4; ++j)
+                memcpy(col + 4 * j, tmp + row * j + 4 * i, 4 * sizeof *col);
+        else
+            row_at_degree(tmp + 4 * i, row, e, tol, col);
+        for (int j = 0; j <= e; ++j)
+            memcpy(low + row * j + 4 * i, col + 4 * j, 4 * sizeof *col);
+    }
+    *du = d;
+    *dv = e;
+}
+
 /* ---- drawing the chosen items ------------------------------------------------------------------ */
 /* The item as a patch of the direct path: clipped to the face's trim box, density for what its
  * approximation error leaves of ε_img. */
@@ -414,8 +495,11 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     double approx_px = f->eps_px * c->err_w / c->eps_obj;
     scr.eps_px = fmax(f->eps_px - approx_px, 0.25 * f->eps_px);
     const double range[4] = {pt->s0, pt->s1, pt->t0, pt->t1};
+    double low[64];
+    int32_t deg_u, deg_v;
+    lowest_degree(c->cpw, low, &deg_u, &deg_v);
     sw_lod_screen_density d;
-    sw_lod_screen_segments(3, 3, c->cpw, range, &scr, f->gpu_segments.n, f->gpu_segments.count,
+    sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->gpu_segments.n, f->gpu_segments.count,
                            MAX_BOUND_SUBDIVISION, &d);
     pt->eps = d.eps_obj;
     pt->nu = d.nu;
