@@ -11,7 +11,9 @@
  *     frame of the same view drawn with a fresh cache: at most 0.1 % of the covered pixels differ
  *     (coverage, or a channel by more than 8 levels).
  *
- * Usage: test_gpu_walkthrough OUTDIR MODEL
+ * Usage: test_gpu_walkthrough OUTDIR MODEL [FRAMES_MOVING [WxH]]
+ * (default 40 frames at 480x270; .ci/run's ThreadSanitizer build runs 2,000 at 320x240, issue 5's
+ * "pipeline under ThreadSanitizer").
  */
 #include "gpu_test_compare.h"
 #include "sw_gpu_internal.h"
@@ -23,7 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { W = 480, H = 270, FRAMES_MOVING = 40, FRAMES_SETTLE = 30 };
+enum { FRAMES_SETTLE = 30 };
+static int frame_w = 480, frame_h = 270, frames_moving = 40;
 
 static sw_gpu_camera orbit_camera(const double box[6], int i)
 {
@@ -48,8 +51,8 @@ static int frame(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *ca
 {
     sw_gpu_frame_desc d;
     memset(&d, 0, sizeof d);
-    d.width = W;
-    d.height = H;
+    d.width = frame_w;
+    d.height = frame_h;
     d.camera = cam;
     d.hierarchies = cache;
     d.walkthrough = walkthrough;
@@ -65,7 +68,7 @@ static int moving(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *c
                   const double box[6])
 {
     uint64_t waits = 0, first_fallbacks = 0, total_fallbacks = 0;
-    for (int i = 0; i < FRAMES_MOVING; ++i) {
+    for (int i = 0; i < frames_moving; ++i) {
         sw_gpu_image img;
         sw_gpu_frame_stats fs;
         if (!frame(ctx, scene, cache, orbit_camera(box, i), 1, &img, &fs))
@@ -78,7 +81,7 @@ static int moving(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *c
     }
     int ok = waits == 0 && first_fallbacks > 0;
     printf("moving: %d frames, waits %llu, fallbacks in the first frame %llu, in all %llu%s\n",
-           FRAMES_MOVING, (unsigned long long)waits, (unsigned long long)first_fallbacks,
+           frames_moving, (unsigned long long)waits, (unsigned long long)first_fallbacks,
            (unsigned long long)total_fallbacks, ok ? "" : "  <-- FAIL");
     return ok;
 }
@@ -86,7 +89,7 @@ static int moving(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *c
 static int settling(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *cache,
                     const double box[6], sw_th_pool *pool, const char *outdir)
 {
-    sw_gpu_camera cam = orbit_camera(box, FRAMES_MOVING);
+    sw_gpu_camera cam = orbit_camera(box, frames_moving);
     sw_gpu_image walk = {0}, conv = {0};
     sw_gpu_frame_stats fs;
     int settled = -1;
@@ -112,8 +115,7 @@ static int settling(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache 
     ok = ok && df.covered > 1000 && frac <= 1e-3;
     printf("stopped: fallbacks 0 after %d frames (limit %d); vs converged: %ld of %ld covered "
            "pixels differ (%.4f %%, limit 0.1 %%)%s\n",
-           settled + 1, FRAMES_SETTLE, df.differ, df.covered, 100.0 * frac,
-           ok ? "" : "  <-- FAIL");
+           settled + 1, FRAMES_SETTLE, df.differ, df.covered, 100.0 * frac, ok ? "" : "  <-- FAIL");
     char path[1100];
     snprintf(path, sizeof path, "%s/walkthrough_settled.png", outdir);
     if (walk.rgba)
@@ -126,8 +128,10 @@ static int settling(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache 
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: %s OUTDIR MODEL\n", argv[0]);
+    if (argc < 3 || argc > 5 || (argc > 3 && sscanf(argv[3], "%d", &frames_moving) != 1) ||
+        (argc > 4 && sscanf(argv[4], "%dx%d", &frame_w, &frame_h) != 2) || frames_moving < 1 ||
+        frame_w < 16 || frame_h < 16) {
+        fprintf(stderr, "usage: %s OUTDIR MODEL [FRAMES_MOVING [WxH]]\n", argv[0]);
         return 2;
     }
     sw_status st = {0};
