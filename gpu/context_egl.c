@@ -191,6 +191,22 @@ static sw_result make_context(sw_gpu_context *ctx, sw_status *status)
     return check_gl_version(ctx, status);
 }
 
+/* The objects every frame uses, in the current context. Reversed-Z needs zero-to-one clip depth:
+ * an adopted context is switched too (and stays so: a host drawing with reversed-Z wants it). */
+static sw_result make_gl_objects(sw_gpu_context *ctx, sw_status *status)
+{
+    ctx->gl_ready = 1;
+    sw_result r = sw__gpu_programs_create(ctx, status);
+    if (r == SW_OK)
+        r = sw__gpu_grids_create(ctx, status);
+    if (r != SW_OK)
+        return r;
+    glGenVertexArrays(1, &ctx->vao);
+    glGenFramebuffers(1, &ctx->trim_fbo);
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    return sw__gpu_check(status, "context set-up");
+}
+
 sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status)
 {
     *out = NULL;
@@ -204,15 +220,35 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
     sw_th_token_init(ctx->walk_token);
     sw_result r = make_context(ctx, status);
     if (r == SW_OK)
-        r = sw__gpu_programs_create(ctx, status);
-    if (r == SW_OK)
-        r = sw__gpu_grids_create(ctx, status);
-    if (r == SW_OK) {
-        glGenVertexArrays(1, &ctx->vao);
-        glGenFramebuffers(1, &ctx->trim_fbo);
-        glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
-        r = sw__gpu_check(status, "context set-up");
+        r = make_gl_objects(ctx, status);
+    if (r != SW_OK) {
+        sw_gpu_context_free(ctx);
+        return r;
     }
+    *out = ctx;
+    sw__status_ok(status);
+    return SW_OK;
+}
+
+sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status)
+{
+    *out = NULL;
+    /* Without a current context glvnd's dispatch answers NULL instead of failing loudly. */
+    if (!glGetString(GL_VERSION))
+        return sw__fail(status, SW_ERR_NO_CONTEXT,
+                        "no OpenGL context is current on this thread: make the host's context "
+                        "current before creating the renderer");
+    sw_gpu_context *ctx = calloc(1, sizeof *ctx);
+    if (ctx)
+        ctx->walk_token = calloc(1, sizeof *ctx->walk_token);
+    if (!ctx || !ctx->walk_token) {
+        free(ctx);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
+    }
+    sw_th_token_init(ctx->walk_token);
+    sw_result r = check_gl_version(ctx, status);
+    if (r == SW_OK)
+        r = make_gl_objects(ctx, status);
     if (r != SW_OK) {
         sw_gpu_context_free(ctx);
         return r;
@@ -226,7 +262,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
 {
     if (!ctx)
         return;
-    if (ctx->egl_context) {
+    if (ctx->gl_ready) {
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);
         sw__gpu_grids_free(ctx);
@@ -235,6 +271,8 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         glDeleteFramebuffers(1, &ctx->fbo);
         glDeleteRenderbuffers(1, &ctx->rb_color);
         glDeleteRenderbuffers(1, &ctx->rb_depth);
+    }
+    if (ctx->egl_context) {
         eglMakeCurrent(ctx->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(ctx->egl_display, ctx->egl_context);
     }

@@ -215,6 +215,30 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, cons
     return sw__gpu_check(status, "frame draw");
 }
 
+void sw__gpu_host_state_save(sw__gpu_host_state *s)
+{
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fb);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &s->read_fb);
+    glGetIntegerv(GL_VIEWPORT, s->viewport);
+}
+
+void sw__gpu_host_state_restore(const sw__gpu_host_state *s)
+{
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)s->draw_fb);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)s->read_fb);
+    glViewport(s->viewport[0], s->viewport[1], s->viewport[2], s->viewport[3]);
+}
+
+sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
+                          const sw__gpu_host_state *host, sw_status *status)
+{
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, ctx->fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)host->draw_fb);
+    glBlitFramebuffer(0, 0, view->width, view->height, 0, 0, view->width, view->height,
+                      GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    return sw__gpu_check(status, "frame present (blit into the host's framebuffer)");
+}
+
 static void flip_rows(const uint8_t *src, uint8_t *dst, int32_t h, size_t row_bytes)
 {
     for (int32_t y = 0; y < h; ++y)

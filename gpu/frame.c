@@ -1254,6 +1254,9 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
         sw_lod_cache_reader_enter(f.cache, f.reader);
     }
 
+    sw__gpu_host_state host;
+    if (desc.present)
+        sw__gpu_host_state_save(&host);
     double t0 = sw__gpu_now_ms();
     sw_result r = tessellate(&f, &desc, status);
     double t1 = sw__gpu_now_ms();
@@ -1266,8 +1269,12 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
         r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws, &f.batch,
                                status);
     double t3 = sw__gpu_now_ms();
-    if (r == SW_OK)
+    if (r == SW_OK && desc.present)
+        r = sw__gpu_present(ctx, &f.view, &host, status);
+    if (r == SW_OK && !desc.no_readback)
         r = sw__gpu_readback(ctx, &f.view, desc.want_depth, out, status);
+    if (desc.present)
+        sw__gpu_host_state_restore(&host);
     double t4 = sw__gpu_now_ms();
 
     f.st.triangles += f.mesh.n_idx / 3 - f.border_triangles;

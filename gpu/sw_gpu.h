@@ -26,6 +26,11 @@ typedef struct sw_gpu_context sw_gpu_context;
  * EGL_DEFAULT_DISPLAY) and makes it current on the calling thread. Errors: SW_ERR_NO_CONTEXT with
  * what failed and what to try. */
 sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status);
+/* Adopts the GL context current on the calling thread (a host's, or a GLFW window's): it must be
+ * OpenGL 4.3+ core with glClipControl. The context stays the caller's: sw_gpu_context_free deletes
+ * the GL objects made here (with the context current) but not the context. Errors:
+ * SW_ERR_NO_CONTEXT (none current, or too old). */
+sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status);
 void sw_gpu_context_free(sw_gpu_context *ctx); /* NULL allowed */
 /* "GL_RENDERER / GL_VERSION" of the context (borrowed). */
 const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
@@ -56,6 +61,10 @@ typedef struct sw_gpu_frame_desc {
                               Bézier patches, leaves too coarse are drawn as they are, and both
                               are requested from the pool for later frames; the requests of earlier
                               frames that have not started are cancelled */
+    int32_t present;       /* 1: the frame is also copied into the framebuffer that was bound to
+                              GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
+                              origin; the caller's framebuffer bindings and viewport are restored */
+    int32_t no_readback;   /* 1: nothing is read back (out stays empty; want_depth ignored) */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */

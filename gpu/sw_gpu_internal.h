@@ -96,7 +96,8 @@ typedef void (*sw__gpu_patch_hook)(void *user, const sw__gpu_drawn_patch *p);
 void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *user);
 
 struct sw_gpu_context {
-    void *egl_display, *egl_context; /* EGLDisplay, EGLContext */
+    void *egl_display, *egl_context; /* EGLDisplay, EGLContext; NULL when adopted */
+    int32_t gl_ready;                /* GL objects made: free deletes them */
     struct sw_th_token *walk_token; /* walkthrough frames' hierarchy requests; bumped every frame,
                                so the requests of frames gone by are cancelled (a pointer: C++
                                tests include this header, and the token is a C11 atomic) */
@@ -355,6 +356,16 @@ double sw__gpu_near_plane(const double eye[3], const double world_box[6]);
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, const float bg[4],
                              const sw__gpu_mesh *mesh, const sw__gpu_draw *draws, size_t n_draws,
                              const sw__gpu_patch_batch *batch, sw_status *status);
+/* The caller's framebuffer bindings and viewport, saved when a presenting frame begins
+ * (desc.present) and restored when it ends. */
+typedef struct sw__gpu_host_state {
+    GLint draw_fb, read_fb, viewport[4];
+} sw__gpu_host_state;
+void sw__gpu_host_state_save(sw__gpu_host_state *s);
+void sw__gpu_host_state_restore(const sw__gpu_host_state *s);
+/* Copies the frame into the host's draw framebuffer (saved in `host`) at its origin. */
+sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
+                          const sw__gpu_host_state *host, sw_status *status);
 /* Reads the frame back into `out` (rows top first; depth as eye-space depth, +INF background). */
 sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int want_depth,
                            sw_gpu_image *out, sw_status *status);

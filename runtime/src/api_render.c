@@ -48,7 +48,9 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
     if (!r)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
     r->worker_threads = workers;
-    sw_result res = sw_gpu_context_create_headless(&r->gpu, status);
+    sw_result res = desc && desc->use_current_context
+                        ? sw_gpu_context_adopt_current(&r->gpu, status)
+                        : sw_gpu_context_create_headless(&r->gpu, status);
     if (res != SW_OK) {
         free(r);
         return res;
@@ -243,6 +245,8 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->background[3] = 1.0f;
     frame->eval_exact = desc->eval_exact != 0;
     frame->walkthrough = desc->walkthrough != 0;
+    frame->present = desc->present != 0;
+    frame->no_readback = desc->present && !desc->output_path;
     frame->want_depth = 0;
     if (desc->output_path) {
         size_t n = strlen(desc->output_path);

@@ -427,10 +427,14 @@ static void test_destroy_after_walkthrough(sw_renderer r)
 static void test_renderer(void)
 {
     sw_renderer r = {77};
-    sw_renderer_desc too_many = {1025}; /* worker_threads above 1024 */
+    sw_renderer_desc too_many = {.worker_threads = 1025};
     EXPECT_RESULT(sw_renderer_create(&too_many, &r, NULL), SW_ERR_INVALID_ARGUMENT);
     EXPECT(r.id == 0);
     EXPECT_RESULT(sw_renderer_create(NULL, NULL, NULL), SW_ERR_INVALID_ARGUMENT);
+    /* No GL context is current on this thread yet: adopting one must fail cleanly. */
+    sw_renderer_desc adopt = {.use_current_context = 1};
+    EXPECT_RESULT(sw_renderer_create(&adopt, &r, NULL), SW_ERR_NO_CONTEXT);
+    EXPECT(r.id == 0);
     sw_status status = {0};
     if (sw_renderer_create(NULL, &r, &status) != SW_OK) {
         fprintf(stderr, "no renderer: %s\n", status.message);

@@ -132,17 +132,24 @@ typedef struct sw_renderer_desc {
     uint32_t worker_threads; /* threads of the worker pool that builds and refines hierarchies;
                                 0 = one per online processor. A converged frame's thread also
                                 runs pool tasks while it waits for them. At most 1024. */
+    int32_t use_current_context; /* 0: the renderer creates and owns a headless EGL context;
+                                1: it draws with the OpenGL context current on the creating thread
+                                (the host's: 4.3+ core with glClipControl), which the host keeps
+                                current there for every call and destroys itself after
+                                sw_renderer_destroy. The renderer switches that context to
+                                zero-to-one clip depth (reversed-Z). */
 } sw_renderer_desc;
 
-/* Creates a headless renderer (EGL; llvmpipe when there is no GPU) owned by the calling thread,
- * whose GL context stays current on that thread; destroy it there with sw_renderer_destroy.
+/* Creates a renderer owned by the calling thread: headless (EGL; llvmpipe when there is no GPU),
+ * its GL context then current on that thread, or on the thread's current context
+ * (desc->use_current_context); destroy it there with sw_renderer_destroy.
  * desc may be NULL (defaults). Several renderers may live on different threads. *out = {0} on
  * failure. Errors: SW_ERR_INVALID_ARGUMENT (NULL out, worker_threads above 1024),
  * SW_ERR_NO_CONTEXT (with what failed), SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (65,535 renderers). */
 SW_API sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out,
                                     sw_status *status);
-/* Frees the renderer, its GL context, its worker pool and the hierarchies it keeps (waiting for
- * the pool's tasks). Owner thread only. Errors: SW_ERR_STALE_HANDLE (already
+/* Frees the renderer, its GL objects, its own GL context (not an adopted one), its worker pool
+ * and the hierarchies it keeps (waiting for the pool's tasks). Owner thread only. Errors: SW_ERR_STALE_HANDLE (already
  * destroyed, or never valid), SW_ERR_INVALID_ARGUMENT (called from another thread: the renderer
  * stays alive and usable by its owner). */
 SW_API sw_result sw_renderer_destroy(sw_renderer renderer);
@@ -167,6 +174,11 @@ typedef struct sw_frame_desc {
                                 refinement it asks for (deterministic images); 1: walkthrough — it
                                 never waits: what is not ready is drawn from what is at hand
                                 (Bézier patches, coarser nodes) and asked for, for later frames */
+    int32_t present;         /* 1: the frame is also copied into the framebuffer bound to
+                                GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
+                                origin, width x height; the host's framebuffer bindings and
+                                viewport are restored (other GL state is the renderer's: set yours
+                                again after the call). Not read back unless output_path is set. */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {

@@ -1,0 +1,438 @@
+/* splinewalk view SCENE: the interactive viewer (issue 5). A GLFW window is the host: its context
+ * is current on this thread, a renderer is made on it (sw_renderer_desc.use_current_context), and
+ * each frame is drawn in walkthrough mode — the same pipeline as `profile` and the embedding API —
+ * then presented into the window (sw_frame_desc.present). --script replays a camera path for a
+ * fixed number of frames (tests under xvfb-run, demos), --record writes the keys set with K.
+ */
+#include "cli.h"
+
+#include "sw_camera_path.h"
+#include "sw_gpu.h"
+
+#ifndef GL_GLEXT_PROTOTYPES
+#define GL_GLEXT_PROTOTYPES
+#endif
+#define GLFW_INCLUDE_GLCOREARB
+#include <GLFW/glfw3.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char k_usage[] =
+    "usage: splinewalk view SCENE [--size WxH] [--error PX] [--speed S] [--record PATH]\n"
+    "                       [--script PATH --frames N [--screenshot OUT.png] [--settle]]\n"
+    "\n"
+    "Opens a window (GLFW; needs a display: under no display use `splinewalk profile`, or run\n"
+    "inside xvfb-run) and walks through SCENE in walkthrough mode: frames never wait for the\n"
+    "worker pool; what is not refined yet is drawn coarser and refined for later frames.\n"
+    "\n"
+    "keys:\n"
+    "  W A S D       forward, left, back, right      Q E   down, up (along +Z)\n"
+    "  mouse drag    look around (left button)      scroll   walking speed x1.25 / x0.8\n"
+    "  + -           screen-space error x2 / x0.5   (shown in the title, with the frame time)\n"
+    "  K             add the current camera as a key to the recording (--record)\n"
+    "  R             back to the iso view           Esc      close\n"
+    "\n"
+    "options:\n"
+    "  --size WxH        window size (default 1280x720)\n"
+    "  --error PX        screen-space error bound in pixels (default 0.5)\n"
+    "  --speed S         walking speed in scene diagonals per second (default 0.1)\n"
+    "  --record PATH     on close, write the keys set with K as a camera path "
+    "(docs/camera-path.md)\n"
+    "  --script PATH     no input: the camera follows the camera path PATH for --frames N frames\n"
+    "  --frames N        frames of the script (default: the path's own count, else 120)\n"
+    "  --screenshot OUT  after the script, save the window's last frame (PNG) and print its "
+    "camera\n"
+    "  --settle          after the script, draw the last view once more converged (every\n"
+    "                    refinement done), as `splinewalk render --camera` draws it\n"
+    "  -h, --help        this text\n";
+
+typedef struct view_args {
+    const char *scene, *record, *script, *screenshot;
+    int32_t w, h;
+    int frames, settle;
+    double error_px, speed;
+} view_args;
+
+static int parse_value(view_args *a, const char *arg, const char *val)
+{
+    if (!strcmp(arg, "--size"))
+        return sw_cli_parse_size(val, &a->w, &a->h);
+    if (!strcmp(arg, "--error"))
+        return sw_cli_parse_positive(val, &a->error_px);
+    if (!strcmp(arg, "--speed"))
+        return sw_cli_parse_positive(val, &a->speed);
+    if (!strcmp(arg, "--frames"))
+        return sw_cli_parse_count(val, 1, (int)SW_RT_PATH_MAX_FRAMES, &a->frames);
+    if (!strcmp(arg, "--record"))
+        a->record = val;
+    else if (!strcmp(arg, "--script"))
+        a->script = val;
+    else if (!strcmp(arg, "--screenshot"))
+        a->screenshot = val;
+    else
+        return -1;
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, view_args *a)
+{
+    *a = (view_args){.w = 1280, .h = 720, .error_px = 0.5, .speed = 0.1};
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(arg, "--settle")) {
+            a->settle = 1;
+            continue;
+        }
+        if (arg[0] != '-' && !a->scene) {
+            a->scene = arg;
+            continue;
+        }
+        int bad = arg[0] == '-' && val ? parse_value(a, arg, val) : -1;
+        if (bad < 0) {
+            fprintf(stderr, "splinewalk view: unexpected argument '%s'\n%s", arg, k_usage);
+            return 2;
+        }
+        if (bad) {
+            fprintf(stderr, "splinewalk view: bad value '%s' for %s\n%s", val, arg, k_usage);
+            return 2;
+        }
+        i++;
+    }
+    if (!a->scene) {
+        fprintf(stderr, "splinewalk view: need SCENE\n%s", k_usage);
+        return 2;
+    }
+    if ((a->screenshot || a->settle || a->frames) && !a->script) {
+        fprintf(stderr, "splinewalk view: --frames, --screenshot and --settle need --script\n%s",
+                k_usage);
+        return 2;
+    }
+    return 0;
+}
+
+/* ---- camera --------------------------------------------------------------------------------- */
+
+typedef struct walker {
+    sw_camera cam;
+    double yaw, pitch; /* radians; the view direction from them, +Z up */
+    double speed;      /* world units per second */
+    double mouse_x, mouse_y;
+    int dragging;
+} walker;
+
+static void walker_look_from(walker *wk, const sw_camera *c)
+{
+    double d[3] = {c->target[0] - c->eye[0], c->target[1] - c->eye[1], c->target[2] - c->eye[2]};
+    double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    wk->cam = *c;
+    wk->yaw = atan2(d[1], d[0]);
+    wk->pitch = asin(fmax(-1.0, fmin(1.0, d[2] / len)));
+}
+
+static void walker_direction(const walker *wk, double d[3])
+{
+    d[0] = cos(wk->pitch) * cos(wk->yaw);
+    d[1] = cos(wk->pitch) * sin(wk->yaw);
+    d[2] = sin(wk->pitch);
+}
+
+/* Moves the eye by the keys held for dt seconds, and keeps the target one unit ahead. */
+static void walker_step(walker *wk, GLFWwindow *win, double dt)
+{
+    double d[3], side[3], move[3] = {0, 0, 0};
+    walker_direction(wk, d);
+    side[0] = sin(wk->yaw);
+    side[1] = -cos(wk->yaw);
+    side[2] = 0.0;
+    const struct {
+        int key;
+        const double *axis;
+        double sign;
+    } binds[] = {
+        {GLFW_KEY_W, d, 1}, {GLFW_KEY_S, d, -1}, {GLFW_KEY_D, side, 1}, {GLFW_KEY_A, side, -1}};
+    for (size_t b = 0; b < sizeof binds / sizeof binds[0]; ++b) {
+        if (glfwGetKey(win, binds[b].key) == GLFW_PRESS)
+            for (int k = 0; k < 3; ++k)
+                move[k] += binds[b].sign * binds[b].axis[k];
+    }
+    move[2] +=
+        (glfwGetKey(win, GLFW_KEY_E) == GLFW_PRESS) - (glfwGetKey(win, GLFW_KEY_Q) == GLFW_PRESS);
+    for (int k = 0; k < 3; ++k) {
+        wk->cam.eye[k] += move[k] * wk->speed * dt;
+        wk->cam.target[k] = wk->cam.eye[k] + d[k];
+    }
+    wk->cam.up[0] = wk->cam.up[1] = 0.0;
+    wk->cam.up[2] = 1.0;
+}
+
+/* ---- the window and its input ------------------------------------------------------------------
+ */
+
+typedef struct viewer {
+    view_args *args;
+    walker wk;
+    sw_camera home;
+    double error_px;
+    sw_rt_camera_path recording;
+    uint32_t cap_keys;
+    double clock_s;
+} viewer;
+
+static void record_key(viewer *v)
+{
+    if (!v->args->record)
+        return;
+    if (v->recording.n_keys == v->cap_keys) {
+        uint32_t cap = v->cap_keys ? 2 * v->cap_keys : 16;
+        sw_rt_path_key *k = realloc(v->recording.keys, cap * sizeof *k);
+        if (!k)
+            return;
+        v->recording.keys = k;
+        v->cap_keys = cap;
+    }
+    /* One second apart: a recording is a set of views, its timing is the path's to choose. */
+    v->recording.keys[v->recording.n_keys] =
+        (sw_rt_path_key){.t = (double)v->recording.n_keys, .camera = v->wk.cam};
+    fprintf(stderr, "splinewalk view: key %u recorded\n", ++v->recording.n_keys);
+}
+
+static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
+{
+    (void)scancode;
+    (void)mods;
+    viewer *v = glfwGetWindowUserPointer(win);
+    if (action != GLFW_PRESS)
+        return;
+    if (key == GLFW_KEY_ESCAPE)
+        glfwSetWindowShouldClose(win, 1);
+    else if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD)
+        v->error_px = fmin(v->error_px * 2.0, 64.0);
+    else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT)
+        v->error_px = fmax(v->error_px * 0.5, 1.0 / 64.0);
+    else if (key == GLFW_KEY_K)
+        record_key(v);
+    else if (key == GLFW_KEY_R)
+        walker_look_from(&v->wk, &v->home);
+}
+
+static void on_scroll(GLFWwindow *win, double dx, double dy)
+{
+    (void)dx;
+    viewer *v = glfwGetWindowUserPointer(win);
+    v->wk.speed *= dy > 0 ? 1.25 : 0.8;
+}
+
+static void on_mouse(GLFWwindow *win, double x, double y)
+{
+    viewer *v = glfwGetWindowUserPointer(win);
+    walker *wk = &v->wk;
+    int down = glfwGetMouseButton(win, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
+    if (down && wk->dragging) {
+        wk->yaw -= (x - wk->mouse_x) * 0.004;
+        wk->pitch = fmax(-1.5, fmin(1.5, wk->pitch - (y - wk->mouse_y) * 0.004));
+    }
+    wk->dragging = down;
+    wk->mouse_x = x;
+    wk->mouse_y = y;
+}
+
+static GLFWwindow *open_window(const view_args *a)
+{
+    if (!glfwInit()) {
+        fprintf(stderr, "splinewalk view: no display to open a window on (GLFW could not start: "
+                        "DISPLAY unset or unreachable). Headless, use `splinewalk profile SCENE "
+                        "--path PATH --out DIR`, or run the viewer inside xvfb-run -a.\n");
+        return NULL;
+    }
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE); /* the frame size is the window's */
+    GLFWwindow *win = glfwCreateWindow(a->w, a->h, "splinewalk", NULL, NULL);
+    if (!win) {
+        fprintf(stderr, "splinewalk view: the display gives no OpenGL 4.5 core window\n");
+        glfwTerminate();
+        return NULL;
+    }
+    glfwMakeContextCurrent(win);
+    glfwSwapInterval(0); /* frame times are the renderer's, not the monitor's */
+    return win;
+}
+
+/* ---- frames -----------------------------------------------------------------------------------
+ */
+
+static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int converged,
+                      const char *output, sw_frame_stats *fs, sw_status *st)
+{
+    sw_frame_desc fd = {0};
+    fd.scene = scene;
+    fd.camera = v->wk.cam;
+    fd.width = v->args->w;
+    fd.height = v->args->h;
+    fd.error_px = v->error_px;
+    fd.walkthrough = !converged;
+    fd.present = 1;
+    fd.output_path = output;
+    return sw_renderer_draw(r, &fd, fs, st);
+}
+
+static void show_title(GLFWwindow *win, const viewer *v, const sw_frame_stats *fs)
+{
+    char title[256];
+    snprintf(title, sizeof title,
+             "splinewalk — %.1f ms, %llu triangles, %llu fallback draws, error %.3g px, speed %.3g",
+             fs->ms_total, (unsigned long long)fs->triangles,
+             (unsigned long long)fs->fallback_draws, v->error_px, v->wk.speed);
+    glfwSetWindowTitle(win, title);
+}
+
+static void print_camera(const char *what, const sw_camera *c)
+{
+    printf("%s camera %.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", what,
+           c->eye[0], c->eye[1], c->eye[2], c->target[0], c->target[1], c->target[2], c->up[0],
+           c->up[1], c->up[2], c->fovy_deg);
+}
+
+/* The scripted run: the path's cameras for `frames` frames, then optionally a converged frame and
+ * a screenshot of what the window shows. */
+static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
+                      const sw_rt_camera_path *path)
+{
+    uint32_t n = v->args->frames ? (uint32_t)v->args->frames : path->frames ? path->frames : 120;
+    sw_status st = {0};
+    sw_frame_stats fs = {0};
+    uint64_t waits = 0, fallbacks = 0;
+    double worst = 0.0, t0 = sw_cli_now_ms();
+    for (uint32_t i = 0; i < n && !glfwWindowShouldClose(win); ++i) {
+        sw_rt_path_eval(path, sw_rt_path_frame_time(path, i, n), &v->wk.cam);
+        if (draw(r, scene, v, 0, NULL, &fs, &st) != SW_OK)
+            return sw_cli_report("view", &st);
+        glfwSwapBuffers(win);
+        glfwPollEvents();
+        waits += fs.pool_waits;
+        fallbacks += fs.fallback_draws;
+        worst = fmax(worst, fs.ms_total);
+        show_title(win, v, &fs);
+    }
+    printf("script: %u frames in %.0f ms (slowest %.1f ms), pool waits %llu, fallback draws %llu\n",
+           n, sw_cli_now_ms() - t0, worst, (unsigned long long)waits,
+           (unsigned long long)fallbacks);
+    if (v->args->settle && draw(r, scene, v, 1, NULL, &fs, &st) != SW_OK)
+        return sw_cli_report("view", &st);
+    if (!v->args->screenshot)
+        return 0;
+    /* What the window shows: its back buffer, read after the present, before the swap. */
+    sw_gpu_image img = {.width = v->args->w, .height = v->args->h};
+    size_t row = (size_t)img.width * 4;
+    uint8_t *bottom_up = malloc(row * (size_t)img.height);
+    img.rgba = malloc(row * (size_t)img.height);
+    if (!bottom_up || !img.rgba) {
+        free(bottom_up);
+        free(img.rgba);
+        fprintf(stderr, "splinewalk view: out of memory for the screenshot\n");
+        return 1;
+    }
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glReadBuffer(GL_BACK);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, img.width, img.height, GL_RGBA, GL_UNSIGNED_BYTE, bottom_up);
+    for (int32_t y = 0; y < img.height; ++y)
+        memcpy(img.rgba + (size_t)y * row, bottom_up + (size_t)(img.height - 1 - y) * row, row);
+    free(bottom_up);
+    sw_result res = sw_gpu_image_write(&img, v->args->screenshot, &st);
+    free(img.rgba);
+    glfwSwapBuffers(win);
+    if (res != SW_OK)
+        return sw_cli_report("view", &st);
+    printf("screenshot %s\n", v->args->screenshot);
+    print_camera("screenshot", &v->wk.cam);
+    return 0;
+}
+
+static int run_interactive(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v)
+{
+    sw_status st = {0};
+    sw_frame_stats fs = {0};
+    double last = glfwGetTime();
+    while (!glfwWindowShouldClose(win)) {
+        glfwPollEvents();
+        double now = glfwGetTime();
+        walker_step(&v->wk, win, fmin(now - last, 0.25));
+        last = now;
+        if (draw(r, scene, v, 0, NULL, &fs, &st) != SW_OK)
+            return sw_cli_report("view", &st);
+        show_title(win, v, &fs);
+        glfwSwapBuffers(win);
+    }
+    if (v->args->record && v->recording.n_keys > 0) {
+        if (sw_rt_path_save(&v->recording, v->args->record, &st) != SW_OK)
+            return sw_cli_report("view", &st);
+        printf("recorded %u keys to %s\n", v->recording.n_keys, v->args->record);
+    }
+    return 0;
+}
+
+static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
+                      const sw_rt_camera_path *script)
+{
+    sw_status st = {0};
+    sw_scene_info info;
+    if (sw_scene_get_info(scene, &info, &st) != SW_OK)
+        return sw_cli_report("view", &st);
+    viewer v = {.args = a, .error_px = a->error_px};
+    if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)
+        return sw_cli_report("view", &st);
+    walker_look_from(&v.wk, &v.home);
+    double diag = 0.0;
+    for (int k = 0; k < 3; ++k)
+        diag += (info.bbox_max[k] - info.bbox_min[k]) * (info.bbox_max[k] - info.bbox_min[k]);
+    v.wk.speed = a->speed * sqrt(diag);
+    glfwSetWindowUserPointer(win, &v);
+    glfwSetKeyCallback(win, on_key);
+    glfwSetScrollCallback(win, on_scroll);
+    glfwSetCursorPosCallback(win, on_mouse);
+    sw_renderer r = {0};
+    sw_renderer_desc rd = {.use_current_context = 1};
+    int rc = sw_renderer_create(&rd, &r, &st) != SW_OK ? sw_cli_report("view", &st) : 0;
+    if (rc == 0) {
+        fprintf(stderr, "splinewalk view: %s\n", sw_renderer_description_ptr(r));
+        rc = script ? run_script(win, r, scene, &v, script) : run_interactive(win, r, scene, &v);
+        sw_renderer_destroy(r); /* while the window's context is still current */
+    }
+    free(v.recording.keys);
+    return rc;
+}
+
+int sw_cli_view(int argc, char **argv)
+{
+    if (sw_cli_print_help(argc, argv, k_usage))
+        return 0;
+    view_args a;
+    int rc = parse_args(argc, argv, &a);
+    if (rc)
+        return rc;
+    sw_status st = {0};
+    sw_rt_camera_path script = {0};
+    if (a.script && sw_rt_path_load(a.script, &script, &st) != SW_OK)
+        return sw_cli_report("view", &st);
+    /* The window first: without a display the user learns it before a long import. */
+    GLFWwindow *win = open_window(&a);
+    sw_scene scene = {0};
+    if (!win)
+        rc = 1;
+    else if (sw_cli_load_scene(a.scene, &scene, &st) != SW_OK)
+        rc = sw_cli_report("view", &st);
+    else
+        rc = view_scene(&a, win, scene, a.script ? &script : NULL);
+    sw_scene_destroy(scene);
+    sw_rt_path_free(&script);
+    if (win) {
+        glfwDestroyWindow(win);
+        glfwTerminate();
+    }
+    return rc;
+}

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# tests/viewer: `splinewalk view` (issue 5) as a user meets it.
+#  1. No display: exit 1 with a message that points to `splinewalk profile` (before any import).
+#  2. Bad arguments: --screenshot without --script is a usage error (2); a missing script file
+#     is named in the error (1).
+#  3. Under xvfb-run: the window opens, 60 frames of a scripted orbit are drawn in walkthrough mode
+#     (0 pool waits), the last view is drawn converged (--settle), the window's back buffer is
+#     saved through OpenImageIO, and the viewer closes cleanly (exit 0). The screenshot must match
+#     `splinewalk render --camera` of the camera it printed (<= 0.1 % of pixels differ): what the
+#     window shows is the renderer's frame, presented into the window's framebuffer.
+# usage: test_view.sh SPLINEWALK PNG_DIFF MODEL WORKDIR
+set -euo pipefail
+sw=$1 diff=$2 model=$3 work=$4
+rm -rf "$work" && mkdir -p "$work"
+fail() { echo "FAIL: $*"; exit 1; }
+
+set +e
+out=$(env -u DISPLAY -u WAYLAND_DISPLAY "$sw" view "$model" 2>&1); rc=$?
+set -e
+[ $rc -eq 1 ] || fail "no display: exit $rc, expected 1"
+grep -q "splinewalk profile" <<<"$out" || fail "no display: message does not point to profile: $out"
+grep -q "% convert" <<<"$out" && fail "no display: the scene was imported before the display check"
+echo "ok: no display -> exit 1, points to splinewalk profile"
+
+set +e
+"$sw" view "$model" --screenshot "$work/x.png" >/dev/null 2>&1; rc=$?
+[ $rc -eq 2 ] || fail "--screenshot without --script: exit $rc, expected 2"
+out=$(xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --script "$work/missing.path" 2>&1); rc=$?
+set -e
+[ $rc -eq 1 ] || fail "missing script: exit $rc, expected 1"
+grep -q "missing.path" <<<"$out" || fail "missing script not named: $out"
+echo "ok: bad arguments -> 2, missing script -> 1 naming it"
+
+"$sw" path orbit "$model" -o "$work/orbit.path" >/dev/null 2>&1
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+  --script "$work/orbit.path" --frames 60 --settle --screenshot "$work/shot.png" \
+  >"$work/view.out" 2>"$work/view.err" || { cat "$work/view.err"; fail "view exited $?"; }
+cat "$work/view.out"
+grep -q "^script: 60 frames" "$work/view.out" || fail "not 60 frames"
+grep -q "pool waits 0," "$work/view.out" || fail "walkthrough frames waited for the pool"
+[ -s "$work/shot.png" ] || fail "no screenshot"
+cam=$(sed -n 's/^screenshot camera //p' "$work/view.out")
+[ -n "$cam" ] || fail "no camera printed"
+"$sw" render "$model" -o "$work/render.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
+"$diff" "$work/shot.png" "$work/render.png" 0.1 || fail "screenshot differs from render"
+# Negative control: the comparison sees a different view.
+"$sw" render "$model" -o "$work/other.png" --size 640x360 --view front >/dev/null 2>&1
+if "$diff" "$work/shot.png" "$work/other.png" 0.1 >/dev/null; then
+  fail "control: the front view compared equal to the screenshot"
+fi
+echo "ok: 60 scripted frames, settled screenshot equals splinewalk render of its camera"
