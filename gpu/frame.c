@@ -106,7 +106,6 @@ static sw_result face_bezier(frame *f, uint32_t face, const sw_sg_bezier_set **o
     return SW_OK;
 }
 
-
 /* Sets up one patch: eye-relative control points, clipping to the uv box, culling, density. */
 static void patch_setup(frame *f, const occurrence *o, const sw_sg_bezier_patch *bp,
                         const double ub[4], int class_grids, double *cpw, sw__gpu_patch *pt,
@@ -174,7 +173,8 @@ sw_result sw__fr_add_draw(frame *f, const occurrence *o, size_t first_idx, int t
                           const trim_need *need, const double cell[2], sw_status *status)
 {
     if (!sw__gpu_grow((void **)&f->draws, &f->cap_draws, f->n_draws + 1, sizeof *f->draws) ||
-        (trimmed && !sw__gpu_grow((void **)&f->trims, &f->cap_trims, f->n_trims + 1, sizeof *f->trims)))
+        (trimmed &&
+         !sw__gpu_grow((void **)&f->trims, &f->cap_trims, f->n_trims + 1, sizeof *f->trims)))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame draws: out of memory");
     sw__gpu_draw *d = &f->draws[f->n_draws];
     d->first_idx = first_idx;
@@ -241,7 +241,8 @@ static sw_result exact_net(frame *f, const occurrence *o, sw_status *status)
     if (f->n_knots + nku + nkv > UINT32_MAX || f->n_dcps + ncp > UINT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "face %u: exact evaluation buffers over 2^32",
                         o->face);
-    if (!sw__gpu_grow((void **)&f->knots, &f->cap_knots, f->n_knots + nku + nkv, sizeof *f->knots) ||
+    if (!sw__gpu_grow((void **)&f->knots, &f->cap_knots, f->n_knots + nku + nkv,
+                      sizeof *f->knots) ||
         !sw__gpu_grow((void **)&f->dcps, &f->cap_dcps, 4 * (f->n_dcps + ncp), sizeof *f->dcps))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     sw__gpu_exact_piece *b = &f->ex_base;
@@ -293,7 +294,6 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
                            const double ub[4], double sign, int32_t draw, int trimmed,
                            sw_status *status)
 {
-    sw_gpu_context *ctx = f->ctx;
     size_t n_cp = f->exact ? 0 : (size_t)(pt->deg_u + 1) * (size_t)(pt->deg_v + 1);
     uint32_t cp_index = (uint32_t)f->n_cps;
     if (f->exact) {
@@ -305,17 +305,17 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
     split_class(pt->nu, &ku, &lu);
     split_class(pt->nv, &kv, &lv);
     size_t n_rec = (size_t)ku * (size_t)kv;
-    if (!sw__gpu_grow((void **)&ctx->cps, &ctx->cap_cps, 4 * (f->n_cps + n_cp), sizeof *ctx->cps) ||
-        !sw__gpu_grow((void **)&ctx->recs, &ctx->cap_recs, f->n_recs + n_rec, sizeof *ctx->recs))
+    if (!sw__gpu_grow((void **)&f->cps, &f->cap_cps, 4 * (f->n_cps + n_cp), sizeof *f->cps) ||
+        !sw__gpu_grow((void **)&f->recs, &f->cap_recs, f->n_recs + n_rec, sizeof *f->recs))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < 4 * n_cp; ++i)
-        ctx->cps[4 * f->n_cps + i] = (float)pt->cpw[i];
+        f->cps[4 * f->n_cps + i] = (float)pt->cpw[i];
     double bw = ub[1] - ub[0], bh = ub[3] - ub[2];
     float map[4] = {(float)((pt->u0 - ub[0]) / bw), (float)((pt->u1 - pt->u0) / bw),
                     (float)((pt->v0 - ub[2]) / bh), (float)((pt->v1 - pt->v0) / bh)};
     for (int32_t b = 0; b < kv; ++b) {
         for (int32_t a = 0; a < ku; ++a) {
-            sw__gpu_patch_rec *rec = &ctx->recs[f->n_recs++];
+            sw__gpu_patch_rec *rec = &f->recs[f->n_recs++];
             memset(rec, 0, sizeof *rec);
             rec->st[0] = (float)(pt->s0 + (pt->s1 - pt->s0) * a / ku);
             rec->st[1] = (float)(a + 1 == ku ? pt->s1 : pt->s0 + (pt->s1 - pt->s0) * (a + 1) / ku);
@@ -329,9 +329,10 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
             rec->draw = draw;
             rec->level_u = lu;
             rec->level_v = lv;
-            if (ctx->patch_hook)
+            if (f->ctx->patch_hook)
                 sw__fr_report_patch(f, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
-                             sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1, trimmed);
+                                    sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1,
+                                    trimmed);
         }
     }
     f->n_cps += n_cp;
@@ -441,9 +442,9 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on)
  * cells meet vertex to vertex as whole patches do. */
 typedef struct tile {
     double rect[4];
-    int32_t i, j;         /* tile indices */
+    int32_t i, j;           /* tile indices */
     int32_t a0, a1, b0, b1; /* patch columns and rows it overlaps (inclusive) */
-    size_t first_cell;    /* (a1 - a0 + 1) x (b1 - b0 + 1) cells, column fastest */
+    size_t first_cell;      /* (a1 - a0 + 1) x (b1 - b0 + 1) cells, column fastest */
     trim_need need;
     int cls; /* sw__gpu_trim_rect_class */
 } tile;
@@ -483,7 +484,8 @@ static void patch_span(const sw_sg_bezier_set *set, int dir, double lo, double h
     *first = n;
     *last = -1;
     for (int32_t a = 0; a < n; ++a) {
-        const sw_sg_bezier_patch *bp = &set->patches[dir ? (size_t)a * (size_t)set->n_u : (size_t)a];
+        const sw_sg_bezier_patch *bp =
+            &set->patches[dir ? (size_t)a * (size_t)set->n_u : (size_t)a];
         double p0 = dir ? bp->v0 : bp->u0, p1 = dir ? bp->v1 : bp->u1;
         if (p1 > lo && p0 < hi) {
             *first = a < *first ? a : *first;
@@ -614,8 +616,8 @@ static int unify_cells(tiling *t, int dir)
         size_t n = (size_t)(tl->a1 - tl->a0 + 1) * (size_t)(tl->b1 - tl->b0 + 1);
         for (size_t c = tl->first_cell; c < tl->first_cell + n; ++c) {
             const sw__gpu_patch *p = &t->cells[c];
-            int64_t key = dir ? (int64_t)tl->j * t->set->n_v + p->row
-                              : (int64_t)tl->i * t->set->n_u + p->col;
+            int64_t key =
+                dir ? (int64_t)tl->j * t->set->n_v + p->row : (int64_t)tl->i * t->set->n_u + p->col;
             if (p->visible)
                 k[m++] = (cell_key){key, c};
         }
@@ -636,8 +638,7 @@ static int unify_cells(tiling *t, int dir)
 
 /* Flattens the face's loops once, finely enough for its finest tile texture, and classifies
  * the tiles against them (a margin of 1 % of a tile so that a loop on a tile's edge counts). */
-sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index,
-                            sw_status *status)
+sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index, sw_status *status)
 {
     const sw_sg_face_rec *rec = &f->sv->faces[face];
     if (!sw__gpu_grow((void **)&f->loops, &f->cap_loops, f->n_loops + 1, sizeof *f->loops))
@@ -662,8 +663,10 @@ static sw_result tile_loops(tiling *t, int64_t *index, sw_status *status)
     double tol = INFINITY;
     for (size_t i = 0; i < t->n_tiles; ++i) {
         const tile *tl = &t->tiles[i];
-        tol = fmin(tol, 0.5 * (tl->rect[1] - tl->rect[0]) / sw__fr_class_texels(tl->need.u, max_entry));
-        tol = fmin(tol, 0.5 * (tl->rect[3] - tl->rect[2]) / sw__fr_class_texels(tl->need.v, max_entry));
+        tol = fmin(tol,
+                   0.5 * (tl->rect[1] - tl->rect[0]) / sw__fr_class_texels(tl->need.u, max_entry));
+        tol = fmin(tol,
+                   0.5 * (tl->rect[3] - tl->rect[2]) / sw__fr_class_texels(tl->need.v, max_entry));
     }
     sw_result r = sw__fr_face_loops(f, t->o->face, tol, index, status);
     const face_loops *fl = r == SW_OK ? &f->loops[*index] : NULL;
@@ -696,8 +699,8 @@ static sw_result tile_draw(tiling *t, const tile *tl, int64_t loops, double sign
         r = sw__gpu_tessellate_face(c, n_cols, n_rows, sign, tl->rect, &f->mesh, status);
         for (size_t p = 0; p < n && f->ctx->patch_hook; ++p)
             if (c[p].visible)
-                sw__fr_report_patch(f, t->o, &c[p], c[p].s0, c[p].s1, c[p].t0, c[p].t1, c[p].nu, c[p].nv,
-                             0, trimmed);
+                sw__fr_report_patch(f, t->o, &c[p], c[p].s0, c[p].s1, c[p].t0, c[p].t1, c[p].nu,
+                                    c[p].nv, 0, trimmed);
         if (r == SW_OK)
             r = sw__fr_add_draw(f, t->o, first, trimmed, &tl->need, cell, status);
     }
@@ -727,7 +730,7 @@ static sw_result tiled_draws(tiling *t, double sign, int on_gpu, sw_status *stat
     const face_loops *fl = loops >= 0 ? &f->loops[loops] : NULL;
     for (uint32_t k = 0; r == SW_OK && fl && !f->ctx->crack_fill_off && k < fl->n; ++k)
         r = sw__fr_fat_border(f, t->o, fl->loops[k].uv, fl->loops[k].count,
-                       sw__fr_left_is_inside(fl->loops, fl->n, k), cell, NULL, 0, status);
+                              sw__fr_left_is_inside(fl->loops, fl->n, k), cell, NULL, 0, status);
     return r;
 }
 
@@ -740,11 +743,24 @@ static int32_t tiles_for(double need)
 }
 
 static sw_result tiled_face(frame *f, const occurrence *o, const sw_sg_bezier_set *set,
-                            const sw__gpu_patch *pt, const trim_need *need, double sign,
-                            int on_gpu, int class_grids, sw_status *status)
+                            const sw__gpu_patch *pt, const trim_need *need, double sign, int on_gpu,
+                            int class_grids, sw_status *status)
 {
-    tiling t = {f, o, set, pt, f->sv->faces[o->face].uv_box, tiles_for(need->u), tiles_for(need->v),
-                class_grids, NULL, 0, 0, NULL, 0, 0, NULL};
+    tiling t = {f,
+                o,
+                set,
+                pt,
+                f->sv->faces[o->face].uv_box,
+                tiles_for(need->u),
+                tiles_for(need->v),
+                class_grids,
+                NULL,
+                0,
+                0,
+                NULL,
+                0,
+                0,
+                NULL};
     int32_t md = 0;
     for (size_t p = 0; p < (size_t)set->n_u * (size_t)set->n_v; ++p)
         md = md > (set->patches[p].deg_u + 1) * (set->patches[p].deg_v + 1)
@@ -761,9 +777,9 @@ static sw_result tiled_face(frame *f, const occurrence *o, const sw_sg_bezier_se
     for (size_t i = 0; i < t.n_tiles && ok; ++i)
         ok = tile_cells(&t, &t.tiles[i]);
     ok = ok && unify_cells(&t, 0) && unify_cells(&t, 1);
-    sw_result r = ok ? tiled_draws(&t, sign, on_gpu, status)
-                     : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u tiles: out of memory",
-                                o->face);
+    sw_result r =
+        ok ? tiled_draws(&t, sign, on_gpu, status)
+           : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u tiles: out of memory", o->face);
     free(t.scratch);
     free(t.tiles);
     free(t.cells);
@@ -830,8 +846,8 @@ sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status)
             r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->mesh, status);
             for (size_t p = 0; p < n && f->ctx->patch_hook; ++p)
                 if (pt[p].visible)
-                    sw__fr_report_patch(f, o, &pt[p], pt[p].s0, pt[p].s1, pt[p].t0, pt[p].t1, pt[p].nu,
-                                 pt[p].nv, 0, trimmed);
+                    sw__fr_report_patch(f, o, &pt[p], pt[p].s0, pt[p].s1, pt[p].t0, pt[p].t1,
+                                        pt[p].nu, pt[p].nv, 0, trimmed);
             if (r == SW_OK)
                 r = sw__fr_add_draw(f, o, first, trimmed, &need, cell, status);
         }
@@ -840,7 +856,8 @@ sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status)
         if (r == SW_OK && !trimmed && !f->ctx->crack_fill_off) {
             const double *b = rec->uv_box;
             const double box_loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
-            r = sw__fr_fat_border(f, o, box_loop, 4, 1, cell, NULL, 0, status); /* counter-clockwise */
+            r = sw__fr_fat_border(f, o, box_loop, 4, 1, cell, NULL, 0,
+                                  status); /* counter-clockwise */
         }
         f->st.faces_drawn++;
         if (trimmed)
@@ -966,7 +983,8 @@ static sw_result collect_bvh(frame *f, const sw_sg_bvh *bvh, double **boxes, sw_
     return SW_OK;
 }
 
-/* Sets the view (near plane from the scene's box), finds the visible occurrences and tessellates. */
+/* Sets the view (near plane from the scene's box), finds the visible occurrences and tessellates.
+ */
 static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *status)
 {
     memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
@@ -980,7 +998,8 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
         r = collect_all(f, &boxes, scene_box, status);
     }
     static const double k_origin[3] = {0.0, 0.0, 0.0};
-    double near_plane = scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
+    double near_plane =
+        scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
     if (r == SW_OK)
         r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane,
                               status);
@@ -1045,7 +1064,8 @@ static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, s
     int32_t w = sw__fr_class_texels(t->width * scale, max_entry);
     int32_t h = sw__fr_class_texels(t->height * scale, max_entry);
     const double *r = t->rect;
-    sw__gpu_trim_key key = {f->scene, t->face, rec->first_loop, rec->n_loops, {r[0], r[1], r[2], r[3]}};
+    sw__gpu_trim_key key = {
+        f->scene, t->face, rec->first_loop, rec->n_loops, {r[0], r[1], r[2], r[3]}};
     int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
     f->draws[t->draw].trim_entry = id;
     if (id >= 0)
@@ -1097,7 +1117,8 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     }
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK && border; ++k)
         r = sw__fr_fat_border(f, &f->occ[t->occ], loops[k].uv, loops[k].count,
-                       sw__fr_left_is_inside(loops, rec->n_loops, k), t->cell, NULL, 0, status);
+                              sw__fr_left_is_inside(loops, rec->n_loops, k), t->cell, NULL, 0,
+                              status);
     for (uint32_t k = 0; k < rec->n_loops; ++k)
         sw_sg_polyline_free(&loops[k]);
     free(loops);
@@ -1141,10 +1162,10 @@ static sw_result build_batch(frame *f, sw_status *status)
     if (f->n_recs == 0)
         return SW_OK;
     if (!sw__gpu_grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, f->n_recs,
-              sizeof *ctx->recs_sorted))
+                      sizeof *ctx->recs_sorted))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < f->n_recs; ++i) {
-        sw__gpu_patch_rec *rec = &ctx->recs[i];
+        sw__gpu_patch_rec *rec = &f->recs[i];
         const sw__gpu_draw *d = &f->draws[rec->draw];
         memcpy(rec->color, d->color, sizeof rec->color);
         if (d->trim_entry >= 0) {
@@ -1166,10 +1187,10 @@ static sw_result build_batch(frame *f, sw_status *status)
         }
     int keep = ctx->capture_max > 0;
     if (keep && !sw__gpu_grow((void **)&ctx->rec_source, &ctx->cap_rec_source, f->n_recs,
-                      sizeof *ctx->rec_source))
+                              sizeof *ctx->rec_source))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < f->n_recs; ++i) {
-        const sw__gpu_patch_rec *rec = &ctx->recs[i];
+        const sw__gpu_patch_rec *rec = &f->recs[i];
         uint32_t slot = next[rec->level_v][rec->level_u]++;
         ctx->recs_sorted[slot] = *rec;
         if (keep)
@@ -1177,7 +1198,7 @@ static sw_result build_batch(frame *f, sw_status *status)
     }
     b->recs = ctx->recs_sorted;
     b->n_recs = f->n_recs;
-    b->cps = ctx->cps;
+    b->cps = f->cps;
     b->n_cps = f->n_cps;
     b->exact = f->exact;
     b->pieces = f->pieces;
@@ -1218,79 +1239,146 @@ static void frame_free(frame *f)
     free(f->knots);
     free(f->dcps);
     free(f->shares);
+    free(f->recs);
+    free(f->cps);
     sw__gpu_mesh_free(&f->mesh);
 }
 
-sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
-                              const sw_gpu_frame_desc *desc_in, sw_gpu_image *out,
+/* Visibility, selection and tessellation of a frame are GL-free (the plan is plain memory),
+ * so that the visibility thread can run them for frame i+1 while the submitting thread draws
+ * frame i (Kumar et al. 1997 §5.2). */
+struct sw_gpu_frame_plan {
+    frame f;
+    sw_gpu_frame_desc desc;
+    double ms_prepare;
+};
+
+static void plan_release_reader(sw_gpu_frame_plan *p)
+{
+    frame *f = &p->f;
+    if (!f->cache || f->reader < 0)
+        return;
+    sw_lod_cache_reader_leave(f->cache, f->reader);
+    sw_lod_cache_reader_remove(f->cache, f->reader);
+    f->reader = -1;
+}
+
+void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan)
+{
+    if (!plan)
+        return;
+    plan_release_reader(plan);
+    frame_free(&plan->f);
+    free(plan);
+}
+
+double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan)
+{
+    return plan->ms_prepare;
+}
+
+static sw_result plan_init(sw_gpu_frame_plan *p, sw_gpu_context *ctx, const sw_sg_scene *scene,
+                           sw_status *status)
+{
+    frame *f = &p->f;
+    f->ctx = ctx;
+    f->scene = scene;
+    f->sv = sw_sg_scene_view_ptr(scene);
+    f->eps_px = p->desc.error_px;
+    f->exact = p->desc.eval_exact != 0;
+    f->reader = -1;
+    f->bez = calloc(f->sv->n_faces ? f->sv->n_faces : 1, sizeof *f->bez);
+    if (!f->bez)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
+    if (!p->desc.hierarchies)
+        return SW_OK;
+    if (sw_lod_cache_scene(p->desc.hierarchies) != scene)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "frame: the hierarchy cache belongs to another scene");
+    f->cache = p->desc.hierarchies;
+    /* A slot per plan: the plans of two overlapping frames are read at the same time. */
+    f->reader = sw_lod_cache_reader_add(f->cache);
+    if (f->reader < 0)
+        return sw__fail(status, SW_ERR_LIMIT, "frame: no free reader slot in the cache");
+    sw_lod_cache_reader_enter(f->cache, f->reader);
+    return SW_OK;
+}
+
+sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                               const sw_gpu_frame_desc *desc, sw_gpu_frame_plan **out,
+                               sw_status *status)
+{
+    *out = NULL;
+    double t0 = sw__gpu_now_ms();
+    sw_gpu_frame_plan *p = calloc(1, sizeof *p);
+    if (!p)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
+    sw__gpu_desc_defaults(desc, &p->desc);
+    sw_result r = plan_init(p, ctx, scene, status);
+    if (r == SW_OK)
+        r = tessellate(&p->f, &p->desc, status);
+    if (r != SW_OK) {
+        sw_gpu_frame_plan_free(p);
+        return r;
+    }
+    p->ms_prepare = sw__gpu_now_ms() - t0;
+    p->f.st.ms_tessellate = p->ms_prepare - p->f.st.ms_hierarchy; /* the waits are counted apart */
+    *out = p;
+    return SW_OK;
+}
+
+sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
                               sw_gpu_frame_stats *stats, sw_status *status)
 {
     memset(out, 0, sizeof *out);
-    sw_gpu_frame_desc desc;
-    sw__gpu_desc_defaults(desc_in, &desc);
-    frame f;
-    memset(&f, 0, sizeof f);
-    f.ctx = ctx;
-    f.scene = scene;
-    f.sv = sw_sg_scene_view_ptr(scene);
-    f.eps_px = desc.error_px;
-    f.exact = desc.eval_exact != 0;
-    f.bez = calloc(f.sv->n_faces ? f.sv->n_faces : 1, sizeof *f.bez);
-    if (!f.bez)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
-    f.reader = -1;
-    if (desc.hierarchies) {
-        if (sw_lod_cache_scene(desc.hierarchies) != scene) {
-            frame_free(&f);
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                            "frame: the hierarchy cache belongs to another scene");
-        }
-        f.cache = desc.hierarchies;
-        f.reader = sw_lod_cache_reader_add(f.cache);
-        if (f.reader < 0) {
-            frame_free(&f);
-            return sw__fail(status, SW_ERR_LIMIT, "frame: no free reader slot in the cache");
-        }
-        sw_lod_cache_reader_enter(f.cache, f.reader);
-    }
-
+    frame *f = &plan->f;
+    const sw_gpu_frame_desc *desc = &plan->desc;
+    sw_result r = f->ctx == ctx ? SW_OK
+                                : sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                                           "frame: the plan was prepared for another context");
     sw__gpu_host_state host;
-    if (desc.present)
+    if (desc->present)
         sw__gpu_host_state_save(&host);
-    double t0 = sw__gpu_now_ms();
-    sw_result r = tessellate(&f, &desc, status);
     double t1 = sw__gpu_now_ms();
     if (r == SW_OK)
-        r = make_trims(&f, status);
+        r = make_trims(f, status);
     double t2 = sw__gpu_now_ms();
     if (r == SW_OK)
-        r = build_batch(&f, status);
+        r = build_batch(f, status);
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &f.view, desc.background, &f.mesh, f.draws, f.n_draws, &f.batch,
-                               status);
+        r = sw__gpu_draw_frame(ctx, &f->view, desc->background, &f->mesh, f->draws, f->n_draws,
+                               &f->batch, status);
     double t3 = sw__gpu_now_ms();
-    if (r == SW_OK && desc.present)
-        r = sw__gpu_present(ctx, &f.view, &host, status);
-    if (r == SW_OK && !desc.no_readback)
-        r = sw__gpu_readback(ctx, &f.view, desc.want_depth, out, status);
-    if (desc.present)
+    if (r == SW_OK && desc->present)
+        r = sw__gpu_present(ctx, &f->view, &host, status);
+    if (r == SW_OK && !desc->no_readback)
+        r = sw__gpu_readback(ctx, &f->view, desc->want_depth, out, status);
+    if (desc->present)
         sw__gpu_host_state_restore(&host);
     double t4 = sw__gpu_now_ms();
 
-    f.st.triangles += f.mesh.n_idx / 3 - f.border_triangles;
-    f.st.ms_tessellate = t1 - t0 - f.st.ms_hierarchy; /* the waits are counted apart */
-    f.st.ms_trim = t2 - t1;
-    f.st.ms_draw = t3 - t2;
-    f.st.ms_readback = t4 - t3;
+    f->st.triangles += f->mesh.n_idx / 3 - f->border_triangles;
+    f->st.ms_trim = t2 - t1;
+    f->st.ms_draw = t3 - t2;
+    f->st.ms_readback = t4 - t3;
     if (stats)
-        *stats = f.st;
-    if (f.cache) {
-        sw_lod_cache_reader_leave(f.cache, f.reader);
-        sw_lod_cache_reader_remove(f.cache, f.reader);
-        sw_lod_cache_collect(f.cache);
-    }
-    frame_free(&f);
+        *stats = f->st;
+    sw_lod_cache *cache = f->cache;
+    plan_release_reader(plan);
+    if (cache)
+        sw_lod_cache_collect(cache);
+    sw_gpu_frame_plan_free(plan);
     if (r == SW_OK)
         sw__status_ok(status);
     return r;
+}
+
+sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                              const sw_gpu_frame_desc *desc, sw_gpu_image *out,
+                              sw_gpu_frame_stats *stats, sw_status *status)
+{
+    memset(out, 0, sizeof *out);
+    sw_gpu_frame_plan *plan;
+    sw_result r = sw_gpu_frame_prepare(ctx, scene, desc, &plan, status);
+    return r == SW_OK ? sw_gpu_frame_submit(ctx, plan, out, stats, status) : r;
 }

@@ -15,8 +15,8 @@
 enum {
     MAX_SEGMENTS = 256, /* grid segments per patch and direction */
     MAX_TRIM_LOOP_VERTICES = 1u << 22,
-    MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
-    MAX_TILES_PER_DIR = 4096,  /* trim tiles of a face per direction */
+    MAX_BOUND_SUBDIVISION = 4,  /* sub-patches per direction for the derivative bounds */
+    MAX_TILES_PER_DIR = 4096,   /* trim tiles of a face per direction */
     MAX_TILES_PER_FACE = 16384, /* visible trim tiles of one face occurrence (else coarser) */
 };
 
@@ -28,8 +28,8 @@ typedef struct segment_set {
 } segment_set;
 static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
 static const double k_max_frame_texels = 256e6;  /* R8 trim texels per frame */
-static const double k_tile_texels = 1024.0; /* wanted trim texels per direction above which a
-                                               face's trim box is split into tiles */
+static const double k_tile_texels = 1024.0;      /* wanted trim texels per direction above which a
+                                                    face's trim box is split into tiles */
 
 typedef struct occurrence {
     uint32_t face;
@@ -69,8 +69,10 @@ typedef struct frame {
     size_t n_draws, cap_draws;
     pending_trim *trims;
     size_t n_trims, cap_trims;
-    size_t n_recs, n_cps; /* GPU-evaluated patches in ctx->recs, control points in ctx->cps */
-    double gpu_vertices;  /* grid vertices the vertex shader will evaluate */
+    sw__gpu_patch_rec *recs; /* GPU-evaluated patches (§4.2) */
+    float *cps;              /* their eye-relative homogeneous control points, 4 per point */
+    size_t n_recs, cap_recs, n_cps, cap_cps;
+    double gpu_vertices; /* grid vertices the vertex shader will evaluate */
     sw__gpu_patch_batch batch;
     sw_lod_screen_view screen; /* the view as the density bound needs it */
     segment_set gpu_segments, cpu_segments;
@@ -84,18 +86,18 @@ typedef struct frame {
     size_t n_pieces, cap_pieces;
     double *knots, *dcps;
     size_t n_knots, cap_knots, n_dcps, cap_dcps;
-    const occurrence *ex_occ; /* the occurrence whose net is at ex_base (NULL: none yet) */
+    const occurrence *ex_occ;    /* the occurrence whose net is at ex_base (NULL: none yet) */
     sw__gpu_exact_piece ex_base; /* its knots, control points, stride and degrees */
     sw_sg_surface ex_srf;
     /* hierarchy traversal (frame_hlod.c; NULL cache: every face drawn by its Bézier patches) */
     sw_lod_cache *cache;
-    int32_t reader;         /* the frame's reader slot in the cache (epochs), -1 when none */
-    sw_th_group group;      /* converged mode: builds and refinements the frame waits for */
-    int planning;           /* 1: traversal only asks for refinements; 0: it draws */
-    int walkthrough;        /* never wait: requests carry `req` and are not waited for */
+    int32_t reader;    /* the frame's reader slot in the cache (epochs), -1 when none */
+    sw_th_group group; /* converged mode: builds and refinements the frame waits for */
+    int planning;      /* 1: traversal only asks for refinements; 0: it draws */
+    int walkthrough;   /* never wait: requests carry `req` and are not waited for */
     sw_lod_cache_req req;
-    uint64_t refine_asked;  /* refinements submitted (or in flight) in this planning round */
-    size_t *shares;         /* pairs (draw, source draw): draw uses the source's trim entry */
+    uint64_t refine_asked; /* refinements submitted (or in flight) in this planning round */
+    size_t *shares;        /* pairs (draw, source draw): draw uses the source's trim entry */
     size_t n_shares, cap_shares;
 } frame;
 
@@ -131,12 +133,12 @@ int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_
 /* The direct path: the face's Bézier patches (§4.2), tiled trim textures when large. */
 sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status);
 /* Flattens the face's trim loops at tolerance tol into a new frame.loops entry; *index is it. */
-sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index,
-                            sw_status *status);
+sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index, sw_status *status);
 
 /* ---- frame_hlod.c ---- */
-/* Walkthrough: only requests the visible faces' hierarchies (never waits). Converged mode: builds the hierarchies of the visible occurrences' faces (boxes: eye-relative,
- * 6 per occurrence) and refines them until the frame's cut needs no more, waiting for the pool. */
+/* Walkthrough: only requests the visible faces' hierarchies (never waits). Converged mode: builds
+ * the hierarchies of the visible occurrences' faces (boxes: eye-relative, 6 per occurrence) and
+ * refines them until the frame's cut needs no more, waiting for the pool. */
 sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, int walkthrough, sw_status *status);
 /* Draws one occurrence from its face's hierarchy (§7), or by the direct path when it has none. */
 sw_result sw__fr_hlod_draw_face(frame *f, const occurrence *o, sw_status *status);

@@ -73,10 +73,7 @@ void sw__gpu_grids_free(sw_gpu_context *ctx)
     ctx->rec_source = NULL;
     ctx->cap_rec_source = 0;
     ctx->grid_ibo = ctx->patch_ssbo = ctx->cp_ssbo = 0;
-    free(ctx->recs);
-    free(ctx->cps);
     free(ctx->recs_sorted);
-    ctx->recs = ctx->recs_sorted = NULL;
-    ctx->cps = NULL;
-    ctx->cap_recs = ctx->cap_cps = ctx->cap_recs_sorted = 0;
+    ctx->recs_sorted = NULL;
+    ctx->cap_recs_sorted = 0;
 }

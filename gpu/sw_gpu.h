@@ -44,11 +44,11 @@ typedef struct sw_gpu_frame_desc {
     int32_t width, height; /* 0 = 1280 x 720 */
     double error_px;       /* screen-space error bound ε_img in pixels; 0 = 0.5 */
     sw_gpu_camera camera;
-    float background[4];   /* RGBA */
-    int32_t want_depth;    /* also read back depth */
-    int32_t eval_exact;    /* 1: every drawn patch piece evaluated in the vertex shader from the
-                              face's knot vectors and control points (B-spline basis in double,
-                              any degree up to SW_GPU_EXACT_MAX_DEGREE); 0: Bézier path */
+    float background[4]; /* RGBA */
+    int32_t want_depth;  /* also read back depth */
+    int32_t eval_exact;  /* 1: every drawn patch piece evaluated in the vertex shader from the
+                            face's knot vectors and control points (B-spline basis in double,
+                            any degree up to SW_GPU_EXACT_MAX_DEGREE); 0: Bézier path */
     struct sw_lod_cache *hierarchies; /* NULL: every face drawn by its own Bézier patches;
                               else the cache of `scene`'s bicubic hierarchies (Guthe §6), traversed
                               per frame (§7); the frame waits for the builds and refinements it
@@ -56,24 +56,24 @@ typedef struct sw_gpu_frame_desc {
     const struct sw_sg_bvh *bvh; /* NULL: every occurrence of the scene's traversal is boxed and
                               culled each frame; else the scene's BVH (sw_sg_bvh.h): subtrees
                               outside the frustum are culled, subtrees inside taken untested */
-    int32_t walkthrough;   /* with hierarchies: 1 = never wait for the pool (ARCHITECTURE.md
-                              walkthrough mode): faces without a hierarchy yet are drawn by their
-                              Bézier patches, leaves too coarse are drawn as they are, and both
-                              are requested from the pool for later frames; the requests of earlier
-                              frames that have not started are cancelled */
-    int32_t present;       /* 1: the frame is also copied into the framebuffer that was bound to
-                              GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
-                              origin; the caller's framebuffer bindings and viewport are restored */
-    int32_t no_readback;   /* 1: nothing is read back (out stays empty; want_depth ignored) */
+    int32_t walkthrough;         /* with hierarchies: 1 = never wait for the pool (ARCHITECTURE.md
+                                    walkthrough mode): faces without a hierarchy yet are drawn by their
+                                    Bézier patches, leaves too coarse are drawn as they are, and both
+                                    are requested from the pool for later frames; the requests of earlier
+                                    frames that have not started are cancelled */
+    int32_t present;     /* 1: the frame is also copied into the framebuffer that was bound to
+                            GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
+                            origin; the caller's framebuffer bindings and viewport are restored */
+    int32_t no_readback; /* 1: nothing is read back (out stays empty; want_depth ignored) */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
 
 typedef struct sw_gpu_frame_stats {
-    uint64_t faces_drawn, faces_culled;          /* face occurrences */
-    uint64_t patches_trimmed;   /* Bézier patches drawn with a trim-texture lookup */
-    uint64_t patches_untrimmed; /* drawn without one */
-    uint64_t patches_culled;    /* outside the view frustum, or outside their face's trim box */
+    uint64_t faces_drawn, faces_culled; /* face occurrences */
+    uint64_t patches_trimmed;           /* Bézier patches drawn with a trim-texture lookup */
+    uint64_t patches_untrimmed;         /* drawn without one */
+    uint64_t patches_culled; /* outside the view frustum, or outside their face's trim box */
     uint64_t triangles;
     uint64_t trim_textures, trim_texels;
     double ms_tessellate; /* traversal, bounds, CPU grids (without ms_hierarchy) */
@@ -81,36 +81,56 @@ typedef struct sw_gpu_frame_stats {
     double ms_draw;       /* draw submission until glFinish */
     double ms_readback;
     /* trim-texture atlas (Guthe §4.4), kept in the context across frames */
-    uint64_t atlas_pages;         /* pages (layers) after this frame */
-    uint64_t atlas_texels;        /* texels of those pages */
-    uint64_t trim_reused;         /* trim textures kept from an earlier frame (of trim_textures) */
-    uint64_t atlas_switches;      /* render-target switches for trim generation in this frame */
+    uint64_t atlas_pages;    /* pages (layers) after this frame */
+    uint64_t atlas_texels;   /* texels of those pages */
+    uint64_t trim_reused;    /* trim textures kept from an earlier frame (of trim_textures) */
+    uint64_t atlas_switches; /* render-target switches for trim generation in this frame */
     uint64_t patches_gpu_evaluated; /* drawn patches evaluated in the vertex shader (§4.2); the
                                        others are CPU grids */
     uint64_t patches_exact; /* of those, evaluated from knots and control points (eval_exact) */
     /* hierarchy traversal (desc.hierarchies) */
-    uint64_t hlod_nodes;          /* hierarchy nodes (or parts of one) drawn */
-    uint64_t hlod_fallback_faces; /* occurrences drawn by their Bézier patches: no hierarchy */
-    uint64_t hlod_refine_rounds;  /* rounds of refinement below the leaves the frame waited for */
-    uint64_t hlod_over_budget;    /* nodes drawn although their error exceeds their share of
-                                     ε_img (refinement stopped at its depth limit) */
-    uint64_t hlod_waits;          /* times the frame waited for the pool (0 in walkthrough) */
+    uint64_t hlod_nodes;           /* hierarchy nodes (or parts of one) drawn */
+    uint64_t hlod_fallback_faces;  /* occurrences drawn by their Bézier patches: no hierarchy */
+    uint64_t hlod_refine_rounds;   /* rounds of refinement below the leaves the frame waited for */
+    uint64_t hlod_over_budget;     /* nodes drawn although their error exceeds their share of
+                                      ε_img (refinement stopped at its depth limit) */
+    uint64_t hlod_waits;           /* times the frame waited for the pool (0 in walkthrough) */
     uint64_t hlod_refine_requests; /* walkthrough: refinements asked for, not waited for */
-    double ms_hierarchy;          /* waiting for hierarchy builds and refinements */
+    double ms_hierarchy;           /* waiting for hierarchy builds and refinements */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {
     int32_t width, height;
-    uint8_t *rgba;   /* width*height*4, top row first */
-    float *depth;    /* width*height, eye-space distance along the view axis; +INF = background;
-                        NULL unless asked for */
+    uint8_t *rgba; /* width*height*4, top row first */
+    float *depth;  /* width*height, eye-space distance along the view axis; +INF = background;
+                      NULL unless asked for */
 } sw_gpu_image;
 
 /* Renders one converged frame of `scene` (SW_SG_SEC_ALL required) into `out` (caller frees with
- * sw_gpu_image_free); `stats` may be NULL. Errors: SW_ERR_GL, SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+ * sw_gpu_image_free); `stats` may be NULL. Errors: SW_ERR_GL, SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT.
+ */
 sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
                               const sw_gpu_frame_desc *desc, sw_gpu_image *out,
                               sw_gpu_frame_stats *stats, sw_status *status);
+
+/* The same frame in two steps, for a visibility thread that prepares frame i+1 while the GL
+ * thread submits frame i (Kumar et al. 1997 §5.2; the runtime's pipeline):
+ *  - sw_gpu_frame_prepare: culling, hierarchy selection (waiting for the pool in converged mode),
+ *    densities and grids, into a plan of plain memory. Any thread; never touches GL; reads the
+ *    context's settings and bumps its walkthrough token only, so it may run while the context's
+ *    owner submits another plan. At most one prepare per context at a time. desc is copied.
+ *  - sw_gpu_frame_submit: trim atlas, upload, draw, present, readback. The context's thread only;
+ *    the plan is consumed (freed) whatever the result. The scene must outlive the plan.
+ * sw_gpu_render_scene is prepare then submit. Errors as for sw_gpu_render_scene; submit adds
+ * SW_ERR_INVALID_ARGUMENT for a plan of another context. */
+typedef struct sw_gpu_frame_plan sw_gpu_frame_plan;
+sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                               const sw_gpu_frame_desc *desc, sw_gpu_frame_plan **out,
+                               sw_status *status);
+sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
+                              sw_gpu_frame_stats *stats, sw_status *status);
+void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan);       /* an unsubmitted plan; NULL allowed */
+double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan); /* prepare's wall time */
 
 /* Renders plain triangles (world-space double positions, 3 per vertex) through the same camera,
  * projection, depth and shading path as sw_gpu_render_scene — the path an independent reference

@@ -50,12 +50,12 @@ typedef struct sw__gpu_patch_rec {
  * one B-spline span of a face occurrence. std430, mirrored by the GLSL struct in shaders.c
  * (64 bytes). The record's st maps to u = u0 + s (u1 - u0), v likewise. */
 typedef struct sw__gpu_exact_piece {
-    double u0, u1, v0, v1;    /* the Bézier patch's rectangle in the face's parameters */
-    uint32_t ku, kv;          /* first knot of the face's u and v knot vectors (double index) */
-    uint32_t cp;              /* first control point of the face occurrence (dvec4 index) */
-    int32_t stride;           /* control points per row (n_u) */
+    double u0, u1, v0, v1; /* the Bézier patch's rectangle in the face's parameters */
+    uint32_t ku, kv;       /* first knot of the face's u and v knot vectors (double index) */
+    uint32_t cp;           /* first control point of the face occurrence (dvec4 index) */
+    int32_t stride;        /* control points per row (n_u) */
     int32_t deg_u, deg_v;
-    int32_t span_u, span_v;   /* knot span of [u0, u1) and [v0, v1) */
+    int32_t span_u, span_v; /* knot span of [u0, u1) and [v0, v1) */
 } sw__gpu_exact_piece;
 
 /* Debug capture (tests): while max_vertices > 0, every vertex the Bézier vertex shader evaluates
@@ -98,9 +98,9 @@ void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *us
 struct sw_gpu_context {
     void *egl_display, *egl_context; /* EGLDisplay, EGLContext; NULL when adopted */
     int32_t gl_ready;                /* GL objects made: free deletes them */
-    struct sw_th_token *walk_token; /* walkthrough frames' hierarchy requests; bumped every frame,
-                               so the requests of frames gone by are cancelled (a pointer: C++
-                               tests include this header, and the token is a C11 atomic) */
+    struct sw_th_token *walk_token;  /* walkthrough frames' hierarchy requests; bumped every frame,
+                                so the requests of frames gone by are cancelled (a pointer: C++
+                                tests include this header, and the token is a C11 atomic) */
     char description[256];
     GLint max_texture_size;
     /* grid / triangle program */
@@ -125,11 +125,7 @@ struct sw_gpu_context {
     uint32_t grid_count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
     GLuint patch_ssbo, cp_ssbo; /* per-frame patch records and control points */
     int32_t eval_mode;          /* sw__gpu_eval_mode */
-    /* per-frame scratch kept between frames (no per-frame allocation once grown) */
-    struct sw__gpu_patch_rec *recs;
-    size_t cap_recs;
-    float *cps;
-    size_t cap_cps;
+    /* the submitting thread's scratch, kept between frames (no allocation once grown) */
     struct sw__gpu_patch_rec *recs_sorted;
     size_t cap_recs_sorted;
     int32_t crack_fill_off;        /* 1: no fat borders (§7.1) */
@@ -142,8 +138,8 @@ struct sw_gpu_context {
     /* debug capture of the Bézier vertex shader's output (sw__gpu_set_capture) */
     GLint loc_eval_capture;
     GLuint capture_ssbo;
-    uint32_t capture_max;   /* vertices; 0 = off */
-    uint32_t *rec_source;   /* sorted record -> record in append (patch hook) order */
+    uint32_t capture_max; /* vertices; 0 = off */
+    uint32_t *rec_source; /* sorted record -> record in append (patch hook) order */
     size_t cap_rec_source;
 };
 
