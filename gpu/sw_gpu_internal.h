@@ -117,6 +117,7 @@ struct sw_gpu_context {
     GLint loc_trim_rect;       /* mesh program: atlas rectangle (x0, y0, w, h), w = 0 untrimmed */
     GLint loc_trim_layer;
     struct sw__gpu_atlas *atlas; /* trim-texture atlas kept across frames (trim_atlas.c) */
+    int32_t atlas_max_side;      /* page side limit (tests); 0 = the default; set between frames */
     /* vertex-shader evaluation of rational Bézier patches (§4.2; shaders.c, grid_set.c) */
     GLuint prog_eval;
     GLint loc_eval_view_proj, loc_eval_grid, loc_eval_base, loc_eval_trim;

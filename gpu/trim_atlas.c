@@ -68,7 +68,7 @@ typedef struct page {
 
 struct sw__gpu_atlas {
     GLuint tex;
-    int32_t side, max_side, tex_side;
+    int32_t side, tex_side;
     int32_t n_pages, cap_layers; /* pages packed / layers allocated in tex */
     page pages[MAX_PAGES];
     entry *entries;
@@ -142,10 +142,11 @@ static struct sw__gpu_atlas *atlas_get(sw_gpu_context *ctx)
     return ctx->atlas;
 }
 
+/* From the context's settings only, never the atlas: a visibility thread preparing the next
+ * frame asks for it while the GL thread creates or repacks the atlas. */
 static int32_t max_side(const sw_gpu_context *ctx)
 {
-    const struct sw__gpu_atlas *a = ctx->atlas;
-    int32_t cap = a && a->max_side ? a->max_side : DEFAULT_MAX_SIDE, s = MIN_SIDE;
+    int32_t cap = ctx->atlas_max_side ? ctx->atlas_max_side : DEFAULT_MAX_SIDE, s = MIN_SIDE;
     if (cap > ctx->max_texture_size)
         cap = ctx->max_texture_size;
     while (s * 2 <= cap)
@@ -155,9 +156,7 @@ static int32_t max_side(const sw_gpu_context *ctx)
 
 void sw__gpu_atlas_set_max_side(sw_gpu_context *ctx, int32_t side)
 {
-    struct sw__gpu_atlas *a = atlas_get(ctx);
-    if (a)
-        a->max_side = side;
+    ctx->atlas_max_side = side;
 }
 
 int32_t sw__gpu_atlas_max_entry(const sw_gpu_context *ctx)

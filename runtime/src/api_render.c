@@ -1,6 +1,7 @@
 /* Public rendering API: a headless renderer owns a GL context on its creating thread and draws
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
 #include "sw_rt.h"
+#include "sw_rt_pipeline.h"
 
 #include "sw_lod_cache.h"
 #include "sw_sg_bvh.h"
@@ -20,12 +21,24 @@
 typedef struct sw_rt_renderer {
     sw_gpu_context *gpu;
     pthread_t owner;
-    sw_th_pool *pool;          /* created on the first frame that needs it */
-    sw_lod_cache *cache;       /* of cache_scene */
-    sw_sg_bvh *bvh;            /* of cache_scene */
-    sw_rt_scene *cache_scene;  /* retained while the cache lives; NULL = none */
-    uint32_t worker_threads;   /* the pool's size; 0 = one per online processor */
+    sw_th_pool *pool;         /* created on the first frame that needs it */
+    sw_lod_cache *cache;      /* of cache_scene */
+    sw_sg_bvh *bvh;           /* of cache_scene */
+    sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
+    uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
+    sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
+    uint32_t in_flight;       /* prepared frames not submitted yet */
+    uint64_t frames_prepared;
 } sw_rt_renderer;
+
+/* A prepared frame: the job V works on, and what its submission needs. */
+typedef struct rt_job {
+    sw_rt_frame_job job; /* first: pipeline pointers are rt_job pointers */
+    sw_rt_scene *scene;  /* a reference held until the frame is submitted */
+    char *output_path;   /* copy of the desc's, or NULL */
+} rt_job;
+
+static void job_free(rt_job *j);
 
 static sw_rt_pool g_renderers = SW_RT_POOL_INIT;
 
@@ -85,8 +98,7 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
     if (r == SW_ERR_STALE_HANDLE)
         return sw__fail(status, r, "%s: renderer handle %#x is stale or invalid", fn, handle.id);
     if (r != SW_OK)
-        return sw__fail(status, r, "%s: called from a thread that does not own the renderer",
-                        fn);
+        return sw__fail(status, r, "%s: called from a thread that does not own the renderer", fn);
     return SW_OK;
 }
 
@@ -136,6 +148,11 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     if (r != SW_OK)
         return r; /* stale, or another thread's context: left untouched */
     sw_rt_renderer *rr = item;
+    while (rr->in_flight) { /* prepared, never submitted: V finishes them, nobody draws them */
+        job_free((rt_job *)sw_rt_pipeline_pop(rr->pipeline));
+        rr->in_flight--;
+    }
+    sw_rt_pipeline_stop(rr->pipeline);
     drop_cache(rr);
     sw_th_pool_destroy(rr->pool);
     sw_gpu_context_free(rr->gpu);
@@ -159,7 +176,8 @@ static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
     if (desc->error_px != 0.0 && !(desc->error_px > 0.0 && isfinite(desc->error_px)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "screen-space error %g px must be positive and finite", desc->error_px);
-    if (desc->camera.fovy_deg != 0.0 && !(desc->camera.fovy_deg > 0.0 && desc->camera.fovy_deg < 180.0))
+    if (desc->camera.fovy_deg != 0.0 &&
+        !(desc->camera.fovy_deg > 0.0 && desc->camera.fovy_deg < 180.0))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "field of view %g° out of (0, 180)",
                         desc->camera.fovy_deg);
     for (int k = 0; k < 3; k++) {
@@ -254,35 +272,149 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     }
 }
 
+/* The GPU frame of a checked desc: its camera resolved, drawn through the renderer's hierarchy
+ * cache and BVH for the scene (made for it if needed). */
+static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
+                           sw_gpu_frame_desc *frame, sw_status *status)
+{
+    frame_from_desc(desc, frame);
+    sw_result res = resolve_camera(&desc->camera, scene, &frame->camera, status);
+    if (res == SW_OK)
+        res = renderer_cache(r, scene, status);
+    if (res != SW_OK)
+        return res;
+    frame->bvh = r->bvh;
+    if (!frame->eval_exact && !desc->no_hierarchy)
+        frame->hierarchies = r->cache;
+    return SW_OK;
+}
+
+/* Writes a drawn frame's image when asked and fills the caller's stats (times from t0). */
+static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
+                              const sw_gpu_frame_stats *gstats, double t0, sw_frame_stats *stats,
+                              sw_status *status)
+{
+    double t1 = now_ms();
+    sw_result res = output_path ? sw_gpu_image_write(image, output_path, status) : SW_OK;
+    double t2 = now_ms();
+    sw_gpu_image_free(image);
+    if (res == SW_OK && stats) {
+        memset(stats, 0, sizeof *stats);
+        copy_stats(gstats, stats);
+        stats->ms_write = t2 - t1;
+        stats->ms_total = t2 - t0;
+    }
+    return res;
+}
+
 /* Renders and writes the frame of a checked desc on the renderer's thread. */
 static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
                             sw_frame_stats *stats, sw_status *status)
 {
     double t0 = now_ms();
     sw_gpu_frame_desc frame = {0};
-    frame_from_desc(desc, &frame);
-    sw_result res = resolve_camera(&desc->camera, scene, &frame.camera, status);
+    sw_result res = gpu_frame(r, scene, desc, &frame, status);
     if (res != SW_OK)
         return res;
-    res = renderer_cache(r, scene, status);
-    if (res != SW_OK)
-        return res;
-    frame.bvh = r->bvh;
-    if (!frame.eval_exact && !desc->no_hierarchy)
-        frame.hierarchies = r->cache;
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
     res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);
-    double t1 = now_ms();
-    if (res == SW_OK && desc->output_path)
-        res = sw_gpu_image_write(&image, desc->output_path, status);
-    double t2 = now_ms();
-    sw_gpu_image_free(&image);
-    if (res == SW_OK && stats) {
-        copy_stats(&gstats, stats);
-        stats->ms_write = t2 - t1;
-        stats->ms_total = t2 - t0;
+    if (res != SW_OK)
+        return res;
+    return finish_frame(&image, desc->output_path, &gstats, t0, stats, status);
+}
+
+static void job_free(rt_job *j)
+{
+    sw_gpu_frame_plan_free(j->job.plan);
+    if (j->scene)
+        sw_rt_scene_release(j->scene);
+    free(j->output_path);
+    free(j);
+}
+
+/* A new job for a checked desc, its scene acquired; NULL with *status set on failure. */
+static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_status *status)
+{
+    rt_job *j = calloc(1, sizeof *j);
+    if (!j) {
+        sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
+        return NULL;
     }
+    sw_result res = sw_rt_scene_acquire(desc->scene, &j->scene, status);
+    if (res == SW_OK && r->in_flight && j->scene != r->cache_scene)
+        res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                       "sw_renderer_prepare: frames of another scene are prepared; submit them "
+                       "before preparing one of this scene");
+    if (res == SW_OK && desc->output_path && !(j->output_path = strdup(desc->output_path)))
+        res = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
+    if (res == SW_OK)
+        res = gpu_frame(r, j->scene, desc, &j->job.desc, status);
+    if (res != SW_OK) {
+        job_free(j);
+        return NULL;
+    }
+    j->job.sg = j->scene->sg;
+    return j;
+}
+
+sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, sw_status *status)
+{
+    if (!desc)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_prepare: NULL desc");
+    sw_rt_renderer *r;
+    sw_result res = owned_renderer(renderer, "sw_renderer_prepare", &r, status);
+    if (res == SW_OK)
+        res = check_frame_desc(desc, status);
+    if (res == SW_OK && r->in_flight >= SW_RENDERER_MAX_PREPARED)
+        res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                       "sw_renderer_prepare: %d frames are prepared already; submit one first",
+                       SW_RENDERER_MAX_PREPARED);
+    if (res == SW_OK && !r->pipeline)
+        res = sw_rt_pipeline_start(r->gpu, &r->pipeline, status);
+    if (res != SW_OK)
+        return res;
+    rt_job *j = job_create(r, desc, status);
+    if (!j)
+        return status ? status->result : SW_ERR_INVALID_ARGUMENT;
+    j->job.frame = ++r->frames_prepared;
+    r->in_flight++;
+    sw_rt_pipeline_push(r->pipeline, &j->job);
+    sw__status_ok(status);
+    return SW_OK;
+}
+
+sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_status *status)
+{
+    sw_rt_renderer *r;
+    sw_result res = owned_renderer(renderer, "sw_renderer_submit", &r, status);
+    if (res != SW_OK)
+        return res;
+    if (!r->in_flight)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "sw_renderer_submit: no prepared frame (call sw_renderer_prepare first)");
+    double t0 = now_ms();
+    rt_job *j = (rt_job *)sw_rt_pipeline_pop(r->pipeline);
+    r->in_flight--;
+    double t1 = now_ms();
+    res = j->job.result;
+    if (res != SW_OK) {
+        if (status)
+            *status = j->job.status;
+        job_free(j);
+        return res;
+    }
+    sw_gpu_image image = {0};
+    sw_gpu_frame_stats gstats = {0};
+    res = sw_gpu_frame_submit(r->gpu, j->job.plan, &image, &gstats, status);
+    j->job.plan = NULL; /* consumed */
+    if (res == SW_OK)
+        res = finish_frame(&image, j->output_path, &gstats, t0, stats, status);
+    if (res == SW_OK && stats) {
+        stats->ms_visibility = j->job.ms_visibility;
+        stats->ms_wait_visibility = t1 - t0;
+    }
+    job_free(j);
     return res;
 }
 
@@ -295,6 +427,10 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     sw_result res = owned_renderer(renderer, "sw_renderer_draw", &r, status);
     if (res != SW_OK)
         return res;
+    if (r->in_flight)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "sw_renderer_draw: %u prepared frames wait; submit them first",
+                        r->in_flight);
     res = check_frame_desc(desc, status);
     if (res != SW_OK)
         return res;

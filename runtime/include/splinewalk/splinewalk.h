@@ -195,6 +195,11 @@ typedef struct sw_frame_stats {
     uint64_t pool_waits;       /* times the frame waited for the pool (0 in walkthrough) */
     double ms_hierarchy;       /* waiting for hierarchy builds and refinements */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
+    /* split frames (sw_renderer_prepare / submit): hierarchy and tessellate ran on the visibility
+     * thread, in ms_visibility there (its whole time for the frame); the rest on the caller's, in
+     * ms_total = ms_wait_visibility (waiting for the visibility thread) + trim + draw + readback
+     * + write + the call's own overhead. Both 0 for sw_renderer_draw. */
+    double ms_visibility, ms_wait_visibility;
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so
@@ -210,6 +215,29 @@ typedef struct sw_frame_stats {
  * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */
 SW_API sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc,
                                   sw_frame_stats *stats, sw_status *status);
+
+/* ---- split frames: the visibility / submission pipeline (Kumar et al. 1997 §5.2) -------------
+ * sw_renderer_prepare hands a frame to the renderer's visibility thread, which culls it, selects
+ * the hierarchy nodes and tessellates while the caller goes on — typically submitting the frame
+ * before: prepare(0); loop { prepare(i + 1); submit(i); } overlaps visibility of frame i + 1 with
+ * the submission of frame i. sw_renderer_submit waits for the oldest prepared frame and draws it
+ * (and writes desc->output_path) on the caller's thread. At most SW_RENDERER_MAX_PREPARED frames
+ * wait at a time; they are submitted in order. Walkthrough frames never wait for the worker pool;
+ * a submit only waits for the visibility thread. Frames prepared together must show one scene.
+ * Owner thread only. */
+#define SW_RENDERER_MAX_PREPARED 2
+
+/* Errors: as sw_renderer_draw for a bad desc or handle; SW_ERR_INVALID_ARGUMENT with
+ * SW_RENDERER_MAX_PREPARED frames waiting, or a waiting frame of another scene; SW_ERR_OUT_OF_MEMORY.
+ * desc (and the output path) are copied; the scene is held until the frame is submitted. */
+SW_API sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc,
+                                     sw_status *status);
+/* Draws the oldest prepared frame. stats may be NULL; written on success only. Errors: those of
+ * sw_renderer_draw, including those its preparation met (then nothing is drawn and the frame is
+ * gone); SW_ERR_INVALID_ARGUMENT when no frame is prepared. sw_renderer_draw refuses to run
+ * while prepared frames wait (SW_ERR_INVALID_ARGUMENT); sw_renderer_destroy drops them. */
+SW_API sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats,
+                                    sw_status *status);
 
 #ifdef __cplusplus
 }
