@@ -16,6 +16,7 @@ static const command k_commands[] = {
     {"render", sw_cli_render, "render one converged frame headlessly to PNG / EXR"},
     {"path", sw_cli_path, "write a camera path (orbit or fly-through) fitted to a scene"},
     {"profile", sw_cli_profile, "time frames along a camera path: CSV, JSON, SVG, HTML report"},
+    {"generate", sw_cli_generate, "write a test scene: instances of a model on a grid"},
     {"demo", sw_cli_demo, "build and render the built-in default scene"},
     {"check-osd", sw_cli_check_osd, "cross-check uniform bicubic regions against OpenSubdiv"},
 };
