@@ -153,7 +153,13 @@ grep -q "4x3x1 grid (spacing 500, 500, 500)" gen.txt || fail "10 instances in 2D
 "$sw" render grid.sws -o grid.png --size 160x120 --eval bezier >render.txt 2>&1 ||
   { fail "render grid.sws"; cat render.txt; }
 [ -s grid.png ] || fail "render of grid.sws wrote no image"
-pass "generate grid: usage errors, failures and a 2x2x2 grid of Motor-c"
+# One instance at the first cell (no translation) draws exactly the model: same bytes.
+"$sw" generate grid --model motor.sws --count 1 -o one.sws >/dev/null 2>&1 || fail "generate --count 1"
+"$sw" render motor.sws -o model1.png --size 160x120 --eval bezier >/dev/null 2>&1 &&
+  "$sw" render one.sws -o one.png --size 160x120 --eval bezier >/dev/null 2>&1 ||
+  fail "render of the model or its 1-instance grid"
+cmp -s model1.png one.png || fail "a 1-instance grid renders differently from its model"
+pass "generate grid: usage errors, failures, a 2x2x2 grid of Motor-c, a 1-instance grid = the model"
 
 echo "$failures failure(s)"
 [ $failures -eq 0 ]
