@@ -229,6 +229,12 @@ size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh)
 }
 
 /* ---- culling ------------------------------------------------------------------------------- */
+/* Kumar §4.4 (a hierarchy of bounding volumes whose visible leaves are all output, also when the
+ * decision is made at an internal node) and §5's visibility thread (nodes totally, partially or not
+ * visible; a totally visible node is queued whole, a partially visible one traversed). The paper
+ * names neither the volume nor the test: axis-aligned boxes here, each plane tested at the box's
+ * corners farthest along and against its normal — exact per plane, conservative for the frustum
+ * (a box near its edges can be outside it without being outside any one plane). */
 
 sw_sg_cull_class sw_sg_planes_classify(const double (*planes)[4], int32_t n_planes,
                                        const double box[6])
