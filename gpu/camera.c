@@ -4,6 +4,7 @@
  * patch boxes), and the depth-buffer-to-distance conversion for readback.
  */
 #include "sw_gpu_internal.h"
+#include "sw_sg_bvh.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -83,30 +84,19 @@ sw_result sw__gpu_view_init(sw__gpu_view *v, const sw_gpu_camera *cam, int32_t w
     return SW_OK;
 }
 
+/* The same box-against-planes test as the BVH's culling (one classification for both). */
+#define N_PLANES(v) ((int32_t)(sizeof(v)->planes / sizeof(v)->planes[0]))
+
 int sw__gpu_view_box_visible(const sw__gpu_view *v, const double box[6])
 {
-    for (int p = 0; p < 5; ++p) {
-        const double *pl = v->planes[p];
-        double s = pl[3];
-        for (int k = 0; k < 3; ++k)
-            s += pl[k] * (pl[k] >= 0.0 ? box[3 + k] : box[k]);
-        if (s < 0.0)
-            return 0;
-    }
-    return 1;
+    return sw_sg_planes_classify((const double(*)[4])v->planes, N_PLANES(v), box) !=
+           SW_SG_CULL_OUTSIDE;
 }
 
 int sw__gpu_view_box_inside(const sw__gpu_view *v, const double box[6])
 {
-    for (int p = 0; p < 5; ++p) {
-        const double *pl = v->planes[p];
-        double s = pl[3];
-        for (int k = 0; k < 3; ++k)
-            s += pl[k] * (pl[k] >= 0.0 ? box[k] : box[3 + k]);
-        if (s < 0.0)
-            return 0;
-    }
-    return 1;
+    return sw_sg_planes_classify((const double(*)[4])v->planes, N_PLANES(v), box) ==
+           SW_SG_CULL_INSIDE;
 }
 
 double sw__gpu_view_box_depth(const sw__gpu_view *v, const double box[6])

@@ -936,49 +936,45 @@ static void eye_box(const frame *f, const double world[6], double out[6])
     }
 }
 
-/* Appends one BVH item as an occurrence with its eye-relative box. */
-static int bvh_take(frame *f, const sw_sg_bvh_item *it, double **boxes, size_t *cap_boxes)
+typedef struct bvh_taker {
+    frame *f;
+    const sw_sg_bvh *bvh;
+    double **boxes;
+    size_t cap_boxes;
+} bvh_taker;
+
+/* Appends one visible BVH item as an occurrence with its eye-relative box. */
+static int bvh_take(void *ctx, uint32_t item)
 {
-    size_t at = f->n_occ;
-    if (collect(f, it->face, it->world, it->color) != 0 ||
-        !sw__gpu_grow((void **)boxes, cap_boxes, 6 * (at + 1), sizeof **boxes))
-        return 0;
-    eye_box(f, it->box, *boxes + 6 * at);
-    return 1;
+    bvh_taker *t = ctx;
+    const sw_sg_bvh_item *it = &t->bvh->items[item];
+    size_t at = t->f->n_occ;
+    if (collect(t->f, it->face, it->world, it->color) != 0 ||
+        !sw__gpu_grow((void **)t->boxes, &t->cap_boxes, 6 * (at + 1), sizeof **t->boxes))
+        return 1;
+    eye_box(t->f, it->box, *t->boxes + 6 * at);
+    return 0;
 }
 
-/* Kumar §4.4: the occurrences whose boxes may meet the frustum, by the BVH: a node outside is
- * culled with its subtree, a node inside takes its subtree untested. */
+/* Kumar §4.4: the occurrences whose boxes may meet the frustum, by the BVH (sw_sg_bvh_cull: a node
+ * outside is culled with its subtree, a node inside takes its subtree untested). */
 static sw_result collect_bvh(frame *f, const sw_sg_bvh *bvh, double **boxes, sw_status *status)
 {
-    size_t cap_boxes = 0;
-    uint32_t stack[128], n = bvh->n_nodes ? 1 : 0; /* depth <= log2(items) + 1 */
-    stack[0] = 0;
-    int ok = 1;
-    while (n > 0 && ok) {
-        const sw_sg_bvh_node *node = &bvh->nodes[stack[--n]];
-        double b[6];
-        eye_box(f, node->box, b);
-        if (!sw__gpu_view_box_visible(&f->view, b)) {
-            f->st.faces_culled += node->count;
-            continue;
-        }
-        int inside = sw__gpu_view_box_inside(&f->view, b);
-        if (node->child[0] >= 0 && !inside && n + 2 <= 128) {
-            stack[n++] = (uint32_t)node->child[1];
-            stack[n++] = (uint32_t)node->child[0];
-            continue;
-        }
-        for (uint32_t i = node->first; i < node->first + node->count && ok; ++i) {
-            double ib[6];
-            eye_box(f, bvh->items[i].box, ib);
-            if (inside || sw__gpu_view_box_visible(&f->view, ib))
-                ok = bvh_take(f, &bvh->items[i], boxes, &cap_boxes);
-            else
-                f->st.faces_culled++;
-        }
-    }
-    if (!ok)
+    sw_sg_frustum fr;
+    memcpy(fr.origin, f->view.eye, sizeof fr.origin);
+    memcpy(fr.planes, f->view.planes, sizeof f->view.planes);
+    fr.n_planes = (int32_t)(sizeof f->view.planes / sizeof f->view.planes[0]);
+    bvh_taker t = {f, bvh, boxes, 0};
+    sw_sg_bvh_cull_stats cs;
+    const int stopped = sw_sg_bvh_cull(bvh, &fr, bvh_take, &t, &cs);
+    f->st.faces_culled += bvh->n_items - cs.items_visible;
+    f->st.bvh_nodes_visited += cs.nodes_visited;
+    f->st.bvh_nodes_inside += cs.nodes_inside;
+    f->st.bvh_nodes_partly += cs.nodes_partly;
+    f->st.bvh_nodes_outside += cs.nodes_outside;
+    f->st.bvh_items_tested += cs.items_tested;
+    f->st.bvh_items_visible += cs.items_visible;
+    if (stopped)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
     return SW_OK;
 }

@@ -97,6 +97,10 @@ typedef struct sw_gpu_frame_stats {
     uint64_t hlod_waits;           /* times the frame waited for the pool (0 in walkthrough) */
     uint64_t hlod_refine_requests; /* walkthrough: refinements asked for, not waited for */
     double ms_hierarchy;           /* waiting for hierarchy builds and refinements */
+    /* BVH culling (desc.bvh; sw_sg_bvh_cull_stats): nodes classified against the frustum, of them
+     * wholly inside, partly inside and outside; items classified one by one; items kept */
+    uint64_t bvh_nodes_visited, bvh_nodes_inside, bvh_nodes_partly, bvh_nodes_outside;
+    uint64_t bvh_items_tested, bvh_items_visible;
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -153,38 +153,63 @@ static uint32_t build_node(sw_sg_bvh *t, uint32_t lo, uint32_t hi)
     return id;
 }
 
+/* Takes `items` (n of them, malloc'ed; freed on failure) and builds the hierarchy over them. */
+static sw_result finish(sw_sg_bvh_item *items, size_t n, sw_sg_bvh **out, sw_status *status)
+{
+    sw_sg_bvh *t = calloc(1, sizeof *t);
+    if (t) {
+        t->items = items;
+        t->n_items = (uint32_t)n;
+        t->nodes = malloc((n ? 2 * n : 1) * sizeof *t->nodes);
+    }
+    if (!t || !t->nodes) {
+        if (!t)
+            free(items);
+        sw_sg_bvh_free(t);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
+    }
+    if (n)
+        build_node(t, 0, t->n_items);
+    *out = t;
+    return SW_OK;
+}
+
 sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *status)
 {
     *out = NULL;
     const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     build b = {scene, malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), NULL, 0, 0, 0};
-    sw_sg_bvh *t = calloc(1, sizeof *t);
-    if (!b.face_box || !t) {
-        free(b.face_box);
-        free(t);
+    if (!b.face_box)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
-    }
     for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
         b.face_box[i] = NAN;
     sw_result r = sw_sg_scene_traverse(scene, visit, &b);
     free(b.face_box);
     if (r != SW_OK || b.oom) {
         free(b.items);
-        free(t);
         return sw__fail(status, b.cap_items >= INT32_MAX / 2 ? SW_ERR_LIMIT : SW_ERR_OUT_OF_MEMORY,
                         "BVH: %zu occurrences: out of memory", b.n_items);
     }
-    t->items = b.items;
-    t->n_items = (uint32_t)b.n_items;
-    t->nodes = malloc((t->n_items ? 2 * (size_t)t->n_items : 1) * sizeof *t->nodes);
-    if (!t->nodes) {
-        sw_sg_bvh_free(t);
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
+    return finish(b.items, b.n_items, out, status);
+}
+
+sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out, sw_status *status)
+{
+    *out = NULL;
+    if (n > INT32_MAX)
+        return sw__fail(status, SW_ERR_LIMIT, "BVH: %u boxes (at most 2^31 - 1)", n);
+    sw_sg_bvh_item *items = malloc((n ? n : 1) * sizeof *items);
+    if (!items)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: %u boxes: out of memory", n);
+    static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    for (uint32_t i = 0; i < n; ++i) {
+        memcpy(items[i].world, k_identity, sizeof k_identity);
+        memcpy(items[i].box, boxes + 6 * (size_t)i, sizeof items[i].box);
+        for (int k = 0; k < 4; ++k)
+            items[i].color[k] = -1.0f;
+        items[i].face = i;
     }
-    if (t->n_items)
-        build_node(t, 0, t->n_items);
-    *out = t;
-    return SW_OK;
+    return finish(items, n, out, status);
 }
 
 void sw_sg_bvh_free(sw_sg_bvh *bvh)
@@ -201,4 +226,112 @@ size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh)
     return bvh ? sizeof *bvh + bvh->n_items * sizeof *bvh->items +
                      2 * (size_t)bvh->n_items * sizeof *bvh->nodes
                : 0;
+}
+
+/* ---- culling ------------------------------------------------------------------------------- */
+/* Kumar §4.4 (a hierarchy of bounding volumes whose visible leaves are all output, also when the
+ * decision is made at an internal node) and §5's visibility thread (nodes totally, partially or not
+ * visible; a totally visible node is queued whole, a partially visible one traversed). The paper
+ * names neither the volume nor the test: axis-aligned boxes here, each plane tested at the box's
+ * corners farthest along and against its normal — exact per plane, conservative for the frustum
+ * (a box near its edges can be outside it without being outside any one plane). */
+
+sw_sg_cull_class sw_sg_planes_classify(const double (*planes)[4], int32_t n_planes,
+                                       const double box[6])
+{
+    sw_sg_cull_class c = SW_SG_CULL_INSIDE;
+    for (int32_t p = 0; p < n_planes; ++p) {
+        const double *pl = planes[p];
+        double far = pl[3], near = pl[3]; /* the corners farthest along and against the normal */
+        for (int k = 0; k < 3; ++k) {
+            far += pl[k] * (pl[k] >= 0.0 ? box[3 + k] : box[k]);
+            near += pl[k] * (pl[k] >= 0.0 ? box[k] : box[3 + k]);
+        }
+        if (far < 0.0)
+            return SW_SG_CULL_OUTSIDE;
+        if (near < 0.0)
+            c = SW_SG_CULL_PARTLY;
+    }
+    return c;
+}
+
+sw_sg_cull_class sw_sg_frustum_classify(const sw_sg_frustum *fr, const double world_box[6])
+{
+    double b[6];
+    for (int k = 0; k < 3; ++k) {
+        b[k] = world_box[k] - fr->origin[k];
+        b[3 + k] = world_box[3 + k] - fr->origin[k];
+    }
+    return sw_sg_planes_classify((const double(*)[4])fr->planes, fr->n_planes, b);
+}
+
+typedef struct cull {
+    const sw_sg_bvh *bvh;
+    const sw_sg_frustum *fr;
+    sw_sg_bvh_cull_fn fn;
+    void *ctx;
+    sw_sg_bvh_cull_stats st;
+} cull;
+
+/* Reports items [first, first + count) untested (stop = the callback's value). */
+static int report_all(cull *c, uint32_t first, uint32_t count)
+{
+    for (uint32_t i = first; i < first + count; ++i) {
+        c->st.items_visible++;
+        int stop = c->fn(c->ctx, i);
+        if (stop)
+            return stop;
+    }
+    return 0;
+}
+
+/* Reports the items of [first, first + count) that are not outside, each tested. */
+static int report_tested(cull *c, uint32_t first, uint32_t count)
+{
+    for (uint32_t i = first; i < first + count; ++i) {
+        c->st.items_tested++;
+        if (sw_sg_frustum_classify(c->fr, c->bvh->items[i].box) == SW_SG_CULL_OUTSIDE)
+            continue;
+        c->st.items_visible++;
+        int stop = c->fn(c->ctx, i);
+        if (stop)
+            return stop;
+    }
+    return 0;
+}
+
+/* Depth-first, first child first, so that items come in increasing order. A median-split tree
+ * over < 2^31 items is at most 31 levels deep; a deeper one (not built here) would have its
+ * overflowing subtrees' items tested one by one, which is slower but reports the same set. */
+enum { CULL_STACK = 64 };
+
+int sw_sg_bvh_cull(const sw_sg_bvh *bvh, const sw_sg_frustum *fr, sw_sg_bvh_cull_fn fn, void *ctx,
+                   sw_sg_bvh_cull_stats *stats)
+{
+    cull c = {bvh, fr, fn, ctx, {0}};
+    uint32_t stack[CULL_STACK], n = bvh->n_nodes ? 1 : 0;
+    stack[0] = 0;
+    int stop = 0;
+    while (n > 0 && !stop) {
+        const sw_sg_bvh_node *node = &bvh->nodes[stack[--n]];
+        c.st.nodes_visited++;
+        const sw_sg_cull_class k = sw_sg_frustum_classify(fr, node->box);
+        if (k == SW_SG_CULL_OUTSIDE) {
+            c.st.nodes_outside++;
+        } else if (k == SW_SG_CULL_INSIDE) {
+            c.st.nodes_inside++;
+            stop = report_all(&c, node->first, node->count);
+        } else {
+            c.st.nodes_partly++;
+            if (node->child[0] >= 0 && n + 2 <= CULL_STACK) {
+                stack[n++] = (uint32_t)node->child[1];
+                stack[n++] = (uint32_t)node->child[0];
+            } else {
+                stop = report_tested(&c, node->first, node->count);
+            }
+        }
+    }
+    if (stats)
+        *stats = c.st;
+    return stop;
 }

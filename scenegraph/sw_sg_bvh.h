@@ -44,8 +44,60 @@ typedef struct sw_sg_bvh {
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than 2^31 occurrences). *out owned by the
  * caller (sw_sg_bvh_free). */
 sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *status);
+/* The same hierarchy over n arbitrary boxes (6 doubles each: min xyz, max xyz): item i has the box
+ * boxes[6 i..], face = i, an identity transform and no colour — a finer granularity than faces
+ * (e.g. one face's Bézier patches) for callers that cull their own pieces. Errors as above. */
+sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out,
+                                sw_status *status);
 void sw_sg_bvh_free(sw_sg_bvh *bvh); /* NULL allowed */
 size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh);
+
+/* ---- view-frustum culling (Kumar §4.4) --------------------------------------------------------
+ * A convex region bounded by up to six planes. Boxes are tested relative to `origin` (the frame
+ * passes the eye: world coordinates far from the origin keep their precision), a point x being
+ * inside where dot(n, x - origin) + d >= 0 for every plane (n = planes[p][0..2], d = planes[p][3];
+ * n need not be unit length). */
+enum { SW_SG_FRUSTUM_MAX_PLANES = 6 };
+
+typedef struct sw_sg_frustum {
+    double origin[3];
+    double planes[SW_SG_FRUSTUM_MAX_PLANES][4];
+    int32_t n_planes; /* 0..SW_SG_FRUSTUM_MAX_PLANES */
+} sw_sg_frustum;
+
+typedef enum sw_sg_cull_class {
+    SW_SG_CULL_OUTSIDE = 0, /* wholly outside one plane: nothing in the box can be seen */
+    SW_SG_CULL_PARTLY = 1,  /* may meet the region (conservative: a box near a corner of the
+                               region can be outside it without being outside any one plane) */
+    SW_SG_CULL_INSIDE = 2,  /* wholly inside every plane */
+} sw_sg_cull_class;
+
+/* Classifies an origin-relative box (min xyz, max xyz) by its nearest and farthest corners along
+ * each plane's normal. */
+sw_sg_cull_class sw_sg_planes_classify(const double (*planes)[4], int32_t n_planes,
+                                       const double box[6]);
+/* Classifies a world box against the frustum (relative to fr->origin). */
+sw_sg_cull_class sw_sg_frustum_classify(const sw_sg_frustum *fr, const double world_box[6]);
+
+typedef struct sw_sg_bvh_cull_stats {
+    uint64_t nodes_visited; /* nodes classified: nodes_inside + nodes_partly + nodes_outside */
+    uint64_t nodes_inside, nodes_partly, nodes_outside;
+    uint64_t items_tested;  /* items classified one by one (those of partly-visible leaves) */
+    uint64_t items_visible; /* items reported */
+} sw_sg_bvh_cull_stats;
+
+/* Receives the index (into bvh->items) of an item whose box may meet the frustum; non-zero stops
+ * the traversal. */
+typedef int (*sw_sg_bvh_cull_fn)(void *ctx, uint32_t item);
+
+/* Reports every item whose box is not outside the frustum, in increasing index order: a node
+ * outside is dropped with its subtree, a node inside reports its subtree untested, a partly
+ * visible node is opened (its leaf items classified one by one). The reported set is exactly the
+ * items whose own box classifies as not outside (a box inside its parent's box classifies at
+ * least as inside, in floating point too: every step of the test is monotone). `stats` may be
+ * NULL; it is overwritten. Returns 0, or the callback's non-zero value when it stopped. */
+int sw_sg_bvh_cull(const sw_sg_bvh *bvh, const sw_sg_frustum *fr, sw_sg_bvh_cull_fn fn, void *ctx,
+                   sw_sg_bvh_cull_stats *stats);
 
 #ifdef __cplusplus
 }
