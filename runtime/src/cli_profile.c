@@ -1,5 +1,6 @@
 /* splinewalk profile SCENE --path PATH --out DIR [...]: frames along a camera path through the
- * public renderer API, timed stage by stage (issue 5, first slice: one thread submits). */
+ * public renderer API, timed stage by stage on the submitting thread and, threaded, on the
+ * renderer's visibility thread (issue 5). */
 #include "cli.h"
 
 #include "sw_camera_path.h"
@@ -20,9 +21,13 @@ static const char k_usage[] =
     "                          [--eval hierarchy|bezier|exact]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
-    "by `splinewalk path orbit|fly`) through the public renderer API and times each frame call\n"
-    "(frame_ms) and its stages: hierarchy (waiting for the pool), tessellate, trim, draw,\n"
-    "readback, write (the PNG of a captured frame) and other = frame_ms minus those. Writes into\n"
+    "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
+    "renderer's visibility thread prepares frame i+1 (culling, hierarchy selection, tessellation:\n"
+    "vis_ms, vis_hierarchy_ms, vis_tessellate_ms) while this thread submits frame i; frame_ms is\n"
+    "this thread's time per frame and its stages: wait_visibility, trim, draw, readback, write\n"
+    "(the PNG of a captured frame) and other = frame_ms minus those. With --sequential each frame\n"
+    "is one call on this thread and hierarchy (waiting for the pool) and tessellate are among its\n"
+    "stages. Writes into\n"
     "DIR: profile.csv and profile.json (one row per frame with the stage times, patches,\n"
     "triangles, trim textures and texels, atlas pages, fallback draws, pool waits and resident\n"
     "memory; the JSON adds the run and a summary: median, p90, p99, max, mean per column),\n"
@@ -41,9 +46,10 @@ static const char k_usage[] =
     "                    (default: walkthrough mode, frames never wait; what is not ready is\n"
     "                    drawn coarser and queued)\n"
     "  --threads N       worker-pool threads (default: one per online processor)\n"
-    "  --sequential      converged, with a pool of one worker: builds run only while the frame\n"
-    "                    waits for them, on that worker and the frame's own thread (the pool\n"
-    "                    cannot be emptied; nothing overlaps the frames)\n"
+    "  --sequential      every stage of a frame in one call on this thread, converged, with a\n"
+    "                    pool of one worker: builds run only while the frame waits for them, on\n"
+    "                    that worker and the frame's own thread (the pool cannot be emptied;\n"
+    "                    nothing overlaps the frames)\n"
     "  --eval MODE       hierarchy (default), bezier or exact, as for `render`\n"
     "  -h, --help        this text\n";
 
@@ -273,43 +279,77 @@ static void show_progress(uint32_t done, uint32_t n, double last_ms)
     sw_cli_progress(NULL, (double)done / n, stage);
 }
 
-/* Draws the n frames; each row's frame_ms is the wall time of sw_renderer_draw alone. */
-static sw_result run_frames(sw_renderer renderer, const sw_rt_camera_path *path, uint32_t n,
-                            sw_frame_desc *frame, staging *st, sw_rt_profile *p, sw_status *status)
+/* Frame i's camera along the path and, when it is captured, its staged PNG in `file`. */
+static double set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, staging *st,
+                        const sw_rt_profile *p, sw_frame_desc *frame, char file[4200])
+{
+    const double t = sw_rt_path_frame_time(path, i, n);
+    sw_rt_path_eval(path, t, &frame->camera);
+    frame->output_path = NULL;
+    if (is_capture(p, i)) {
+        char name[64];
+        sw_rt_profile_capture_name(i, name, sizeof name);
+        staged_path(st, name, file, 4200);
+        staging_remember(st, name);
+        frame->output_path = file;
+    }
+    return t;
+}
+
+/* One frame on this thread: drawn in one call (sequential), or — threaded — frame i + 1 handed
+ * to the renderer's visibility thread, then frame i (prepared while frame i - 1 was submitted)
+ * submitted. */
+static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camera_path *path,
+                           uint32_t i, uint32_t n, sw_frame_desc *frame, staging *st,
+                           sw_rt_profile *p, sw_frame_stats *stats, sw_status *status)
+{
+    char file[4200];
+    if (!threaded) {
+        set_frame(path, i, n, st, p, frame, file);
+        return sw_renderer_draw(renderer, frame, stats, status);
+    }
+    sw_result r = SW_OK;
+    if (i + 1 < n) {
+        set_frame(path, i + 1, n, st, p, frame, file);
+        r = sw_renderer_prepare(renderer, frame, status);
+    }
+    return r == SW_OK ? sw_renderer_submit(renderer, stats, status) : r;
+}
+
+/* Draws the n frames; each row's frame_ms is this thread's wall time for its frame. */
+static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_camera_path *path,
+                            uint32_t n, sw_frame_desc *frame, staging *st, sw_rt_profile *p,
+                            sw_status *status)
 {
     const int tty = isatty(STDERR_FILENO);
-    for (uint32_t i = 0; i < n; i++) {
-        const double t = sw_rt_path_frame_time(path, i, n);
-        sw_rt_path_eval(path, t, &frame->camera);
-        char name[64], file[4200];
-        const int captured = is_capture(p, i);
-        if (captured) {
-            sw_rt_profile_capture_name(i, name, sizeof name);
-            staged_path(st, name, file, sizeof file);
-            staging_remember(st, name);
-        }
-        frame->output_path = captured ? file : NULL;
+    char file[4200];
+    sw_result r = SW_OK;
+    if (threaded) {
+        set_frame(path, 0, n, st, p, frame, file);
+        r = sw_renderer_prepare(renderer, frame, status);
+    }
+    for (uint32_t i = 0; i < n && r == SW_OK; i++) {
         sw_frame_stats stats = {0};
         const double t0 = sw_cli_now_ms();
-        sw_result r = sw_renderer_draw(renderer, frame, &stats, status);
+        r = one_frame(renderer, threaded, path, i, n, frame, st, p, &stats, status);
         const double ms = sw_cli_now_ms() - t0;
+        const double t = sw_rt_path_frame_time(path, i, n);
         if (r != SW_OK) {
-            if (tty)
-                sw_cli_progress_end();
             char msg[sizeof status->message];
             snprintf(msg, sizeof msg, "%s", status->message);
-            return sw__fail(status, r, "frame %u (t = %g s): %s", i, t, msg);
+            r = sw__fail(status, r, "frame %u (t = %g s): %s", i, t, msg);
+            break;
         }
         sw_rt_prof_row row;
-        sw_rt_profile_row(&stats, i, t, ms, resident_bytes(), captured, &row);
+        sw_rt_profile_row(&stats, i, t, ms, resident_bytes(), is_capture(p, i), &row);
         if (sw_rt_profile_push(p, &row) != 0)
-            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
+            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
         if (tty)
             show_progress(i + 1, n, ms);
     }
     if (tty)
         sw_cli_progress_end();
-    return SW_OK;
+    return r;
 }
 
 /* The pool size the renderer is asked for; 0 = one per online processor. */
@@ -355,7 +395,7 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
         a->frame.walkthrough = !a->converged;
         choose_captures(p, n);
         const double t0 = sw_cli_now_ms();
-        r = run_frames(renderer, path, n, &a->frame, &st, p, status);
+        r = run_frames(renderer, !a->sequential, path, n, &a->frame, &st, p, status);
         p->meta.wall_s = (sw_cli_now_ms() - t0) / 1e3;
         if (r == SW_OK && sw_rt_profile_summarize(p) != 0)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");

@@ -19,8 +19,8 @@ static const col_info k_cols[SW_RT_COL_COUNT] = {
 };
 
 /* Stage colours, in stacking order (hierarchy at the bottom, other on top). */
-static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#59a14f", "#f28e2b",
-                                             "#e15759", "#b07aa1", "#a0a0a0"};
+static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#59a14f",
+                                             "#f28e2b", "#e15759", "#b07aa1", "#a0a0a0"};
 #define FIRST_STAGE SW_RT_COL_HIERARCHY_MS
 #define N_STAGES (SW_RT_COL_OTHER_MS - SW_RT_COL_HIERARCHY_MS + 1)
 
@@ -51,8 +51,11 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_FRAME] = index;
     v[SW_RT_COL_T] = t;
     v[SW_RT_COL_FRAME_MS] = frame_ms;
-    v[SW_RT_COL_HIERARCHY_MS] = st->ms_hierarchy;
-    v[SW_RT_COL_TESSELLATE_MS] = st->ms_tessellate;
+    const int split = st->ms_visibility > 0.0;
+    v[split ? SW_RT_COL_VIS_HIERARCHY_MS : SW_RT_COL_HIERARCHY_MS] = st->ms_hierarchy;
+    v[split ? SW_RT_COL_VIS_TESSELLATE_MS : SW_RT_COL_TESSELLATE_MS] = st->ms_tessellate;
+    v[SW_RT_COL_VIS_MS] = st->ms_visibility;
+    v[SW_RT_COL_WAIT_VISIBILITY_MS] = st->ms_wait_visibility;
     v[SW_RT_COL_TRIM_MS] = st->ms_trim;
     v[SW_RT_COL_DRAW_MS] = st->ms_draw;
     v[SW_RT_COL_READBACK_MS] = st->ms_readback;
@@ -519,7 +522,8 @@ static void html_summary(FILE *f, const sw_rt_profile *p)
         if (!summarized((sw_rt_prof_col)c))
             continue;
         const sw_rt_prof_stat *s = &p->summary[c];
-        const int ms = k_cols[c].kind == SW_RT_KIND_STAGE || k_cols[c].kind == SW_RT_KIND_FRAME;
+        const int ms = k_cols[c].kind == SW_RT_KIND_STAGE || k_cols[c].kind == SW_RT_KIND_FRAME ||
+                       k_cols[c].kind == SW_RT_KIND_VSTAGE;
         const char *fmt = ms ? "<td>%.2f</td>" : "<td>%.0f</td>";
         fprintf(f, "<tr><td>%s</td>", k_cols[c].name);
         const double v[5] = {s->median, s->p90, s->p99, s->max, s->mean};
@@ -571,7 +575,7 @@ int sw_rt_profile_write_html(FILE *f, const sw_rt_profile *p, const char *svg)
 void sw_rt_profile_print_summary(FILE *f, const sw_rt_profile *p)
 {
     fprintf(f, "%-16s %9s %9s %9s %9s %9s\n", "ms", "median", "p90", "p99", "max", "mean");
-    for (int c = SW_RT_COL_FRAME_MS; c <= SW_RT_COL_OTHER_MS; c++) {
+    for (int c = SW_RT_COL_FRAME_MS; c <= SW_RT_COL_VIS_TESSELLATE_MS; c++) {
         const sw_rt_prof_stat *s = &p->summary[c];
         const char *name = k_cols[c].name;
         fprintf(f, "%s%-*.*s %9.2f %9.2f %9.2f %9.2f %9.2f\n", c == SW_RT_COL_FRAME_MS ? "" : "  ",

@@ -19,14 +19,24 @@
 #define SW_RT_PROFILE_COLUMNS(X)                                                                   \
     X(FRAME, "frame", INDEX, "frame index along the path")                                         \
     X(T, "t_s", SECONDS, "path time of the frame (s)")                                             \
-    X(FRAME_MS, "frame_ms", FRAME, "wall time of the frame call (sw_renderer_draw)")               \
-    X(HIERARCHY_MS, "hierarchy_ms", STAGE, "waiting for hierarchy builds and refinements")         \
-    X(TESSELLATE_MS, "tessellate_ms", STAGE, "traversal, bounds, CPU grids, requests")             \
+    X(FRAME_MS, "frame_ms", FRAME,                                                                 \
+      "the submitting thread's time for the frame (sw_renderer_draw, or prepare + submit)")        \
+    X(HIERARCHY_MS, "hierarchy_ms", STAGE,                                                         \
+      "waiting for hierarchy builds and refinements (0 when on the visibility thread)")            \
+    X(TESSELLATE_MS, "tessellate_ms", STAGE,                                                       \
+      "culling, traversal, bounds, CPU grids, requests (0 when on the visibility thread)")         \
+    X(WAIT_VISIBILITY_MS, "wait_visibility_ms", STAGE,                                             \
+      "threaded: waiting for the visibility thread to finish the frame")                           \
     X(TRIM_MS, "trim_ms", STAGE, "trim-texture generation into the atlas")                         \
     X(DRAW_MS, "draw_ms", STAGE, "draw submission until glFinish")                                 \
     X(READBACK_MS, "readback_ms", STAGE, "glReadPixels of the frame")                              \
     X(WRITE_MS, "write_ms", STAGE, "PNG write (captured frames only)")                             \
     X(OTHER_MS, "other_ms", STAGE, "frame_ms minus the stages above")                              \
+    X(VIS_MS, "vis_ms", VSTAGE, "threaded: the visibility thread's time for the frame")            \
+    X(VIS_HIERARCHY_MS, "vis_hierarchy_ms", VSTAGE,                                                \
+      "threaded: of vis_ms, waiting for hierarchy builds and refinements")                         \
+    X(VIS_TESSELLATE_MS, "vis_tessellate_ms", VSTAGE,                                              \
+      "threaded: of vis_ms, culling, traversal, bounds, CPU grids, requests")                      \
     X(PATCHES, "patches", COUNT, "patches drawn (trimmed + untrimmed)")                            \
     X(PATCHES_TRIMMED, "patches_trimmed", COUNT, "patches drawn with a trim texture")              \
     X(PATCHES_CULLED, "patches_culled", COUNT, "patches culled")                                   \
@@ -56,7 +66,8 @@ typedef enum sw_rt_prof_kind {
     SW_RT_KIND_INDEX,
     SW_RT_KIND_SECONDS,
     SW_RT_KIND_FRAME,
-    SW_RT_KIND_STAGE,
+    SW_RT_KIND_STAGE,  /* on the submitting thread: the stages add up to frame_ms */
+    SW_RT_KIND_VSTAGE, /* on the visibility thread (threaded runs): beside frame_ms, not in it */
     SW_RT_KIND_COUNT
 } sw_rt_prof_kind;
 
@@ -91,8 +102,10 @@ typedef struct sw_rt_profile {
     sw_rt_prof_stat summary[SW_RT_COL_COUNT]; /* after sw_rt_profile_summarize */
 } sw_rt_profile;
 
-/* A frame's row from the renderer's stats, the frame call's wall time and resident memory;
- * OTHER_MS is frame_ms minus the measured stages. */
+/* A frame's row from the renderer's stats, the submitting thread's wall time for it and resident
+ * memory; OTHER_MS is frame_ms minus the measured stages. A split frame (prepared on the
+ * visibility thread: st->ms_visibility > 0) has its hierarchy and tessellate times in the VIS_
+ * columns, a frame drawn in one call in the stage columns. */
 void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, double frame_ms,
                        double resident_bytes, int captured, sw_rt_prof_row *out);
 /* Appends a row. Returns 0, or -1 when out of memory. */

@@ -18,7 +18,7 @@ for tool in xmllint jq awk; do
   command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
 done
 
-columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,resident_bytes,captured"
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,resident_bytes,captured"
 
 # ---- help and usage ---------------------------------------------------------------------------
 "$sw" --help | grep -q '^  profile' || fail "splinewalk --help does not list profile"
@@ -55,12 +55,12 @@ check_run() {
   local dir=$1 n=$2
   [ "$(head -1 "$dir/profile.csv")" = "$columns" ] || fail "$dir: CSV header: $(head -1 "$dir/profile.csv")"
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
-  awk -F, -v n=26 'NR > 1 {
+  awk -F, -v n=30 'NR > 1 {
       if (NF != n) { print "row " NR ": " NF " fields"; bad = 1 }
       for (i = 1; i <= NF; i++) if ($i !~ /^-?[0-9]+(\.[0-9]+)?$/) { print "row " NR " field " i ": " $i; bad = 1 }
       if ($1 != NR - 2) { print "row " NR ": frame " $1; bad = 1 }
-      stages = $4 + $5 + $6 + $7 + $8 + $9
-      if (($3 - stages - $10) > 0.002 || ($3 - stages - $10) < -0.002) { print "row " NR ": other " $10 " != " $3 - stages; bad = 1 }
+      stages = $4 + $5 + $6 + $7 + $8 + $9 + $10
+      if (($3 - stages - $11) > 0.002 || ($3 - stages - $11) < -0.002) { print "row " NR ": other " $11 " != " $3 - stages; bad = 1 }
       if (NR > 2 && $2 <= prev_t) { print "row " NR ": t_s not increasing"; bad = 1 }
       prev_t = $2
     } END { exit bad }' "$dir/profile.csv" >awk.txt || { fail "$dir: CSV rows"; head -5 awk.txt; }
@@ -72,7 +72,7 @@ check_run() {
   med_json=$(jq '.summary.frame_ms.median' "$dir/profile.json")
   awk -v a="$med_csv" -v b="$med_json" 'BEGIN { exit !(a - b < 0.001 && b - a < 0.001) }' ||
     fail "$dir: JSON median frame_ms $med_json, CSV gives $med_csv"
-  for s in hierarchy tessellate trim draw readback write other; do
+  for s in hierarchy tessellate wait_visibility trim draw readback write other vis vis_hierarchy vis_tessellate; do
     jq -e ".summary.${s}_ms | has(\"median\") and has(\"p90\") and has(\"p99\") and has(\"max\")" \
       "$dir/profile.json" >/dev/null || fail "$dir: summary lacks ${s}_ms"
   done
@@ -80,7 +80,7 @@ check_run() {
   xmllint --noout "$dir/report.html" 2>xml.txt || { fail "$dir: report.html not well-formed"; cat xml.txt; }
   grep -q '<svg' "$dir/report.html" || fail "$dir: report.html holds no SVG"
   local caps
-  caps=$(awk -F, 'NR > 1 && $26 == 1 { printf "%s ", $1 }' "$dir/profile.csv")
+  caps=$(awk -F, 'NR > 1 && $30 == 1 { printf "%s ", $1 }' "$dir/profile.csv")
   [ "$caps" = "0 $((n / 2)) $((n - 1)) " ] || fail "$dir: captured frames '$caps'"
   for f in $caps; do
     local png
@@ -95,12 +95,26 @@ check_run() {
 # column VALUE of DIR: every row's value of a column, one a line.
 column() { awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == c) k = i; next } { print $k }' "$1/profile.csv"; }
 
-# ---- walkthrough (the default mode) -------------------------------------------------------------
+# stages_add_up DIR ROW: on the ROW-th fastest frame (the median), the submitting thread's stages
+# add up to frame_ms within 5 % (other <= 5 %).
+stages_add_up() {
+  tail -n +2 "$1/profile.csv" | sort -t, -k3 -g | sed -n "$2p" | awk -F, '{
+    stages = $4 + $5 + $6 + $7 + $8 + $9 + $10
+    printf "median frame %d: frame %.3f ms, stages %.3f ms, other %.3f ms (%.2f %%)\n", $1, $3, stages, $11, 100 * $11 / $3
+    exit !($3 > 0 && stages >= 0.95 * $3 && stages <= 1.05 * $3 && $11 <= 0.05 * $3) }'
+}
+
+# ---- walkthrough (the default mode), threaded: the visibility thread prepares the next frame ----
 "$sw" profile $scene --path orbit.path --size 320x240 --out walk >walk.txt 2>walk.err ||
   { fail "profile (walkthrough)"; cat walk.txt walk.err; }
 check_run walk 40
 [ "$(column walk pool_waits | sort -u)" = 0 ] || fail "walkthrough: a frame waited for the pool"
 [ "$(column walk hierarchy_ms | sort -u)" = 0.0000 ] || fail "walkthrough: hierarchy waits"
+[ "$(column walk vis_hierarchy_ms | sort -u)" = 0.0000 ] || fail "walkthrough: hierarchy waits on the visibility thread"
+[ "$(column walk tessellate_ms | sort -u)" = 0.0000 ] || fail "threaded: tessellation counted on the submitting thread"
+column walk vis_ms | awk '!($1 > 0) { bad = 1 } END { exit bad }' || fail "threaded: a frame without visibility-thread time"
+stages_add_up walk 20 >median.txt || fail "threaded: the submitting thread's stages do not add up: $(cat median.txt)"
+pass "threaded: $(cat median.txt)"
 jq -e '.mode == "walkthrough" and .lp_num_threads == "2"' walk/profile.json >/dev/null ||
   fail "walkthrough: run description in profile.json"
 grep -q 'frames in' walk.err || fail "no final progress line on a non-terminal stderr"
@@ -111,17 +125,17 @@ pass "walkthrough: 40 frames, $(sed -n 's/^frame *\([0-9.]*\).*/\1/p' walk.txt) 
   >conv.txt 2>&1 || { fail "profile --converged"; cat conv.txt; }
 check_run conv 40
 [ "$(column conv fallback_draws | sort -u)" = 0 ] || fail "converged: fallback draws"
-tail -n +2 conv/profile.csv | sort -t, -k3 -g | sed -n 20p | awk -F, '{
-    stages = $4 + $5 + $6 + $7 + $8 + $9
-    printf "median frame %d: frame %.3f ms, stages %.3f ms, other %.3f ms (%.2f %%)\n", $1, $3, stages, $10, 100 * $10 / $3
-    exit !($3 > 0 && stages >= 0.95 * $3 && stages <= 1.05 * $3 && $10 <= 0.05 * $3) }' >median.txt ||
-  fail "converged: stages do not add up on the median frame: $(cat median.txt)"
+stages_add_up conv 20 >median.txt || fail "converged: stages do not add up on the median frame: $(cat median.txt)"
 pass "converged: $(cat median.txt)"
 
 # ---- sequential and the fly-through -------------------------------------------------------------
 "$sw" profile $scene --path orbit.path --frames 6 --size 160x120 --out seq --sequential >seq.txt 2>&1 ||
   { fail "profile --sequential"; cat seq.txt; }
 check_run seq 6
+[ "$(column seq vis_ms | sort -u)" = 0.0000 ] || fail "--sequential: work on a visibility thread"
+column seq tessellate_ms | awk '!($1 > 0) { bad = 1 } END { exit bad }' || fail "--sequential: no tessellate stage"
+stages_add_up seq 3 >median.txt || fail "--sequential: stages do not add up: $(cat median.txt)"
+echo "      sequential: $(cat median.txt)"
 jq -e '.worker_threads == 1 and .sequential == true and .mode == "converged"' seq/profile.json \
   >/dev/null || fail "--sequential: not one worker, converged: $(jq -c '[.worker_threads, .sequential, .mode]' seq/profile.json)"
 "$sw" profile $scene --path fly.path --size 160x120 --out fly --threads 1 >fly.txt 2>&1 ||
