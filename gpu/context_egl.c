@@ -207,7 +207,9 @@ static sw_result make_gl_objects(sw_gpu_context *ctx, sw_status *status)
     return sw__gpu_check(status, "context set-up");
 }
 
-sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status)
+/* A context made by `make` (its GL context current afterwards), then the frame's GL objects. */
+static sw_result context_create(sw_result (*make)(sw_gpu_context *, sw_status *),
+                                sw_gpu_context **out, sw_status *status)
 {
     *out = NULL;
     sw_gpu_context *ctx = calloc(1, sizeof *ctx);
@@ -218,7 +220,7 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
     }
     sw_th_token_init(ctx->walk_token);
-    sw_result r = make_context(ctx, status);
+    sw_result r = make(ctx, status);
     if (r == SW_OK)
         r = make_gl_objects(ctx, status);
     if (r != SW_OK) {
@@ -230,6 +232,11 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
     return SW_OK;
 }
 
+sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status)
+{
+    return context_create(make_context, out, status);
+}
+
 sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status)
 {
     *out = NULL;
@@ -238,24 +245,7 @@ sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status)
         return sw__fail(status, SW_ERR_NO_CONTEXT,
                         "no OpenGL context is current on this thread: make the host's context "
                         "current before creating the renderer");
-    sw_gpu_context *ctx = calloc(1, sizeof *ctx);
-    if (ctx)
-        ctx->walk_token = calloc(1, sizeof *ctx->walk_token);
-    if (!ctx || !ctx->walk_token) {
-        free(ctx);
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
-    }
-    sw_th_token_init(ctx->walk_token);
-    sw_result r = check_gl_version(ctx, status);
-    if (r == SW_OK)
-        r = make_gl_objects(ctx, status);
-    if (r != SW_OK) {
-        sw_gpu_context_free(ctx);
-        return r;
-    }
-    *out = ctx;
-    sw__status_ok(status);
-    return SW_OK;
+    return context_create(check_gl_version, out, status);
 }
 
 void sw_gpu_context_free(sw_gpu_context *ctx)
