@@ -5,6 +5,7 @@
  * fixed number of frames (tests under xvfb-run, demos), --record writes the keys set with K.
  */
 #include "cli.h"
+#include "cli_view_overlay.h"
 
 #include "sw_camera_path.h"
 #include "sw_gpu.h"
@@ -32,6 +33,8 @@ static const char k_usage[] =
     "  mouse drag    look around (left button)      scroll   walking speed x1.25 / x0.8\n"
     "  + -           screen-space error x2 / x0.5   (shown in the title, with the frame time)\n"
     "  K             add the current camera as a key to the recording (--record)\n"
+    "  F             frame-time overlay on / off (bars of the last 120 frames, marks at 60 and\n"
+    "                30 frames per second; orange: the frame drew something coarser than asked)\n"
     "  R             back to the iso view           Esc      close\n"
     "\n"
     "options:\n"
@@ -46,12 +49,14 @@ static const char k_usage[] =
     "camera\n"
     "  --settle          after the script, draw the last view once more converged (every\n"
     "                    refinement done), as `splinewalk render --camera` draws it\n"
+    "  --overlay         with --script: draw the frame-time overlay too (interactive: always,\n"
+    "                    F toggles it)\n"
     "  -h, --help        this text\n";
 
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot;
     int32_t w, h;
-    int frames, settle;
+    int frames, settle, overlay;
     double error_px, speed;
 } view_args;
 
@@ -81,8 +86,8 @@ static int parse_args(int argc, char **argv, view_args *a)
     *a = (view_args){.w = 1280, .h = 720, .error_px = 0.5, .speed = 0.1};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(arg, "--settle")) {
-            a->settle = 1;
+        if (!strcmp(arg, "--settle") || !strcmp(arg, "--overlay")) {
+            *(!strcmp(arg, "--settle") ? &a->settle : &a->overlay) = 1;
             continue;
         }
         if (arg[0] != '-' && !a->scene) {
@@ -104,8 +109,9 @@ static int parse_args(int argc, char **argv, view_args *a)
         fprintf(stderr, "splinewalk view: need SCENE\n%s", k_usage);
         return 2;
     }
-    if ((a->screenshot || a->settle || a->frames) && !a->script) {
-        fprintf(stderr, "splinewalk view: --frames, --screenshot and --settle need --script\n%s",
+    if ((a->screenshot || a->settle || a->frames || a->overlay) && !a->script) {
+        fprintf(stderr,
+                "splinewalk view: --frames, --screenshot, --settle and --overlay need --script\n%s",
                 k_usage);
         return 2;
     }
@@ -177,7 +183,7 @@ typedef struct viewer {
     double error_px;
     sw_rt_camera_path recording;
     uint32_t cap_keys;
-    double clock_s;
+    sw_cli_overlay overlay;
 } viewer;
 
 static void record_key(viewer *v)
@@ -213,6 +219,8 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         v->error_px = fmax(v->error_px * 0.5, 1.0 / 64.0);
     else if (key == GLFW_KEY_K)
         record_key(v);
+    else if (key == GLFW_KEY_F)
+        v->overlay.enabled = !v->overlay.enabled;
     else if (key == GLFW_KEY_R)
         walker_look_from(&v->wk, &v->home);
 }
@@ -290,6 +298,14 @@ static void show_title(GLFWwindow *win, const viewer *v, const sw_frame_stats *f
     glfwSetWindowTitle(win, title);
 }
 
+/* The host's own drawing over the presented frame (the renderer restored the framebuffer binding
+ * and viewport; the rest of the state is set by the overlay). */
+static void show_overlay(viewer *v, const sw_frame_stats *fs)
+{
+    sw_cli_overlay_push(&v->overlay, fs->ms_total, fs->fallback_draws > 0);
+    sw_cli_overlay_draw(&v->overlay, v->args->w, v->args->h);
+}
+
 static void print_camera(const char *what, const sw_camera *c)
 {
     printf("%s camera %.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", what,
@@ -311,6 +327,7 @@ static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
         sw_rt_path_eval(path, sw_rt_path_frame_time(path, i, n), &v->wk.cam);
         if (draw(r, scene, v, 0, NULL, &fs, &st) != SW_OK)
             return sw_cli_report("view", &st);
+        show_overlay(v, &fs);
         glfwSwapBuffers(win);
         glfwPollEvents();
         waits += fs.pool_waits;
@@ -323,6 +340,8 @@ static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
            (unsigned long long)fallbacks);
     if (v->args->settle && draw(r, scene, v, 1, NULL, &fs, &st) != SW_OK)
         return sw_cli_report("view", &st);
+    if (v->args->settle)
+        show_overlay(v, &fs);
     if (!v->args->screenshot)
         return 0;
     /* What the window shows: its back buffer, read after the present, before the swap. */
@@ -365,6 +384,7 @@ static int run_interactive(GLFWwindow *win, sw_renderer r, sw_scene scene, viewe
         last = now;
         if (draw(r, scene, v, 0, NULL, &fs, &st) != SW_OK)
             return sw_cli_report("view", &st);
+        show_overlay(v, &fs);
         show_title(win, v, &fs);
         glfwSwapBuffers(win);
     }
@@ -398,9 +418,13 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
     sw_renderer r = {0};
     sw_renderer_desc rd = {.use_current_context = 1};
     int rc = sw_renderer_create(&rd, &r, &st) != SW_OK ? sw_cli_report("view", &st) : 0;
+    if (rc == 0 && sw_cli_overlay_init(&v.overlay) != 0)
+        fprintf(stderr, "splinewalk view: the frame-time overlay's shaders do not build here\n");
+    v.overlay.enabled = !script || a->overlay;
     if (rc == 0) {
         fprintf(stderr, "splinewalk view: %s\n", sw_renderer_description_ptr(r));
         rc = script ? run_script(win, r, scene, &v, script) : run_interactive(win, r, scene, &v);
+        sw_cli_overlay_free(&v.overlay);
         sw_renderer_destroy(r); /* while the window's context is still current */
     }
     free(v.recording.keys);

@@ -49,3 +49,17 @@ if "$diff" "$work/shot.png" "$work/other.png" 0.1 >/dev/null; then
   fail "control: the front view compared equal to the screenshot"
 fi
 echo "ok: 60 scripted frames, settled screenshot equals splinewalk render of its camera"
+
+# The frame-time overlay (the viewer's own GL drawing over the presented frame): the same run with
+# --overlay differs from the render, but only in the overlay's corner (at most 20 % of the pixels:
+# a 360 x 120 box of 640 x 360 is 18.75 %).
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+  --script "$work/orbit.path" --frames 10 --settle --overlay --screenshot "$work/overlay.png" \
+  >"$work/overlay.out" 2>"$work/overlay.err" || { cat "$work/overlay.err"; fail "view --overlay"; }
+cam=$(sed -n 's/^screenshot camera //p' "$work/overlay.out")
+"$sw" render "$model" -o "$work/render10.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
+if "$diff" "$work/overlay.png" "$work/render10.png" 0.1 >/dev/null; then
+  fail "--overlay: no overlay drawn"
+fi
+"$diff" "$work/overlay.png" "$work/render10.png" 20 || fail "--overlay changed more than its corner"
+echo "ok: the overlay is drawn over the frame, in its corner only"

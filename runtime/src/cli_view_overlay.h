@@ -1,0 +1,23 @@
+/* The viewer's frame-time overlay (cli_view_overlay.c). The window's GL thread only. */
+#ifndef SW_CLI_VIEW_OVERLAY_H
+#define SW_CLI_VIEW_OVERLAY_H
+
+enum { SW_CLI_OVERLAY_FRAMES = 120 };
+
+typedef struct sw_cli_overlay {
+    unsigned program, vao, vbo;
+    float ms[SW_CLI_OVERLAY_FRAMES];
+    unsigned char fallback[SW_CLI_OVERLAY_FRAMES];
+    int next, count;
+    int enabled;
+} sw_cli_overlay;
+
+/* Needs the window's context current. Returns 0, or -1 when the shaders do not build (the
+ * overlay then draws nothing). */
+int sw_cli_overlay_init(sw_cli_overlay *o);
+void sw_cli_overlay_free(sw_cli_overlay *o);
+void sw_cli_overlay_push(sw_cli_overlay *o, double frame_ms, int fallback);
+/* Draws into the window's framebuffer (0) of w x h pixels; sets the GL state it needs. */
+void sw_cli_overlay_draw(const sw_cli_overlay *o, int w, int h);
+
+#endif
