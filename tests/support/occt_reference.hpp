@@ -33,6 +33,15 @@ struct occt_triangles {
     std::array<double, 6> box() const;
 };
 
+/* Is the B-rep closed, and how tightly? free_edges: non-degenerate edges bounding only one face
+ * (a seam counts its face twice); max_tolerance: the largest edge or vertex tolerance, which
+ * bounds how far the faces meeting there may stand apart (OCCT's tolerance model: each face's
+ * boundary lies within the edge's tolerance of its 3D curve, so the gap is at most twice it). */
+struct occt_closure {
+    size_t edges = 0, free_edges = 0;
+    double max_tolerance = 0.0;
+};
+
 /* Selects a face by its world-space bounding box (min xyz, max xyz). */
 using occt_face_filter = std::function<bool(const std::array<double, 6> &box)>;
 
@@ -50,6 +59,7 @@ class occt_model
     /* Face occurrences (a face shared by two instances counts twice) and their world boxes. */
     size_t n_faces() const;
     const std::vector<std::array<double, 6>> &face_boxes() const;
+    occt_closure closure() const;
     /* Box of all faces' boxes (OCCT's, which may be looser than the geometry). */
     std::array<double, 6> box() const;
 
