@@ -56,6 +56,13 @@ cc "${flags[@]}" "$work/embed_headless.c" $(pkg-config --cflags --libs splinewal
    -Wl,-rpath,"$libdir" -o "$work/embed_pc"
 bin_pc=$work/embed_pc
 
+step "build samples/embed_minimal.c (a GLFW host) through pkg-config"
+cp "$src/samples/embed_minimal.c" "$work/embed_minimal.c"
+# shellcheck disable=SC2046
+cc "${flags[@]}" "$work/embed_minimal.c" $(pkg-config --cflags --libs splinewalk) \
+   $(env -u PKG_CONFIG_LIBDIR pkg-config --cflags --libs glfw3) -lm -Wl,-rpath,"$libdir" \
+   -o "$work/embed_minimal" || fail "embed_minimal does not build against the installed package"
+
 for b in "$bin_cmake" "$bin_pc"; do
   deps=$(ldd "$b")
   grep -q "libsplinewalk.so.0 => $prefix/" <<<"$deps" ||

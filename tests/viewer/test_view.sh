@@ -8,9 +8,11 @@
 #     saved through OpenImageIO, and the viewer closes cleanly (exit 0). The screenshot must match
 #     `splinewalk render --camera` of the camera it printed (<= 0.1 % of pixels differ): what the
 #     window shows is the renderer's frame, presented into the window's framebuffer.
-# usage: test_view.sh SPLINEWALK PNG_DIFF MODEL WORKDIR
+#  4. samples/embed_minimal (a GLFW host of the public API) draws 30 frames into its window and
+#     exits 0.
+# usage: test_view.sh SPLINEWALK PNG_DIFF MODEL WORKDIR EMBED_MINIMAL
 set -euo pipefail
-sw=$1 diff=$2 model=$3 work=$4
+sw=$1 diff=$2 model=$3 work=$4 embed=$5
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*"; exit 1; }
 
@@ -63,3 +65,9 @@ if "$diff" "$work/overlay.png" "$work/render10.png" 0.1 >/dev/null; then
 fi
 "$diff" "$work/overlay.png" "$work/render10.png" 20 || fail "--overlay changed more than its corner"
 echo "ok: the overlay is drawn over the frame, in its corner only"
+
+"$sw" import "$model" -o "$work/model.sws" >/dev/null 2>&1
+xvfb-run -a -s "-screen 0 1280x1024x24" "$embed" "$work/model.sws" 30 >"$work/embed.out" 2>&1 ||
+  { cat "$work/embed.out"; fail "embed_minimal"; }
+grep -q "^embed_minimal: 30 frames" "$work/embed.out" || fail "embed_minimal: $(cat "$work/embed.out")"
+echo "ok: $(cat "$work/embed.out")"
