@@ -173,10 +173,12 @@ static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
     }
 }
 
-sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, const float bg[4],
-                             const sw__gpu_mesh *mesh, const sw__gpu_draw *draws, size_t n_draws,
+sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
+                             const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
+                             const sw__gpu_draw *draws, size_t n_draws,
                              const sw__gpu_patch_batch *batch, sw_status *status)
 {
+    const float *bg = desc->background;
     sw_result r = sw__gpu_target_ensure(ctx, view->width, view->height, status);
     if (r != SW_OK)
         return r;
@@ -191,6 +193,9 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, cons
     glClearColor(bg[0], bg[1], bg[2], bg[3]);
     glClearDepth(0.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    /* Lines only for the surfaces: the trim textures were made before, with filled fans. */
+    if (desc->wireframe)
+        glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     bind_mesh(ctx, mesh);
     glUseProgram(ctx->prog_mesh);
     glUniformMatrix4fv(ctx->loc_view_proj, 1, GL_FALSE, view->view_proj);
@@ -211,6 +216,8 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view, cons
     }
     if (batch && batch->n_recs > 0)
         draw_patches(ctx, view, batch);
+    if (desc->wireframe)
+        glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     glFinish();
     return sw__gpu_check(status, "frame draw");
 }
@@ -361,7 +368,7 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
         r = triangles_to_mesh(positions, n_vertices, indices, n_indices, view.eye, &mesh, status);
     sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1};
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &view, desc.background, &mesh, &draw, 1, NULL, status);
+        r = sw__gpu_draw_frame(ctx, &view, &desc, &mesh, &draw, 1, NULL, status);
     sw__gpu_mesh_free(&mesh);
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &view, desc.want_depth, out, status);

@@ -1342,7 +1342,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
     if (r == SW_OK)
         r = build_batch(f, status);
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &f->view, desc->background, &f->mesh, f->draws, f->n_draws,
+        r = sw__gpu_draw_frame(ctx, &f->view, desc, &f->mesh, f->draws, f->n_draws,
                                &f->batch, status);
     double t3 = sw__gpu_now_ms();
     if (r == SW_OK && desc->present)

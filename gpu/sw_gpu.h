@@ -65,6 +65,8 @@ typedef struct sw_gpu_frame_desc {
                             GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
                             origin; the caller's framebuffer bindings and viewport are restored */
     int32_t no_readback; /* 1: nothing is read back (out stays empty; want_depth ignored) */
+    int32_t wireframe;   /* 1: the surfaces' triangles drawn as lines, trimmed parts still cut
+                            away (inspection: grid densities, hierarchy nodes, fat borders) */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */

@@ -264,6 +264,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->eval_exact = desc->eval_exact != 0;
     frame->walkthrough = desc->walkthrough != 0;
     frame->present = desc->present != 0;
+    frame->wireframe = desc->wireframe != 0;
     frame->no_readback = desc->present && !desc->output_path;
     frame->want_depth = 0;
     if (desc->output_path) {

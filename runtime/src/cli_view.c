@@ -33,6 +33,7 @@ static const char k_usage[] =
     "  mouse drag    look around (left button)      scroll   walking speed x1.25 / x0.8\n"
     "  + -           screen-space error x2 / x0.5   (shown in the title, with the frame time)\n"
     "  K             add the current camera as a key to the recording (--record)\n"
+    "  L             wireframe on / off (the tessellation the error bound chose)\n"
     "  F             frame-time overlay on / off (bars of the last 120 frames, marks at 60 and\n"
     "                30 frames per second; orange: the frame drew something coarser than asked)\n"
     "  R             back to the iso view           Esc      close\n"
@@ -51,12 +52,13 @@ static const char k_usage[] =
     "                    refinement done), as `splinewalk render --camera` draws it\n"
     "  --overlay         with --script: draw the frame-time overlay too (interactive: always,\n"
     "                    F toggles it)\n"
+    "  --wireframe       start with the wireframe on (L toggles it)\n"
     "  -h, --help        this text\n";
 
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot;
     int32_t w, h;
-    int frames, settle, overlay;
+    int frames, settle, overlay, wireframe;
     double error_px, speed;
 } view_args;
 
@@ -86,8 +88,12 @@ static int parse_args(int argc, char **argv, view_args *a)
     *a = (view_args){.w = 1280, .h = 720, .error_px = 0.5, .speed = 0.1};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(arg, "--settle") || !strcmp(arg, "--overlay")) {
-            *(!strcmp(arg, "--settle") ? &a->settle : &a->overlay) = 1;
+        int *flag = !strcmp(arg, "--settle")      ? &a->settle
+                    : !strcmp(arg, "--overlay")   ? &a->overlay
+                    : !strcmp(arg, "--wireframe") ? &a->wireframe
+                                                  : NULL;
+        if (flag) {
+            *flag = 1;
             continue;
         }
         if (arg[0] != '-' && !a->scene) {
@@ -184,6 +190,7 @@ typedef struct viewer {
     sw_rt_camera_path recording;
     uint32_t cap_keys;
     sw_cli_overlay overlay;
+    int wireframe;
 } viewer;
 
 static void record_key(viewer *v)
@@ -221,6 +228,8 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         record_key(v);
     else if (key == GLFW_KEY_F)
         v->overlay.enabled = !v->overlay.enabled;
+    else if (key == GLFW_KEY_L)
+        v->wireframe = !v->wireframe;
     else if (key == GLFW_KEY_R)
         walker_look_from(&v->wk, &v->home);
 }
@@ -284,6 +293,7 @@ static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int conver
     fd.error_px = v->error_px;
     fd.walkthrough = !converged;
     fd.present = 1;
+    fd.wireframe = v->wireframe;
     fd.output_path = output;
     return sw_renderer_draw(r, &fd, fs, st);
 }
@@ -403,7 +413,7 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
     sw_scene_info info;
     if (sw_scene_get_info(scene, &info, &st) != SW_OK)
         return sw_cli_report("view", &st);
-    viewer v = {.args = a, .error_px = a->error_px};
+    viewer v = {.args = a, .error_px = a->error_px, .wireframe = a->wireframe};
     if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)
         return sw_cli_report("view", &st);
     walker_look_from(&v.wk, &v.home);

@@ -66,6 +66,16 @@ fi
 "$diff" "$work/overlay.png" "$work/render10.png" 20 || fail "--overlay changed more than its corner"
 echo "ok: the overlay is drawn over the frame, in its corner only"
 
+# Wireframe: the same settled view drawn as lines differs from the shaded render in over 1 % of
+# the pixels (the surfaces' interiors turn to background between the lines).
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+  --script "$work/orbit.path" --frames 10 --settle --wireframe --screenshot "$work/wire.png" \
+  >"$work/wire.out" 2>"$work/wire.err" || { cat "$work/wire.err"; fail "view --wireframe"; }
+if "$diff" "$work/wire.png" "$work/render10.png" 1 >/dev/null; then
+  fail "--wireframe: the frame looks shaded"
+fi
+echo "ok: --wireframe draws lines"
+
 "$sw" import "$model" -o "$work/model.sws" >/dev/null 2>&1
 xvfb-run -a -s "-screen 0 1280x1024x24" "$embed" "$work/model.sws" 30 >"$work/embed.out" 2>&1 ||
   { cat "$work/embed.out"; fail "embed_minimal"; }

@@ -40,17 +40,21 @@ extern "C" {
 
 #define SW_VERSION_STRING "0.1.0"
 
-typedef struct sw_scene { uint32_t id; } sw_scene;
-typedef struct sw_renderer { uint32_t id; } sw_renderer;
+typedef struct sw_scene {
+    uint32_t id;
+} sw_scene;
+typedef struct sw_renderer {
+    uint32_t id;
+} sw_renderer;
 
 /* ---- scenes ---------------------------------------------------------------------------------- */
 typedef void (*sw_progress_fn)(void *user_data, double fraction, const char *stage);
 typedef void (*sw_warning_fn)(void *user_data, const char *message);
 
 typedef struct sw_scene_load_desc {
-    const char *path;         /* required: .sws, .step/.stp, .iges/.igs, .brep, .tsm (T-spline) */
-    sw_progress_fn progress;  /* NULL: none; called on the loading thread */
-    sw_warning_fn warning;    /* NULL: none; a face that cannot be converted is reported here */
+    const char *path;        /* required: .sws, .step/.stp, .iges/.igs, .brep, .tsm (T-spline) */
+    sw_progress_fn progress; /* NULL: none; called on the loading thread */
+    sw_warning_fn warning;   /* NULL: none; a face that cannot be converted is reported here */
     void *user_data;
 } sw_scene_load_desc;
 
@@ -81,7 +85,8 @@ SW_API sw_result sw_scene_save(sw_scene scene, const char *path, sw_status *stat
 /* Frees the scene; later use of the handle yields SW_ERR_STALE_HANDLE. Any thread: a call using
  * the scene on another thread at that moment completes first (the memory goes with the last of
  * them), and a renderer that last drew the scene keeps its memory, with the hierarchies it built,
- * until it draws another scene or is destroyed. Errors: SW_ERR_STALE_HANDLE (already destroyed, or never valid). */
+ * until it draws another scene or is destroyed. Errors: SW_ERR_STALE_HANDLE (already destroyed, or
+ * never valid). */
 SW_API sw_result sw_scene_destroy(sw_scene scene);
 
 #define SW_SURFACE_KIND_COUNT 12
@@ -129,9 +134,9 @@ SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *o
 
 /* ---- rendering ------------------------------------------------------------------------------- */
 typedef struct sw_renderer_desc {
-    uint32_t worker_threads; /* threads of the worker pool that builds and refines hierarchies;
-                                0 = one per online processor. A converged frame's thread also
-                                runs pool tasks while it waits for them. At most 1024. */
+    uint32_t worker_threads;     /* threads of the worker pool that builds and refines hierarchies;
+                                    0 = one per online processor. A converged frame's thread also
+                                    runs pool tasks while it waits for them. At most 1024. */
     int32_t use_current_context; /* 0: the renderer creates and owns a headless EGL context;
                                 1: it draws with the OpenGL context current on the creating thread
                                 (the host's: 4.3+ core with glClipControl), which the host keeps
@@ -149,9 +154,9 @@ typedef struct sw_renderer_desc {
 SW_API sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out,
                                     sw_status *status);
 /* Frees the renderer, its GL objects, its own GL context (not an adopted one), its worker pool
- * and the hierarchies it keeps (waiting for the pool's tasks). Owner thread only. Errors: SW_ERR_STALE_HANDLE (already
- * destroyed, or never valid), SW_ERR_INVALID_ARGUMENT (called from another thread: the renderer
- * stays alive and usable by its owner). */
+ * and the hierarchies it keeps (waiting for the pool's tasks). Owner thread only. Errors:
+ * SW_ERR_STALE_HANDLE (already destroyed, or never valid), SW_ERR_INVALID_ARGUMENT (called from
+ * another thread: the renderer stays alive and usable by its owner). */
 SW_API sw_result sw_renderer_destroy(sw_renderer renderer);
 /* "renderer / GL version" of the renderer's context, borrowed until the renderer is destroyed;
  * "" for a stale handle or a call from a thread other than the owner. Never NULL. */
@@ -160,8 +165,8 @@ SW_API const char *sw_renderer_description_ptr(sw_renderer renderer);
 typedef struct sw_frame_desc {
     sw_scene scene;
     sw_camera camera;
-    int32_t width, height; /* 0 = 1280 x 720 */
-    double error_px;       /* screen-space error ε_img in pixels; 0 = 0.5 */
+    int32_t width, height;   /* 0 = 1280 x 720 */
+    double error_px;         /* screen-space error ε_img in pixels; 0 = 0.5 */
     const char *output_path; /* .png or .exr (with depth); NULL = render only */
     int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
                                 vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
@@ -179,21 +184,23 @@ typedef struct sw_frame_desc {
                                 origin, width x height; the host's framebuffer bindings and
                                 viewport are restored (other GL state is the renderer's: set yours
                                 again after the call). Not read back unless output_path is set. */
+    int32_t wireframe;       /* 1: triangles drawn as lines (trimmed parts still cut away), to see
+                                the tessellation the error bound chose */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
     uint64_t faces_drawn, faces_culled;
     uint64_t patches_trimmed, patches_untrimmed, patches_culled;
     uint64_t triangles, trim_textures, trim_texels;
-    uint64_t patches_gpu_evaluated; /* evaluated in the vertex shader; the rest are CPU grids */
-    uint64_t patches_exact;         /* of those, by the exact NURBS path (eval_exact) */
+    uint64_t patches_gpu_evaluated;    /* evaluated in the vertex shader; the rest are CPU grids */
+    uint64_t patches_exact;            /* of those, by the exact NURBS path (eval_exact) */
     uint64_t atlas_pages, trim_reused; /* trim-texture atlas pages; textures kept from before */
-    uint64_t hierarchy_nodes;  /* hierarchy nodes drawn (0 with no_hierarchy) */
-    uint64_t refine_rounds;    /* rounds of refinement below the hierarchies' leaves waited for */
-    uint64_t fallback_draws;   /* walkthrough: faces drawn without their hierarchy, plus leaves
-                                  drawn coarser than the error asks, both requested from the pool */
-    uint64_t pool_waits;       /* times the frame waited for the pool (0 in walkthrough) */
-    double ms_hierarchy;       /* waiting for hierarchy builds and refinements */
+    uint64_t hierarchy_nodes;          /* hierarchy nodes drawn (0 with no_hierarchy) */
+    uint64_t refine_rounds;  /* rounds of refinement below the hierarchies' leaves waited for */
+    uint64_t fallback_draws; /* walkthrough: faces drawn without their hierarchy, plus leaves
+                                drawn coarser than the error asks, both requested from the pool */
+    uint64_t pool_waits;     /* times the frame waited for the pool (0 in walkthrough) */
+    double ms_hierarchy;     /* waiting for hierarchy builds and refinements */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
     /* split frames (sw_renderer_prepare / submit): hierarchy and tessellate ran on the visibility
      * thread, in ms_visibility there (its whole time for the frame); the rest on the caller's, in
@@ -228,16 +235,16 @@ SW_API sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *des
 #define SW_RENDERER_MAX_PREPARED 2
 
 /* Errors: as sw_renderer_draw for a bad desc or handle; SW_ERR_INVALID_ARGUMENT with
- * SW_RENDERER_MAX_PREPARED frames waiting, or a waiting frame of another scene; SW_ERR_OUT_OF_MEMORY.
- * desc (and the output path) are copied; the scene is held until the frame is submitted. */
+ * SW_RENDERER_MAX_PREPARED frames waiting, or a waiting frame of another scene;
+ * SW_ERR_OUT_OF_MEMORY. desc (and the output path) are copied; the scene is held until the frame is
+ * submitted. */
 SW_API sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc,
                                      sw_status *status);
 /* Draws the oldest prepared frame. stats may be NULL; written on success only. Errors: those of
  * sw_renderer_draw, including those its preparation met (then nothing is drawn and the frame is
  * gone); SW_ERR_INVALID_ARGUMENT when no frame is prepared. sw_renderer_draw refuses to run
  * while prepared frames wait (SW_ERR_INVALID_ARGUMENT); sw_renderer_destroy drops them. */
-SW_API sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats,
-                                    sw_status *status);
+SW_API sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_status *status);
 
 #ifdef __cplusplus
 }
