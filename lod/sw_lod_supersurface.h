@@ -57,7 +57,7 @@ typedef struct sw_lod_cone {
 /* The cone bounds the direction of N(s, t) wherever |N(s, t)| >= SW_LOD_GAUSS_VALID_REL * (largest
  * control ray's length); nearer a degenerate point N has no reliable direction (it is the noise of
  * the dropped rays). The rays dropped as noise widen the cone by asin(their sum / that floor). */
-#define SW_LOD_GAUSS_VALID_REL 1e-7
+#define SW_LOD_GAUSS_VALID_REL 1e-6
 
 /* Largest patch degree the Bézier form is computed for: 3 * 23 - 1 stays within
  * SW_LOD_BEZ_MAX_DEGREE. Patches of higher degree get the full cone. */
