@@ -374,8 +374,12 @@ int sw_lod_gauss_cone(int32_t deg_u, int32_t deg_v, const double *cpw, double *s
     }
     const caps c = {dirs, 3, NULL, 0, kept};
     enclose_caps(&c, out);
-    if (out->half_angle >= M_PI)
+    /* A cone wider than a half-space is not convex: it holds the rays but not necessarily their
+     * non-negative combinations, the normals. */
+    if (!(out->half_angle < 0.5 * M_PI)) {
+        set_full(out);
         return 0;
+    }
     sw_lod_cone_set_angle(out, out->half_angle + asin(e / floor));
     return out->half_angle < M_PI;
 }

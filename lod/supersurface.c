@@ -282,8 +282,11 @@ static sw_result face_samples(state *st, uint32_t f, const sw_sg_bezier_set *set
     sw_sg_surface s;
     sw_sg_scene_face_surface(st->scene, f, &s);
     const double *bx = rec->uv_box;
-    /* steps: a quarter of the narrowest patch, but not more than the per-face budget */
-    double h = INFINITY, perimeter = 2.0 * ((bx[1] - bx[0]) + (bx[3] - bx[2]));
+    /* steps: a quarter of the narrowest patch and 1/256 of the box's perimeter (a sample's reach
+     * is half its spacing: sparse samples would pair patches near a corner that do not touch),
+     * but not more than the per-face budget */
+    const double perimeter = 2.0 * ((bx[1] - bx[0]) + (bx[3] - bx[2]));
+    double h = perimeter / 256.0;
     for (int32_t k = 0; k < set->n_u * set->n_v; ++k) {
         const sw_sg_bezier_patch *p = &set->patches[k];
         h = fmin(h, 0.25 * fmin(p->u1 - p->u0, p->v1 - p->v0));
@@ -827,7 +830,6 @@ sw_result sw_lod_supersurfaces_build(const sw_sg_scene *scene, const sw_lod_ss_d
     *out = NULL;
     state st = {0};
     st.scene = scene;
-    st.view = sw_sg_scene_view_ptr(scene);
     st.status = status;
     if (desc)
         st.desc = *desc;
@@ -838,6 +840,7 @@ sw_result sw_lod_supersurfaces_build(const sw_sg_scene *scene, const sw_lod_ss_d
                         "super-surfaces: alpha %g, merge alpha %g, tiny %g (need 0 < alpha <= "
                         "merge alpha < 180)",
                         st.desc.alpha_deg, st.desc.merge_alpha_deg, st.desc.tiny_rel);
+    st.view = sw_sg_scene_view_ptr(scene);
     st.alpha = st.desc.alpha_deg * M_PI / 180.0;
     st.merge_alpha = st.desc.merge_alpha_deg * M_PI / 180.0;
     st.faces = calloc((size_t)st.view->n_faces + 1, sizeof *st.faces);

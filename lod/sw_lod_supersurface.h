@@ -78,9 +78,10 @@ void sw_lod_pseudo_normal_net(int32_t deg_u, int32_t deg_v, const double *cpw, d
                               double *out, double *mag);
 
 /* The normal cone of the patch from its control rays (as sw_lod_pseudo_normal_net, zero rays
- * dropped as described above), for the un-negated S_u x S_v. Degrees above
- * SW_LOD_GAUSS_MAX_DEGREE, a patch whose rays are all zero or non-finite, or a widening that
- * reaches pi give the full cone. Returns 1 when the cone is a bound (not the full cone), else 0. */
+ * dropped as described above), for the un-negated S_u x S_v. Rays that need a cone of 90 degrees
+ * or more (a cone wider than a half-space is not convex, so it need not hold their non-negative
+ * combinations), degrees above SW_LOD_GAUSS_MAX_DEGREE, or rays all zero or non-finite give the
+ * full cone. Returns 1 when the cone is a bound (not the full cone), else 0. */
 int sw_lod_gauss_cone(int32_t deg_u, int32_t deg_v, const double *cpw, double *scratch,
                       sw_lod_cone *out);
 
