@@ -242,21 +242,33 @@ static double cap_half(const caps *c, size_t k)
     return c->half ? c->half[k * c->half_stride] : 0.0;
 }
 
-/* Half-angle `axis` needs to contain every cap; *far gets the cap that needs the most. */
-static double needed(const caps *c, const double *axis, size_t *far)
+/* Half-angle `axis` needs to contain every cap; *far gets the cap that needs the most. `exact`
+ * takes every angle by atan2 (accurate near 0 and pi); otherwise plain caps are ranked by their
+ * dot product and only the farthest one's angle is taken, and caps by acos — for the search. */
+static double needed(const caps *c, const double *axis, size_t *far, int exact)
 {
+    if (!exact && !c->half) {
+        double lowest = INFINITY;
+        for (size_t k = 0; k < c->n; ++k) {
+            const double d = dot3(axis, c->axes + k * c->stride);
+            if (d < lowest)
+                lowest = d, *far = k;
+        }
+        return angle3(axis, c->axes + *far * c->stride);
+    }
     double worst = -1.0;
     for (size_t k = 0; k < c->n; ++k) {
-        const double a = angle3(axis, c->axes + k * c->stride) + cap_half(c, k);
-        if (a > worst)
-            worst = a, *far = k;
+        const double *a = c->axes + k * c->stride;
+        const double g = exact ? angle3(axis, a) : acos(fmax(-1.0, fmin(1.0, dot3(axis, a))));
+        if (g + cap_half(c, k) > worst)
+            worst = g + cap_half(c, k), *far = k;
     }
     return worst;
 }
 
 /* Bădoiu-Clarkson on the sphere: from the mean direction, step toward the farthest cap by a
  * shrinking fraction and keep the best axis seen. Any axis gives a valid cone with the half-angle
- * it needs; the iteration only makes it smaller. */
+ * it needs (taken exactly at the end); the iteration only makes it smaller. */
 static void enclose_caps(const caps *c, sw_lod_cone *out)
 {
     double axis[3] = {0.0, 0.0, 0.0};
@@ -271,20 +283,22 @@ static void enclose_caps(const caps *c, sw_lod_cone *out)
     for (int a = 0; a < 3; ++a)
         axis[a] /= len;
     size_t far = 0;
-    double best = needed(c, axis, &far);
+    double best = needed(c, axis, &far, 0);
     memcpy(out->axis, axis, sizeof axis);
-    for (int it = 0; it < 40 && best > 0.0; ++it) {
+    for (int it = 0, since_best = 0; it < 32 && since_best < 8 && best > 0.0; ++it) {
         const double *f = c->axes + far * c->stride;
         const double gap = angle3(axis, f) + cap_half(c, far);
         double next[3];
         turn_toward(axis, f, gap / (double)(it + 2), next);
         memcpy(axis, next, sizeof axis);
-        const double need = needed(c, axis, &far);
+        const double need = needed(c, axis, &far, 0);
+        ++since_best;
         if (need < best) {
-            best = need;
+            best = need, since_best = 0;
             memcpy(out->axis, axis, sizeof axis);
         }
     }
+    best = needed(c, out->axis, &far, 1);
     if (!(best < M_PI))
         set_full(out);
     else
