@@ -31,7 +31,7 @@
  * Passes repeat in cluster order until nothing merges. Merging only adjacent clusters keeps every
  * cluster connected.
  */
-#include "sw_lod_bezier.h"
+#include "sw_lod_hierarchy.h"
 #include "sw_lod_supersurface.h"
 #include "sw_sg_trim.h"
 #include "sw_status_util.h"
@@ -65,20 +65,9 @@ sw_result sw_lod_face_patches(const sw_sg_scene *scene, uint32_t face, sw_sg_bez
     if (res != SW_OK)
         return res;
     const int32_t np = out->n_u * out->n_v;
-    for (int32_t k = 0; k < np; ++k) {
-        sw_sg_bezier_patch *p = &out->patches[k];
-        const double r[4] = {fmax(p->u0, box[0]), fmin(p->u1, box[1]), fmax(p->v0, box[2]),
-                             fmin(p->v1, box[3])};
-        if (!(r[0] < r[1] && r[2] < r[3])) {
-            sw_sg_bezier_set_free(out);
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "face %u: uv box misses patch %d",
-                            face, (int)k);
-        }
-        const double local[4] = {(r[0] - p->u0) / (p->u1 - p->u0), (r[1] - p->u0) / (p->u1 - p->u0),
-                                 (r[2] - p->v0) / (p->v1 - p->v0),
-                                 (r[3] - p->v0) / (p->v1 - p->v0)};
-        sw_lod_bez_restrict(p->deg_u, p->deg_v, 4, p->cpw, local, p->cpw);
-        p->u0 = r[0], p->u1 = r[1], p->v0 = r[2], p->v1 = r[3];
+    if (np > 0 && (res = sw_lod_bezier_set_cut(out, box, status)) != SW_OK) {
+        sw_sg_bezier_set_free(out);
+        return res;
     }
     if (np == 0) {
         sw_sg_bezier_set_free(out);
