@@ -4,9 +4,10 @@
  * Adjacency. Inside a face, Bézier-grid neighbours (they share a knot line). Across faces, the
  * scene records only which faces share a B-rep edge; which of their patches touch along it is
  * found by sampling both faces' trim boundaries in 3D (each sample labelled with the patch whose
- * rectangle holds it) and pairing samples of A and B closer than the faces' edge tolerances plus
- * half the local sample spacing: a sample on the common edge has a sample of the other face's copy
- * of that edge at most half a spacing (plus the tolerance gap) away.
+ * rectangle holds it) and pairing a sample of one face with a chord of the other's sampled
+ * boundary when it lies within the faces' edge tolerances (plus 1 % of the chord, for its sagitta)
+ * of that chord: a point of the common edge is that close to the other face's copy of the edge.
+ * Chords rather than points, so that a sparse sampling of one side cannot reach around a corner.
  *
  * Growth (§3 steps 1a-1f). Seeds are taken in patch order — (face, iv, iu) ascending, the lowest
  * not yet clustered — instead of the paper's random pick, so builds are reproducible. The frontier
@@ -19,9 +20,13 @@
  *
  * Where the paper is loose: it bounds the span (largest angle between two control rays) by alpha
  * and gives no value. We bound the cone's half-angle, because back-patch culling tests a cone.
- * Default alpha = 30 degrees: a cone of half-angle theta is back-facing for a fraction
- * (1 - sin theta) / 2 of view directions, 25 % at 30 degrees (15 % at 45, 0 at 90), while a span
- * of up to 60 degrees still leaves the "relatively flat" surfaces §4.1 simplifies well.
+ * Default alpha = 45 degrees, i.e. no two normals of a super-surface more than 90 degrees apart
+ * (a span of at most 90): the widest patches CAD kernels emit are quarter circles (rational
+ * quadratic arcs, whose cone is 45 degrees), below 45 hardly any two patches of a cylinder or a
+ * fillet could join (measured: at 30 degrees 331 of Motor-c's 450 patches are wider than alpha and
+ * stay alone, 1.22 patches per cluster; at 45, 164 and 1.89), while a cone of 45 degrees is still
+ * back-facing for (1 - sin 45) / 2 = 15 % of view directions and leaves the merge pass room below
+ * 90 (merge_alpha 67.5).
  *
  * Second pass (§7.1, "a second pass, combining small super-surfaces"). A cluster with fewer than
  * min_patches patches merges into the adjacent cluster whose merged cone is smallest (tie: lower
@@ -43,7 +48,7 @@
 void sw_lod_ss_desc_defaults(sw_lod_ss_desc *d)
 {
     if (!(d->alpha_deg > 0.0))
-        d->alpha_deg = 30.0;
+        d->alpha_deg = 45.0;
     if (d->min_patches == 0)
         d->min_patches = 4;
     if (!(d->merge_alpha_deg > 0.0))
@@ -79,8 +84,10 @@ sw_result sw_lod_face_patches(const sw_sg_scene *scene, uint32_t face, sw_sg_bez
 /* ---- build state ----------------------------------------------------------------------------- */
 typedef struct bsample {
     double p[3];
-    double spacing; /* largest 3D distance to the neighbouring samples of its loop */
-    uint32_t patch; /* global patch index */
+    double q[3];                 /* the next sample of its loop: the chord p-q */
+    double uv[2];                /* of p */
+    double mid_x;                /* x of the chord's midpoint (sort key) */
+    uint32_t patch, chord_patch; /* global patch of p and of the chord; SW_SG_NONE: off patches */
 } bsample;
 
 typedef struct face_info {
@@ -214,6 +221,13 @@ static uint32_t cell_of(const sw_sg_bezier_set *set, int dir, double t)
     return (uint32_t)a;
 }
 
+static uint32_t patch_at(const sw_sg_bezier_set *set, uint32_t first_patch, double u, double v)
+{
+    return first_patch + cell_of(set, 1, v) * (uint32_t)set->n_u + cell_of(set, 0, u);
+}
+
+/* Appends a sample at (u, v); one outside the extracted patches (a loop bulging past uv_box) lies
+ * on none of them and is kept unlabelled (patch SW_SG_NONE), so no chord spans the gap. */
 static int push_sample(state *st, const sw_sg_surface *s, const sw_sg_bezier_set *set,
                        uint32_t first_patch, double u, double v)
 {
@@ -225,41 +239,77 @@ static int push_sample(state *st, const sw_sg_surface *s, const sw_sg_bezier_set
         st->samples = g, st->cap_samples = cap;
     }
     bsample *b = &st->samples[st->n_samples++];
+    b->uv[0] = u, b->uv[1] = v;
+    const sw_sg_bezier_patch *lo = &set->patches[0], *hi = &set->patches[set->n_u * set->n_v - 1];
+    const double su = 1e-9 * (hi->u1 - lo->u0), sv = 1e-9 * (hi->v1 - lo->v0);
     sw_sg_surface_eval(s, u, v, b->p);
-    b->spacing = 0.0;
-    b->patch = first_patch + cell_of(set, 1, v) * (uint32_t)set->n_u + cell_of(set, 0, u);
+    b->patch = u < lo->u0 - su || u > hi->u1 + su || v < lo->v0 - sv || v > hi->v1 + sv
+                   ? SW_SG_NONE
+                   : patch_at(set, first_patch, u, v);
     return 1;
 }
 
 #define SW__SAMPLES_PER_FACE 4096
 
-/* Samples one closed polyline of the face's boundary at uv steps of at most h. */
+static int cmp_t(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Appends to ts the parameters in (0, 1) where the segment a-b of one coordinate crosses a knot
+ * line of the patch grid along dir. */
+static size_t crossings(const sw_sg_bezier_set *set, int dir, double a, double b, double *ts,
+                        size_t n)
+{
+    const double lo = fmin(a, b), hi = fmax(a, b);
+    const int32_t cells = dir ? set->n_v : set->n_u;
+    for (int32_t c = 1; c < cells && hi > lo; ++c) {
+        const double x = dir ? set->patches[c * set->n_u].v0 : set->patches[c].u0;
+        if (lo < x && x < hi)
+            ts[n++] = (x - a) / (b - a);
+    }
+    return n;
+}
+
+/* Samples one closed polyline of the face's boundary at uv steps of at most h and at every knot
+ * line it crosses, so that each chord between consecutive samples lies in one patch. */
 static int sample_polyline(state *st, const sw_sg_surface *s, const sw_sg_bezier_set *set,
                            uint32_t first_patch, const double *uv, uint32_t count, double h)
 {
     const size_t start = st->n_samples;
+    double *ts = malloc(((size_t)SW__SAMPLES_PER_FACE + (size_t)set->n_u + (size_t)set->n_v + 1) *
+                        sizeof *ts);
+    if (!ts)
+        return 0;
     for (uint32_t k = 0; k < count; ++k) {
         const double *a = uv + 2 * k, *b = uv + 2 * ((k + 1) % count);
         const double len = hypot(b[0] - a[0], b[1] - a[1]);
         const int32_t steps = (int32_t)fmin(ceil(len / h), SW__SAMPLES_PER_FACE);
-        for (int32_t i = 0; i < (steps > 0 ? steps : 1); ++i) {
-            const double t = steps > 0 ? (double)i / steps : 0.0;
-            if (!push_sample(st, s, set, first_patch, a[0] + t * (b[0] - a[0]),
-                             a[1] + t * (b[1] - a[1])))
+        size_t n = 0;
+        for (int32_t i = 0; i < (steps > 0 ? steps : 1); ++i)
+            ts[n++] = steps > 0 ? (double)i / steps : 0.0;
+        n = crossings(set, 0, a[0], b[0], ts, n);
+        n = crossings(set, 1, a[1], b[1], ts, n);
+        qsort(ts, n, sizeof *ts, cmp_t);
+        for (size_t i = 0; i < n; ++i)
+            if (!push_sample(st, s, set, first_patch, a[0] + ts[i] * (b[0] - a[0]),
+                             a[1] + ts[i] * (b[1] - a[1]))) {
+                free(ts);
                 return 0;
-        }
+            }
     }
+    free(ts);
     const size_t n = st->n_samples - start;
     for (size_t k = 0; k < n; ++k) {
         bsample *c = &st->samples[start + k];
         const bsample *nx = &st->samples[start + (k + 1) % n];
-        const bsample *pv = &st->samples[start + (k + n - 1) % n];
-        double dn = 0.0, dp = 0.0;
-        for (int a = 0; a < 3; ++a) {
-            dn += (nx->p[a] - c->p[a]) * (nx->p[a] - c->p[a]);
-            dp += (pv->p[a] - c->p[a]) * (pv->p[a] - c->p[a]);
-        }
-        c->spacing = sqrt(fmax(dn, dp));
+        memcpy(c->q, nx->p, sizeof c->q);
+        c->mid_x = 0.5 * (c->p[0] + c->q[0]);
+        c->chord_patch = c->patch == SW_SG_NONE || nx->patch == SW_SG_NONE
+                             ? SW_SG_NONE
+                             : patch_at(set, first_patch, 0.5 * (c->uv[0] + nx->uv[0]),
+                                        0.5 * (c->uv[1] + nx->uv[1]));
     }
     return 1;
 }
@@ -271,9 +321,8 @@ static sw_result face_samples(state *st, uint32_t f, const sw_sg_bezier_set *set
     sw_sg_surface s;
     sw_sg_scene_face_surface(st->scene, f, &s);
     const double *bx = rec->uv_box;
-    /* steps: a quarter of the narrowest patch and 1/256 of the box's perimeter (a sample's reach
-     * is half its spacing: sparse samples would pair patches near a corner that do not touch),
-     * but not more than the per-face budget */
+    /* steps: a quarter of the narrowest patch and 1/256 of the box's perimeter (short chords keep
+     * their sagitta small), but not more than the per-face budget */
     const double perimeter = 2.0 * ((bx[1] - bx[0]) + (bx[3] - bx[2]));
     double h = perimeter / 256.0;
     for (int32_t k = 0; k < set->n_u * set->n_v; ++k) {
@@ -302,7 +351,8 @@ static sw_result face_samples(state *st, uint32_t f, const sw_sg_bezier_set *set
     fi->n_samples = (uint32_t)(st->n_samples - fi->first_sample);
     box_empty(fi->box);
     for (uint32_t k = 0; k < fi->n_samples; ++k)
-        box_add_point(fi->box, st->samples[fi->first_sample + k].p);
+        if (st->samples[fi->first_sample + k].patch != SW_SG_NONE)
+            box_add_point(fi->box, st->samples[fi->first_sample + k].p);
     return SW_OK;
 }
 
@@ -314,33 +364,59 @@ static int cmp_sample_x(const void *a, const void *b)
                                : (x->patch > y->patch) - (x->patch < y->patch);
 }
 
-/* Patch pairs of two B-rep-adjacent faces: samples of A near samples of B (B's sorted by x). */
+static double dist2(const double *a, const double *b)
+{
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+           (a[2] - b[2]) * (a[2] - b[2]);
+}
+
+/* Distance from x to the chord p-q; *t gets the parameter of the nearest point. */
+static double chord_distance(const double *x, const double *p, const double *q, double *t)
+{
+    double d[3], w[3];
+    for (int a = 0; a < 3; ++a)
+        d[a] = q[a] - p[a], w[a] = x[a] - p[a];
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    double s = dd > 0.0 ? (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]) / dd : 0.0;
+    s = s < 0.0 ? 0.0 : s > 1.0 ? 1.0 : s;
+    const double y[3] = {p[0] + s * d[0], p[1] + s * d[1], p[2] + s * d[2]};
+    *t = s;
+    return sqrt(dist2(x, y));
+}
+
+/* Patch pairs from the samples of face fa near the chords of face fb (fb's sorted by mid_x). */
 static int match_faces(state *st, uint32_t fa, uint32_t fb)
 {
     const face_info *A = &st->faces[fa], *B = &st->faces[fb];
     const double tol = st->view->faces[fa].tolerance + st->view->faces[fb].tolerance +
                        1e-9 * fmax(box_diagonal(A->box), box_diagonal(B->box));
     const bsample *sb = st->samples + B->first_sample;
-    double reach = 0.0;
+    double half = 0.0;
     for (uint32_t k = 0; k < B->n_samples; ++k)
-        reach = fmax(reach, 0.5 * sb[k].spacing);
-    reach += tol;
+        if (sb[k].chord_patch != SW_SG_NONE)
+            half = fmax(half, 0.5 * sqrt(dist2(sb[k].p, sb[k].q)));
+    const double reach = 1.01 * half + tol;
     for (uint32_t i = 0; i < A->n_samples; ++i) {
         const bsample *a = &st->samples[A->first_sample + i];
+        if (a->patch == SW_SG_NONE || a->p[0] < B->box[0] - reach || a->p[0] > B->box[3] + reach ||
+            a->p[1] < B->box[1] - reach || a->p[1] > B->box[4] + reach ||
+            a->p[2] < B->box[2] - reach || a->p[2] > B->box[5] + reach)
+            continue;
         uint32_t lo = 0, hi = B->n_samples;
         while (lo < hi) {
             const uint32_t m = (lo + hi) / 2;
-            if (sb[m].p[0] < a->p[0] - reach)
+            if (sb[m].mid_x < a->p[0] - reach)
                 lo = m + 1;
             else
                 hi = m;
         }
-        for (uint32_t k = lo; k < B->n_samples && sb[k].p[0] <= a->p[0] + reach; ++k) {
-            const double *p = sb[k].p;
-            const double d =
-                sqrt((p[0] - a->p[0]) * (p[0] - a->p[0]) + (p[1] - a->p[1]) * (p[1] - a->p[1]) +
-                     (p[2] - a->p[2]) * (p[2] - a->p[2]));
-            if (d <= tol + 0.5 * sb[k].spacing && !push_pair(st, a->patch, sb[k].patch))
+        for (uint32_t k = lo; k < B->n_samples && sb[k].mid_x <= a->p[0] + reach; ++k) {
+            if (sb[k].chord_patch == SW_SG_NONE)
+                continue;
+            double t;
+            const double d = chord_distance(a->p, sb[k].p, sb[k].q, &t);
+            if (d <= tol + 0.01 * sqrt(dist2(sb[k].p, sb[k].q)) &&
+                !push_pair(st, a->patch, sb[k].chord_patch))
                 return 0;
         }
     }
@@ -734,7 +810,7 @@ static sw_result collect_patches(state *st)
 static sw_result cross_face_pairs(state *st)
 {
     const uint32_t nf = st->view->n_faces;
-    /* per face, its samples sorted by x for the sweep in match_faces */
+    /* per face, its chords sorted by their midpoints' x for the sweep in match_faces */
     for (uint32_t f = 0; f < nf; ++f)
         if (st->faces[f].n_samples)
             qsort(st->samples + st->faces[f].first_sample, st->faces[f].n_samples,
@@ -743,7 +819,7 @@ static sw_result cross_face_pairs(state *st)
         const sw_sg_adjacency_rec *a = &st->view->adjacency[k];
         if (a->face_a >= nf || a->face_b >= nf || a->face_a == a->face_b)
             continue;
-        if (!match_faces(st, a->face_a, a->face_b))
+        if (!match_faces(st, a->face_a, a->face_b) || !match_faces(st, a->face_b, a->face_a))
             return oom(st, "adjacency");
     }
     return SW_OK;

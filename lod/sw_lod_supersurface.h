@@ -156,7 +156,7 @@ typedef struct sw_lod_supersurfaces {
 
 /* Zero fields take the defaults (sw_lod_ss_desc_defaults). */
 typedef struct sw_lod_ss_desc {
-    double alpha_deg;       /* cone half-angle bound of a grown cluster; default 30 */
+    double alpha_deg;       /* cone half-angle bound of a grown cluster; default 45 */
     uint32_t min_patches;   /* second pass: clusters below this many patches merge; default 4 */
     double merge_alpha_deg; /* bound a merged cluster's cone must stay within; default 1.5 alpha */
     double tiny_rel;        /* a cluster below min_patches whose box diagonal is below tiny_rel of

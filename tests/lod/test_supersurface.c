@@ -66,6 +66,12 @@ static void cross(const double *a, const double *b, double *c)
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
+static double diagonal(const double *b)
+{
+    return sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                (b[5] - b[2]) * (b[5] - b[2]));
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     const double x = *(const double *)a, y = *(const double *)b;
@@ -352,6 +358,7 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
                         (long)ss->n_patches);
     unsigned char *seen = calloc(total + 1, 1);
     uint32_t *where = calloc(total + 1, sizeof *where);
+    double(*pbox)[6] = calloc(total + 1, sizeof *pbox);
     for (uint32_t k = 0; k < ss->n_patches && !fail; ++k) {
         const sw_lod_ss_patch *p = &ss->patches[k];
         const uint64_t g = first[p->face] + (uint64_t)p->iv * nu[p->face] + p->iu;
@@ -365,6 +372,15 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
         sw_sg_bezier_set set;
         sw_lod_face_patches(scene, f, &set, NULL);
         for (int32_t k = 0; k < set.n_u * set.n_v && !fail; ++k) {
+            double *pb = pbox[where[first[f] + (uint32_t)k]];
+            const sw_sg_bezier_patch *bp = &set.patches[k];
+            for (int a = 0; a < 3; ++a)
+                pb[a] = INFINITY, pb[3 + a] = -INFINITY;
+            for (int32_t q = 0; q < (bp->deg_u + 1) * (bp->deg_v + 1); ++q)
+                for (int a = 0; a < 3; ++a) {
+                    const double x = bp->cpw[4 * q + a] / bp->cpw[4 * q + 3];
+                    pb[a] = fmin(pb[a], x), pb[3 + a] = fmax(pb[3 + a], x);
+                }
             const uint32_t c = ss->cluster_of[where[first[f] + (uint32_t)k]];
             const double *box = ss->clusters[c].box;
             for (int j = 0; j <= 4; ++j)
@@ -425,6 +441,16 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
             if (!adjacent_faces(v, fa, fb))
                 fail = fail_msg(path, "patches of non-adjacent faces paired", fa, fb);
         }
+        /* patches that share an edge have control-point boxes that meet, up to the edge
+         * tolerances and the matching's allowance for chord sagitta (1 % of a chord; taken here
+         * as 1 % of the smaller box's diagonal) */
+        const double *x = pbox[p->a], *y = pbox[p->b];
+        const double slack = 2.0 * (v->faces[fa].tolerance + v->faces[fb].tolerance) +
+                             0.01 * fmin(diagonal(x), diagonal(y)) +
+                             1e-9 * (fabs(x[0]) + fabs(x[3]) + fabs(x[4]) + 1.0);
+        for (int a = 0; a < 3 && !fail; ++a)
+            if (x[a] > y[3 + a] + slack || y[a] > x[3 + a] + slack)
+                fail = fail_msg(path, "paired patches whose boxes do not meet", p->a, p->b);
     }
     for (uint32_t k = 0; k < ss->n_patches; ++k)
         tot->wide += ss->patch_cones[k].half_angle > ss->alpha;
@@ -434,6 +460,7 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
     free(nu);
     free(seen);
     free(where);
+    free(pbox);
     return fail;
 }
 
