@@ -137,7 +137,12 @@ typedef struct sw_lod_ss_cluster {
 } sw_lod_ss_cluster;
 
 /* Two patches (indices into patches[]) that share an edge: a Bézier-grid neighbour in one face,
- * or patches of B-rep-adjacent faces along their common trim boundary. a < b. */
+ * or patches of B-rep-adjacent faces along their common trim boundary (found by sampling both
+ * boundaries in 3D: a sample of one face within the edge tolerances + 1 % of a chord of the other
+ * face's sampled boundary; chords are split at knot lines so each lies in one patch). Not
+ * included: a periodic face's seam (the importer records no face as adjacent to itself), and
+ * patches that touch only at a corner are paired only when the sampling happens to meet there.
+ * a < b. */
 typedef struct sw_lod_ss_pair {
     uint32_t a, b;
 } sw_lod_ss_pair;
