@@ -9,7 +9,7 @@
  *
  * Where the paper is loose: "we ignore any hull points that lie on the origin" — in floating point
  * the rays at a pole are not zero but rounding noise with arbitrary directions. We drop rays below
- * SW_LOD_GAUSS_ZERO_REL of their own magnitude bound and pay for it (and for the rounding of the
+ * their rounding bound (SW_LOD_GAUSS_ROUNDING_ULPS) and pay for it (and for the rounding of the
  * rays we keep) with a widening that makes the cone rigorous wherever |N| is above
  * SW_LOD_GAUSS_VALID_REL of the largest ray: there N = N_kept + R with N_kept inside the cone of
  * the kept rays and |R| <= E (E = the largest dropped ray + the rounding bound, Bernstein weights
@@ -19,6 +19,7 @@
 #include "sw_lod_supersurface.h"
 
 #include <assert.h>
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -363,10 +364,12 @@ int sw_lod_gauss_cone(int32_t deg_u, int32_t deg_v, const double *cpw, double *s
     double *net = scratch + l.net, *mag = scratch + l.mag, *dirs = scratch + l.dirs;
     sw_lod_pseudo_normal_net(deg_u, deg_v, cpw, scratch, net, mag);
     const size_t nc = sw_lod_bez_count(3 * deg_u - 1, 3 * deg_v - 1, 1);
+    const double ulps =
+        SW_LOD_GAUSS_ROUNDING_ULPS * (2.0 * (deg_u + 1) * (deg_v + 1) + 16.0) * DBL_EPSILON;
     double longest = 0.0, dropped = 0.0, rounding = 0.0;
     size_t kept = 0;
     for (size_t k = 0; k < nc; ++k) {
-        const double len = norm3(net + 3 * k), noise = SW_LOD_GAUSS_ZERO_REL * mag[k];
+        const double len = norm3(net + 3 * k), noise = ulps * mag[k];
         if (!isfinite(len) || !isfinite(noise)) {
             set_full(out);
             return 0;

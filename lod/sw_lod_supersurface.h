@@ -50,13 +50,17 @@ typedef struct sw_lod_cone {
     double cos_half_angle;
 } sw_lod_cone;
 
-/* Control rays closer to zero than this fraction of their own magnitude bound (the same products
- * taken in absolute value) are rounding noise of a zero ray — the degenerate edges at poles of
- * spheres and apexes of cones, where S_u x S_v vanishes — and carry no direction. */
-#define SW_LOD_GAUSS_ZERO_REL 1e-11
+/* The rounding bound of a control ray: SW_LOD_GAUSS_ROUNDING_ULPS * (2 (m+1)(n+1) + 16) *
+ * DBL_EPSILON times its magnitude bound (the same products taken in absolute value) — the products
+ * are summed in two stages of at most (m+1)(n+1) terms each, and the factor 4 is headroom. Rays
+ * within their bound are rounding noise of a zero ray — the degenerate edges at poles of spheres
+ * and apexes of cones, where S_u x S_v vanishes — and carry no direction. */
+#define SW_LOD_GAUSS_ROUNDING_ULPS 4.0
 /* The cone bounds the direction of N(s, t) wherever |N(s, t)| >= SW_LOD_GAUSS_VALID_REL * (largest
  * control ray's length); nearer a degenerate point N has no reliable direction (it is the noise of
- * the dropped rays). The rays dropped as noise widen the cone by asin(their sum / that floor). */
+ * the dropped rays). The dropped rays and the rounding of the kept ones widen the cone by
+ * asin(E / that floor), E = the largest dropped ray + the largest rounding bound (about 1e-8 rad
+ * for a bicubic patch without heavy cancellation). */
 #define SW_LOD_GAUSS_VALID_REL 1e-6
 
 /* Largest patch degree the Bézier form is computed for: 3 * 23 - 1 stays within
