@@ -8,7 +8,10 @@
  *     apart. Any sample outside its cone fails; the median over patches of (largest sampled angle
  *     from the axis) / half-angle is printed as the tightness.
  *  2. The pseudo-normal net is W^3 (S_u x S_v): de Casteljau on the net against the evaluator's
- *     derivatives at random (s, t), relative to |W|^3 |S_s| |S_t|, within 1e-9.
+ *     derivatives at random (s, t), relative to |W|^3 |S_s| |S_t|, within 1e-9 beyond what the
+ *     rounding of positions explains (sliver and collapsed patches have derivatives at that level);
+ *     and the net's true degree is at most (3m-2, 3n-2): every row's and column's top forward
+ *     difference vanishes to 1e-9 beyond rounding.
  *  3. Clusters: every patch of every face in exactly one cluster; each cluster's cone within alpha
  *     (merge_alpha when SW_LOD_SS_MERGED, 90 degrees when SW_LOD_SS_MERGED_TINY) and containing
  *     every member patch's cone; sampled surface points inside the cluster's box; each cluster
@@ -82,7 +85,8 @@ static int cmp_double(const void *a, const void *b)
 typedef struct cone_stats {
     long patches, full, samples, degenerate, violations, identity_checked, identity_bad;
     double worst_excess, worst_identity, worst_identity_raw;
-    long blurred;
+    long blurred, degree_bad;
+    double worst_degree;
     double *ratios;
     long n_ratios, cap_ratios;
     double *scratch;
@@ -168,6 +172,31 @@ static void check_patch(cone_stats *cs, int32_t m, int32_t n, const double *cpw,
             ++cs->identity_bad;
         }
     }
+    /* The header's claim that N has degree <= (3m-2, 3n-2): the top forward difference of every
+     * row (and column) of the (3m-1, 3n-1) net vanishes. */
+    for (int dir = 0; dir < 2; ++dir) {
+        const int32_t du = 3 * m - 1, dv = 3 * n - 1, d = dir ? dv : du, lines = dir ? du : dv;
+        double row[3 * SW_LOD_GAUSS_MAX_DEGREE + 1];
+        sw_lod_binomial_row(d, row);
+        for (int32_t l = 0; l <= lines; ++l)
+            for (int a = 0; a < 3; ++a) {
+                /* relative to the coefficients, beyond their rounding (rows of zero rays at a
+                 * pole are pure rounding noise) */
+                double sum = 0.0, abs_sum = 0.0, noise = 0.0;
+                for (int32_t i = 0; i <= d; ++i) {
+                    const int32_t k = dir ? i * (du + 1) + l : l * (du + 1) + i;
+                    const double c = net[3 * k + a] * row[i];
+                    sum += (i % 2 ? -c : c);
+                    abs_sum += fabs(c);
+                    noise += 1e-12 * mag[k] * row[i];
+                }
+                const double excess = fmax(0.0, fabs(sum) - noise);
+                if (abs_sum > 0.0) {
+                    cs->worst_degree = fmax(cs->worst_degree, excess / abs_sum);
+                    cs->degree_bad += !(excess <= 1e-9 * abs_sum);
+                }
+            }
+    }
     if (!bounded) {
         ++cs->full;
         return;
@@ -252,11 +281,14 @@ static int cone_report(const char *what, cone_stats *cs)
     printf("%s: %ld patches (%ld full cones), %ld normals sampled (%ld without direction), %ld "
            "outside the cone (worst by %.3g rad); tightness median %.3f over %ld patches; "
            "identity: %ld points, %ld beyond 1e-9 beyond position rounding (worst %.3g, raw "
-           "worst %.3g); %ld normals with a reference blur above 1e-6 rad\n",
+           "worst %.3g); %ld normals with a reference blur above 1e-6 rad; top differences of "
+           "the net: %ld beyond 1e-9 (worst %.3g)\n",
            what, cs->patches, cs->full, cs->samples, cs->degenerate, cs->violations,
            cs->worst_excess, median, cs->n_ratios, cs->identity_checked, cs->identity_bad,
-           cs->worst_identity, cs->worst_identity_raw, cs->blurred);
-    const int fail = cs->violations > 0 || cs->identity_bad > 0 || cs->patches == 0;
+           cs->worst_identity, cs->worst_identity_raw, cs->blurred, cs->degree_bad,
+           cs->worst_degree);
+    const int fail =
+        cs->violations > 0 || cs->identity_bad > 0 || cs->degree_bad > 0 || cs->patches == 0;
     free(cs->ratios);
     cs->ratios = NULL;
     cs->n_ratios = cs->cap_ratios = 0;
