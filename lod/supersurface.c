@@ -86,7 +86,7 @@ typedef struct bsample {
     double p[3];
     double q[3];                 /* the next sample of its loop: the chord p-q */
     double uv[2];                /* of p */
-    double mid_x;                /* x of the chord's midpoint (sort key) */
+    double mid;                  /* the chord's midpoint along its face's sweep axis (sort key) */
     uint32_t patch, chord_patch; /* global patch of p and of the chord; SW_SG_NONE: off patches */
 } bsample;
 
@@ -94,6 +94,7 @@ typedef struct face_info {
     uint32_t first_patch, n_u, n_v;
     uint32_t first_sample, n_samples;
     double box[6]; /* of its boundary samples */
+    int axis;      /* the box's longest axis: its samples are sorted along it */
 } face_info;
 
 typedef struct heap_item {
@@ -305,7 +306,6 @@ static int sample_polyline(state *st, const sw_sg_surface *s, const sw_sg_bezier
         bsample *c = &st->samples[start + k];
         const bsample *nx = &st->samples[start + (k + 1) % n];
         memcpy(c->q, nx->p, sizeof c->q);
-        c->mid_x = 0.5 * (c->p[0] + c->q[0]);
         c->chord_patch = c->patch == SW_SG_NONE || nx->patch == SW_SG_NONE
                              ? SW_SG_NONE
                              : patch_at(set, first_patch, 0.5 * (c->uv[0] + nx->uv[0]),
@@ -356,12 +356,12 @@ static sw_result face_samples(state *st, uint32_t f, const sw_sg_bezier_set *set
     return SW_OK;
 }
 
-static int cmp_sample_x(const void *a, const void *b)
+static int cmp_sample_mid(const void *a, const void *b)
 {
     const bsample *x = a, *y = b;
-    return x->p[0] < y->p[0]   ? -1
-           : x->p[0] > y->p[0] ? 1
-                               : (x->patch > y->patch) - (x->patch < y->patch);
+    if (x->mid != y->mid)
+        return x->mid < y->mid ? -1 : 1;
+    return (x->patch > y->patch) - (x->patch < y->patch);
 }
 
 static double dist2(const double *a, const double *b)
@@ -384,7 +384,7 @@ static double chord_distance(const double *x, const double *p, const double *q, 
     return sqrt(dist2(x, y));
 }
 
-/* Patch pairs from the samples of face fa near the chords of face fb (fb's sorted by mid_x). */
+/* Patch pairs from the samples of face fa near the chords of face fb (fb's sorted by mid). */
 static int match_faces(state *st, uint32_t fa, uint32_t fb)
 {
     const face_info *A = &st->faces[fa], *B = &st->faces[fb];
@@ -395,7 +395,8 @@ static int match_faces(state *st, uint32_t fa, uint32_t fb)
     for (uint32_t k = 0; k < B->n_samples; ++k)
         if (sb[k].chord_patch != SW_SG_NONE)
             half = fmax(half, 0.5 * sqrt(dist2(sb[k].p, sb[k].q)));
-    const double reach = 1.01 * half + tol;
+    const double reach = 1.03 * half + tol;
+    const int ax = B->axis;
     for (uint32_t i = 0; i < A->n_samples; ++i) {
         const bsample *a = &st->samples[A->first_sample + i];
         if (a->patch == SW_SG_NONE || a->p[0] < B->box[0] - reach || a->p[0] > B->box[3] + reach ||
@@ -405,12 +406,12 @@ static int match_faces(state *st, uint32_t fa, uint32_t fb)
         uint32_t lo = 0, hi = B->n_samples;
         while (lo < hi) {
             const uint32_t m = (lo + hi) / 2;
-            if (sb[m].mid_x < a->p[0] - reach)
+            if (sb[m].mid < a->p[ax] - reach)
                 lo = m + 1;
             else
                 hi = m;
         }
-        for (uint32_t k = lo; k < B->n_samples && sb[k].mid_x <= a->p[0] + reach; ++k) {
+        for (uint32_t k = lo; k < B->n_samples && sb[k].mid <= a->p[ax] + reach; ++k) {
             if (sb[k].chord_patch == SW_SG_NONE)
                 continue;
             double t;
@@ -810,11 +811,19 @@ static sw_result collect_patches(state *st)
 static sw_result cross_face_pairs(state *st)
 {
     const uint32_t nf = st->view->n_faces;
-    /* per face, its chords sorted by their midpoints' x for the sweep in match_faces */
-    for (uint32_t f = 0; f < nf; ++f)
-        if (st->faces[f].n_samples)
-            qsort(st->samples + st->faces[f].first_sample, st->faces[f].n_samples,
-                  sizeof *st->samples, cmp_sample_x);
+    /* per face, its chords sorted along its longest axis for the sweep in match_faces */
+    for (uint32_t f = 0; f < nf; ++f) {
+        face_info *fi = &st->faces[f];
+        if (!fi->n_samples)
+            continue;
+        const double *b = fi->box;
+        fi->axis = b[4] - b[1] > b[3] - b[0] ? 1 : 0;
+        fi->axis = b[5] - b[2] > b[3 + fi->axis] - b[fi->axis] ? 2 : fi->axis;
+        bsample *sm = st->samples + fi->first_sample;
+        for (uint32_t k = 0; k < fi->n_samples; ++k)
+            sm[k].mid = 0.5 * (sm[k].p[fi->axis] + sm[k].q[fi->axis]);
+        qsort(sm, fi->n_samples, sizeof *sm, cmp_sample_mid);
+    }
     for (uint32_t k = 0; k < st->view->n_adjacency; ++k) {
         const sw_sg_adjacency_rec *a = &st->view->adjacency[k];
         if (a->face_a >= nf || a->face_b >= nf || a->face_a == a->face_b)

@@ -353,7 +353,7 @@ static int adjacent_faces(const sw_sg_scene_view *v, uint32_t a, uint32_t b)
 }
 
 typedef struct model_totals {
-    long faces, patches, clusters, merged, cross_pairs, wide, multi_face, largest;
+    long faces, patches, clusters, merged, cross_pairs, wide, multi_face, largest, unpaired_faces;
 } model_totals;
 
 static sw_lod_ss_desc g_desc; /* --alpha, --min */
@@ -484,6 +484,17 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
             if (x[a] > y[3 + a] + slack || y[a] > x[3 + a] + slack)
                 fail = fail_msg(path, "paired patches whose boxes do not meet", p->a, p->b);
     }
+    /* every B-rep edge gives at least one pair of patches across it */
+    for (uint32_t k = 0; k < v->n_adjacency; ++k) {
+        const uint32_t fa = v->adjacency[k].face_a, fb = v->adjacency[k].face_b;
+        int found = 0;
+        for (uint32_t j = 0; j < ss->n_adjacency && !found; ++j) {
+            const uint32_t ga = ss->patches[ss->adjacency[j].a].face;
+            const uint32_t gb = ss->patches[ss->adjacency[j].b].face;
+            found = (ga == fa && gb == fb) || (ga == fb && gb == fa);
+        }
+        tot->unpaired_faces += !found;
+    }
     for (uint32_t k = 0; k < ss->n_patches; ++k)
         tot->wide += ss->patch_cones[k].half_angle > ss->alpha;
     if (!fail)
@@ -527,12 +538,12 @@ static int check_model(const char *path, cone_stats *cs, model_totals *all)
         const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
         printf("%s: %u faces, %u patches (%ld wider than alpha), %u clusters (%.2f patches "
                "each, largest %ld, %ld over several faces, %ld grown by merging), %u adjacency "
-               "pairs (%ld across faces, %u B-rep face pairs), build %.1f ms, %ld cone "
-               "violations\n",
+               "pairs (%ld across faces, %u B-rep face pairs, %ld of them without a patch pair), "
+               "build %.1f ms, %ld cone violations\n",
                path, v->n_faces, a->n_patches, tot.wide, a->n_clusters,
                (double)a->n_patches / (a->n_clusters ? a->n_clusters : 1), tot.largest,
                tot.multi_face, tot.merged, a->n_adjacency, tot.cross_pairs, v->n_adjacency,
-               1e3 * (t1 - t0), cs->violations - before);
+               tot.unpaired_faces, 1e3 * (t1 - t0), cs->violations - before);
         all->faces += v->n_faces;
         all->patches += a->n_patches;
         all->clusters += a->n_clusters;
