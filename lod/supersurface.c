@@ -24,7 +24,7 @@
  * (a span of at most 90): the widest patches CAD kernels emit are quarter circles (rational
  * quadratic arcs, whose cone is 45 degrees), below 45 hardly any two patches of a cylinder or a
  * fillet could join (measured: at 30 degrees 331 of Motor-c's 450 patches are wider than alpha and
- * stay alone, 1.22 patches per cluster; at 45, 164 and 1.89), while a cone of 45 degrees is still
+ * stay alone, 1.22 patches per cluster; at 45, 164 and 1.91), while a cone of 45 degrees is still
  * back-facing for (1 - sin 45) / 2 = 15 % of view directions and leaves the merge pass room below
  * 90 (merge_alpha 67.5).
  *
