@@ -228,8 +228,27 @@ static double net_diagonal(const sw_sg_surface *s)
                 (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
-/* Each patch's rectangle, cut to the box (§4.4), and its control points over it. */
-static sw_result cut_patches(builder *b, const sw_lod_hierarchy_desc *d)
+sw_result sw_lod_bezier_set_cut(sw_sg_bezier_set *set, const double uv_box[4], sw_status *status)
+{
+    const double *box = uv_box;
+    for (int32_t k = 0; k < set->n_u * set->n_v; ++k) {
+        sw_sg_bezier_patch *p = &set->patches[k];
+        const double r[4] = {fmax(p->u0, box[0]), fmin(p->u1, box[1]), fmax(p->v0, box[2]),
+                             fmin(p->v1, box[3])};
+        if (!(r[0] < r[1] && r[2] < r[3]))
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "uv box misses patch %d", (int)k);
+        const double local[4] = {(r[0] - p->u0) / (p->u1 - p->u0), (r[1] - p->u0) / (p->u1 - p->u0),
+                                 (r[2] - p->v0) / (p->v1 - p->v0),
+                                 (r[3] - p->v0) / (p->v1 - p->v0)};
+        /* the extraction owns p->cpw: cut in place */
+        sw_lod_bez_restrict(p->deg_u, p->deg_v, 4, p->cpw, local, p->cpw);
+        p->u0 = r[0], p->u1 = r[1], p->v0 = r[2], p->v1 = r[3];
+    }
+    return SW_OK;
+}
+
+/* Each patch's rectangle (after the box cut, §4.4) and its control points over it. */
+static sw_result cut_patches(builder *b)
 {
     const sw_sg_bezier_set *set = b->set;
     const int32_t np = set->n_u * set->n_v;
@@ -242,18 +261,6 @@ static sw_result cut_patches(builder *b, const sw_lod_hierarchy_desc *d)
         double *r = b->rects[k];
         r[0] = p->u0, r[1] = p->u1, r[2] = p->v0, r[3] = p->v1;
         b->nets[k] = p->cpw;
-        if (!d->use_box)
-            continue;
-        r[0] = fmax(r[0], d->uv_box[0]), r[1] = fmin(r[1], d->uv_box[1]);
-        r[2] = fmax(r[2], d->uv_box[2]), r[3] = fmin(r[3], d->uv_box[3]);
-        if (!(r[0] < r[1] && r[2] < r[3]))
-            return sw__fail(b->status, SW_ERR_INVALID_ARGUMENT, "hierarchy: uv box misses patch %d",
-                            (int)k);
-        const double local[4] = {(r[0] - p->u0) / (p->u1 - p->u0), (r[1] - p->u0) / (p->u1 - p->u0),
-                                 (r[2] - p->v0) / (p->v1 - p->v0),
-                                 (r[3] - p->v0) / (p->v1 - p->v0)};
-        /* the extraction owns p->cpw: cut in place */
-        sw_lod_bez_restrict(p->deg_u, p->deg_v, 4, p->cpw, local, p->cpw);
     }
     return SW_OK;
 }
@@ -274,6 +281,10 @@ sw_result sw_lod_hierarchy_build(const sw_sg_surface *s, const sw_lod_hierarchy_
         sw_sg_bezier_set_free(&set);
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "hierarchy: uv box misses the domain");
     }
+    if (d.use_box && (res = sw_lod_bezier_set_cut(&set, d.uv_box, status)) != SW_OK) {
+        sw_sg_bezier_set_free(&set);
+        return res;
+    }
     sw_lod_hierarchy *h = calloc(1, sizeof *h);
     builder b = {h, 0, &d, &set, NULL, NULL, {0.0, 1.0, 0.0, 1.0}, status};
     if (!h)
@@ -283,7 +294,7 @@ sw_result sw_lod_hierarchy_build(const sw_sg_surface *s, const sw_lod_hierarchy_
         if (!(h->leaf_tolerance > 0.0))
             h->leaf_tolerance = 1e-12; /* a surface collapsed to a point */
         h->n_patches = set.n_u * set.n_v;
-        res = cut_patches(&b, &d);
+        res = cut_patches(&b);
     }
     if (res == SW_OK)
         res = build_block(&b, 0, set.n_u, 0, set.n_v, &h->root);

@@ -50,7 +50,8 @@ static double region_net(const double *verts, int32_t n_u, int32_t ku, int32_t k
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t j = 0; j < 4; j++) {
         for (int32_t i = 0; i < 4; i++) {
-            const double *p = verts + ((size_t)(kv - 3 + j) * (size_t)n_u + (size_t)(ku - 3 + i)) * 3;
+            const double *p =
+                verts + ((size_t)(kv - 3 + j) * (size_t)n_u + (size_t)(ku - 3 + i)) * 3;
             for (int c = 0; c < 3; c++) {
                 net[(j * 4 + i) * 3 + c] = p[c];
                 lo[c] = fmin(lo[c], p[c]);
@@ -188,8 +189,8 @@ sw_result sw_lod_osd_check_face(const sw_sg_scene *scene, uint32_t face, int sam
     return check_surface(&s, samples_per_region, seed, report, status);
 }
 
-sw_result sw_lod_osd_check_generated(int32_t nx, int32_t ny, int samples_per_region,
-                                     uint64_t seed, sw_lod_osd_report *report, sw_status *status)
+sw_result sw_lod_osd_check_generated(int32_t nx, int32_t ny, int samples_per_region, uint64_t seed,
+                                     sw_lod_osd_report *report, sw_status *status)
 {
     if (nx < 4 || ny < 4 || nx > 4096 || ny > 4096)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "generated net %dx%d out of 4..4096", nx,

@@ -80,6 +80,13 @@ sw_result sw_lod_hierarchy_build(const sw_sg_surface *s, const sw_lod_hierarchy_
                                  sw_lod_hierarchy **out, sw_status *status);
 void sw_lod_hierarchy_free(sw_lod_hierarchy *h); /* NULL allowed */
 
+/* The box cut of §4.4 on an extracted set (sw_sg_surface_extract_bezier_in over the same box):
+ * every patch's net is cut in place to its rectangle intersected with uv_box (u0, u1, v0, v1) and
+ * its u0, u1, v0, v1 set to that rectangle. Errors: SW_ERR_INVALID_ARGUMENT when the box misses a
+ * patch (the set is then partly cut). Shared by the hierarchy and super-surfaces, so both see the
+ * same patches. */
+sw_result sw_lod_bezier_set_cut(sw_sg_bezier_set *set, const double uv_box[4], sw_status *status);
+
 /* The node's bicubic, or NULL when the node is not representable by one. */
 static inline const double *sw_lod_hnode_cpw_ptr(const sw_lod_hnode *n)
 {
