@@ -216,7 +216,10 @@ static void json_string(FILE *f, const char *s)
 
 static const char *kind_name(sw_rt_prof_kind k)
 {
-    static const char *const names[] = {"index", "seconds", "frame", "stage", "count"};
+    static const char *const names[] = {"index", "seconds",          "frame",
+                                        "stage", "visibility stage", "count"};
+    _Static_assert(sizeof names / sizeof names[0] == SW_RT_KIND_COUNT + 1,
+                   "a name per kind (SW_RT_KIND_COUNT, the count kind, is the last)");
     return names[k];
 }
 
