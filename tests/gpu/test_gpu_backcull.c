@@ -10,6 +10,7 @@
  * Usage: test_gpu_backcull CLOSED_MODEL... --open OPEN_MODEL... --mirror MODEL
  */
 #include "gpu_test_compare.h"
+#include "sw_lod_cache.h"
 #include "sw_lod_face_cones.h"
 #include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
@@ -21,6 +22,7 @@
 
 enum { W = 320, H = 180, N_VIEWS = 8 };
 static int g_failures;
+static sw_th_pool *g_pool; /* the hierarchy cache's workers */
 
 #define CHECK(cond, ...)                                                                           \
     do {                                                                                           \
@@ -100,9 +102,10 @@ static slivers classify(const sw_gpu_image *a, const sw_gpu_image *b)
 }
 
 /* Renders every view with and without culling; returns the occurrences culled over all views,
- * or UINT64_MAX on a render failure. Even views use the BVH, odd ones the full traversal. */
+ * or UINT64_MAX on a render failure. Even views use the BVH, odd ones the full traversal; the
+ * last two draw from the faces' hierarchies (Guthe §7) when `cache` is given. */
 static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
-                              const sw_lod_face_cones *fc, const sw_sg_bvh *t)
+                              const sw_lod_face_cones *fc, const sw_sg_bvh *t, sw_lod_cache *cache)
 {
     uint64_t culled = 0;
     for (int v = 0; v < N_VIEWS; ++v) {
@@ -112,6 +115,7 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
         d.height = H;
         d.camera = view_camera(t->nodes[0].box, v);
         d.bvh = v % 2 == 0 ? t : NULL;
+        d.hierarchies = v >= N_VIEWS - 2 ? cache : NULL;
         sw_gpu_image a = {0}, b = {0};
         sw_gpu_frame_stats fa, fb;
         sw_status st = {0};
@@ -138,10 +142,13 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
         printf("  view %d (%s): faces drawn %llu without, %llu with, back-culled %llu; "
                "triangles %llu -> %llu; tessellate %.1f -> %.1f ms; %ld px covered, %ld differ "
                "(silhouette slivers)\n",
-               v, d.bvh ? "bvh" : "all", (unsigned long long)fa.faces_drawn,
-               (unsigned long long)fb.faces_drawn, (unsigned long long)fb.faces_backculled,
-               (unsigned long long)fa.triangles, (unsigned long long)fb.triangles, fa.ms_tessellate,
-               fb.ms_tessellate, df.covered, df.any);
+               v,
+               d.hierarchies ? (d.bvh ? "bvh, hierarchies" : "all, hierarchies")
+                             : (d.bvh ? "bvh" : "all"),
+               (unsigned long long)fa.faces_drawn, (unsigned long long)fb.faces_drawn,
+               (unsigned long long)fb.faces_backculled, (unsigned long long)fa.triangles,
+               (unsigned long long)fb.triangles, fa.ms_tessellate, fb.ms_tessellate, df.covered,
+               df.any);
         culled += fb.faces_backculled;
         sw_gpu_image_free(&a);
         sw_gpu_image_free(&b);
@@ -149,23 +156,27 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
     return culled;
 }
 
-/* Cones and BVH of the scene, then every view; returns the culled total (UINT64_MAX: failed). */
+/* Cones, BVH and hierarchy cache of the scene, then every view; returns the culled total
+ * (UINT64_MAX: failed). */
 static uint64_t run_scene(sw_gpu_context *ctx, const sw_sg_scene *scene, const char *name)
 {
     sw_status st = {0};
     sw_lod_face_cones *fc = NULL;
     sw_sg_bvh *t = NULL;
+    sw_lod_cache *cache = NULL;
     uint64_t culled = UINT64_MAX;
     if (sw_lod_face_cones_build(scene, &fc, &st) != SW_OK ||
-        sw_sg_bvh_build(scene, &t, &st) != SW_OK)
-        CHECK(0, "%s: cones or BVH: %s", name, st.message);
+        sw_sg_bvh_build(scene, &t, &st) != SW_OK ||
+        sw_lod_cache_create(scene, g_pool, NULL, &cache, &st) != SW_OK)
+        CHECK(0, "%s: cones, BVH or hierarchy cache: %s", name, st.message);
     else if (t->n_nodes == 0)
         CHECK(0, "%s: no occurrences", name);
     else {
         printf("%s: %u faces, %u closed-shell, %u with a bounded cone; %u occurrences\n", name,
                fc->n_faces, closed_faces(scene), fc->n_bounded, t->n_items);
-        culled = compare_views(ctx, scene, fc, t);
+        culled = compare_views(ctx, scene, fc, t, cache);
     }
+    sw_lod_cache_destroy(cache);
     sw_lod_face_cones_free(fc);
     sw_sg_bvh_free(t);
     return culled;
@@ -237,6 +248,11 @@ int main(int argc, char **argv)
     }
     sw_status st = {0};
     sw_gpu_context *ctx = NULL;
+    sw_th_pool_desc pd = {0};
+    if (sw_th_pool_create(&pd, &g_pool) != SW_OK) {
+        fprintf(stderr, "FAIL: worker pool\n");
+        return 1;
+    }
     if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK) {
         fprintf(stderr, "FAIL: %s\n", st.message);
         return 1;
@@ -272,6 +288,7 @@ int main(int argc, char **argv)
         sw_sg_scene_free(scene);
     }
     sw_gpu_context_free(ctx);
+    sw_th_pool_destroy(g_pool);
     puts(g_failures ? "FAIL" : "PASS");
     return g_failures ? 1 : 0;
 }
