@@ -60,11 +60,11 @@ static uint32_t closed_faces(const sw_sg_scene *scene)
  * ε_img of its exact surface; where one meets a front face along a silhouette or crease its
  * triangles can win pixel centres the front face's own tessellation leaves (a sliver at most about
  * ε_img + 1 px wide), so exact equality is not a property of a correct cull. What is: no pixel
- * becomes covered (culling adds nothing); a pixel that loses coverage has a covered neighbour in
- * the culled frame (it was a sliver beyond a silhouette); and every changed pixel has an unchanged
- * 8-neighbour — the changes are lines at most two pixels wide, while a visible face culled by
- * mistake leaves a hole as wide as the face (wider than two pixels for every face of these views
- * but the smallest). */
+ * becomes covered (culling adds nothing); a pixel that loses coverage has a covered pixel within
+ * two pixels in the culled frame (it was a sliver beyond a silhouette: linkrods.step has one two
+ * pixels wide at a corner); and every changed pixel has an unchanged 8-neighbour — the changes are
+ * lines at most two pixels wide, while a visible face culled by mistake leaves a hole as wide as
+ * the face (wider than two pixels for every face of these views but the smallest). */
 typedef struct slivers {
     long gained, lone_loss, thick;
 } slivers;
@@ -72,6 +72,17 @@ typedef struct slivers {
 static int pixel_differs(const sw_gpu_image *a, const sw_gpu_image *b, size_t i)
 {
     return memcmp(a->rgba + 4 * i, b->rgba + 4 * i, 4) != 0;
+}
+
+/* Whether some pixel within `r` pixels (Chebyshev) of (x, y) is covered in img. */
+static int covered_near(const sw_gpu_image *img, int32_t x, int32_t y, int32_t r)
+{
+    for (int32_t yy = y - r; yy <= y + r; ++yy)
+        for (int32_t xx = x - r; xx <= x + r; ++xx)
+            if (xx >= 0 && yy >= 0 && xx < img->width && yy < img->height &&
+                img->rgba[4 * ((size_t)yy * (size_t)img->width + (size_t)xx) + 3] != 0)
+                return 1;
+    return 0;
 }
 
 static slivers classify(const sw_gpu_image *a, const sw_gpu_image *b)
@@ -84,19 +95,17 @@ static slivers classify(const sw_gpu_image *a, const sw_gpu_image *b)
                 continue;
             const int ca = a->rgba[4 * i + 3] != 0, cb = b->rgba[4 * i + 3] != 0;
             s.gained += !ca && cb;
-            int unchanged = 0, covered = 0;
+            int unchanged = 0;
             for (int32_t dy = -1; dy <= 1; ++dy)
                 for (int32_t dx = -1; dx <= 1; ++dx) {
                     const int32_t xx = x + dx, yy = y + dy;
                     if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= a->width ||
                         yy >= a->height)
                         continue;
-                    const size_t j = (size_t)yy * (size_t)a->width + (size_t)xx;
-                    unchanged += !pixel_differs(a, b, j);
-                    covered += b->rgba[4 * j + 3] != 0;
+                    unchanged += !pixel_differs(a, b, (size_t)yy * (size_t)a->width + (size_t)xx);
                 }
             s.thick += unchanged == 0;
-            s.lone_loss += ca && !cb && covered == 0;
+            s.lone_loss += ca && !cb && !covered_near(b, x, y, 2);
         }
     return s;
 }
@@ -132,7 +141,7 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
         const slivers sl = classify(&a, &b);
         CHECK(sl.gained == 0 && sl.thick == 0 && sl.lone_loss == 0,
               "view %d: %ld pixels differ with back-patch culling: %ld newly covered, %ld inside "
-              "a 3x3 block of changes, %ld uncovered away from coverage",
+              "a 3x3 block of changes, %ld uncovered > 2 px from coverage",
               v, df.any, sl.gained, sl.thick, sl.lone_loss);
         CHECK(fa.faces_backculled == 0 && fb.faces_drawn + fb.faces_backculled >= fa.faces_drawn &&
                   fb.faces_drawn <= fa.faces_drawn,
