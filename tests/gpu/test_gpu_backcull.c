@@ -3,6 +3,7 @@
  *    model up to silhouette slivers of the back faces' tessellation (see `slivers`: culling must
  *    never remove anything visible), while some occurrences are culled (printed per view) — a test
  *    that is not vacuous;
+ *  - the flag survives a .sws round trip (the reader's validation accepts bit 2);
  *  - on open sheets no face is flagged SW_SG_FACE_CLOSED_SHELL and nothing is culled;
  *  - a closed model drawn twice through instances, once mirrored (negative determinant): the same
  *    frames, and the mirrored instance alone has occurrences culled too (a wrong orientation rule
@@ -19,6 +20,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 enum { W = 320, H = 180, N_VIEWS = 8 };
 static int g_failures;
@@ -191,6 +193,23 @@ static uint64_t run_scene(sw_gpu_context *ctx, const sw_sg_scene *scene, const c
     return culled;
 }
 
+/* The flag survives a .sws round trip, and the reader's validation accepts it. */
+static void check_sws(sw_sg_scene *scene, const char *name)
+{
+    char path[512];
+    const char *dir = getenv("TMPDIR");
+    snprintf(path, sizeof path, "%s/test_gpu_backcull_%ld.sws", dir ? dir : "/tmp", (long)getpid());
+    sw_status st = {0};
+    sw_sg_scene *back = NULL;
+    int ok = sw_sg_scene_save(scene, path, &st) == SW_OK &&
+             sw_sg_scene_open(path, &back, &st) == SW_OK &&
+             sw_sg_scene_require(back, SW_SG_SEC_ALL, &st) == SW_OK;
+    CHECK(ok && closed_faces(back) == closed_faces(scene), "%s: .sws round trip: %s", name,
+          ok ? "closed-shell faces differ" : st.message);
+    sw_sg_scene_free(back);
+    remove(path);
+}
+
 static sw_sg_scene *load(const char *path)
 {
     sw_sg_import_desc id = {path, NULL, NULL, NULL};
@@ -288,6 +307,7 @@ int main(int argc, char **argv)
         if (!scene)
             continue;
         const uint32_t n_closed = closed_faces(scene);
+        check_sws(scene, argv[a]);
         uint64_t c = run_scene(ctx, scene, argv[a]);
         if (mode == 0)
             CHECK(c != UINT64_MAX && c > 0, "%s: closed model, nothing back-culled", argv[a]);
