@@ -13,6 +13,7 @@
  */
 #include "sw_gpu_internal.h"
 #include "sw_lod_bezier.h"
+#include "sw_lod_face_cones.h"
 #include "sw_lod_sampling.h"
 #include "sw_sg_trim.h"
 #include "sw_status_util.h"
@@ -979,6 +980,37 @@ static sw_result collect_bvh(frame *f, const sw_sg_bvh *bvh, double **boxes, sw_
     return SW_OK;
 }
 
+/* Kumar §4.4's back-patch culling: drops (compacting occ and boxes) the occurrences of closed-shell
+ * faces whose outward cone, in the world, faces away from every view direction into their box.
+ * Done before the hierarchies are asked for, so culled faces cost nothing further. Sound only for
+ * an eye outside the solids: from inside a solid's material its back faces are what one sees. */
+static sw_result cull_back_faces(frame *f, const sw_lod_face_cones *fc, double *boxes,
+                                 sw_status *status)
+{
+    if (fc->n_faces != f->sv->n_faces)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "frame: face cones of %u faces for a scene of %u", fc->n_faces,
+                        f->sv->n_faces);
+    size_t k = 0;
+    for (size_t i = 0; i < f->n_occ; ++i) {
+        const occurrence *o = &f->occ[i];
+        sw_lod_cone w;
+        if (sw_lod_cone_to_world(&fc->cones[o->face], o->world, &w) &&
+            sw_lod_cone_back_facing(&w, boxes + 6 * i)) {
+            f->st.faces_backculled++;
+            f->st.faces_culled++;
+            continue;
+        }
+        if (k != i) {
+            f->occ[k] = f->occ[i];
+            memcpy(boxes + 6 * k, boxes + 6 * i, 6 * sizeof *boxes);
+        }
+        k++;
+    }
+    f->n_occ = k;
+    return SW_OK;
+}
+
 /* Sets the view (near plane from the scene's box), finds the visible occurrences and tessellates.
  */
 static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *status)
@@ -1001,6 +1033,8 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
                               status);
     if (r == SW_OK && desc->bvh)
         r = collect_bvh(f, desc->bvh, &boxes, status);
+    if (r == SW_OK && desc->face_cones && boxes)
+        r = cull_back_faces(f, desc->face_cones, boxes, status);
     screen_view_init(f);
     int hierarchy = f->cache && !f->exact;
     if (r == SW_OK && hierarchy)

@@ -67,6 +67,10 @@ typedef struct sw_gpu_frame_desc {
     int32_t no_readback; /* 1: nothing is read back (out stays empty; want_depth ignored) */
     int32_t wireframe;   /* 1: the surfaces' triangles drawn as lines, trimmed parts still cut
                             away (inspection: grid densities, hierarchy nodes, fat borders) */
+    const struct sw_lod_face_cones *face_cones; /* NULL: no back-patch culling; else the
+                              scene's per-face outward normal cones (sw_lod_face_cones.h, built once
+                              per scene): an occurrence of a SW_SG_FACE_CLOSED_SHELL face facing
+                              away from the eye over its whole box is culled (Kumar §4.4) */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -103,6 +107,7 @@ typedef struct sw_gpu_frame_stats {
      * wholly inside, partly inside and outside; items classified one by one; items kept */
     uint64_t bvh_nodes_visited, bvh_nodes_inside, bvh_nodes_partly, bvh_nodes_outside;
     uint64_t bvh_items_tested, bvh_items_visible;
+    uint64_t faces_backculled; /* of faces_culled: back-facing closed-shell occurrences */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

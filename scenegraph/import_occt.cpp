@@ -13,15 +13,19 @@
 #include "sw_status_util.h"
 
 #include <BRepAdaptor_Surface.hxx>
+#include <BRepBndLib.hxx>
+#include <BRepGProp.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
 #include <BRepTools.hxx>
 #include <BRepTools_WireExplorer.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
+#include <Bnd_Box.hxx>
 #include <Geom2dConvert.hxx>
 #include <Geom2d_BSplineCurve.hxx>
 #include <Geom2d_TrimmedCurve.hxx>
 #include <GeomConvert.hxx>
+#include <GProp_GProps.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
@@ -46,6 +50,7 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Iterator.hxx>
+#include <TopoDS_Shell.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
@@ -447,6 +452,10 @@ class importer
 
     NCollection_DataMap<TopoDS_Shape, uint32_t, TopTools_ShapeMapHasher> faces_;
     std::set<std::pair<uint32_t, uint32_t>> adjacency_;
+    /* Per converted face: the orientation its REVERSED flag was taken from, and its shell vote
+     * (1: every part context so far a closed outward shell, 2: some context is not). */
+    std::unordered_map<uint32_t, TopAbs_Orientation> face_orient_;
+    std::unordered_map<uint32_t, uint8_t> closed_vote_;
     /* TopoDS sharing: occurrences of (TShape, orientation) among compound children. */
     std::map<std::pair<const void *, int>, int> uses_;
     std::map<std::pair<const void *, int>, uint32_t> protos_;
@@ -485,6 +494,9 @@ class importer
     void add_shape(const TopoDS_Shape &s, uint32_t parent);
     void fill_shape(const TopoDS_Shape &local, uint32_t n);
     void add_part(const TopoDS_Shape &part, uint32_t n);
+    bool shell_closed_outward(const TopoDS_Shape &shell) const;
+    void vote_shells(const TopoDS_Shape &part);
+    void mark_closed_faces();
     uint32_t face_index(const TopoDS_Face &f);
     uint32_t push_face(face_data &fd);
 
@@ -683,6 +695,99 @@ void importer::add_part(const TopoDS_Shape &part, uint32_t n)
                 if (idx[a] != idx[c])
                     adjacency_.insert({std::min(idx[a], idx[c]), std::max(idx[a], idx[c])});
     }
+    vote_shells(part);
+}
+
+/* Kumar et al. 1997 §4.4 culls back patches only of closed shells with consistent orientation
+ * (an open sheet is seen from both sides). A shell qualifies when (1) each of its faces was
+ * converted (a missing face is a hole to look through) with the orientation its scene face's
+ * REVERSED flag was taken from; (2) every edge but degenerate ones (poles, apexes) is used exactly
+ * twice, once FORWARD and once REVERSED in the orientation composed down from the shell — closed
+ * and consistently oriented: neighbours traverse their common edge in opposite directions (a seam
+ * is two uses in one face); (3) its signed volume (the divergence theorem over the oriented faces,
+ * BRepGProp) is clearly positive, so the consistent normals point out, not in (a reversed shell,
+ * or a solid's void). Anything else, or an OCCT failure, counts as not closed. */
+bool importer::shell_closed_outward(const TopoDS_Shape &shell) const
+{
+    if (shell.Orientation() != TopAbs_FORWARD && shell.Orientation() != TopAbs_REVERSED)
+        return false;
+    NCollection_DataMap<TopoDS_Shape, std::pair<int, int>, TopTools_ShapeMapHasher> uses;
+    int n_faces = 0;
+    for (TopExp_Explorer fx(shell, TopAbs_FACE); fx.More(); fx.Next(), n_faces++) {
+        const TopoDS_Shape &f = fx.Current();
+        const uint32_t *k = faces_.Seek(f);
+        if (!k || *k == SW_SG_NONE)
+            return false;
+        auto o = face_orient_.find(*k);
+        if (o == face_orient_.end() || o->second != f.Orientation())
+            return false;
+        for (TopExp_Explorer ex(f, TopAbs_EDGE); ex.More(); ex.Next()) {
+            const TopoDS_Edge &e = TopoDS::Edge(ex.Current());
+            if (BRep_Tool::Degenerated(e))
+                continue;
+            if (e.Orientation() != TopAbs_FORWARD && e.Orientation() != TopAbs_REVERSED)
+                return false;
+            std::pair<int, int> *c = uses.ChangeSeek(e);
+            if (!c)
+                c = uses.Bound(e, {0, 0});
+            (e.Orientation() == TopAbs_FORWARD ? c->first : c->second)++;
+        }
+    }
+    if (n_faces == 0 || uses.IsEmpty())
+        return false;
+    for (NCollection_DataMap<TopoDS_Shape, std::pair<int, int>, TopTools_ShapeMapHasher>::Iterator
+             it(uses);
+         it.More(); it.Next())
+        if (it.Value().first != 1 || it.Value().second != 1)
+            return false;
+    Bnd_Box bb;
+    BRepBndLib::Add(shell, bb);
+    if (bb.IsVoid())
+        return false;
+    const double diag = std::sqrt(bb.SquareExtent());
+    GProp_GProps props;
+    BRepGProp::VolumeProperties(shell, props);
+    /* Far above the integration's noise, far below any real part's volume. */
+    return std::isfinite(props.Mass()) && props.Mass() > 1e-9 * diag * diag * diag;
+}
+
+/* Every face of the part votes: closed when its shell qualifies, open otherwise (also a face in
+ * no shell). A face is flagged only when all its votes, over all parts, say closed. */
+void importer::vote_shells(const TopoDS_Shape &part)
+{
+    TopTools_IndexedMapOfShape in_shell;
+    auto vote = [this](const TopoDS_Shape &f, bool closed) {
+        const uint32_t *k = faces_.Seek(f);
+        if (!k || *k == SW_SG_NONE)
+            return;
+        uint8_t &v = closed_vote_[*k];
+        v = closed ? (v == 0 ? 1 : v) : 2;
+    };
+    for (TopExp_Explorer sx(part, TopAbs_SHELL); sx.More(); sx.Next()) {
+        bool closed = false;
+        try {
+            closed = shell_closed_outward(sx.Current());
+        } catch (const Standard_Failure &) {
+            closed = false;
+        }
+        for (TopExp_Explorer fx(sx.Current(), TopAbs_FACE); fx.More(); fx.Next()) {
+            vote(fx.Current(), closed);
+            in_shell.Add(fx.Current());
+        }
+    }
+    for (TopExp_Explorer fx(part, TopAbs_FACE); fx.More(); fx.Next())
+        if (!in_shell.Contains(fx.Current()))
+            vote(fx.Current(), false);
+}
+
+void importer::mark_closed_faces()
+{
+    for (const auto &v : closed_vote_)
+        if (v.second == 1) {
+            sw_sg_face_rec *rec = sw_sg_builder_face_ptr(b_, v.first);
+            if (rec)
+                rec->flags |= SW_SG_FACE_CLOSED_SHELL;
+        }
 }
 
 /* The scene face of `f`, converting it the first time; SW_SG_NONE when it failed. */
@@ -698,6 +803,7 @@ uint32_t importer::face_index(const TopoDS_Face &f)
     try {
         face_data fd = convert_face(f, converted, what);
         idx = push_face(fd);
+        face_orient_[idx] = f.Orientation();
     } catch (const face_error &e) {
         why = e.why;
     } catch (const Standard_Failure &e) {
@@ -926,6 +1032,7 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
         } else {
             add_shape(shape, top);
         }
+        mark_closed_faces();
         for (const auto &a : adjacency_)
             if (sw_sg_builder_add_adjacency(b_, a.first, a.second) == SW_SG_NONE)
                 throw oom_error{};

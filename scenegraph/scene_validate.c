@@ -68,7 +68,7 @@ static sw_result check_face_record(const vctx *c, uint32_t i, const sw_sg_face_r
     if (f->first_loop > v->n_loops || f->n_loops > v->n_loops - f->first_loop)
         return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: loops [%u, +%u) of %u", c->what,
                         i, at, f->first_loop, f->n_loops, v->n_loops);
-    if (f->kind >= SW_SG_KIND_COUNT || (f->flags & ~(uint32_t)3u))
+    if (f->kind >= SW_SG_KIND_COUNT || (f->flags & ~(uint32_t)SW_SG_FACE_FLAGS_ALL))
         return sw__fail(c->status, SW_ERR_FORMAT, "%s: face %u%s: kind %u, flags 0x%x", c->what, i,
                         at, f->kind, f->flags);
     if (!all_finite(f->uv_box, 4) || f->uv_box[0] > f->uv_box[1] || f->uv_box[2] > f->uv_box[3] ||

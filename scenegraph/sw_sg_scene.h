@@ -51,6 +51,11 @@ const char *sw_sg_surface_kind_str(uint32_t kind);
 enum sw_sg_face_flags {
     SW_SG_FACE_REVERSED = 1u << 0, /* the B-rep face's normal is opposite to Su x Sv */
     SW_SG_FACE_TRIMMED = 1u << 1,  /* its loops cut the domain (not just the domain's rectangle) */
+    /* Every occurrence of the face bounds a closed, consistently oriented shell whose outward
+     * side is the face's normal (Su x Sv, negated with REVERSED): it can be seen only from
+     * outside, so back-patch culling may drop it (Kumar et al. 1997 §4.4). Set only when sure. */
+    SW_SG_FACE_CLOSED_SHELL = 1u << 2,
+    SW_SG_FACE_FLAGS_ALL = (1u << 3) - 1,
 };
 
 /* One face: a NURBS surface and its trim loops. Offsets are indices into the double pool. */

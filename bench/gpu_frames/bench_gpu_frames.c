@@ -4,9 +4,12 @@
  *   kept   the atlas kept across frames (walkthrough: textures reused while their class holds)
  *   cpu    as kept, but every patch tessellated as a CPU grid instead of evaluated in the vertex
  *          shader (§4.2; degree > 3 patches are CPU grids in both)
+ *   cull   as kept, with back-patch culling of closed-shell faces by their normal cones (Kumar
+ *          et al. 1997 §4.4; the cones' one-off build time is printed apart)
  * Usage: bench_gpu_frames [--frames N] [--size WxH] FILE...   (set LP_NUM_THREADS and say so)
  */
 #include "sw_gpu_internal.h"
+#include "sw_lod_face_cones.h"
 #include "sw_sg_import.h"
 
 #include <math.h>
@@ -74,11 +77,13 @@ static void print(const char *what, series *s, int frames)
 {
     const sw_gpu_frame_stats *f = &s->last;
     printf(
-        "  %-6s tessellate %7.2f  trim %7.2f  draw %7.2f  total %7.2f ms | %llu triangles, "
+        "  %-6s tessellate %7.2f  trim %7.2f  draw %7.2f  total %7.2f ms | %llu faces drawn "
+        "(%llu back-culled), %llu triangles, "
         "%llu shader-evaluated patches, %llu trim textures (%llu reused, %.1f Mtexels), %llu atlas "
         "pages (%.1f Mtexels), %llu switches\n",
         what, median(s->tess, frames), median(s->trim, frames), median(s->draw, frames),
-        median(s->total, frames), (unsigned long long)f->triangles,
+        median(s->total, frames), (unsigned long long)f->faces_drawn,
+        (unsigned long long)f->faces_backculled, (unsigned long long)f->triangles,
         (unsigned long long)f->patches_gpu_evaluated, (unsigned long long)f->trim_textures,
         (unsigned long long)f->trim_reused, f->trim_texels * 1e-6,
         (unsigned long long)f->atlas_pages, f->atlas_texels * 1e-6,
@@ -136,6 +141,21 @@ int main(int argc, char **argv)
         if (ok && run(ctx, scene, &desc, frames, 0, &s))
             print("cpu", &s, frames);
         sw__gpu_set_eval_mode(ctx, SW__GPU_EVAL_AUTO);
+        sw_lod_face_cones *fc = NULL;
+        const double t0 = sw__gpu_now_ms();
+        if (ok && sw_lod_face_cones_build(scene, &fc, &st) != SW_OK) {
+            fprintf(stderr, "%s: face cones: %s\n", argv[a], st.message);
+            ok = 0;
+        }
+        if (ok) {
+            printf("  cones: %u of %u faces bounded, built in %.1f ms\n", fc->n_bounded,
+                   fc->n_faces, sw__gpu_now_ms() - t0);
+            desc.face_cones = fc;
+            if (run(ctx, scene, &desc, frames, 0, &s))
+                print("cull", &s, frames);
+            desc.face_cones = NULL;
+        }
+        sw_lod_face_cones_free(fc);
         sw_sg_scene_free(scene);
     }
     sw_gpu_context_free(ctx);
