@@ -168,7 +168,8 @@ class exporter
     const TopoDS_Face &face(uint32_t f);
     TopoDS_Face make_face(uint32_t f);
     TopoDS_Wire make_wire(const sw_sg_loop_rec &l, const Handle(Geom_BSplineSurface) & s,
-                          const TopoDS_Face &face, const double *affine);
+                          const TopoDS_Face &face, const double *affine, bool flip);
+    double loop_area(const sw_sg_loop_rec &l) const;
     TopoDS_Shape children(uint32_t n, uint64_t &occ);
     TopoDS_Shape shape(uint32_t n, uint64_t &occ);
 };
@@ -189,8 +190,31 @@ bool is_identity(const double x[12])
     return true;
 }
 
+/* Signed area of a loop's control polygon: its orientation (the curves stay near it). */
+double exporter::loop_area(const sw_sg_loop_rec &l) const
+{
+    double a = 0.0, first[2] = {0, 0}, prev[2] = {0, 0};
+    bool any = false;
+    for (uint32_t k = 0; k < l.n_curves; ++k) {
+        sw_sg_curve c;
+        sw_sg_scene_curve(scene_, l.first_curve + k, &c);
+        for (int i = 0; i < c.n; ++i) {
+            const double *h = c.cpw + (size_t)i * 3, p[2] = {h[0] / h[2], h[1] / h[2]};
+            if (any)
+                a += prev[0] * p[1] - p[0] * prev[1];
+            else
+                first[0] = p[0], first[1] = p[1], any = true;
+            prev[0] = p[0], prev[1] = p[1];
+        }
+    }
+    return 0.5 * (a + prev[0] * first[1] - first[0] * prev[1]);
+}
+
+/* The loop as a wire; flip: its edges reversed (and in reverse order), for loops that run
+ * against OCCT's convention (the importer keeps a REVERSED face's loops as its wire explorer
+ * walks them, reversed). */
 TopoDS_Wire exporter::make_wire(const sw_sg_loop_rec &l, const Handle(Geom_BSplineSurface) & s,
-                                const TopoDS_Face &face, const double *affine)
+                                const TopoDS_Face &face, const double *affine, bool flip)
 {
     std::vector<TopoDS_Vertex> verts(l.n_curves);
     std::vector<sw_sg_curve> cs(l.n_curves);
@@ -201,6 +225,7 @@ TopoDS_Wire exporter::make_wire(const sw_sg_loop_rec &l, const Handle(Geom_BSpli
     }
     TopoDS_Wire w;
     bb_.MakeWire(w);
+    std::vector<TopoDS_Edge> edges(l.n_curves);
     for (uint32_t k = 0; k < l.n_curves; ++k) {
         const sw_sg_curve &c = cs[k];
         Handle(Geom2d_BSplineCurve) c2;
@@ -224,8 +249,10 @@ TopoDS_Wire exporter::make_wire(const sw_sg_loop_rec &l, const Handle(Geom_BSpli
             bb_.Degenerated(e, Standard_True);
         else if (!c3)
             BRepLib::BuildCurve3d(e, k_tol);
-        bb_.Add(w, e);
+        edges[k] = e;
     }
+    for (uint32_t k = 0; k < l.n_curves; ++k)
+        bb_.Add(w, flip ? TopoDS::Edge(edges[l.n_curves - 1 - k].Reversed()) : edges[k]);
     w.Closed(Standard_True);
     return w;
 }
@@ -248,8 +275,14 @@ TopoDS_Face exporter::make_face(uint32_t f)
         double affine[9];
         const bool flat = affine_map(s, affine);
         bb_.MakeFace(face, bs, k_tol);
+        uint32_t outer = 0;
         for (uint32_t l = 0; l < rec.n_loops; ++l)
-            bb_.Add(face, make_wire(v_->loops[rec.first_loop + l], bs, face, flat ? affine : 0));
+            if (v_->loops[rec.first_loop + l].flags & SW_SG_LOOP_OUTER)
+                outer = l;
+        const bool flip = loop_area(v_->loops[rec.first_loop + outer]) < 0.0;
+        for (uint32_t l = 0; l < rec.n_loops; ++l)
+            bb_.Add(face,
+                    make_wire(v_->loops[rec.first_loop + l], bs, face, flat ? affine : 0, flip));
     }
     if (rec.flags & SW_SG_FACE_REVERSED)
         face.Orientation(TopAbs_REVERSED);
