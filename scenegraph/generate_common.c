@@ -184,8 +184,16 @@ void sw__gen_ellipse_arcs(sw__gen_face *f, double cu, double cv, double ru, doub
 /* Closes the loop: a line back to its start unless the pen is there already. */
 void sw__gen_loop_end(sw__gen_face *f)
 {
-    if (f->pen[0] != f->start[0] || f->pen[1] != f->start[1])
+    const double du = f->pen[0] - f->start[0], dv = f->pen[1] - f->start[1];
+    const double tiny = 1e-12 * (1.0 + fabs(f->start[0]) + fabs(f->start[1]));
+    if (f->n_curves > 0 && (du != 0.0 || dv != 0.0) && fabs(du) <= tiny && fabs(dv) <= tiny) {
+        /* an arc ending a rounding error away from the start: its end moved onto the start */
+        sw__gen_curve *c = &f->c[f->n_curves - 1];
+        double *e = c->cpw + 3 * (c->n - 1);
+        e[0] = f->start[0] * e[2], e[1] = f->start[1] * e[2];
+    } else if (du != 0.0 || dv != 0.0) {
         sw__gen_line_to(f, f->start[0], f->start[1]);
+    }
     f->loop_first[++f->n_loops] = f->n_curves;
     if (f->n_loops > 1 || f->n_curves != 4)
         f->flags |= SW_SG_FACE_TRIMMED;

@@ -4,7 +4,7 @@
 
 #include "sw_sg_generate.h"
 
-enum { SW__GEN_MAX_CURVES = 48, SW__GEN_MAX_LOOPS = 6, SW__GEN_MAX_NU = 9, SW__GEN_MAX_NV = 3 };
+enum { SW__GEN_MAX_CURVES = 48, SW__GEN_MAX_LOOPS = 6, SW__GEN_MAX_NU = 9, SW__GEN_MAX_NV = 4 };
 
 /* ---- a face under construction -------------------------------------------------------------- */
 
@@ -15,7 +15,7 @@ typedef struct sw__gen_curve {
 
 typedef struct sw__gen_face {
     int deg_u, deg_v, n_u, n_v;
-    double ku[SW__GEN_MAX_NU + 3], kv[SW__GEN_MAX_NV + 3], cpw[SW__GEN_MAX_NU * SW__GEN_MAX_NV * 4];
+    double ku[SW__GEN_MAX_NU + 4], kv[SW__GEN_MAX_NV + 4], cpw[SW__GEN_MAX_NU * SW__GEN_MAX_NV * 4];
     uint32_t kind, flags;
     int n_loops, loop_first[SW__GEN_MAX_LOOPS + 1];
     uint32_t loop_flags[SW__GEN_MAX_LOOPS];

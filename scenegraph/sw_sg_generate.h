@@ -82,6 +82,32 @@ typedef struct sw_sg_building_report {
 sw_result sw_sg_generate_building(const sw_sg_building_desc *desc, sw_sg_scene **out,
                                   sw_sg_building_report *report, sw_status *status);
 
+/* ---- vehicle ----------------------------------------------------------------------------------
+ */
+
+/* A parking lot of generated cars, 100..10^7 surfaces like the building. */
+enum { SW_SG_VEHICLE_N_MODELS = 3 };
+extern const char *const sw_sg_vehicle_model_files[SW_SG_VEHICLE_N_MODELS];
+
+typedef struct sw_sg_vehicle_desc {
+    uint64_t surfaces;                /* SW_SG_BUILDING_MIN..MAX_SURFACES, met exactly */
+    uint64_t seed;                    /* same seed, same scene (byte for byte) */
+    const sw_sg_scene *const *models; /* SW_SG_VEHICLE_N_MODELS: sw_sg_vehicle_model_files */
+    sw_sg_progress_fn progress;       /* may be NULL */
+    void *user_data;
+} sw_sg_vehicle_desc;
+
+typedef struct sw_sg_vehicle_report {
+    uint32_t vehicles, with_engine; /* cars; cars with the instanced engine parts */
+    uint64_t occurrences, unique_faces, instances;
+    uint32_t panels, arches, windows, gaps, bollards;
+} sw_sg_vehicle_report;
+
+/* Builds the lot. Units are millimetres (Motor-c's), z up, cars along x. Errors as for
+ * sw_sg_generate_building. `report` may be NULL. */
+sw_result sw_sg_generate_vehicle(const sw_sg_vehicle_desc *desc, sw_sg_scene **out,
+                                 sw_sg_vehicle_report *report, sw_status *status);
+
 #ifdef __cplusplus
 }
 #endif

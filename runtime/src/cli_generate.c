@@ -17,8 +17,8 @@
 
 static const char k_usage[] =
     "usage: splinewalk generate grid --model M --count N -o OUT.sws [--spacing S] [--dims 2|3]\n"
-    "       splinewalk generate building --surfaces N [--seed S] -o OUT.sws [--brep OUT.brep]\n"
-    "                                    [--data DIR]\n"
+    "       splinewalk generate building|vehicle --surfaces N [--seed S] -o OUT.sws\n"
+    "                                    [--brep OUT.brep] [--data DIR]\n"
     "\n"
     "grid:\n"
     "Writes a test scene (Kumar et al. 1997 §4.4 culling tests): N instances of the model M (any\n"
@@ -54,15 +54,25 @@ static const char k_usage[] =
     "count. The same N and seed give the same file, byte for byte. Both outputs are written to\n"
     "temporary names, then renamed: a failed run leaves nothing behind.\n"
     "\n"
+    "vehicle:\n"
+    "The same for a parking lot of cars, in millimetres: each car unique, its body of lofted\n"
+    "bicubic B-spline panels (rear quarter, doors, front fender per side, cut apart by door gaps,\n"
+    "trimmed by exact wheel arches; a cabin side trimmed by its windows; roof with or without a\n"
+    "sunroof, windscreen, rear window, bonnet, boot lid, bumpers), four instances of one wheel\n"
+    "(exact rational tyre and hub, a disc trimmed by circles), and under some bonnets instances "
+    "of\n"
+    "Motor-c.brep, CrankArm.brep and Pump_Nut.brep (within the same 3 x budget). Parking bollards\n"
+    "make up the exact count.\n"
+    "\n"
     "options:\n"
     "  --surfaces N        face occurrences, 100..10000000 (10^7: about 2.5 million unique faces)\n"
     "  --seed S            the random seed, an unsigned 64-bit integer (default 1)\n"
     "  -o, --output FILE   the .sws file to write (required)\n"
     "  --brep FILE         also write the scene as an OCCT BREP compound (instances share their\n"
     "                      TShape), which `splinewalk import` and OCCT-based programs read\n"
-    "  --data DIR          the OCCT sample-data folder holding occ/MODERN_Chair_1.brep and the\n"
-    "                      other models (default " DEFAULT_DATA ", Debian's\n"
-    "                      occt-misc)\n"
+    "  --data DIR          the OCCT sample-data folder holding occ/MODERN_Chair_1.brep,\n"
+    "                      occ/Motor-c.brep and the other models (default\n"
+    "                      " DEFAULT_DATA ", Debian's occt-misc)\n"
     "  -h, --help          this text\n";
 
 typedef struct gen_args {
@@ -115,10 +125,11 @@ static int is_number_option(const char *arg)
 /* What the generator named in a->kind needs. */
 static int check_args(const gen_args *a)
 {
-    const int grid = !strcmp(a->kind, "grid"), building = !strcmp(a->kind, "building");
+    const int grid = !strcmp(a->kind, "grid");
+    const int building = !strcmp(a->kind, "building") || !strcmp(a->kind, "vehicle");
     if (!grid && !building) {
-        fprintf(stderr, "splinewalk generate: unknown generator '%s' (grid, building)\n%s", a->kind,
-                k_usage);
+        fprintf(stderr, "splinewalk generate: unknown generator '%s' (grid, building, vehicle)\n%s",
+                a->kind, k_usage);
         return 2;
     }
     if (grid && (!a->model || !a->count || !a->out)) {
@@ -127,7 +138,7 @@ static int check_args(const gen_args *a)
         return 2;
     }
     if (building && (!a->surfaces || !a->out)) {
-        fprintf(stderr, "splinewalk generate: need building, --surfaces N and -o OUT.sws\n%s",
+        fprintf(stderr, "splinewalk generate: need %s, --surfaces N and -o OUT.sws\n%s", a->kind,
                 k_usage);
         return 2;
     }
@@ -169,7 +180,8 @@ static int parse_args(int argc, char **argv, gen_args *a)
         i++;
     }
     if (!a->kind) {
-        fprintf(stderr, "splinewalk generate: need a generator (grid, building)\n%s", k_usage);
+        fprintf(stderr, "splinewalk generate: need a generator (grid, building, vehicle)\n%s",
+                k_usage);
         return 2;
     }
     return check_args(a);
@@ -215,16 +227,17 @@ static sw_result write_grid(const gen_args *a, const sw_rt_scene *model, sw_sg_g
 
 /* ---- building ------------------------------------------------------------------------------ */
 
-/* Imports the furniture models from the sample-data folder, each once. */
-static sw_result load_models(const char *data, sw_sg_scene **models, sw_status *status)
+/* Imports the models from the sample-data folder, each once. */
+static sw_result load_models(const char *data, const char *const *files, int n,
+                             sw_sg_scene **models, sw_status *status)
 {
-    for (int m = 0; m < SW_SG_BUILDING_N_MODELS; ++m) {
+    for (int m = 0; m < n; ++m) {
         char path[4096];
-        snprintf(path, sizeof path, "%s/%s", data, sw_sg_building_model_files[m]);
+        snprintf(path, sizeof path, "%s/%s", data, files[m]);
         struct stat sb;
         if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode))
             return sw__fail(status, SW_ERR_NOT_FOUND,
-                            "%s: no such file: the furniture comes from the OCCT sample "
+                            "%s: no such file: the models come from the OCCT sample "
                             "data (Debian's occt-misc); give its folder with --data DIR",
                             path);
         sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL};
@@ -268,22 +281,56 @@ static sw_result write_building(const gen_args *a, sw_sg_scene *scene, double *m
     return r;
 }
 
-static int generate_building(const gen_args *a)
+static void print_building(const gen_args *a, const sw_sg_building_report *rep)
 {
+    printf("%s: building of %llu surfaces, %llu unique faces (%.1f %%), %u storeys of %ux%u rooms, "
+           "%u rooms (%u furnished), %llu instances, %u domes, %u vaults, %u columns, %u windows, "
+           "%u doors, %u arches, %u stairs, %u bollards",
+           a->out, (unsigned long long)rep->occurrences, (unsigned long long)rep->unique_faces,
+           100.0 * (double)rep->unique_faces / (double)rep->occurrences, rep->floors, rep->nx,
+           rep->ny, rep->rooms, rep->furnished, (unsigned long long)rep->instances, rep->domes,
+           rep->vaults, rep->columns, rep->windows, rep->doors, rep->arches, rep->stairs,
+           rep->bollards);
+}
+
+static void print_vehicle(const gen_args *a, const sw_sg_vehicle_report *rep)
+{
+    printf("%s: %u cars of %llu surfaces, %llu unique faces (%.1f %%), %llu instances, %u with "
+           "an engine, %u panels, %u wheel arches, %u windows, %u door gaps, %u bollards",
+           a->out, rep->vehicles, (unsigned long long)rep->occurrences,
+           (unsigned long long)rep->unique_faces,
+           100.0 * (double)rep->unique_faces / (double)rep->occurrences,
+           (unsigned long long)rep->instances, rep->with_engine, rep->panels, rep->arches,
+           rep->windows, rep->gaps, rep->bollards);
+}
+
+/* building or vehicle: models, generation, the outputs. */
+static int generate_scene(const gen_args *a)
+{
+    const int vehicle = !strcmp(a->kind, "vehicle");
+    const int n = vehicle ? SW_SG_VEHICLE_N_MODELS : SW_SG_BUILDING_N_MODELS;
     sw_status status = {0};
     sw_sg_scene *models[SW_SG_BUILDING_N_MODELS] = {0};
     const double t0 = sw_cli_now_ms();
-    sw_result r = load_models(a->data ? a->data : DEFAULT_DATA, models, &status);
+    sw_result r = load_models(a->data ? a->data : DEFAULT_DATA,
+                              vehicle ? sw_sg_vehicle_model_files : sw_sg_building_model_files, n,
+                              models, &status);
     const double t1 = sw_cli_now_ms();
     quiet_progress q = {t1, 0};
-    sw_sg_building_desc d = {(uint64_t)a->surfaces, a->seed, (const sw_sg_scene *const *)models,
-                             progress, &q};
-    sw_sg_building_report rep;
+    sw_sg_building_report brep;
+    sw_sg_vehicle_report vrep;
     sw_sg_export_report er = {0, 0};
     sw_sg_scene *scene = NULL;
     double ms_write = 0.0;
-    if (r == SW_OK)
-        r = sw_sg_generate_building(&d, &scene, &rep, &status);
+    if (r == SW_OK && vehicle) {
+        sw_sg_vehicle_desc d = {(uint64_t)a->surfaces, a->seed, (const sw_sg_scene *const *)models,
+                                progress, &q};
+        r = sw_sg_generate_vehicle(&d, &scene, &vrep, &status);
+    } else if (r == SW_OK) {
+        sw_sg_building_desc d = {(uint64_t)a->surfaces, a->seed, (const sw_sg_scene *const *)models,
+                                 progress, &q};
+        r = sw_sg_generate_building(&d, &scene, &brep, &status);
+    }
     const double t2 = sw_cli_now_ms();
     if (r == SW_OK) {
         q.on = q.on || sw_sg_scene_memory(scene) >= SLOW_WRITE_BYTES || a->brep;
@@ -293,18 +340,15 @@ static int generate_building(const gen_args *a)
     sw_cli_progress_end();
     const size_t bytes = scene ? sw_sg_scene_memory(scene) : 0;
     sw_sg_scene_free(scene);
-    for (int m = 0; m < SW_SG_BUILDING_N_MODELS; ++m)
+    for (int m = 0; m < n; ++m)
         sw_sg_scene_free(models[m]);
     if (r != SW_OK)
         return sw_cli_report("generate", &status);
-    printf("%s: building of %llu surfaces, %llu unique faces (%.1f %%), %u storeys of %ux%u rooms, "
-           "%u rooms (%u furnished), %llu instances, %u domes, %u vaults, %u columns, %u windows, "
-           "%u doors, %u arches, %u stairs, %u bollards; %.0f MB in memory; load models %.0f ms, "
-           "generate %.0f ms, write %.0f ms\n",
-           a->out, (unsigned long long)rep.occurrences, (unsigned long long)rep.unique_faces,
-           100.0 * (double)rep.unique_faces / (double)rep.occurrences, rep.floors, rep.nx, rep.ny,
-           rep.rooms, rep.furnished, (unsigned long long)rep.instances, rep.domes, rep.vaults,
-           rep.columns, rep.windows, rep.doors, rep.arches, rep.stairs, rep.bollards,
+    if (vehicle)
+        print_vehicle(a, &vrep);
+    else
+        print_building(a, &brep);
+    printf("; %.0f MB in memory; load models %.0f ms, generate %.0f ms, write %.0f ms\n",
            (double)bytes / 1e6, t1 - t0, t2 - t1, ms_write);
     if (a->brep)
         printf("%s: %u faces, %llu face occurrences\n", a->brep, er.faces,
@@ -322,8 +366,8 @@ int sw_cli_generate(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;
-    if (!strcmp(a.kind, "building"))
-        return generate_building(&a);
+    if (strcmp(a.kind, "grid") != 0)
+        return generate_scene(&a);
 
     sw_status status = {0};
     sw_scene scene;

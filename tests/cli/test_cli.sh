@@ -211,5 +211,21 @@ tris=$(sed -n 's/.*; \([0-9]*\) triangles;.*/\1/p' render.txt)
 [ "$(stat -c %s b1.png 2>/dev/null || echo 0)" -gt 4000 ] || fail "render of the building: blank image"
 pass "generate building: usage errors, failures, 1000 surfaces ($faces unique) twice the same, rendered ($drawn faces, $tris triangles), BREP read back"
 
+# generate vehicle: the same options and guarantees, cars instead of rooms.
+"$sw" generate vehicle -o bad.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "generate vehicle without --surfaces accepted"
+"$sw" generate vehicle --surfaces 20000000 -o bad.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "generate vehicle --surfaces 2e7 accepted"
+expect_error "generate vehicle: missing sample data" SW_ERR_NOT_FOUND no-such-dir/occ/Motor-c.brep -- \
+  "$sw" generate vehicle --surfaces 1000 --data no-such-dir -o bad.sws
+[ ! -e bad.sws ] || fail "a failed generate vehicle left bad.sws"
+"$sw" generate vehicle --surfaces 1000 -o v1.sws --brep v1.brep >gen.txt 2>&1 || { fail "generate vehicle"; cat gen.txt; }
+"$sw" info v1.sws --json >v1.json || fail "info v1.sws"
+grep -q '"face_occurrences": 1000,' v1.json || fail "vehicle of 1000 surfaces: $(cat v1.json)"
+vfaces=$(sed -n 's/.*"faces": \([0-9]*\),.*/\1/p' v1.json)
+"$sw" info v1.brep --json 2>/dev/null | grep -q "\"faces\": $vfaces,.*\"face_occurrences\": 1000," ||
+  fail "the vehicle BREP read back differs from $vfaces faces, 1000 occurrences"
+"$sw" render v1.sws -o v1.png --size 320x240 >render.txt 2>&1 || { fail "render v1.sws"; cat render.txt; }
+[ "$(stat -c %s v1.png 2>/dev/null || echo 0)" -gt 4000 ] || fail "render of the vehicles: blank image"
+pass "generate vehicle: usage errors, missing data, 1000 surfaces ($vfaces unique), BREP read back, rendered"
+
 echo "$failures failure(s)"
 [ $failures -eq 0 ]

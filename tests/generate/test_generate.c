@@ -1,5 +1,5 @@
-/* tests/generate: the building generator (scenegraph/generate_building.c, `splinewalk generate
- * building`), for each N given:
+/* tests/generate: the building and vehicle generators (scenegraph/generate_building.c,
+ * generate_vehicle.c: `splinewalk generate building|vehicle`), for each N given:
  *  - determinism: two runs with one seed save byte-identical .sws files, another seed differs;
  *  - counts: the scene's own traversal (sw_sg_scene_compute_stats) finds N within ±10 % face
  *    occurrences, at least 10 % of them unique faces, and as many faces as the report says;
@@ -20,7 +20,7 @@
  *    would be off by far more);
  *  - the first N also through the BREP exporter: OCCT's reader, via the importer, finds the same
  *    faces and face occurrences, and BRepCheck_Analyzer finds every face valid.
- * Usage: test_generate DATA_DIR WORKDIR N...
+ * Usage: test_generate DATA_DIR WORKDIR building|vehicle N...
  */
 #include "sw_sg_export.h"
 #include "sw_sg_generate.h"
@@ -46,13 +46,44 @@ static int g_failures;
     } while (0)
 
 static sw_sg_scene *g_models[SW_SG_BUILDING_N_MODELS];
+static int g_vehicle;
 
-static sw_sg_scene *generate(uint64_t n, uint64_t seed, sw_sg_building_report *rep)
+/* What the tests need of either generator's report. */
+typedef struct gen_report {
+    uint64_t occurrences, unique_faces;
+    int features; /* every kind of part the generator promises is there */
+    char text[160];
+} gen_report;
+
+static sw_sg_scene *generate(uint64_t n, uint64_t seed, gen_report *rep)
 {
-    sw_sg_building_desc d = {n, seed, (const sw_sg_scene *const *)g_models, NULL, NULL};
     sw_sg_scene *s = NULL;
     sw_status st = {0};
-    if (sw_sg_generate_building(&d, &s, rep, &st) != SW_OK) {
+    sw_result r;
+    if (g_vehicle) {
+        sw_sg_vehicle_desc d = {n, seed, (const sw_sg_scene *const *)g_models, NULL, NULL};
+        sw_sg_vehicle_report vr;
+        r = sw_sg_generate_vehicle(&d, &s, &vr, &st);
+        rep->occurrences = vr.occurrences, rep->unique_faces = vr.unique_faces;
+        rep->features = vr.vehicles > 0 && vr.with_engine > 0 && vr.arches == 4 * vr.vehicles &&
+                        vr.windows >= 4 * vr.vehicles && vr.gaps == 6 * vr.vehicles;
+        snprintf(rep->text, sizeof rep->text,
+                 "%u cars (%u with an engine), %u arches, %u windows, %u gaps", vr.vehicles,
+                 vr.with_engine, vr.arches, vr.windows, vr.gaps);
+    } else {
+        sw_sg_building_desc d = {n, seed, (const sw_sg_scene *const *)g_models, NULL, NULL};
+        sw_sg_building_report br;
+        r = sw_sg_generate_building(&d, &s, &br, &st);
+        rep->occurrences = br.occurrences, rep->unique_faces = br.unique_faces;
+        rep->features = br.domes + br.vaults > 0 && br.windows > 0 && br.doors > 0 &&
+                        br.stairs > 0 && br.furnished > 0 && br.columns > 0;
+        snprintf(rep->text, sizeof rep->text,
+                 "%u storeys of %ux%u, %u domes, %u vaults, %u windows, %u doors, %u stairs, %u "
+                 "furnished rooms",
+                 br.floors, br.nx, br.ny, br.domes, br.vaults, br.windows, br.doors, br.stairs,
+                 br.furnished);
+    }
+    if (r != SW_OK) {
         CHECK(0, "generate %llu seed %llu: %s", (unsigned long long)n, (unsigned long long)seed,
               st.message);
         return NULL;
@@ -95,7 +126,7 @@ static void test_determinism(uint64_t n, const char *work)
     snprintf(pa, sizeof pa, "%s/a.sws", work);
     snprintf(pb, sizeof pb, "%s/b.sws", work);
     snprintf(pc, sizeof pc, "%s/c.sws", work);
-    sw_sg_building_report rep;
+    gen_report rep;
     sw_sg_scene *a = generate(n, 7, &rep), *b = generate(n, 7, &rep), *c = generate(n, 8, &rep);
     if (!a || !b || !c || !save(a, pa) || !save(b, pb) || !save(c, pc)) {
         sw_sg_scene_free(a), sw_sg_scene_free(b), sw_sg_scene_free(c);
@@ -454,7 +485,7 @@ static void test_circles(const sw_sg_scene *s, const unsigned char *imp)
 
 /* ---- counts ---------------------------------------------------------------------------------- */
 
-static void test_counts(const sw_sg_scene *s, uint64_t n, const sw_sg_building_report *rep)
+static void test_counts(const sw_sg_scene *s, uint64_t n, const gen_report *rep)
 {
     sw_sg_scene_stats ss;
     CHECK(sw_sg_scene_compute_stats(s, &ss) == SW_OK, "stats");
@@ -467,19 +498,15 @@ static void test_counts(const sw_sg_scene *s, uint64_t n, const sw_sg_building_r
           "report: %llu occurrences, %llu unique; the scene: %llu, %u",
           (unsigned long long)rep->occurrences, (unsigned long long)rep->unique_faces,
           (unsigned long long)ss.face_occurrences, ss.faces);
-    CHECK(ss.instances > 0 && rep->domes + rep->vaults > 0 && rep->windows > 0 && rep->doors > 0 &&
-              rep->stairs > 0 && rep->furnished > 0,
-          "N %llu: %u instances, %u domes, %u vaults, %u windows, %u doors, %u stairs, %u "
-          "furnished rooms",
-          (unsigned long long)n, ss.instances, rep->domes, rep->vaults, rep->windows, rep->doors,
-          rep->stairs, rep->furnished);
+    CHECK(ss.instances > 0 && rep->features, "N %llu: %u instances, %s", (unsigned long long)n,
+          ss.instances, rep->text);
     sw_status st = {0};
-    CHECK(sw_sg_scene_validate(sw_sg_scene_view_ptr(s), "building", &st) == SW_OK, "validate: %s",
+    CHECK(sw_sg_scene_validate(sw_sg_scene_view_ptr(s), "generated", &st) == SW_OK, "validate: %s",
           st.message);
     printf("  counts: %llu occurrences (N %llu), %u unique faces (%.1f %%), %u instances, %u "
-           "trimmed faces, %u storeys of %ux%u\n",
+           "trimmed faces; %s\n",
            (unsigned long long)ss.face_occurrences, (unsigned long long)n, ss.faces,
-           100.0 * ss.faces / occ, ss.instances, ss.trimmed_faces, rep->floors, rep->nx, rep->ny);
+           100.0 * ss.faces / occ, ss.instances, ss.trimmed_faces, rep->text);
 }
 
 /* ---- BREP round trip ------------------------------------------------------------------------- */
@@ -522,13 +549,16 @@ static void test_brep(const sw_sg_scene *s, const char *work)
 
 int main(int argc, char **argv)
 {
-    if (argc < 4) {
-        fprintf(stderr, "usage: test_generate DATA_DIR WORKDIR N...\n");
+    if (argc < 5) {
+        fprintf(stderr, "usage: test_generate DATA_DIR WORKDIR building|vehicle N...\n");
         return 2;
     }
-    for (int m = 0; m < SW_SG_BUILDING_N_MODELS; ++m) {
+    g_vehicle = !strcmp(argv[3], "vehicle");
+    const int n_models = g_vehicle ? SW_SG_VEHICLE_N_MODELS : SW_SG_BUILDING_N_MODELS;
+    const char *const *files = g_vehicle ? sw_sg_vehicle_model_files : sw_sg_building_model_files;
+    for (int m = 0; m < n_models; ++m) {
         char path[1024];
-        snprintf(path, sizeof path, "%s/%s", argv[1], sw_sg_building_model_files[m]);
+        snprintf(path, sizeof path, "%s/%s", argv[1], files[m]);
         sw_sg_import_desc d = {path, NULL, NULL, NULL};
         sw_status st = {0};
         if (sw_sg_import_file(&d, &g_models[m], NULL, &st) != SW_OK) {
@@ -536,11 +566,11 @@ int main(int argc, char **argv)
             return 1;
         }
     }
-    for (int i = 3; i < argc; ++i) {
+    for (int i = 4; i < argc; ++i) {
         const uint64_t n = strtoull(argv[i], NULL, 10);
         printf("N = %llu\n", (unsigned long long)n);
         test_determinism(n, argv[2]);
-        sw_sg_building_report rep;
+        gen_report rep;
         sw_sg_scene *s = generate(n, 1, &rep);
         if (!s)
             continue;
@@ -549,11 +579,11 @@ int main(int argc, char **argv)
         test_trims(s, imp);
         test_circles(s, imp);
         free(imp);
-        if (i == 3)
+        if (i == 4)
             test_brep(s, argv[2]);
         sw_sg_scene_free(s);
     }
-    for (int m = 0; m < SW_SG_BUILDING_N_MODELS; ++m)
+    for (int m = 0; m < n_models; ++m)
         sw_sg_scene_free(g_models[m]);
     printf("%d failure(s)\n", g_failures);
     return g_failures ? 1 : 0;
