@@ -194,7 +194,7 @@ typedef struct quiet_progress {
     int on;
 } quiet_progress;
 
-enum { SLOW_WRITE_BYTES = 256 << 20 };
+enum { SLOW_WRITE_BYTES = 256 << 20, SLOW_BREP_BYTES = 16 << 20 };
 
 static void progress(void *user_data, double fraction, const char *stage)
 {
@@ -333,7 +333,8 @@ static int generate_scene(const gen_args *a)
     }
     const double t2 = sw_cli_now_ms();
     if (r == SW_OK) {
-        q.on = q.on || sw_sg_scene_memory(scene) >= SLOW_WRITE_BYTES || a->brep;
+        /* the BREP writer runs at ~11 MB of scene a second here */
+        q.on = q.on || sw_sg_scene_memory(scene) >= (a->brep ? SLOW_BREP_BYTES : SLOW_WRITE_BYTES);
         progress(&q, 1.0, "writing");
         r = write_building(a, scene, &ms_write, &er, &status);
     }

@@ -18,6 +18,9 @@
  *    over its domain, at its radius from its axis / centre to within 1e-12 of the coordinates'
  *    magnitude (rounding of the evaluation; a polynomial approximation of a circle of radius 18
  *    would be off by far more);
+ *  - the vehicles' wheel arches (pairs of rational quarter arcs in a lofted bicubic panel's outer
+ *    loop) map to exact semicircles in 3D: every surface point along them lies in one vertical
+ *    plane's circle through the two ends, to within 1e-12 of the coordinates' magnitude;
  *  - the first N also through the BREP exporter: OCCT's reader, via the importer, finds the same
  *    faces and face occurrences, and BRepCheck_Analyzer finds every face valid.
  * Usage: test_generate DATA_DIR WORKDIR building|vehicle N...
@@ -483,6 +486,60 @@ static void test_circles(const sw_sg_scene *s, const unsigned char *imp)
            cyl, dome, worst);
 }
 
+/* Wheel arches: the outer loop's consecutive quadratic pairs on a bicubic face; the circle through
+ * their 3D end points (a diameter) in the xz plane, every sample on it. */
+static void test_arches(const sw_sg_scene *s, const unsigned char *imp)
+{
+    const sw_sg_scene_view *v = sw_sg_scene_view_ptr(s);
+    uint32_t arches = 0;
+    double worst = 0.0;
+    for (uint32_t f = 0; f < v->n_faces; ++f) {
+        const sw_sg_face_rec *r = &v->faces[f];
+        if (imp[f] || r->deg_u != 3 || r->deg_v != 3 || r->n_loops == 0)
+            continue;
+        sw_sg_surface sf;
+        sw_sg_scene_face_surface(s, f, &sf);
+        const sw_sg_loop_rec *lp = &v->loops[r->first_loop];
+        for (uint32_t k = 0; k + 1 < lp->n_curves; ++k) {
+            sw_sg_curve a, b;
+            sw_sg_scene_curve(s, lp->first_curve + k, &a);
+            sw_sg_scene_curve(s, lp->first_curve + k + 1, &b);
+            if (a.degree != 2 || b.degree != 2)
+                continue;
+            double uv0[2], uv1[2], p0[3], p1[3], c[3], rad = 0.0, scale = 1.0;
+            sw_sg_curve_eval(&a, a.knots[a.degree], uv0);
+            sw_sg_curve_eval(&b, b.knots[b.n], uv1);
+            sw_sg_surface_eval(&sf, uv0[0], uv0[1], p0);
+            sw_sg_surface_eval(&sf, uv1[0], uv1[1], p1);
+            for (int q = 0; q < 3; ++q) {
+                c[q] = 0.5 * (p0[q] + p1[q]);
+                scale = fmax(scale, fabs(c[q]));
+            }
+            rad = 0.5 * hypot(p1[0] - p0[0], p1[2] - p0[2]);
+            for (int half = 0; half < 2; ++half) {
+                const sw_sg_curve *cv = half ? &b : &a;
+                for (int i = 0; i <= 16; ++i) {
+                    const double t0 = cv->knots[cv->degree], t1 = cv->knots[cv->n];
+                    double uv[2], p[3];
+                    sw_sg_curve_eval(cv, t0 + (t1 - t0) * i / 16.0, uv);
+                    sw_sg_surface_eval(&sf, uv[0], uv[1], p);
+                    const double err = fabs(hypot(p[0] - c[0], p[2] - c[2]) - rad) / scale;
+                    worst = fmax(worst, err);
+                    CHECK(err <= 1e-12 && p[2] >= c[2] - 1e-9 * scale,
+                          "face %u arch at curve %u: a point %.17g from the centre, radius %.17g",
+                          f, k, hypot(p[0] - c[0], p[2] - c[2]), rad);
+                }
+            }
+            arches++;
+            ++k;
+        }
+    }
+    if (g_vehicle)
+        CHECK(arches > 0, "no wheel arch found");
+    printf("  arches: %u wheel arches on lofted panels, exact semicircles in 3D within %.2g\n",
+           arches, worst);
+}
+
 /* ---- counts ---------------------------------------------------------------------------------- */
 
 static void test_counts(const sw_sg_scene *s, uint64_t n, const gen_report *rep)
@@ -578,6 +635,8 @@ int main(int argc, char **argv)
         unsigned char *imp = imported_faces(sw_sg_scene_view_ptr(s));
         test_trims(s, imp);
         test_circles(s, imp);
+        if (g_vehicle)
+            test_arches(s, imp);
         free(imp);
         if (i == 4)
             test_brep(s, argv[2]);
