@@ -26,33 +26,57 @@ static void lattice(uint32_t n, int32_t dims, uint32_t out[3])
     out[2] = (uint32_t)((n + nx * ny - 1) / (nx * ny));
 }
 
-/* Copies the geometry records of the model into the empty builder `b` with unchanged indices and
- * pool offsets (names come with the nodes). */
-static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, sw_status *status)
+/* Appends the geometry records of the model to `b` with indices and pool offsets shifted by what
+ * `b` already holds (names come with the nodes); base[0..2] = face, loop, curve index bases. */
+static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base[3],
+                             sw_status *status)
 {
-    int ok = v->n_pool == 0 || sw_sg_builder_push_doubles(b, v->pool, v->n_pool) == 0;
-    for (uint32_t i = 0; ok && i < v->n_faces; ++i)
-        ok = sw_sg_builder_add_face(b, &v->faces[i]) == i;
-    for (uint32_t i = 0; ok && i < v->n_loops; ++i)
-        ok = sw_sg_builder_add_loop(b, &v->loops[i]) == i;
-    for (uint32_t i = 0; ok && i < v->n_curves; ++i)
-        ok = sw_sg_builder_add_curve(b, &v->curves[i]) == i;
+    const uint64_t pool = v->n_pool ? sw_sg_builder_push_doubles(b, v->pool, v->n_pool) : 0;
+    base[0] = sw_sg_builder_face_count(b);
+    base[1] = base[2] = 0; /* the indices the first appends return */
+    int ok = pool != UINT64_MAX;
+    for (uint32_t i = 0; ok && i < v->n_curves; ++i) {
+        sw_sg_curve_rec c = v->curves[i];
+        c.knots += pool;
+        c.cpw += pool;
+        const uint32_t got = sw_sg_builder_add_curve(b, &c);
+        if (i == 0)
+            base[2] = got;
+        ok = got != SW_SG_NONE && got == base[2] + i;
+    }
+    for (uint32_t i = 0; ok && i < v->n_loops; ++i) {
+        sw_sg_loop_rec l = v->loops[i];
+        l.first_curve += base[2];
+        const uint32_t got = sw_sg_builder_add_loop(b, &l);
+        if (i == 0)
+            base[1] = got;
+        ok = got != SW_SG_NONE && got == base[1] + i;
+    }
+    for (uint32_t i = 0; ok && i < v->n_faces; ++i) {
+        sw_sg_face_rec f = v->faces[i];
+        f.knots_u += pool;
+        f.knots_v += pool;
+        f.cpw += pool;
+        f.first_loop += base[1];
+        ok = sw_sg_builder_add_face(b, &f) == base[0] + i;
+    }
     for (uint32_t i = 0; ok && i < v->n_adjacency; ++i)
-        ok = sw_sg_builder_add_adjacency(b, v->adjacency[i].face_a, v->adjacency[i].face_b) == i;
+        ok = sw_sg_builder_add_adjacency(b, base[0] + v->adjacency[i].face_a,
+                                         base[0] + v->adjacency[i].face_b) != SW_SG_NONE;
     if (!ok)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid: copying the model: out of memory");
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     return SW_OK;
 }
 
 /* Preorder of the model's node forest (every parentless node, in index order, its subtree first
  * child first), so that a node is added after its parent; map[i] = the builder index of node i,
- * which is 1 + its position in that order (node 0 is the builder's root). */
-static sw_result node_order(const sw_sg_scene_view *v, uint32_t *order, uint32_t *map,
-                            sw_status *status)
+ * which is base + its position in that order. */
+static sw_result node_order(const sw_sg_scene_view *v, uint32_t base, uint32_t *order,
+                            uint32_t *map, sw_status *status)
 {
     uint32_t *stack = malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *stack);
     if (!stack)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid: out of memory");
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     uint32_t n = 0;
     for (uint32_t r = 0; r < v->n_nodes; ++r) {
         if (v->nodes[r].parent != SW_SG_NONE)
@@ -61,7 +85,7 @@ static sw_result node_order(const sw_sg_scene_view *v, uint32_t *order, uint32_t
         stack[top++] = r;
         while (top > 0) {
             const uint32_t i = stack[--top];
-            map[i] = n + 1;
+            map[i] = base + n;
             order[n++] = i;
             /* children pushed last first, so the first child is taken first */
             uint32_t first = top;
@@ -77,33 +101,44 @@ static sw_result node_order(const sw_sg_scene_view *v, uint32_t *order, uint32_t
     }
     free(stack);
     if (n != v->n_nodes) /* validation rules this out; the copy loop relies on it */
-        return sw__fail(status, SW_ERR_FORMAT, "grid: %u of the model's %u nodes unreachable",
+        return sw__fail(status, SW_ERR_FORMAT, "copying a model: %u of its %u nodes unreachable",
                         v->n_nodes - n, v->n_nodes);
     return SW_OK;
 }
 
 /* Adds the model's nodes as detached nodes of the builder (the prototype), refs remapped. */
-static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t *proto,
-                            sw_status *status)
+static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base,
+                            uint32_t face_base, uint32_t *proto, sw_status *status)
 {
     uint32_t *order = malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *order);
     uint32_t *map = malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *map);
-    sw_result r = order && map ? node_order(v, order, map, status)
-                               : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid: out of memory");
+    sw_result r = order && map
+                      ? node_order(v, base, order, map, status)
+                      : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     for (uint32_t k = 0; r == SW_OK && k < v->n_nodes; ++k) {
         const sw_sg_node_rec *s = &v->nodes[order[k]];
         const uint32_t parent = s->parent == SW_SG_NONE ? SW_SG_NONE : map[s->parent];
-        const uint32_t ref = s->kind == SW_SG_NODE_INSTANCE ? map[s->ref] : s->ref;
+        const uint32_t ref = s->kind == SW_SG_NODE_INSTANCE  ? map[s->ref]
+                             : s->kind == SW_SG_NODE_SURFACE ? face_base + s->ref
+                                                             : s->ref;
         const char *name = s->name == SW_SG_NONE ? NULL : v->strings + s->name;
         const uint32_t got = sw_sg_builder_add_node(b, (sw_sg_node_kind)s->kind, parent, ref,
                                                     s->xform, s->color, name);
-        if (got != k + 1)
-            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid: copying the model: out of memory");
+        if (got != base + k)
+            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     }
     *proto = r == SW_OK ? map[v->root] : SW_SG_NONE;
     free(order);
     free(map);
     return r;
+}
+
+sw_result sw__sg_append_model(sw_sg_builder *b, const sw_sg_scene_view *model, uint32_t node_base,
+                              uint32_t *proto, sw_status *status)
+{
+    uint32_t base[3];
+    sw_result r = copy_arrays(model, b, base, status);
+    return r == SW_OK ? copy_nodes(model, b, node_base, base[0], proto, status) : r;
 }
 
 static sw_result check_desc(const sw_sg_grid_desc *d, sw_status *status)
@@ -193,9 +228,7 @@ sw_result sw_sg_generate_grid(const sw_sg_scene *model, const sw_sg_grid_desc *d
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid: out of memory");
     const sw_sg_scene_view *v = sw_sg_scene_view_ptr(model);
     uint32_t proto = SW_SG_NONE;
-    r = copy_arrays(v, b, status);
-    if (r == SW_OK)
-        r = copy_nodes(v, b, &proto, status);
+    r = sw__sg_append_model(b, v, 1, &proto, status); /* the builder holds its root only */
     if (r == SW_OK)
         r = add_instances(b, desc, &rep, proto, status);
     if (r != SW_OK) {

@@ -17,7 +17,7 @@ static const command k_commands[] = {
     {"path", sw_cli_path, "write a camera path (orbit or fly-through) fitted to a scene"},
     {"profile", sw_cli_profile, "time frames along a camera path: CSV, JSON, SVG, HTML report"},
     {"view", sw_cli_view, "walk through a scene in a window (WASD, mouse; needs a display)"},
-    {"generate", sw_cli_generate, "write a test scene: instances of a model on a grid"},
+    {"generate", sw_cli_generate, "write a test scene: a grid of instances, or a building"},
     {"demo", sw_cli_demo, "build and render the built-in default scene"},
     {"check-osd", sw_cli_check_osd, "cross-check uniform bicubic regions against OpenSubdiv"},
 };

@@ -161,5 +161,71 @@ grep -q "4x3x1 grid (spacing 500, 500, 500)" gen.txt || fail "10 instances in 2D
 cmp -s model1.png one.png || fail "a 1-instance grid renders differently from its model"
 pass "generate grid: usage errors, failures, a 2x2x2 grid of Motor-c, a 1-instance grid = the model"
 
+# generate building: exactly N surfaces, deterministic, rendered, its BREP read back; bad input is
+# a usage error (2) or a named failure (1) and leaves nothing behind.
+"$sw" generate --help >help.txt
+for opt in building --surfaces --seed --brep --data 10000000 occt-misc; do
+  grep -q -- "$opt" help.txt || fail "generate --help does not mention $opt"
+done
+for bad in "--surfaces -5" "--surfaces 0" "--surfaces 99" "--surfaces 10000001" \
+           "--surfaces 99999999999" "--surfaces 1e3" "--surfaces abc" "--seed -1" "--seed x"; do
+  "$sw" generate building $bad -o bad.sws >/dev/null 2>err.txt
+  rc=$?
+  [ $rc -eq 2 ] || fail "generate building $bad: exit status $rc, expected 2"
+  grep -q -- "${bad%% *}" err.txt || fail "generate building $bad: stderr does not name ${bad%% *}"
+done
+"$sw" generate building --surfaces 1000 >/dev/null 2>&1; [ $? -eq 2 ] || fail "generate building without -o accepted"
+"$sw" generate building -o bad.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "generate building without --surfaces accepted"
+"$sw" generate building --surfaces 1000 --model motor.sws -o bad.sws >/dev/null 2>&1; [ $? -eq 2 ] ||
+  fail "generate building --model accepted"
+expect_error "generate building: missing sample data" SW_ERR_NOT_FOUND no-such-dir/occ/MODERN_Chair_1.brep -- \
+  "$sw" generate building --surfaces 1000 --data no-such-dir -o bad.sws --brep bad.brep
+expect_error "generate building: output in a missing directory" SW_ERR_NOT_FOUND nodir/b.sws -- \
+  "$sw" generate building --surfaces 1000 -o nodir/b.sws --brep b-nodir.brep
+expect_error "generate building: BREP in a missing directory" SW_ERR_IO nodir/b.brep -- \
+  "$sw" generate building --surfaces 1000 -o b-nodir.sws --brep nodir/b.brep
+if [ "$(id -u)" -ne 0 ]; then
+  expect_error "generate building: unwritable output" SW_ERR_IO ro/b.sws -- \
+    "$sw" generate building --surfaces 1000 -o ro/b.sws
+fi
+for f in bad.sws bad.brep b-nodir.brep b-nodir.sws; do
+  [ ! -e $f ] && ! ls $f.tmp* >/dev/null 2>&1 || fail "a failed generate building left $f"
+done
+"$sw" generate building --surfaces 1000 --seed 3 -o b1.sws --brep b1.brep >gen.txt 2>&1 ||
+  { fail "generate building"; cat gen.txt; }
+"$sw" generate building --surfaces 1000 --seed 3 -o b2.sws >/dev/null 2>&1 || fail "generate building again"
+cmp -s b1.sws b2.sws || fail "generate building: one seed, two different files"
+"$sw" info b1.sws --json >b1.json || fail "info b1.sws"
+grep -q '"face_occurrences": 1000,' b1.json || fail "building of 1000 surfaces: $(cat b1.json)"
+faces=$(sed -n 's/.*"faces": \([0-9]*\),.*/\1/p' b1.json)
+[ -n "$faces" ] && [ "$faces" -ge 100 ] || fail "building: $faces unique faces of 1000"
+"$sw" info b1.brep --json >b1brep.json 2>/dev/null || fail "info b1.brep"
+grep -q "\"faces\": $faces," b1brep.json && grep -q '"face_occurrences": 1000,' b1brep.json ||
+  fail "the BREP read back differs: $(cat b1brep.json) vs $faces faces, 1000 occurrences"
+"$sw" render b1.sws -o b1.png --size 320x240 >render.txt 2>&1 || { fail "render b1.sws"; cat render.txt; }
+drawn=$(sed -n 's/.*faces drawn \([0-9]*\),.*/\1/p' render.txt)
+tris=$(sed -n 's/.*; \([0-9]*\) triangles;.*/\1/p' render.txt)
+[ -n "$drawn" ] && [ "$drawn" -gt 0 ] && [ -n "$tris" ] && [ "$tris" -gt 0 ] ||
+  fail "render of the building drew nothing: $(cat render.txt)"
+# a blank 320x240 PNG compresses to a few hundred bytes; the building's image does not
+[ "$(stat -c %s b1.png 2>/dev/null || echo 0)" -gt 4000 ] || fail "render of the building: blank image"
+pass "generate building: usage errors, failures, 1000 surfaces ($faces unique) twice the same, rendered ($drawn faces, $tris triangles), BREP read back"
+
+# generate vehicle: the same options and guarantees, cars instead of rooms.
+"$sw" generate vehicle -o bad.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "generate vehicle without --surfaces accepted"
+"$sw" generate vehicle --surfaces 20000000 -o bad.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "generate vehicle --surfaces 2e7 accepted"
+expect_error "generate vehicle: missing sample data" SW_ERR_NOT_FOUND no-such-dir/occ/Motor-c.brep -- \
+  "$sw" generate vehicle --surfaces 1000 --data no-such-dir -o bad.sws
+[ ! -e bad.sws ] || fail "a failed generate vehicle left bad.sws"
+"$sw" generate vehicle --surfaces 1000 -o v1.sws --brep v1.brep >gen.txt 2>&1 || { fail "generate vehicle"; cat gen.txt; }
+"$sw" info v1.sws --json >v1.json || fail "info v1.sws"
+grep -q '"face_occurrences": 1000,' v1.json || fail "vehicle of 1000 surfaces: $(cat v1.json)"
+vfaces=$(sed -n 's/.*"faces": \([0-9]*\),.*/\1/p' v1.json)
+"$sw" info v1.brep --json 2>/dev/null | grep -q "\"faces\": $vfaces,.*\"face_occurrences\": 1000," ||
+  fail "the vehicle BREP read back differs from $vfaces faces, 1000 occurrences"
+"$sw" render v1.sws -o v1.png --size 320x240 >render.txt 2>&1 || { fail "render v1.sws"; cat render.txt; }
+[ "$(stat -c %s v1.png 2>/dev/null || echo 0)" -gt 4000 ] || fail "render of the vehicles: blank image"
+pass "generate vehicle: usage errors, missing data, 1000 surfaces ($vfaces unique), BREP read back, rendered"
+
 echo "$failures failure(s)"
 [ $failures -eq 0 ]
