@@ -1,7 +1,9 @@
 /* Public scene API: load (.sws mapped, or imported through OCCT), save, describe, fit cameras. */
 #include "sw_rt.h"
 
+#include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
+#include "sw_sg_pick.h"
 #include "sw_sg_tspline.h"
 #include "sw_status_util.h"
 
@@ -104,8 +106,8 @@ static const double k_chair_twin[12] = {-1, 0, 0, 400.0, 0, -1, 0, 428.6, 0, 0, 
 static const double k_motor_on_table[12] = {0.3, 0, 0, 216.4, 0, 0.3, 0, 215.0, 0, 0, 0.3, 82.8};
 
 static sw_result import_part(sw_sg_builder *b, uint32_t parent, const double *xform,
-                             const char *data_dir, const char *file,
-                             const sw_scene_load_desc *desc, sw_status *status)
+                             const char *data_dir, const char *file, const sw_scene_load_desc *desc,
+                             sw_status *status)
 {
     char path[4096];
     int n = snprintf(path, sizeof path, "%s/%s", data_dir, file);
@@ -125,14 +127,14 @@ static sw_result build_default(sw_sg_builder *b, const char *data_dir,
         if (desc && desc->progress)
             desc->progress(desc->user_data, (double)i / (double)count, part->file);
         int is_motor = strstr(part->file, "Motor-c") != NULL;
-        uint32_t parent = sw_sg_builder_add_node(b, SW_SG_NODE_GROUP,
-                                                 part->instanced ? SW_SG_NONE : 0, 0, NULL,
-                                                 part->color, part->file);
+        uint32_t parent =
+            sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, part->instanced ? SW_SG_NONE : 0, 0, NULL,
+                                   part->color, part->file);
         if (parent == SW_SG_NONE)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
         if (part->instanced &&
-            (sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_identity, NULL,
-                                    "chair") == SW_SG_NONE ||
+            (sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_identity, NULL, "chair") ==
+                 SW_SG_NONE ||
              sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, parent, k_chair_twin, NULL,
                                     "chair twin") == SW_SG_NONE))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
@@ -146,8 +148,8 @@ static sw_result build_default(sw_sg_builder *b, const char *data_dir,
     return SW_OK;
 }
 
-sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *desc,
-                                sw_scene *out, sw_status *status)
+sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *desc, sw_scene *out,
+                                sw_status *status)
 {
     if (!out)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load_default: NULL out");
@@ -190,6 +192,7 @@ void sw_rt_scene_release(sw_rt_scene *scene)
     /* acq_rel: every use of the scene by other holders happens before the last one frees it. */
     if (atomic_fetch_sub_explicit(&scene->refs, 1u, memory_order_acq_rel) != 1u)
         return;
+    sw_sg_bvh_free(scene->pick_bvh);
     sw_sg_scene_free(scene->sg);
     pthread_mutex_destroy(&scene->once_lock);
     free(scene);
@@ -308,4 +311,41 @@ sw_result sw_camera_fit(sw_scene handle, sw_view_preset view, sw_camera *out, sw
     sw_rt_camera_fit_box(scene->stats.bbox, view, out);
     sw_rt_scene_release(scene);
     return SW_OK;
+}
+
+/* The scene's BVH for picking, built by the first pick (under once_lock; immutable after). */
+static sw_result pick_bvh(sw_rt_scene *scene, const sw_sg_bvh **out, sw_status *status)
+{
+    pthread_mutex_lock(&scene->once_lock);
+    sw_result r = scene->pick_bvh ? SW_OK : sw_sg_bvh_build(scene->sg, &scene->pick_bvh, status);
+    *out = scene->pick_bvh;
+    pthread_mutex_unlock(&scene->once_lock);
+    return r;
+}
+
+sw_result sw_scene_pick(sw_scene handle, const double origin[3], const double direction[3],
+                        sw_pick_hit *out, sw_status *status)
+{
+    if (!origin || !direction || !out)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_pick: NULL argument");
+    memset(out, 0, sizeof *out);
+    sw_rt_scene *scene;
+    sw_result r = sw_rt_scene_acquire(handle, &scene, status);
+    if (r != SW_OK)
+        return r;
+    const sw_sg_bvh *bvh = NULL;
+    sw_sg_pick_hit hit;
+    r = pick_bvh(scene, &bvh, status);
+    if (r == SW_OK)
+        r = sw_sg_pick(scene->sg, bvh, origin, direction, 0.0, &hit, status);
+    if (r == SW_OK && hit.face != SW_SG_NONE) {
+        out->hit = 1;
+        out->surface = hit.face;
+        out->t = hit.t;
+        memcpy(out->point, hit.point, sizeof out->point);
+        memcpy(out->uv, hit.uv, sizeof out->uv);
+        out->occurrence = hit.item;
+    }
+    sw_rt_scene_release(scene);
+    return r;
 }

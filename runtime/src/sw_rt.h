@@ -21,7 +21,10 @@ typedef struct sw_rt_pool {
     uint32_t capacity;
 } sw_rt_pool;
 
-#define SW_RT_POOL_INIT {PTHREAD_MUTEX_INITIALIZER, NULL, NULL, 0}
+#define SW_RT_POOL_INIT                                                                            \
+    {                                                                                              \
+        PTHREAD_MUTEX_INITIALIZER, NULL, NULL, 0                                                   \
+    }
 #define SW_RT_POOL_MAX_SLOTS 65535u
 
 uint32_t sw_rt_pool_add(sw_rt_pool *pool, void *item);  /* 0 when full or out of memory */
@@ -45,10 +48,12 @@ typedef struct sw_rt_scene {
     /* The pool's reference plus one per call using the scene: a scene destroyed while another
      * thread saves or draws it is freed by the last of them, never under their feet. */
     atomic_uint refs;
-    pthread_mutex_t once_lock; /* guards `ready`, `ready_result` and `stats` (first use only) */
+    pthread_mutex_t once_lock; /* guards `ready`, `ready_result` and `stats` (first use only),
+                                  and `pick_bvh` (built by the first pick) */
     int ready;
     sw_result ready_result;
     sw_sg_scene_stats stats;
+    struct sw_sg_bvh *pick_bvh; /* immutable once built; freed with the scene */
 } sw_rt_scene;
 
 /* The scene behind a handle, with every section verified and its stats computed (first call does

@@ -131,6 +131,43 @@ static void test_stale_and_double_destroy(void)
     EXPECT_RESULT(sw_scene_destroy(b), SW_OK);
 }
 
+/* sw_scene_pick through the public API: rays from the fitted presets' eyes to the box centre of
+ * the T-spline sample — at least one hits, every hit is in front of the eye and on its ray, every
+ * opposite ray misses; bad arguments and stale handles give the documented results. (Accuracy
+ * against OCCT: tests/pick.) */
+static void test_pick(void)
+{
+    sw_scene scene = load_scene();
+    sw_pick_hit hit;
+    int hits = 0;
+    double d[3] = {0, 0, 0}, eye[3] = {0, 0, 0};
+    for (int view = SW_VIEW_ISO; view <= SW_VIEW_RIGHT; view++) {
+        sw_camera cam;
+        EXPECT_RESULT(sw_camera_fit(scene, (sw_view_preset)view, &cam, NULL), SW_OK);
+        double back[3], scale = 0.0, off = 0.0;
+        for (int k = 0; k < 3; k++) {
+            eye[k] = cam.eye[k];
+            d[k] = cam.target[k] - cam.eye[k];
+            back[k] = -d[k];
+            scale += fabs(d[k]);
+        }
+        EXPECT_RESULT(sw_scene_pick(scene, eye, d, &hit, NULL), SW_OK);
+        for (int k = 0; hit.hit && k < 3; k++)
+            off += fabs(eye[k] + hit.t * d[k] - hit.point[k]);
+        EXPECT(!hit.hit || (hit.t > 0.0 && off < 1e-9 * scale));
+        hits += hit.hit;
+        EXPECT_RESULT(sw_scene_pick(scene, eye, back, &hit, NULL), SW_OK);
+        EXPECT(!hit.hit);
+    }
+    EXPECT(hits > 0);
+    double zero[3] = {0, 0, 0};
+    EXPECT_RESULT(sw_scene_pick(scene, eye, zero, &hit, NULL), SW_ERR_INVALID_ARGUMENT);
+    EXPECT_RESULT(sw_scene_pick(scene, NULL, d, &hit, NULL), SW_ERR_INVALID_ARGUMENT);
+    EXPECT_RESULT(sw_scene_pick(scene, eye, d, NULL, NULL), SW_ERR_INVALID_ARGUMENT);
+    EXPECT_RESULT(sw_scene_destroy(scene), SW_OK);
+    EXPECT_RESULT(sw_scene_pick(scene, eye, d, &hit, NULL), SW_ERR_STALE_HANDLE);
+}
+
 static void test_strings(void)
 {
     EXPECT(strcmp(sw_result_id_str((sw_result)SW_RESULT_COUNT), "SW_RESULT_UNKNOWN") == 0);
@@ -481,6 +518,7 @@ int main(int argc, char **argv)
         test_null_arguments();
         test_stale_and_double_destroy();
         test_strings();
+        test_pick();
         test_destroy_while_saving();
     } else {
         test_renderer();

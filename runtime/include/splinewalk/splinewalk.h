@@ -110,6 +110,25 @@ SW_API sw_result sw_scene_get_info(sw_scene scene, sw_scene_info *out, sw_status
 /* "plane", "cylinder", ...; "unknown" out of range; never NULL. A static string; any thread. */
 SW_API const char *sw_surface_kind_name(uint32_t kind);
 
+/* ---- picking --------------------------------------------------------------------------------- */
+typedef struct sw_pick_hit {
+    int32_t hit;         /* 0: the ray meets no surface (the rest is zero) */
+    uint32_t surface;    /* the surface (face) hit, as counted by sw_scene_info.faces */
+    uint64_t occurrence; /* which drawn occurrence of it (instances expanded; stable per scene) */
+    double t;            /* point = origin + t * direction, t > 0 */
+    double point[3];     /* world */
+    double uv[2];        /* the surface's parameters at the point (inside its trim loops) */
+} sw_pick_hit;
+
+/* The nearest point where the ray origin + t direction (t > 0; direction not unit, not zero) meets
+ * a trimmed surface of the scene, through a BVH over the scene's surface occurrences (built by the
+ * first pick and kept with the scene), Bézier subdivision and Newton's method on the exact NURBS
+ * surface. A ray tangent to a surface may miss it. Any thread. Errors: SW_ERR_INVALID_ARGUMENT
+ * (NULL pointer, zero or non-finite ray), SW_ERR_STALE_HANDLE, SW_ERR_OUT_OF_MEMORY,
+ * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene). out->hit = 0 with SW_OK: no hit. */
+SW_API sw_result sw_scene_pick(sw_scene scene, const double origin[3], const double direction[3],
+                               sw_pick_hit *out, sw_status *status);
+
 /* ---- cameras --------------------------------------------------------------------------------- */
 /* Right-handed, world units. All zero: the iso preset fitted to the drawn scene. Otherwise eye and
  * target must differ and up must not be parallel to target - eye. */
