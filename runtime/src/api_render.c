@@ -4,6 +4,7 @@
 #include "sw_rt_pipeline.h"
 
 #include "sw_lod_cache.h"
+#include "sw_lod_face_cones.h"
 #include "sw_sg_bvh.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
@@ -24,6 +25,7 @@ typedef struct sw_rt_renderer {
     sw_th_pool *pool;         /* created on the first frame that needs it */
     sw_lod_cache *cache;      /* of cache_scene */
     sw_sg_bvh *bvh;           /* of cache_scene */
+    sw_lod_face_cones *cones; /* of cache_scene: back-patch culling of closed shells */
     sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
     sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
@@ -110,6 +112,8 @@ static void drop_cache(sw_rt_renderer *r)
     r->cache = NULL;
     sw_sg_bvh_free(r->bvh);
     r->bvh = NULL;
+    sw_lod_face_cones_free(r->cones);
+    r->cones = NULL;
     if (r->cache_scene)
         sw_rt_scene_release(r->cache_scene);
     r->cache_scene = NULL;
@@ -132,6 +136,8 @@ static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_status
     sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
     if (res == SW_OK)
         res = sw_sg_bvh_build(scene->sg, &r->bvh, status);
+    if (res == SW_OK)
+        res = sw_lod_face_cones_build(scene->sg, &r->cones, status);
     if (res != SW_OK) {
         drop_cache(r);
         return res;
@@ -211,6 +217,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->ms_trim = g->ms_trim;
     out->ms_draw = g->ms_draw;
     out->ms_readback = g->ms_readback;
+    out->faces_backculled = g->faces_backculled;
 }
 
 static int camera_is_zero(const sw_camera *c)
@@ -285,6 +292,7 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
     if (res != SW_OK)
         return res;
     frame->bvh = r->bvh;
+    frame->face_cones = r->cones;
     if (!frame->eval_exact && !desc->no_hierarchy)
         frame->hierarchies = r->cache;
     return SW_OK;

@@ -226,6 +226,8 @@ typedef struct sw_frame_stats {
      * ms_total = ms_wait_visibility (waiting for the visibility thread) + trim + draw + readback
      * + write + the call's own overhead. Both 0 for sw_renderer_draw. */
     double ms_visibility, ms_wait_visibility;
+    uint64_t faces_backculled; /* of faces_culled: back-facing surfaces of closed shells (Kumar
+                                  §4.4 back-patch culling by normal cones) */
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so
