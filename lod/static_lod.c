@@ -1093,7 +1093,7 @@ static double dist_at(const face_dom *fd, const double p[3], double u, double v)
  * |S(u, v) - p|^2 from (u, v) over the uv_box; the best iterate inside the domain, or, when the
  * foot lies outside, the surface point at the nearest point of the selected patch (of the start)
  * and of the loops (flattened within 1 % of the level's ε: a border point of the surface). */
-static double project(const face_dom *fd, const double p[3], double u, double v)
+static double project(const face_dom *fd, const double p[3], double u, double v, int *inside)
 {
     double best = INFINITY;
     const double lu = fd->ub[fd->nu] - fd->ub[0], lv = fd->vb[fd->nv] - fd->vb[0];
@@ -1123,7 +1123,8 @@ static double project(const face_dom *fd, const double p[3], double u, double v)
         if (fabs(du) <= 1e-13 * lu && fabs(dv) <= 1e-13 * lv)
             break;
     }
-    if (in_domain(fd, u, v))
+    *inside = in_domain(fd, u, v);
+    if (*inside)
         return fmin(best, dist_at(fd, p, u, v));
     if (!fd->sel[locate(fd->vb, fd->nv, v) * fd->nu + locate(fd->ub, fd->nu, u)]) {
         if (!fd->sel[pj * fd->nu + pi])
@@ -1230,17 +1231,53 @@ static double longest2(const sw_lod_static_level *lv, uint32_t t)
     return l;
 }
 
+/* Upper bound of the distance to the surface of the triangle point with barycentric (w0, w1). */
+typedef struct mesh_ref {
+    const sw_lod_mesh_distance *level0; /* may be NULL */
+    double delta;
+} mesh_ref;
+
+static double mesh_point_distance(const face_dom *fd, const mesh_ref *ref, const double *const P[3],
+                                  const double *const UV[3], double w0, double w1)
+{
+    const double w2 = 1.0 - w0 - w1;
+    double x[3], uv[2];
+    for (int c = 0; c < 3; ++c)
+        x[c] = w0 * P[0][c] + w1 * P[1][c] + w2 * P[2][c];
+    for (int c = 0; c < 2; ++c)
+        uv[c] = w0 * UV[0][c] + w1 * UV[1][c] + w2 * UV[2][c];
+    /* a foot outside the domain gives a loose bound: retry from the vertices */
+    int inside;
+    double dist = project(fd, x, uv[0], uv[1], &inside);
+    for (int c = 0; c < 3 && !inside; ++c)
+        dist = fmin(dist, project(fd, x, UV[c][0], UV[c][1], &inside));
+    if (!(dist < INFINITY)) /* no start in the domain: the nearest vertex bounds it */
+        for (int c = 0; c < 3; ++c)
+            dist = fmin(dist, sqrt((x[0] - P[c][0]) * (x[0] - P[c][0]) +
+                                   (x[1] - P[c][1]) * (x[1] - P[c][1]) +
+                                   (x[2] - P[c][2]) * (x[2] - P[c][2])));
+    /* Newton finds a local foot only: where the surface folds back (a thread's next turn) the
+     * nearest point lies elsewhere. Level 0 is within delta of the surface everywhere (a
+     * rigorous bound), so the exact distance to it plus delta also bounds the distance. */
+    if (ref->level0)
+        dist = fmin(dist, sw_lod_mesh_distance_query(ref->level0, x) + ref->delta);
+    return dist;
+}
+
 /* Mesh -> surface: points of each triangle, projected by Newton from their interpolated (u, v). */
-static void measure_mesh(const patch_set *ps, const sw_lod_static_level *lv,
+static void measure_mesh(const patch_set *ps, const mesh_ref *ref, const sw_lod_static_level *lv,
                          const sw_lod_static_measure_desc *d, rng *rg, sw_lod_static_distance *out)
 {
     /* Samples in proportion to the triangles' squared longest edges (an area that does not
      * vanish for slivers), at least 3 per triangle (its edge midpoints in the lattice), in all
-     * max(20k, 2 per triangle) x triangle_samples / 6. */
+     * max(3 per triangle, min(20k, max(4k, 64 per triangle))) x triangle_samples / 6: a
+     * coarse level's few large triangles are sampled densely. */
     double sum = 0.0;
     for (uint32_t t = 0; t < lv->n_triangles; ++t)
         sum += longest2(lv, t);
-    const double budget = fmax(20000.0, 2.0 * lv->n_triangles) * d->triangle_samples / 6.0;
+    const double budget =
+        fmax(3.0 * lv->n_triangles, fmin(20000.0, fmax(4000.0, 64.0 * lv->n_triangles))) *
+        d->triangle_samples / 6.0;
     for (uint32_t t = 0; t < lv->n_triangles; ++t) {
         const uint32_t *tv = lv->triangles + 3 * (size_t)t;
         const face_dom *fd = find_face(ps, lv->face[tv[0]]);
@@ -1257,6 +1294,7 @@ static void measure_mesh(const patch_set *ps, const sw_lod_static_level *lv,
         while ((k + 1) * (k + 2) / 2 - 3 < want)
             ++k;
         const int32_t n_pts = (k + 1) * (k + 2) / 2;
+        double tbest = 0.0, bw0 = 1.0 / 3.0, bw1 = 1.0 / 3.0;
         for (int32_t q = 0; q < n_pts; ++q) {
             double w0, w1;
             if (d->random) {
@@ -1271,28 +1309,41 @@ static void measure_mesh(const patch_set *ps, const sw_lod_static_level *lv,
             const double w2 = 1.0 - w0 - w1;
             if (w0 == 1.0 || w1 == 1.0 || w2 == 1.0)
                 continue; /* a vertex: on the surface by construction */
-            double x[3], uv[2];
-            for (int c = 0; c < 3; ++c)
-                x[c] = w0 * P[0][c] + w1 * P[1][c] + w2 * P[2][c];
-            for (int c = 0; c < 2; ++c)
-                uv[c] = w0 * UV[0][c] + w1 * UV[1][c] + w2 * UV[2][c];
-            double dist = project(fd, x, uv[0], uv[1]);
-            for (int c = 0; c < 3 && !(dist < INFINITY); ++c)
-                dist = fmin(dist, project(fd, x, UV[c][0], UV[c][1]));
-            if (!(dist < INFINITY)) /* no start in the domain: the nearest vertex bounds it */
-                for (int c = 0; c < 3; ++c)
-                    dist = fmin(dist, sqrt((x[0] - P[c][0]) * (x[0] - P[c][0]) +
-                                           (x[1] - P[c][1]) * (x[1] - P[c][1]) +
-                                           (x[2] - P[c][2]) * (x[2] - P[c][2])));
+            const double dist = mesh_point_distance(fd, ref, P, UV, w0, w1);
+            if (dist > tbest)
+                tbest = dist, bw0 = w0, bw1 = w1;
             out->mesh_to_surface = fmax(out->mesh_to_surface, dist);
             out->n_mesh++;
         }
+        /* Coarse levels: a pattern search from the triangle's worst sample, since the peak of a
+         * needle triangle is narrow (one-sided decimation lets such triangles leave the surface).
+         */
+        if (lv->n_triangles > 20000 || !(tbest > 0.0))
+            continue;
+        for (double h = 0.5 / k; h > 0.02 / k; h *= 0.5)
+            for (int improved = 1; improved;) {
+                improved = 0;
+                static const double dir[6][2] = {{1, 0},  {-1, 0}, {0, 1},
+                                                 {0, -1}, {1, -1}, {-1, 1}};
+                for (int q = 0; q < 6; ++q) {
+                    const double w0 = bw0 + h * dir[q][0], w1 = bw1 + h * dir[q][1];
+                    if (w0 < 0.0 || w1 < 0.0 || w0 + w1 > 1.0)
+                        continue;
+                    const double dist = mesh_point_distance(fd, ref, P, UV, w0, w1);
+                    out->n_mesh++;
+                    if (dist > tbest) {
+                        tbest = dist, bw0 = w0, bw1 = w1, improved = 1;
+                        out->mesh_to_surface = fmax(out->mesh_to_surface, dist);
+                    }
+                }
+            }
     }
 }
 
 static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
-                             double eps_hint, const sw_lod_static_measure_desc *din,
-                             sw_lod_static_distance *out, sw_status *status)
+                             const sw_lod_static_level *level0, double delta, double eps_hint,
+                             const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
+                             sw_status *status)
 {
     sw_lod_static_measure_desc d;
     measure_desc_defaults(din, &d);
@@ -1301,7 +1352,9 @@ static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_l
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: empty level");
     for (uint32_t f = 0; f < ps->n_faces; ++f) {
         face_dom *fd = &ps->faces[f];
-        const double tol = 0.01 * eps_hint / (fd->grad > 0.0 ? fd->grad : 1.0);
+        /* a floor: a level measured exact (a plane) must not flatten at rounding level */
+        const double range = fmax(fd->ub[fd->nu] - fd->ub[0], fd->vb[fd->nv] - fd->vb[0]);
+        const double tol = fmax(0.01 * eps_hint / (fd->grad > 0.0 ? fd->grad : 1.0), 1e-9 * range);
         sw_result r = face_dom_flatten(scene, fd, tol, status);
         if (r != SW_OK)
             return r;
@@ -1319,13 +1372,20 @@ static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_l
         measure_face_surface(&ps->faces[f], md, &d, (m + sub - 1) / sub, &rg, out);
     }
     sw_lod_mesh_distance_free(md);
-    measure_mesh(ps, lv, &d, &rg, out);
+    mesh_ref ref = {NULL, delta};
+    if (level0 && level0 != lv && level0->n_triangles > 0 &&
+        (r = sw_lod_mesh_distance_create(level0->positions, level0->triangles, level0->n_triangles,
+                                         (sw_lod_mesh_distance **)&ref.level0, status)) != SW_OK)
+        return r;
+    measure_mesh(ps, &ref, lv, &d, &rg, out);
+    sw_lod_mesh_distance_free((sw_lod_mesh_distance *)ref.level0);
     sw__status_ok(status);
     return SW_OK;
 }
 
 sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
-                                uint32_t n, const sw_lod_static_level *level, double eps_hint,
+                                uint32_t n, const sw_lod_static_level *level,
+                                const sw_lod_static_level *level0, double delta, double eps_hint,
                                 const sw_lod_static_measure_desc *desc, sw_lod_static_distance *out,
                                 sw_status *status)
 {
@@ -1334,7 +1394,7 @@ sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_pa
     if (r == SW_OK && !(eps_hint > 0.0))
         r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: eps_hint %g", eps_hint);
     if (r == SW_OK)
-        r = measure_set(scene, &ps, level, eps_hint, desc, out, status);
+        r = measure_set(scene, &ps, level, level0, delta, eps_hint, desc, out, status);
     patch_set_free(&ps);
     return r;
 }
@@ -1465,14 +1525,25 @@ typedef struct build_ctx {
 static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
 {
     const double t0 = now_seconds();
-    sw_lod_static_distance dist;
-    sw_result r = measure_set(b->scene, b->ps, l, l->eps_target, NULL, &dist, b->status);
+    /* a lattice and random points: the random pass catches the sharp peaks near slivers that a
+     * lattice of the same size can step over */
+    sw_lod_static_distance dist, dr;
+    const sw_lod_static_measure_desc random = {1, 0, 0, 1};
+    const sw_lod_static_level *l0 = &b->chain->levels[0];
+    const double delta = b->chain->delta;
+    sw_result r = measure_set(b->scene, b->ps, l, l0, delta, l->eps_target, NULL, &dist, b->status);
+    if (r == SW_OK)
+        r = measure_set(b->scene, b->ps, l, l0, delta, l->eps_target, &random, &dr, b->status);
     b->t_measure += now_seconds() - t0;
     if (r != SW_OK)
         return r;
+    dist.surface_to_mesh = fmax(dist.surface_to_mesh, dr.surface_to_mesh);
+    dist.mesh_to_surface = fmax(dist.mesh_to_surface, dr.mesh_to_surface);
     l->measured[0] = dist.surface_to_mesh;
     l->measured[1] = dist.mesh_to_surface;
-    l->eps = b->d->safety * fmax(dist.surface_to_mesh, dist.mesh_to_surface);
+    /* never below level 0's δ: its vertices are level 0's, and a level measured exact (planes)
+     * would otherwise declare rounding noise */
+    l->eps = fmax(b->chain->delta, b->d->safety * fmax(dist.surface_to_mesh, dist.mesh_to_surface));
     return SW_OK;
 }
 
@@ -1509,7 +1580,7 @@ static sw_result desc_defaults(const sw_lod_static_desc *in, const patch_set *ps
     if (d->eps_growth == 0.0)
         d->eps_growth = 4.0;
     if (d->safety == 0.0)
-        d->safety = 1.25;
+        d->safety = 1.5;
     if (d->max_vertices == 0)
         d->max_vertices = 4000000;
     if (!(d->delta > 0.0 && isfinite(d->delta)) || d->n_levels < 0 || d->n_levels > 8 ||
@@ -1583,7 +1654,8 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         const double t1 = now_seconds();
         sw_lod_static_distance dist;
         if (r == SW_OK)
-            r = measure_set(scene, &ps, &chain->levels[0], d.delta, NULL, &dist, status);
+            r = measure_set(scene, &ps, &chain->levels[0], NULL, d.delta, d.delta, NULL, &dist,
+                            status);
         if (r == SW_OK) {
             chain->levels[0].measured[0] = dist.surface_to_mesh;
             chain->levels[0].measured[1] = dist.mesh_to_surface;

@@ -14,8 +14,10 @@
  * the borders simplified first and then locked. Each level's ε_k is declared from a two-sided
  * measurement against the exact surface (sw_lod_static_measure), times a safety factor.
  *
- * Memory of a chain: per level 48 bytes per vertex (position 24, normal 12, (u, v) 16 with the
- * face index 4... see sw_lod_static_memory for the exact count) and 12 bytes per triangle.
+ * Memory of a chain (sw_lod_static_memory): per level 56 bytes per vertex (position 24, normal
+ * 12, (u, v) 16, face 4) and 12 bytes per triangle; the levels after level 0 are small (their
+ * triangle counts are in the test output). Building needs about 3x level 0 besides (the CDT, the
+ * OpenMesh copy).
  */
 #ifndef SW_LOD_STATIC_H
 #define SW_LOD_STATIC_H
@@ -44,7 +46,7 @@ typedef struct sw_lod_static_desc {
     int32_t n_levels;  /* simplified levels after level 0 (1..8); 0 = 4; -1 = none */
     double eps_first;  /* target ε of level 1 in units of δ (> 1); 0 = 4 */
     double eps_growth; /* ratio of consecutive target ε (> 1); 0 = 4 */
-    double safety;     /* declared ε_k = safety x measured two-sided distance (>= 1); 0 = 1.25 */
+    double safety;     /* declared ε_k = safety x measured two-sided distance (>= 1); 0 = 1.5 */
     uint32_t max_vertices; /* level 0 limit (SW_ERR_LIMIT beyond it); 0 = 4,000,000 */
 } sw_lod_static_desc;
 
@@ -101,12 +103,21 @@ typedef struct sw_lod_static_distance {
     uint64_t n_surface, n_mesh; /* samples taken */
 } sw_lod_static_distance;
 
-/* Measures level `level` of the patches both ways. Surface samples: a lattice of the selected
- * patches' domains inside the trim loops, the trim loops themselves (flattened at 1 % of the
- * level's ε) and the super-surface's patch-rectangle borders. Mesh samples: points of each
- * triangle (not its vertices, which lie on the surface). Errors as sw_lod_static_build. */
+/* Measures `level` of the patches both ways. Surface samples: a lattice (or random points) of the
+ * selected patches' domains inside the trim loops, the loops themselves (flattened within 1 % of
+ * eps_hint > 0, the level's ε, in object space) and the super-surface's patch-rectangle borders.
+ * Mesh samples: points of each triangle, more on larger ones (not its vertices, which lie on the
+ * surface), each projected by Newton's iteration from its interpolated (u, v); a foot outside the
+ * trimmed domain is moved to the nearest loop point, so each value bounds the distance from above.
+ * level0 (may be NULL or equal to level) with its rigorous bound delta gives a second upper bound
+ * at each mesh sample, the exact distance to level 0 plus delta, which Newton's local foot can
+ * exceed where the surface folds back (a thread's next turn).
+ * The surface side is a sampled maximum, so it can miss a peak between samples: the builder
+ * multiplies by desc->safety and the tests re-measure with other samples. Errors as
+ * sw_lod_static_build. */
 sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
-                                uint32_t n, const sw_lod_static_level *level, double eps_hint,
+                                uint32_t n, const sw_lod_static_level *level,
+                                const sw_lod_static_level *level0, double delta, double eps_hint,
                                 const sw_lod_static_measure_desc *desc, sw_lod_static_distance *out,
                                 sw_status *status);
 

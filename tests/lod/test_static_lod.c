@@ -56,13 +56,15 @@ static uint32_t face_patches(const sw_sg_scene *scene, uint32_t face, sw_lod_sta
 }
 
 static int check_level(const sw_sg_scene *scene, const sw_lod_static_patch *p, uint32_t n,
-                       const sw_lod_static_level *l, int32_t k, uint32_t face, totals *t)
+                       const sw_lod_static_chain *c, int32_t k, uint32_t face, totals *t)
 {
     /* independent of the declaring measurement: random points, another seed, other counts */
+    const sw_lod_static_level *l = &c->levels[k];
     const sw_lod_static_measure_desc md = {977u + (uint32_t)k, 13, 7, 1};
     sw_lod_static_distance dist;
     sw_status st = {0};
-    if (sw_lod_static_measure(scene, p, n, l, l->eps, &md, &dist, &st) != SW_OK) {
+    if (sw_lod_static_measure(scene, p, n, l, &c->levels[0], c->delta, l->eps, &md, &dist, &st) !=
+        SW_OK) {
         fprintf(stderr, "face %u level %d: measure failed: %s\n", face, (int)k, st.message);
         return 1;
     }
@@ -134,7 +136,7 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
         for (int32_t k = 0; k < c->n_levels; ++k) {
             t.tri[k] += c->levels[k].n_triangles;
             t.eps_rel[k] += c->levels[k].eps / c->delta;
-            fail |= check_level(scene, p, n, &c->levels[k], k, f, &t);
+            fail |= check_level(scene, p, n, c, k, f, &t);
         }
         t.coarse_below_2n += c->levels[c->n_levels - 1].n_triangles < 2 * n;
         for (int q = 0; q < 3; ++q)
