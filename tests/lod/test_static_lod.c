@@ -85,6 +85,25 @@ static int check_level(const sw_sg_scene *scene, const sw_lod_static_patch *p, u
 
 static int verbose;
 
+/* Bad input is an sw_result, never a crash: no patches, a face or (iu, iv) out of range, bad desc.
+ */
+static int check_bad_input(const sw_sg_scene *scene)
+{
+    const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
+    sw_lod_static_chain *c = NULL;
+    sw_status st = {0};
+    const sw_lod_static_patch bad_face = {v->n_faces, 0, 0}, bad_iu = {0, 60000, 0}, ok = {0, 0, 0};
+    const sw_lod_static_desc bad_desc = {-1.0, 0, 0.0, 0.0, 0.0, 0};
+    int fail = 0;
+    fail |= sw_lod_static_build(scene, &ok, 0, NULL, &c, &st) != SW_ERR_INVALID_ARGUMENT;
+    fail |= sw_lod_static_build(scene, &bad_face, 1, NULL, &c, &st) != SW_ERR_INVALID_ARGUMENT;
+    fail |= sw_lod_static_build(scene, &bad_iu, 1, NULL, &c, &st) != SW_ERR_INVALID_ARGUMENT;
+    fail |= sw_lod_static_build(scene, &ok, 1, &bad_desc, &c, &st) != SW_ERR_INVALID_ARGUMENT;
+    fail |= c != NULL;
+    printf("bad input: %s\n", fail ? "FAILED" : "every case rejected with SW_ERR_INVALID_ARGUMENT");
+    return fail;
+}
+
 static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t max_faces)
 {
     sw_sg_import_desc d = {path, NULL, NULL, NULL};
@@ -101,7 +120,8 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
     }
     const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
     totals t = {0};
-    int fail = 0;
+    static int bad_input_checked;
+    int fail = bad_input_checked++ ? 0 : check_bad_input(scene);
     for (uint32_t f = 0; f < v->n_faces && t.faces < (long)max_faces; f += stride) {
         sw_lod_static_patch *p = NULL;
         const uint32_t n = face_patches(scene, f, &p);
