@@ -5,8 +5,10 @@
  * declared ε_k — must find every level within its declared ε_k both ways: surface -> mesh and
  * mesh -> surface. Zero violations, or exit 1.
  *
- * Usage: test_static_lod [--levels N] [--stride K] [--max-faces N] [--verbose] model files...
- * --levels -1 checks level 0 only; --stride K takes every K-th face; --verbose prints each face.
+ * Usage: test_static_lod [--levels N] [--stride K] [--max-faces N] [--verbose] [--split] model
+ * files...
+ * --levels -1 checks level 0 only; --stride K takes every K-th face; --verbose prints each face;
+ * --split takes the lower half of each face's patch grid (a super-surface ending inside a face).
  * Prints per model: patches, triangles of level 0 and each level, reduction against level 0,
  * whether the coarsest level has fewer than 2n triangles for n patches, the worst measured / ε
  * ratio, and the build time split into tessellation, decimation and measurement.
@@ -83,7 +85,7 @@ static int check_level(const sw_sg_scene *scene, const sw_lod_static_patch *p, u
     return 0;
 }
 
-static int verbose;
+static int verbose, split;
 
 /* Bad input is an sw_result, never a crash: no patches, a face or (iu, iv) out of range, bad desc.
  */
@@ -124,7 +126,17 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
     int fail = bad_input_checked++ ? 0 : check_bad_input(scene);
     for (uint32_t f = 0; f < v->n_faces && t.faces < (long)max_faces; f += stride) {
         sw_lod_static_patch *p = NULL;
-        const uint32_t n = face_patches(scene, f, &p);
+        uint32_t n = face_patches(scene, f, &p);
+        if (split && n >= 2) { /* a partial super-surface: the lower half of the face's grid */
+            uint32_t nu = 0, nv = 0, m = 0;
+            for (uint32_t k = 0; k < n; ++k)
+                nu = p[k].iu + 1u > nu ? p[k].iu + 1u : nu,
+                nv = p[k].iv + 1u > nv ? p[k].iv + 1u : nv;
+            for (uint32_t k = 0; k < n; ++k)
+                if (nu >= 2 ? p[k].iu < nu / 2 : p[k].iv < nv / 2)
+                    p[m++] = p[k];
+            n = m;
+        }
         if (n == 0) {
             free(p);
             t.skipped++;
@@ -197,6 +209,8 @@ int main(int argc, char **argv)
             stride = (uint32_t)atoi(argv[++a]);
         else if (!strcmp(argv[a], "--verbose"))
             verbose = 1;
+        else if (!strcmp(argv[a], "--split"))
+            split = 1;
         else if (!strcmp(argv[a], "--max-faces") && a + 1 < argc)
             max_faces = (uint32_t)atoi(argv[++a]);
         else {
