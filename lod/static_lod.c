@@ -20,9 +20,18 @@
  *    (sw_sg_trim_flatten_loop), where G bounds |S_u du + S_v dv| per unit (du, dv) over the
  *    selected patches. The exact trimmed domain and the polygon's differ by tol at most, so their
  *    images differ by δ_trim at most, both ways.
- * Interior points form a grid per patch whose cells' triangles meet 0.6 δ_tri; triangles along the
- * loops that still exceed δ_tri are refined at the centre of their smallest enclosing disc (Kumar
- * inserts the point of maximal |F_uv|, §4.1 step 2; any interior point reduces R).
+ * Interior points form a grid per cell (a patch, or a half, quarter or eighth of one where the
+ * quarters' bounds are much tighter) whose triangles meet 0.6 δ_tri; triangles along the loops
+ * that still exceed δ_tri are refined at the centre of their smallest enclosing disc (Kumar inserts
+ * the point of maximal |F_uv|, §4.1 step 2; any interior point reduces R). The triangulation runs
+ * in the face's scaled coordinates, so that Delaunay's round triangles are round in the bound's
+ * metric.
+ *
+ * ε_k of the simplified levels is measured (sw_lod_static_measure): the maximum over lattice and
+ * random samples of both distances, times desc.safety. Mesh-to-surface values are upper bounds
+ * at each sample (a surface point found by Newton's iteration, or level 0 plus δ); the
+ * surface-to-mesh side is exact per sample (CGAL AABB tree). Neither side is a bound between
+ * samples: that is what the safety factor and the independent re-measurement in the tests are for.
  *
  * Where the paper is loose: §4.1 obtains M1..M3 by solving polynomial systems (elimination
  * theory); we use the rigorous but coarser control-net bounds of lod/sampling.c over each patch.
