@@ -9,7 +9,7 @@ packages=(
   libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev
   libglu1-mesa-dev
   libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev
-  libocct-foundation-dev libtbb-dev occt-misc
+  libocct-foundation-dev libtbb-dev occt-misc libcgal-dev
   xvfb xauth libcmocka-dev
   libxml2-utils jq  # tests/profile: xmllint checks the SVG and HTML, jq the JSON
 )

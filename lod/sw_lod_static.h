@@ -1,0 +1,127 @@
+/* splinewalk lod/: static levels of detail of a super-surface, Kumar et al. 1997 §4.1-§4.3.
+ *
+ * Input: a set of trimmed rational Bézier patches (a super-surface, §3), each named by its face and
+ * its (iu, iv) in the face's Bézier grid extracted over the face's uv_box, every net cut to its
+ * knot rectangle intersected with uv_box — the patches lod/hierarchy.c builds its trees from.
+ *
+ * Level 0, the adaptive tessellation within δ (§4.1, §4.3): per face, a constrained Delaunay
+ * triangulation (CGAL, lod/trim_mesh_cgal.cpp) of the part of the face's (u, v) domain covered by
+ * the selected patches and inside its trim loops. The loops and the selected patches' knot lines
+ * are constraints, so the mesh follows the trim curves and no triangle straddles two patches;
+ * triangles are refined until a rigorous bound of their deviation meets δ (see static_lod.c).
+ *
+ * Levels 1..n, simplification (§4.2): OpenMesh's Decimater (lod/static_lod_openmesh.cpp) with
+ * the borders simplified first and then locked. Each level's ε_k is declared from a two-sided
+ * measurement against the exact surface (sw_lod_static_measure), times a safety factor.
+ *
+ * Memory of a chain (sw_lod_static_memory): per level 56 bytes per vertex (position 24, normal
+ * 12, (u, v) 16, face 4) and 12 bytes per triangle; the levels after level 0 are small (their
+ * triangle counts are in the test output). Building needs about 3x level 0 besides (the CDT, the
+ * OpenMesh copy).
+ */
+#ifndef SW_LOD_STATIC_H
+#define SW_LOD_STATIC_H
+
+#include "sw_sg_scene.h"
+
+#include <splinewalk/sw_result.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* One Bézier patch of a super-surface. Same layout as sw_lod_ss_patch of the super-surface
+ * clustering (lod/sw_lod_supersurface.h), so a cluster's patch range can be passed as it is. */
+typedef struct sw_lod_static_patch {
+    uint32_t face;
+    uint16_t iu, iv;
+} sw_lod_static_patch;
+
+/* Zero fields take the defaults. */
+typedef struct sw_lod_static_desc {
+    double delta;      /* δ of level 0, object space; 0 = 1e-3 x the diagonal of the patches'
+                          control-point box */
+    int32_t n_levels;  /* simplified levels after level 0 (1..8); 0 = 4; -1 = none */
+    double eps_first;  /* target ε of level 1 in units of δ (> 1); 0 = 4 */
+    double eps_growth; /* ratio of consecutive target ε (> 1); 0 = 4 */
+    double safety;     /* declared ε_k = safety x measured two-sided distance (>= 1); 0 = 1.5 */
+    uint32_t max_vertices; /* level 0 limit (SW_ERR_LIMIT beyond it); 0 = 4,000,000 */
+} sw_lod_static_desc;
+
+/* One level. Vertices are points of the exact surface (decimation only removes vertices), each
+ * with the face and (u, v) it was evaluated at. */
+typedef struct sw_lod_static_level {
+    double *positions;   /* 3 per vertex */
+    float *normals;      /* 3 per vertex, unit, outward (the B-rep face orientation) */
+    double *uv;          /* 2 per vertex: parameters of the vertex's face */
+    uint32_t *face;      /* per vertex: scene face index */
+    uint32_t *triangles; /* 3 per triangle, counter-clockwise seen from outside */
+    uint32_t n_vertices, n_triangles;
+    double eps;         /* declared ε_k: every point of the level is within eps of the exact
+                           trimmed surface and vice versa (level 0: δ, a rigorous bound) */
+    double eps_target;  /* the ε the simplification aimed at (level 0: δ) */
+    double measured[2]; /* measured surface->mesh, mesh->surface distances */
+} sw_lod_static_level;
+
+typedef struct sw_lod_static_chain {
+    sw_lod_static_level *levels; /* n_levels + 1, fine -> coarse; [0] is the exact tessellation */
+    int32_t n_levels;            /* entries of levels[] */
+    uint32_t n_patches;
+    double delta;
+    double seconds[3]; /* build time: tessellation, decimation, measurement */
+} sw_lod_static_chain;
+
+/* Builds the chain of the n >= 1 patches (repeats allowed, order irrelevant). desc may be NULL.
+ * Precondition: SW_SG_SEC_FACES, LOOPS, CURVES and POOL required and validated.
+ * Errors: SW_ERR_INVALID_ARGUMENT (a face or (iu, iv) out of range, bad desc values, no patch),
+ * SW_ERR_INVALID_GEOMETRY (a trim loop that cannot be flattened, a mesh OpenMesh rejects),
+ * SW_ERR_LIMIT (more than max_vertices), SW_ERR_OUT_OF_MEMORY, SW_ERR_INTERNAL (CGAL/OpenMesh).
+ * On success *out is owned by the caller (sw_lod_static_free). */
+sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
+                              uint32_t n, const sw_lod_static_desc *desc, sw_lod_static_chain **out,
+                              sw_status *status);
+void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
+
+/* Bytes the chain owns. */
+size_t sw_lod_static_memory(const sw_lod_static_chain *chain);
+
+/* How the two-sided distance is sampled. Zero fields take the defaults. */
+typedef struct sw_lod_static_measure_desc {
+    uint32_t seed;            /* offsets of the lattices; 0 = 1 */
+    int32_t patch_samples;    /* surface lattice per patch side; 0 = 10 */
+    int32_t triangle_samples; /* barycentric points per triangle at the level-0 edge length
+                                 (more on larger triangles); 0 = 6 */
+    int random;               /* 1: random points instead of lattices (same counts) */
+} sw_lod_static_measure_desc;
+
+typedef struct sw_lod_static_distance {
+    double surface_to_mesh; /* max over samples of the exact trimmed surface: distance to mesh */
+    double mesh_to_surface; /* max over mesh samples: an upper bound of the distance to the
+                               surface at that sample (a surface point found by Newton) */
+    uint64_t n_surface, n_mesh; /* samples taken */
+} sw_lod_static_distance;
+
+/* Measures `level` of the patches both ways. Surface samples: a lattice (or random points) of the
+ * selected patches' domains inside the trim loops, the loops themselves (flattened within 1 % of
+ * eps_hint > 0, the level's ε, in object space) and the super-surface's patch-rectangle borders.
+ * Mesh samples: points of each triangle, more on larger ones (not its vertices, which lie on the
+ * surface), each projected by Newton's iteration from its interpolated (u, v); a foot outside the
+ * trimmed domain is moved to the nearest loop point, so each value bounds the distance from above.
+ * level0 (may be NULL or equal to level) with its rigorous bound delta gives a second upper bound
+ * at each mesh sample, the exact distance to level 0 plus delta, which Newton's local foot can
+ * exceed where the surface folds back (a thread's next turn).
+ * The surface side is a sampled maximum, so it can miss a peak between samples: the builder
+ * multiplies by desc->safety and the tests re-measure with other samples. Errors as
+ * sw_lod_static_build. */
+sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
+                                uint32_t n, const sw_lod_static_level *level,
+                                const sw_lod_static_level *level0, double delta, double eps_hint,
+                                const sw_lod_static_measure_desc *desc, sw_lod_static_distance *out,
+                                sw_status *status);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
