@@ -32,6 +32,9 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
  * SW_ERR_NO_CONTEXT (none current, or too old). */
 sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status);
 void sw_gpu_context_free(sw_gpu_context *ctx); /* NULL allowed */
+/* Makes an owned (headless) context current on the calling thread if another one is; an adopted
+ * context is the host's to keep current. Call before a frame when a thread owns several. */
+void sw_gpu_context_make_current(sw_gpu_context *ctx);
 /* "GL_RENDERER / GL_VERSION" of the context (borrowed). */
 const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
 

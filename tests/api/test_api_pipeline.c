@@ -186,6 +186,32 @@ static void test_walkthrough_overlap(sw_scene scene, const sw_camera *home, int 
     EXPECT_RESULT(sw_renderer_destroy(r), SW_OK);
 }
 
+/* Two headless renderers on one thread, frames interleaved: each draws with its own context
+ * (before the renderer made its context current, the second one's context stayed current and
+ * the first one's frames failed with GL errors). */
+static void test_two_renderers_one_thread(sw_scene scene, const sw_camera *home)
+{
+    sw_renderer a = {0}, b = {0};
+    EXPECT_RESULT(sw_renderer_create(NULL, &a, NULL), SW_OK);
+    EXPECT_RESULT(sw_renderer_create(NULL, &b, NULL), SW_OK);
+    char first[1024], again[1024], other[1024];
+    path(first, "two_a", 0);
+    path(other, "two_b", 0);
+    path(again, "two_a", 1);
+    sw_frame_desc fa = frame_at(scene, orbit(home, 2), first);
+    sw_frame_desc fb = frame_at(scene, orbit(home, 9), other);
+    EXPECT_RESULT(sw_renderer_draw(a, &fa, NULL, NULL), SW_OK);
+    EXPECT_RESULT(sw_renderer_draw(b, &fb, NULL, NULL), SW_OK);
+    fa.output_path = again;
+    EXPECT_RESULT(sw_renderer_draw(a, &fa, NULL, NULL), SW_OK);
+    int same = same_file(first, again), differs = !same_file(first, other);
+    EXPECT(same && differs);
+    printf("two renderers on one thread: the first one's frame %s after the second drew\n",
+           same ? "unchanged" : "CHANGED");
+    EXPECT_RESULT(sw_renderer_destroy(a), SW_OK);
+    EXPECT_RESULT(sw_renderer_destroy(b), SW_OK);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 3 || argc > 4) {
@@ -210,6 +236,7 @@ int main(int argc, char **argv)
     test_contract(r, scene, &home);
     EXPECT_RESULT(sw_renderer_destroy(r), SW_OK);
     test_walkthrough_overlap(scene, &home, frames);
+    test_two_renderers_one_thread(scene, &home);
     EXPECT_RESULT(sw_scene_destroy(scene), SW_OK);
     printf("%s: %d failure(s)\n", g_failures ? "FAIL" : "ok", g_failures);
     return g_failures ? 1 : 0;
