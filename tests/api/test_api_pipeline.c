@@ -186,9 +186,10 @@ static void test_walkthrough_overlap(sw_scene scene, const sw_camera *home, int 
     EXPECT_RESULT(sw_renderer_destroy(r), SW_OK);
 }
 
-/* Two headless renderers on one thread, frames interleaved: each draws with its own context
- * (before the renderer made its context current, the second one's context stayed current and
- * the first one's frames failed with GL errors). */
+/* Two headless renderers on one thread, frames interleaved: the first one's frame is the same
+ * after the second drew. (The bug this guards — the last-created context staying current —
+ * showed as GL_INVALID_OPERATION in bench_pipeline's 120-frame runs of two renderers; this short
+ * case does not reproduce it, since both contexts then hold same-named, alike objects.) */
 static void test_two_renderers_one_thread(sw_scene scene, const sw_camera *home)
 {
     sw_renderer a = {0}, b = {0};
@@ -200,12 +201,14 @@ static void test_two_renderers_one_thread(sw_scene scene, const sw_camera *home)
     path(again, "two_a", 1);
     sw_frame_desc fa = frame_at(scene, orbit(home, 2), first);
     sw_frame_desc fb = frame_at(scene, orbit(home, 9), other);
+    fb.width = 800; /* other sizes and trims: same-named objects of the two contexts differ */
+    fb.height = 600;
     EXPECT_RESULT(sw_renderer_draw(a, &fa, NULL, NULL), SW_OK);
     EXPECT_RESULT(sw_renderer_draw(b, &fb, NULL, NULL), SW_OK);
     fa.output_path = again;
     EXPECT_RESULT(sw_renderer_draw(a, &fa, NULL, NULL), SW_OK);
-    int same = same_file(first, again), differs = !same_file(first, other);
-    EXPECT(same && differs);
+    int same = same_file(first, again);
+    EXPECT(same);
     printf("two renderers on one thread: the first one's frame %s after the second drew\n",
            same ? "unchanged" : "CHANGED");
     EXPECT_RESULT(sw_renderer_destroy(a), SW_OK);
