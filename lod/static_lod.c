@@ -39,6 +39,7 @@
  * sampled; ours are sampled for δ_trim in object space.
  */
 #include "sw_lod_static.h"
+#include "sw_lod_supersurface.h"
 
 #include "sw_lod_bezier.h"
 #include "sw_lod_mesh_distance.h"
@@ -360,8 +361,8 @@ static int face_dom_refine(face_dom *fd, double c)
     return set_cells(fd, best, scale);
 }
 
-/* Extracts the face's patches over its uv_box, cuts them to it (as lod/hierarchy.c does with
- * use_box) and bounds the selected ones. patches[0..n) are this face's, sorted. */
+/* The face's patches as the hierarchy and the super-surfaces see them (sw_lod_face_patches: over
+ * its uv_box, cut to it) and the selected ones. patches[0..n) are this face's, sorted. */
 static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
                                uint32_t n, face_dom *fd, sw_status *status)
 {
@@ -372,16 +373,10 @@ static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_pat
     fd->face = face;
     fd->reversed = (fr->flags & SW_SG_FACE_REVERSED) != 0;
     sw_sg_scene_face_surface(scene, face, &fd->s);
-    sw_result r = sw_sg_surface_extract_bezier_in(&fd->s, fr->uv_box[0], fr->uv_box[1],
-                                                  fr->uv_box[2], fr->uv_box[3], &fd->set, status);
+    sw_result r = sw_lod_face_patches(scene, face, &fd->set, status);
     if (r != SW_OK)
         return r;
     fd->pnu = fd->set.n_u, fd->pnv = fd->set.n_v;
-    if (fd->pnu * fd->pnv == 0)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "static lod: face %u: uv box misses "
-                        "the domain",
-                        face);
     const size_t np = (size_t)fd->pnu * fd->pnv;
     fd->pub = malloc(((size_t)fd->pnu + 1) * sizeof *fd->pub);
     fd->pvb = malloc(((size_t)fd->pnv + 1) * sizeof *fd->pvb);
@@ -389,12 +384,12 @@ static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_pat
     if (!fd->pub || !fd->pvb || !fd->psel)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", face);
     for (int32_t i = 0; i < fd->pnu; ++i) {
-        fd->pub[i] = fmax(fd->set.patches[i].u0, fr->uv_box[0]);
-        fd->pub[i + 1] = fmin(fd->set.patches[i].u1, fr->uv_box[1]);
+        fd->pub[i] = fd->set.patches[i].u0;
+        fd->pub[i + 1] = fd->set.patches[i].u1;
     }
     for (int32_t j = 0; j < fd->pnv; ++j) {
-        fd->pvb[j] = fmax(fd->set.patches[j * fd->pnu].v0, fr->uv_box[2]);
-        fd->pvb[j + 1] = fmin(fd->set.patches[j * fd->pnu].v1, fr->uv_box[3]);
+        fd->pvb[j] = fd->set.patches[j * fd->pnu].v0;
+        fd->pvb[j + 1] = fd->set.patches[j * fd->pnu].v1;
     }
     for (uint32_t k = 0; k < n; ++k) {
         if (patches[k].iu >= fd->pnu || patches[k].iv >= fd->pnv)
@@ -410,11 +405,7 @@ static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_pat
             if (!fd->psel[j * fd->pnu + i])
                 continue;
             fd->n_sel++;
-            sw_sg_bezier_patch *p = &fd->set.patches[j * fd->pnu + i];
-            const double local[4] = {
-                (fd->pub[i] - p->u0) / (p->u1 - p->u0), (fd->pub[i + 1] - p->u0) / (p->u1 - p->u0),
-                (fd->pvb[j] - p->v0) / (p->v1 - p->v0), (fd->pvb[j + 1] - p->v0) / (p->v1 - p->v0)};
-            sw_lod_bez_restrict(p->deg_u, p->deg_v, 4, p->cpw, local, p->cpw);
+            const sw_sg_bezier_patch *p = &fd->set.patches[j * fd->pnu + i]; /* cut already */
             const int32_t ncp = (p->deg_u + 1) * (p->deg_v + 1);
             for (int32_t q = 0; q < ncp; ++q)
                 for (int c = 0; c < 3; ++c) {
