@@ -677,6 +677,19 @@ static uint32_t merge_pass(const state *st, cl *c, uint32_t n_cl, const uint32_t
 }
 
 /* ---- output ---------------------------------------------------------------------------------- */
+
+/* Kumar §4.4: a super-surface may be culled from behind only when every face of it belongs to a
+ * closed, consistently oriented shell (the importer's SW_SG_FACE_CLOSED_SHELL). */
+static int all_closed_shell(const sw_sg_scene *scene, const sw_lod_supersurfaces *ss,
+                            const sw_lod_ss_cluster *cluster)
+{
+    const sw_sg_face_rec *faces = sw_sg_scene_view_ptr(scene)->faces;
+    for (uint32_t k = cluster->first; k < cluster->first + cluster->count; ++k)
+        if (!(faces[ss->patches[k].face].flags & SW_SG_FACE_CLOSED_SHELL))
+            return 0;
+    return cluster->count > 0;
+}
+
 static sw_result make_output(state *st, cl *c, uint32_t n_cl, const uint32_t *cluster_of,
                              sw_lod_supersurfaces **out)
 {
@@ -739,7 +752,7 @@ static sw_result make_output(state *st, cl *c, uint32_t n_cl, const uint32_t *cl
         o->cos_half_angle = cone.cos_half_angle;
         o->half_angle = cone.half_angle;
         memcpy(o->box, c[r].box, sizeof o->box);
-        o->flags = c[r].flags;
+        o->flags = c[r].flags | (all_closed_shell(st->scene, ss, o) ? SW_LOD_SS_BACK_CULLABLE : 0);
     }
     for (size_t k = 0; k < st->n_pairs; ++k) {
         const uint32_t a = pos[st->pairs[k].a], b = pos[st->pairs[k].b];

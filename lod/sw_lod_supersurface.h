@@ -119,8 +119,8 @@ typedef struct sw_lod_ss_patch {
 } sw_lod_ss_patch;
 
 enum sw_lod_ss_cluster_flags {
-    /* All its faces belong to a closed shell with consistent orientation, so the cone may cull it
-     * from behind. The scene records no shells or closedness yet, so this is never set. */
+    /* All its faces belong to a closed shell with consistent orientation (the importer's
+     * SW_SG_FACE_CLOSED_SHELL), so the cone may cull it from behind (Kumar §4.4). */
     SW_LOD_SS_BACK_CULLABLE = 1u << 0,
     /* A single patch without a usable cone bound (full cone; see sw_lod_gauss_cone). */
     SW_LOD_SS_FULL_CONE = 1u << 1,

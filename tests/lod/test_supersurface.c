@@ -438,13 +438,19 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
                              : (cl->flags & SW_LOD_SS_MERGED)    ? ss->merge_alpha
                                                                  : ss->alpha;
         /* a single patch wider than alpha is a cluster of its own, with its own cone */
-        const int wide_patch = cl->count == 1 && !(cl->flags & ~SW_LOD_SS_FULL_CONE);
+        const int wide_patch =
+            cl->count == 1 && !(cl->flags & ~(SW_LOD_SS_FULL_CONE | SW_LOD_SS_BACK_CULLABLE));
         if (!wide_patch && !(cl->half_angle <= bound + 1e-12))
             fail = fail_msg(path, "cluster cone beyond its bound", c, cl->flags);
         if ((cl->flags & SW_LOD_SS_FULL_CONE) && cl->count != 1)
             fail = fail_msg(path, "full-cone cluster with several patches", c, cl->count);
-        if (cl->flags & SW_LOD_SS_BACK_CULLABLE)
-            fail = fail_msg(path, "back-cullable without shell information", c, 0);
+        int closed = cl->count > 0;
+        for (uint32_t k = cl->first; k < cl->first + cl->count; ++k)
+            closed &= (sw_sg_scene_view_ptr(scene)->faces[ss->patches[k].face].flags &
+                       SW_SG_FACE_CLOSED_SHELL) != 0;
+        if (!(cl->flags & SW_LOD_SS_BACK_CULLABLE) != !closed)
+            fail = fail_msg(path, "back-cullable flag differs from the faces' closed shells", c,
+                            cl->flags);
         const sw_lod_cone cc = {
             {cl->axis[0], cl->axis[1], cl->axis[2]}, cl->half_angle, cl->cos_half_angle};
         for (uint32_t k = cl->first; k < cl->first + cl->count && !fail; ++k) {
