@@ -16,6 +16,7 @@
 #include "sw_lod_bezier.h"
 #include "sw_lod_hierarchy.h"
 #include "sw_lod_reduce.h"
+#include "model_import.h"
 #include "sw_sg_import.h"
 
 #include <float.h>
@@ -376,18 +377,10 @@ static void random_curves(checks *ck, int per_degree)
 
 static int check_model(checks *ck, const char *path, int stride)
 {
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
     sw_sg_scene *scene = NULL;
-    sw_status st = {0};
-    sw_result r = sw_sg_import_file(&d, &scene, NULL, &st);
-    if (r == SW_ERR_FORMAT) { /* e.g. edge.brep: a shape without faces */
-        printf("%s: skipped (%s)\n", path, st.message);
-        return 0;
-    }
-    if (r != SW_OK) {
-        fprintf(stderr, "%s: import failed: %s\n", path, st.message);
-        return 1;
-    }
+    const int imported = sw_test_import_model(path, &scene);
+    if (imported <= 0)
+        return imported < 0;
     const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
     long patches = 0, curves = 0, counter = 0;
     for (uint32_t f = 0; f < v->n_faces; ++f) {

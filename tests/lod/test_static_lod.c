@@ -15,6 +15,7 @@
  */
 #include "sw_lod_static.h"
 #include "sw_sg_geom.h"
+#include "model_import.h"
 #include "sw_sg_import.h"
 
 #include <math.h>
@@ -108,18 +109,10 @@ static int check_bad_input(const sw_sg_scene *scene)
 
 static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t max_faces)
 {
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
     sw_sg_scene *scene = NULL;
-    sw_status st = {0};
-    sw_result r = sw_sg_import_file(&d, &scene, NULL, &st);
-    if (r == SW_ERR_FORMAT) { /* e.g. edge.brep: a shape without faces */
-        printf("%s: skipped (%s)\n", path, st.message);
-        return 0;
-    }
-    if (r != SW_OK) {
-        fprintf(stderr, "%s: import failed: %s\n", path, st.message);
-        return 1;
-    }
+    const int imported = sw_test_import_model(path, &scene);
+    if (imported <= 0)
+        return imported < 0;
     const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
     totals t = {0};
     static int bad_input_checked;
@@ -144,7 +137,8 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
         }
         const sw_lod_static_desc desc = {0.0, levels, 0.0, 0.0, 0.0, 0};
         sw_lod_static_chain *c = NULL;
-        r = sw_lod_static_build(scene, p, n, &desc, &c, &st);
+        sw_status st = {0};
+        const sw_result r = sw_lod_static_build(scene, p, n, &desc, &c, &st);
         if (r != SW_OK) {
             fprintf(stderr, "%s face %u (%u patches): %s: %s\n", path, f, n, sw_result_id_str(r),
                     st.message);

@@ -23,6 +23,7 @@
  */
 #include "sw_lod_bezier.h"
 #include "sw_lod_supersurface.h"
+#include "model_import.h"
 #include "sw_sg_import.h"
 
 #include <math.h>
@@ -515,21 +516,14 @@ static int check_clusters(const char *path, const sw_sg_scene *scene,
 
 static int check_model(const char *path, cone_stats *cs, model_totals *all)
 {
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
     sw_sg_scene *scene = NULL;
-    sw_status st = {0};
-    sw_result r = sw_sg_import_file(&d, &scene, NULL, &st);
-    if (r == SW_ERR_FORMAT) { /* e.g. edge.brep: a shape without faces */
-        printf("%s: skipped (%s)\n", path, st.message);
-        return 0;
-    }
-    if (r != SW_OK) {
-        fprintf(stderr, "%s: import failed: %s\n", path, st.message);
-        return 1;
-    }
+    const int imported = sw_test_import_model(path, &scene);
+    if (imported <= 0)
+        return imported < 0;
     sw_lod_supersurfaces *a = NULL, *b = NULL;
+    sw_status st = {0};
     const double t0 = now_s();
-    r = sw_lod_supersurfaces_build(scene, &g_desc, &a, &st);
+    const sw_result r = sw_lod_supersurfaces_build(scene, &g_desc, &a, &st);
     const double t1 = now_s();
     int fail = 0;
     if (r != SW_OK) {
