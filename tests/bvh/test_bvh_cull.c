@@ -30,16 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int g_failures;
-
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            ++g_failures;                                                                          \
-            printf("  FAIL: " __VA_ARGS__);                                                        \
-            printf("\n");                                                                          \
-        }                                                                                          \
-    } while (0)
+#include "test_check.h"
 
 enum { CAMERAS_PER_CLASS = 40, N_CLASSES = 6 };
 static const char *const k_class_name[N_CLASSES] = {"inside",        "outside, at it",

@@ -36,18 +36,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "test_check.h"
+
 int sw_test_brep_check(const char *path, uint32_t *faces, uint32_t *invalid); /* brep_check.cpp */
-
-static int g_failures;
-
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            ++g_failures;                                                                          \
-            printf("  FAIL: " __VA_ARGS__);                                                        \
-            printf("\n");                                                                          \
-        }                                                                                          \
-    } while (0)
 
 static sw_sg_scene *g_models[SW_SG_BUILDING_N_MODELS];
 static int g_vehicle;

@@ -22,18 +22,10 @@
 #include <string.h>
 #include <unistd.h>
 
-enum { W = 320, H = 180, N_VIEWS = 8 };
-static int g_failures;
-static sw_th_pool *g_pool; /* the hierarchy cache's workers */
+#include "test_check.h"
 
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            ++g_failures;                                                                          \
-            printf("  FAIL: " __VA_ARGS__);                                                        \
-            printf("\n");                                                                          \
-        }                                                                                          \
-    } while (0)
+enum { W = 320, H = 180, N_VIEWS = 8 };
+static sw_th_pool *g_pool; /* the hierarchy cache's workers */
 
 /* Views from the eight octant directions, at the distance of `splinewalk render`'s preset. */
 static sw_gpu_camera view_camera(const double b[6], int v)

@@ -18,17 +18,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { W = 320, H = 180 };
-static int g_failures;
+#include "test_check.h"
 
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            ++g_failures;                                                                          \
-            printf("  FAIL: " __VA_ARGS__);                                                        \
-            printf("\n");                                                                          \
-        }                                                                                          \
-    } while (0)
+enum { W = 320, H = 180 };
 
 typedef struct counter {
     uint64_t n;
@@ -57,8 +49,8 @@ static void check_item(const sw_sg_scene *scene, const sw_sg_bvh_item *it)
     for (size_t i = 0; i < (size_t)s.n_u * (size_t)s.n_v; ++i) {
         const double *h = s.cpw + 4 * i;
         for (int r = 0; r < 3; ++r) {
-            double x = (m[4 * r] * h[0] + m[4 * r + 1] * h[1] + m[4 * r + 2] * h[2]) / h[3] +
-                       m[4 * r + 3];
+            double x =
+                (m[4 * r] * h[0] + m[4 * r + 1] * h[1] + m[4 * r + 2] * h[2]) / h[3] + m[4 * r + 3];
             double tol = 1e-12 * (fabs(it->box[r]) + fabs(it->box[3 + r]) + 1.0);
             if (x < it->box[r] - tol || x > it->box[3 + r] + tol) {
                 CHECK(0, "face %u: a control point outside its item box", it->face);
@@ -72,8 +64,7 @@ static void check_structure(const sw_sg_scene *scene, const sw_sg_bvh *t)
 {
     counter c = {0};
     sw_sg_scene_traverse(scene, count_visit, &c);
-    CHECK(t->n_items == c.n, "%u items for %llu occurrences", t->n_items,
-          (unsigned long long)c.n);
+    CHECK(t->n_items == c.n, "%u items for %llu occurrences", t->n_items, (unsigned long long)c.n);
     uint32_t leaf_items = 0, max_leaf = 0;
     for (uint32_t i = 0; i < t->n_nodes; ++i) {
         const sw_sg_bvh_node *n = &t->nodes[i];
@@ -114,12 +105,11 @@ static sw_gpu_camera camera_at(const double b[6], const double from[3], const do
 static void compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_sg_bvh *t,
                           const double box[6])
 {
-    static const double k_views[5][6] = {
-        {1.6, 1.6, 1.6, 0.5, 0.5, 0.5},   /* all of it */
-        {0.9, 0.9, 0.7, 1.0, 1.0, 0.5},   /* a corner, close */
-        {0.5, 0.5, 0.5, 0.0, 0.5, 0.5},   /* from inside */
-        {0.2, -0.3, 0.6, 0.4, 0.3, 0.4},  /* part */
-        {-2.0, -2.0, 0.5, -3.0, -3.0, 0.5} /* away from it */};
+    static const double k_views[5][6] = {{1.6, 1.6, 1.6, 0.5, 0.5, 0.5},  /* all of it */
+                                         {0.9, 0.9, 0.7, 1.0, 1.0, 0.5},  /* a corner, close */
+                                         {0.5, 0.5, 0.5, 0.0, 0.5, 0.5},  /* from inside */
+                                         {0.2, -0.3, 0.6, 0.4, 0.3, 0.4}, /* part */
+                                         {-2.0, -2.0, 0.5, -3.0, -3.0, 0.5} /* away from it */};
     for (int v = 0; v < 5; ++v) {
         sw_gpu_frame_desc d;
         memset(&d, 0, sizeof d);
@@ -135,8 +125,7 @@ static void compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene, const s
         CHECK(ok, "view %d: render: %s", v, st.message);
         if (ok) {
             sw_test_image_diff df = sw_test_compare_images(&a, &b, 0);
-            CHECK(df.any == 0 && fa.faces_drawn == fb.faces_drawn &&
-                      fa.triangles == fb.triangles,
+            CHECK(df.any == 0 && fa.faces_drawn == fb.faces_drawn && fa.triangles == fb.triangles,
                   "view %d: %ld pixels differ, faces drawn %llu vs %llu", v, df.any,
                   (unsigned long long)fa.faces_drawn, (unsigned long long)fb.faces_drawn);
             printf("  view %d: faces drawn %llu, culled %llu (without BVH culled %llu); "
