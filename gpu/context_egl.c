@@ -248,7 +248,7 @@ sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status)
     return context_create(check_gl_version, out, status);
 }
 
-void sw_gpu_context_make_current(sw_gpu_context *ctx)
+void sw__gpu_make_current(sw_gpu_context *ctx)
 {
     /* One check per frame: a thread owning several headless contexts switches between them. */
     if (ctx->egl_context && eglGetCurrentContext() != ctx->egl_context)
@@ -259,7 +259,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
 {
     if (!ctx)
         return;
-    sw_gpu_context_make_current(ctx); /* its objects are deleted in its own context */
+    sw__gpu_make_current(ctx); /* its objects are deleted in its own context */
     if (ctx->gl_ready) {
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);

@@ -100,6 +100,7 @@ void sw__gpu_set_capture(sw_gpu_context *ctx, uint32_t max_vertices)
 sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out, size_t *n,
                                size_t *total, sw_status *status)
 {
+    sw__gpu_make_current(ctx);
     *out = NULL;
     *n = *total = 0;
     if (!ctx->capture_ssbo || ctx->capture_max == 0)
@@ -356,6 +357,7 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
                                   sw_status *status)
 {
     memset(out, 0, sizeof *out);
+    sw__gpu_make_current(ctx);
     sw_gpu_frame_desc desc;
     sw__gpu_desc_defaults(desc_in, &desc);
     double box[6];

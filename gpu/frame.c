@@ -1361,6 +1361,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
                               sw_gpu_frame_stats *stats, sw_status *status)
 {
     memset(out, 0, sizeof *out);
+    sw__gpu_make_current(ctx);
     frame *f = &plan->f;
     const sw_gpu_frame_desc *desc = &plan->desc;
     sw_result r = f->ctx == ctx ? SW_OK
@@ -1376,8 +1377,8 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
     if (r == SW_OK)
         r = build_batch(f, status);
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &f->view, desc, &f->mesh, f->draws, f->n_draws,
-                               &f->batch, status);
+        r = sw__gpu_draw_frame(ctx, &f->view, desc, &f->mesh, f->draws, f->n_draws, &f->batch,
+                               status);
     double t3 = sw__gpu_now_ms();
     if (r == SW_OK && desc->present)
         r = sw__gpu_present(ctx, &f->view, &host, status);

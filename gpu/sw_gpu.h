@@ -5,7 +5,9 @@
  * fragment-discarding lookup. Frame images go out through OpenImageIO (capture_oiio.cpp).
  *
  * Threads: only the thread that created a context may call the functions taking it
- * (ARCHITECTURE.md: only the GL owner touches GL). Precision: positions are kept in double and
+ * (ARCHITECTURE.md: only the GL owner touches GL). A thread may own several headless contexts:
+ * every call that draws makes its own context current first (an adopted context is the host's to
+ * keep current). Precision: positions are kept in double and
  * sent relative to the camera in float; depth is reversed-Z with a float depth buffer.
  */
 #ifndef SW_GPU_H
@@ -32,9 +34,7 @@ sw_result sw_gpu_context_create_headless(sw_gpu_context **out, sw_status *status
  * SW_ERR_NO_CONTEXT (none current, or too old). */
 sw_result sw_gpu_context_adopt_current(sw_gpu_context **out, sw_status *status);
 void sw_gpu_context_free(sw_gpu_context *ctx); /* NULL allowed */
-/* Makes an owned (headless) context current on the calling thread if another one is; an adopted
- * context is the host's to keep current. Call before a frame when a thread owns several. */
-void sw_gpu_context_make_current(sw_gpu_context *ctx);
+
 /* "GL_RENDERER / GL_VERSION" of the context (borrowed). */
 const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
 

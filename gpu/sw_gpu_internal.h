@@ -146,6 +146,9 @@ struct sw_gpu_context {
 
 /* Last GL error as SW_ERR_GL naming `what`, or SW_OK. */
 sw_result sw__gpu_check(sw_status *status, const char *what);
+/* Makes an owned (headless) context current on the calling thread if another one is; an adopted
+ * context is left alone. Every entry point that issues GL calls starts with it. */
+void sw__gpu_make_current(sw_gpu_context *ctx);
 /* Compiles the programs (shaders.c). */
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status);
 void sw__gpu_programs_free(sw_gpu_context *ctx);

@@ -640,6 +640,7 @@ void sw__gpu_atlas_invalidate(sw_gpu_context *ctx)
 sw_result sw__gpu_atlas_read_page(sw_gpu_context *ctx, int32_t layer, uint8_t *out, size_t size,
                                   int32_t *side, sw_status *status)
 {
+    sw__gpu_make_current(ctx);
     const struct sw__gpu_atlas *a = ctx->atlas;
     *side = a ? a->side : 0;
     if (!a || !a->tex || layer < 0 || layer >= a->cap_layers)

@@ -154,7 +154,6 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     if (r != SW_OK)
         return r; /* stale, or another thread's context: left untouched */
     sw_rt_renderer *rr = item;
-    sw_gpu_context_make_current(rr->gpu);
     while (rr->in_flight) { /* prepared, never submitted: V finishes them, nobody draws them */
         job_free((rt_job *)sw_rt_pipeline_pop(rr->pipeline));
         rr->in_flight--;
@@ -328,7 +327,6 @@ static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_fram
         return res;
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
-    sw_gpu_context_make_current(r->gpu);
     res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);
     if (res != SW_OK)
         return res;
@@ -417,7 +415,6 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     }
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
-    sw_gpu_context_make_current(r->gpu);
     res = sw_gpu_frame_submit(r->gpu, j->job.plan, &image, &gstats, status);
     j->job.plan = NULL; /* consumed */
     if (res == SW_OK)
