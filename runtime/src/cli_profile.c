@@ -279,12 +279,12 @@ static void show_progress(uint32_t done, uint32_t n, double last_ms)
     sw_cli_progress(NULL, (double)done / n, stage);
 }
 
-/* Frame i's camera along the path and, when it is captured, its staged PNG in `file`. */
-static double set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, staging *st,
-                        const sw_rt_profile *p, sw_frame_desc *frame, char file[4200])
+/* Frame i's camera along the path and, when it is captured, its staged PNG in `file` (the
+ * renderer copies the path: one buffer serves the frame prepared ahead too). */
+static void set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, staging *st,
+                      const sw_rt_profile *p, sw_frame_desc *frame, char file[4200])
 {
-    const double t = sw_rt_path_frame_time(path, i, n);
-    sw_rt_path_eval(path, t, &frame->camera);
+    sw_rt_path_eval(path, sw_rt_path_frame_time(path, i, n), &frame->camera);
     frame->output_path = NULL;
     if (is_capture(p, i)) {
         char name[64];
@@ -293,7 +293,6 @@ static double set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, s
         staging_remember(st, name);
         frame->output_path = file;
     }
-    return t;
 }
 
 /* One frame on this thread: drawn in one call (sequential), or — threaded — frame i + 1 handed
