@@ -383,3 +383,15 @@ sw_result sw__gen_measure(sw__gen *g, const char *const *names, sw_status *statu
     }
     return SW_OK;
 }
+
+sw_result sw__gen_check_request(const char *what, uint64_t surfaces, const void *models,
+                                sw_status *status)
+{
+    if (surfaces < SW_SG_BUILDING_MIN_SURFACES || surfaces > SW_SG_BUILDING_MAX_SURFACES)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: %llu surfaces outside %u..%u", what,
+                        (unsigned long long)surfaces, (unsigned)SW_SG_BUILDING_MIN_SURFACES,
+                        (unsigned)SW_SG_BUILDING_MAX_SURFACES);
+    if (!models)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: no sample models", what);
+    return SW_OK;
+}

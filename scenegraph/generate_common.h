@@ -48,6 +48,10 @@ void sw__gen_v3(double out[3], const double o[3], double a, const double e[3], d
                 const double f[3]);
 void sw__gen_cross(const double a[3], const double b[3], double out[3]);
 uint64_t sw__gen_mix64(uint64_t x);
+/* SW_OK when a requested surface count and its models are usable, else SW_ERR_INVALID_ARGUMENT
+ * naming `what` ("building", "vehicle"). */
+sw_result sw__gen_check_request(const char *what, uint64_t surfaces, const void *models,
+                                sw_status *status);
 uint32_t sw__gen_pick(uint64_t *s, uint32_t n); /* 0..n-1 from the stream s */
 
 /* Surfaces of the scratch face. Planes: o + u e + v g over [0, l] x [0, h]. Cylinders:

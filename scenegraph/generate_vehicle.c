@@ -361,13 +361,9 @@ sw_result sw_sg_generate_vehicle(const sw_sg_vehicle_desc *desc, sw_sg_scene **o
                                  sw_sg_vehicle_report *report, sw_status *status)
 {
     *out = NULL;
-    if (desc->surfaces < SW_SG_BUILDING_MIN_SURFACES ||
-        desc->surfaces > SW_SG_BUILDING_MAX_SURFACES)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "vehicle: %llu surfaces outside %u..%u",
-                        (unsigned long long)desc->surfaces, (unsigned)SW_SG_BUILDING_MIN_SURFACES,
-                        (unsigned)SW_SG_BUILDING_MAX_SURFACES);
-    if (!desc->models)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "vehicle: no part models");
+    sw_result checked = sw__gen_check_request("vehicle", desc->surfaces, desc->models, status);
+    if (checked != SW_OK)
+        return checked;
     gveh g;
     memset(&g, 0, sizeof g);
     g.d = desc;
