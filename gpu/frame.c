@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "frame_internal.h"
+#include "sw_lod_static_set.h"
 #include "sw_sg_bvh.h"
 
 static int collect(void *user, uint32_t face, const double world[12], const float color[4])
@@ -1036,6 +1037,10 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     if (r == SW_OK && desc->face_cones && boxes)
         r = cull_back_faces(f, desc->face_cones, boxes, status);
     screen_view_init(f);
+    for (size_t i = 0; f->lod_colors && i < f->n_occ; ++i)
+        sw__fr_lod_color(-1, f->occ[i].color);
+    if (r == SW_OK && boxes)
+        r = sw__fr_static_draw(f, boxes, status);
     int hierarchy = f->cache && !f->exact;
     if (r == SW_OK && hierarchy)
         r = sw__fr_hlod_prepare(f, boxes, desc->walkthrough, status);
@@ -1317,6 +1322,14 @@ static sw_result plan_init(sw_gpu_frame_plan *p, sw_gpu_context *ctx, const sw_s
     f->eps_px = p->desc.error_px;
     f->exact = p->desc.eval_exact != 0;
     f->reader = -1;
+    f->walkthrough = p->desc.walkthrough != 0;
+    f->statics = p->desc.static_lods;
+    f->static_force = p->desc.static_force;
+    f->static_delta = p->desc.static_delta;
+    f->lod_colors = p->desc.lod_colors != 0;
+    if (f->statics && sw_lod_static_set_scene(f->statics) != scene)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "frame: the static LODs belong to another scene");
     f->bez = calloc(f->sv->n_faces ? f->sv->n_faces : 1, sizeof *f->bez);
     if (!f->bez)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");

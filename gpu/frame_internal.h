@@ -99,6 +99,11 @@ typedef struct frame {
     uint64_t refine_asked; /* refinements submitted (or in flight) in this planning round */
     size_t *shares;        /* pairs (draw, source draw): draw uses the source's trim entry */
     size_t n_shares, cap_shares;
+    /* static LODs (frame_static.c; NULL: every face by the per-frame path) */
+    struct sw_lod_static_set *statics;
+    int32_t static_force; /* desc.static_force */
+    double static_delta;  /* δ the set's chains are built with (0: per unit) */
+    int lod_colors;       /* desc.lod_colors */
 } frame;
 
 /* Texels wanted per direction of a face's trim texture (max over its drawn patches). */
@@ -142,5 +147,13 @@ sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index,
 sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, int walkthrough, sw_status *status);
 /* Draws one occurrence from its face's hierarchy (§7), or by the direct path when it has none. */
 sw_result sw__fr_hlod_draw_face(frame *f, const occurrence *o, sw_status *status);
+
+/* ---- frame_static.c ---- */
+/* Kumar §4's static LODs merged into the frame: draws the visible occurrences whose unit has a
+ * level fine enough for the view (their fat borders too) and removes them, with their boxes, from
+ * f->occ; the rest stay for the per-frame path. No-op without desc.static_lods. */
+sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status);
+/* LOD colouring: static level k (fine -> coarse), or -1 for the per-frame path. */
+void sw__fr_lod_color(int32_t level, float out[4]);
 
 #endif

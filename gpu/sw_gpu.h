@@ -74,6 +74,17 @@ typedef struct sw_gpu_frame_desc {
                               scene's per-face outward normal cones (sw_lod_face_cones.h, built once
                               per scene): an occurrence of a SW_SG_FACE_CLOSED_SHELL face facing
                               away from the eye over its whole box is culled (Kumar §4.4) */
+    struct sw_lod_static_set *static_lods; /* NULL: no static LODs; else the scene's set
+                              (lod/sw_lod_static_set.h): a visible unit is drawn at the coarsest
+                              level within the view's tolerance at its nearest point, built in
+                              the pool on first need (walkthrough: queued, drawn per frame
+                              meanwhile; converged: waited for). Ignored with eval_exact */
+    double static_delta;  /* δ of the set's level 0 (its desc's levels.delta; 0: per unit) */
+    int32_t static_force; /* tests: k > 0 draws every unit at level (unit + k) mod (levels + 1),
+                             the last value meaning the per-frame path, whatever the view
+                             needs: neighbours at different levels and beside the trim-texture
+                             path. 0: by the view */
+    int32_t lod_colors;   /* 1: each draw coloured by its representation (sw__fr_lod_color) */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -111,6 +122,12 @@ typedef struct sw_gpu_frame_stats {
     uint64_t bvh_nodes_visited, bvh_nodes_inside, bvh_nodes_partly, bvh_nodes_outside;
     uint64_t bvh_items_tested, bvh_items_visible;
     uint64_t faces_backculled; /* of faces_culled: back-facing closed-shell occurrences */
+    /* static LODs (desc.static_lods) */
+    uint64_t static_units_drawn; /* (unit, instance) pairs drawn from a static level */
+    uint64_t static_faces;       /* face occurrences they cover (of faces_drawn) */
+    uint64_t static_triangles;   /* their triangles (of triangles; fat borders apart) */
+    uint64_t static_requests;    /* walkthrough: unit builds queued, not waited for */
+    uint64_t static_waits;       /* converged: units the frame waited for */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -5,11 +5,13 @@
 
 #include "sw_lod_cache.h"
 #include "sw_lod_face_cones.h"
+#include "sw_lod_static_set.h"
 #include "sw_sg_bvh.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -26,6 +28,13 @@ typedef struct sw_rt_renderer {
     sw_lod_cache *cache;      /* of cache_scene */
     sw_sg_bvh *bvh;           /* of cache_scene */
     sw_lod_face_cones *cones; /* of cache_scene: back-patch culling of closed shells */
+    /* of cache_scene: static LODs (Kumar §3-§4), the set made by a pool task on the first frame
+     * that asks for them and published by one pointer store; statics_state: 0 none, 1 being
+     * made, 2 ready, 3 failed (statics_failure says why) */
+    _Atomic(sw_lod_static_set *) statics;
+    _Atomic int statics_state;
+    sw_th_group statics_group;
+    sw_status statics_failure;
     sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
     sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
@@ -108,6 +117,11 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
  * needed. */
 static void drop_cache(sw_rt_renderer *r)
 {
+    if (r->pool)
+        sw_th_group_wait(r->pool, &r->statics_group);
+    sw_lod_static_set_destroy(atomic_load(&r->statics));
+    atomic_store(&r->statics, NULL);
+    atomic_store(&r->statics_state, 0);
     sw_lod_cache_destroy(r->cache);
     r->cache = NULL;
     sw_sg_bvh_free(r->bvh);
@@ -218,6 +232,10 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->ms_draw = g->ms_draw;
     out->ms_readback = g->ms_readback;
     out->faces_backculled = g->faces_backculled;
+    out->static_drawn = g->static_units_drawn;
+    out->static_faces = g->static_faces;
+    out->static_triangles = g->static_triangles;
+    out->static_requests = g->static_requests;
 }
 
 static int camera_is_zero(const sw_camera *c)
@@ -280,6 +298,47 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     }
 }
 
+static void statics_task(void *ctx)
+{
+    sw_rt_renderer *r = ctx;
+    sw_lod_static_set *set = NULL;
+    sw_status st = {0};
+    sw_result res =
+        sw_lod_static_set_create(r->cache_scene->sg, r->pool, NULL, &set, &st);
+    if (res != SW_OK) {
+        r->statics_failure = st;
+        r->statics_failure.result = res;
+        atomic_store(&r->statics_state, 3);
+        return;
+    }
+    atomic_store(&r->statics, set);
+    atomic_store(&r->statics_state, 2);
+}
+
+/* The static LODs of the cache's scene for this frame: their clustering is started in the pool
+ * on first need; a walkthrough frame goes on without it (drawn per frame), a converged one
+ * waits. */
+static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_status *status)
+{
+    int expect = 0;
+    if (atomic_compare_exchange_strong(&r->statics_state, &expect, 1)) {
+        const sw_th_task task = {statics_task, r, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
+                                 &r->statics_group};
+        if (sw_th_pool_submit(r->pool, &task) != SW_OK) {
+            atomic_store(&r->statics_state, 0);
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: could not submit");
+        }
+    }
+    if (!frame->walkthrough)
+        sw_th_group_wait(r->pool, &r->statics_group);
+    const int state = atomic_load(&r->statics_state);
+    if (state == 3 && !frame->walkthrough)
+        return sw__fail(status, r->statics_failure.result, "static LODs: %s",
+                        r->statics_failure.message);
+    frame->static_lods = state == 2 ? atomic_load(&r->statics) : NULL;
+    return SW_OK;
+}
+
 /* The GPU frame of a checked desc: its camera resolved, drawn through the renderer's hierarchy
  * cache and BVH for the scene (made for it if needed). */
 static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
@@ -295,7 +354,11 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
     frame->face_cones = r->cones;
     if (!frame->eval_exact && !desc->no_hierarchy)
         frame->hierarchies = r->cache;
-    return SW_OK;
+    frame->lod_colors = desc->lod_colors != 0;
+    frame->static_force = desc->static_force > 0 ? desc->static_force : 0;
+    if (desc->static_lods && !frame->eval_exact)
+        res = frame_statics(r, frame, status);
+    return res;
 }
 
 /* Writes a drawn frame's image when asked and fills the caller's stats (times from t0). */

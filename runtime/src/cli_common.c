@@ -177,6 +177,12 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
     if (s->hierarchy_nodes > 0)
         printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
                (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);
+    if (s->static_drawn > 0 || s->static_requests > 0)
+        printf("%*s  static LODs: %llu super-surface instances drawn (%llu faces, %llu triangles), "
+               "%llu builds queued\n",
+               (int)strlen(label), "", (unsigned long long)s->static_drawn,
+               (unsigned long long)s->static_faces, (unsigned long long)s->static_triangles,
+               (unsigned long long)s->static_requests);
     printf("%*s  time: hierarchy builds %.1f ms, tessellate %.1f ms, trim textures %.1f ms, draw "
            "%.1f ms, readback %.1f ms, write %.1f ms, total %.1f ms\n",
            (int)strlen(label), "", s->ms_hierarchy, s->ms_tessellate, s->ms_trim, s->ms_draw,

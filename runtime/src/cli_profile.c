@@ -18,7 +18,7 @@
 static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
-    "                          [--eval hierarchy|bezier|exact]\n"
+    "                          [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
     "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
@@ -51,6 +51,10 @@ static const char k_usage[] =
     "                    that worker and the frame's own thread (the pool cannot be emptied;\n"
     "                    nothing overlaps the frames)\n"
     "  --eval MODE       hierarchy (default), bezier or exact, as for `render`\n"
+    "  --static-lod      static LODs of super-surfaces where fine enough (Kumar et al. 1997),\n"
+    "                    built in the pool on first need: static_drawn, static_faces,\n"
+    "                    static_triangles, static_requests columns\n"
+    "  --lod-colors      colour by representation, as for `render`\n"
     "  -h, --help        this text\n";
 
 typedef struct profile_args {
@@ -91,6 +95,10 @@ static int parse_args(int argc, char **argv, profile_args *a)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
+            *(!strcmp(arg, "--static-lod") ? &a->frame.static_lods : &a->frame.lod_colors) = 1;
+            continue;
+        }
         if (!strcmp(arg, "--converged") || !strcmp(arg, "--sequential")) {
             a->converged = 1; /* --sequential implies it */
             if (!strcmp(arg, "--sequential"))

@@ -9,7 +9,8 @@
 static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
-    "                         [--eval hierarchy|bezier|exact]\n"
+    "                         [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
+    "                         [--static-force K]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as EXR\n"
@@ -32,6 +33,14 @@ static const char k_usage[] =
     "                      in the vertex shader, higher degrees on the CPU; exact: every patch\n"
     "                      evaluated in the vertex shader from its knot vectors and control\n"
     "                      points (Krishnamurthy & Yasui), degree <= 15\n"
+    "  --static-lod        super-surfaces far enough for one of their static LODs (Kumar et\n"
+    "                      al. 1997) are drawn from it; the clustering and the levels are built\n"
+    "                      first (or read from the scene's LOD cache: `build-lod`)\n"
+    "  --lod-colors        colour each surface by how it is drawn: static levels fine to coarse\n"
+    "                      blue, teal, green, yellow, orange, pink; per-frame tessellation grey\n"
+    "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at level\n"
+    "                      (i + K) mod (levels + 1), the last value meaning per-frame, whatever\n"
+    "                      the view needs\n"
     "  -h, --help          this text\n";
 
 typedef struct render_args {
@@ -47,7 +56,13 @@ static int parse_args(int argc, char **argv, render_args *a)
         const char *arg = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
-        if ((!strcmp(arg, "-o") || !strcmp(arg, "--output")) && val) {
+        if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
+            *(!strcmp(arg, "--static-lod") ? &a->frame.static_lods : &a->frame.lod_colors) = 1;
+            continue;
+        }
+        if (!strcmp(arg, "--static-force") && val) {
+            bad = sw_cli_parse_count(val, 1, 1 << 20, &a->frame.static_force);
+        } else if ((!strcmp(arg, "-o") || !strcmp(arg, "--output")) && val) {
             a->out = val;
         } else if (!strcmp(arg, "--size") && val) {
             bad = sw_cli_parse_size(val, &a->frame.width, &a->frame.height);

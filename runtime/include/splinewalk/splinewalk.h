@@ -205,6 +205,18 @@ typedef struct sw_frame_desc {
                                 again after the call). Not read back unless output_path is set. */
     int32_t wireframe;       /* 1: triangles drawn as lines (trimmed parts still cut away), to see
                                 the tessellation the error bound chose */
+    int32_t static_lods;     /* 1: Kumar et al. 1997 static LODs: the scene's super-surfaces
+                                (whole faces grouped under a normal-cone bound) get simplified
+                                meshes with declared errors, built in the worker pool on first
+                                need (their clustering too); a visible one is drawn at the
+                                coarsest level within ε_img at its nearest point, else by the
+                                per-frame path. Walkthrough frames never wait for the builds;
+                                converged frames do. 0: every face by the per-frame path */
+    int32_t lod_colors;      /* 1: each surface coloured by how it is drawn: static levels fine
+                                to coarse blue, teal, green, yellow, orange, pink; per-frame grey */
+    int32_t static_force;    /* tests of the joins: k > 0 draws every super-surface at level
+                                (index + k) mod (levels + 1), the last value meaning the per-frame
+                                path, whatever the view needs. 0: by the view */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -228,6 +240,11 @@ typedef struct sw_frame_stats {
     double ms_visibility, ms_wait_visibility;
     uint64_t faces_backculled; /* of faces_culled: back-facing surfaces of closed shells (Kumar
                                   §4.4 back-patch culling by normal cones) */
+    /* static LODs (desc.static_lods) */
+    uint64_t static_drawn;     /* super-surface instances drawn from a static level */
+    uint64_t static_faces;     /* face instances they cover (of faces_drawn) */
+    uint64_t static_triangles; /* their triangles (of triangles) */
+    uint64_t static_requests;  /* walkthrough: builds queued instead of waited for */
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so

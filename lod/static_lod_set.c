@@ -1,0 +1,414 @@
+/* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
+ * units are formed and how slots are published). */
+#include "sw_lod_static_set.h"
+
+#include "sw_sg_geom.h"
+#include "sw_status_util.h"
+
+#include <assert.h>
+#include <math.h>
+#include <sched.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+typedef struct slot {
+    _Atomic int state;                         /* sw_lod_static_state */
+    _Atomic(sw_lod_static_chain *) chain;      /* READY: the chain */
+    sw_th_group group;                         /* the slot's build task */
+    sw_status failure;                         /* FAILED: why (written before the state) */
+} slot;
+
+struct sw_lod_static_set {
+    const sw_sg_scene *scene;
+    sw_th_pool *pool;
+    sw_lod_static_desc levels;
+    sw_lod_supersurfaces *ss;
+    uint32_t n_faces;
+    uint32_t *unit_of_face;       /* n_faces */
+    uint32_t *faces;              /* grouped by unit */
+    sw_lod_static_patch *patches; /* grouped by unit, sorted by (face, iv, iu) inside */
+    sw_lod_static_unit *units;
+    uint32_t n_units;
+    slot *slots;
+    _Atomic uint64_t n_builds, n_adopted;
+    _Atomic uint64_t build_ns;
+};
+
+typedef struct build_job {
+    sw_lod_static_set *set;
+    uint32_t unit;
+} build_job;
+
+/* ---- units ------------------------------------------------------------------------------------ */
+
+/* Home cluster of every face: the cluster holding most of its patches, ties to the lowest index
+ * (patches are grouped by cluster and sorted by face inside, so a face's patches in one cluster
+ * are consecutive). Faces without patches get SW_LOD_STATIC_NO_UNIT. */
+static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint32_t *home)
+{
+    uint32_t *best = calloc(n_faces ? n_faces : 1, sizeof *best);
+    if (!best)
+        return 0;
+    for (uint32_t f = 0; f < n_faces; ++f)
+        home[f] = SW_LOD_STATIC_NO_UNIT;
+    for (uint32_t k = 0; k < ss->n_patches;) {
+        const uint32_t face = ss->patches[k].face, c = ss->cluster_of[k];
+        uint32_t run = 0;
+        while (k < ss->n_patches && ss->patches[k].face == face && ss->cluster_of[k] == c) {
+            ++run;
+            ++k;
+        }
+        if (face < n_faces &&
+            (run > best[face] || (run == best[face] && c < home[face]))) {
+            best[face] = run;
+            home[face] = c;
+        }
+    }
+    free(best);
+    return 1;
+}
+
+static int patch_cmp(const void *a, const void *b)
+{
+    const sw_lod_static_patch *p = a, *q = b;
+    if (p->face != q->face)
+        return p->face < q->face ? -1 : 1;
+    if (p->iv != q->iv)
+        return p->iv < q->iv ? -1 : 1;
+    return (p->iu > q->iu) - (p->iu < q->iu);
+}
+
+/* Renumbers home clusters into units (in cluster order, so deterministic) and fills faces[],
+ * patches[] and the units' ranges. */
+static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_status *status)
+{
+    const sw_lod_supersurfaces *ss = s->ss;
+    uint32_t *unit_of_cluster = malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
+    uint32_t *count = calloc(ss->n_clusters + 1, sizeof(uint32_t));
+    if (!unit_of_cluster || !count) {
+        free(unit_of_cluster);
+        free(count);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    }
+    for (uint32_t f = 0; f < s->n_faces; ++f)
+        if (home[f] != SW_LOD_STATIC_NO_UNIT)
+            count[home[f]]++;
+    for (uint32_t c = 0; c < ss->n_clusters; ++c)
+        unit_of_cluster[c] = count[c] ? s->n_units++ : SW_LOD_STATIC_NO_UNIT;
+    free(count);
+    s->units = calloc(s->n_units ? s->n_units : 1, sizeof *s->units);
+    s->faces = malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->faces);
+    s->patches = malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *s->patches);
+    if (!s->units || !s->faces || !s->patches) {
+        free(unit_of_cluster);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    }
+    for (uint32_t f = 0; f < s->n_faces; ++f) {
+        s->unit_of_face[f] = home[f] == SW_LOD_STATIC_NO_UNIT ? SW_LOD_STATIC_NO_UNIT
+                                                              : unit_of_cluster[home[f]];
+        if (s->unit_of_face[f] != SW_LOD_STATIC_NO_UNIT)
+            s->units[s->unit_of_face[f]].n_faces++;
+    }
+    for (uint32_t k = 0; k < ss->n_patches; ++k) {
+        const uint32_t f = ss->patches[k].face;
+        if (f < s->n_faces && s->unit_of_face[f] != SW_LOD_STATIC_NO_UNIT)
+            s->units[s->unit_of_face[f]].n_patches++;
+    }
+    uint32_t face_at = 0, patch_at = 0;
+    for (uint32_t u = 0; u < s->n_units; ++u) {
+        s->units[u].first_face = face_at;
+        s->units[u].first_patch = patch_at;
+        face_at += s->units[u].n_faces;
+        patch_at += s->units[u].n_patches;
+        s->units[u].n_faces = s->units[u].n_patches = 0;
+    }
+    for (uint32_t f = 0; f < s->n_faces; ++f) {
+        const uint32_t u = s->unit_of_face[f];
+        if (u != SW_LOD_STATIC_NO_UNIT)
+            s->faces[s->units[u].first_face + s->units[u].n_faces++] = f;
+    }
+    for (uint32_t k = 0; k < ss->n_patches; ++k) {
+        const uint32_t f = ss->patches[k].face;
+        if (f >= s->n_faces || s->unit_of_face[f] == SW_LOD_STATIC_NO_UNIT)
+            continue;
+        sw_lod_static_unit *un = &s->units[s->unit_of_face[f]];
+        s->patches[un->first_patch + un->n_patches++] =
+            (sw_lod_static_patch){f, ss->patches[k].iu, ss->patches[k].iv};
+    }
+    for (uint32_t u = 0; u < s->n_units; ++u)
+        qsort(s->patches + s->units[u].first_patch, s->units[u].n_patches, sizeof *s->patches,
+              patch_cmp);
+    free(unit_of_cluster);
+    return SW_OK;
+}
+
+static void box_add_net(double box[6], const sw_sg_bezier_patch *p)
+{
+    const int32_t n = (p->deg_u + 1) * (p->deg_v + 1);
+    for (int32_t i = 0; i < n; ++i) {
+        const double *h = p->cpw + 4 * i;
+        for (int a = 0; a < 3; ++a) {
+            const double x = h[a] / h[3];
+            box[a] = fmin(box[a], x);
+            box[3 + a] = fmax(box[3 + a], x);
+        }
+    }
+}
+
+/* Each unit's box from its faces' cut nets (the patches a chain is built from: the box holds its
+ * every vertex, so the frame's nearest-depth test on it is conservative). */
+static sw_result unit_boxes(sw_lod_static_set *s, sw_status *status)
+{
+    for (uint32_t u = 0; u < s->n_units; ++u) {
+        sw_lod_static_unit *un = &s->units[u];
+        for (int a = 0; a < 3; ++a) {
+            un->box[a] = INFINITY;
+            un->box[3 + a] = -INFINITY;
+        }
+        for (uint32_t i = 0; i < un->n_faces; ++i) {
+            sw_sg_bezier_set set;
+            sw_result r = sw_lod_face_patches(s->scene, s->faces[un->first_face + i], &set, status);
+            if (r != SW_OK)
+                return r;
+            for (int32_t k = 0; k < set.n_u * set.n_v; ++k)
+                box_add_net(un->box, &set.patches[k]);
+            sw_sg_bezier_set_free(&set);
+        }
+    }
+    return SW_OK;
+}
+
+sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
+                                   const sw_lod_static_set_desc *desc, sw_lod_static_set **out,
+                                   sw_status *status)
+{
+    assert(scene && pool && out);
+    *out = NULL;
+    sw_lod_static_set *s = calloc(1, sizeof *s);
+    if (!s)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    s->scene = scene;
+    s->pool = pool;
+    if (desc)
+        s->levels = desc->levels;
+    s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
+    sw_result r = sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
+    uint32_t *home = NULL;
+    if (r == SW_OK) {
+        home = malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);
+        s->unit_of_face = malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->unit_of_face);
+        if (!home || !s->unit_of_face || !home_clusters(s->ss, s->n_faces, home))
+            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    }
+    if (r == SW_OK)
+        r = form_units(s, home, status);
+    free(home);
+    if (r == SW_OK)
+        r = unit_boxes(s, status);
+    if (r == SW_OK && !(s->slots = calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
+        r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    if (r != SW_OK) {
+        sw_lod_static_set_destroy(s);
+        return r;
+    }
+    *out = s;
+    return SW_OK;
+}
+
+void sw_lod_static_set_destroy(sw_lod_static_set *s)
+{
+    if (!s)
+        return;
+    if (s->slots) {
+        for (uint32_t u = 0; u < s->n_units; ++u) {
+            sw_th_group_wait(s->pool, &s->slots[u].group);
+            sw_lod_static_free(atomic_load(&s->slots[u].chain));
+        }
+    }
+    free(s->slots);
+    free(s->units);
+    free(s->faces);
+    free(s->patches);
+    free(s->unit_of_face);
+    sw_lod_supersurfaces_free(s->ss);
+    free(s);
+}
+
+/* ---- lookups ---------------------------------------------------------------------------------- */
+
+uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *s)
+{
+    return s->n_units;
+}
+
+const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *s)
+{
+    return s->scene;
+}
+
+uint32_t sw_lod_static_set_unit_of(const sw_lod_static_set *s, uint32_t face)
+{
+    return face < s->n_faces ? s->unit_of_face[face] : SW_LOD_STATIC_NO_UNIT;
+}
+
+const sw_lod_static_unit *sw_lod_static_set_unit(const sw_lod_static_set *s, uint32_t unit)
+{
+    return unit < s->n_units ? &s->units[unit] : NULL;
+}
+
+const uint32_t *sw_lod_static_set_faces(const sw_lod_static_set *s)
+{
+    return s->faces;
+}
+
+const sw_lod_static_patch *sw_lod_static_set_patches(const sw_lod_static_set *s)
+{
+    return s->patches;
+}
+
+const sw_lod_supersurfaces *sw_lod_static_set_supersurfaces(const sw_lod_static_set *s)
+{
+    return s->ss;
+}
+
+sw_lod_static_state sw_lod_static_set_state(const sw_lod_static_set *s, uint32_t unit)
+{
+    assert(unit < s->n_units);
+    return (sw_lod_static_state)atomic_load_explicit(&s->slots[unit].state, memory_order_acquire);
+}
+
+const sw_lod_static_chain *sw_lod_static_set_get(const sw_lod_static_set *s, uint32_t unit)
+{
+    if (unit >= s->n_units)
+        return NULL;
+    return atomic_load_explicit(&s->slots[unit].chain, memory_order_acquire);
+}
+
+sw_result sw_lod_static_set_failure(const sw_lod_static_set *s, uint32_t unit, const char **message)
+{
+    if (message)
+        *message = NULL;
+    if (unit >= s->n_units || sw_lod_static_set_state(s, unit) != SW_LOD_STATIC_FAILED)
+        return SW_OK;
+    if (message)
+        *message = s->slots[unit].failure.message;
+    return s->slots[unit].failure.result;
+}
+
+/* ---- builds ----------------------------------------------------------------------------------- */
+
+static uint64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+static void publish(slot *sl, sw_lod_static_chain *chain)
+{
+    atomic_store_explicit(&sl->chain, chain, memory_order_release);
+    atomic_store_explicit(&sl->state, SW_LOD_STATIC_READY, memory_order_release);
+}
+
+static void build_task(void *ctx)
+{
+    build_job *job = ctx;
+    sw_lod_static_set *s = job->set;
+    const sw_lod_static_unit *un = &s->units[job->unit];
+    slot *sl = &s->slots[job->unit];
+    free(job);
+    const uint64_t t0 = now_ns();
+    sw_lod_static_chain *chain = NULL;
+    sw_status st = {0};
+    const sw_result r = sw_lod_static_build(s->scene, s->patches + un->first_patch, un->n_patches,
+                                            &s->levels, &chain, &st);
+    atomic_fetch_add(&s->build_ns, now_ns() - t0);
+    atomic_fetch_add(&s->n_builds, 1);
+    if (r == SW_OK) {
+        publish(sl, chain);
+        return;
+    }
+    sl->failure = st;
+    sl->failure.result = r;
+    atomic_store_explicit(&sl->state, SW_LOD_STATIC_FAILED, memory_order_release);
+}
+
+sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_priority priority)
+{
+    if (unit >= s->n_units)
+        return SW_ERR_INVALID_ARGUMENT;
+    slot *sl = &s->slots[unit];
+    int expect = SW_LOD_STATIC_EMPTY;
+    if (atomic_load_explicit(&sl->state, memory_order_acquire) != SW_LOD_STATIC_EMPTY ||
+        !atomic_compare_exchange_strong(&sl->state, &expect, SW_LOD_STATIC_QUEUED))
+        return SW_OK;
+    build_job *job = malloc(sizeof *job);
+    if (job) {
+        *job = (build_job){s, unit};
+        /* in the slot's group: converged frames and destroy wait on it */
+        const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group};
+        if (sw_th_pool_submit(s->pool, &task) == SW_OK)
+            return SW_OK;
+        free(job);
+    }
+    atomic_store(&sl->state, SW_LOD_STATIC_EMPTY);
+    return SW_ERR_OUT_OF_MEMORY;
+}
+
+sw_lod_static_state sw_lod_static_set_wait(sw_lod_static_set *s, uint32_t unit)
+{
+    if (unit >= s->n_units)
+        return SW_LOD_STATIC_EMPTY;
+    if (sw_lod_static_set_request(s, unit, SW_TH_PRIORITY_FRAME) != SW_OK)
+        return SW_LOD_STATIC_EMPTY;
+    slot *sl = &s->slots[unit];
+    for (;;) {
+        const int st = atomic_load_explicit(&sl->state, memory_order_acquire);
+        if (st == SW_LOD_STATIC_READY || st == SW_LOD_STATIC_FAILED)
+            return (sw_lod_static_state)st;
+        if (st == SW_LOD_STATIC_EMPTY)
+            return SW_LOD_STATIC_EMPTY;
+        sw_th_group_wait(s->pool, &sl->group); /* runs pool tasks meanwhile */
+        if (sw_th_group_pending(&sl->group) == 0)
+            sched_yield(); /* a requester is between its claim and its submission */
+    }
+}
+
+sw_result sw_lod_static_set_adopt(sw_lod_static_set *s, uint32_t unit, sw_lod_static_chain *chain)
+{
+    if (unit >= s->n_units) {
+        sw_lod_static_free(chain);
+        return SW_ERR_INVALID_ARGUMENT;
+    }
+    slot *sl = &s->slots[unit];
+    int expect = SW_LOD_STATIC_EMPTY;
+    if (!atomic_compare_exchange_strong(&sl->state, &expect, SW_LOD_STATIC_QUEUED)) {
+        sw_lod_static_free(chain);
+        return SW_ERR_INVALID_ARGUMENT;
+    }
+    publish(sl, chain);
+    atomic_fetch_add(&s->n_adopted, 1);
+    return SW_OK;
+}
+
+void sw_lod_static_set_get_stats(const sw_lod_static_set *s, sw_lod_static_set_stats *out)
+{
+    memset(out, 0, sizeof *out);
+    out->n_units = s->n_units;
+    for (uint32_t u = 0; u < s->n_units; ++u) {
+        switch (sw_lod_static_set_state(s, u)) {
+        case SW_LOD_STATIC_READY:
+            out->ready++;
+            out->memory_bytes += sw_lod_static_memory(sw_lod_static_set_get(s, u));
+            break;
+        case SW_LOD_STATIC_FAILED: out->failed++; break;
+        case SW_LOD_STATIC_QUEUED: out->queued++; break;
+        default: break;
+        }
+    }
+    out->builds = atomic_load(&s->n_builds);
+    out->adopted = atomic_load(&s->n_adopted);
+    out->build_seconds = 1e-9 * (double)atomic_load(&s->build_ns);
+}

@@ -1,0 +1,107 @@
+/* splinewalk lod/: a scene's static LODs, built lazily in the worker pool and chosen per frame
+ * (Kumar et al. 1997 §4, merged with the per-frame path as ARCHITECTURE.md says).
+ *
+ * Units. The super-surfaces of §3 (sw_lod_supersurfaces_build) partition the scene's Bézier
+ * patches, and a face's patches may fall into several of them. The frame draws whole faces
+ * (a face's hierarchy, its trim texture, its fat borders), so the static path works on whole faces
+ * too: every face goes to its home cluster, the one that holds most of its patches (ties: the
+ * lowest index), and a unit is the set of faces of one home cluster. A unit is a super-surface
+ * whose border follows face borders; its static LOD chain is built from all its faces' patches.
+ * Units of faces shared by several instances are built once (object space of the faces).
+ *
+ * Slots. One per unit: its state word moves EMPTY -> QUEUED -> READY | FAILED by compare-and-swap
+ * (only the winner of EMPTY -> QUEUED submits), the finished chain is immutable and published by
+ * one atomic pointer store (release); sw_lod_static_set_get reads it with no lock. A chain is
+ * never replaced, so readers need no epochs: chains live until the set is destroyed.
+ * Builds are not cancelled when the camera moves on: a static LOD does not depend on the view, so
+ * a build once asked for is used by every later frame that looks that way.
+ *
+ * Threads: every function but create and destroy may be called from any thread at any time.
+ */
+#ifndef SW_LOD_STATIC_SET_H
+#define SW_LOD_STATIC_SET_H
+
+#include "sw_lod_static.h"
+#include "sw_lod_supersurface.h"
+#include "sw_th_pool.h"
+
+#include <splinewalk/sw_result.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SW_LOD_STATIC_NO_UNIT UINT32_MAX
+
+typedef struct sw_lod_static_set sw_lod_static_set;
+
+typedef enum sw_lod_static_state {
+    SW_LOD_STATIC_EMPTY = 0,  /* not built, not asked for */
+    SW_LOD_STATIC_QUEUED = 1, /* a build task is in the pool (or running) */
+    SW_LOD_STATIC_READY = 2,  /* sw_lod_static_set_get returns the chain */
+    SW_LOD_STATIC_FAILED = 3  /* the build failed; never retried (the unit is drawn dynamically) */
+} sw_lod_static_state;
+
+typedef struct sw_lod_static_unit {
+    uint32_t first_face, n_faces;     /* into sw_lod_static_set_faces() */
+    uint32_t first_patch, n_patches;  /* into sw_lod_static_set_patches() */
+    double box[6];                    /* object-space box of its cut Bézier nets: lo xyz, hi xyz */
+} sw_lod_static_unit;
+
+/* Zero fields take the defaults of each part. */
+typedef struct sw_lod_static_set_desc {
+    sw_lod_ss_desc clustering; /* §3 */
+    sw_lod_static_desc levels; /* §4.1-§4.2, per unit; delta 0 = per unit, 1e-3 x its diagonal */
+} sw_lod_static_set_desc;
+
+typedef struct sw_lod_static_set_stats {
+    uint32_t n_units, ready, failed, queued;
+    uint64_t builds;     /* chains built by the pool */
+    uint64_t adopted;    /* chains handed in (sw_lod_static_set_adopt: read from a cache) */
+    double build_seconds; /* summed over builds (pool threads in parallel) */
+    size_t memory_bytes; /* the chains' memory */
+} sw_lod_static_set_stats;
+
+/* Clusters the scene (§3) and forms the units; builds no LOD. scene: FACES, LOOPS, CURVES,
+ * ADJACENCY and POOL required and validated; it and pool outlive the set. desc may be NULL.
+ * Errors: those of sw_lod_supersurfaces_build, SW_ERR_OUT_OF_MEMORY. */
+sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
+                                   const sw_lod_static_set_desc *desc, sw_lod_static_set **out,
+                                   sw_status *status);
+/* Waits for the builds in flight, frees every chain. No other thread may use the set. NULL ok. */
+void sw_lod_static_set_destroy(sw_lod_static_set *set);
+
+uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *set);
+const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *set);
+/* The unit of `face`, SW_LOD_STATIC_NO_UNIT for a face out of range. */
+uint32_t sw_lod_static_set_unit_of(const sw_lod_static_set *set, uint32_t face);
+const sw_lod_static_unit *sw_lod_static_set_unit(const sw_lod_static_set *set, uint32_t unit);
+const uint32_t *sw_lod_static_set_faces(const sw_lod_static_set *set);
+const sw_lod_static_patch *sw_lod_static_set_patches(const sw_lod_static_set *set);
+const sw_lod_supersurfaces *sw_lod_static_set_supersurfaces(const sw_lod_static_set *set);
+
+sw_lod_static_state sw_lod_static_set_state(const sw_lod_static_set *set, uint32_t unit);
+/* The unit's chain once READY, else NULL. No lock (acquire load). */
+const sw_lod_static_chain *sw_lod_static_set_get(const sw_lod_static_set *set, uint32_t unit);
+/* Submits the unit's build unless it is QUEUED, READY or FAILED. SW_OK, SW_ERR_INVALID_ARGUMENT
+ * (unit out of range), SW_ERR_OUT_OF_MEMORY (not submitted; the slot stays EMPTY). */
+sw_result sw_lod_static_set_request(sw_lod_static_set *set, uint32_t unit,
+                                    sw_th_priority priority);
+/* Converged frames: requests the unit and returns once it is READY or FAILED, running pool tasks
+ * meanwhile. Returns its state then (EMPTY only when the request could not be submitted). */
+sw_lod_static_state sw_lod_static_set_wait(sw_lod_static_set *set, uint32_t unit);
+/* Hands in a chain made elsewhere (a cache read from a file) for an EMPTY unit; the set owns it
+ * from then on, whatever the result. SW_ERR_INVALID_ARGUMENT: unit out of range or not EMPTY. */
+sw_result sw_lod_static_set_adopt(sw_lod_static_set *set, uint32_t unit,
+                                  sw_lod_static_chain *chain);
+/* The failure of a FAILED unit (SW_OK otherwise), and its message (NULL otherwise). */
+sw_result sw_lod_static_set_failure(const sw_lod_static_set *set, uint32_t unit,
+                                    const char **message);
+void sw_lod_static_set_get_stats(const sw_lod_static_set *set, sw_lod_static_set_stats *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
