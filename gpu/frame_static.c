@@ -139,16 +139,18 @@ static int32_t choose_level(frame *f, uint32_t unit, const double m[12],
 {
     const sw_lod_static_unit *un = sw_lod_static_set_unit(f->statics, unit);
     *chain = NULL;
+    const double tol = unit_tolerance(f, un, m);
     if (f->static_force > 0) {
-        /* tests: neighbouring units at different levels and beside the per-frame path */
+        /* tests: neighbours at different levels, each within the view's tolerance, and beside
+         * the per-frame path: unit i takes choice (i + k) mod (valid levels + 1) */
         const sw_lod_static_chain *c = unit_chain(f, unit);
         if (!c)
             return -1;
-        const int32_t k = (int32_t)((unit + (uint32_t)f->static_force) % (uint32_t)(c->n_levels + 1));
+        const uint32_t n_valid = (uint32_t)(level_for(c, tol) + 1);
+        const uint32_t k = (unit + (uint32_t)f->static_force) % (n_valid + 1);
         *chain = c;
-        return k == c->n_levels ? -1 : k;
+        return k == n_valid ? -1 : (int32_t)k;
     }
-    const double tol = unit_tolerance(f, un, m);
     if (unit_delta(un, f->static_delta) > tol)
         return -1; /* not even level 0 would do: do not build it for this view */
     const sw_lod_static_chain *c = unit_chain(f, unit);
@@ -288,6 +290,7 @@ sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status)
             r = append_level(f, &f->occ[i], &g->chain->levels[g->level], g->level, status);
             g->drawn = 1;
             f->st.static_units_drawn++;
+            f->st.static_levels_used |= 1u << (g->level < 31 ? g->level : 31);
         }
         if (r == SW_OK)
             r = face_borders(f, &f->occ[i], status);

@@ -80,10 +80,11 @@ typedef struct sw_gpu_frame_desc {
                               the pool on first need (walkthrough: queued, drawn per frame
                               meanwhile; converged: waited for). Ignored with eval_exact */
     double static_delta;  /* δ of the set's level 0 (its desc's levels.delta; 0: per unit) */
-    int32_t static_force; /* tests: k > 0 draws every unit at level (unit + k) mod (levels + 1),
-                             the last value meaning the per-frame path, whatever the view
-                             needs: neighbours at different levels and beside the trim-texture
-                             path. 0: by the view */
+    int32_t static_force; /* tests of the joins: k > 0 draws unit i at choice (i + k) mod
+                             (n + 1) among its n levels within the view's tolerance, the last
+                             choice meaning the per-frame path: neighbours at different levels,
+                             each good enough, and beside the trim-texture path. 0: the
+                             coarsest good level */
     int32_t lod_colors;   /* 1: each draw coloured by its representation (sw__fr_lod_color) */
 } sw_gpu_frame_desc;
 
@@ -128,6 +129,7 @@ typedef struct sw_gpu_frame_stats {
     uint64_t static_triangles;   /* their triangles (of triangles; fat borders apart) */
     uint64_t static_requests;    /* walkthrough: unit builds queued, not waited for */
     uint64_t static_waits;       /* converged: units the frame waited for */
+    uint32_t static_levels_used; /* bit k: some unit drawn at level k (31: 31 and beyond) */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -38,9 +38,9 @@ static const char k_usage[] =
     "                      first (or read from the scene's LOD cache: `build-lod`)\n"
     "  --lod-colors        colour each surface by how it is drawn: static levels fine to coarse\n"
     "                      blue, teal, green, yellow, orange, pink; per-frame tessellation grey\n"
-    "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at level\n"
-    "                      (i + K) mod (levels + 1), the last value meaning per-frame, whatever\n"
-    "                      the view needs\n"
+    "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
+    "                      (i + K) mod (n + 1) of its n levels good enough for the view, the last\n"
+    "                      choice meaning per-frame: neighbours at different levels\n"
     "  -h, --help          this text\n";
 
 typedef struct render_args {

@@ -15,7 +15,12 @@
  * one face are then different bicubics at different densities, and their own fat borders must
  * close those cracks too.
  *
- * Usage: test_gpu_cracks [--hierarchy] OUTDIR FILE...   (.brep / .step / .tsm)
+ * With --static (implies --hierarchy) the scene's static LODs (Kumar §4, gpu/frame_static.c) are
+ * forced: super-surface i at level (i + K) mod (levels + 1), the last value meaning the per-frame
+ * trim-texture path, for K = 1 and 2 in every view — neighbouring super-surfaces at different
+ * levels, and static beside per-frame, so every kind of join shows.
+ *
+ * Usage: test_gpu_cracks [--hierarchy | --static] OUTDIR FILE...   (.brep / .step / .tsm)
  */
 #include "occt_reference.hpp" /* tests/support */
 
@@ -34,14 +39,17 @@ namespace
 
 const int k_width = 1280, k_height = 720;
 bool g_hierarchy = false; /* --hierarchy */
+bool g_static = false;    /* --static */
 sw_lod_cache *g_cache = nullptr;
+sw_lod_static_set *g_statics = nullptr;
+uint32_t g_levels_seen = 0; /* --static: bit k level k drawn in some view, bit 31 per-frame */
 
-sw_gpu_camera view_camera(const double b[6], const double dir_in[3])
+sw_gpu_camera view_camera(const double b[6], const double dir_in[3], double far_factor)
 {
     sw_gpu_camera c{};
     double diag =
         std::sqrt(std::pow(b[3] - b[0], 2) + std::pow(b[4] - b[1], 2) + std::pow(b[5] - b[2], 2));
-    double dist = diag / (2.0 * std::tan(20.0 * M_PI / 180.0)) * 1.1;
+    double dist = diag / (2.0 * std::tan(20.0 * M_PI / 180.0)) * 1.1 * far_factor;
     double n = std::sqrt(dir_in[0] * dir_in[0] + dir_in[1] * dir_in[1] + dir_in[2] * dir_in[2]);
     for (int k = 0; k < 3; ++k) {
         c.target[k] = 0.5 * (b[k] + b[3 + k]);
@@ -147,13 +155,17 @@ bool render(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_gpu_frame_de
 const double k_dirs[4][3] = {{1, 1, 1}, {0, -1, 0.2}, {-1, 0.6, 0.5}, {0.7, -0.4, -0.8}};
 
 bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_test::occt_triangles *ref, double deflection,
-              const double box[6], int view, const std::string &prefix)
+              const double box[6], int view, int force, const std::string &prefix_in)
 {
+    const std::string prefix = force ? prefix_in + "_static" + std::to_string(force) : prefix_in;
     sw_gpu_frame_desc desc{};
+    desc.static_lods = g_statics;
+    desc.static_force = force;
     desc.width = k_width;
     desc.height = k_height;
     desc.want_depth = 1;
-    desc.camera = view_camera(box, k_dirs[view]);
+    /* static: 3x farther, so that several levels of a super-surface are good enough */
+    desc.camera = view_camera(box, k_dirs[view], force ? 3.0 : 1.0);
     desc.hierarchies = g_cache;
     sw_gpu_image off{}, on{}, theirs{};
     sw_gpu_frame_stats fs_off{}, fs_on{};
@@ -180,6 +192,16 @@ bool run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_test::occt
                 prefix.c_str(), view, c_off, c_on, (unsigned long long)fs_on.triangles,
                 (unsigned long long)(fs_on.triangles - fs_off.triangles), fs_on.ms_draw,
                 fs_off.ms_draw, c_on ? "  <-- FAIL" : "");
+    if (force)
+        std::printf("%*s static: %llu super-surface instances (%llu faces, %llu triangles), %llu "
+                    "faces per frame\n",
+                    (int)prefix.size(), "", (unsigned long long)fs_on.static_units_drawn,
+                    (unsigned long long)fs_on.static_faces,
+                    (unsigned long long)fs_on.static_triangles,
+                    (unsigned long long)(fs_on.faces_drawn - fs_on.static_faces));
+    if (force)
+        g_levels_seen |= fs_on.static_levels_used |
+                         (fs_on.faces_drawn > fs_on.static_faces ? 1u << 31 : 0u);
     sw_status st{};
     std::string path = prefix + "_v" + std::to_string(view);
     sw_gpu_image_write(&off, (path + "_nofill.png").c_str(), &st);
@@ -238,8 +260,32 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
     sw_test_hierarchies *hier = g_hierarchy ? sw_test_hierarchies_create(scene) : nullptr;
     g_cache = sw_test_hierarchies_cache(hier);
     ok = !g_hierarchy || hier;
-    for (int v = 0; v < 4 && ok; ++v)
-        ok = run_view(ctx, scene, tsm ? nullptr : &ref, deflection, box, v, prefix) && ok;
+    g_statics = g_static && hier ? sw_test_hierarchies_statics(hier) : nullptr;
+    ok = ok && (!g_static || g_statics);
+    for (int v = 0; v < 4 && ok; ++v) {
+        if (!g_static) {
+            ok = run_view(ctx, scene, tsm ? nullptr : &ref, deflection, box, v, 0, prefix) && ok;
+            continue;
+        }
+        for (int force = 1; force <= 2; ++force)
+            ok = run_view(ctx, scene, tsm ? nullptr : &ref, deflection, box, v, force, prefix) &&
+                 ok;
+    }
+    if (g_static) {
+        /* the joins must have been shown: two static levels and the per-frame path at least */
+        int levels = 0;
+        for (int k = 0; k < 31; ++k)
+            levels += (g_levels_seen >> k) & 1u;
+        std::printf("%s: static levels drawn %d (mask 0x%x), per-frame faces beside them: %s\n",
+                    prefix.c_str(), levels, g_levels_seen & 0x7fffffffu,
+                    (g_levels_seen >> 31) ? "yes" : "no");
+        if (levels < 2 || !(g_levels_seen >> 31)) {
+            std::printf("FAIL: %s: the forced mix did not show the joins\n", prefix.c_str());
+            ok = false;
+        }
+        g_levels_seen = 0;
+    }
+    g_statics = nullptr;
     sw_test_hierarchies_free(hier);
     g_cache = nullptr;
     sw_sg_scene_free(scene);
@@ -250,11 +296,13 @@ bool run_file(sw_gpu_context *ctx, const std::string &path, const std::string &o
 
 int main(int argc, char **argv)
 {
-    bool hierarchy = argc > 1 && std::strcmp(argv[1], "--hierarchy") == 0;
+    bool stat = argc > 1 && std::strcmp(argv[1], "--static") == 0;
+    bool hierarchy = stat || (argc > 1 && std::strcmp(argv[1], "--hierarchy") == 0);
     argc -= hierarchy;
     argv += hierarchy;
+    g_static = stat;
     if (argc < 3) {
-        std::fprintf(stderr, "usage: %s [--hierarchy] OUTDIR FILE...\n", argv[0]);
+        std::fprintf(stderr, "usage: %s [--hierarchy | --static] OUTDIR FILE...\n", argv[0]);
         return 2;
     }
     g_hierarchy = hierarchy;

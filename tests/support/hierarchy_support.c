@@ -1,6 +1,7 @@
 #include "hierarchy_support.h"
 
 #include "sw_lod_cache.h"
+#include "sw_lod_static_set.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,6 +9,8 @@
 struct sw_test_hierarchies {
     sw_th_pool *pool;
     sw_lod_cache *cache;
+    const sw_sg_scene *scene;
+    sw_lod_static_set *statics; /* made on first ask */
 };
 
 sw_test_hierarchies *sw_test_hierarchies_create(const sw_sg_scene *scene)
@@ -20,6 +23,7 @@ sw_test_hierarchies *sw_test_hierarchies_create(const sw_sg_scene *scene)
         free(h);
         return NULL;
     }
+    h->scene = scene;
     if (sw_lod_cache_create(scene, h->pool, NULL, &h->cache, &st) != SW_OK) {
         fprintf(stderr, "hierarchies: %s\n", st.message);
         sw_test_hierarchies_free(h);
@@ -33,10 +37,20 @@ struct sw_lod_cache *sw_test_hierarchies_cache(sw_test_hierarchies *h)
     return h ? h->cache : NULL;
 }
 
+struct sw_lod_static_set *sw_test_hierarchies_statics(sw_test_hierarchies *h)
+{
+    sw_status st = {0};
+    if (h && !h->statics &&
+        sw_lod_static_set_create(h->scene, h->pool, NULL, &h->statics, &st) != SW_OK)
+        fprintf(stderr, "static LODs: %s\n", st.message);
+    return h ? h->statics : NULL;
+}
+
 void sw_test_hierarchies_free(sw_test_hierarchies *h)
 {
     if (!h)
         return;
+    sw_lod_static_set_destroy(h->statics);
     sw_lod_cache_destroy(h->cache);
     sw_th_pool_destroy(h->pool);
     free(h);

@@ -214,9 +214,10 @@ typedef struct sw_frame_desc {
                                 converged frames do. 0: every face by the per-frame path */
     int32_t lod_colors;      /* 1: each surface coloured by how it is drawn: static levels fine
                                 to coarse blue, teal, green, yellow, orange, pink; per-frame grey */
-    int32_t static_force;    /* tests of the joins: k > 0 draws every super-surface at level
-                                (index + k) mod (levels + 1), the last value meaning the per-frame
-                                path, whatever the view needs. 0: by the view */
+    int32_t static_force;    /* tests of the joins: k > 0 draws super-surface i at choice
+                                (i + k) mod (n + 1) among its n levels good enough for the view,
+                                the last choice meaning the per-frame path: neighbours at
+                                different levels. 0: the coarsest good level */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
