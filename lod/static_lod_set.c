@@ -248,6 +248,11 @@ const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *s)
     return s->scene;
 }
 
+const sw_lod_static_desc *sw__lod_static_set_levels(const sw_lod_static_set *s)
+{
+    return &s->levels;
+}
+
 uint32_t sw_lod_static_set_unit_of(const sw_lod_static_set *s, uint32_t face)
 {
     return face < s->n_faces ? s->unit_of_face[face] : SW_LOD_STATIC_NO_UNIT;

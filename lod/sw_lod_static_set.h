@@ -75,6 +75,8 @@ void sw_lod_static_set_destroy(sw_lod_static_set *set);
 
 uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *set);
 const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *set);
+/* The level settings the set builds with (its desc's, zero fields as given). */
+const sw_lod_static_desc *sw__lod_static_set_levels(const sw_lod_static_set *set);
 /* The unit of `face`, SW_LOD_STATIC_NO_UNIT for a face out of range. */
 uint32_t sw_lod_static_set_unit_of(const sw_lod_static_set *set, uint32_t face);
 const sw_lod_static_unit *sw_lod_static_set_unit(const sw_lod_static_set *set, uint32_t unit);
@@ -100,6 +102,27 @@ sw_result sw_lod_static_set_adopt(sw_lod_static_set *set, uint32_t unit,
 sw_result sw_lod_static_set_failure(const sw_lod_static_set *set, uint32_t unit,
                                     const char **message);
 void sw_lod_static_set_get_stats(const sw_lod_static_set *set, sw_lod_static_set_stats *out);
+
+/* ---- the LOD cache (static_lod_io.c) ---------------------------------------------------------
+ * The READY chains as one byte string (the .sws file's LODS section, `splinewalk build-lod`):
+ *   "SWLODS\0\0", u32 version 1, u32 unit count, u64 key, then per unit a u32 (0: no chain,
+ *   1: a chain follows): i32 levels, u32 patches, f64 δ, and per level u32 vertices, u32
+ *   triangles, f64 ε, ε_target, measured[2], then positions (f64 x 3), normals (f32 x 3),
+ *   (u, v) (f64 x 2), faces (u32) per vertex and the triangles (u32 x 3); little-endian.
+ * The key hashes the units (their faces and patches) and the level settings, so a cache made
+ * for another clustering, scene or setting is refused rather than misread. */
+
+/* *out (malloc, the caller frees) and *size. Errors: SW_ERR_OUT_OF_MEMORY. */
+sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,
+                                      sw_status *status);
+/* Adopts every chain of a cache made by sw_lod_static_set_serialize for the same units and
+ * settings; `what` names the source in messages. All or nothing: the whole string is checked
+ * (bounds, counts, finite values, triangle and face indices inside the unit) before one chain is
+ * adopted. *adopted (may be NULL) = chains adopted. Errors: SW_ERR_FORMAT (with the offset),
+ * SW_ERR_VERSION, SW_ERR_INVALID_ARGUMENT (a cache of other units or settings: stale),
+ * SW_ERR_OUT_OF_MEMORY. Units already READY or QUEUED keep what they have. */
+sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_t size,
+                                 const char *what, uint32_t *adopted, sw_status *status);
 
 #ifdef __cplusplus
 }

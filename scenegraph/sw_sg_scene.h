@@ -198,6 +198,16 @@ sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *s
 /* ---- .sws files (sws_file.c) ----------------------------------------------------------------- */
 /* Writes to PATH.tmp-<pid> and renames it over PATH; nothing is left behind on failure. */
 sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *status);
+/* As sw_sg_scene_save, with lods_size bytes at lods as the file's optional LODS section (the
+ * static-LOD cache, lod/static_lod_io.c); lods NULL or lods_size 0 writes none. sw_sg_scene_save
+ * keeps a mapped scene's LODS section (verified first). Same errors. */
+sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void *lods,
+                                size_t lods_size, sw_status *status);
+/* The LODS section of a mapped scene, checked against its checksum on every call (it is read
+ * once per renderer). *data stays valid while the scene lives. Errors: SW_ERR_NOT_FOUND (no such
+ * section: a scene in memory or a file without one), SW_ERR_CHECKSUM. Any thread. */
+sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *size,
+                           sw_status *status);
 /* Maps a .sws file. Checks the header, version, the section table and that the file is as long as
  * the table says (a short mapping would raise SIGBUS); checksums are verified per section by
  * sw_sg_scene_require. Errors: SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_VERSION,

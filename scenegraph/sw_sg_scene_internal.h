@@ -38,6 +38,7 @@ struct sw_sg_scene {
     void *map; /* mapped file, NULL in memory */
     size_t map_size;
     sw__sg_section_info sec[SW__SG_SEC_COUNT]; /* mapped only */
+    sw__sg_section_info lods;  /* mapped only: the optional LODS section (size 0: none) */
     uint32_t verified;         /* sections whose checksum matched (sw_sg_section bits) */
     int validated;             /* 1 once sw_sg_scene_validate passed, -1 once it failed */
     sw_status validate_status; /* the failure, repeated to later callers */

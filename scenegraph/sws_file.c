@@ -8,7 +8,7 @@
  *   0       8     magic "SWSCENE\0"
  *   8       4     version = 1
  *   12      4     flags = 0
- *   16      4     section count = 8
+ *   16      4     section count = 8, or 9 with the optional LODS section
  *   20      4     header size = 64
  *   24      8     total file size in bytes
  *   32      8     offset of the section table (16-byte aligned, >= 64)
@@ -17,7 +17,9 @@
  *   60      4     header checksum: CRC-32C of bytes [0, 60) followed by the whole section table
  *
  *   section table entry (40 bytes):
- *   0  u32 id (0 FACES, 1 LOOPS, 2 CURVES, 3 NODES, 4 ADJACENCY, 5 POOL, 6 STRINGS, 7 META)
+ *   0  u32 id (0 FACES, 1 LOOPS, 2 CURVES, 3 NODES, 4 ADJACENCY, 5 POOL, 6 STRINGS, 7 META,
+ *            8 LODS: optional, the static-LOD cache, opaque bytes with their own format owned by
+ *            lod/static_lod_io.c; only when the count is 9)
  *   4  u32 reserved, zero
  *   8  u64 offset of the section (16-byte aligned, after the table, sections do not overlap)
  *   16 u64 size in bytes = element count * record size
@@ -64,6 +66,8 @@ _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/bin
 #define SWS_ENTRY_SIZE 40u
 #define SWS_ALIGN 16u
 #define SWS_HEADER_CRC_AT 60u
+#define SWS_SEC_LODS SW__SG_SEC_COUNT       /* id of the optional section */
+#define SWS_MAX_SECTIONS (SW__SG_SEC_COUNT + 1)
 
 typedef struct sws_header {
     uint32_t version, flags, section_count, header_size;
@@ -182,7 +186,9 @@ static void read_header(const unsigned char *p, sws_header *h)
 static sw_result check_header(const char *path, const unsigned char *p, uint64_t size,
                               const sws_header *h, sw_status *status)
 {
-    const uint64_t table_bytes = (uint64_t)SW__SG_SEC_COUNT * SWS_ENTRY_SIZE;
+    const uint32_t n_sec =
+        h->section_count == SWS_MAX_SECTIONS ? SWS_MAX_SECTIONS : SW__SG_SEC_COUNT;
+    const uint64_t table_bytes = (uint64_t)n_sec * SWS_ENTRY_SIZE;
     if (h->table_offset < SWS_HEADER_SIZE || h->table_offset % SWS_ALIGN ||
         h->table_offset > h->file_size || table_bytes > h->file_size - h->table_offset)
         return sw__fail(status, SW_ERR_FORMAT,
@@ -203,12 +209,13 @@ static sw_result check_header(const char *path, const unsigned char *p, uint64_t
                         "0x%08x)",
                         path, h->header_crc, crc);
     if (h->flags != 0 || h->header_size != SWS_HEADER_SIZE || h->entry_size != SWS_ENTRY_SIZE ||
-        h->section_count != SW__SG_SEC_COUNT || !h->reserved_zero)
+        (h->section_count != SW__SG_SEC_COUNT && h->section_count != SWS_MAX_SECTIONS) ||
+        !h->reserved_zero)
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: header at offset 12: flags 0x%x, %u sections, header size %u, entry "
-                        "size %u (expected 0, %u, %u, %u, reserved zero)",
+                        "size %u (expected 0, %u or %u, %u, %u, reserved zero)",
                         path, h->flags, h->section_count, h->header_size, h->entry_size,
-                        SW__SG_SEC_COUNT, SWS_HEADER_SIZE, SWS_ENTRY_SIZE);
+                        SW__SG_SEC_COUNT, SWS_MAX_SECTIONS, SWS_HEADER_SIZE, SWS_ENTRY_SIZE);
     if (h->file_size > size)
         return sw__fail(status, SW_ERR_TRUNCATED,
                         "%s: offset %llu: file is %llu bytes, its section table says %llu", path,
@@ -224,17 +231,19 @@ static sw_result check_header(const char *path, const unsigned char *p, uint64_t
 /* One table entry: known id, not seen before, aligned, inside the file, after the table, and
  * count * record size == size (all without overflow). */
 static sw_result check_entry(const char *path, const unsigned char *ent, uint64_t ent_off,
-                             uint64_t data_start, uint64_t file_size, sw__sg_section_info *sec,
-                             uint32_t *seen, sw_status *status)
+                             uint64_t data_start, uint64_t file_size, uint32_t n_sec,
+                             sw__sg_section_info *sec, uint32_t *seen, sw_status *status)
 {
     uint32_t id = rd32(ent);
     uint64_t off = rd64(ent + 8), sz = rd64(ent + 16), count = rd64(ent + 24);
-    if (id >= SW__SG_SEC_COUNT || (*seen & (1u << id)) || rd32(ent + 4) || rd32(ent + 36))
+    /* ids below n_sec, each once: with 8 sections the core ones, with 9 also LODS */
+    if (id >= n_sec || (*seen & (1u << id)) || rd32(ent + 4) || rd32(ent + 36))
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: section table entry at offset %llu: unknown or repeated id %u", path,
                         (unsigned long long)ent_off, id);
-    const char *name = sw__sg_section_names[id];
-    const uint64_t rec = sw__sg_section_record_size[id];
+    const int lods = id == SWS_SEC_LODS;
+    const char *name = lods ? "LODS" : sw__sg_section_names[id];
+    const uint64_t rec = lods ? 1 : sw__sg_section_record_size[id];
     if (off % SWS_ALIGN || off < data_start || off > file_size || sz > file_size - off)
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: section %s (table entry at offset %llu): offset %llu, size %llu "
@@ -242,7 +251,7 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
                         path, name, (unsigned long long)ent_off, (unsigned long long)off,
                         (unsigned long long)sz, (unsigned long long)data_start,
                         (unsigned long long)file_size);
-    uint64_t max_count = id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS ? UINT64_MAX
+    uint64_t max_count = id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS || lods ? UINT64_MAX
                          : id == SW__SG_SEC_META                           ? 1
                                                                            : SW_SG_NONE - 1;
     if (count > max_count || count > UINT64_MAX / rec || count * rec != sz ||
@@ -259,15 +268,17 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
 
 static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec, sw_status *status)
 {
-    for (int a = 0; a < SW__SG_SEC_COUNT; a++)
-        for (int b = a + 1; b < SW__SG_SEC_COUNT; b++) {
+    for (int a = 0; a < SWS_MAX_SECTIONS; a++)
+        for (int b = a + 1; b < SWS_MAX_SECTIONS; b++) {
             const sw__sg_section_info *x = &sec[a], *y = &sec[b];
             if (x->size && y->size && x->offset < y->offset + y->size &&
                 y->offset < x->offset + x->size)
                 return sw__fail(status, SW_ERR_FORMAT,
                                 "%s: section %s at offset %llu overlaps section %s at offset %llu",
-                                path, sw__sg_section_names[a], (unsigned long long)x->offset,
-                                sw__sg_section_names[b], (unsigned long long)y->offset);
+                                path, a == SWS_SEC_LODS ? "LODS" : sw__sg_section_names[a],
+                                (unsigned long long)x->offset,
+                                b == SWS_SEC_LODS ? "LODS" : sw__sg_section_names[b],
+                                (unsigned long long)y->offset);
         }
     return SW_OK;
 }
@@ -275,18 +286,22 @@ static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec
 static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status *status)
 {
     const unsigned char *p = scene->map;
-    const uint64_t data_start = h->table_offset + (uint64_t)SW__SG_SEC_COUNT * SWS_ENTRY_SIZE;
+    const uint32_t n_sec = h->section_count;
+    const uint64_t data_start = h->table_offset + (uint64_t)n_sec * SWS_ENTRY_SIZE;
     uint32_t seen = 0;
-    for (uint32_t i = 0; i < SW__SG_SEC_COUNT; i++) {
+    sw__sg_section_info sec[SWS_MAX_SECTIONS] = {{0}};
+    for (uint32_t i = 0; i < n_sec; i++) {
         uint64_t ent_off = h->table_offset + (uint64_t)i * SWS_ENTRY_SIZE;
         sw_result r = check_entry(scene->path, p + ent_off, ent_off, data_start, h->file_size,
-                                  scene->sec, &seen, status);
+                                  n_sec, sec, &seen, status);
         if (r != SW_OK)
             return r;
     }
-    sw_result r = check_overlaps(scene->path, scene->sec, status);
+    sw_result r = check_overlaps(scene->path, sec, status);
     if (r != SW_OK)
         return r;
+    memcpy(scene->sec, sec, sizeof scene->sec);
+    scene->lods = sec[SWS_SEC_LODS];
     /* META is 16 bytes: verified here, as the root is part of the view. */
     const sw__sg_section_info *m = &scene->sec[SW__SG_SEC_META];
     uint32_t crc = sw__crc32c(0, p + m->offset, m->size);
@@ -406,8 +421,10 @@ static int write_all(int fd, const void *data, uint64_t n)
     return 1;
 }
 
-/* Header, table and META for a scene's view; fills the section offsets and the file size. */
-static void build_header(const sw_sg_scene_view *v, const void *ptr[SW__SG_SEC_COUNT],
+/* Header, table and META for a scene's view and n_sec sections (the 9th: lods, lods_bytes);
+ * fills the section offsets and the file size. */
+static void build_header(const sw_sg_scene_view *v, uint32_t n_sec, const void *lods,
+                         uint64_t lods_bytes, const void *ptr[SWS_MAX_SECTIONS],
                          unsigned char meta[16], unsigned char *head, uint64_t head_bytes,
                          uint64_t *file_size)
 {
@@ -416,11 +433,14 @@ static void build_header(const sw_sg_scene_view *v, const void *ptr[SW__SG_SEC_C
     wr32(meta, v->root);
     uint64_t off = head_bytes;
     unsigned char *table = head + SWS_HEADER_SIZE;
-    for (int s = 0; s < SW__SG_SEC_COUNT; s++) {
+    for (int s = 0; s < (int)n_sec; s++) {
         uint64_t bytes = 16, count = 1;
         if (s == SW__SG_SEC_META)
             ptr[s] = meta;
-        else
+        else if (s == SWS_SEC_LODS) {
+            ptr[s] = lods;
+            bytes = count = lods_bytes;
+        } else
             ptr[s] = sw__sg_view_section(v, s, &bytes, &count);
         off = align16(off);
         unsigned char *e = table + (size_t)s * SWS_ENTRY_SIZE;
@@ -434,25 +454,25 @@ static void build_header(const sw_sg_scene_view *v, const void *ptr[SW__SG_SEC_C
     *file_size = off;
     memcpy(head, SWS_MAGIC, 8);
     wr32(head + 8, SWS_VERSION);
-    wr32(head + 16, SW__SG_SEC_COUNT);
+    wr32(head + 16, n_sec);
     wr32(head + 20, SWS_HEADER_SIZE);
     wr64(head + 24, off);
     wr64(head + 32, SWS_HEADER_SIZE);
     wr32(head + 40, SWS_ENTRY_SIZE);
     uint32_t crc = sw__crc32c(0, head, SWS_HEADER_CRC_AT);
-    crc = sw__crc32c(crc, table, (size_t)SW__SG_SEC_COUNT * SWS_ENTRY_SIZE);
+    crc = sw__crc32c(crc, table, (size_t)n_sec * SWS_ENTRY_SIZE);
     wr32(head + SWS_HEADER_CRC_AT, crc);
 }
 
 /* Writes the sections in table order with zero padding up to each 16-byte boundary. */
-static int write_body(int fd, const unsigned char *head, uint64_t head_bytes,
-                      const void *const ptr[SW__SG_SEC_COUNT])
+static int write_body(int fd, const unsigned char *head, uint64_t head_bytes, uint32_t n_sec,
+                      const void *const ptr[SWS_MAX_SECTIONS])
 {
     static const unsigned char zeros[SWS_ALIGN];
     if (!write_all(fd, head, head_bytes))
         return 0;
     uint64_t pos = head_bytes;
-    for (int s = 0; s < SW__SG_SEC_COUNT; s++) {
+    for (int s = 0; s < (int)n_sec; s++) {
         const unsigned char *e = head + SWS_HEADER_SIZE + (size_t)s * SWS_ENTRY_SIZE;
         uint64_t off = rd64(e + 8), bytes = rd64(e + 16);
         if (!write_all(fd, zeros, off - pos) || !write_all(fd, ptr[s], bytes))
@@ -480,18 +500,54 @@ static void sync_parent_dir(const char *path)
     }
 }
 
+sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *size,
+                           sw_status *status)
+{
+    *data = NULL;
+    *size = 0;
+    const sw__sg_section_info *e = &scene->lods;
+    if (!scene->map || e->size == 0)
+        return sw__fail(status, SW_ERR_NOT_FOUND, "%s: no LODS section", scene->path);
+    const unsigned char *p = (const unsigned char *)scene->map + e->offset;
+    const uint32_t crc = sw__crc32c(0, p, e->size);
+    if (crc != e->checksum)
+        return sw__fail(status, SW_ERR_CHECKSUM,
+                        "%s: section LODS at offset %llu: checksum mismatch (stored 0x%08x, "
+                        "computed 0x%08x)",
+                        scene->path, (unsigned long long)e->offset, e->checksum, crc);
+    *data = p;
+    *size = (size_t)e->size;
+    sw__status_ok(status);
+    return SW_OK;
+}
+
 sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *status)
+{
+    const void *lods = NULL;
+    size_t lods_size = 0;
+    if (scene->map && scene->lods.size) {
+        sw_result r = sw_sg_scene_lods(scene, &lods, &lods_size, status);
+        if (r != SW_OK)
+            return r; /* a corrupt LODS section is not rewritten with a fresh checksum either */
+    }
+    return sw_sg_scene_save_lods(scene, path, lods, lods_size, status);
+}
+
+sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void *lods,
+                                size_t lods_size, sw_status *status)
 {
     /* A mapped scene is verified first: a corrupted section must not be rewritten with a fresh,
      * matching checksum. */
     sw_result r = sw_sg_scene_require(scene, SW_SG_SEC_ALL, status);
     if (r != SW_OK)
         return r;
-    enum { HEAD = SWS_HEADER_SIZE + SW__SG_SEC_COUNT * SWS_ENTRY_SIZE };
+    const uint32_t n_sec = lods && lods_size ? SWS_MAX_SECTIONS : SW__SG_SEC_COUNT;
+    enum { HEAD = SWS_HEADER_SIZE + SWS_MAX_SECTIONS * SWS_ENTRY_SIZE };
+    const uint64_t head_bytes = SWS_HEADER_SIZE + (uint64_t)n_sec * SWS_ENTRY_SIZE;
     unsigned char head[HEAD], meta[16];
-    const void *ptr[SW__SG_SEC_COUNT];
+    const void *ptr[SWS_MAX_SECTIONS];
     uint64_t file_size;
-    build_header(&scene->view, ptr, meta, head, HEAD, &file_size);
+    build_header(&scene->view, n_sec, lods, lods_size, ptr, meta, head, head_bytes, &file_size);
 
     size_t tlen = strlen(path) + 32;
     char *tmp = malloc(tlen);
@@ -506,7 +562,7 @@ sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *stat
         return r;
     }
     const char *step = NULL;
-    if (!write_body(fd, head, HEAD, ptr))
+    if (!write_body(fd, head, head_bytes, n_sec, ptr))
         step = "write";
     else if (fsync(fd) != 0)
         step = "fsync";

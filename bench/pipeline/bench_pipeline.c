@@ -18,6 +18,7 @@
  */
 #include <splinewalk/splinewalk.h>
 
+#include "bench_stats.h"
 #include "sw_camera_path.h"
 
 #include <math.h>
@@ -33,27 +34,6 @@ typedef struct bench {
     int frames, passes, w, h;
     int threaded, sequential;
 } bench;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double quantile(double *v, int n, double q)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    double pos = q * (n - 1);
-    int lo = (int)pos;
-    return lo + 1 < n ? v[lo] + (pos - lo) * (v[lo + 1] - v[lo]) : v[n - 1];
-}
 
 static sw_frame_desc frame_at(const bench *b, int i)
 {
@@ -77,7 +57,7 @@ static int pass(const bench *b, sw_renderer r, int threaded, double *ms, double 
         goto fail;
     for (int i = 0; i < b->frames; ++i) {
         sw_frame_stats fs = {0};
-        double t0 = now_ms();
+        double t0 = bench_now_ms();
         if (threaded) {
             if (i + 1 < b->frames) {
                 f = frame_at(b, i + 1);
@@ -91,7 +71,7 @@ static int pass(const bench *b, sw_renderer r, int threaded, double *ms, double 
             if (sw_renderer_draw(r, &f, &fs, &st) != SW_OK)
                 goto fail;
         }
-        ms[i] = now_ms() - t0;
+        ms[i] = bench_now_ms() - t0;
         vis[i] = threaded ? fs.ms_visibility : fs.ms_tessellate + fs.ms_hierarchy;
         *fallbacks += fs.fallback_draws;
     }
@@ -143,9 +123,9 @@ static int run(bench *b)
     for (int m = 0; m < 2; ++m) {
         if (!modes[m])
             continue;
-        median[m] = quantile(res[m].ms, res[m].n, 0.5);
-        p99[m] = quantile(res[m].ms, res[m].n, 0.99);
-        double vmed = quantile(res[m].vis, res[m].n, 0.5);
+        median[m] = bench_quantile(res[m].ms, res[m].n, 0.5);
+        p99[m] = bench_quantile(res[m].ms, res[m].n, 0.99);
+        double vmed = bench_quantile(res[m].vis, res[m].n, 0.5);
         printf("%-10s frames %d: median %.2f ms, p99 %.2f ms; visibility + selection + "
                "tessellation median %.2f ms (%s); fallback draws %llu\n",
                names[m], res[m].n, median[m], p99[m], vmed,

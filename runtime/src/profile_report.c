@@ -78,6 +78,10 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_ATLAS_PAGES] = (double)st->atlas_pages;
     v[SW_RT_COL_FALLBACK_DRAWS] = (double)st->fallback_draws;
     v[SW_RT_COL_POOL_WAITS] = (double)st->pool_waits;
+    v[SW_RT_COL_STATIC_DRAWN] = (double)st->static_drawn;
+    v[SW_RT_COL_STATIC_FACES] = (double)st->static_faces;
+    v[SW_RT_COL_STATIC_TRIANGLES] = (double)st->static_triangles;
+    v[SW_RT_COL_STATIC_REQUESTS] = (double)st->static_requests;
     v[SW_RT_COL_RESIDENT_BYTES] = resident_bytes;
     v[SW_RT_COL_CAPTURED] = captured ? 1.0 : 0.0;
 }

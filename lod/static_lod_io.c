@@ -1,0 +1,302 @@
+/* The static-LOD cache: a set's READY chains as one byte string and back (the layout is in
+ * lod/sw_lod_static_set.h). Reading trusts nothing: every count is checked against the bytes left
+ * before anything is allocated, every value against what a chain may hold, and the whole string
+ * is parsed into new chains before the first one is adopted. */
+#include "sw_lod_static_set.h"
+
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LODS_MAGIC "SWLODS\0"
+#define LODS_VERSION 1u
+#define LODS_MAX_LEVELS 9
+
+/* ---- the key ---------------------------------------------------------------------------------- */
+
+static uint64_t fnv(uint64_t h, const void *data, size_t n)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+/* The units' faces and patches, and the level settings the set builds with. */
+static uint64_t set_key(const sw_lod_static_set *set, const sw_lod_static_desc *levels)
+{
+    uint64_t h = 1469598103934665603ull;
+    const uint32_t n = sw_lod_static_set_unit_count(set);
+    h = fnv(h, &n, sizeof n);
+    const uint32_t *faces = sw_lod_static_set_faces(set);
+    const sw_lod_static_patch *patches = sw_lod_static_set_patches(set);
+    for (uint32_t u = 0; u < n; ++u) {
+        const sw_lod_static_unit *un = sw_lod_static_set_unit(set, u);
+        h = fnv(h, &un->n_faces, sizeof un->n_faces);
+        h = fnv(h, faces + un->first_face, un->n_faces * sizeof *faces);
+        for (uint32_t k = 0; k < un->n_patches; ++k) {
+            const sw_lod_static_patch *p = &patches[un->first_patch + k];
+            const uint32_t rec[3] = {p->face, p->iu, p->iv};
+            h = fnv(h, rec, sizeof rec);
+        }
+    }
+    const double d[4] = {levels->delta, levels->eps_first, levels->eps_growth, levels->safety};
+    const int32_t i[2] = {levels->n_levels, (int32_t)levels->max_vertices};
+    h = fnv(h, d, sizeof d);
+    return fnv(h, i, sizeof i);
+}
+
+/* ---- writing ---------------------------------------------------------------------------------- */
+
+typedef struct writer {
+    unsigned char *p;
+    size_t n, cap;
+    int oom;
+} writer;
+
+static void put(writer *w, const void *data, size_t n)
+{
+    if (w->oom)
+        return;
+    if (w->n + n > w->cap) {
+        size_t cap = w->cap ? w->cap : 4096;
+        while (cap < w->n + n)
+            cap *= 2;
+        unsigned char *g = realloc(w->p, cap);
+        if (!g) {
+            w->oom = 1;
+            return;
+        }
+        w->p = g;
+        w->cap = cap;
+    }
+    memcpy(w->p + w->n, data, n);
+    w->n += n;
+}
+
+static void put_u32(writer *w, uint32_t x)
+{
+    put(w, &x, sizeof x);
+}
+
+static void put_level(writer *w, const sw_lod_static_level *l)
+{
+    put_u32(w, l->n_vertices);
+    put_u32(w, l->n_triangles);
+    const double d[4] = {l->eps, l->eps_target, l->measured[0], l->measured[1]};
+    put(w, d, sizeof d);
+    put(w, l->positions, (size_t)l->n_vertices * 3 * sizeof *l->positions);
+    put(w, l->normals, (size_t)l->n_vertices * 3 * sizeof *l->normals);
+    put(w, l->uv, (size_t)l->n_vertices * 2 * sizeof *l->uv);
+    put(w, l->face, (size_t)l->n_vertices * sizeof *l->face);
+    put(w, l->triangles, (size_t)l->n_triangles * 3 * sizeof *l->triangles);
+}
+
+sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,
+                                      sw_status *status)
+{
+    *out = NULL;
+    *size = 0;
+    writer w = {0};
+    const uint32_t n = sw_lod_static_set_unit_count(set);
+    put(&w, LODS_MAGIC, 8);
+    put_u32(&w, LODS_VERSION);
+    put_u32(&w, n);
+    const uint64_t key = set_key(set, sw__lod_static_set_levels(set));
+    put(&w, &key, sizeof key);
+    for (uint32_t u = 0; u < n; ++u) {
+        const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
+        put_u32(&w, c ? 1u : 0u);
+        if (!c)
+            continue;
+        put(&w, &c->n_levels, sizeof c->n_levels);
+        put_u32(&w, c->n_patches);
+        put(&w, &c->delta, sizeof c->delta);
+        for (int32_t k = 0; k < c->n_levels; ++k)
+            put_level(&w, &c->levels[k]);
+    }
+    if (w.oom) {
+        free(w.p);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LOD cache: out of memory");
+    }
+    *out = w.p;
+    *size = w.n;
+    return SW_OK;
+}
+
+/* ---- reading ---------------------------------------------------------------------------------- */
+
+typedef struct reader {
+    const unsigned char *p;
+    size_t n, at;
+    const char *what;
+    sw_status *status;
+} reader;
+
+static int take(reader *r, void *out, size_t n)
+{
+    if (n > r->n - r->at)
+        return 0;
+    memcpy(out, r->p + r->at, n);
+    r->at += n;
+    return 1;
+}
+
+static sw_result bad(reader *r, const char *fmt, const char *detail)
+{
+    return sw__fail(r->status, SW_ERR_FORMAT, "%s: LODS offset %zu: %s%s", r->what, r->at, fmt,
+                    detail ? detail : "");
+}
+
+/* An array of count elements of elem bytes, checked against the bytes left first. */
+static void *take_array(reader *r, uint64_t count, size_t elem)
+{
+    if (count > (r->n - r->at) / elem)
+        return NULL;
+    void *a = malloc(count ? (size_t)count * elem : 1);
+    if (a)
+        take(r, a, (size_t)count * elem);
+    return a;
+}
+
+static int finite_all(const double *v, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+static int finite_all_f(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+/* Whether `face` is one of the unit's faces (sorted ascending: units list faces in order). */
+static int unit_has_face(const sw_lod_static_set *set, const sw_lod_static_unit *un, uint32_t face)
+{
+    const uint32_t *f = sw_lod_static_set_faces(set) + un->first_face;
+    uint32_t lo = 0, hi = un->n_faces;
+    while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (f[mid] < face)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo < un->n_faces && f[lo] == face;
+}
+
+static sw_result read_level(reader *r, const sw_lod_static_set *set, const sw_lod_static_unit *un,
+                            sw_lod_static_level *l)
+{
+    double d[4];
+    if (!take(r, &l->n_vertices, 4) || !take(r, &l->n_triangles, 4) || !take(r, d, sizeof d))
+        return bad(r, "truncated level header", NULL);
+    l->eps = d[0], l->eps_target = d[1], l->measured[0] = d[2], l->measured[1] = d[3];
+    if (!finite_all(d, 4) || !(l->eps >= 0.0))
+        return bad(r, "a level's ε is not a finite non-negative number", NULL);
+    const uint64_t nv = l->n_vertices, nt = l->n_triangles;
+    if (!(l->positions = take_array(r, 3 * nv, sizeof *l->positions)) ||
+        !(l->normals = take_array(r, 3 * nv, sizeof *l->normals)) ||
+        !(l->uv = take_array(r, 2 * nv, sizeof *l->uv)) ||
+        !(l->face = take_array(r, nv, sizeof *l->face)) ||
+        !(l->triangles = take_array(r, 3 * nt, sizeof *l->triangles)))
+        return bad(r, "a level's arrays run past the end (or out of memory)", NULL);
+    if (!finite_all(l->positions, 3 * nv) || !finite_all_f(l->normals, 3 * nv) ||
+        !finite_all(l->uv, 2 * nv))
+        return bad(r, "a vertex with a non-finite coordinate", NULL);
+    for (uint64_t t = 0; t < 3 * nt; ++t)
+        if (l->triangles[t] >= nv)
+            return bad(r, "a triangle names a vertex out of range", NULL);
+    for (uint64_t v = 0; v < nv; ++v)
+        if (!unit_has_face(set, un, l->face[v]))
+            return bad(r, "a vertex on a face outside its super-surface", NULL);
+    return SW_OK;
+}
+
+static sw_result read_chain(reader *r, const sw_lod_static_set *set, uint32_t unit,
+                            sw_lod_static_chain **out)
+{
+    sw_lod_static_chain *c = calloc(1, sizeof *c);
+    if (!c)
+        return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+    *out = c;
+    int32_t n_levels;
+    if (!take(r, &n_levels, 4) || !take(r, &c->n_patches, 4) || !take(r, &c->delta, 8))
+        return bad(r, "truncated chain header", NULL);
+    const sw_lod_static_unit *un = sw_lod_static_set_unit(set, unit);
+    if (n_levels < 1 || n_levels > LODS_MAX_LEVELS || c->n_patches != un->n_patches ||
+        !(c->delta > 0.0) || !isfinite(c->delta))
+        return bad(r, "a chain's level count, patch count or δ does not fit its super-surface",
+                   NULL);
+    if (!(c->levels = calloc((size_t)n_levels, sizeof *c->levels)))
+        return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+    for (int32_t k = 0; k < n_levels; ++k) {
+        c->n_levels = k + 1; /* what sw_lod_static_free frees */
+        sw_result res = read_level(r, set, un, &c->levels[k]);
+        if (res != SW_OK)
+            return res;
+    }
+    return SW_OK;
+}
+
+static void free_chains(sw_lod_static_chain **chains, uint32_t n)
+{
+    for (uint32_t u = 0; u < n; ++u)
+        sw_lod_static_free(chains[u]);
+    free(chains);
+}
+
+sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_t size,
+                                 const char *what, uint32_t *adopted, sw_status *status)
+{
+    if (adopted)
+        *adopted = 0;
+    reader r = {data, size, 0, what, status};
+    char magic[8];
+    uint32_t version = 0, n = 0;
+    uint64_t key = 0;
+    if (!take(&r, magic, 8) || memcmp(magic, LODS_MAGIC, 8) != 0)
+        return bad(&r, "not a static LOD cache (bad magic)", NULL);
+    if (!take(&r, &version, 4) || version != LODS_VERSION)
+        return sw__fail(status, SW_ERR_VERSION, "%s: LODS offset 8: cache version %u, this program "
+                        "reads %u", what, version, LODS_VERSION);
+    if (!take(&r, &n, 4) || !take(&r, &key, 8))
+        return bad(&r, "truncated header", NULL);
+    if (n != sw_lod_static_set_unit_count(set) || key != set_key(set, sw__lod_static_set_levels(set)))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "%s: the static LOD cache was made for other super-surfaces or settings "
+                        "(%u units, this scene has %u): run `splinewalk build-lod` again",
+                        what, n, sw_lod_static_set_unit_count(set));
+    sw_lod_static_chain **chains = calloc(n ? n : 1, sizeof *chains);
+    if (!chains)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
+    sw_result res = SW_OK;
+    for (uint32_t u = 0; u < n && res == SW_OK; ++u) {
+        uint32_t has;
+        if (!take(&r, &has, 4) || has > 1)
+            res = bad(&r, "a unit's chain flag is not 0 or 1", NULL);
+        else if (has)
+            res = read_chain(&r, set, u, &chains[u]);
+    }
+    if (res == SW_OK && r.at != r.n)
+        res = bad(&r, "bytes after the last chain", NULL);
+    if (res != SW_OK) {
+        free_chains(chains, n);
+        return res;
+    }
+    for (uint32_t u = 0; u < n; ++u) {
+        /* adopt owns the chain whatever the result (a unit built meanwhile keeps its own) */
+        if (chains[u] && sw_lod_static_set_adopt(set, u, chains[u]) == SW_OK && adopted)
+            (*adopted)++;
+        chains[u] = NULL;
+    }
+    free(chains);
+    return SW_OK;
+}
