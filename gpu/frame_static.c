@@ -33,7 +33,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-enum { STATIC_BORDER_CELLS = 32 }; /* fat-border samples per face side (uv extent / 32) */
+/* Fat-border sampling of a statically drawn face: its uv box cut into cells of about
+ * STATIC_BORDER_PX pixels of its unit's screen extent, between 2 and 32 per side. A chord over
+ * 4 px of a curve of radius r px strays 2 / r px from it: within the ribbon's quarter width at
+ * ε_img = 0.5 for r >= 8 px (tighter turns are features of a few pixels). Not rigorous between
+ * samples, as gpu/crack_fill.c says of its own sampling; cost now follows the screen size. */
+enum { STATIC_BORDER_MIN_CELLS = 2, STATIC_BORDER_MAX_CELLS = 32 };
+static const double k_border_px = 4.0;
 
 /* Colours of LOD colouring: static levels fine -> coarse, then the per-frame path. */
 static const float k_level_colors[6][4] = {
@@ -82,13 +88,18 @@ static void unit_eye_box(const frame *f, const double obj[6], const double m[12]
     }
 }
 
-/* The object-space tolerance the unit needs under this occurrence (see the top of the file). */
-static double unit_tolerance(const frame *f, const sw_lod_static_unit *un, const double m[12])
+/* The object-space tolerance the unit needs under this occurrence (see the top of the file),
+ * and (extent_px) a bound of its size on screen. */
+static double unit_tolerance(const frame *f, const sw_lod_static_unit *un, const double m[12],
+                             double *extent_px)
 {
     double eb[6];
     unit_eye_box(f, un->box, m, eb);
     const double z = sw__gpu_view_box_depth(&f->view, eb);
     const double t = hypot(f->view.tan_x, f->view.tan_y);
+    const double diag = sqrt((eb[3] - eb[0]) * (eb[3] - eb[0]) + (eb[4] - eb[1]) * (eb[4] - eb[1]) +
+                             (eb[5] - eb[2]) * (eb[5] - eb[2]));
+    *extent_px = diag * f->view.focal_px * sqrt(1.0 + t * t) / z;
     return f->eps_px * z / (f->view.focal_px * sqrt(1.0 + t * t)) / stretch_bound(m);
 }
 
@@ -102,6 +113,14 @@ static double unit_delta(const sw_lod_static_unit *un, double desc_delta)
                        (un->box[5] - un->box[2]) * (un->box[5] - un->box[2]));
 }
 
+/* A static level is drawn only when it has at most this many triangles per Bézier patch: its
+ * vertices are sent every frame, while the per-frame path evaluates each patch's grid in the
+ * vertex shader from 16 control points, so a fine static level (level 0 within δ = 1e-3 of the
+ * diagonal has ~160 per patch on CrankArm) costs more than the patches it replaces; the per-frame
+ * path drew ~40 per patch on the 64-CrankArm grid's orbit. Kumar §4 meant static LODs for the far
+ * field, where few triangles do. */
+static const double k_static_max_tri_per_patch = 24.0;
+
 /* Coarsest level within tol, -1 when none. */
 static int32_t level_for(const sw_lod_static_chain *c, double tol)
 {
@@ -109,6 +128,15 @@ static int32_t level_for(const sw_lod_static_chain *c, double tol)
         if (c->levels[k].eps <= tol && c->levels[k].n_triangles > 0)
             return k;
     return -1;
+}
+
+/* The level to draw for tol: the coarsest within it, if cheap enough (see above). */
+static int32_t level_to_draw(const sw_lod_static_chain *c, double tol)
+{
+    const int32_t k = level_for(c, tol);
+    if (k < 0 || c->levels[k].n_triangles > k_static_max_tri_per_patch * c->n_patches)
+        return -1;
+    return k;
 }
 
 /* The chain to use, asked for when missing: walkthrough frames only queue the build (drawn by
@@ -135,11 +163,11 @@ static const sw_lod_static_chain *unit_chain(frame *f, uint32_t unit)
 
 /* The level a unit is drawn at under one occurrence, -1 for the per-frame path. */
 static int32_t choose_level(frame *f, uint32_t unit, const double m[12],
-                            const sw_lod_static_chain **chain)
+                            const sw_lod_static_chain **chain, double *extent_px)
 {
     const sw_lod_static_unit *un = sw_lod_static_set_unit(f->statics, unit);
     *chain = NULL;
-    const double tol = unit_tolerance(f, un, m);
+    const double tol = unit_tolerance(f, un, m, extent_px);
     if (f->static_force > 0) {
         /* tests: neighbours at different levels, each within the view's tolerance, and beside
          * the per-frame path: unit i takes choice (i + k) mod (valid levels + 1) */
@@ -157,7 +185,7 @@ static int32_t choose_level(frame *f, uint32_t unit, const double m[12],
     if (!c)
         return -1;
     *chain = c;
-    return level_for(c, tol);
+    return level_to_draw(c, tol);
 }
 
 /* Appends the level's triangles, transformed to eye-relative world space, as one draw. */
@@ -194,14 +222,15 @@ static sw_result append_level(frame *f, const occurrence *o, const sw_lod_static
 }
 
 /* The fat borders of one statically drawn face occurrence (see the top of the file). */
-static sw_result face_borders(frame *f, const occurrence *o, sw_status *status)
+static sw_result face_borders(frame *f, const occurrence *o, double extent_px, sw_status *status)
 {
     if (f->ctx->crack_fill_off)
         return SW_OK;
     const sw_sg_face_rec *rec = &f->sv->faces[o->face];
     const double *ub = rec->uv_box;
-    const double cell[2] = {(ub[1] - ub[0]) / STATIC_BORDER_CELLS,
-                            (ub[3] - ub[2]) / STATIC_BORDER_CELLS};
+    const double cells = fmin(fmax(ceil(extent_px / k_border_px), STATIC_BORDER_MIN_CELLS),
+                              STATIC_BORDER_MAX_CELLS);
+    const double cell[2] = {(ub[1] - ub[0]) / cells, (ub[3] - ub[2]) / cells};
     if (!((rec->flags & SW_SG_FACE_TRIMMED) && rec->n_loops > 0)) {
         const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
         return sw__fr_fat_border(f, o, box_loop, 4, 1, cell, NULL, 0, status);
@@ -222,6 +251,7 @@ typedef struct group {
     uint32_t unit;
     int32_t level; /* -1: per-frame path */
     int drawn;     /* the level's triangles are in the frame */
+    double extent_px; /* the unit's size on screen, bounded */
     double world[12];
     const sw_lod_static_chain *chain;
 } group;
@@ -251,7 +281,7 @@ static group *group_of(frame *f, group_map *gm, uint32_t unit, size_t occ)
             g->unit = unit;
             g->drawn = 0;
             memcpy(g->world, m, sizeof g->world);
-            g->level = choose_level(f, unit, m, &g->chain);
+            g->level = choose_level(f, unit, m, &g->chain, &g->extent_px);
             return g;
         }
         if (g->unit == unit && memcmp(g->world, m, sizeof g->world) == 0)
@@ -293,7 +323,7 @@ sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status)
             f->st.static_levels_used |= 1u << (g->level < 31 ? g->level : 31);
         }
         if (r == SW_OK)
-            r = face_borders(f, &f->occ[i], status);
+            r = face_borders(f, &f->occ[i], g->extent_px, status);
         f->st.static_faces++;
         f->st.faces_drawn++;
     }

@@ -311,6 +311,14 @@ static void statics_task(void *ctx)
         atomic_store(&r->statics_state, 3);
         return;
     }
+    /* the scene file's LOD cache (build-lod), when it has one made for these super-surfaces; a
+     * stale or damaged cache is refused as a whole (nothing adopted) and the units are built
+     * as they are needed instead */
+    const void *cache = NULL;
+    size_t cache_bytes = 0;
+    if (sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st) == SW_OK)
+        (void)sw_lod_static_set_load(set, cache, cache_bytes, sw_sg_scene_path_ptr(r->cache_scene->sg),
+                                     NULL, &st);
     atomic_store(&r->statics, set);
     atomic_store(&r->statics_state, 2);
 }

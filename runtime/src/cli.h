@@ -14,6 +14,7 @@ int sw_cli_path(int argc, char **argv);
 int sw_cli_profile(int argc, char **argv);
 int sw_cli_view(int argc, char **argv);
 int sw_cli_generate(int argc, char **argv);
+int sw_cli_build_lod(int argc, char **argv);
 
 /* ---- shared helpers (cli_common.c) ---------------------------------------------------------- */
 int sw_cli_is_help(const char *arg);

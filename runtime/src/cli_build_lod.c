@@ -1,0 +1,183 @@
+/* splinewalk build-lod SCENE [-o OUT.sws] [--threads N] */
+#include "cli.h"
+
+#include "sw_lod_static_set.h"
+#include "sw_rt.h"
+#include "sw_status_util.h"
+#include "sw_th_pool.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char k_usage[] =
+    "usage: splinewalk build-lod SCENE [-o OUT.sws] [--threads N]\n"
+    "\n"
+    "Builds the static LODs of every super-surface of SCENE (Kumar et al. 1997 §3-§4): the\n"
+    "scene's Bézier patches clustered under a 45° normal-cone bound into super-surfaces of whole\n"
+    "faces, each tessellated within δ (1e-3 of its diagonal) and simplified into 4 more levels\n"
+    "whose errors are measured both ways against the exact surface. The levels are written into\n"
+    "the scene file's LODS section (a new file written aside, then renamed over OUT), so that\n"
+    "`render`, `profile` and `view` with --static-lod start from them instead of building them.\n"
+    "Prints, per level, the triangles against level 0 (the exact adaptive tessellation) and the\n"
+    "declared errors; a progress bar on stderr. A super-surface whose build fails is named and\n"
+    "drawn by the per-frame path; the others are kept.\n"
+    "\n"
+    "options:\n"
+    "  -o, --output FILE   the .sws to write (default: SCENE itself; SCENE must then be a .sws)\n"
+    "  --threads N         worker-pool threads (default: one per online processor)\n"
+    "  -h, --help          this text\n";
+
+typedef struct lod_args {
+    const char *scene, *out;
+    int threads;
+} lod_args;
+
+static int parse_args(int argc, char **argv, lod_args *a)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if ((!strcmp(argv[i], "-o") || !strcmp(argv[i], "--output")) && val) {
+            a->out = argv[++i];
+        } else if (!strcmp(argv[i], "--threads") && val) {
+            if (sw_cli_parse_count(val, 1, 1024, &a->threads)) {
+                fprintf(stderr, "splinewalk build-lod: bad value '%s' for --threads\n%s", val,
+                        k_usage);
+                return 2;
+            }
+            i++;
+        } else if (argv[i][0] != '-' && !a->scene) {
+            a->scene = argv[i];
+        } else {
+            fprintf(stderr, "splinewalk build-lod: unexpected argument '%s'\n%s", argv[i], k_usage);
+            return 2;
+        }
+    }
+    if (!a->scene) {
+        fprintf(stderr, "splinewalk build-lod: need SCENE\n%s", k_usage);
+        return 2;
+    }
+    const size_t n = strlen(a->scene);
+    if (!a->out && (n < 4 || strcmp(a->scene + n - 4, ".sws") != 0)) {
+        fprintf(stderr, "splinewalk build-lod: %s is not a .sws: name the output with -o\n",
+                a->scene);
+        return 2;
+    }
+    if (!a->out)
+        a->out = a->scene;
+    return 0;
+}
+
+/* Requests every unit and shows the progress until each is READY or FAILED. */
+static void build_all(sw_lod_static_set *set)
+{
+    const uint32_t n = sw_lod_static_set_unit_count(set);
+    for (uint32_t u = 0; u < n; ++u)
+        sw_lod_static_set_request(set, u, SW_TH_PRIORITY_FRAME);
+    for (uint32_t u = 0; u < n; ++u) {
+        sw_lod_static_set_wait(set, u); /* runs pool tasks meanwhile */
+        char stage[64];
+        snprintf(stage, sizeof stage, "super-surface %u / %u", u + 1, n);
+        sw_cli_progress(NULL, (double)(u + 1) / n, stage);
+    }
+    sw_cli_progress_end();
+}
+
+typedef struct level_sum {
+    uint64_t triangles;
+    double eps_rel_max; /* declared ε / δ, largest */
+    uint32_t chains;
+} level_sum;
+
+static void print_summary(const sw_lod_static_set *set, uint64_t patches)
+{
+    level_sum sum[9] = {{0}};
+    const uint32_t n = sw_lod_static_set_unit_count(set);
+    uint32_t failed = 0;
+    for (uint32_t u = 0; u < n; ++u) {
+        const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
+        if (!c) {
+            const char *msg = NULL;
+            sw_lod_static_set_failure(set, u, &msg);
+            if (failed++ < 5)
+                fprintf(stderr, "splinewalk build-lod: super-surface %u: %s (drawn per frame)\n",
+                        u, msg ? msg : "not built");
+            continue;
+        }
+        for (int32_t k = 0; k < c->n_levels && k < 9; ++k) {
+            sum[k].triangles += c->levels[k].n_triangles;
+            sum[k].chains++;
+            const double rel = c->levels[k].eps / c->delta;
+            sum[k].eps_rel_max = rel > sum[k].eps_rel_max ? rel : sum[k].eps_rel_max;
+        }
+    }
+    printf("%u super-surfaces of whole faces (%llu Bézier patches), %u built, %u failed\n", n,
+           (unsigned long long)patches, n - failed, failed);
+    printf("level  triangles   vs level 0   per patch   largest declared ε / δ\n");
+    for (int k = 0; k < 9 && sum[k].chains; ++k)
+        printf("%5d  %9llu   %9.1f %%   %9.2f   %8.1f\n", k,
+               (unsigned long long)sum[k].triangles,
+               100.0 * (double)sum[k].triangles / (double)(sum[0].triangles ? sum[0].triangles : 1),
+               (double)sum[k].triangles / (double)(patches ? patches : 1), sum[k].eps_rel_max);
+}
+
+static sw_result write_cache(sw_sg_scene *sg, const sw_lod_static_set *set, const char *out,
+                             size_t *bytes, sw_status *status)
+{
+    void *blob = NULL;
+    sw_result r = sw_lod_static_set_serialize(set, &blob, bytes, status);
+    if (r == SW_OK)
+        r = sw_sg_scene_save_lods(sg, out, blob, *bytes, status);
+    free(blob);
+    return r;
+}
+
+int sw_cli_build_lod(int argc, char **argv)
+{
+    if (sw_cli_print_help(argc, argv, k_usage))
+        return 0;
+    lod_args a = {0};
+    int rc = parse_args(argc, argv, &a);
+    if (rc)
+        return rc;
+    sw_status status = {0};
+    sw_scene handle;
+    const double t0 = sw_cli_now_ms();
+    if (sw_cli_load_scene(a.scene, &handle, &status) != SW_OK)
+        return sw_cli_report("build-lod", &status);
+    sw_rt_scene *scene = NULL;
+    sw_th_pool *pool = NULL;
+    sw_lod_static_set *set = NULL;
+    sw_th_pool_desc pd = {0};
+    pd.worker_count = (uint32_t)a.threads;
+    sw_result r = sw_rt_scene_acquire(handle, &scene, &status);
+    if (r == SW_OK)
+        r = sw_sg_scene_require(scene->sg, SW_SG_SEC_ALL, &status);
+    if (r == SW_OK && sw_th_pool_create(&pd, &pool) != SW_OK)
+        r = sw__fail(&status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
+    const double t1 = sw_cli_now_ms();
+    if (r == SW_OK)
+        r = sw_lod_static_set_create(scene->sg, pool, NULL, &set, &status);
+    const double t2 = sw_cli_now_ms();
+    size_t bytes = 0;
+    if (r == SW_OK) {
+        build_all(set);
+        const sw_lod_supersurfaces *ss = sw_lod_static_set_supersurfaces(set);
+        print_summary(set, ss->n_patches);
+    }
+    const double t3 = sw_cli_now_ms();
+    if (r == SW_OK)
+        r = write_cache(scene->sg, set, a.out, &bytes, &status);
+    sw_lod_static_set_destroy(set);
+    sw_th_pool_destroy(pool);
+    if (scene)
+        sw_rt_scene_release(scene);
+    sw_scene_destroy(handle);
+    if (r != SW_OK)
+        return sw_cli_report("build-lod", &status);
+    printf("%s -> %s: LOD cache %.1f MiB; load %.0f ms, clustering %.0f ms, levels %.1f s, "
+           "write %.0f ms\n",
+           a.scene, a.out, (double)bytes / (1024.0 * 1024.0), t1 - t0, t2 - t1,
+           1e-3 * (t3 - t2), sw_cli_now_ms() - t3);
+    return 0;
+}

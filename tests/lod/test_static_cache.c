@@ -1,0 +1,232 @@
+/* The static-LOD set and its cache (lod/sw_lod_static_set.h, lod/static_lod_io.c; issue 4:
+ * "cached in the .sws file by splinewalk build-lod"):
+ *  - units partition the faces: every face with patches in exactly one unit, each unit's patches
+ *    exactly its faces' patches of the clustering, its box holding every vertex of its chain;
+ *  - serialize -> load into a fresh set (a second clustering of the same scene: the cache's key
+ *    hashes its units, so this also checks that clustering is reproducible) adopts every chain,
+ *    equal to the original byte for byte;
+ *  - every truncation of the cache, a wrong key and a triangle index out of range are refused
+ *    as a whole (nothing adopted), with SW_ERR_FORMAT / SW_ERR_INVALID_ARGUMENT;
+ *  - the .sws LODS section: saved, reopened, the same bytes back; the core sections unchanged; a
+ *    flipped byte in it gives SW_ERR_CHECKSUM while the scene itself still opens and validates.
+ * usage: test_static_cache MODEL WORKDIR
+ */
+#include "model_import.h"
+#include "sw_lod_static_set.h"
+#include "sw_sg_scene.h"
+#include "test_check.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void check_units(const sw_lod_static_set *set, const sw_sg_scene *scene)
+{
+    const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces, n = sw_lod_static_set_unit_count(set);
+    const sw_lod_supersurfaces *ss = sw_lod_static_set_supersurfaces(set);
+    uint32_t *seen = calloc(n_faces, sizeof *seen), patches = 0;
+    for (uint32_t u = 0; u < n; ++u) {
+        const sw_lod_static_unit *un = sw_lod_static_set_unit(set, u);
+        CHECK(un->n_faces > 0 && un->n_patches >= un->n_faces, "unit %u: %u faces, %u patches", u,
+              un->n_faces, un->n_patches);
+        for (uint32_t i = 0; i < un->n_faces; ++i) {
+            const uint32_t f = sw_lod_static_set_faces(set)[un->first_face + i];
+            seen[f]++;
+            CHECK(sw_lod_static_set_unit_of(set, f) == u, "face %u: unit_of %u, listed in %u", f,
+                  sw_lod_static_set_unit_of(set, f), u);
+        }
+        for (uint32_t k = 0; k < un->n_patches; ++k) {
+            const uint32_t f = sw_lod_static_set_patches(set)[un->first_patch + k].face;
+            CHECK(sw_lod_static_set_unit_of(set, f) == u, "unit %u holds a patch of face %u", u, f);
+        }
+        patches += un->n_patches;
+        const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
+        for (int32_t k = 0; c && k < c->n_levels; ++k)
+            for (uint32_t v = 0; v < c->levels[k].n_vertices; ++v)
+                for (int a = 0; a < 3; ++a) {
+                    const double x = c->levels[k].positions[3 * v + a];
+                    const double slack = 1e-9 * (1.0 + fabs(x));
+                    CHECK(x >= un->box[a] - slack && x <= un->box[3 + a] + slack,
+                          "unit %u level %d: a vertex outside the unit's box", u, k);
+                }
+    }
+    uint32_t with_patches = 0;
+    for (uint32_t f = 0; f < n_faces; ++f)
+        with_patches += sw_lod_static_set_unit_of(set, f) != SW_LOD_STATIC_NO_UNIT;
+    for (uint32_t f = 0; f < n_faces; ++f)
+        CHECK(seen[f] <= 1, "face %u in %u units", f, seen[f]);
+    CHECK(patches == ss->n_patches, "units hold %u patches, the clustering %u", patches,
+          ss->n_patches);
+    printf("  %u units over %u of %u faces, %u patches\n", n, with_patches, n_faces, patches);
+    free(seen);
+}
+
+static int chains_equal(const sw_lod_static_chain *a, const sw_lod_static_chain *b)
+{
+    if (a->n_levels != b->n_levels || a->n_patches != b->n_patches || a->delta != b->delta)
+        return 0;
+    for (int32_t k = 0; k < a->n_levels; ++k) {
+        const sw_lod_static_level *x = &a->levels[k], *y = &b->levels[k];
+        const size_t nv = x->n_vertices;
+        if (x->n_vertices != y->n_vertices || x->n_triangles != y->n_triangles || x->eps != y->eps ||
+            memcmp(x->positions, y->positions, 3 * nv * sizeof(double)) ||
+            memcmp(x->normals, y->normals, 3 * nv * sizeof(float)) ||
+            memcmp(x->uv, y->uv, 2 * nv * sizeof(double)) ||
+            memcmp(x->face, y->face, nv * sizeof(uint32_t)) ||
+            memcmp(x->triangles, y->triangles, 3 * (size_t)x->n_triangles * sizeof(uint32_t)))
+            return 0;
+    }
+    return 1;
+}
+
+static uint32_t ready_units(const sw_lod_static_set *set)
+{
+    sw_lod_static_set_stats st;
+    sw_lod_static_set_get_stats(set, &st);
+    return st.ready;
+}
+
+/* Loads data into a fresh set; returns the result, *adopted the chains it took. */
+static sw_result load_fresh(const sw_sg_scene *scene, sw_th_pool *pool, const void *data,
+                            size_t size, uint32_t *adopted, sw_lod_static_set **keep)
+{
+    sw_lod_static_set *b = NULL;
+    sw_status st = {0};
+    if (sw_lod_static_set_create(scene, pool, NULL, &b, &st) != SW_OK)
+        return SW_ERR_INTERNAL;
+    sw_result r = sw_lod_static_set_load(b, data, size, "test", adopted, &st);
+    if (r == SW_OK)
+        CHECK(ready_units(b) == *adopted, "load: %u ready, %u adopted", ready_units(b), *adopted);
+    else
+        CHECK(ready_units(b) == 0, "a refused cache left %u chains behind", ready_units(b));
+    if (keep)
+        *keep = b;
+    else
+        sw_lod_static_set_destroy(b);
+    return r;
+}
+
+static void check_cache(const sw_sg_scene *scene, sw_th_pool *pool, const sw_lod_static_set *a,
+                        const unsigned char *blob, size_t size)
+{
+    uint32_t adopted = 0;
+    sw_lod_static_set *b = NULL;
+    CHECK(load_fresh(scene, pool, blob, size, &adopted, &b) == SW_OK, "load of the cache failed");
+    CHECK(adopted == ready_units(a), "adopted %u of %u chains", adopted, ready_units(a));
+    for (uint32_t u = 0; b && u < sw_lod_static_set_unit_count(a); ++u) {
+        const sw_lod_static_chain *x = sw_lod_static_set_get(a, u), *y = sw_lod_static_set_get(b, u);
+        CHECK((!x && !y) || (x && y && chains_equal(x, y)), "unit %u: chain differs after load", u);
+    }
+    sw_lod_static_set_destroy(b);
+    /* every truncation (a few hundred, spread over the string) is refused as a whole */
+    unsigned char *copy = malloc(size);
+    const size_t step = size / 300 + 1;
+    int refused = 0, tried = 0;
+    for (size_t cut = 0; cut < size; cut += step, ++tried) {
+        const sw_result r = load_fresh(scene, pool, blob, cut, &adopted, NULL);
+        /* inside the 24-byte header: FORMAT, VERSION or a stale key; after it: FORMAT */
+        refused += cut < 24 ? r != SW_OK : r == SW_ERR_FORMAT;
+    }
+    CHECK(refused == tried, "%d of %d truncations refused", refused, tried);
+    memcpy(copy, blob, size);
+    copy[16] ^= 1u; /* the key */
+    CHECK(load_fresh(scene, pool, copy, size, &adopted, NULL) == SW_ERR_INVALID_ARGUMENT,
+          "a cache of another key was not refused as stale");
+    memcpy(copy, blob, size);
+    uint32_t huge = 0xFFFFFFF0u; /* the last triangle index of the string */
+    memcpy(copy + size - 4, &huge, 4);
+    CHECK(load_fresh(scene, pool, copy, size, &adopted, NULL) == SW_ERR_FORMAT,
+          "a triangle index out of range was not refused");
+    free(copy);
+    printf("  cache of %zu bytes: reloaded equal; %d truncations, a stale key, a bad index "
+           "refused\n", size, tried);
+}
+
+static void check_file(sw_sg_scene *scene, const void *blob, size_t size, const char *dir)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/cache.sws", dir);
+    sw_status st = {0};
+    CHECK(sw_sg_scene_save_lods(scene, path, blob, size, &st) == SW_OK, "save: %s", st.message);
+    sw_sg_scene *back = NULL;
+    const void *data = NULL;
+    size_t n = 0;
+    CHECK(sw_sg_scene_open(path, &back, &st) == SW_OK, "reopen: %s", st.message);
+    if (!back)
+        return;
+    CHECK(sw_sg_scene_require(back, SW_SG_SEC_ALL, &st) == SW_OK, "require: %s", st.message);
+    CHECK(sw_sg_scene_lods(back, &data, &n, &st) == SW_OK && n == size &&
+              memcmp(data, blob, size) == 0,
+          "LODS section not read back as written");
+    CHECK(sw_sg_scene_view_ptr(back)->n_faces == sw_sg_scene_view_ptr(scene)->n_faces,
+          "faces changed");
+    /* saving the reopened scene keeps its LODS section */
+    char path2[4096];
+    snprintf(path2, sizeof path2, "%s/cache2.sws", dir);
+    CHECK(sw_sg_scene_save(back, path2, &st) == SW_OK, "resave: %s", st.message);
+    sw_sg_scene_free(back);
+    sw_sg_scene *again = NULL;
+    CHECK(sw_sg_scene_open(path2, &again, &st) == SW_OK &&
+              sw_sg_scene_lods(again, &data, &n, &st) == SW_OK && n == size,
+          "sw_sg_scene_save dropped the LODS section");
+    sw_sg_scene_free(again);
+    /* a flipped byte in the LODS section (the file's last bytes): checksum error, scene fine */
+    FILE *fp = fopen(path, "r+b");
+    if (fp && fseek(fp, -5, SEEK_END) == 0) {
+        int c = fgetc(fp);
+        fseek(fp, -5, SEEK_END);
+        fputc(c ^ 0x40, fp);
+    }
+    if (fp)
+        fclose(fp);
+    CHECK(sw_sg_scene_open(path, &back, &st) == SW_OK, "reopen damaged: %s", st.message);
+    if (back) {
+        CHECK(sw_sg_scene_require(back, SW_SG_SEC_ALL, &st) == SW_OK,
+              "a damaged LODS section broke the scene: %s", st.message);
+        CHECK(sw_sg_scene_lods(back, &data, &n, &st) == SW_ERR_CHECKSUM,
+              "a damaged LODS section was not reported");
+        printf("  damaged LODS section: %s\n", st.message);
+        sw_sg_scene_free(back);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s MODEL WORKDIR\n", argv[0]);
+        return 2;
+    }
+    sw_sg_scene *scene = NULL;
+    if (sw_test_import_model(argv[1], &scene) != 1)
+        return 1;
+    sw_status st = {0};
+    sw_th_pool *pool = NULL;
+    sw_lod_static_set *a = NULL;
+    if (sw_sg_scene_require(scene, SW_SG_SEC_ALL, &st) != SW_OK ||
+        sw_th_pool_create(NULL, &pool) != SW_OK ||
+        sw_lod_static_set_create(scene, pool, NULL, &a, &st) != SW_OK) {
+        printf("FAIL: set up: %s\n", st.message);
+        return 1;
+    }
+    const uint32_t n = sw_lod_static_set_unit_count(a);
+    for (uint32_t u = 0; u < n; ++u)
+        sw_lod_static_set_request(a, u, SW_TH_PRIORITY_FRAME);
+    for (uint32_t u = 0; u < n; ++u)
+        CHECK(sw_lod_static_set_wait(a, u) == SW_LOD_STATIC_READY, "unit %u not built", u);
+    printf("%s:\n", argv[1]);
+    check_units(a, scene);
+    void *blob = NULL;
+    size_t size = 0;
+    CHECK(sw_lod_static_set_serialize(a, &blob, &size, &st) == SW_OK, "serialize: %s", st.message);
+    if (blob) {
+        check_cache(scene, pool, a, blob, size);
+        check_file(scene, blob, size, argv[2]);
+    }
+    free(blob);
+    sw_lod_static_set_destroy(a);
+    sw_th_pool_destroy(pool);
+    sw_sg_scene_free(scene);
+    puts(g_failures ? "FAIL" : "PASS");
+    return g_failures != 0;
+}
