@@ -34,6 +34,9 @@ static const char k_usage[] =
     "  + -           screen-space error x2 / x0.5   (shown in the title, with the frame time)\n"
     "  K             add the current camera as a key to the recording (--record)\n"
     "  L             wireframe on / off (the tessellation the error bound chose)\n"
+    "  T             static LODs of super-surfaces on / off (Kumar et al. 1997; --static-lod)\n"
+    "  C             LOD colouring on / off: static levels fine to coarse blue, teal, green,\n"
+    "                yellow, orange, pink; per-frame tessellation grey\n"
     "  F             frame-time overlay on / off (bars of the last 120 frames, marks at 60 and\n"
     "                30 frames per second; orange: the frame drew something coarser than asked)\n"
     "  R             back to the iso view           Esc      close\n"
@@ -53,12 +56,15 @@ static const char k_usage[] =
     "  --overlay         with --script: draw the frame-time overlay too (interactive: always,\n"
     "                    F toggles it)\n"
     "  --wireframe       start with the wireframe on (L toggles it)\n"
+    "  --static-lod      start with static LODs on (T toggles them; built in the pool as\n"
+    "                    needed, or read from the scene's `build-lod` cache)\n"
+    "  --lod-colors      start with LOD colouring on (C toggles it)\n"
     "  -h, --help        this text\n";
 
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot;
     int32_t w, h;
-    int frames, settle, overlay, wireframe;
+    int frames, settle, overlay, wireframe, static_lods, lod_colors;
     double error_px, speed;
 } view_args;
 
@@ -91,6 +97,8 @@ static int parse_args(int argc, char **argv, view_args *a)
         int *flag = !strcmp(arg, "--settle")      ? &a->settle
                     : !strcmp(arg, "--overlay")   ? &a->overlay
                     : !strcmp(arg, "--wireframe") ? &a->wireframe
+                    : !strcmp(arg, "--static-lod") ? &a->static_lods
+                    : !strcmp(arg, "--lod-colors") ? &a->lod_colors
                                                   : NULL;
         if (flag) {
             *flag = 1;
@@ -190,7 +198,7 @@ typedef struct viewer {
     sw_rt_camera_path recording;
     uint32_t cap_keys;
     sw_cli_overlay overlay;
-    int wireframe;
+    int wireframe, static_lods, lod_colors;
 } viewer;
 
 static void record_key(viewer *v)
@@ -230,6 +238,10 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         v->overlay.enabled = !v->overlay.enabled;
     else if (key == GLFW_KEY_L)
         v->wireframe = !v->wireframe;
+    else if (key == GLFW_KEY_T)
+        v->static_lods = !v->static_lods;
+    else if (key == GLFW_KEY_C)
+        v->lod_colors = !v->lod_colors;
     else if (key == GLFW_KEY_R)
         walker_look_from(&v->wk, &v->home);
 }
@@ -294,6 +306,8 @@ static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int conver
     fd.walkthrough = !converged;
     fd.present = 1;
     fd.wireframe = v->wireframe;
+    fd.static_lods = v->static_lods;
+    fd.lod_colors = v->lod_colors;
     fd.output_path = output;
     return sw_renderer_draw(r, &fd, fs, st);
 }
@@ -413,7 +427,11 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
     sw_scene_info info;
     if (sw_scene_get_info(scene, &info, &st) != SW_OK)
         return sw_cli_report("view", &st);
-    viewer v = {.args = a, .error_px = a->error_px, .wireframe = a->wireframe};
+    viewer v = {.args = a,
+                .error_px = a->error_px,
+                .wireframe = a->wireframe,
+                .static_lods = a->static_lods,
+                .lod_colors = a->lod_colors};
     if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)
         return sw_cli_report("view", &st);
     walker_look_from(&v.wk, &v.home);

@@ -10,9 +10,12 @@
 #     window shows is the renderer's frame, presented into the window's framebuffer.
 #  4. samples/embed_minimal (a GLFW host of the public API) draws 30 frames into its window and
 #     exits 0.
-# usage: test_view.sh SPLINEWALK PNG_DIFF MODEL WORKDIR EMBED_MINIMAL
+#  5. Static LODs and LOD colouring (--static-lod --lod-colors, keys T and C) on STATIC_MODEL: the
+#     settled screenshot equals `render --static-lod --lod-colors` of its camera, and differs from
+#     the plain render (the colours show which representation drew each surface).
+# usage: test_view.sh SPLINEWALK PNG_DIFF MODEL WORKDIR EMBED_MINIMAL STATIC_MODEL
 set -euo pipefail
-sw=$1 diff=$2 model=$3 work=$4 embed=$5
+sw=$1 diff=$2 model=$3 work=$4 embed=$5 static_model=$6
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*"; exit 1; }
 
@@ -81,3 +84,18 @@ xvfb-run -a -s "-screen 0 1280x1024x24" "$embed" "$work/model.sws" 30 >"$work/em
   { cat "$work/embed.out"; fail "embed_minimal"; }
 grep -q "^embed_minimal: 30 frames" "$work/embed.out" || fail "embed_minimal: $(cat "$work/embed.out")"
 echo "ok: $(cat "$work/embed.out")"
+
+"$sw" path orbit "$static_model" -o "$work/static.path" >/dev/null 2>&1
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$static_model" --size 640x360 \
+  --script "$work/static.path" --frames 10 --settle --static-lod --lod-colors \
+  --screenshot "$work/lod.png" >"$work/lod.out" 2>"$work/lod.err" ||
+  { cat "$work/lod.err"; fail "view --static-lod --lod-colors"; }
+cam=$(sed -n 's/^screenshot camera //p' "$work/lod.out")
+"$sw" render "$static_model" -o "$work/lod_render.png" --size 640x360 --camera "$cam" \
+  --static-lod --lod-colors >/dev/null 2>&1
+"$diff" "$work/lod.png" "$work/lod_render.png" 0.1 || fail "--static-lod --lod-colors differs from render"
+"$sw" render "$static_model" -o "$work/plain.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
+if "$diff" "$work/lod.png" "$work/plain.png" 1 >/dev/null; then
+  fail "--lod-colors: the frame shows no LOD colours"
+fi
+echo "ok: --static-lod --lod-colors equals render of its camera, coloured by representation"
