@@ -13,7 +13,7 @@
 #include <splinewalk/splinewalk.h>
 
 #include "bench_stats.h"
-#include "sw_camera_path.h"
+#include "bench_scene.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -156,14 +156,10 @@ static int parse(int argc, char **argv, bench *b, const char **scene)
     *b = (bench){.frames = 120, .passes = 3, .w = 1280, .h = 720, .distance = 1.0};
     for (int i = 1; i < argc; ++i) {
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(argv[i], "--frames") && v)
-            b->frames = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--passes") && v)
-            b->passes = atoi(argv[++i]);
+        if (bench_common_option(argc, argv, &i, &b->frames, &b->passes, &b->w, &b->h))
+            continue;
         else if (!strcmp(argv[i], "--distance") && v)
             b->distance = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--size") && v && sscanf(argv[++i], "%dx%d", &b->w, &b->h) == 2)
-            continue;
         else if (argv[i][0] != '-' && !*scene)
             *scene = argv[i];
         else
@@ -182,21 +178,7 @@ int main(int argc, char **argv)
         return 2;
     }
     sw_status st = {0};
-    sw_scene_load_desc ld = {scene_path, NULL, NULL, NULL};
-    sw_result r = scene_path ? sw_scene_load(&ld, &b.scene, &st)
-                             : sw_scene_load_default(NULL, NULL, &b.scene, &st);
-    sw_scene_info info;
-    if (r == SW_OK)
-        r = sw_scene_get_info(b.scene, &info, &st);
-    double box[6];
-    for (int k = 0; r == SW_OK && k < 3; ++k) { /* the box scaled about its centre: distance F */
-        const double c = 0.5 * (info.bbox_min[k] + info.bbox_max[k]);
-        const double h = 0.5 * (info.bbox_max[k] - info.bbox_min[k]) * b.distance;
-        box[k] = c - h;
-        box[3 + k] = c + h;
-    }
-    if (r == SW_OK)
-        r = sw_rt_path_orbit(box, 10.0, (uint32_t)b.frames, &b.path, &st);
+    sw_result r = bench_scene_orbit(scene_path, b.distance, b.frames, &b.scene, &b.path, &st);
     if (r != SW_OK) {
         fprintf(stderr, "bench_lod: %s\n", st.message);
         return 1;

@@ -19,7 +19,7 @@
 #include <splinewalk/splinewalk.h>
 
 #include "bench_stats.h"
-#include "sw_camera_path.h"
+#include "bench_scene.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -146,11 +146,7 @@ static int parse(int argc, char **argv, bench *b, const char **scene)
     *b = (bench){.frames = 120, .passes = 3, .w = 1280, .h = 720, .threaded = 1, .sequential = 1};
     for (int i = 1; i < argc; ++i) {
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(argv[i], "--frames") && v)
-            b->frames = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--passes") && v)
-            b->passes = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--size") && v && sscanf(argv[++i], "%dx%d", &b->w, &b->h) == 2)
+        if (bench_common_option(argc, argv, &i, &b->frames, &b->passes, &b->w, &b->h))
             continue;
         else if (!strcmp(argv[i], "--mode") && v) {
             const char *m = argv[++i];
@@ -175,19 +171,7 @@ int main(int argc, char **argv)
         return 2;
     }
     sw_status st = {0};
-    sw_scene_load_desc ld = {scene_path, NULL, NULL, NULL};
-    sw_result r = scene_path ? sw_scene_load(&ld, &b.scene, &st)
-                             : sw_scene_load_default(NULL, NULL, &b.scene, &st);
-    sw_scene_info info;
-    if (r == SW_OK)
-        r = sw_scene_get_info(b.scene, &info, &st);
-    double box[6];
-    for (int k = 0; k < 3; ++k) {
-        box[k] = info.bbox_min[k];
-        box[3 + k] = info.bbox_max[k];
-    }
-    if (r == SW_OK)
-        r = sw_rt_path_orbit(box, 10.0, (uint32_t)b.frames, &b.path, &st);
+    sw_result r = bench_scene_orbit(scene_path, 1.0, b.frames, &b.scene, &b.path, &st);
     if (r != SW_OK) {
         fprintf(stderr, "bench_pipeline: %s\n", st.message);
         return 1;
