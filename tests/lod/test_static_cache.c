@@ -2,6 +2,9 @@
  * "cached in the .sws file by splinewalk build-lod"):
  *  - units partition the faces: every face with patches in exactly one unit, each unit's patches
  *    exactly its faces' patches of the clustering, its box holding every vertex of its chain;
+ *  - every level of every unit (super-surfaces of several faces, as the frame draws them) within
+ *    its declared ε_k both ways, by a measurement independent of the one that declared it (random
+ *    points, another seed, other counts); zero violations;
  *  - serialize -> load into a fresh set (a second clustering of the same scene: the cache's key
  *    hashes its units, so this also checks that clustering is reproducible) adopts every chain,
  *    equal to the original byte for byte;
@@ -60,6 +63,40 @@ static void check_units(const sw_lod_static_set *set, const sw_sg_scene *scene)
           ss->n_patches);
     printf("  %u units over %u of %u faces, %u patches\n", n, with_patches, n_faces, patches);
     free(seen);
+}
+
+/* Re-measures every level of every READY unit; returns the violations. */
+static int check_bounds(const sw_lod_static_set *set, const sw_sg_scene *scene)
+{
+    int checks = 0, violations = 0;
+    double worst_ratio = 0.0;
+    for (uint32_t u = 0; u < sw_lod_static_set_unit_count(set); ++u) {
+        const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
+        const sw_lod_static_unit *un = sw_lod_static_set_unit(set, u);
+        const sw_lod_static_patch *p = sw_lod_static_set_patches(set) + un->first_patch;
+        for (int32_t k = 0; c && k < c->n_levels; ++k) {
+            const sw_lod_static_level *l = &c->levels[k];
+            const sw_lod_static_measure_desc md = {4391u + (uint32_t)k, 11, 5, 1};
+            sw_lod_static_distance d;
+            sw_status st = {0};
+            if (sw_lod_static_measure(scene, p, un->n_patches, l, &c->levels[0], c->delta, l->eps,
+                                      &md, &d, &st) != SW_OK) {
+                CHECK(0, "unit %u level %d: measure failed: %s", u, k, st.message);
+                continue;
+            }
+            const double worst = fmax(d.surface_to_mesh, d.mesh_to_surface);
+            worst_ratio = fmax(worst_ratio, worst / l->eps);
+            checks++;
+            if (!(worst <= l->eps) || d.n_surface == 0 || d.n_mesh == 0) {
+                violations++;
+                CHECK(0, "unit %u (%u faces) level %d: surface->mesh %.6g, mesh->surface %.6g > "
+                      "eps %.6g", u, un->n_faces, k, d.surface_to_mesh, d.mesh_to_surface, l->eps);
+            }
+        }
+    }
+    printf("  bounds: %d levels re-measured both ways, %d violations, worst measured / ε %.3f\n",
+           checks, violations, worst_ratio);
+    return violations;
 }
 
 static int chains_equal(const sw_lod_static_chain *a, const sw_lod_static_chain *b)
@@ -216,6 +253,7 @@ int main(int argc, char **argv)
         CHECK(sw_lod_static_set_wait(a, u) == SW_LOD_STATIC_READY, "unit %u not built", u);
     printf("%s:\n", argv[1]);
     check_units(a, scene);
+    check_bounds(a, scene);
     void *blob = NULL;
     size_t size = 0;
     CHECK(sw_lod_static_set_serialize(a, &blob, &size, &st) == SW_OK, "serialize: %s", st.message);
