@@ -175,6 +175,12 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
 
 void sw_gpu_image_free(sw_gpu_image *img); /* NULL allowed */
 
+/* The trim-texture atlas kept in the context (Guthe §4.4): its GL_TEXTURE_2D_ARRAY (R8; 0 before
+ * the first trimmed frame), the pages in use and their side in texels — for inspection (the
+ * viewer's atlas overlay). The context's thread; the texture is valid until the next frame. */
+void sw_gpu_trim_atlas_info(const sw_gpu_context *ctx, uint32_t *texture, int32_t *pages,
+                            int32_t *side);
+
 /* Writes an image: .png (RGBA8) or .exr (half RGBA plus a float Z channel when depth exists),
  * through a temporary name and rename. Errors: SW_ERR_IO, SW_ERR_UNSUPPORTED (extension). */
 sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *path, sw_status *status);

@@ -659,6 +659,15 @@ GLuint sw__gpu_atlas_texture(const sw_gpu_context *ctx)
     return ctx->atlas ? ctx->atlas->tex : 0;
 }
 
+void sw_gpu_trim_atlas_info(const sw_gpu_context *ctx, uint32_t *texture, int32_t *pages,
+                            int32_t *side)
+{
+    const struct sw__gpu_atlas *a = ctx->atlas;
+    *texture = a ? a->tex : 0;
+    *pages = a && a->tex ? a->n_pages : 0;
+    *side = a ? a->side : 0;
+}
+
 void sw__gpu_atlas_free(sw_gpu_context *ctx)
 {
     struct sw__gpu_atlas *a = ctx->atlas;

@@ -180,6 +180,18 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     return SW_OK;
 }
 
+int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *pages,
+                              int32_t *side)
+{
+    sw_rt_renderer *r;
+    *texture = 0;
+    *pages = *side = 0;
+    if (owned_renderer(renderer, "sw_rt_renderer_trim_atlas", &r, NULL) != SW_OK)
+        return -1;
+    sw_gpu_trim_atlas_info(r->gpu, texture, pages, side);
+    return 0;
+}
+
 const char *sw_renderer_description_ptr(sw_renderer renderer)
 {
     sw_rt_renderer *r;

@@ -6,6 +6,7 @@
  */
 #include "cli.h"
 #include "cli_view_overlay.h"
+#include "sw_rt.h"
 
 #include "sw_camera_path.h"
 #include "sw_gpu.h"
@@ -37,6 +38,8 @@ static const char k_usage[] =
     "  T             static LODs of super-surfaces on / off (Kumar et al. 1997; --static-lod)\n"
     "  C             LOD colouring on / off: static levels fine to coarse blue, teal, green,\n"
     "                yellow, orange, pink; per-frame tessellation grey\n"
+    "  A             trim-atlas overlay: the next page of the trim-texture atlas in the upper\n"
+    "                right corner (white: inside the trimmed surface), then off\n"
     "  F             frame-time overlay on / off (bars of the last 120 frames, marks at 60 and\n"
     "                30 frames per second; orange: the frame drew something coarser than asked)\n"
     "  R             back to the iso view           Esc      close\n"
@@ -59,12 +62,13 @@ static const char k_usage[] =
     "  --static-lod      start with static LODs on (T toggles them; built in the pool as\n"
     "                    needed, or read from the scene's `build-lod` cache)\n"
     "  --lod-colors      start with LOD colouring on (C toggles it)\n"
+    "  --atlas-overlay   start with the trim atlas's first page shown (A cycles the pages)\n"
     "  -h, --help        this text\n";
 
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot;
     int32_t w, h;
-    int frames, settle, overlay, wireframe, static_lods, lod_colors;
+    int frames, settle, overlay, wireframe, static_lods, lod_colors, atlas_overlay;
     double error_px, speed;
 } view_args;
 
@@ -99,6 +103,7 @@ static int parse_args(int argc, char **argv, view_args *a)
                     : !strcmp(arg, "--wireframe") ? &a->wireframe
                     : !strcmp(arg, "--static-lod") ? &a->static_lods
                     : !strcmp(arg, "--lod-colors") ? &a->lod_colors
+                    : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
                                                   : NULL;
         if (flag) {
             *flag = 1;
@@ -198,6 +203,8 @@ typedef struct viewer {
     sw_rt_camera_path recording;
     uint32_t cap_keys;
     sw_cli_overlay overlay;
+    sw_cli_atlas_view atlas;
+    sw_renderer renderer;
     int wireframe, static_lods, lod_colors;
 } viewer;
 
@@ -242,6 +249,12 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         v->static_lods = !v->static_lods;
     else if (key == GLFW_KEY_C)
         v->lod_colors = !v->lod_colors;
+    else if (key == GLFW_KEY_A) {
+        uint32_t tex;
+        int32_t pages, side;
+        sw_rt_renderer_trim_atlas(v->renderer, &tex, &pages, &side);
+        sw_cli_atlas_view_next(&v->atlas, pages);
+    }
     else if (key == GLFW_KEY_R)
         walker_look_from(&v->wk, &v->home);
 }
@@ -328,6 +341,10 @@ static void show_overlay(viewer *v, const sw_frame_stats *fs)
 {
     sw_cli_overlay_push(&v->overlay, fs->ms_total, fs->fallback_draws > 0);
     sw_cli_overlay_draw(&v->overlay, v->args->w, v->args->h);
+    uint32_t tex;
+    int32_t pages, side;
+    if (v->atlas.page >= 0 && sw_rt_renderer_trim_atlas(v->renderer, &tex, &pages, &side) == 0)
+        sw_cli_atlas_view_draw(&v->atlas, tex, pages, v->args->w, v->args->h);
 }
 
 static void print_camera(const char *what, const sw_camera *c)
@@ -448,11 +465,16 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
     int rc = sw_renderer_create(&rd, &r, &st) != SW_OK ? sw_cli_report("view", &st) : 0;
     if (rc == 0 && sw_cli_overlay_init(&v.overlay) != 0)
         fprintf(stderr, "splinewalk view: the frame-time overlay's shaders do not build here\n");
+    if (rc == 0 && sw_cli_atlas_view_init(&v.atlas) != 0)
+        fprintf(stderr, "splinewalk view: the trim-atlas overlay's shaders do not build here\n");
     v.overlay.enabled = !script || a->overlay;
+    v.atlas.page = a->atlas_overlay ? 0 : -1;
+    v.renderer = r;
     if (rc == 0) {
         fprintf(stderr, "splinewalk view: %s\n", sw_renderer_description_ptr(r));
         rc = script ? run_script(win, r, scene, &v, script) : run_interactive(win, r, scene, &v);
         sw_cli_overlay_free(&v.overlay);
+        sw_cli_atlas_view_free(&v.atlas);
         sw_renderer_destroy(r); /* while the window's context is still current */
     }
     free(v.recording.keys);

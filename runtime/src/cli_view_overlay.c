@@ -34,25 +34,34 @@ static GLuint compile(GLenum kind, const char *src)
     return ok ? s : 0;
 }
 
-int sw_cli_overlay_init(sw_cli_overlay *o)
+/* The program of a vertex and a fragment shader, 0 when they do not build. */
+static GLuint build_program(const char *vs_src, const char *fs_src)
 {
-    memset(o, 0, sizeof *o);
-    GLuint vs = compile(GL_VERTEX_SHADER, k_vs), fs = compile(GL_FRAGMENT_SHADER, k_fs);
-    if (!vs || !fs)
-        return -1;
-    o->program = glCreateProgram();
-    glAttachShader(o->program, vs);
-    glAttachShader(o->program, fs);
-    glLinkProgram(o->program);
+    GLuint vs = compile(GL_VERTEX_SHADER, vs_src), fs = compile(GL_FRAGMENT_SHADER, fs_src);
+    GLuint prog = vs && fs ? glCreateProgram() : 0;
+    if (prog) {
+        glAttachShader(prog, vs);
+        glAttachShader(prog, fs);
+        glLinkProgram(prog);
+    }
     glDeleteShader(vs);
     glDeleteShader(fs);
     GLint ok = 0;
-    glGetProgramiv(o->program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        glDeleteProgram(o->program);
-        o->program = 0;
-        return -1;
+    if (prog)
+        glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (prog && !ok) {
+        glDeleteProgram(prog);
+        prog = 0;
     }
+    return prog;
+}
+
+int sw_cli_overlay_init(sw_cli_overlay *o)
+{
+    memset(o, 0, sizeof *o);
+    o->program = build_program(k_vs, k_fs);
+    if (!o->program)
+        return -1;
     glGenVertexArrays(1, &o->vao);
     glGenBuffers(1, &o->vbo);
     glBindVertexArray(o->vao);
@@ -132,4 +141,87 @@ void sw_cli_overlay_draw(const sw_cli_overlay *o, int w, int h)
     glDrawArrays(GL_TRIANGLES, 0, n);
     glBindVertexArray(0);
     glDisable(GL_BLEND);
+}
+
+/* ---- the trim-atlas overlay --------------------------------------------------------------------
+ * One page of the renderer's trim-texture atlas (Guthe §4.4) in the window's upper right corner,
+ * texels as grey levels (white: inside the trimmed surface), on a dark frame. */
+
+static const char *k_atlas_vs = "#version 430 core\n"
+                                "layout(location = 0) in vec2 pos;\n"
+                                "layout(location = 1) in vec2 uv;\n"
+                                "out vec2 v_uv;\n"
+                                "void main() { v_uv = uv; gl_Position = vec4(pos, 0.0, 1.0); }\n";
+static const char *k_atlas_fs = "#version 430 core\n"
+                                "uniform sampler2DArray atlas;\n"
+                                "uniform float layer;\n"
+                                "in vec2 v_uv;\n"
+                                "out vec4 colour;\n"
+                                "void main() {\n"
+                                "  float t = texture(atlas, vec3(v_uv, layer)).r;\n"
+                                "  colour = vec4(vec3(0.15 + 0.85 * t), 1.0);\n"
+                                "}\n";
+
+int sw_cli_atlas_view_init(sw_cli_atlas_view *a)
+{
+    memset(a, 0, sizeof *a);
+    a->page = -1;
+    a->program = build_program(k_atlas_vs, k_atlas_fs);
+    if (!a->program)
+        return -1;
+    glGenVertexArrays(1, &a->vao);
+    glGenBuffers(1, &a->vbo);
+    glBindVertexArray(a->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, a->vbo);
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), (void *)0);
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), (void *)(2 * sizeof(float)));
+    glBindVertexArray(0);
+    return 0;
+}
+
+void sw_cli_atlas_view_free(sw_cli_atlas_view *a)
+{
+    glDeleteProgram(a->program);
+    glDeleteBuffers(1, &a->vbo);
+    glDeleteVertexArrays(1, &a->vao);
+}
+
+void sw_cli_atlas_view_next(sw_cli_atlas_view *a, int pages)
+{
+    a->page = a->page + 1 < pages ? a->page + 1 : -1;
+}
+
+void sw_cli_atlas_view_draw(const sw_cli_atlas_view *a, unsigned texture, int pages, int w, int h)
+{
+    if (a->page < 0 || !a->program || !texture || pages <= 0)
+        return;
+    const int layer = a->page < pages ? a->page : pages - 1;
+    const double side = (w < h ? w : h) / 2.0, x1 = w - 8.0, y1 = h - 8.0;
+    const double x0 = x1 - side, y0 = y1 - side;
+    float v[6 * 4];
+    const double xs[6] = {x0, x1, x1, x0, x1, x0}, ys[6] = {y0, y0, y1, y0, y1, y1};
+    for (int k = 0; k < 6; ++k) {
+        v[4 * k] = (float)(2.0 * xs[k] / w - 1.0);
+        v[4 * k + 1] = (float)(2.0 * ys[k] / h - 1.0);
+        v[4 * k + 2] = xs[k] == x0 ? 0.0f : 1.0f;
+        v[4 * k + 3] = ys[k] == y0 ? 0.0f : 1.0f;
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, w, h);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glDisable(GL_COLOR_LOGIC_OP);
+    glUseProgram(a->program);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, texture);
+    glUniform1i(glGetUniformLocation(a->program, "atlas"), 0);
+    glUniform1f(glGetUniformLocation(a->program, "layer"), (float)layer);
+    glBindVertexArray(a->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, a->vbo);
+    glBufferData(GL_ARRAY_BUFFER, sizeof v, v, GL_STREAM_DRAW);
+    glDrawArrays(GL_TRIANGLES, 0, 6);
+    glBindVertexArray(0);
 }

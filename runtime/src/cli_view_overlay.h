@@ -1,4 +1,5 @@
-/* The viewer's frame-time overlay (cli_view_overlay.c). The window's GL thread only. */
+/* The viewer's overlays (cli_view_overlay.c): frame times, trim atlas. The window's GL thread
+ * only. */
 #ifndef SW_CLI_VIEW_OVERLAY_H
 #define SW_CLI_VIEW_OVERLAY_H
 
@@ -19,5 +20,18 @@ void sw_cli_overlay_free(sw_cli_overlay *o);
 void sw_cli_overlay_push(sw_cli_overlay *o, double frame_ms, int fallback);
 /* Draws into the window's framebuffer (0) of w x h pixels; sets the GL state it needs. */
 void sw_cli_overlay_draw(const sw_cli_overlay *o, int w, int h);
+
+/* One page of the renderer's trim atlas in the upper right corner (key A cycles the pages). */
+typedef struct sw_cli_atlas_view {
+    unsigned program, vao, vbo;
+    int page; /* -1: off */
+} sw_cli_atlas_view;
+
+int sw_cli_atlas_view_init(sw_cli_atlas_view *a); /* 0, or -1 (shaders do not build) */
+void sw_cli_atlas_view_free(sw_cli_atlas_view *a);
+/* Off -> page 0 -> ... -> the last of `pages` -> off. */
+void sw_cli_atlas_view_next(sw_cli_atlas_view *a, int pages);
+/* texture: the atlas's GL_TEXTURE_2D_ARRAY in the window's context (sw_gpu_trim_atlas_info). */
+void sw_cli_atlas_view_draw(const sw_cli_atlas_view *a, unsigned texture, int pages, int w, int h);
 
 #endif

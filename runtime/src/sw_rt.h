@@ -72,4 +72,9 @@ void sw_rt_camera_fit_box(const double bbox[6], sw_view_preset view, sw_camera *
 /* Parses "iso|front|top|right"; returns 0 on success. */
 int sw_rt_view_parse(const char *text, sw_view_preset *out);
 
+/* The renderer's trim atlas (sw_gpu_trim_atlas_info), for the viewer's overlay. Owner thread;
+ * 0 with the outputs set, -1 for a stale handle or another thread. */
+int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *pages,
+                              int32_t *side);
+
 #endif

@@ -8,6 +8,7 @@
 #     saved through OpenImageIO, and the viewer closes cleanly (exit 0). The screenshot must match
 #     `splinewalk render --camera` of the camera it printed (<= 0.1 % of pixels differ): what the
 #     window shows is the renderer's frame, presented into the window's framebuffer.
+#     The frame-time, wireframe and trim-atlas overlays change the frame, each only as it should.
 #  4. samples/embed_minimal (a GLFW host of the public API) draws 30 frames into its window and
 #     exits 0.
 #  5. Static LODs and LOD colouring (--static-lod --lod-colors, keys T and C) on STATIC_MODEL: the
@@ -78,6 +79,18 @@ if "$diff" "$work/wire.png" "$work/render10.png" 1 >/dev/null; then
   fail "--wireframe: the frame looks shaded"
 fi
 echo "ok: --wireframe draws lines"
+
+# The trim-atlas overlay: one page of the atlas in the upper right corner (a 180 x 180 box of
+# 640 x 360: 14 % of the pixels); the frame outside it is the render's. Motor-c has trimmed faces,
+# so the page is not empty: the overlay changes more than 1 % of the pixels.
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+  --script "$work/orbit.path" --frames 10 --settle --atlas-overlay --screenshot "$work/atlas.png" \
+  >"$work/atlas.out" 2>"$work/atlas.err" || { cat "$work/atlas.err"; fail "view --atlas-overlay"; }
+if "$diff" "$work/atlas.png" "$work/render10.png" 1 >/dev/null; then
+  fail "--atlas-overlay: no atlas page drawn"
+fi
+"$diff" "$work/atlas.png" "$work/render10.png" 15 || fail "--atlas-overlay changed more than its corner"
+echo "ok: the trim-atlas overlay shows a page in its corner only"
 
 "$sw" import "$model" -o "$work/model.sws" >/dev/null 2>&1
 xvfb-run -a -s "-screen 0 1280x1024x24" "$embed" "$work/model.sws" 30 >"$work/embed.out" 2>&1 ||
