@@ -18,7 +18,8 @@ static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 #define SW__NODES_MAX_POINTS (1u << 20)
 #define SW__NODES_MAX_LOOPS 65536u
 
-/* ---- the model's life -------------------------------------------------------------------------- */
+/* ---- the model's life --------------------------------------------------------------------------
+ */
 
 static void free_node(rt_node *n)
 {
@@ -120,7 +121,8 @@ sw_result sw_scene_create(const sw_scene_desc *desc, sw_scene *out, sw_status *s
     return sw_rt_scene_add_handle(container, out, status);
 }
 
-/* ---- looking things up ------------------------------------------------------------------------ */
+/* ---- looking things up ------------------------------------------------------------------------
+ */
 
 /* The scene's model with its edit lock held, and a reference on the container that end_edit
  * gives back. */
@@ -161,13 +163,14 @@ static sw_result find_node(sw_rt_model *m, sw_node node, const char *fn, rt_node
 {
     void *item = NULL;
     if (sw_rt_pool_get_checked(&m->nodes, node.id, accept_node, NULL, &item) != SW_OK)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid",
-                        fn, node.id);
+        return sw__fail(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid", fn,
+                        node.id);
     *out = item;
     return SW_OK;
 }
 
-/* ---- checking descs ---------------------------------------------------------------------------- */
+/* ---- checking descs ----------------------------------------------------------------------------
+ */
 
 static int all_finite(const double *v, size_t n)
 {
@@ -237,7 +240,8 @@ static sw_result check_camera(const sw_camera *c, const char *fn, sw_status *sta
     return SW_OK;
 }
 
-/* ---- geometry: private one-object scenes ------------------------------------------------------- */
+/* ---- geometry: private one-object scenes -------------------------------------------------------
+ */
 
 static double *homogeneous(const double *points, const double *weights, uint32_t n, int dim)
 {
@@ -294,8 +298,8 @@ static sw_result check_nurbs_desc(const sw_nurbs_desc *d, sw_status *status)
             if (tc->degree < 1 || tc->degree > SW_SG_MAX_DEGREE || tc->count < tc->degree + 1 ||
                 tc->count > SW__NODES_MAX_POINTS)
                 return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
-                                "%s: loop %u curve %u: degree %u with %u control points", fn, l,
-                                c, tc->degree, tc->count);
+                                "%s: loop %u curve %u: degree %u with %u control points", fn, l, c,
+                                tc->degree, tc->count);
             if (!tc->knots || !tc->points)
                 return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                                 "%s: loop %u curve %u: NULL knots or points", fn, l, c);
@@ -371,7 +375,7 @@ static sw_result fill_surface(sw_sg_builder *b, const sw_nurbs_desc *d, sw_sg_fa
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "NURBS surface: out of memory");
     const double *pool = sw_sg_builder_pool_ptr(b);
     sw_sg_surface s = {(int32_t)rec->deg_u, (int32_t)rec->deg_v, (int32_t)rec->n_u,
-                       (int32_t)rec->n_v,   pool + rec->knots_u,  pool + rec->knots_v,
+                       (int32_t)rec->n_v,   pool + rec->knots_u, pool + rec->knots_v,
                        pool + rec->cpw};
     sw_result r = sw_sg_surface_validate(&s, "NURBS surface", status);
     if (r != SW_OK)
@@ -425,9 +429,9 @@ static sw_result nurbs_geom(const sw_nurbs_desc *d, sw_sg_scene **out, sw_status
     if (r == SW_OK && d->loop_count)
         r = fill_loops(b, d, &rec, status);
     uint32_t face = r == SW_OK ? sw_sg_builder_add_face(b, &rec) : SW_SG_NONE;
-    if (r == SW_OK && (face == SW_SG_NONE ||
-                       sw_sg_builder_add_node(b, SW_SG_NODE_SURFACE, 0, face, NULL, NULL, NULL) ==
-                           SW_SG_NONE))
+    if (r == SW_OK &&
+        (face == SW_SG_NONE ||
+         sw_sg_builder_add_node(b, SW_SG_NODE_SURFACE, 0, face, NULL, NULL, NULL) == SW_SG_NONE))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "NURBS surface: out of memory");
     if (r != SW_OK) {
         sw_sg_builder_free(b);
@@ -447,7 +451,10 @@ static sw_result tspline_from_arrays(const sw_tspline_desc *d, sw_sg_tspline **t
     double *cpw = homogeneous(d->points, d->weights, d->point_count, 3);
     if (!cpw)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "T-spline: out of memory");
-    sw_sg_tspline_desc td = {d->point_count, cpw, d->knots_u, d->knots_v,
+    sw_sg_tspline_desc td = {d->point_count,
+                             cpw,
+                             d->knots_u,
+                             d->knots_v,
                              {d->domain[0], d->domain[1], d->domain[2], d->domain[3]}};
     sw_result r = sw_sg_tspline_create(&td, "T-spline", ts, status);
     free(cpw);
@@ -508,7 +515,8 @@ static sw_result make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *
     }
 }
 
-/* ---- the tree ---------------------------------------------------------------------------------- */
+/* ---- the tree ----------------------------------------------------------------------------------
+ */
 
 static void link_last(rt_node *parent, rt_node *n)
 {
@@ -601,7 +609,8 @@ static sw_result new_node(const sw_node_desc *d, rt_node **out, sw_status *statu
         r = read_transform(d->transform, fn, n->xform, status);
     else
         memcpy(n->xform, k_identity, sizeof n->xform);
-    if (r == SW_OK && d->kind == SW_NODE_CAMERA && (r = check_camera(d->camera, fn, status)) == SW_OK)
+    if (r == SW_OK && d->kind == SW_NODE_CAMERA &&
+        (r = check_camera(d->camera, fn, status)) == SW_OK)
         n->camera = *d->camera;
     if (r == SW_OK && d->name && !(n->name = strdup(d->name)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
@@ -726,7 +735,8 @@ sw_result sw_node_remove(sw_scene scene, sw_node node, sw_status *status)
     return r;
 }
 
-/* ---- per-node edits ---------------------------------------------------------------------------- */
+/* ---- per-node edits ----------------------------------------------------------------------------
+ */
 
 typedef sw_result (*edit_fn)(rt_node *n, const void *arg, sw_status *status);
 
@@ -820,7 +830,8 @@ sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_desc *d
     return r;
 }
 
-/* ---- queries ----------------------------------------------------------------------------------- */
+/* ---- queries -----------------------------------------------------------------------------------
+ */
 
 sw_result sw_node_get_info(sw_scene scene, sw_node node, sw_node_info *out, sw_status *status)
 {

@@ -15,7 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- compiling --------------------------------------------------------------------------------- */
+/* ---- compiling ---------------------------------------------------------------------------------
+ */
 
 typedef struct compile_state {
     sw_sg_builder *b;
@@ -162,8 +163,8 @@ static void compile_instances(compile_state *cs, pending *p)
             if (t->mark == 1)
                 continue;
             if (t->compiled != SW_SG_NONE) /* else its target is hidden: n draws nothing */
-                n->compiled = add_node(cs, SW_SG_NODE_INSTANCE, parent_index(n), t->compiled,
-                                       n->xform, n);
+                n->compiled =
+                    add_node(cs, SW_SG_NODE_INSTANCE, parent_index(n), t->compiled, n->xform, n);
             n->mark = 0;
             p->items[i--] = p->items[--p->count];
             progress = 1;
@@ -353,10 +354,9 @@ sw_result sw_rt_model_acquire_version(sw_rt_model *m, int latest, sw_rt_scene **
         pthread_mutex_lock(&m->pub_lock);
         while (m->compiled_revision < target)
             pthread_cond_wait(&m->pub_cond, &m->pub_lock);
-        sw_result r =
-            atomic_load_explicit(&m->published_revision, memory_order_acquire) >= target
-                ? SW_OK
-                : m->compile_result;
+        sw_result r = atomic_load_explicit(&m->published_revision, memory_order_acquire) >= target
+                          ? SW_OK
+                          : m->compile_result;
         if (r != SW_OK && status)
             *status = m->compile_status;
         pthread_mutex_unlock(&m->pub_lock);

@@ -15,13 +15,13 @@ struct rt_node {
     rt_node *parent, *first_child, *last_child, *prev, *next;
     int32_t hidden;
     uint32_t n_children;
-    float color[4];     /* color[3] < 0: inherit (the scene graph's convention) */
-    double xform[12];   /* identity where the kind has none */
-    rt_node *target;    /* INSTANCE */
+    float color[4];         /* color[3] < 0: inherit (the scene graph's convention) */
+    double xform[12];       /* identity where the kind has none */
+    rt_node *target;        /* INSTANCE */
     uint32_t instance_refs; /* INSTANCE nodes whose target this is */
-    sw_sg_scene *geom;  /* NURBS, TSPLINE, IMPORT: a private immutable scene, its root drawn */
+    sw_sg_scene *geom;      /* NURBS, TSPLINE, IMPORT: a private immutable scene, its root drawn */
     uint32_t geom_faces;
-    sw_camera camera;   /* CAMERA */
+    sw_camera camera; /* CAMERA */
     char *name;
     /* scratch of one operation under the edit lock (compile, remove, cycle test) */
     uint32_t compiled;

@@ -42,11 +42,12 @@ static const char *g_tsm, *g_brep, *g_work;
         sw_status st_ = {0};                                                                       \
         (void)st_;                                                                                 \
         sw_result got_ = (call);                                                                   \
-        CHECK(got_ == (want), "line %d: %s -> %s, expected %s", __LINE__, #call,                 \
+        CHECK(got_ == (want), "line %d: %s -> %s, expected %s", __LINE__, #call,                   \
               sw_result_id_str(got_), sw_result_id_str(want));                                     \
     } while (0)
 
-/* ---- geometry --------------------------------------------------------------------------------- */
+/* ---- geometry ---------------------------------------------------------------------------------
+ */
 static const double k_knots4[8] = {0, 0, 0, 0, 1, 1, 1, 1};
 static double g_plane[48];
 /* Loop 0: the domain's boundary; loop 1: the hole [0.4, 0.6]^2 (degree-1 closed polylines). */
@@ -249,8 +250,8 @@ static void test_misuse(built *b)
     EXPECT_RESULT(sw_node_set_nurbs(b->scene, b->tspline, &nd, NULL), SW_ERR_INVALID_ARGUMENT);
     sw_node_desc under_surface = {.kind = SW_NODE_GROUP, .parent = b->plane};
     EXPECT_RESULT(sw_node_add(b->scene, &under_surface, &n, NULL), SW_ERR_INVALID_ARGUMENT);
-    sw_node_desc cycle = {.kind = SW_NODE_INSTANCE, .parent = b->shifted,
-                          .instance_of = b->shifted};
+    sw_node_desc cycle = {
+        .kind = SW_NODE_INSTANCE, .parent = b->shifted, .instance_of = b->shifted};
     EXPECT_RESULT(sw_node_add(b->scene, &cycle, &n, NULL), SW_ERR_INVALID_ARGUMENT);
     sw_node_desc nan_color = {.kind = SW_NODE_GROUP};
     nan_color.color[0] = NAN;
@@ -343,7 +344,8 @@ static double image_distance(const char *a, const char *b)
     unsigned char *pa = sw_test_read_rgba(a, &wa, &ha), *pb = sw_test_read_rgba(b, &wb, &hb);
     double percent = 100.0;
     if (pa && pb && wa == wb && ha == hb && wa > 0)
-        percent = fmax(one_pixel_percent(pa, pb, wa, ha, 12), one_pixel_percent(pb, pa, wa, ha, 12));
+        percent =
+            fmax(one_pixel_percent(pa, pb, wa, ha, 12), one_pixel_percent(pb, pa, wa, ha, 12));
     free(pa);
     free(pb);
     return percent;
@@ -381,8 +383,8 @@ static void compare_with_file(sw_renderer r, const char *file, sw_node_desc *nod
     EXPECT_RESULT(sw_node_set_color(built_scene, n, green, NULL), SW_OK);
     draw(r, built_scene, &cam, cn, c);
     double same = differing_percent(a, b), control = differing_percent(a, c);
-    CHECK(same <= 0.1 && control > 1.0, "%s: %.4f %% differ (limit 0.1), recoloured %.2f %%",
-          name, same, control);
+    CHECK(same <= 0.1 && control > 1.0, "%s: %.4f %% differ (limit 0.1), recoloured %.2f %%", name,
+          same, control);
     printf("%s: node scene vs file scene %.4f %% of pixels differ (limit 0.1 %%); after a "
            "colour edit %.2f %% differ\n",
            name, same, control);
@@ -413,7 +415,6 @@ static void test_render(void)
     sw_scene_destroy(empty);
     sw_renderer_destroy(r);
 }
-
 
 /* ---- live edit ------------------------------------------------------------------------------- */
 enum { LIVE_N = 6, LIVE_FRAMES = 300, LIVE_CHECK_EVERY = 20 };
@@ -457,8 +458,8 @@ static void reference_frame(sw_renderer ref, double phase, const char *name, cha
     EXPECT_RESULT(sw_scene_create(NULL, &s, NULL), SW_OK);
     EXPECT_RESULT(sw_node_add(s, &d, &n, NULL), SW_OK);
     snprintf(path, 1024, "%s/%s.png", g_work, name);
-    sw_frame_desc f = {.scene = s, .camera = k_live_camera, .width = 160, .height = 120,
-                       .output_path = path};
+    sw_frame_desc f = {
+        .scene = s, .camera = k_live_camera, .width = 160, .height = 120, .output_path = path};
     sw_status st = {0};
     CHECK(sw_renderer_draw(ref, &f, NULL, &st) == SW_OK, "reference: %s", st.message);
     sw_scene_destroy(s);
@@ -494,7 +495,8 @@ static void test_live(void)
     EXPECT_RESULT(sw_scene_get_revisions(s, &rev, NULL), SW_OK);
     edit_of_revision[rev.latest] = 0;
     uint64_t waits = 0, lag_max = 0, fallback = 0;
-    double ms[LIVE_FRAMES], lags[LIVE_FRAMES], worst_same = 0.0, worst_exact = 0.0, least_control = 100.0;
+    double ms[LIVE_FRAMES], lags[LIVE_FRAMES], worst_same = 0.0, worst_exact = 0.0,
+                                               least_control = 100.0;
     int compared = 0;
     for (int k = 1; k <= LIVE_FRAMES; k++) {
         nd = wave_desc(phase_of_edit(k), pts);
@@ -513,8 +515,12 @@ static void test_live(void)
         char live_path[1024], name[64];
         snprintf(name, sizeof name, "live_%03d", k);
         snprintf(live_path, sizeof live_path, "%s/%s.png", g_work, name);
-        sw_frame_desc f = {.scene = s, .camera = k_live_camera, .width = 160, .height = 120,
-                           .walkthrough = 1, .output_path = check ? live_path : NULL};
+        sw_frame_desc f = {.scene = s,
+                           .camera = k_live_camera,
+                           .width = 160,
+                           .height = 120,
+                           .walkthrough = 1,
+                           .output_path = check ? live_path : NULL};
         sw_frame_stats fs;
         CHECK(sw_renderer_draw(r, &f, &fs, &st) == SW_OK, "frame %d: %s", k, st.message);
         waits += fs.pool_waits;

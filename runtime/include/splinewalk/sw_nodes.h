@@ -48,7 +48,8 @@ typedef struct sw_scene_desc {
  * be NULL (defaults). Any thread. The scene is the caller's: free it with sw_scene_destroy, which
  * frees its nodes too (a frame still drawing a version keeps that version alive). Starts one
  * worker thread for the scene's compilations on the first edit. *out = {0} on failure.
- * Errors: SW_ERR_INVALID_ARGUMENT (NULL out), SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (65,535 scenes). */
+ * Errors: SW_ERR_INVALID_ARGUMENT (NULL out), SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (65,535 scenes).
+ */
 SW_API sw_result sw_scene_create(const sw_scene_desc *desc, sw_scene *out, sw_status *status);
 
 typedef struct sw_scene_revisions {
@@ -59,8 +60,7 @@ typedef struct sw_scene_revisions {
 
 /* Any thread; never waits. Errors: SW_ERR_INVALID_ARGUMENT (NULL out, or a scene loaded from a
  * file, which has no revisions), SW_ERR_STALE_HANDLE. */
-SW_API sw_result sw_scene_get_revisions(sw_scene scene, sw_scene_revisions *out,
-                                        sw_status *status);
+SW_API sw_result sw_scene_get_revisions(sw_scene scene, sw_scene_revisions *out, sw_status *status);
 /* Waits until every edit made before the call is published. Any thread. Errors:
  * SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT (a scene loaded from a file), and what compiling
  * met (SW_ERR_OUT_OF_MEMORY, SW_ERR_INVALID_GEOMETRY, SW_ERR_LIMIT): the version before stays
@@ -181,13 +181,13 @@ SW_API sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_
 
 typedef struct sw_node_info {
     sw_node_kind kind;
-    sw_node parent;        /* {0}: the root, or detached */
-    uint32_t children;     /* direct children */
+    sw_node parent;    /* {0}: the root, or detached */
+    uint32_t children; /* direct children */
     int32_t detached, visible;
-    float color[4];        /* as set; color[3] == 0: inherited */
-    double transform[12];  /* local (identity for GROUP and CAMERA) */
-    uint32_t faces;        /* surfaces the node holds itself (NURBS 1, TSPLINE its Bézier
-                              patches, IMPORT the file's faces; 0 otherwise) */
+    float color[4];       /* as set; color[3] == 0: inherited */
+    double transform[12]; /* local (identity for GROUP and CAMERA) */
+    uint32_t faces;       /* surfaces the node holds itself (NURBS 1, TSPLINE its Bézier
+                             patches, IMPORT the file's faces; 0 otherwise) */
 } sw_node_info;
 
 /* Any thread; never waits. Errors: SW_ERR_INVALID_ARGUMENT (NULL out, a loaded scene),
