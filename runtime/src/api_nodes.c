@@ -50,6 +50,7 @@ static void model_free(sw_rt_model *m)
         sw_rt_scene_release(v); /* frames still drawing it keep their references */
     free_children(&m->root);
     free_children(&m->detached);
+    free(m->name);
     free(m->nodes.items);
     free(m->nodes.generations);
     pthread_mutex_destroy(&m->nodes.lock);
@@ -75,13 +76,18 @@ static void init_sentinel(rt_node *n, sw_node_kind kind)
     n->color[3] = -1.0f;
 }
 
-static sw_rt_model *model_create(sw_status *status)
+static atomic_uint_fast64_t g_model_serial;
+
+static sw_rt_model *model_create(const sw_scene_desc *desc, sw_status *status)
 {
     sw_rt_model *m = calloc(1, sizeof *m);
-    if (!m) {
+    if (!m || (desc && desc->name && !(m->name = strdup(desc->name)))) {
+        free(m);
         sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_scene_create: out of memory");
         return NULL;
     }
+    /* relaxed: only uniqueness matters */
+    m->serial = atomic_fetch_add_explicit(&g_model_serial, 1u, memory_order_relaxed) + 1u;
     pthread_mutex_init(&m->edit_lock, NULL);
     pthread_mutex_init(&m->nodes.lock, NULL);
     pthread_mutex_init(&m->pub_lock, NULL);
@@ -105,11 +111,10 @@ static sw_rt_model *model_create(sw_status *status)
 
 sw_result sw_scene_create(const sw_scene_desc *desc, sw_scene *out, sw_status *status)
 {
-    (void)desc; /* name: kept for messages by later issues; nothing reads it yet */
     if (!out)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_create: NULL out");
     out->id = 0;
-    sw_rt_model *m = model_create(status);
+    sw_rt_model *m = model_create(desc, status);
     if (!m)
         return status ? status->result : SW_ERR_OUT_OF_MEMORY;
     sw_rt_scene *container = sw_rt_scene_alloc(NULL);
@@ -785,16 +790,23 @@ static sw_result edit_transform(rt_node *n, const void *arg, sw_status *status)
     return r;
 }
 
-/* arg: a sw_sg_scene ** whose scene replaces the node's (the old one comes back through it). */
+/* A node's new geometry, and the kind of node it is for. */
+typedef struct geometry_swap {
+    sw_sg_scene *geom; /* the new one in; the old one out */
+    sw_node_kind kind;
+    const char *fn;
+} geometry_swap;
+
 static sw_result edit_geometry(rt_node *n, const void *arg, sw_status *status)
 {
-    if (n->kind != SW_NODE_NURBS)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "sw_node_set_nurbs: node %#x is not a NURBS node", n->id);
-    sw_sg_scene **swap = (sw_sg_scene **)arg;
+    geometry_swap *swap = (geometry_swap *)arg;
+    if (n->kind != swap->kind)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: node %#x is not a %s node", swap->fn,
+                        n->id, swap->kind == SW_NODE_NURBS ? "NURBS" : "TSPLINE");
     sw_sg_scene *old = n->geom;
-    n->geom = *swap;
-    *swap = old;
+    n->geom = swap->geom;
+    n->geom_faces = sw_sg_scene_view_ptr(n->geom)->n_faces;
+    swap->geom = old;
     return SW_OK;
 }
 
@@ -816,18 +828,33 @@ sw_result sw_node_set_transform(sw_scene scene, sw_node node, const double trans
     return edit_node(scene, node, "sw_node_set_transform", edit_transform, transform, status);
 }
 
+/* Checks and builds the new geometry before locking, then swaps it in. */
+static sw_result set_geometry(sw_scene scene, sw_node node, geometry_swap *swap, sw_result built,
+                              sw_status *status)
+{
+    if (built != SW_OK)
+        return built;
+    sw_result r = edit_node(scene, node, swap->fn, edit_geometry, swap, status);
+    sw_sg_scene_free(swap->geom); /* the node's old geometry, or the new one when it failed */
+    return r;
+}
+
 sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_desc *desc,
                             sw_status *status)
 {
     if (!desc)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_nurbs: NULL desc");
-    sw_sg_scene *geom = NULL;
-    sw_result r = nurbs_geom(desc, &geom, status); /* checked and built before locking */
-    if (r != SW_OK)
-        return r;
-    r = edit_node(scene, node, "sw_node_set_nurbs", edit_geometry, &geom, status);
-    sw_sg_scene_free(geom); /* the node's old surface, or the new one when the edit failed */
-    return r;
+    geometry_swap swap = {NULL, SW_NODE_NURBS, "sw_node_set_nurbs"};
+    return set_geometry(scene, node, &swap, nurbs_geom(desc, &swap.geom, status), status);
+}
+
+sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_desc *desc,
+                              sw_status *status)
+{
+    if (!desc)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_tspline: NULL desc");
+    geometry_swap swap = {NULL, SW_NODE_TSPLINE, "sw_node_set_tspline"};
+    return set_geometry(scene, node, &swap, tspline_geom(desc, &swap.geom, status), status);
 }
 
 /* ---- queries -----------------------------------------------------------------------------------

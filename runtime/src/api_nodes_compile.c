@@ -12,6 +12,7 @@
 #include "sw_status_util.h"
 
 #include <sched.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -201,8 +202,8 @@ static sw_result copy_tree(sw_rt_model *m, compile_state *cs, sw_status *status)
 
 /* The version's extras, made before it is published: stats (ready), the BVH renderers cull with
  * and picks use, the back-patch cones. */
-static sw_result finish_version(sw_sg_scene *sg, uint32_t *face_nodes, uint64_t revision,
-                                sw_rt_scene **out, sw_status *status)
+static sw_result finish_version(sw_sg_scene *sg, uint32_t *face_nodes, uint64_t lineage,
+                                uint64_t revision, sw_rt_scene **out, sw_status *status)
 {
     sw_rt_scene *v = sw_rt_scene_alloc(sg);
     if (!v) {
@@ -210,6 +211,7 @@ static sw_result finish_version(sw_sg_scene *sg, uint32_t *face_nodes, uint64_t 
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "node scene: out of memory");
     }
     v->face_nodes = face_nodes;
+    v->lineage = lineage;
     v->revision = revision;
     sw_result r = sw_sg_scene_compute_stats(sg, &v->stats);
     if (r != SW_OK)
@@ -248,7 +250,7 @@ sw_result sw__rt_model_compile(sw_rt_model *m, int unlock, sw_rt_scene **out, ui
         free(cs.face_nodes);
         return r;
     }
-    return finish_version(sg, cs.face_nodes, *revision, out, status);
+    return finish_version(sg, cs.face_nodes, m->serial, *revision, out, status);
 }
 
 /* ---- publication and grace period ---------------------------------------------------------- */
@@ -305,6 +307,11 @@ static void compile_task(void *ctx)
     if (r == SW_OK) {
         sw__rt_model_publish(m, v);
         atomic_fetch_add_explicit(&m->compiles, 1u, memory_order_relaxed);
+    }
+    if (r != SW_OK && m->name) {
+        char message[sizeof st.message];
+        snprintf(message, sizeof message, "scene \"%.64s\": %.400s", m->name, st.message);
+        memcpy(st.message, message, sizeof message);
     }
     pthread_mutex_lock(&m->pub_lock);
     m->compiled_revision = revision;

@@ -36,6 +36,8 @@ typedef struct sw_rt_model {
     sw_rt_pool nodes;
     rt_node root;     /* the implicit root group (the builder's node 0) */
     rt_node detached; /* sentinel parent of detached subtrees (prototypes) */
+    uint64_t serial;  /* unique per model in the process: its versions' lineage */
+    char *name;       /* sw_scene_desc.name, or NULL: prefixes compile failures */
     uint64_t revision;
     int compile_queued; /* a compile task is queued or running and will look at `revision` */
     sw_th_pool *pool;   /* one worker: compilations, in order */

@@ -423,6 +423,15 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
         return NULL;
     }
     sw_result res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &j->scene, status);
+    if (res == SW_OK && r->in_flight && j->scene != r->cache_scene && j->scene->lineage &&
+        j->scene->lineage == r->cache_scene->lineage) {
+        /* A node scene published a version since the waiting frames were prepared: this frame
+         * draws theirs too (the pipeline draws one version at a time); the next prepare with no
+         * frame waiting moves on to the newest. */
+        sw_rt_scene_release(j->scene);
+        j->scene = r->cache_scene;
+        sw_rt_scene_retain(j->scene);
+    }
     if (res == SW_OK && r->in_flight && j->scene != r->cache_scene)
         res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                        "sw_renderer_prepare: frames of another scene are prepared; submit them "

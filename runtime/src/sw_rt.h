@@ -60,10 +60,11 @@ typedef struct sw_rt_scene {
      * published (then immutable): ready, stats, pick_bvh (also what renderers cull with),
      * cones, and the node handle id of each face. */
     struct sw_rt_model *model;
+    uint64_t lineage; /* a version: its model's serial number (never reused); 0 otherwise */
     uint64_t revision;
-    const struct sw_sg_bvh *prebuilt_bvh;        /* = pick_bvh of a version; NULL otherwise */
-    struct sw_lod_face_cones *prebuilt_cones;    /* owned */
-    uint32_t *face_nodes;                        /* owned; n_faces entries */
+    const struct sw_sg_bvh *prebuilt_bvh;     /* = pick_bvh of a version; NULL otherwise */
+    struct sw_lod_face_cones *prebuilt_cones; /* owned */
+    uint32_t *face_nodes;                     /* owned; n_faces entries */
 } sw_rt_scene;
 
 /* A new scene holding sg (one reference, the caller's; NULL on failure, sg then freed). */

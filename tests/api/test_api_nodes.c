@@ -8,7 +8,8 @@
  *   T-spline and a camera. Checked against independent facts: face and occurrence counts against
  *   the loaded .tsm's; picks against the plane's exact parameters (S(u, v) = (10u, 10v, 0)), a
  *   ray through the hole misses, the instance's hit names the same node with another occurrence;
- *   hiding removes both occurrences; a saved .sws reloads with the same counts and hits. Misuse:
+ *   hiding removes both occurrences; the T-spline replaced by a regular 4 x 4 one (arrays) is one
+ *   patch picked at its exact (u, v); a saved .sws reloads with the same counts and hits. Misuse:
  *   NULL desc, bad geometry, a cycle, removing a node an instance draws, stale handles after
  *   remove (double remove), a loaded scene given to node calls, a destroyed scene.
  * render: a node scene must draw through sw_renderer_draw like the same content loaded from a
@@ -22,13 +23,18 @@
  *   it drew: at most 0.1 % of pixels have no pixel of the same colour (12 levels) within one
  *   pixel in the other image (ε_img = 0.5 px between two tessellations), while the build of the
  *   edit 5 before leaves more than 1 % unmatched (the check can fail).
- *   After a flush every edit is published.
+ *   After a flush every edit is published. Then: split frames (prepare / submit) with an edit
+ *   between each, all submitted without pool waits; another thread adding, hiding, removing
+ *   nodes and editing the surface while this one draws walkthrough frames and picks (run under
+ *   TSan too); a draw with the destroyed scene's handle is SW_ERR_STALE_HANDLE.
  */
 #include <splinewalk/splinewalk.h>
 
 #include "test_check.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -191,6 +197,44 @@ static void test_counts_and_picks(built *b)
     EXPECT_RESULT(sw_scene_get_revisions(b->scene, &rev, NULL), SW_OK);
     CHECK(rev.published == rev.latest && rev.latest >= 8, "revisions %llu / %llu",
           (unsigned long long)rev.published, (unsigned long long)rev.latest);
+}
+
+/* A regular 4 x 4 T-spline is one bicubic Bézier patch: each point's local knot vector is five
+ * consecutive knots of [0 0 0 0 1 1 1 1]. Evenly spaced points give S(u, v) = (10u, 10v, 0). */
+static void test_set_tspline(built *b)
+{
+    static const double k[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+    double pts[48], ku[80], kv[80];
+    for (int j = 0; j < 4; j++) {
+        for (int i = 0; i < 4; i++) {
+            int p = 4 * j + i;
+            pts[3 * p] = 10.0 * i / 3.0, pts[3 * p + 1] = 10.0 * j / 3.0, pts[3 * p + 2] = 0.0;
+            memcpy(ku + 5 * p, k + i, 5 * sizeof *k);
+            memcpy(kv + 5 * p, k + j, 5 * sizeof *k);
+        }
+    }
+    sw_tspline_desc td = {
+        .point_count = 16, .points = pts, .knots_u = ku, .knots_v = kv, .domain = {0, 1, 0, 1}};
+    sw_status st = {0};
+    CHECK(sw_node_set_tspline(b->scene, b->tspline, &td, &st) == SW_OK, "set_tspline: %s",
+          st.message);
+    sw_node_info ni;
+    EXPECT_RESULT(sw_node_get_info(b->scene, b->tspline, &ni, NULL), SW_OK);
+    CHECK(ni.faces == 1, "a regular T-spline became %u patches", ni.faces);
+    sw_pick_hit h = pick_down(b->scene, 103.0, 4.0);
+    CHECK(h.hit && h.node.id == b->tspline.id && fabs(h.uv[0] - 0.3) < 1e-9 &&
+              fabs(h.uv[1] - 0.4) < 1e-9,
+          "pick on the new T-spline: hit %d node %#x uv (%g, %g)", h.hit, h.node.id, h.uv[0],
+          h.uv[1]);
+    td.domain[1] = 0.0;
+    EXPECT_RESULT(sw_node_set_tspline(b->scene, b->tspline, &td, NULL), SW_ERR_INVALID_GEOMETRY);
+    EXPECT_RESULT(
+        sw_node_set_tspline(b->scene, b->plane, &(sw_tspline_desc){.tsm_path = g_tsm}, NULL),
+        SW_ERR_INVALID_ARGUMENT);
+    sw_tspline_desc back = {.tsm_path = g_tsm};
+    EXPECT_RESULT(sw_node_set_tspline(b->scene, b->tspline, &back, NULL), SW_OK);
+    printf("set_tspline: a regular 4 x 4 T-spline -> %u patch, picked at uv (%.12f, %.12f)\n",
+           ni.faces, h.uv[0], h.uv[1]);
 }
 
 static void test_save_reload(built *b)
@@ -471,6 +515,102 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* Split frames (prepare on the visibility thread, submit here) while the surface is edited
+ * between them: every frame is submitted, none waits for the pool, and frames prepared while
+ * another waits draw its version (the pipeline shows one version at a time). */
+static void test_live_split(sw_renderer r, sw_scene s, sw_node node)
+{
+    enum { SPLIT_FRAMES = 60 };
+    double pts[LIVE_N * LIVE_N * 3];
+    sw_frame_desc f = {
+        .scene = s, .camera = k_live_camera, .width = 160, .height = 120, .walkthrough = 1};
+    sw_status st = {0};
+    uint64_t waits = 0;
+    int submitted = 0;
+    CHECK(sw_renderer_prepare(r, &f, &st) == SW_OK, "prepare 0: %s", st.message);
+    for (int k = 1; k <= SPLIT_FRAMES; k++) {
+        sw_nurbs_desc nd = wave_desc(phase_of_edit(1000 + k), pts);
+        EXPECT_RESULT(sw_node_set_nurbs(s, node, &nd, NULL), SW_OK);
+        if (k < SPLIT_FRAMES)
+            CHECK(sw_renderer_prepare(r, &f, &st) == SW_OK, "prepare %d: %s", k, st.message);
+        sw_frame_stats fs;
+        if (sw_renderer_submit(r, &fs, &st) == SW_OK) {
+            submitted++;
+            waits += fs.pool_waits;
+        } else {
+            CHECK(0, "submit %d: %s", k, st.message);
+        }
+    }
+    CHECK(submitted == SPLIT_FRAMES && waits == 0, "split frames: %d of %d submitted, %llu waits",
+          submitted, SPLIT_FRAMES, (unsigned long long)waits);
+    printf("live edit, split frames: %d edits between prepare and submit, %d frames submitted, "
+           "pool waits %llu\n",
+           SPLIT_FRAMES, submitted, (unsigned long long)waits);
+}
+
+typedef struct editor {
+    sw_scene scene;
+    sw_node node;
+    int edits;
+    atomic_int failures, done;
+} editor;
+
+/* Another thread edits while the renderer's thread draws and picks: surfaces, visibility, nodes
+ * added and removed. */
+static void *edit_concurrently(void *arg)
+{
+    editor *e = arg;
+    double pts[LIVE_N * LIVE_N * 3];
+    for (int k = 0; k < e->edits; k++) {
+        sw_nurbs_desc nd = wave_desc(phase_of_edit(2000 + k), pts);
+        sw_node extra = {0};
+        sw_node_desc g = {.kind = SW_NODE_NURBS, .nurbs = &nd};
+        g.transform[0] = g.transform[5] = g.transform[10] = 1.0;
+        g.transform[7] = 12.0;
+        int ok = sw_node_set_nurbs(e->scene, e->node, &nd, NULL) == SW_OK &&
+                 sw_node_add(e->scene, &g, &extra, NULL) == SW_OK &&
+                 sw_node_set_visible(e->scene, extra, k % 2, NULL) == SW_OK &&
+                 (k % 3 == 0 || sw_node_remove(e->scene, extra, NULL) == SW_OK);
+        if (!ok)
+            atomic_fetch_add(&e->failures, 1);
+        nanosleep(&(struct timespec){0, 500000}, NULL); /* let frames interleave */
+    }
+    atomic_store(&e->done, 1);
+    return NULL;
+}
+
+static void test_live_concurrent(sw_renderer r, sw_scene s, sw_node node)
+{
+    editor e = {.scene = s, .node = node, .edits = 150};
+    pthread_t t;
+    if (pthread_create(&t, NULL, edit_concurrently, &e) != 0) {
+        CHECK(0, "editor thread");
+        return;
+    }
+    sw_frame_desc f = {
+        .scene = s, .camera = k_live_camera, .width = 160, .height = 120, .walkthrough = 1};
+    uint64_t waits = 0;
+    int frames = 0, picks = 0, bad = 0;
+    while (!atomic_load(&e.done) || frames < 20) {
+        sw_frame_stats fs;
+        bad += sw_renderer_draw(r, &f, &fs, NULL) != SW_OK;
+        waits += fs.pool_waits;
+        frames++;
+        double o[3] = {5, 5, 20}, d[3] = {0, 0, -1};
+        sw_pick_hit h;
+        bad += sw_scene_pick(s, o, d, &h, NULL) != SW_OK;
+        picks += h.hit && h.node.id == node.id;
+    }
+    pthread_join(t, NULL);
+    CHECK(atomic_load(&e.failures) == 0 && bad == 0 && waits == 0 && picks == frames,
+          "concurrent edits: %d failed edits, %d failed frames or picks, %llu waits, %d of %d "
+          "picks on the surface",
+          atomic_load(&e.failures), bad, (unsigned long long)waits, picks, frames);
+    printf("live edit, another thread editing: %d edit rounds, %d walkthrough frames and picks "
+           "meanwhile, pool waits %llu, picks naming the surface %d of %d\n",
+           e.edits, frames, (unsigned long long)waits, picks, frames);
+}
+
 static void test_live(void)
 {
     sw_renderer r, ref;
@@ -573,7 +713,13 @@ static void test_live(void)
            "%% of pixels unmatched within 1 px (limit 0.1 %%; %.3f %% not bit-identical); by the "
            "build of 5 edits before: at least %.2f %% unmatched\n",
            compared, worst_same, worst_exact, least_control);
-    sw_scene_destroy(s);
+    test_live_split(r, s, node);
+    test_live_concurrent(r, s, node);
+    EXPECT_RESULT(sw_scene_destroy(s), SW_OK);
+    /* The renderer still holds the last version it drew; the handle is stale. */
+    sw_frame_desc f = {
+        .scene = s, .camera = k_live_camera, .width = 160, .height = 120, .walkthrough = 1};
+    EXPECT_RESULT(sw_renderer_draw(r, &f, NULL, NULL), SW_ERR_STALE_HANDLE);
     sw_renderer_destroy(ref);
     sw_renderer_destroy(r);
 }
@@ -584,6 +730,7 @@ int main(int argc, char **argv)
         g_tsm = argv[2], g_work = argv[3];
         built b = build_scene();
         test_counts_and_picks(&b);
+        test_set_tspline(&b);
         test_save_reload(&b);
         test_misuse(&b);
     } else if (argc >= 5 && strcmp(argv[1], "render") == 0) {

@@ -41,7 +41,7 @@ extern "C" {
 
 /* ---- node scenes ----------------------------------------------------------------------------- */
 typedef struct sw_scene_desc {
-    const char *name; /* NULL: "" (messages name the scene by its handle) */
+    const char *name; /* NULL: none; copied; names the scene in compile failures */
 } sw_scene_desc;
 
 /* Creates an empty node scene (its root is an implicit group; {0} names it as a parent). desc may
@@ -178,6 +178,11 @@ SW_API sw_result sw_node_set_transform(sw_scene scene, sw_node node, const doubl
  * SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY; the node keeps its surface then. */
 SW_API sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_desc *desc,
                                    sw_status *status);
+/* The same for a TSPLINE node: a new T-spline (points, knots, or another .tsm file, read during
+ * the call) replaces its Bézier patches. Errors: as sw_node_set_nurbs (SW_ERR_INVALID_ARGUMENT
+ * for a node that is not TSPLINE), and those of reading a .tsm file. */
+SW_API sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_desc *desc,
+                                     sw_status *status);
 
 typedef struct sw_node_info {
     sw_node_kind kind;
