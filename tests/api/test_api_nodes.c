@@ -193,6 +193,17 @@ static void test_counts_and_picks(built *b)
     EXPECT_RESULT(sw_node_set_visible(b->scene, b->plane, 1, NULL), SW_OK);
     CHECK(pick_down(b->scene, 2.0, 3.0).hit, "visible again, not picked");
 
+    double moved[12];
+    translation(moved, 40, 0, 0);
+    EXPECT_RESULT(sw_node_set_transform(b->scene, b->shifted, moved, NULL), SW_OK);
+    sw_pick_hit there = pick_down(b->scene, 42.0, 3.0), gone = pick_down(b->scene, 22.0, 3.0);
+    CHECK(there.hit && there.node.id == b->plane.id && !gone.hit,
+          "after moving the instance's transform: hit at x = 42 %d, at x = 22 %d", there.hit,
+          gone.hit);
+    translation(moved, 20, 0, 0);
+    EXPECT_RESULT(sw_node_set_transform(b->scene, b->shifted, moved, NULL), SW_OK);
+    EXPECT_RESULT(sw_scene_flush(b->scene, NULL), SW_OK);
+
     sw_scene_revisions rev;
     EXPECT_RESULT(sw_scene_get_revisions(b->scene, &rev, NULL), SW_OK);
     CHECK(rev.published == rev.latest && rev.latest >= 8, "revisions %llu / %llu",
@@ -254,6 +265,22 @@ static void test_save_reload(built *b)
           (unsigned long long)a.face_occurrences, (unsigned long long)c.face_occurrences);
     sw_pick_hit h = pick_down(loaded, 2.0, 3.0);
     CHECK(h.hit && h.node.id == 0 && fabs(h.uv[0] - 0.2) < 1e-9, "reloaded pick");
+    /* The saved file imported under a node of another scene: the same counts, picks name it. */
+    sw_scene again;
+    sw_node imported;
+    EXPECT_RESULT(sw_scene_create(&(sw_scene_desc){.name = "re-import"}, &again, NULL), SW_OK);
+    sw_node_desc imp = {.kind = SW_NODE_IMPORT, .import_path = path};
+    CHECK(sw_node_add(again, &imp, &imported, &st) == SW_OK, "import .sws: %s", st.message);
+    sw_scene_info ai;
+    EXPECT_RESULT(sw_scene_get_info(again, &ai, NULL), SW_OK);
+    sw_pick_hit hi = pick_down(again, 2.0, 3.0);
+    CHECK(ai.faces == c.faces && ai.face_occurrences == c.face_occurrences && hi.hit &&
+              hi.node.id == imported.id,
+          "the .sws imported under a node: %u faces, %llu occurrences, pick node %#x", ai.faces,
+          (unsigned long long)ai.face_occurrences, hi.node.id);
+    sw_node_desc missing = {.kind = SW_NODE_IMPORT, .import_path = "/nonexistent/part.step"};
+    EXPECT_RESULT(sw_node_add(again, &missing, &imported, NULL), SW_ERR_NOT_FOUND);
+    sw_scene_destroy(again);
     sw_node n;
     sw_node_desc g = {0};
     EXPECT_RESULT(sw_node_add(loaded, &g, &n, NULL), SW_ERR_INVALID_ARGUMENT);
@@ -533,7 +560,7 @@ static void test_live_split(sw_renderer r, sw_scene s, sw_node node)
         EXPECT_RESULT(sw_node_set_nurbs(s, node, &nd, NULL), SW_OK);
         if (k < SPLIT_FRAMES)
             CHECK(sw_renderer_prepare(r, &f, &st) == SW_OK, "prepare %d: %s", k, st.message);
-        sw_frame_stats fs;
+        sw_frame_stats fs = {0};
         if (sw_renderer_submit(r, &fs, &st) == SW_OK) {
             submitted++;
             waits += fs.pool_waits;
@@ -592,7 +619,7 @@ static void test_live_concurrent(sw_renderer r, sw_scene s, sw_node node)
     uint64_t waits = 0;
     int frames = 0, picks = 0, bad = 0;
     while (!atomic_load(&e.done) || frames < 20) {
-        sw_frame_stats fs;
+        sw_frame_stats fs = {0};
         bad += sw_renderer_draw(r, &f, &fs, NULL) != SW_OK;
         waits += fs.pool_waits;
         frames++;
@@ -661,7 +688,7 @@ static void test_live(void)
                            .height = 120,
                            .walkthrough = 1,
                            .output_path = check ? live_path : NULL};
-        sw_frame_stats fs;
+        sw_frame_stats fs = {0};
         CHECK(sw_renderer_draw(r, &f, &fs, &st) == SW_OK, "frame %d: %s", k, st.message);
         waits += fs.pool_waits;
         fallback += fs.fallback_draws;
