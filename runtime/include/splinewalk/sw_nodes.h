@@ -15,15 +15,23 @@
  *    starts and never waits for a compilation;
  *  - a converged frame, sw_scene_save, sw_scene_pick, sw_scene_get_info and sw_camera_fit wait
  *    until every edit made before the call is compiled, and then use that version.
- * sw_scene_flush waits the same way; sw_scene_get_revisions tells what is published.
+ * sw_scene_flush waits the same way; sw_scene_get_revisions tells what is published. Split
+ * frames (sw_renderer_prepare) prepared while others wait draw the version those draw. A version
+ * is compiled whole (every node copied, validated, boxed), so its cost grows with the scene; a
+ * renderer switching to a new version builds that version's hierarchies again in its pool (the
+ * faces are drawn from their Bézier patches meanwhile, within the same error bound).
  *
  * Handles. sw_node is a pool index and a 16-bit generation per scene, {0} never valid; a node
  * handle is only meaningful with the scene that made it. After sw_node_remove every copy of the
  * handle (and those of the removed subtree) is stale: calls return SW_ERR_STALE_HANDLE.
  *
  * Threads. Every function here may be called from any thread; calls on one scene are serialised
- * by the scene's edit lock (they do not wait for compilations, except those documented to). The
- * renderer's thread rules are those of splinewalk.h.
+ * by the scene's edit lock, which a compilation also holds while it copies the tree (not while it
+ * validates and boxes it); no call waits for a compilation to finish but those documented to.
+ * The renderer's thread rules are those of splinewalk.h.
+ *
+ * Colours. A node's own colour wins over its parent's and over the colour of an instance that
+ * draws it; a node with color[3] == 0 takes the colour of what draws it.
  *
  * Ownership. Descs and the arrays they point at are read during the call only (copied).
  *
