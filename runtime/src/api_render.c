@@ -148,9 +148,10 @@ static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_status
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
     }
     sw_result res = sw_lod_cache_create(scene->sg, r->pool, NULL, &r->cache, status);
-    if (res == SW_OK)
+    /* A node scene's version comes with them, built by its compile task (gpu_frame). */
+    if (res == SW_OK && !scene->prebuilt_bvh)
         res = sw_sg_bvh_build(scene->sg, &r->bvh, status);
-    if (res == SW_OK)
+    if (res == SW_OK && !scene->prebuilt_cones)
         res = sw_lod_face_cones_build(scene->sg, &r->cones, status);
     if (res != SW_OK) {
         drop_cache(r);
@@ -370,8 +371,8 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
         res = renderer_cache(r, scene, status);
     if (res != SW_OK)
         return res;
-    frame->bvh = r->bvh;
-    frame->face_cones = r->cones;
+    frame->bvh = r->bvh ? r->bvh : scene->prebuilt_bvh;
+    frame->face_cones = r->cones ? r->cones : scene->prebuilt_cones;
     if (!frame->eval_exact && !desc->no_hierarchy)
         frame->hierarchies = r->cache;
     frame->lod_colors = desc->lod_colors != 0;
@@ -433,7 +434,16 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
         sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
         return NULL;
     }
-    sw_result res = sw_rt_scene_acquire(desc->scene, &j->scene, status);
+    sw_result res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &j->scene, status);
+    if (res == SW_OK && r->in_flight && j->scene != r->cache_scene && j->scene->lineage &&
+        j->scene->lineage == r->cache_scene->lineage) {
+        /* A node scene published a version since the waiting frames were prepared: this frame
+         * draws theirs too (the pipeline draws one version at a time); the next prepare with no
+         * frame waiting moves on to the newest. */
+        sw_rt_scene_release(j->scene);
+        j->scene = r->cache_scene;
+        sw_rt_scene_retain(j->scene);
+    }
     if (res == SW_OK && r->in_flight && j->scene != r->cache_scene)
         res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                        "sw_renderer_prepare: frames of another scene are prepared; submit them "
@@ -527,7 +537,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     if (res != SW_OK)
         return res;
     sw_rt_scene *scene;
-    res = sw_rt_scene_acquire(desc->scene, &scene, status);
+    res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &scene, status);
     if (res != SW_OK)
         return res;
     res = draw_frame(r, scene, desc, stats, status);

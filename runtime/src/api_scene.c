@@ -30,26 +30,53 @@ static int is_cad_file(const char *path)
     return 0;
 }
 
-static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
+sw_rt_scene *sw_rt_scene_alloc(sw_sg_scene *sg)
 {
     sw_rt_scene *scene = calloc(1, sizeof *scene);
     if (!scene) {
         sw_sg_scene_free(sg);
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+        return NULL;
     }
     scene->sg = sg;
-    atomic_init(&scene->refs, 1u); /* the pool's reference, dropped by sw_scene_destroy */
+    atomic_init(&scene->refs, 1u);
     pthread_mutex_init(&scene->once_lock, NULL);
+    return scene;
+}
+
+sw_result sw_rt_scene_add_handle(sw_rt_scene *scene, sw_scene *out, sw_status *status)
+{
     uint32_t id = sw_rt_pool_add(&g_scenes, scene);
     if (!id) {
-        pthread_mutex_destroy(&scene->once_lock);
-        sw_sg_scene_free(sg);
-        free(scene);
+        sw_rt_scene_release(scene);
         return sw__fail(status, SW_ERR_LIMIT, "too many scenes loaded at once");
     }
     out->id = id;
     sw__status_ok(status);
     return SW_OK;
+}
+
+/* The loaded scene's reference becomes the pool's, dropped by sw_scene_destroy. */
+static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
+{
+    sw_rt_scene *scene = sw_rt_scene_alloc(sg);
+    if (!scene)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+    return sw_rt_scene_add_handle(scene, out, status);
+}
+
+sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out, sw_status *status)
+{
+    if (has_extension(desc->path, ".sws"))
+        return sw_sg_scene_open(desc->path, out, status);
+    if (has_extension(desc->path, ".tsm"))
+        return sw_sg_tspline_import_file(desc->path, out, status);
+    if (!is_cad_file(desc->path))
+        return sw__fail(status, SW_ERR_UNSUPPORTED,
+                        "%s: unknown extension (expected .sws, .step, .stp, .iges, .igs, .brep "
+                        "or .tsm)",
+                        desc->path);
+    sw_sg_import_desc import = {desc->path, desc->progress, desc->warning, desc->user_data};
+    return sw_sg_import_file(&import, out, NULL, status);
 }
 
 sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status)
@@ -59,20 +86,7 @@ sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status
     if (!desc || !desc->path || !out)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load: NULL desc, path or out");
     sw_sg_scene *sg = NULL;
-    sw_result r;
-    if (has_extension(desc->path, ".sws")) {
-        r = sw_sg_scene_open(desc->path, &sg, status);
-    } else if (has_extension(desc->path, ".tsm")) {
-        r = sw_sg_tspline_import_file(desc->path, &sg, status);
-    } else if (!is_cad_file(desc->path)) {
-        return sw__fail(status, SW_ERR_UNSUPPORTED,
-                        "%s: unknown extension (expected .sws, .step, .stp, .iges, .igs, .brep "
-                        "or .tsm)",
-                        desc->path);
-    } else {
-        sw_sg_import_desc import = {desc->path, desc->progress, desc->warning, desc->user_data};
-        r = sw_sg_import_file(&import, &sg, NULL, status);
-    }
+    sw_result r = sw_rt_scene_read(desc, &sg, status);
     if (r != SW_OK)
         return r;
     return wrap_scene(sg, out, status);
@@ -192,6 +206,7 @@ void sw_rt_scene_release(sw_rt_scene *scene)
     /* acq_rel: every use of the scene by other holders happens before the last one frees it. */
     if (atomic_fetch_sub_explicit(&scene->refs, 1u, memory_order_acq_rel) != 1u)
         return;
+    sw_rt_nodes_scene_free(scene);
     sw_sg_bvh_free(scene->pick_bvh);
     sw_sg_scene_free(scene->sg);
     pthread_mutex_destroy(&scene->once_lock);
@@ -224,21 +239,43 @@ static sw_result make_ready(sw_rt_scene *scene, sw_status *status)
     return r;
 }
 
-sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status)
+sw_result sw_rt_scene_lookup(sw_scene handle, sw_rt_scene **out, sw_status *status)
 {
     void *item;
     *out = NULL;
     if (sw_rt_pool_get_checked(&g_scenes, handle.id, retain_scene, NULL, &item) != SW_OK)
         return sw__fail(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
                         handle.id);
-    sw_rt_scene *scene = item;
-    sw_result r = make_ready(scene, status);
+    *out = item;
+    return SW_OK;
+}
+
+sw_result sw_rt_scene_acquire_frame(sw_scene handle, int walkthrough, sw_rt_scene **out,
+                                    sw_status *status)
+{
+    sw_rt_scene *scene;
+    sw_result r = sw_rt_scene_lookup(handle, &scene, status);
+    if (r != SW_OK)
+        return r;
+    if (scene->model) { /* a node scene: its version (made ready by the compile task) */
+        sw_rt_scene *version = NULL;
+        r = sw_rt_model_acquire_version(scene->model, !walkthrough, &version, status);
+        sw_rt_scene_release(scene);
+        *out = version;
+        return r;
+    }
+    r = make_ready(scene, status);
     if (r != SW_OK) {
         sw_rt_scene_release(scene);
         return r;
     }
     *out = scene;
     return SW_OK;
+}
+
+sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status)
+{
+    return sw_rt_scene_acquire_frame(handle, 0, out, status);
 }
 
 sw_result sw_scene_save(sw_scene handle, const char *path, sw_status *status)
@@ -345,6 +382,8 @@ sw_result sw_scene_pick(sw_scene handle, const double origin[3], const double di
         memcpy(out->point, hit.point, sizeof out->point);
         memcpy(out->uv, hit.uv, sizeof out->uv);
         out->occurrence = hit.item;
+        if (scene->face_nodes)
+            out->node.id = scene->face_nodes[hit.face];
     }
     sw_rt_scene_release(scene);
     return r;

@@ -54,13 +54,47 @@ typedef struct sw_rt_scene {
     sw_result ready_result;
     sw_sg_scene_stats stats;
     struct sw_sg_bvh *pick_bvh; /* immutable once built; freed with the scene */
+    /* Node scenes (api_nodes*.c). The handle's scene is a container: sg NULL, `model` the node
+     * tree, and acquiring it yields the model's published version instead. A version is an
+     * ordinary scene made by the model's compile task with everything below set before it is
+     * published (then immutable): ready, stats, pick_bvh (also what renderers cull with),
+     * cones, and the node handle id of each face. */
+    struct sw_rt_model *model;
+    uint64_t lineage; /* a version: its model's serial number (never reused); 0 otherwise */
+    uint64_t revision;
+    const struct sw_sg_bvh *prebuilt_bvh;     /* = pick_bvh of a version; NULL otherwise */
+    struct sw_lod_face_cones *prebuilt_cones; /* owned */
+    uint32_t *face_nodes;                     /* owned; n_faces entries */
 } sw_rt_scene;
+
+/* A new scene holding sg (one reference, the caller's; NULL on failure, sg then freed). */
+sw_rt_scene *sw_rt_scene_alloc(sw_sg_scene *sg);
+/* Gives the scene a handle (the pool takes the caller's reference). On failure frees the scene
+ * and returns SW_ERR_LIMIT. */
+sw_result sw_rt_scene_add_handle(sw_rt_scene *scene, sw_scene *out, sw_status *status);
+/* Reads a scene file as sw_scene_load does (.sws mapped, .tsm, or CAD through OCCT). */
+sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out, sw_status *status);
+/* Node scenes: frees the model of a container and what a version owns (api_nodes.c); called by
+ * the last release. */
+void sw_rt_nodes_scene_free(sw_rt_scene *scene);
+/* Node scenes: the version to use for a container — the published one (latest = 0: never waits)
+ * or the one holding every edit made before the call (latest = 1: waits for the compile task);
+ * a reference the caller releases. Errors: those of compiling (sw_scene_flush). */
+sw_result sw_rt_model_acquire_version(struct sw_rt_model *model, int latest, sw_rt_scene **out,
+                                      sw_status *status);
 
 /* The scene behind a handle, with every section verified and its stats computed (first call does
  * the work), holding a reference that the caller gives back with sw_rt_scene_release. Errors:
  * SW_ERR_STALE_HANDLE, or whatever the first verification found (then *out = NULL and no
  * reference is held). */
 sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *status);
+/* The same for a frame: a walkthrough frame (walkthrough = 1) takes a node scene's published
+ * version without waiting; sw_rt_scene_acquire waits for every edit made before the call. */
+sw_result sw_rt_scene_acquire_frame(sw_scene handle, int walkthrough, sw_rt_scene **out,
+                                    sw_status *status);
+/* The scene behind a handle as the pool holds it (a node scene's container, not a version), with
+ * a reference; no verification. SW_ERR_STALE_HANDLE. */
+sw_result sw_rt_scene_lookup(sw_scene handle, sw_rt_scene **out, sw_status *status);
 void sw_rt_scene_release(sw_rt_scene *scene); /* frees it when it was the last reference */
 /* One more reference, for a caller that already holds one (acquire) and keeps the scene beyond
  * its call (a renderer's hierarchy cache). */

@@ -46,6 +46,10 @@ typedef struct sw_scene {
 typedef struct sw_renderer {
     uint32_t id;
 } sw_renderer;
+/* A node of a node scene (sw_nodes.h): meaningful with the scene that made it. */
+typedef struct sw_node {
+    uint32_t id;
+} sw_node;
 
 /* ---- scenes ---------------------------------------------------------------------------------- */
 typedef void (*sw_progress_fn)(void *user_data, double fraction, const char *stage);
@@ -118,6 +122,9 @@ typedef struct sw_pick_hit {
     double t;            /* point = origin + t * direction, t > 0 */
     double point[3];     /* world */
     double uv[2];        /* the surface's parameters at the point (inside its trim loops) */
+    sw_node node;        /* node scenes (sw_nodes.h): the NURBS, TSPLINE or IMPORT node holding
+                            the surface, as it was when the picked version was compiled; {0} for
+                            scenes loaded from files */
 } sw_pick_hit;
 
 /* The nearest point where the ray origin + t direction (t > 0; direction not unit, not zero) meets
@@ -288,4 +295,6 @@ SW_API sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats,
 #ifdef __cplusplus
 }
 #endif
+
+#include <splinewalk/sw_nodes.h>
 #endif

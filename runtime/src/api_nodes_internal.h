@@ -1,0 +1,71 @@
+/* Node scenes, inside the runtime (never installed): the mutable node tree (api_nodes.c) and its
+ * compilation into published immutable versions (api_nodes_compile.c). sw_nodes.h says what the
+ * host sees. */
+#ifndef SW_RT_NODES_INTERNAL_H
+#define SW_RT_NODES_INTERNAL_H
+
+#include "sw_rt.h"
+
+#include "sw_th_pool.h"
+
+typedef struct rt_node rt_node;
+struct rt_node {
+    uint32_t id; /* handle id in the model's node pool; 0 for the two sentinels */
+    sw_node_kind kind;
+    rt_node *parent, *first_child, *last_child, *prev, *next;
+    int32_t hidden;
+    uint32_t n_children;
+    float color[4];         /* color[3] < 0: inherit (the scene graph's convention) */
+    double xform[12];       /* identity where the kind has none */
+    rt_node *target;        /* INSTANCE */
+    uint32_t instance_refs; /* INSTANCE nodes whose target this is */
+    sw_sg_scene *geom;      /* NURBS, TSPLINE, IMPORT: a private immutable scene, its root drawn */
+    uint32_t geom_faces;
+    sw_camera camera; /* CAMERA */
+    char *name;
+    /* scratch of one operation under the edit lock (compile, remove, cycle test) */
+    uint32_t compiled;
+    uint32_t mark;
+};
+
+typedef struct sw_rt_model {
+    /* Protects the tree (every rt_node), the node pool's contents, `revision` and
+     * `compile_queued`. Taken by every API call on the scene and by the compile task while it
+     * copies the tree into a builder; never by a frame. Order: edit_lock, then nodes.lock. */
+    pthread_mutex_t edit_lock;
+    sw_rt_pool nodes;
+    rt_node root;     /* the implicit root group (the builder's node 0) */
+    rt_node detached; /* sentinel parent of detached subtrees (prototypes) */
+    uint64_t serial;  /* unique per model in the process: its versions' lineage */
+    char *name;       /* sw_scene_desc.name, or NULL: prefixes compile failures */
+    uint64_t revision;
+    int compile_queued; /* a compile task is queued or running and will look at `revision` */
+    sw_th_pool *pool;   /* one worker: compilations, in order */
+
+    /* Publication (api_nodes_compile.c): one pointer exchange, then a grace period over the
+     * readers counted in readers[epoch & 1] (they only retain the version inside it). */
+    _Atomic(sw_rt_scene *) published;
+    atomic_uint epoch;
+    atomic_uint readers[2];
+    atomic_uint_fast64_t published_revision, compiles;
+
+    /* Protects compiled_revision, compile_result and compile_status; pub_cond is signalled
+     * when compiled_revision moves. Taken after edit_lock when both are held. */
+    pthread_mutex_t pub_lock;
+    pthread_cond_t pub_cond;
+    uint64_t compiled_revision; /* the last revision a compilation finished (or failed) */
+    sw_result compile_result;
+    sw_status compile_status;
+} sw_rt_model;
+
+/* Compiles the tree as it is now into a version (the edit lock held by the caller for the copy
+ * only: it is released before the builder is finished when `unlock` is set). */
+sw_result sw__rt_model_compile(sw_rt_model *m, int unlock, sw_rt_scene **out, uint64_t *revision,
+                               sw_status *status);
+/* Publishes v (the model takes the caller's reference) and reclaims the version before it once
+ * no reader can still be taking it. */
+void sw__rt_model_publish(sw_rt_model *m, sw_rt_scene *v);
+/* After an edit, under the edit lock: revision + 1 and a compile task unless one is queued. */
+void sw__rt_model_edited(sw_rt_model *m);
+
+#endif
