@@ -34,6 +34,7 @@ struct sw_lod_static_set {
     slot *slots;
     _Atomic uint64_t n_builds, n_adopted;
     _Atomic uint64_t build_ns;
+    _Atomic int cancelled; /* builds not started yet return at once (the set is going away) */
 };
 
 typedef struct build_job {
@@ -217,6 +218,12 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     return SW_OK;
 }
 
+void sw_lod_static_set_cancel(sw_lod_static_set *s)
+{
+    if (s)
+        atomic_store_explicit(&s->cancelled, 1, memory_order_release);
+}
+
 void sw_lod_static_set_destroy(sw_lod_static_set *s)
 {
     if (!s)
@@ -324,6 +331,8 @@ static void build_task(void *ctx)
     const sw_lod_static_unit *un = &s->units[job->unit];
     slot *sl = &s->slots[job->unit];
     free(job);
+    if (atomic_load_explicit(&s->cancelled, memory_order_acquire))
+        return; /* the slot stays QUEUED: nobody reads it any more */
     const uint64_t t0 = now_ns();
     sw_lod_static_chain *chain = NULL;
     sw_status st = {0};

@@ -70,7 +70,12 @@ typedef struct sw_lod_static_set_stats {
 sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
                                    const sw_lod_static_set_desc *desc, sw_lod_static_set **out,
                                    sw_status *status);
-/* Waits for the builds in flight, frees every chain. No other thread may use the set. NULL ok. */
+/* Builds queued from now on return without building (those running finish): called before a
+ * set that is going away is destroyed, so that its destroy waits for the running builds only.
+ * Any thread; NULL ok. */
+void sw_lod_static_set_cancel(sw_lod_static_set *set);
+/* Waits for the builds in flight, frees every chain. No other thread may use the set. NULL ok.
+ * May run as a pool task (it runs pool tasks while it waits). */
 void sw_lod_static_set_destroy(sw_lod_static_set *set);
 
 uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *set);

@@ -113,15 +113,50 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
     return SW_OK;
 }
 
-/* Drops the hierarchy cache (waiting for its tasks) and the BVH, then the scene reference they
- * needed. */
-static void drop_cache(sw_rt_renderer *r)
+typedef struct retired_statics {
+    sw_lod_static_set *set;
+    sw_rt_scene *scene; /* a reference the set's builds need until they are done */
+} retired_statics;
+
+static void retire_statics_task(void *ctx)
+{
+    retired_statics *rs = ctx;
+    sw_lod_static_set_destroy(rs->set); /* waits for its running builds, runs pool tasks */
+    sw_rt_scene_release(rs->scene);
+    free(rs);
+}
+
+/* The scene's static LODs, given up (another scene, a new version of a node scene, the renderer
+ * going away): queued builds are cancelled, and the set is freed by a pool task once its running
+ * builds end, so the frame thread never waits for them (a level build takes seconds). Only the
+ * clustering task, if it is still running, is waited for here: it writes r->statics. */
+static void retire_statics(sw_rt_renderer *r)
 {
     if (r->pool)
         sw_th_group_wait(r->pool, &r->statics_group);
-    sw_lod_static_set_destroy(atomic_load(&r->statics));
-    atomic_store(&r->statics, NULL);
+    sw_lod_static_set *set = atomic_exchange(&r->statics, NULL);
     atomic_store(&r->statics_state, 0);
+    if (!set)
+        return;
+    sw_lod_static_set_cancel(set);
+    retired_statics *rs = malloc(sizeof *rs);
+    if (rs) {
+        *rs = (retired_statics){set, r->cache_scene};
+        sw_rt_scene_retain(r->cache_scene);
+        const sw_th_task task = {retire_statics_task, rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL};
+        if (sw_th_pool_submit(r->pool, &task) == SW_OK)
+            return;
+        sw_rt_scene_release(r->cache_scene);
+        free(rs);
+    }
+    sw_lod_static_set_destroy(set); /* out of memory: here, waiting */
+}
+
+/* Drops the hierarchy cache (waiting for its tasks), the static LODs (freed in the pool) and the
+ * BVH, then the scene reference they needed. */
+static void drop_cache(sw_rt_renderer *r)
+{
+    retire_statics(r);
     sw_lod_cache_destroy(r->cache);
     r->cache = NULL;
     sw_sg_bvh_free(r->bvh);
