@@ -150,8 +150,17 @@ static void upload(bt_draw *d, const float *v, size_t n_v, size_t stride, const 
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, bytes, (const void *)(3 * sizeof(float)));
 }
 
-unsigned bt_draw_mesh(bt_draw *d, const float view_proj[16], const float *v, size_t n_v,
-                      size_t stride, const uint32_t *idx, size_t n_idx)
+unsigned bt_draw_upload(bt_draw *d, const float *v, size_t n_v, size_t stride,
+                        const uint32_t *idx, size_t n_idx)
+{
+    GLenum pending = glGetError();
+    if (pending != GL_NO_ERROR)
+        return pending;
+    upload(d, v, n_v, stride, idx, n_idx);
+    return glGetError();
+}
+
+unsigned bt_draw_uploaded(bt_draw *d, const float view_proj[16], size_t n_idx)
 {
     GLenum pending = glGetError();
     if (pending != GL_NO_ERROR)
@@ -168,12 +177,19 @@ unsigned bt_draw_mesh(bt_draw *d, const float view_proj[16], const float *v, siz
     glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
     glClearDepth(0.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    upload(d, v, n_v, stride, idx, n_idx);
+    glBindVertexArray(d->vao);
     glUseProgram(d->prog);
     glUniformMatrix4fv(d->loc_vp, 1, GL_FALSE, view_proj);
     glDrawElements(GL_TRIANGLES, (GLsizei)n_idx, GL_UNSIGNED_INT, (const void *)0);
     glFinish();
     return glGetError();
+}
+
+unsigned bt_draw_mesh(bt_draw *d, const float view_proj[16], const float *v, size_t n_v,
+                      size_t stride, const uint32_t *idx, size_t n_idx)
+{
+    unsigned e = bt_draw_upload(d, v, n_v, stride, idx, n_idx);
+    return e != 0 ? e : bt_draw_uploaded(d, view_proj, n_idx);
 }
 
 unsigned bt_draw_drain_errors(void)

@@ -1,0 +1,276 @@
+/* bench_peers (issue 6): splinewalk beside Mesa's GLU NURBS tessellator and OpenCASCADE's mesher
+ * on the same scene, camera path, frame size and ε_img; each peer in its own child process. See
+ * k_usage for what is measured and how; the figures and their reading are in bench/peers/README.md.
+ */
+#include "bench_peer.h"
+#include "peer_glu.h"
+#include "peer_mesh.h"
+#include "peer_splinewalk.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static const char k_usage[] =
+    "usage: bench_peers [options] SCENE...\n"
+    "\n"
+    "Runs three renderers of trimmed NURBS on each SCENE (.sws, or .brep / .step / .iges as\n"
+    "sw_scene_load reads them) along the same camera path at the same frame size and error\n"
+    "bound eps_img, each in its own child process (fork), one after the other:\n"
+    "  splinewalk  the public API, threaded (sw_renderer_prepare of frame i+1 while\n"
+    "              sw_renderer_submit draws frame i), walkthrough mode, default renderer\n"
+    "  glu         Mesa's GLU NURBS tessellator (GLU_NURBS_TESSELLATOR, GLU_PARAMETRIC_ERROR =\n"
+    "              eps_img px, gluLoadSamplingMatrices per frame, GLU_CULLING on, trim loops as\n"
+    "              gluNurbsCurve) re-tessellating every face occurrence every frame; its\n"
+    "              triangles uploaded to one VBO and drawn in a 4.5 core EGL context\n"
+    "  occt        OpenCASCADE's BRepMesh_IncrementalMesh of the scene's BREP, once, at the\n"
+    "              deflection of eps_img px at the path's nearest eye-to-scene-box distance;\n"
+    "              one VBO drawn every frame\n"
+    "Frame time = the frame's draw calls until glFinish (no readback); for splinewalk the\n"
+    "submitting thread's prepare(i+1) + submit(i); for glu tessellation + upload + draw.\n"
+    "Warm-up passes are drawn first and not counted (the first frame is among them). Per peer:\n"
+    "median and p99 frame time, time to first frame (from the child's start: load,\n"
+    "preprocessing - hierarchies are built in the background, GLU's control points, OCCT's mesh -\n"
+    "and the first frame), peak RSS (the child's VmHWM minus its resident memory at the fork),\n"
+    "triangles per frame (median), and splinewalk / peer ratios of each. Faces GLU reports an\n"
+    "error for are counted (column refused_faces) and not drawn after their first error.\n"
+    "Set LP_NUM_THREADS and EGL_PLATFORM=surfaceless yourself: the header line echoes them.\n"
+    "\n"
+    "options:\n"
+    "  --peers LIST    comma-separated subset of splinewalk,glu,occt (default: all three)\n"
+    "  --frames N      frames along the path per pass (default 120)\n"
+    "  --warmup W      uncounted passes first (default 1)\n"
+    "  --passes P      counted passes (default 1)\n"
+    "  --size WxH      frame size (default 1280x720)\n"
+    "  --error PX      eps_img in pixels (default 0.5)\n"
+    "  --path FILE     camera path (docs/camera-path.md; default: the orbit `splinewalk path\n"
+    "                  orbit` makes for the scene's box)\n"
+    "  --brep FILE     the scene's BREP for occt (default: SCENE itself if it is .brep, else\n"
+    "                  SCENE with its extension replaced by .brep if that file exists; none:\n"
+    "                  occt is skipped with a note). Only with one SCENE.\n"
+    "  --csv FILE      also write the rows as CSV (written aside, then renamed)\n"
+    "  -h, --help      this text\n";
+
+enum { PEER_SW, PEER_GLU, PEER_OCCT, N_PEERS };
+static const char *const k_peer_names[N_PEERS] = {"splinewalk", "glu", "occt"};
+static const bp_peer_fn k_peer_fns[N_PEERS] = {bp_peer_splinewalk, bp_peer_glu, bp_peer_occt};
+
+typedef struct args {
+    int use[N_PEERS];
+    uint32_t frames, warmup, passes;
+    int32_t w, h;
+    double error_px;
+    const char *path_file, *brep, *csv;
+    char **scenes;
+    int n_scenes;
+} args;
+
+static int parse_peers(const char *list, int use[N_PEERS])
+{
+    memset(use, 0, N_PEERS * sizeof *use);
+    char buf[128];
+    snprintf(buf, sizeof buf, "%s", list);
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        int found = 0;
+        for (int p = 0; p < N_PEERS; ++p)
+            if (!strcmp(tok, k_peer_names[p]))
+                use[p] = found = 1;
+        if (!found)
+            return -1;
+    }
+    return use[0] || use[1] || use[2] ? 0 : -1;
+}
+
+static int parse(int argc, char **argv, args *a)
+{
+    *a = (args){{1, 1, 1}, 120, 1, 1, 1280, 720, 0.5, NULL, NULL, NULL, NULL, 0};
+    a->scenes = calloc((size_t)argc, sizeof *a->scenes);
+    for (int i = 1; i < argc && a->scenes; ++i) {
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int takes = v && o[0] == '-' && strcmp(o, "-h") && strcmp(o, "--help");
+        if (!strcmp(o, "-h") || !strcmp(o, "--help"))
+            return 1;
+        if (o[0] != '-') {
+            a->scenes[a->n_scenes++] = argv[i];
+            continue;
+        }
+        if (!takes)
+            return -1;
+        ++i;
+        if (!strcmp(o, "--peers") && parse_peers(v, a->use) == 0)
+            continue;
+        else if (!strcmp(o, "--frames"))
+            a->frames = (uint32_t)strtoul(v, NULL, 10);
+        else if (!strcmp(o, "--warmup"))
+            a->warmup = (uint32_t)strtoul(v, NULL, 10);
+        else if (!strcmp(o, "--passes"))
+            a->passes = (uint32_t)strtoul(v, NULL, 10);
+        else if (!strcmp(o, "--size") && sscanf(v, "%dx%d", &a->w, &a->h) == 2)
+            continue;
+        else if (!strcmp(o, "--error"))
+            a->error_px = strtod(v, NULL);
+        else if (!strcmp(o, "--path"))
+            a->path_file = v;
+        else if (!strcmp(o, "--brep"))
+            a->brep = v;
+        else if (!strcmp(o, "--csv"))
+            a->csv = v;
+        else
+            return -1;
+    }
+    int ok = a->scenes && a->n_scenes > 0 && a->frames >= 2 && a->frames <= 100000 &&
+             a->passes >= 1 && a->passes <= 100 && a->warmup <= 100 && a->w > 0 && a->h > 0 &&
+             a->w <= 16384 && a->h <= 16384 && a->error_px > 0.0 && isfinite(a->error_px) &&
+             !(a->brep && a->n_scenes > 1);
+    return ok ? 0 : -1;
+}
+
+static int has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    return n > e && !strcasecmp(path + n - e, ext);
+}
+
+/* The BREP beside a scene: itself, or SCENE.brep in place of its extension; NULL if none. */
+static const char *brep_for(const char *scene, char *buf, size_t size)
+{
+    if (has_ext(scene, ".brep"))
+        return scene;
+    snprintf(buf, size, "%s", scene);
+    char *dot = strrchr(buf, '.'), *slash = strrchr(buf, '/');
+    if (dot && (!slash || dot > slash) && (size_t)(dot - buf) + 6 <= size)
+        strcpy(dot, ".brep");
+    return access(buf, R_OK) == 0 ? buf : NULL;
+}
+
+static double ratio(double sw, double peer)
+{
+    return sw > 0.0 && peer > 0.0 ? sw / peer : NAN;
+}
+
+static void print_row(const char *name, const bp_result *r, const bp_result *sw)
+{
+    if (!r->ok) {
+        printf("  %-10s | not run: %s\n", name, r->note);
+        return;
+    }
+    printf("  %-10s | %7.2f %8.2f | %9.0f | %8.1f | %10.0f | %6.2f %6.2f %7.2f %6.2f %8.3f\n", name,
+           r->median_ms, r->p99_ms, r->first_frame_ms, r->peak_rss_bytes / 1048576.0, r->triangles,
+           ratio(sw->median_ms, r->median_ms), ratio(sw->p99_ms, r->p99_ms),
+           ratio(sw->first_frame_ms, r->first_frame_ms),
+           ratio(sw->peak_rss_bytes, r->peak_rss_bytes), ratio(sw->triangles, r->triangles));
+}
+
+static void print_notes(const bp_result res[N_PEERS], const int use[N_PEERS])
+{
+    for (int p = 0; p < N_PEERS; ++p)
+        if (use[p] && res[p].ok && res[p].note[0])
+            printf("  %s: %s\n", k_peer_names[p], res[p].note);
+    for (int p = PEER_GLU; p < N_PEERS; ++p)
+        if (use[p] && res[p].ok)
+            printf("  %s: %.0f pixels covered in the last frame\n", k_peer_names[p],
+                   res[p].covered_px);
+    if (use[PEER_GLU] && res[PEER_GLU].ok)
+        printf("  glu: %llu face occurrences, %llu faces refused (%llu occurrences), %llu GL errors "
+               "from GLU's fixed-function calls drained\n",
+               (unsigned long long)res[PEER_GLU].faces,
+               (unsigned long long)res[PEER_GLU].refused_faces,
+               (unsigned long long)res[PEER_GLU].refused_occurrences,
+               (unsigned long long)res[PEER_GLU].gl_errors);
+}
+
+static void csv_row(FILE *f, const char *scene, const args *a, const char *name,
+                    const bp_result *r, const bp_result *sw)
+{
+    fprintf(f, "%s,%s,%d,%d,%g,%u,%d,%.4f,%.4f,%.2f,%.0f,%.0f,%.5g,%.5g,%.5g,%.5g,%.5g,%llu,%llu,%.6g\n",
+            scene, name, a->w, a->h, a->error_px, r->frames, r->ok, r->median_ms, r->p99_ms,
+            r->first_frame_ms, r->peak_rss_bytes, r->triangles,
+            ratio(sw->median_ms, r->median_ms), ratio(sw->p99_ms, r->p99_ms),
+            ratio(sw->first_frame_ms, r->first_frame_ms),
+            ratio(sw->peak_rss_bytes, r->peak_rss_bytes), ratio(sw->triangles, r->triangles),
+            (unsigned long long)r->faces, (unsigned long long)r->refused_faces, r->param);
+}
+
+static const char k_csv_header[] =
+    "scene,peer,width,height,error_px,frames,ok,median_ms,p99_ms,first_frame_ms,peak_rss_bytes,"
+    "triangles_per_frame,ratio_median,ratio_p99,ratio_first_frame,ratio_peak_rss,"
+    "ratio_triangles,face_occurrences,refused_faces,occt_deflection\n";
+
+/* Runs the peers on one scene; prints its table; appends CSV rows to csv (may be NULL). */
+static int run_scene(const args *a, const char *scene, FILE *csv)
+{
+    char brep_buf[4096], err[512];
+    bp_job job = {scene, a->brep ? a->brep : brep_for(scene, brep_buf, sizeof brep_buf), NULL,
+                  a->frames, a->warmup, a->passes, a->w, a->h, a->error_px, {0}};
+    sw_rt_camera_path path;
+    memset(&path, 0, sizeof path);
+    if (bp_job_path(&job, a->path_file, &path, err, sizeof err) != 0) {
+        fprintf(stderr, "bench_peers: %s: %s\n", scene, err);
+        return -1;
+    }
+    bp_result res[N_PEERS];
+    memset(res, 0, sizeof res);
+    int failed = 0;
+    for (int p = 0; p < N_PEERS; ++p)
+        if (a->use[p] && bp_run_in_child(k_peer_fns[p], &job, &res[p]) != 0) {
+            fprintf(stderr, "bench_peers: %s: %s: %s\n", scene, k_peer_names[p], res[p].note);
+            failed = 1;
+        }
+    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s\n", scene,
+           job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
+           a->path_file ? a->path_file : "orbit of the scene box");
+    printf("  peer       |  frame ms: median      p99 | first (ms) | peak RSS MB | triangles | "
+           "splinewalk / peer: median p99 first RSS triangles\n");
+    for (int p = 0; p < N_PEERS; ++p)
+        if (a->use[p]) {
+            print_row(k_peer_names[p], &res[p], &res[PEER_SW]);
+            if (csv)
+                csv_row(csv, scene, a, k_peer_names[p], &res[p], &res[PEER_SW]);
+        }
+    print_notes(res, a->use);
+    sw_rt_path_free(&path);
+    return failed ? -1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    args a;
+    int pr = parse(argc, argv, &a);
+    if (pr != 0) {
+        fputs(k_usage, pr > 0 ? stdout : stderr);
+        free(a.scenes);
+        return pr > 0 ? 0 : 2;
+    }
+    const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
+    printf("bench_peers: %dx%d, eps_img %g px, LP_NUM_THREADS=%s, EGL_PLATFORM=%s, %ld "
+           "processors online\n",
+           a.w, a.h, a.error_px, lp ? lp : "(unset)", egl ? egl : "(unset)",
+           sysconf(_SC_NPROCESSORS_ONLN));
+    char tmp[4200];
+    FILE *csv = NULL;
+    if (a.csv) {
+        snprintf(tmp, sizeof tmp, "%s.tmp-%ld", a.csv, (long)getpid());
+        csv = fopen(tmp, "w");
+        if (!csv) {
+            fprintf(stderr, "bench_peers: %s: cannot write\n", tmp);
+            free(a.scenes);
+            return 1;
+        }
+        fputs(k_csv_header, csv);
+    }
+    int rc = 0;
+    for (int s = 0; s < a.n_scenes; ++s)
+        rc |= run_scene(&a, a.scenes[s], csv) != 0;
+    if (csv) {
+        int bad = ferror(csv) | fclose(csv);
+        if (bad || rename(tmp, a.csv) != 0) {
+            fprintf(stderr, "bench_peers: %s: write failed\n", a.csv);
+            remove(tmp);
+            rc = 1;
+        }
+    }
+    free(a.scenes);
+    return rc;
+}

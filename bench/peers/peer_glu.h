@@ -1,0 +1,21 @@
+/* bench/peers: Mesa's GLU NURBS tessellator as a peer (bench/tessellation's bt_glu wrapper:
+ * GLU_NURBS_TESSELLATOR mode, GLU_AUTO_LOAD_MATRIX off with each frame's matrices passed by
+ * gluLoadSamplingMatrices, GLU_SAMPLING_METHOD = GLU_PARAMETRIC_ERROR at ε_img pixels,
+ * GLU_CULLING on, the *_DATA callbacks collecting fans and strips as indexed triangles). Every face
+ * occurrence of the splinewalk scene (sw_sg_scene_traverse: instance transforms applied to the
+ * homogeneous control points, made eye-relative per frame in float) is tessellated every frame
+ * with its trim loops (gluBeginTrim, gluNurbsCurve with GLU_MAP1_TRIM_3), the triangles uploaded
+ * to one VBO and drawn with splinewalk's view-projection and glFinish (bench/tessellation's
+ * bt_draw). GLU needs no GL context in tessellator mode; its few fixed-function calls
+ * (glPushAttrib, ...) only raise errors in the 4.5 core context, which are drained and counted.
+ * A face GLU reports an error for (its order above GLU's limit, a trim loop it rejects) is counted
+ * as refused, with its first error, and not drawn in later frames.
+ */
+#ifndef BP_PEER_GLU_H
+#define BP_PEER_GLU_H
+
+#include "bench_peer.h"
+
+int bp_peer_glu(const bp_job *job, bp_result *out);
+
+#endif

@@ -1,0 +1,131 @@
+/* bench/peers: the splinewalk peer (see peer_splinewalk.h). */
+#include "peer_splinewalk.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct sw_run {
+    bp_job job; /* a copy whose path may be the one made here */
+    sw_scene scene;
+    sw_renderer renderer;
+    sw_status st;
+} sw_run;
+
+static sw_frame_desc frame_at(const sw_run *r, uint32_t i)
+{
+    sw_frame_desc f;
+    memset(&f, 0, sizeof f);
+    f.scene = r->scene;
+    f.width = r->job.width;
+    f.height = r->job.height;
+    f.error_px = r->job.error_px;
+    f.walkthrough = 1;
+    bp_frame_camera(&r->job, i, &f.camera);
+    return f;
+}
+
+/* One pass along the path; ms[i], tri[i] for frame i (either may be NULL). The first frame's
+ * end time goes to *t_first when not NULL. */
+static int pass(sw_run *r, double *ms, double *tri, double *t_first)
+{
+    sw_frame_desc f = frame_at(r, 0);
+    if (sw_renderer_prepare(r->renderer, &f, &r->st) != SW_OK)
+        return -1;
+    for (uint32_t i = 0; i < r->job.frames; ++i) {
+        sw_frame_stats fs;
+        double t0 = bp_now_ms();
+        if (i + 1 < r->job.frames) {
+            f = frame_at(r, i + 1);
+            if (sw_renderer_prepare(r->renderer, &f, &r->st) != SW_OK)
+                return -1;
+        }
+        if (sw_renderer_submit(r->renderer, &fs, &r->st) != SW_OK)
+            return -1;
+        double t1 = bp_now_ms();
+        if (i == 0 && t_first)
+            *t_first = t1;
+        if (ms)
+            ms[i] = t1 - t0;
+        if (tri)
+            tri[i] = (double)fs.triangles;
+    }
+    return 0;
+}
+
+static int load(sw_run *r, sw_rt_camera_path *own_path, bp_result *out)
+{
+    sw_scene_load_desc ld = {r->job.scene, NULL, NULL, NULL};
+    sw_scene_info info;
+    if (sw_scene_load(&ld, &r->scene, &r->st) != SW_OK ||
+        sw_scene_get_info(r->scene, &info, &r->st) != SW_OK)
+        return -1;
+    out->scene_bytes = (double)info.memory_bytes;
+    out->faces = info.face_occurrences;
+    if (!r->job.path) {
+        for (int k = 0; k < 3; ++k) {
+            r->job.scene_box[k] = info.bbox_min[k];
+            r->job.scene_box[3 + k] = info.bbox_max[k];
+        }
+        if (sw_rt_path_orbit(r->job.scene_box, 10.0, r->job.frames, own_path, &r->st) != SW_OK)
+            return -1;
+        r->job.path = own_path;
+    }
+    memcpy(out->box, r->job.scene_box, sizeof out->box);
+    return 0;
+}
+
+static int measure(sw_run *r, double t_start, bp_result *out)
+{
+    uint32_t n = r->job.frames * r->job.passes;
+    double *ms = calloc(n, sizeof *ms), *tri = calloc(n, sizeof *tri);
+    double t_first = 0.0;
+    int rc = ms && tri ? 0 : -1;
+    if (rc == 0 && sw_renderer_create(NULL, &r->renderer, &r->st) != SW_OK)
+        rc = -1;
+    /* Warm-up passes (the first frame among them) let the pool build the hierarchies, as a
+     * walkthrough's first seconds would; GLU and OCCT get the same passes. */
+    for (uint32_t w = 0; rc == 0 && w < r->job.warmup_passes; ++w)
+        rc = pass(r, NULL, NULL, w == 0 ? &t_first : NULL);
+    for (uint32_t p = 0; rc == 0 && p < r->job.passes; ++p)
+        rc = pass(r, ms + p * r->job.frames, tri + p * r->job.frames,
+                  r->job.warmup_passes == 0 && p == 0 ? &t_first : NULL);
+    if (rc == 0) {
+        double tri_p99;
+        out->frames = n;
+        out->first_frame_ms = t_first - t_start;
+        rc = bp_summarize(ms, n, &out->median_ms, &out->p99_ms) == 0 &&
+                     bp_summarize(tri, n, &out->triangles, &tri_p99) == 0
+                 ? 0
+                 : -1;
+        snprintf(out->note, sizeof out->note, "%s", sw_renderer_description_ptr(r->renderer));
+    } else if (r->st.message[0]) {
+        snprintf(out->note, sizeof out->note, "%s", r->st.message);
+    } else {
+        snprintf(out->note, sizeof out->note, "out of memory");
+    }
+    free(ms);
+    free(tri);
+    return rc;
+}
+
+int bp_peer_splinewalk(const bp_job *job, bp_result *out)
+{
+    double t_start = bp_now_ms();
+    sw_run r;
+    memset(&r, 0, sizeof r);
+    r.job = *job;
+    sw_rt_camera_path own_path;
+    memset(&own_path, 0, sizeof own_path);
+    int rc = load(&r, &own_path, out);
+    if (rc != 0)
+        snprintf(out->note, sizeof out->note, "%s", r.st.message);
+    else
+        rc = measure(&r, t_start, out);
+    if (r.renderer.id)
+        sw_renderer_destroy(r.renderer);
+    if (r.scene.id)
+        sw_scene_destroy(r.scene);
+    sw_rt_path_free(&own_path);
+    return rc;
+}
