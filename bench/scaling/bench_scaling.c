@@ -1,0 +1,252 @@
+/* bench_scaling (issue 6): how splinewalk's frame time and memory grow with the scene — generated
+ * buildings of N = 10^3, 10^4, 10^5 (10^6 with --max) surfaces, each drawn along the orbit of its
+ * own box (the same relative path: the view composition stays, the detail grows), each in its own
+ * child process. The claim to test (ARCHITECTURE.md, "Scale"): cost grows with what is visible at
+ * the required detail, not with the model's size. See k_usage.
+ */
+#define _GNU_SOURCE
+#include "bench_peer.h"
+#include "peer_splinewalk.h"
+#include "scaling_svg.h"
+
+#include <errno.h>
+#include <libgen.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static const char k_usage[] =
+    "usage: bench_scaling [options]\n"
+    "\n"
+    "Generates buildings of N surfaces (`splinewalk generate building --surfaces N`, seed 1;\n"
+    "kept in DIR and reused when present) for N = MIN, 10 MIN, ... up to MAX, and renders each\n"
+    "with splinewalk (public API, threaded, walkthrough, as bench_peers) along the orbit of its\n"
+    "own box (`splinewalk path orbit`: the same view composition at every N), each N in its own\n"
+    "child process. Prints per N: face occurrences, the scene's own bytes\n"
+    "(sw_scene_info.memory_bytes), median and p99 frame time (draw until glFinish, no readback;\n"
+    "warm-up passes not counted), time to first frame (load + renderer + first frame), peak RSS\n"
+    "(the child's VmHWM minus its resident memory at the fork) and triangles per frame (median).\n"
+    "Set LP_NUM_THREADS and EGL_PLATFORM=surfaceless yourself: the header line echoes them.\n"
+    "\n"
+    "options:\n"
+    "  --min N          smallest scene (default 1000; at least 100)\n"
+    "  --max N          largest scene (default 100000; 1000000 takes minutes and GBs)\n"
+    "  --frames N       frames along the path per pass (default 120)\n"
+    "  --warmup W       uncounted passes first (default 1)\n"
+    "  --passes P       counted passes (default 1)\n"
+    "  --size WxH       frame size (default 1280x720)\n"
+    "  --error PX       eps_img in pixels (default 0.5)\n"
+    "  --dir DIR        where the scenes are generated (default bench-scaling-scenes)\n"
+    "  --splinewalk B   the CLI that generates them (default: splinewalk beside this program)\n"
+    "  --csv FILE       the rows as CSV (default: none; written aside, then renamed)\n"
+    "  --svg FILE       the plot: log-x N, frame time and memory (default: none)\n"
+    "  -h, --help       this text\n";
+
+typedef struct args {
+    uint64_t min_n, max_n;
+    uint32_t frames, warmup, passes;
+    int32_t w, h;
+    double error_px;
+    const char *dir, *csv, *svg;
+    char splinewalk[PATH_MAX];
+} args;
+
+static int parse(int argc, char **argv, args *a)
+{
+    *a = (args){1000, 100000, 120, 1, 1, 1280, 720, 0.5, "bench-scaling-scenes", NULL, NULL, ""};
+    for (int i = 1; i < argc; ++i) {
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(o, "-h") || !strcmp(o, "--help"))
+            return 1;
+        if (!v)
+            return -1;
+        ++i;
+        if (!strcmp(o, "--min"))
+            a->min_n = strtoull(v, NULL, 10);
+        else if (!strcmp(o, "--max"))
+            a->max_n = strtoull(v, NULL, 10);
+        else if (!strcmp(o, "--frames"))
+            a->frames = (uint32_t)strtoul(v, NULL, 10);
+        else if (!strcmp(o, "--warmup"))
+            a->warmup = (uint32_t)strtoul(v, NULL, 10);
+        else if (!strcmp(o, "--passes"))
+            a->passes = (uint32_t)strtoul(v, NULL, 10);
+        else if (!strcmp(o, "--size") && sscanf(v, "%dx%d", &a->w, &a->h) == 2)
+            continue;
+        else if (!strcmp(o, "--error"))
+            a->error_px = strtod(v, NULL);
+        else if (!strcmp(o, "--dir"))
+            a->dir = v;
+        else if (!strcmp(o, "--splinewalk"))
+            snprintf(a->splinewalk, sizeof a->splinewalk, "%s", v);
+        else if (!strcmp(o, "--csv"))
+            a->csv = v;
+        else if (!strcmp(o, "--svg"))
+            a->svg = v;
+        else
+            return -1;
+    }
+    return a->min_n >= 100 && a->max_n >= a->min_n && a->max_n <= 10000000 && a->frames >= 2 &&
+                   a->frames <= 100000 && a->passes >= 1 && a->passes <= 100 &&
+                   a->warmup <= 100 && a->w > 0 && a->h > 0 && a->w <= 16384 &&
+                   a->h <= 16384 && a->error_px > 0.0 && isfinite(a->error_px)
+               ? 0
+               : -1;
+}
+
+/* splinewalk beside /proc/self/exe (both land in build/bin). */
+static int default_cli(char *out, size_t size)
+{
+    char self[PATH_MAX];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (n <= 0)
+        return -1;
+    self[n] = '\0';
+    return snprintf(out, size, "%s/splinewalk", dirname(self)) < (int)size ? 0 : -1;
+}
+
+/* DIR/building-N.sws, generated by the CLI unless it exists. Returns 0 or -1 (message printed). */
+static int scene_for(const args *a, uint64_t n, char *path, size_t size)
+{
+    snprintf(path, size, "%s/building-%llu.sws", a->dir, (unsigned long long)n);
+    if (access(path, R_OK) == 0)
+        return 0;
+    if (mkdir(a->dir, 0777) != 0 && errno != EEXIST) {
+        fprintf(stderr, "bench_scaling: %s: %s\n", a->dir, strerror(errno));
+        return -1;
+    }
+    char count[32];
+    snprintf(count, sizeof count, "%llu", (unsigned long long)n);
+    fprintf(stderr, "bench_scaling: generating %s\n", path);
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(STDERR_FILENO, STDOUT_FILENO); /* its report must not break the table */
+        char *const argv[] = {(char *)a->splinewalk, "generate", "building", "--surfaces", count,
+                              "--seed", "1", "-o", path, NULL};
+        execv(a->splinewalk, argv);
+        fprintf(stderr, "bench_scaling: %s: %s\n", a->splinewalk, strerror(errno));
+        _exit(127);
+    }
+    int status = 0;
+    if (pid < 0 || waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status)) {
+        fprintf(stderr, "bench_scaling: `%s generate building --surfaces %s -o %s` failed\n",
+                a->splinewalk, count, path);
+        return -1;
+    }
+    return 0;
+}
+
+static const char k_csv_header[] =
+    "surfaces,face_occurrences,scene_bytes,width,height,error_px,frames,median_ms,p99_ms,"
+    "first_frame_ms,peak_rss_bytes,triangles_per_frame\n";
+
+/* Writes text through a temporary file renamed over `path`. */
+static int write_csv(const char *path, const uint64_t *ns, const bp_result *r, uint32_t n,
+                     const args *a)
+{
+    char tmp[PATH_MAX + 32];
+    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return -1;
+    fputs(k_csv_header, f);
+    for (uint32_t i = 0; i < n; ++i)
+        fprintf(f, "%llu,%llu,%.0f,%d,%d,%g,%u,%.4f,%.4f,%.2f,%.0f,%.0f\n",
+                (unsigned long long)ns[i], (unsigned long long)r[i].faces, r[i].scene_bytes, a->w,
+                a->h, a->error_px, r[i].frames, r[i].median_ms, r[i].p99_ms, r[i].first_frame_ms,
+                r[i].peak_rss_bytes, r[i].triangles);
+    int bad = ferror(f) | fclose(f);
+    if (bad || rename(tmp, path) != 0) {
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+static int write_svg(const char *path, const uint64_t *ns, const bp_result *r, uint32_t n,
+                     const args *a)
+{
+    bs_point pts[16];
+    for (uint32_t i = 0; i < n; ++i)
+        pts[i] = (bs_point){(double)ns[i], r[i].median_ms, r[i].p99_ms,
+                            r[i].peak_rss_bytes / 1048576.0, r[i].scene_bytes / 1048576.0};
+    char title[256], tmp[PATH_MAX + 32];
+    snprintf(title, sizeof title,
+             "splinewalk: generated buildings, orbit of each box, %dx%d, eps %g px, threaded "
+             "walkthrough",
+             a->w, a->h, a->error_px);
+    snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
+    FILE *f = fopen(tmp, "w");
+    if (!f)
+        return -1;
+    int bad = bs_write_svg(f, pts, n, title) | ferror(f) | fclose(f);
+    if (bad || rename(tmp, path) != 0) {
+        remove(tmp);
+        return -1;
+    }
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    args a;
+    int pr = parse(argc, argv, &a);
+    if (pr != 0) {
+        fputs(k_usage, pr > 0 ? stdout : stderr);
+        return pr > 0 ? 0 : 2;
+    }
+    if (!a.splinewalk[0] && default_cli(a.splinewalk, sizeof a.splinewalk) != 0) {
+        fprintf(stderr, "bench_scaling: cannot find splinewalk beside this program; --splinewalk\n");
+        return 1;
+    }
+    const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
+    printf("bench_scaling: %dx%d, eps_img %g px, %u frames x %u counted passes after %u warm-up, "
+           "LP_NUM_THREADS=%s, EGL_PLATFORM=%s, %ld processors online\n",
+           a.w, a.h, a.error_px, a.frames, a.passes, a.warmup, lp ? lp : "(unset)",
+           egl ? egl : "(unset)", sysconf(_SC_NPROCESSORS_ONLN));
+    printf("  surfaces | occurrences | scene MB | frame ms: median     p99 | first (ms) | peak RSS "
+           "MB | triangles\n");
+    uint64_t ns[16];
+    bp_result res[16];
+    uint32_t n = 0;
+    int rc = 0;
+    for (uint64_t s = a.min_n; s <= a.max_n && n < 16; s *= 10) {
+        char scene[PATH_MAX];
+        if (scene_for(&a, s, scene, sizeof scene) != 0)
+            return 1;
+        bp_job job = {scene, NULL, NULL, a.frames, a.warmup, a.passes, a.w, a.h, a.error_px, {0}};
+        if (bp_run_in_child(bp_peer_splinewalk, &job, &res[n]) != 0) {
+            fprintf(stderr, "bench_scaling: %s: %s\n", scene, res[n].note);
+            rc = 1;
+            break;
+        }
+        const bp_result *r = &res[n];
+        printf("  %8llu | %11llu | %8.2f | %15.2f %7.2f | %10.0f | %11.1f | %9.0f\n",
+               (unsigned long long)s, (unsigned long long)r->faces, r->scene_bytes / 1048576.0,
+               r->median_ms, r->p99_ms, r->first_frame_ms, r->peak_rss_bytes / 1048576.0,
+               r->triangles);
+        fflush(stdout);
+        ns[n++] = s;
+    }
+    if (n > 1)
+        printf("  %llu / %llu surfaces: median frame time x%.2f, peak RSS x%.2f, scene bytes x%.2f\n",
+               (unsigned long long)ns[n - 1], (unsigned long long)ns[0],
+               res[n - 1].median_ms / res[0].median_ms,
+               res[n - 1].peak_rss_bytes / res[0].peak_rss_bytes,
+               res[n - 1].scene_bytes / res[0].scene_bytes);
+    if (n > 0 && a.csv && write_csv(a.csv, ns, res, n, &a) != 0) {
+        fprintf(stderr, "bench_scaling: %s: write failed\n", a.csv);
+        rc = 1;
+    }
+    if (n > 0 && a.svg && write_svg(a.svg, ns, res, n, &a) != 0) {
+        fprintf(stderr, "bench_scaling: %s: write failed\n", a.svg);
+        rc = 1;
+    }
+    return rc;
+}
