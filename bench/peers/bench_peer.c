@@ -78,6 +78,7 @@ int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out)
         snprintf(out->note, sizeof out->note, "pipe: %s", strerror(errno));
         return -1;
     }
+    double t0 = bp_now_ms();
     pid_t pid = fork();
     if (pid < 0) {
         snprintf(out->note, sizeof out->note, "fork: %s", strerror(errno));
@@ -104,6 +105,8 @@ int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out)
     int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
         ;
+    if (got == sizeof *out)
+        out->wall_ms = bp_now_ms() - t0;
     if (got != sizeof *out) {
         memset(out, 0, sizeof *out);
         if (WIFSIGNALED(status))

@@ -28,8 +28,11 @@ typedef struct bp_result {
     double scene_bytes;         /* splinewalk: sw_scene_info.memory_bytes; else 0 */
     uint64_t faces, refused_faces, refused_occurrences; /* GLU: faces it reported an error for */
     uint64_t gl_errors;         /* GLU: GL errors its fixed-function calls raised (drained) */
+    uint32_t crashed_faces;     /* GLU: of refused_faces, those that crashed it when screened */
+    double screen_ms;           /* GLU: the screening of every face (not in first_frame_ms) */
     double param;               /* OCCT: deflection used (object units); else 0 */
     double box[6];              /* bp_probe_scene: the scene's world box */
+    double wall_ms;             /* the parent's: the peer's process from fork to exit */
     double covered_px;          /* glu, occt: pixels drawn in the last frame (same shape?) */
     char note[640];
 } bp_result;

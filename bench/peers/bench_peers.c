@@ -36,8 +36,9 @@ static const char k_usage[] =
     "and the first frame), peak RSS (the child's VmHWM minus its resident memory at the fork),\n"
     "triangles per frame (median), and splinewalk / peer ratios of each; for glu and occt the\n"
     "pixels their last frame covered (read back once after the timed frames), to see that both\n"
-    "drew the same shape. Faces GLU reports an\n"
-    "error for are counted (column refused_faces) and not drawn after their first error.\n"
+    "drew the same shape. glu first tessellates every face once in child processes of its own\n"
+    "(Mesa's GLU crashes on a few faces; not counted in its time to first frame): faces it\n"
+    "reports an error for or crashes on are counted (refused_faces, crashed_faces), not drawn.\n"
     "Set LP_NUM_THREADS and EGL_PLATFORM=surfaceless yourself: the header line echoes them.\n"
     "\n"
     "options:\n"
@@ -168,31 +169,31 @@ static void print_row(const char *name, const bp_result *r, const bp_result *sw)
 static void print_notes(const bp_result res[N_PEERS], const int use[N_PEERS])
 {
     for (int p = 0; p < N_PEERS; ++p)
-        if (use[p] && res[p].ok && res[p].note[0])
-            printf("  %s: %s\n", k_peer_names[p], res[p].note);
+        if (use[p] && res[p].ok)
+            printf("  %s: %s%sits process ran %.1f s\n", k_peer_names[p], res[p].note,
+                   res[p].note[0] ? "; " : "", res[p].wall_ms / 1000.0);
     for (int p = PEER_GLU; p < N_PEERS; ++p)
         if (use[p] && res[p].ok)
             printf("  %s: %.0f pixels covered in the last frame\n", k_peer_names[p],
                    res[p].covered_px);
     if (use[PEER_GLU] && res[PEER_GLU].ok)
-        printf("  glu: %llu face occurrences, %llu faces refused (%llu occurrences), %llu GL errors "
-               "from GLU's fixed-function calls drained\n",
+        printf("  glu: %llu face occurrences; %llu GL errors from GLU's fixed-function calls "
+               "drained\n",
                (unsigned long long)res[PEER_GLU].faces,
-               (unsigned long long)res[PEER_GLU].refused_faces,
-               (unsigned long long)res[PEER_GLU].refused_occurrences,
                (unsigned long long)res[PEER_GLU].gl_errors);
 }
 
 static void csv_row(FILE *f, const char *scene, const args *a, const char *name,
                     const bp_result *r, const bp_result *sw)
 {
-    fprintf(f, "%s,%s,%d,%d,%g,%u,%d,%.4f,%.4f,%.2f,%.0f,%.0f,%.5g,%.5g,%.5g,%.5g,%.5g,%llu,%llu,%.6g,",
+    fprintf(f, "%s,%s,%d,%d,%g,%u,%d,%.4f,%.4f,%.2f,%.0f,%.0f,%.5g,%.5g,%.5g,%.5g,%.5g,%llu,%llu,%u,%.6g,",
             scene, name, a->w, a->h, a->error_px, r->frames, r->ok, r->median_ms, r->p99_ms,
             r->first_frame_ms, r->peak_rss_bytes, r->triangles,
             ratio(sw->median_ms, r->median_ms), ratio(sw->p99_ms, r->p99_ms),
             ratio(sw->first_frame_ms, r->first_frame_ms),
             ratio(sw->peak_rss_bytes, r->peak_rss_bytes), ratio(sw->triangles, r->triangles),
-            (unsigned long long)r->faces, (unsigned long long)r->refused_faces, r->param);
+            (unsigned long long)r->faces, (unsigned long long)r->refused_faces, r->crashed_faces,
+            r->param);
     if (r->covered_px > 0.0) /* glu, occt; splinewalk's frame is not read back: empty */
         fprintf(f, "%.0f", r->covered_px);
     fputc('\n', f);
@@ -201,7 +202,7 @@ static void csv_row(FILE *f, const char *scene, const args *a, const char *name,
 static const char k_csv_header[] =
     "scene,peer,width,height,error_px,frames,ok,median_ms,p99_ms,first_frame_ms,peak_rss_bytes,"
     "triangles_per_frame,ratio_median,ratio_p99,ratio_first_frame,ratio_peak_rss,"
-    "ratio_triangles,face_occurrences,refused_faces,occt_deflection,covered_px\n";
+    "ratio_triangles,face_occurrences,refused_faces,crashed_faces,occt_deflection,covered_px\n";
 
 /* Runs the peers on one scene; prints its table; appends CSV rows to csv (may be NULL). */
 static int run_scene(const args *a, const char *scene, FILE *csv)

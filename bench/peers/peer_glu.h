@@ -8,8 +8,11 @@
  * to one VBO and drawn with splinewalk's view-projection and glFinish (bench/tessellation's
  * bt_draw). GLU needs no GL context in tessellator mode; its few fixed-function calls
  * (glPushAttrib, ...) only raise errors in the 4.5 core context, which are drained and counted.
- * A face GLU reports an error for (its order above GLU's limit, a trim loop it rejects) is counted
- * as refused, with its first error, and not drawn in later frames.
+ * Mesa's GLU has no order limit that the samples reach (degree 12 surfaces, degree 11 trims
+ * pass), but it crashes on a few faces it accepts: every face is screened once in child processes
+ * (peer_glu.c says how) before the timed frames. A face GLU reports an error for ("knot
+ * multiplicity greater than order of spline", ...) or that crashed it is counted as refused, with
+ * its first error or signal, and not drawn.
  */
 #ifndef BP_PEER_GLU_H
 #define BP_PEER_GLU_H
