@@ -19,28 +19,28 @@
 
 /* One run along one path (all times in ms). Plain data: it crosses the child's pipe. */
 typedef struct bp_result {
-    int ok;                     /* 1: the peer ran; else `note` says why not */
-    uint32_t frames;            /* frames measured (warm-up passes excluded) */
-    double median_ms, p99_ms;   /* frame time: draw + glFinish, no readback */
-    double first_frame_ms;      /* load + preprocessing + the first frame, from the child's start */
-    double peak_rss_bytes;      /* child's VmHWM minus its VmRSS at the fork */
-    double triangles;           /* per frame, median over the measured frames */
-    double scene_bytes;         /* splinewalk: sw_scene_info.memory_bytes; else 0 */
+    int ok;                   /* 1: the peer ran; else `note` says why not */
+    uint32_t frames;          /* frames measured (warm-up passes excluded) */
+    double median_ms, p99_ms; /* frame time: draw + glFinish, no readback */
+    double first_frame_ms;    /* load + preprocessing + the first frame, from the child's start */
+    double peak_rss_bytes;    /* child's VmHWM minus its VmRSS at the fork */
+    double triangles;         /* per frame, median over the measured frames */
+    double scene_bytes;       /* splinewalk: sw_scene_info.memory_bytes; else 0 */
     uint64_t faces, refused_faces, refused_occurrences; /* GLU: faces it reported an error for */
-    uint64_t gl_errors;         /* GLU: GL errors its fixed-function calls raised (drained) */
-    uint32_t crashed_faces;     /* GLU: of refused_faces, those that crashed it when screened */
-    double screen_ms;           /* GLU: the screening of every face (not in first_frame_ms) */
-    double param;               /* OCCT: deflection used (object units); else 0 */
-    double box[6];              /* bp_probe_scene: the scene's world box */
-    double wall_ms;             /* the parent's: the peer's process from fork to exit */
-    double covered_px;          /* glu, occt: pixels drawn in the last frame (same shape?) */
+    uint64_t gl_errors;     /* GLU: GL errors its fixed-function calls raised (drained) */
+    uint32_t crashed_faces; /* GLU: of refused_faces, those that crashed it when screened */
+    double screen_ms;       /* GLU: the screening of every face (not in first_frame_ms) */
+    double param;           /* OCCT: deflection used (object units); else 0 */
+    double box[6];          /* bp_probe_scene: the scene's world box */
+    double wall_ms;         /* the parent's: the peer's process from fork to exit */
+    double covered_px;      /* glu, occt: pixels drawn in the last frame (same shape?) */
     char note[640];
 } bp_result;
 
 /* What a peer is given: scene, path, frame size, ε_img and the passes. */
 typedef struct bp_job {
-    const char *scene; /* what sw_scene_load reads (.sws, .brep, .step, .iges) */
-    const char *brep;  /* OCCT: the same geometry as BREP (NULL: none) */
+    const char *scene;             /* what sw_scene_load reads (.sws, .brep, .step, .iges) */
+    const char *brep;              /* OCCT: the same geometry as BREP (NULL: none) */
     const sw_rt_camera_path *path; /* NULL: an orbit of the scene's box made in the child */
     uint32_t frames, warmup_passes, passes;
     int32_t width, height;
@@ -57,7 +57,8 @@ int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out);
 
 /* Median and p99 of ms[0..n) (n >= 1) through sw_rt_profile_summarize. Returns 0 or -1 (memory). */
 int bp_summarize(const double *ms, uint32_t n, double *median, double *p99);
-/* The camera of frame i of job->frames along the path, fovy 0 resolved to 40 as the renderer does. */
+/* The camera of frame i of job->frames along the path, fovy 0 resolved to 40 as the renderer does.
+ */
 void bp_frame_camera(const bp_job *job, uint32_t i, sw_camera *out);
 /* The view splinewalk draws that frame with (near plane from the scene box, as gpu/draw.c). */
 int bp_frame_view(const bp_job *job, const sw_camera *cam, sw__gpu_view *out);

@@ -38,7 +38,9 @@ static const char k_usage[] =
     "pixels their last frame covered (read back once after the timed frames), to see that both\n"
     "drew the same shape. glu first tessellates every face once in child processes of its own\n"
     "(Mesa's GLU crashes on a few faces; not counted in its time to first frame): faces it\n"
-    "reports an error for or crashes on are counted (refused_faces, crashed_faces), not drawn.\n"
+    "reports an error for or crashes on are counted (refused_faces, crashed_faces), not drawn;\n"
+    "a glu frame longer than 120 s (GLU hangs on some faces in some views) ends the glu peer\n"
+    "with a message naming the face.\n"
     "Set LP_NUM_THREADS and EGL_PLATFORM=surfaceless yourself: the header line echoes them.\n"
     "\n"
     "options:\n"
@@ -183,17 +185,18 @@ static void print_notes(const bp_result res[N_PEERS], const int use[N_PEERS])
                (unsigned long long)res[PEER_GLU].gl_errors);
 }
 
-static void csv_row(FILE *f, const char *scene, const args *a, const char *name,
-                    const bp_result *r, const bp_result *sw)
+static void csv_row(FILE *f, const char *scene, const args *a, const char *name, const bp_result *r,
+                    const bp_result *sw)
 {
-    fprintf(f, "%s,%s,%d,%d,%g,%u,%d,%.4f,%.4f,%.2f,%.0f,%.0f,%.5g,%.5g,%.5g,%.5g,%.5g,%llu,%llu,%u,%.6g,",
-            scene, name, a->w, a->h, a->error_px, r->frames, r->ok, r->median_ms, r->p99_ms,
-            r->first_frame_ms, r->peak_rss_bytes, r->triangles,
-            ratio(sw->median_ms, r->median_ms), ratio(sw->p99_ms, r->p99_ms),
-            ratio(sw->first_frame_ms, r->first_frame_ms),
-            ratio(sw->peak_rss_bytes, r->peak_rss_bytes), ratio(sw->triangles, r->triangles),
-            (unsigned long long)r->faces, (unsigned long long)r->refused_faces, r->crashed_faces,
-            r->param);
+    fprintf(
+        f,
+        "%s,%s,%d,%d,%g,%u,%d,%.4f,%.4f,%.2f,%.0f,%.0f,%.5g,%.5g,%.5g,%.5g,%.5g,%llu,%llu,%u,%.6g,",
+        scene, name, a->w, a->h, a->error_px, r->frames, r->ok, r->median_ms, r->p99_ms,
+        r->first_frame_ms, r->peak_rss_bytes, r->triangles, ratio(sw->median_ms, r->median_ms),
+        ratio(sw->p99_ms, r->p99_ms), ratio(sw->first_frame_ms, r->first_frame_ms),
+        ratio(sw->peak_rss_bytes, r->peak_rss_bytes), ratio(sw->triangles, r->triangles),
+        (unsigned long long)r->faces, (unsigned long long)r->refused_faces, r->crashed_faces,
+        r->param);
     if (r->covered_px > 0.0) /* glu, occt; splinewalk's frame is not read back: empty */
         fprintf(f, "%.0f", r->covered_px);
     fputc('\n', f);
@@ -208,8 +211,11 @@ static const char k_csv_header[] =
 static int run_scene(const args *a, const char *scene, FILE *csv)
 {
     char brep_buf[4096], err[512];
-    bp_job job = {scene, a->brep ? a->brep : brep_for(scene, brep_buf, sizeof brep_buf), NULL,
-                  a->frames, a->warmup, a->passes, a->w, a->h, a->error_px, {0}};
+    bp_job job = {scene,       a->brep ? a->brep : brep_for(scene, brep_buf, sizeof brep_buf),
+                  NULL,        a->frames,
+                  a->warmup,   a->passes,
+                  a->w,        a->h,
+                  a->error_px, {0}};
     sw_rt_camera_path path;
     memset(&path, 0, sizeof path);
     if (bp_job_path(&job, a->path_file, &path, err, sizeof err) != 0) {

@@ -20,7 +20,8 @@
 #include <new>
 #include <vector>
 
-namespace {
+namespace
+{
 
 double ms_since(std::chrono::steady_clock::time_point t0)
 {
@@ -63,8 +64,8 @@ void append_face(const TopoDS_Face &face, std::vector<float> &v, std::vector<uin
 
 } // namespace
 
-extern "C" int bp_occt_mesh_brep(const char *path, double deflection, bp_occt_mesh *out,
-                                 char *err, size_t err_size)
+extern "C" int bp_occt_mesh_brep(const char *path, double deflection, bp_occt_mesh *out, char *err,
+                                 size_t err_size)
 {
     std::memset(out, 0, sizeof *out);
     try {

@@ -17,7 +17,7 @@ extern "C" {
 enum { BP_OCCT_VERTEX_FLOATS = 6 };
 
 typedef struct bp_occt_mesh {
-    float *v;      /* n_v * BP_OCCT_VERTEX_FLOATS, world space; malloc'd, free with bp_occt_mesh_free */
+    float *v; /* n_v * BP_OCCT_VERTEX_FLOATS, world space; malloc'd, free with bp_occt_mesh_free */
     uint32_t *idx; /* n_idx */
     size_t n_v, n_idx;
     uint64_t faces, faces_unmeshed; /* face occurrences; of them, left without a triangulation */

@@ -92,9 +92,9 @@ static int parse(int argc, char **argv, args *a)
             return -1;
     }
     return a->min_n >= 100 && a->max_n >= a->min_n && a->max_n <= 10000000 && a->frames >= 2 &&
-                   a->frames <= 100000 && a->passes >= 1 && a->passes <= 100 &&
-                   a->warmup <= 100 && a->w > 0 && a->h > 0 && a->w <= 16384 &&
-                   a->h <= 16384 && a->error_px > 0.0 && isfinite(a->error_px)
+                   a->frames <= 100000 && a->passes >= 1 && a->passes <= 100 && a->warmup <= 100 &&
+                   a->w > 0 && a->h > 0 && a->w <= 16384 && a->h <= 16384 && a->error_px > 0.0 &&
+                   isfinite(a->error_px)
                ? 0
                : -1;
 }
@@ -127,8 +127,16 @@ static int scene_for(const args *a, uint64_t n, char *path, size_t size)
     pid_t pid = fork();
     if (pid == 0) {
         dup2(STDERR_FILENO, STDOUT_FILENO); /* its report must not break the table */
-        char *const argv[] = {(char *)a->splinewalk, "generate", "building", "--surfaces", count,
-                              "--seed", "1", "-o", path, NULL};
+        char *const argv[] = {(char *)a->splinewalk,
+                              "generate",
+                              "building",
+                              "--surfaces",
+                              count,
+                              "--seed",
+                              "1",
+                              "-o",
+                              path,
+                              NULL};
         execv(a->splinewalk, argv);
         fprintf(stderr, "bench_scaling: %s: %s\n", a->splinewalk, strerror(errno));
         _exit(127);
@@ -202,7 +210,8 @@ int main(int argc, char **argv)
         return pr > 0 ? 0 : 2;
     }
     if (!a.splinewalk[0] && default_cli(a.splinewalk, sizeof a.splinewalk) != 0) {
-        fprintf(stderr, "bench_scaling: cannot find splinewalk beside this program; --splinewalk\n");
+        fprintf(stderr,
+                "bench_scaling: cannot find splinewalk beside this program; --splinewalk\n");
         return 1;
     }
     const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
@@ -235,11 +244,12 @@ int main(int argc, char **argv)
         ns[n++] = s;
     }
     if (n > 1)
-        printf("  %llu / %llu surfaces: median frame time x%.2f, peak RSS x%.2f, scene bytes x%.2f\n",
-               (unsigned long long)ns[n - 1], (unsigned long long)ns[0],
-               res[n - 1].median_ms / res[0].median_ms,
-               res[n - 1].peak_rss_bytes / res[0].peak_rss_bytes,
-               res[n - 1].scene_bytes / res[0].scene_bytes);
+        printf(
+            "  %llu / %llu surfaces: median frame time x%.2f, peak RSS x%.2f, scene bytes x%.2f\n",
+            (unsigned long long)ns[n - 1], (unsigned long long)ns[0],
+            res[n - 1].median_ms / res[0].median_ms,
+            res[n - 1].peak_rss_bytes / res[0].peak_rss_bytes,
+            res[n - 1].scene_bytes / res[0].scene_bytes);
     if (n > 0 && a.csv && write_csv(a.csv, ns, res, n, &a) != 0) {
         fprintf(stderr, "bench_scaling: %s: write failed\n", a.csv);
         rc = 1;

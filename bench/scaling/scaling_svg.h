@@ -10,7 +10,7 @@
 #include <stdio.h>
 
 typedef struct bs_point {
-    double n;                /* surfaces (x, > 0) */
+    double n;                 /* surfaces (x, > 0) */
     double median_ms, p99_ms; /* top panel */
     double rss_mb, scene_mb;  /* bottom panel */
 } bs_point;

@@ -150,8 +150,8 @@ static void upload(bt_draw *d, const float *v, size_t n_v, size_t stride, const 
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, bytes, (const void *)(3 * sizeof(float)));
 }
 
-unsigned bt_draw_upload(bt_draw *d, const float *v, size_t n_v, size_t stride,
-                        const uint32_t *idx, size_t n_idx)
+unsigned bt_draw_upload(bt_draw *d, const float *v, size_t n_v, size_t stride, const uint32_t *idx,
+                        size_t n_idx)
 {
     GLenum pending = glGetError();
     if (pending != GL_NO_ERROR)

@@ -24,8 +24,8 @@ unsigned bt_draw_mesh(bt_draw *d, const float view_proj[16], const float *v, siz
  * OCCT peer): bt_draw_upload fills the VBO and index buffer; bt_draw_uploaded clears, draws the
  * first n_idx indices of what was uploaded last and waits (glFinish). Each returns 0 or the first
  * GL error code (also one pending from before the call). */
-unsigned bt_draw_upload(bt_draw *d, const float *v, size_t n_v, size_t stride,
-                        const uint32_t *idx, size_t n_idx);
+unsigned bt_draw_upload(bt_draw *d, const float *v, size_t n_v, size_t stride, const uint32_t *idx,
+                        size_t n_idx);
 unsigned bt_draw_uploaded(bt_draw *d, const float view_proj[16], size_t n_idx);
 /* Clears pending GL errors and returns how many there were. GLU issues a few fixed-function calls
  * (glPushAttrib, glEnable(GL_MAP2_VERTEX_4), ...) even in tessellator mode; in a core context they
