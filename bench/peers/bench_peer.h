@@ -41,7 +41,8 @@ typedef struct bp_result {
 typedef struct bp_job {
     const char *scene;             /* what sw_scene_load reads (.sws, .brep, .step, .iges) */
     const char *brep;              /* OCCT: the same geometry as BREP (NULL: none) */
-    const sw_rt_camera_path *path; /* NULL: an orbit of the scene's box made in the child */
+    const sw_rt_camera_path *path; /* NULL: a stock path of the scene's box made in the child */
+    int fly; /* with path NULL: 0 = orbit (sw_rt_path_orbit), 1 = fly-through (sw_rt_path_fly) */
     uint32_t frames, warmup_passes, passes;
     int32_t width, height;
     double error_px;

@@ -211,11 +211,14 @@ static const char k_csv_header[] =
 static int run_scene(const args *a, const char *scene, FILE *csv)
 {
     char brep_buf[4096], err[512];
-    bp_job job = {scene,       a->brep ? a->brep : brep_for(scene, brep_buf, sizeof brep_buf),
-                  NULL,        a->frames,
-                  a->warmup,   a->passes,
-                  a->w,        a->h,
-                  a->error_px, {0}};
+    bp_job job = {.scene = scene,
+                  .brep = a->brep ? a->brep : brep_for(scene, brep_buf, sizeof brep_buf),
+                  .frames = a->frames,
+                  .warmup_passes = a->warmup,
+                  .passes = a->passes,
+                  .width = a->w,
+                  .height = a->h,
+                  .error_px = a->error_px};
     sw_rt_camera_path path;
     memset(&path, 0, sizeof path);
     if (bp_job_path(&job, a->path_file, &path, err, sizeof err) != 0) {

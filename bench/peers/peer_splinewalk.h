@@ -9,7 +9,8 @@
 
 #include "bench_peer.h"
 
-/* bp_peer_fn. With job->path NULL the orbit of the scene's box is made here, after the load
+/* bp_peer_fn. With job->path NULL the orbit (or, job->fly, the fly-through) of the scene's box is
+ * made here, after the load
  * (bench_scaling: the same relative path for every scene). */
 int bp_peer_splinewalk(const bp_job *job, bp_result *out);
 

@@ -1,6 +1,7 @@
 /* bench_scaling (issue 6): how splinewalk's frame time and memory grow with the scene — generated
  * buildings of N = 10^3, 10^4, 10^5 (10^6 with --max) surfaces, each drawn along the orbit of its
- * own box (the same relative path: the view composition stays, the detail grows), each in its own
+ * own box (the same relative path: the view composition stays, the detail grows; --fly: the low
+ * fly-through instead), each in its own
  * child process. The claim to test (ARCHITECTURE.md, "Scale"): cost grows with what is visible at
  * the required detail, not with the model's size. See k_usage.
  */
@@ -41,6 +42,8 @@ static const char k_usage[] =
     "  --passes P       counted passes (default 1)\n"
     "  --size WxH       frame size (default 1280x720)\n"
     "  --error PX       eps_img in pixels (default 0.5)\n"
+    "  --fly            the low fly-through `splinewalk path fly` makes for each box instead of\n"
+    "                   the orbit (what is visible then grows less than the scene)\n"
     "  --dir DIR        where the scenes are generated (default bench-scaling-scenes)\n"
     "  --splinewalk B   the CLI that generates them (default: splinewalk beside this program)\n"
     "  --csv FILE       the rows as CSV (default: none; written aside, then renamed)\n"
@@ -53,16 +56,21 @@ typedef struct args {
     int32_t w, h;
     double error_px;
     const char *dir, *csv, *svg;
+    int fly;
     char splinewalk[PATH_MAX];
 } args;
 
 static int parse(int argc, char **argv, args *a)
 {
-    *a = (args){1000, 100000, 120, 1, 1, 1280, 720, 0.5, "bench-scaling-scenes", NULL, NULL, ""};
+    *a = (args){1000, 100000, 120, 1, 1, 1280, 720, 0.5, "bench-scaling-scenes", NULL, NULL, 0, ""};
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "-h") || !strcmp(o, "--help"))
             return 1;
+        if (!strcmp(o, "--fly")) {
+            a->fly = 1;
+            continue;
+        }
         if (!v)
             return -1;
         ++i;
@@ -186,9 +194,9 @@ static int write_svg(const char *path, const uint64_t *ns, const bp_result *r, u
                             r[i].peak_rss_bytes / 1048576.0, r[i].scene_bytes / 1048576.0};
     char title[256], tmp[PATH_MAX + 32];
     snprintf(title, sizeof title,
-             "splinewalk: generated buildings, orbit of each box, %dx%d, eps %g px, threaded "
+             "splinewalk: generated buildings, %s of each box, %dx%d, eps %g px, threaded "
              "walkthrough",
-             a->w, a->h, a->error_px);
+             a->fly ? "fly-through" : "orbit", a->w, a->h, a->error_px);
     snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "w");
     if (!f)
@@ -215,10 +223,11 @@ int main(int argc, char **argv)
         return 1;
     }
     const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
-    printf("bench_scaling: %dx%d, eps_img %g px, %u frames x %u counted passes after %u warm-up, "
+    printf("bench_scaling: %s of each box, %dx%d, eps_img %g px, %u frames x %u counted passes "
+           "after %u warm-up, "
            "LP_NUM_THREADS=%s, EGL_PLATFORM=%s, %ld processors online\n",
-           a.w, a.h, a.error_px, a.frames, a.passes, a.warmup, lp ? lp : "(unset)",
-           egl ? egl : "(unset)", sysconf(_SC_NPROCESSORS_ONLN));
+           a.fly ? "fly-through" : "orbit", a.w, a.h, a.error_px, a.frames, a.passes, a.warmup,
+           lp ? lp : "(unset)", egl ? egl : "(unset)", sysconf(_SC_NPROCESSORS_ONLN));
     printf("  surfaces | occurrences | scene MB | frame ms: median     p99 | first (ms) | peak RSS "
            "MB | triangles\n");
     uint64_t ns[16];
@@ -229,7 +238,14 @@ int main(int argc, char **argv)
         char scene[PATH_MAX];
         if (scene_for(&a, s, scene, sizeof scene) != 0)
             return 1;
-        bp_job job = {scene, NULL, NULL, a.frames, a.warmup, a.passes, a.w, a.h, a.error_px, {0}};
+        bp_job job = {.scene = scene,
+                      .fly = a.fly,
+                      .frames = a.frames,
+                      .warmup_passes = a.warmup,
+                      .passes = a.passes,
+                      .width = a.w,
+                      .height = a.h,
+                      .error_px = a.error_px};
         if (bp_run_in_child(bp_peer_splinewalk, &job, &res[n]) != 0) {
             fprintf(stderr, "bench_scaling: %s: %s\n", scene, res[n].note);
             rc = 1;

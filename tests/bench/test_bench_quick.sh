@@ -42,7 +42,7 @@ done
 "$peers" --frames 1 tiny.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "bench_peers --frames 1: not 2"
 "$peers" --peers gl tiny.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "bench_peers --peers gl: not 2"
 "$scaling" --help >help.txt || fail "bench_scaling --help exit status"
-for opt in --min --max --frames --size --error --dir --splinewalk --csv --svg; do
+for opt in --min --max --frames --size --error --fly --dir --splinewalk --csv --svg; do
   grep -q -- "$opt" help.txt || fail "bench_scaling --help does not mention $opt"
 done
 "$scaling" --min 10 >/dev/null 2>&1; [ $? -eq 2 ] || fail "bench_scaling --min 10: not 2"
@@ -75,6 +75,10 @@ check_csv scaling.csv 2 surfaces face_occurrences scene_bytes frames median_ms p
   first_frame_ms peak_rss_bytes triangles_per_frame
 awk -F, 'NR == 2 { a = $3 } NR == 3 { b = $3 } END { exit !(b > a) }' scaling.csv \
   && pass "scene bytes grow with the surfaces" || fail "scene bytes do not grow with the surfaces"
+"$scaling" --fly --min 100 --max 100 --frames 3 --size 160x120 --dir scenes --csv fly.csv \
+  >fly.txt 2>&1 || { cat fly.txt; fail "bench_scaling --fly exit status"; }
+grep -q "fly-through" fly.txt || fail "bench_scaling --fly does not say it flies"
+check_csv fly.csv 1 surfaces median_ms p99_ms first_frame_ms peak_rss_bytes triangles_per_frame
 [ "$(grep -c '<polyline' scaling.svg)" -eq 4 ] && tail -n 1 scaling.svg | grep -q '</svg>' \
   && pass "scaling.svg: 4 lines, closed" || fail "scaling.svg malformed"
 
