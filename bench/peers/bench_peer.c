@@ -2,7 +2,7 @@
 #define _GNU_SOURCE
 #include "bench_peer.h"
 
-#include "sw_profile_report.h"
+#include "bench_stats.h"
 
 #include <errno.h>
 #include <math.h>
@@ -11,15 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
-
-double bp_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 /* A "VmHWM:" or "VmRSS:" line of /proc/self/status, in bytes (0 if absent). */
 static double proc_status_kb(const char *key)
@@ -78,7 +70,7 @@ int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out)
         snprintf(out->note, sizeof out->note, "pipe: %s", strerror(errno));
         return -1;
     }
-    double t0 = bp_now_ms();
+    double t0 = bench_now_ms();
     pid_t pid = fork();
     if (pid < 0) {
         snprintf(out->note, sizeof out->note, "fork: %s", strerror(errno));
@@ -106,7 +98,7 @@ int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out)
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
         ;
     if (got == sizeof *out)
-        out->wall_ms = bp_now_ms() - t0;
+        out->wall_ms = bench_now_ms() - t0;
     if (got != sizeof *out) {
         memset(out, 0, sizeof *out);
         if (WIFSIGNALED(status))
@@ -122,23 +114,14 @@ int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out)
 
 int bp_summarize(const double *ms, uint32_t n, double *median, double *p99)
 {
-    sw_rt_profile p;
-    memset(&p, 0, sizeof p);
-    for (uint32_t i = 0; i < n; ++i) {
-        sw_rt_prof_row row;
-        memset(&row, 0, sizeof row);
-        row.v[SW_RT_COL_FRAME] = i;
-        row.v[SW_RT_COL_FRAME_MS] = ms[i];
-        if (sw_rt_profile_push(&p, &row) != 0) {
-            sw_rt_profile_free(&p);
-            return -1;
-        }
-    }
-    int rc = sw_rt_profile_summarize(&p);
-    *median = p.summary[SW_RT_COL_FRAME_MS].median;
-    *p99 = p.summary[SW_RT_COL_FRAME_MS].p99;
-    sw_rt_profile_free(&p);
-    return rc;
+    double *v = malloc((size_t)n * sizeof *v); /* bench_quantile sorts */
+    if (!v)
+        return -1;
+    memcpy(v, ms, (size_t)n * sizeof *v);
+    *median = bench_quantile(v, (int)n, 0.5);
+    *p99 = bench_quantile(v, (int)n, 0.99);
+    free(v);
+    return 0;
 }
 
 void bp_frame_camera(const bp_job *job, uint32_t i, sw_camera *out)

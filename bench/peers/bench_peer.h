@@ -1,7 +1,7 @@
 /* bench/peers and bench/scaling (issue 6): what every peer of a side-by-side run shares — a
  * result record, running one peer in its own child process (fork) so that its peak resident
  * memory is its own (VmHWM of the child minus the resident memory it inherited at the fork), the
- * frame-time summary (median, p99: sw_rt_profile's percentiles, numpy's default), the camera of
+ * frame-time summary (median, p99: bench/common's bench_quantile), the camera of
  * frame i along a path and the matrices splinewalk's frame uses for it (gpu/camera.c). Nothing
  * here touches GL: the parent of the children never creates a context (EGL after fork is not
  * safe), each child creates its own.
@@ -13,6 +13,7 @@
 
 #include "sw_camera_path.h"
 #include "sw_gpu_internal.h"
+#include "bench_stats.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -43,6 +44,7 @@ typedef struct bp_job {
     const char *brep;              /* OCCT: the same geometry as BREP (NULL: none) */
     const sw_rt_camera_path *path; /* NULL: a stock path of the scene's box made in the child */
     int fly; /* with path NULL: 0 = orbit (sw_rt_path_orbit), 1 = fly-through (sw_rt_path_fly) */
+    int static_lods; /* splinewalk: sw_frame_desc.static_lods (Kumar et al. 1997 static LODs) */
     uint32_t frames, warmup_passes, passes;
     int32_t width, height;
     double error_px;
@@ -51,12 +53,12 @@ typedef struct bp_job {
 
 typedef int (*bp_peer_fn)(const bp_job *job, bp_result *out);
 
-double bp_now_ms(void);
 /* Runs fn(job, out) in a child process and fills *out from it (peak_rss_bytes measured there).
  * Returns 0, or -1 when the child could not run or died (out->note says how). */
 int bp_run_in_child(bp_peer_fn fn, const bp_job *job, bp_result *out);
 
-/* Median and p99 of ms[0..n) (n >= 1) through sw_rt_profile_summarize. Returns 0 or -1 (memory). */
+/* Median and p99 of ms[0..n) (n >= 1; not reordered) by bench_quantile. Returns 0 or -1 (memory).
+ */
 int bp_summarize(const double *ms, uint32_t n, double *median, double *p99);
 /* The camera of frame i of job->frames along the path, fovy 0 resolved to 40 as the renderer does.
  */

@@ -330,11 +330,11 @@ static uint32_t screen_from(glu_run *r, uint32_t first)
 
 static int screen_faces(glu_run *r)
 {
-    double t0 = bp_now_ms();
+    double t0 = bench_now_ms();
     for (uint32_t f = 0; f < r->n_faces;)
         if ((f = screen_from(r, f)) == UINT32_MAX)
             return -1;
-    r->screen_ms = bp_now_ms() - t0;
+    r->screen_ms = bench_now_ms() - t0;
     return 0;
 }
 
@@ -481,9 +481,9 @@ static int measure(glu_run *r, double t_start, bp_result *out)
         for (uint32_t i = 0; rc == 0 && i < job->frames; ++i) {
             int counted = p >= job->warmup_passes;
             size_t at = (size_t)(p - (counted ? job->warmup_passes : 0)) * job->frames + i;
-            double t0 = bp_now_ms();
+            double t0 = bench_now_ms();
             rc = frame(r, i, counted ? &tri[at] : &scratch_tri);
-            double t1 = bp_now_ms();
+            double t1 = bench_now_ms();
             if (p == 0 && i == 0) /* the screening is GLU's fault, not its preprocessing */
                 t_first = t1 - t_start - r->screen_ms;
             if (counted)
@@ -542,7 +542,7 @@ static void release(glu_run *r)
 
 int bp_peer_glu(const bp_job *job, bp_result *out)
 {
-    double t_start = bp_now_ms();
+    double t_start = bench_now_ms();
     sw_status st;
     memset(&st, 0, sizeof st);
     sw_scene_load_desc ld = {job->scene, NULL, NULL, NULL};

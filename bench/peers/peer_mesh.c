@@ -56,9 +56,9 @@ static int frames(const bp_job *job, bt_draw *d, size_t n_idx, double t_start, b
     int rc = 0;
     for (uint32_t p = 0; rc == 0 && p < job->warmup_passes + job->passes; ++p)
         for (uint32_t i = 0; rc == 0 && i < job->frames; ++i) {
-            double t0 = bp_now_ms();
+            double t0 = bench_now_ms();
             rc = draw_frame(job, d, i, n_idx);
-            double t1 = bp_now_ms();
+            double t1 = bench_now_ms();
             if (p == 0 && i == 0)
                 out->first_frame_ms = t1 - t_start;
             if (p >= job->warmup_passes)
@@ -74,7 +74,7 @@ static int frames(const bp_job *job, bt_draw *d, size_t n_idx, double t_start, b
 
 int bp_peer_occt(const bp_job *job, bp_result *out)
 {
-    double t_start = bp_now_ms();
+    double t_start = bench_now_ms();
     if (!job->brep) {
         snprintf(out->note, sizeof out->note, "no BREP of the scene");
         return -1;

@@ -21,6 +21,7 @@ static sw_frame_desc frame_at(const sw_run *r, uint32_t i)
     f.height = r->job.height;
     f.error_px = r->job.error_px;
     f.walkthrough = 1;
+    f.static_lods = r->job.static_lods;
     bp_frame_camera(&r->job, i, &f.camera);
     return f;
 }
@@ -34,7 +35,7 @@ static int pass(sw_run *r, double *ms, double *tri, double *t_first)
         return -1;
     for (uint32_t i = 0; i < r->job.frames; ++i) {
         sw_frame_stats fs;
-        double t0 = bp_now_ms();
+        double t0 = bench_now_ms();
         if (i + 1 < r->job.frames) {
             f = frame_at(r, i + 1);
             if (sw_renderer_prepare(r->renderer, &f, &r->st) != SW_OK)
@@ -42,7 +43,7 @@ static int pass(sw_run *r, double *ms, double *tri, double *t_first)
         }
         if (sw_renderer_submit(r->renderer, &fs, &r->st) != SW_OK)
             return -1;
-        double t1 = bp_now_ms();
+        double t1 = bench_now_ms();
         if (i == 0 && t_first)
             *t_first = t1;
         if (ms)
@@ -114,7 +115,7 @@ static int measure(sw_run *r, double t_start, bp_result *out)
 
 int bp_peer_splinewalk(const bp_job *job, bp_result *out)
 {
-    double t_start = bp_now_ms();
+    double t_start = bench_now_ms();
     sw_run r;
     memset(&r, 0, sizeof r);
     r.job = *job;
