@@ -5,6 +5,8 @@
  * The stages are those of runtime/src/api_render.c (renderer_cache) after the public API's load:
  *   open      sw_sg_scene_open: maps the .sws (nothing read yet)
  *   verify    sw_sg_scene_require(SW_SG_SEC_ALL): checksums and validation (touches every page)
+ *   stats     sw_sg_scene_compute_stats: what the public API's first acquire of a scene computes
+ *             (api_scene.c make_ready) before any frame: Bézier extraction of every face
  *   cache     sw_lod_cache_create: one slot per face, hierarchies built later on first sight
  *   bvh       sw_sg_bvh_build: every face occurrence (instances expanded)
  *   cones     sw_lod_face_cones_build: the back-patch cones of closed-shell faces
@@ -101,6 +103,13 @@ int main(int argc, char **argv)
     if (sw_sg_scene_require(scene, SW_SG_SEC_ALL, &st) != SW_OK)
         return fail("verify", &st);
     stage_end(&s, "verify", 0);
+    s = stage_begin();
+    sw_sg_scene_stats stats;
+    if (sw_sg_scene_compute_stats(scene, &stats) != SW_OK) {
+        fprintf(stderr, "scale_setup: stats: out of memory\n");
+        return 1;
+    }
+    stage_end(&s, "stats", 0);
     const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
     printf("  faces %u, nodes %u\n", v->n_faces, v->n_nodes);
 
