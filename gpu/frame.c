@@ -1160,14 +1160,43 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     return r;
 }
 
-/* Trim textures for every drawn trimmed face through the atlas (§4.4), scaled down together if
- * over the frame budget. */
-static sw_result make_trims(frame *f, sw_status *status)
+/* Atlas texels the frame's trims take at `scale`: their classes' footprints, gutters included. */
+static double trim_footprint(const frame *f, double scale)
+{
+    const int32_t max_entry = sw__gpu_atlas_max_entry(f->ctx), g2 = 2 * SW__GPU_ATLAS_GUTTER;
+    double sum = 0.0;
+    for (size_t i = 0; i < f->n_trims; ++i)
+        sum += (double)(sw__fr_class_texels(f->trims[i].width * scale, max_entry) + g2) *
+               (double)(sw__fr_class_texels(f->trims[i].height * scale, max_entry) + g2);
+    return sum;
+}
+
+/* The common scale of the wanted trim resolutions that keeps the frame's atlas footprints within
+ * k_max_frame_texels. The wanted texels alone are no bound: rounding up to classes and the gutters
+ * make the footprints up to ~4x larger (a 10^6-surface building wanted 3.4e8 texels, scaled to the
+ * budget, and still needed 5.7e8, more than the atlas holds). Each step shrinks the scale by at
+ * least 10 %; when every trim is at the smallest class the footprints cannot shrink further and the
+ * atlas reports the overflow. */
+static double trim_scale(const frame *f)
 {
     double total = 0.0;
     for (size_t i = 0; i < f->n_trims; ++i)
         total += f->trims[i].width * f->trims[i].height;
     double scale = total > k_max_frame_texels ? sqrt(k_max_frame_texels / total) : 1.0;
+    for (int step = 0; step < 64; ++step) {
+        const double foot = trim_footprint(f, scale);
+        if (foot <= k_max_frame_texels)
+            break;
+        scale *= fmin(0.9, sqrt(k_max_frame_texels / foot));
+    }
+    return scale;
+}
+
+/* Trim textures for every drawn trimmed face through the atlas (§4.4), scaled down together if
+ * over the frame budget. */
+static sw_result make_trims(frame *f, sw_status *status)
+{
+    const double scale = trim_scale(f);
     sw_result r = sw__gpu_atlas_begin(f->ctx, status);
     for (size_t i = 0; i < f->n_trims && r == SW_OK; ++i)
         r = make_trim(f, &f->trims[i], scale, status);

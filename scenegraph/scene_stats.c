@@ -25,6 +25,20 @@ static void box_add(double box[6], const double p[3])
     }
 }
 
+/* Whether the surface is one bilinear piece: degree 1 x 1, one span each way, equal weights. On
+ * any rectangle of its domain each coordinate is then bilinear in (u, v), so every sample of the
+ * grid below is a convex combination of the four corner samples, and the corners alone give the
+ * box. Most faces of generated buildings are such planes: sampling them on the full grid was most
+ * of the time a 10^6-surface building took before its first frame (sw_scene_get_info's stats are
+ * computed on a scene's first use). */
+static int is_bilinear(const sw_sg_surface *s)
+{
+    if (s->deg_u != 1 || s->deg_v != 1 || s->n_u != 2 || s->n_v != 2)
+        return 0;
+    const double w = s->cpw[3];
+    return s->cpw[7] == w && s->cpw[11] == w && s->cpw[15] == w;
+}
+
 /* The box of the face sampled on a grid over its trim box (uv_box), not of its control net: a
  * converted cylinder's net can reach far beyond the trimmed face (linkrods.step's box grew 7x),
  * which made camera presets frame a speck. A sampled box may miss a bulge between samples by a
@@ -38,9 +52,11 @@ static void face_sample_box(const sw_sg_scene *scene, uint32_t face, double box[
         box[r] = DBL_MAX;
         box[3 + r] = -DBL_MAX;
     }
-    for (int j = 0; j < SW__STATS_GRID; j++) {
+    /* the grid's corners only, for a bilinear face: the same box (see is_bilinear) */
+    const int step = is_bilinear(&s) ? SW__STATS_GRID - 1 : 1;
+    for (int j = 0; j < SW__STATS_GRID; j += step) {
         double v = f->uv_box[2] + (f->uv_box[3] - f->uv_box[2]) * j / (SW__STATS_GRID - 1);
-        for (int i = 0; i < SW__STATS_GRID; i++) {
+        for (int i = 0; i < SW__STATS_GRID; i += step) {
             double u = f->uv_box[0] + (f->uv_box[1] - f->uv_box[0]) * i / (SW__STATS_GRID - 1);
             double p[3];
             sw_sg_surface_eval(&s, u, v, p);
