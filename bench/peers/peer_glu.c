@@ -250,8 +250,12 @@ static int screen_one(glu_run *r, uint32_t f)
  * the result. 20 s and 2 GB per child at most: a hang or a runaway allocation is a crash too. */
 static void screen_child(glu_run *r, uint32_t first, int fd)
 {
+#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+    /* Under a sanitizer the shadow memory is address space: a limit would break its allocator
+     * ("Failed to mmap"); its own allocation limit then stops a runaway GLU instead. */
     struct rlimit lim = {(rlim_t)2 << 30, (rlim_t)2 << 30};
     setrlimit(RLIMIT_AS, &lim);
+#endif
     for (uint32_t f = first; f < r->n_faces; ++f) {
         alarm(20);
         int32_t msg[2] = {(int32_t)f, 0};
