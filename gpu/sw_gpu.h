@@ -101,6 +101,7 @@ typedef struct sw_gpu_frame_stats {
     double ms_trim;       /* trim-texture generation */
     double ms_draw;       /* draw submission until glFinish */
     double ms_readback;
+    double ms_gpu;        /* GPU time of trim textures + draw (two GL_TIMESTAMP queries) */
     /* trim-texture atlas (Guthe §4.4), kept in the context across frames */
     uint64_t atlas_pages;    /* pages (layers) after this frame */
     uint64_t atlas_texels;   /* texels of those pages */

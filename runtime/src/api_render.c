@@ -280,6 +280,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->ms_draw = g->ms_draw;
     out->ms_readback = g->ms_readback;
     out->faces_backculled = g->faces_backculled;
+    out->ms_gpu = g->ms_gpu;
     out->static_drawn = g->static_units_drawn;
     out->static_faces = g->static_faces;
     out->static_triangles = g->static_triangles;

@@ -78,6 +78,7 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_ATLAS_PAGES] = (double)st->atlas_pages;
     v[SW_RT_COL_FALLBACK_DRAWS] = (double)st->fallback_draws;
     v[SW_RT_COL_POOL_WAITS] = (double)st->pool_waits;
+    v[SW_RT_COL_GPU_MS] = st->ms_gpu;
     v[SW_RT_COL_STATIC_DRAWN] = (double)st->static_drawn;
     v[SW_RT_COL_STATIC_FACES] = (double)st->static_faces;
     v[SW_RT_COL_STATIC_TRIANGLES] = (double)st->static_triangles;
@@ -221,7 +222,7 @@ static void json_string(FILE *f, const char *s)
 static const char *kind_name(sw_rt_prof_kind k)
 {
     static const char *const names[] = {"index", "seconds",          "frame",
-                                        "stage", "visibility stage", "count"};
+                                        "stage", "visibility stage", "gpu",   "count"};
     _Static_assert(sizeof names / sizeof names[0] == SW_RT_KIND_COUNT + 1,
                    "a name per kind (SW_RT_KIND_COUNT, the count kind, is the last)");
     return names[k];
@@ -530,7 +531,7 @@ static void html_summary(FILE *f, const sw_rt_profile *p)
             continue;
         const sw_rt_prof_stat *s = &p->summary[c];
         const int ms = k_cols[c].kind == SW_RT_KIND_STAGE || k_cols[c].kind == SW_RT_KIND_FRAME ||
-                       k_cols[c].kind == SW_RT_KIND_VSTAGE;
+                       k_cols[c].kind == SW_RT_KIND_VSTAGE || k_cols[c].kind == SW_RT_KIND_GPU;
         const char *fmt = ms ? "<td>%.2f</td>" : "<td>%.0f</td>";
         fprintf(f, "<tr><td>%s</td>", k_cols[c].name);
         const double v[5] = {s->median, s->p90, s->p99, s->max, s->mean};

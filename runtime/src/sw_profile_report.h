@@ -51,6 +51,7 @@
     X(ATLAS_PAGES, "atlas_pages", COUNT, "trim-atlas pages after the frame")                       \
     X(FALLBACK_DRAWS, "fallback_draws", COUNT, "walkthrough: drawn coarser than asked, queued")    \
     X(POOL_WAITS, "pool_waits", COUNT, "times the frame waited for the worker pool")               \
+    X(GPU_MS, "gpu_ms", GPU, "GPU time of trim + draw (GL timer query; overlaps them)")         \
     X(STATIC_DRAWN, "static_drawn", COUNT, "super-surface instances drawn from static LODs")        \
     X(STATIC_FACES, "static_faces", COUNT, "face instances they cover (of faces_drawn)")           \
     X(STATIC_TRIANGLES, "static_triangles", COUNT, "their triangles (of triangles)")               \
@@ -72,6 +73,7 @@ typedef enum sw_rt_prof_kind {
     SW_RT_KIND_FRAME,
     SW_RT_KIND_STAGE,  /* on the submitting thread: the stages add up to frame_ms */
     SW_RT_KIND_VSTAGE, /* on the visibility thread (threaded runs): beside frame_ms, not in it */
+    SW_RT_KIND_GPU,    /* ms on the GPU (timer queries): overlaps the submitting thread's stages */
     SW_RT_KIND_COUNT
 } sw_rt_prof_kind;
 

@@ -246,6 +246,8 @@ typedef struct sw_frame_stats {
      * ms_total = ms_wait_visibility (waiting for the visibility thread) + trim + draw + readback
      * + write + the call's own overhead. Both 0 for sw_renderer_draw. */
     double ms_visibility, ms_wait_visibility;
+    double ms_gpu; /* GPU time of the trim textures and the draw, by a GL timer query (on
+                      llvmpipe: the rasterizer threads' work; it overlaps ms_trim + ms_draw) */
     uint64_t faces_backculled; /* of faces_culled: back-facing surfaces of closed shells (Kumar
                                   §4.4 back-patch culling by normal cones) */
     /* static LODs (desc.static_lods) */
