@@ -4,6 +4,7 @@
 #include "../tessellation/glu_nurbs.h"
 #include "../tessellation/vbo_draw.h"
 #include "sw_gpu.h"
+#include "sw_gpu_internal.h"
 #include "sw_rt.h"
 #include "sw_sg_scene.h"
 
@@ -54,21 +55,6 @@ typedef struct glu_run {
     char first_error[160], first_crash[160];
     int oom;
 } glu_run;
-
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap * 2 : 1024;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*p, c * elem);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
 
 static float *to_floats(const double *d, size_t n)
 {
@@ -161,8 +147,8 @@ static int visit(void *ctx, uint32_t face, const double m[12], const float color
     sw_sg_surface s;
     sw_sg_scene_face_surface(r->sg, face, &s);
     size_t n = (size_t)s.n_u * (size_t)s.n_v;
-    if (!grow((void **)&r->occ, &r->cap_occ, r->n_occ + 1, sizeof *r->occ) ||
-        !grow((void **)&r->world_cpw, &r->cap_world, r->n_world + 4 * n, sizeof(double))) {
+    if (!sw__gpu_grow((void **)&r->occ, &r->cap_occ, r->n_occ + 1, sizeof *r->occ) ||
+        !sw__gpu_grow((void **)&r->world_cpw, &r->cap_world, r->n_world + 4 * n, sizeof(double))) {
         r->oom = 1;
         return 1;
     }
@@ -182,9 +168,9 @@ static int visit(void *ctx, uint32_t face, const double m[12], const float color
 static int append_face(bt_glu_mesh *dst, const bt_glu_mesh *src)
 {
     size_t base = dst->n_v;
-    if (!grow((void **)&dst->v, &dst->cap_v, (dst->n_v + src->n_v) * BT_GLU_VERTEX_FLOATS,
+    if (!sw__gpu_grow((void **)&dst->v, &dst->cap_v, (dst->n_v + src->n_v) * BT_GLU_VERTEX_FLOATS,
               sizeof(float)) ||
-        !grow((void **)&dst->idx, &dst->cap_idx, dst->n_idx + src->n_idx, sizeof(uint32_t)))
+        !sw__gpu_grow((void **)&dst->idx, &dst->cap_idx, dst->n_idx + src->n_idx, sizeof(uint32_t)))
         return -1;
     memcpy(dst->v + base * BT_GLU_VERTEX_FLOATS, src->v,
            src->n_v * BT_GLU_VERTEX_FLOATS * sizeof(float));
@@ -206,7 +192,7 @@ static int append_face(bt_glu_mesh *dst, const bt_glu_mesh *src)
 static int fitted_points(glu_run *r, const sw_sg_surface *s)
 {
     size_t n = (size_t)s->n_u * (size_t)s->n_v;
-    if (!grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
+    if (!sw__gpu_grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
         return -1;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < n; ++i)
@@ -398,7 +384,7 @@ static int tessellate_occurrence(glu_run *r, size_t k, const sw__gpu_view *view)
     sw_sg_surface s;
     sw_sg_scene_face_surface(r->sg, o->face, &s);
     size_t n = (size_t)s.n_u * (size_t)s.n_v;
-    if (!grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
+    if (!sw__gpu_grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
         return -1;
     const double *w = r->world_cpw + o->cpw;
     for (size_t i = 0; i < n; ++i) { /* eye-relative: w * (x - eye) */
