@@ -81,6 +81,23 @@ static void occurrence_box(const frame *f, const occurrence *o, double box[6])
     }
 }
 
+/* An upper bound of the spectral norm of the occurrence's linear part, sqrt(|M|_1 |M|_inf): 1 for
+ * a rigid transform (the Frobenius norm would give sqrt(3) and make every tolerance 1.7x tighter). */
+double sw__fr_stretch_bound(const double m[12])
+{
+    double col = 0.0, row = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        double c = 0.0, r = 0.0;
+        for (int j = 0; j < 3; ++j) {
+            c += fabs(m[4 * j + i]);
+            r += fabs(m[4 * i + j]);
+        }
+        col = fmax(col, c);
+        row = fmax(row, r);
+    }
+    return sqrt(col * row);
+}
+
 double sw__fr_det3(const double m[12])
 {
     return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +
@@ -1354,7 +1371,6 @@ static sw_result plan_init(sw_gpu_frame_plan *p, sw_gpu_context *ctx, const sw_s
     f->walkthrough = p->desc.walkthrough != 0;
     f->statics = p->desc.static_lods;
     f->static_force = p->desc.static_force;
-    f->static_delta = p->desc.static_delta;
     f->lod_colors = p->desc.lod_colors != 0;
     if (f->statics && sw_lod_static_set_scene(f->statics) != scene)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,

@@ -54,7 +54,7 @@ typedef struct hl_face {
     frame *f;
     const occurrence *o;
     const sw_lod_hierarchy *h;
-    double scale; /* bounds the occurrence transform's stretch (stretch_bound) */
+    double scale; /* bounds the occurrence transform's stretch (sw__fr_stretch_bound) */
     int trimmed;
     hl_item *stack;
     size_t n_stack, cap_stack;
@@ -65,23 +65,6 @@ typedef struct hl_face {
     size_t n_refine, cap_refine, cap_refine_tol;
     int oom;
 } hl_face;
-
-/* An upper bound of the spectral norm of the occurrence's linear part, sqrt(|M|_1 |M|_inf): 1 for
- * a rigid transform (the Frobenius norm would give sqrt(3) and make every tolerance 1.7x tighter). */
-static double stretch_bound(const double m[12])
-{
-    double col = 0.0, row = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        double c = 0.0, r = 0.0;
-        for (int j = 0; j < 3; ++j) {
-            c += fabs(m[4 * j + i]);
-            r += fabs(m[4 * i + j]);
-        }
-        col = fmax(col, c);
-        row = fmax(row, r);
-    }
-    return sqrt(col * row);
-}
 
 static void item_rect(const sw_lod_hnode *n, const double range[4], double out[4])
 {
@@ -287,7 +270,7 @@ static void hl_face_init(hl_face *hf, frame *f, const occurrence *o, const sw_lo
     hf->f = f;
     hf->o = o;
     hf->h = h;
-    hf->scale = stretch_bound(o->world);
+    hf->scale = sw__fr_stretch_bound(o->world);
     const sw_sg_face_rec *rec = &f->sv->faces[o->face];
     hf->trimmed = (rec->flags & SW_SG_FACE_TRIMMED) && rec->n_loops > 0;
 }

@@ -102,7 +102,6 @@ typedef struct frame {
     /* static LODs (frame_static.c; NULL: every face by the per-frame path) */
     struct sw_lod_static_set *statics;
     int32_t static_force; /* desc.static_force */
-    double static_delta;  /* δ the set's chains are built with (0: per unit) */
     int lod_colors;       /* desc.lod_colors */
 } frame;
 
@@ -117,6 +116,8 @@ void sw__fr_xform_h(const double m[12], const double eye[3], const double in[4],
 void sw__fr_box_empty(double box[6]);
 void sw__fr_box_add(double box[6], const double h[4]); /* adds the point h / h[3] */
 double sw__fr_det3(const double m[12]);
+/* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm, 1 for a rigid one. */
+double sw__fr_stretch_bound(const double m[12]);
 /* A draw record for mesh indices from first_idx on (or for patch records pointing at it); a
  * trimmed one also gets a pending trim texture of the face's whole trim box, with `need` texels. */
 sw_result sw__fr_add_draw(frame *f, const occurrence *o, size_t first_idx, int trimmed,

@@ -10,8 +10,8 @@
  * plane) and tangents within the frustum's corner, so a level within
  *     ε_world = ε_img z_min / (focal_px sqrt(1 + tan_corner^2))
  * of the exact surface is within ε_img pixels wherever it shows; in the faces' object space that
- * is ε_world / s, s an upper bound of the instance transform's stretch (exact for similarities,
- * the Frobenius norm otherwise). Kumar §4.4 measures the distance to the bounding box's centre
+ * is ε_world / s, s the bound of the instance transform's stretch the hierarchy path uses too
+ * (sw__fr_stretch_bound: 1 for a rigid one). Kumar §4.4 measures the distance to the box's centre
  * ("the distance of the super-surface from the viewer"): it is no bound for a large unit seen
  * from close by, so we take the box's nearest depth.
  *
@@ -54,28 +54,6 @@ void sw__fr_lod_color(int32_t level, float out[4])
     memcpy(out, c, 4 * sizeof *out);
 }
 
-/* Upper bound of |M x| / |x| for the 3x3 part of the row-major 3x4 m. */
-static double stretch_bound(const double m[12])
-{
-    double g[3][3], fro = 0.0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) {
-            g[i][j] = 0.0;
-            for (int k = 0; k < 3; ++k)
-                g[i][j] += m[4 * k + i] * m[4 * k + j];
-            fro += m[4 * i + j] * m[4 * i + j];
-        }
-    const double s2 = g[0][0];
-    double off = 0.0;
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-            off = fmax(off, fabs(g[i][j] - (i == j ? s2 : 0.0)));
-    /* M^T M = s^2 I (a similarity) up to rounding: s is exact, with the rounding as margin */
-    if (off <= 1e-12 * s2)
-        return sqrt(s2) * (1.0 + 1e-9);
-    return sqrt(fro);
-}
-
 /* Eye-relative world box of the unit's object box under the occurrence's transform. */
 static void unit_eye_box(const frame *f, const double obj[6], const double m[12], double out[6])
 {
@@ -100,17 +78,7 @@ static double unit_tolerance(const frame *f, const sw_lod_static_unit *un, const
     const double diag = sqrt((eb[3] - eb[0]) * (eb[3] - eb[0]) + (eb[4] - eb[1]) * (eb[4] - eb[1]) +
                              (eb[5] - eb[2]) * (eb[5] - eb[2]));
     *extent_px = diag * f->view.focal_px * sqrt(1.0 + t * t) / z;
-    return f->eps_px * z / (f->view.focal_px * sqrt(1.0 + t * t)) / stretch_bound(m);
-}
-
-/* δ the unit's level 0 is built with (the builder's default when the desc leaves it 0). */
-static double unit_delta(const sw_lod_static_unit *un, double desc_delta)
-{
-    if (desc_delta > 0.0)
-        return desc_delta;
-    return 1e-3 * sqrt((un->box[3] - un->box[0]) * (un->box[3] - un->box[0]) +
-                       (un->box[4] - un->box[1]) * (un->box[4] - un->box[1]) +
-                       (un->box[5] - un->box[2]) * (un->box[5] - un->box[2]));
+    return f->eps_px * z / (f->view.focal_px * sqrt(1.0 + t * t)) / sw__fr_stretch_bound(m);
 }
 
 /* A static level is drawn only when it has at most this many triangles per Bézier patch: its
@@ -179,7 +147,7 @@ static int32_t choose_level(frame *f, uint32_t unit, const double m[12],
         *chain = c;
         return k == n_valid ? -1 : (int32_t)k;
     }
-    if (unit_delta(un, f->static_delta) > tol)
+    if (un->delta > tol)
         return -1; /* not even level 0 would do: do not build it for this view */
     const sw_lod_static_chain *c = unit_chain(f, unit);
     if (!c)

@@ -79,7 +79,6 @@ typedef struct sw_gpu_frame_desc {
                               level within the view's tolerance at its nearest point, built in
                               the pool on first need (walkthrough: queued, drawn per frame
                               meanwhile; converged: waited for). Ignored with eval_exact */
-    double static_delta;  /* δ of the set's level 0 (its desc's levels.delta; 0: per unit) */
     int32_t static_force; /* tests of the joins: k > 0 draws unit i at choice (i + k) mod
                              (n + 1) among its n levels within the view's tolerance, the last
                              choice meaning the per-frame path: neighbours at different levels,

@@ -1561,16 +1561,20 @@ static int on_level(void *ctx, int32_t level, const uint32_t *tri, uint32_t n_tr
     return b->r != SW_OK;
 }
 
+double sw_lod_static_default_delta(const double box[6])
+{
+    const double d = 1e-3 * sqrt((box[3] - box[0]) * (box[3] - box[0]) +
+                                 (box[4] - box[1]) * (box[4] - box[1]) +
+                                 (box[5] - box[2]) * (box[5] - box[2]));
+    return d > 0.0 ? d : 1e-12; /* a super-surface collapsed to a point */
+}
+
 static sw_result desc_defaults(const sw_lod_static_desc *in, const patch_set *ps,
                                sw_lod_static_desc *d, sw_status *status)
 {
     *d = in ? *in : (sw_lod_static_desc){0};
     if (d->delta == 0.0)
-        d->delta = 1e-3 * sqrt((ps->box[3] - ps->box[0]) * (ps->box[3] - ps->box[0]) +
-                               (ps->box[4] - ps->box[1]) * (ps->box[4] - ps->box[1]) +
-                               (ps->box[5] - ps->box[2]) * (ps->box[5] - ps->box[2]));
-    if (d->delta == 0.0)
-        d->delta = 1e-12; /* a super-surface collapsed to a point */
+        d->delta = sw_lod_static_default_delta(ps->box);
     if (d->n_levels == 0)
         d->n_levels = 4;
     else if (d->n_levels == -1)

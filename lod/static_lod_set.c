@@ -177,6 +177,7 @@ static sw_result unit_boxes(sw_lod_static_set *s, sw_status *status)
                 box_add_net(un->box, &set.patches[k]);
             sw_sg_bezier_set_free(&set);
         }
+        un->delta = s->levels.delta > 0.0 ? s->levels.delta : sw_lod_static_default_delta(un->box);
     }
     return SW_OK;
 }

@@ -84,6 +84,10 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                               sw_status *status);
 void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
 
+/* The δ of level 0 when the desc leaves it 0: 1e-3 x the diagonal of `box` (the patches'
+ * control-point box), 1e-12 for an empty one. */
+double sw_lod_static_default_delta(const double box[6]);
+
 /* Bytes the chain owns. */
 size_t sw_lod_static_memory(const sw_lod_static_chain *chain);
 

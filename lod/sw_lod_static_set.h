@@ -48,6 +48,7 @@ typedef struct sw_lod_static_unit {
     uint32_t first_face, n_faces;     /* into sw_lod_static_set_faces() */
     uint32_t first_patch, n_patches;  /* into sw_lod_static_set_patches() */
     double box[6];                    /* object-space box of its cut Bézier nets: lo xyz, hi xyz */
+    double delta;                     /* δ its level 0 is built with (known before the build) */
 } sw_lod_static_unit;
 
 /* Zero fields take the defaults of each part. */

@@ -1,7 +1,8 @@
 /* The static-LOD set and its cache (lod/sw_lod_static_set.h, lod/static_lod_io.c; issue 4:
  * "cached in the .sws file by splinewalk build-lod"):
  *  - units partition the faces: every face with patches in exactly one unit, each unit's patches
- *    exactly its faces' patches of the clustering, its box holding every vertex of its chain;
+ *    exactly its faces' patches of the clustering, its box holding every vertex of its chain, its
+ *    δ (which the frame reads before any build) the one its chain was built with;
  *  - every level of every unit (super-surfaces of several faces, as the frame draws them) within
  *    its declared ε_k both ways, by a measurement independent of the one that declared it (random
  *    points, another seed, other counts); zero violations;
@@ -45,6 +46,8 @@ static void check_units(const sw_lod_static_set *set, const sw_sg_scene *scene)
         }
         patches += un->n_patches;
         const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
+        CHECK(!c || c->delta == un->delta, "unit %u: built with δ %.17g, the frame expects %.17g",
+              u, c ? c->delta : 0.0, un->delta);
         for (int32_t k = 0; c && k < c->n_levels; ++k)
             for (uint32_t v = 0; v < c->levels[k].n_vertices; ++v)
                 for (int a = 0; a < 3; ++a) {
