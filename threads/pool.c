@@ -30,6 +30,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 enum {
@@ -72,6 +73,7 @@ typedef struct worker {
     /* Written by the owner only (load + store), read by sw_th_pool_stats_get. */
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t executed;
     _Atomic uint64_t cancelled, steals, stolen, sleeps;
+    _Atomic uint64_t kind_executed[SW_TH_TASK_KIND_COUNT], kind_ns[SW_TH_TASK_KIND_COUNT];
 } worker;
 
 struct sw_th_pool {
@@ -87,6 +89,8 @@ struct sw_th_pool {
     alignas(SW_TH_CACHE_LINE) _Atomic(node *) spare[SPARE_SLOTS];
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t ext_executed;
     _Atomic uint64_t ext_cancelled, ext_steals;
+    _Atomic uint64_t ext_kind_executed[SW_TH_TASK_KIND_COUNT], ext_kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic int time_tasks; /* read per task (relaxed): a switch, it orders nothing */
     pthread_mutex_t lock;
     pthread_cond_t wake_cond;
     int wakes; /* under lock */
@@ -94,6 +98,9 @@ struct sw_th_pool {
 
 static _Thread_local worker *tls_worker;
 static _Thread_local uint64_t tls_rng;
+/* Time of the timed tasks that ran nested in the calling thread's current task (in
+ * sw_th_group_wait), subtracted from its own; see timed_run. */
+static _Thread_local uint64_t tls_nested_ns;
 
 static void cpu_relax(void)
 {
@@ -396,6 +403,45 @@ static void group_release(sw_th_pool *pool, sw_th_group *g)
     pthread_mutex_unlock(&pool->lock);
 }
 
+static uint64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+/* Runs t and returns its own time: its wall time minus that of the timed tasks it ran nested
+ * (a task waiting on a group runs others meanwhile), so that the kinds' times add up to the
+ * thread's busy time instead of counting nested work twice. */
+static uint64_t timed_run(const sw_th_task *t)
+{
+    const uint64_t outer = tls_nested_ns;
+    tls_nested_ns = 0;
+    const uint64_t t0 = now_ns();
+    t->fn(t->ctx);
+    const uint64_t wall = now_ns() - t0;
+    const uint64_t own = wall > tls_nested_ns ? wall - tls_nested_ns : 0;
+    tls_nested_ns = outer + wall;
+    return own;
+}
+
+/* Counts a task that ran: on the worker's single-writer counters, or (a thread outside the pool
+ * waiting on a group) on the pool's shared ones. */
+static void count_executed(sw_th_pool *pool, worker *w, sw_th_task_kind kind, uint64_t ns)
+{
+    if (w) {
+        bump(&w->executed, 1);
+        bump(&w->kind_executed[kind], 1);
+        if (ns)
+            bump(&w->kind_ns[kind], ns);
+        return;
+    }
+    atomic_fetch_add_explicit(&pool->ext_executed, 1, memory_order_relaxed);
+    atomic_fetch_add_explicit(&pool->ext_kind_executed[kind], 1, memory_order_relaxed);
+    if (ns)
+        atomic_fetch_add_explicit(&pool->ext_kind_ns[kind], ns, memory_order_relaxed);
+}
+
 static void run_node(sw_th_pool *pool, worker *w, node *n)
 {
     sw_th_task t = n->task;
@@ -403,13 +449,20 @@ static void run_node(sw_th_pool *pool, worker *w, node *n)
     /* acquire: pairs with the release increment in sw_th_token_cancel. */
     bool stale =
         t.token && atomic_load_explicit(&t.token->generation, memory_order_acquire) != t.generation;
-    if (!stale)
-        t.fn(t.ctx);
-    if (w)
-        bump(stale ? &w->cancelled : &w->executed, 1);
-    else
-        atomic_fetch_add_explicit(stale ? &pool->ext_cancelled : &pool->ext_executed, 1,
-                                  memory_order_relaxed);
+    if (stale) {
+        if (w)
+            bump(&w->cancelled, 1);
+        else
+            atomic_fetch_add_explicit(&pool->ext_cancelled, 1, memory_order_relaxed);
+    } else {
+        uint64_t ns = 0;
+        /* relaxed: a switch; a task that starts just after it flips may go either way */
+        if (atomic_load_explicit(&pool->time_tasks, memory_order_relaxed))
+            ns = timed_run(&t);
+        else
+            t.fn(t.ctx);
+        count_executed(pool, w, t.kind, ns);
+    }
     if (t.group)
         group_release(pool, t.group);
 }
@@ -618,6 +671,7 @@ sw_result sw_th_pool_create(const sw_th_pool_desc *desc, sw_th_pool **out)
     pool->count = d.worker_count;
     pool->mode = d.steal_mode;
     pool->spin_rounds = d.spin_rounds;
+    atomic_store_explicit(&pool->time_tasks, d.time_tasks != 0, memory_order_relaxed);
     for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++) {
         inject_queue *q = &pool->inject[p];
         atomic_init(&q->head, &q->stub);
@@ -656,6 +710,7 @@ sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task)
 {
     assert(pool && task && task->fn);
     assert((unsigned)task->priority < SW_TH_PRIORITY_COUNT);
+    assert((unsigned)task->kind < SW_TH_TASK_KIND_COUNT);
     worker *w = own_worker(pool);
     node *n = node_alloc(pool, w);
     if (!n)
@@ -749,9 +804,51 @@ void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out)
         out->steals += atomic_load_explicit(&w->steals, memory_order_relaxed);
         out->stolen_tasks += atomic_load_explicit(&w->stolen, memory_order_relaxed);
         out->sleeps += atomic_load_explicit(&w->sleeps, memory_order_relaxed);
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+            out->executed_by_kind[k] +=
+                atomic_load_explicit(&w->kind_executed[k], memory_order_relaxed);
+            out->ns_by_kind[k] += atomic_load_explicit(&w->kind_ns[k], memory_order_relaxed);
+        }
+    }
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        out->executed_by_kind[k] +=
+            atomic_load_explicit(&pool->ext_kind_executed[k], memory_order_relaxed);
+        out->ns_by_kind[k] += atomic_load_explicit(&pool->ext_kind_ns[k], memory_order_relaxed);
     }
     out->executed += atomic_load_explicit(&pool->ext_executed, memory_order_relaxed);
     out->cancelled += atomic_load_explicit(&pool->ext_cancelled, memory_order_relaxed);
     out->steals += atomic_load_explicit(&pool->ext_steals, memory_order_relaxed);
     out->stolen_tasks += atomic_load_explicit(&pool->ext_steals, memory_order_relaxed);
+}
+
+void sw_th_pool_set_task_timing(sw_th_pool *pool, int on)
+{
+    atomic_store_explicit(&pool->time_tasks, on != 0, memory_order_relaxed);
+}
+
+int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRIORITY_COUNT])
+{
+    int64_t total = 0;
+    for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++) {
+        /* relaxed: a statistic; the count of an injection queue may run ahead of its links
+         * (incremented before linking), which is what "submitted, not yet taken" means */
+        int64_t n = atomic_load_explicit(&pool->inject[p].count, memory_order_relaxed);
+        n = n > 0 ? n : 0;
+        for (uint32_t i = 0; i < pool->count; i++)
+            n += sw_th_deque_size_estimate(&pool->workers[i].deques[p]);
+        if (by_priority)
+            by_priority[p] = n;
+        total += n;
+    }
+    return total;
+}
+
+const char *sw_th_task_kind_name(sw_th_task_kind kind)
+{
+    static const char *const names[SW_TH_TASK_KIND_COUNT] = {
+#define SW_TH__KIND_NAME(a, id, name, what) name,
+        SW_TH_TASK_KINDS(SW_TH__KIND_NAME, ~)
+#undef SW_TH__KIND_NAME
+    };
+    return (unsigned)kind < SW_TH_TASK_KIND_COUNT ? names[kind] : "?";
 }

@@ -143,7 +143,8 @@ static void retire_statics(sw_rt_renderer *r)
     if (rs) {
         *rs = (retired_statics){set, r->cache_scene};
         sw_rt_scene_retain(r->cache_scene);
-        const sw_th_task task = {retire_statics_task, rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL};
+        const sw_th_task task = {retire_statics_task, rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
+                                 NULL, SW_TH_TASK_STATIC_RETIRE};
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;
         sw_rt_scene_release(r->cache_scene);
@@ -380,7 +381,7 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
     int expect = 0;
     if (atomic_compare_exchange_strong(&r->statics_state, &expect, 1)) {
         const sw_th_task task = {statics_task, r, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
-                                 &r->statics_group};
+                                 &r->statics_group, SW_TH_TASK_STATIC_CLUSTER};
         if (sw_th_pool_submit(r->pool, &task) != SW_OK) {
             atomic_store(&r->statics_state, 0);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: could not submit");
