@@ -90,7 +90,9 @@ struct sw_th_pool {
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t ext_executed;
     _Atomic uint64_t ext_cancelled, ext_steals;
     _Atomic uint64_t ext_kind_executed[SW_TH_TASK_KIND_COUNT], ext_kind_ns[SW_TH_TASK_KIND_COUNT];
-    _Atomic int time_tasks; /* read per task (relaxed): a switch, it orders nothing */
+    _Atomic int time_tasks;      /* read per task (relaxed): a switch, it orders nothing */
+    _Atomic int64_t inject_peak; /* longest injection queue a submission made since the last
+                                    sw_th_pool_inject_peak_take */
     pthread_mutex_t lock;
     pthread_cond_t wake_cond;
     int wakes; /* under lock */
@@ -202,12 +204,26 @@ static void inject_link(inject_queue *q, node *n)
     atomic_store_explicit(&prev->next, n, memory_order_release);
 }
 
-static void inject_push(inject_queue *q, node *n)
+/* Returns the queue's length with n (its count just after the increment). */
+static int64_t inject_push(inject_queue *q, node *n)
 {
     /* seq_cst, and before linking: a worker about to sleep that sees count > 0 keeps searching
      * (the Dekker pair of the sleep protocol, file comment). */
-    atomic_fetch_add_explicit(&q->count, 1, memory_order_seq_cst);
+    const int64_t len = atomic_fetch_add_explicit(&q->count, 1, memory_order_seq_cst) + 1;
     inject_link(q, n);
+    return len;
+}
+
+/* Raises inject_peak to len. relaxed: a statistic; the load first, so a submitter writes the
+ * shared line only while the queue grows past the mark. */
+static void record_inject_peak(sw_th_pool *pool, int64_t len)
+{
+    int64_t peak = atomic_load_explicit(&pool->inject_peak, memory_order_relaxed);
+    while (len > peak &&
+           !atomic_compare_exchange_weak_explicit(&pool->inject_peak, &peak, len,
+                                                  memory_order_relaxed, memory_order_relaxed)) {
+        /* the failed CAS reloaded peak */
+    }
 }
 
 /* Holder of q->busy only. NULL when empty or while a producer is between exchange and link. */
@@ -296,7 +312,7 @@ static bool work_visible(sw_th_pool *pool)
 static void push_or_inject(sw_th_pool *pool, worker *w, int prio, node *n)
 {
     if (sw_th_deque_push_owner(&w->deques[prio], n) != SW_OK)
-        inject_push(&pool->inject[prio], n);
+        (void)inject_push(&pool->inject[prio], n);
 }
 
 static node *take_injected(sw_th_pool *pool, worker *w, int prio)
@@ -728,7 +744,7 @@ sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task)
             return SW_ERR_OUT_OF_MEMORY;
         }
     } else {
-        inject_push(&pool->inject[task->priority], n);
+        record_inject_peak(pool, inject_push(&pool->inject[task->priority], n));
     }
     notify(pool);
     return SW_OK;
@@ -841,6 +857,12 @@ int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRIORITY_C
         total += n;
     }
     return total;
+}
+
+int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool)
+{
+    /* relaxed: a statistic; a submission racing with the reset counts in one period or the next */
+    return atomic_exchange_explicit(&pool->inject_peak, 0, memory_order_relaxed);
 }
 
 const char *sw_th_task_kind_name(sw_th_task_kind kind)

@@ -19,7 +19,8 @@
  * counts the tasks of each kind it ran and, when timing is on (the desc's time_tasks or
  * sw_th_pool_set_task_timing: two CLOCK_MONOTONIC reads per task, measurable on tasks of ~0.1 us,
  * bench/steal --timing), the time it spent in them; single-writer counters, summed by any thread
- * like the other statistics. sw_th_pool_queued counts the tasks waiting.
+ * like the other statistics. sw_th_pool_queued counts the tasks waiting, and
+ * sw_th_pool_inject_peak_take the longest the injection queues grew.
  */
 #ifndef SPLINEWALK_SW_TH_POOL_H
 #define SPLINEWALK_SW_TH_POOL_H
@@ -154,6 +155,11 @@ SW_API void sw_th_pool_set_task_timing(sw_th_pool *pool, int on);
  * deques), in total and per priority into by_priority (may be NULL). A snapshot of counters
  * read one after the other: approximate while tasks move, exact when the pool is quiescent. */
 SW_API int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRIORITY_COUNT]);
+/* Any thread: the longest an injection queue (tasks submitted from outside the pool, one queue
+ * per priority) grew by a submission since the previous call (or the pool's creation); resets
+ * it. A backlog the end-of-frame snapshot of sw_th_pool_queued misses when the workers catch up
+ * within the frame. */
+SW_API int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool);
 /* "hierarchy", ...; "?" for a value out of range. */
 SW_API const char *sw_th_task_kind_name(sw_th_task_kind kind);
 

@@ -37,6 +37,7 @@ typedef struct sw_rt_renderer {
     sw_status statics_failure;
     sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
+    int time_pool_tasks;      /* sw_rt_renderer_time_pool_tasks: the pool times its tasks */
     sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
     uint32_t in_flight;       /* prepared frames not submitted yet */
     uint64_t frames_prepared;
@@ -180,6 +181,7 @@ static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_status
     if (!r->pool) {
         sw_th_pool_desc pd = {0};
         pd.worker_count = r->worker_threads;
+        pd.time_tasks = r->time_pool_tasks != 0;
         if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
     }
@@ -226,6 +228,25 @@ int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *
     if (owned_renderer(renderer, "sw_rt_renderer_trim_atlas", &r, NULL) != SW_OK)
         return -1;
     sw_gpu_trim_atlas_info(r->gpu, texture, pages, side);
+    return 0;
+}
+
+sw_th_pool *sw_rt_renderer_pool_ptr(sw_renderer renderer)
+{
+    sw_rt_renderer *r;
+    if (owned_renderer(renderer, "sw_rt_renderer_pool_ptr", &r, NULL) != SW_OK)
+        return NULL;
+    return r->pool;
+}
+
+int sw_rt_renderer_time_pool_tasks(sw_renderer renderer, int on)
+{
+    sw_rt_renderer *r;
+    if (owned_renderer(renderer, "sw_rt_renderer_time_pool_tasks", &r, NULL) != SW_OK)
+        return -1;
+    r->time_pool_tasks = on != 0;
+    if (r->pool)
+        sw_th_pool_set_task_timing(r->pool, on);
     return 0;
 }
 

@@ -1,6 +1,7 @@
 /* tests/threads: worker-pool behaviour (threads/sw_th_pool.h) — cancellation of stale requests,
- * priorities, group waiters that help, fork-join from tasks, shutdown that drains, and idle
- * workers that sleep instead of spinning. */
+ * priorities, group waiters that help, fork-join from tasks, shutdown that drains, idle
+ * workers that sleep instead of spinning, and the accounting by task kind (counts, own time of
+ * nested tasks, queue lengths, the injection peak). */
 #include "sw_th_pool.h"
 
 #include <sched.h>
@@ -432,6 +433,149 @@ static void test_idle_workers_sleep(void **state)
     sw_th_pool_destroy(h.pool);
 }
 
+/* ---- accounting: kinds, queue lengths, timing ----------------------------------------------- */
+
+typedef struct kind_spawner {
+    sw_th_pool *pool;
+    sw_th_group *group;
+    gate *g;
+    _Atomic int children_ran;
+} kind_spawner;
+
+static void child_fn(void *ctx)
+{
+    kind_spawner *sp = ctx;
+    atomic_fetch_add(&sp->children_ran, 1);
+}
+
+/* Submits 4 HIERARCHY children to its worker's own deque, then holds the worker until opened. */
+static void hold_after_spawning_fn(void *ctx)
+{
+    kind_spawner *sp = ctx;
+    for (int i = 0; i < 4; i++) {
+        sw_th_task t = {
+            .fn = child_fn, .ctx = sp, .group = sp->group, .kind = SW_TH_TASK_HIERARCHY};
+        assert_int_equal(sw_th_pool_submit(sp->pool, &t), SW_OK);
+    }
+    gate_fn(sp->g);
+}
+
+/* One worker held by a COMPILE task that queued 4 children in its deque; 5 FRAME tasks and 3
+ * BACKGROUND ones injected from here: the queue holds exactly 12 (9 + 3 by priority) while
+ * nothing can move, the injection peak is the 5 of the FRAME queue (the children never went
+ * through it), and once everything ran each kind counts exactly its own tasks, untimed. */
+static void test_kinds_and_queue(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = pool_with(1);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    gate g = {0};
+    kind_spawner sp = {.pool = pool, .group = &grp, .g = &g};
+    sw_th_task hold = {
+        .fn = hold_after_spawning_fn, .ctx = &sp, .group = &grp, .kind = SW_TH_TASK_COMPILE};
+    assert_int_equal(sw_th_pool_submit(pool, &hold), SW_OK);
+    while (!atomic_load(&g.running))
+        sched_yield();
+    assert_int_equal(sw_th_pool_inject_peak_take(pool), 1); /* the hold task itself */
+    for (int i = 0; i < 8; i++) {
+        sw_th_task t = {.fn = child_fn,
+                        .ctx = &sp,
+                        .group = &grp,
+                        .priority = i < 5 ? SW_TH_PRIORITY_FRAME : SW_TH_PRIORITY_BACKGROUND,
+                        .kind = i < 5 ? SW_TH_TASK_REFINE : SW_TH_TASK_STATIC_BUILD};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    }
+    int64_t by[SW_TH_PRIORITY_COUNT] = {0};
+    assert_int_equal(sw_th_pool_queued(pool, by), 12);
+    assert_int_equal(by[SW_TH_PRIORITY_FRAME], 9);
+    assert_int_equal(by[SW_TH_PRIORITY_BACKGROUND], 3);
+    assert_int_equal(sw_th_pool_inject_peak_take(pool), 5);
+    assert_int_equal(sw_th_pool_inject_peak_take(pool), 0);
+    atomic_store(&g.open, 1);
+    sw_th_group_wait(pool, &grp);
+    assert_int_equal(atomic_load(&sp.children_ran), 12);
+    assert_int_equal(sw_th_pool_queued(pool, NULL), 0);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    const uint64_t want[SW_TH_TASK_KIND_COUNT] = {[SW_TH_TASK_COMPILE] = 1,
+                                                  [SW_TH_TASK_HIERARCHY] = 4,
+                                                  [SW_TH_TASK_REFINE] = 5,
+                                                  [SW_TH_TASK_STATIC_BUILD] = 3};
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        assert_int_equal(st.executed_by_kind[k], want[k]);
+        assert_int_equal(st.ns_by_kind[k], 0); /* timing is off by default */
+    }
+    assert_int_equal(st.executed, 13);
+    sw_th_pool_destroy(pool);
+    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_STATIC_BUILD), "static_build");
+    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_KIND_COUNT), "?");
+}
+
+enum { NAP_MS = 30 };
+
+static void nap_fn(void *ctx)
+{
+    (void)ctx;
+    sleep_ms(NAP_MS);
+}
+
+typedef struct waiter {
+    sw_th_pool *pool;
+} waiter;
+
+/* Runs two naps in a group and waits for them: on a one-worker pool it runs them itself,
+ * nested in sw_th_group_wait. */
+static void wait_for_naps_fn(void *ctx)
+{
+    waiter *w = ctx;
+    sw_th_group naps;
+    sw_th_group_init(&naps);
+    for (int i = 0; i < 2; i++) {
+        sw_th_task t = {.fn = nap_fn, .group = &naps, .kind = SW_TH_TASK_HIERARCHY};
+        assert_int_equal(sw_th_pool_submit(w->pool, &t), SW_OK);
+    }
+    sw_th_group_wait(w->pool, &naps);
+}
+
+/* Timed: the two nested naps count >= 2 x 30 ms under HIERARCHY, and the waiting task only its
+ * own time (not the naps again: well under one nap). Untimed again: a further nap is counted
+ * but adds no time. */
+static void test_kind_timing_nested(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc d = {.worker_count = 1, .time_tasks = 1};
+    assert_int_equal(sw_th_pool_create(&d, &pool), SW_OK);
+    waiter w = {pool};
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    sw_th_task t = {
+        .fn = wait_for_naps_fn, .ctx = &w, .group = &grp, .kind = SW_TH_TASK_HIERARCHY_WAIT};
+    assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    while (sw_th_group_pending(&grp) > 0) /* polls: a helping caller could take a nap itself */
+        sleep_ms(1);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    print_message("naps %.3f ms, their waiter's own time %.3f ms\n",
+                  1e-6 * (double)st.ns_by_kind[SW_TH_TASK_HIERARCHY],
+                  1e-6 * (double)st.ns_by_kind[SW_TH_TASK_HIERARCHY_WAIT]);
+    assert_int_equal(st.executed_by_kind[SW_TH_TASK_HIERARCHY], 2);
+    assert_int_equal(st.executed_by_kind[SW_TH_TASK_HIERARCHY_WAIT], 1);
+    assert_true(st.ns_by_kind[SW_TH_TASK_HIERARCHY] >= 2u * NAP_MS * 1000000u);
+    assert_true(st.ns_by_kind[SW_TH_TASK_HIERARCHY_WAIT] < NAP_MS * 1000000u);
+    sw_th_pool_set_task_timing(pool, 0);
+    sw_th_task nap = {.fn = nap_fn, .group = &grp, .kind = SW_TH_TASK_HIERARCHY};
+    assert_int_equal(sw_th_pool_submit(pool, &nap), SW_OK);
+    while (sw_th_group_pending(&grp) > 0)
+        sleep_ms(1);
+    sw_th_pool_stats st2;
+    sw_th_pool_stats_get(pool, &st2);
+    assert_int_equal(st2.executed_by_kind[SW_TH_TASK_HIERARCHY], 3);
+    assert_int_equal(st2.ns_by_kind[SW_TH_TASK_HIERARCHY], st.ns_by_kind[SW_TH_TASK_HIERARCHY]);
+    sw_th_pool_destroy(pool);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -439,7 +583,8 @@ int main(void)
         cmocka_unit_test(test_priority_external),  cmocka_unit_test(test_priority_local),
         cmocka_unit_test(test_group_wait_helps),   cmocka_unit_test(test_fork_join),
         cmocka_unit_test(test_shutdown_drains),    cmocka_unit_test(test_no_lost_wakeup),
-        cmocka_unit_test(test_idle_workers_sleep),
+        cmocka_unit_test(test_idle_workers_sleep), cmocka_unit_test(test_kinds_and_queue),
+        cmocka_unit_test(test_kind_timing_nested),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
