@@ -391,7 +391,7 @@ static double py(const plot *pl, double ms)
     return pl->top + pl->height * (1.0 - fmin(fmax(ms, 0.0), pl->ymax) / pl->ymax);
 }
 
-/* A stack of areas: columns first .. first + n - 1 (stage or pool-kind times) with a colour each. */
+/* A stack of areas: columns first .. first + n - 1 (stage or pool-kind times), a colour each. */
 typedef struct stack {
     int first, n;
     const char *const *colour;
@@ -470,8 +470,8 @@ static void svg_areas(FILE *f, const sw_rt_profile *p, const plot *pl, const sta
 }
 
 /* A column as a line, scaled so that `vmax` is the plot's top. */
-static void svg_line(FILE *f, const sw_rt_profile *p, const plot *pl, sw_rt_prof_col c,
-                     double vmax, const char *style)
+static void svg_line(FILE *f, const sw_rt_profile *p, const plot *pl, sw_rt_prof_col c, double vmax,
+                     const char *style)
 {
     fprintf(f, "<polyline fill=\"none\" %s points=\"", style);
     for (uint32_t i = 0; i < p->n_rows; i++)
@@ -535,11 +535,11 @@ static void svg_pool_legend(FILE *f, const sw_rt_profile *p, const plot *pl)
             "<text x=\"%.1f\" y=\"%.1f\" font-weight=\"bold\">pool ms, whole run</text>\n",
             x, pl->top + 4);
     svg_line_key(f, x, pl->top + 22, "stroke=\"#111\" stroke-dasharray=\"5,2\"");
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">queued at end, max %.0f</text>\n", x + 20,
-            pl->top + 26, p->summary[SW_RT_COL_POOL_QUEUED].max);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">queued at end, max %.0f</text>\n", x + 20, pl->top + 26,
+            p->summary[SW_RT_COL_POOL_QUEUED].max);
     svg_line_key(f, x, pl->top + 40, "stroke=\"#d62728\" stroke-dasharray=\"1,2\"");
-    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">inject peak, max %.0f</text>\n", x + 20,
-            pl->top + 44, p->summary[SW_RT_COL_POOL_INJECT_PEAK].max);
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">inject peak, max %.0f</text>\n", x + 20, pl->top + 44,
+            p->summary[SW_RT_COL_POOL_INJECT_PEAK].max);
     for (int k = SW_TH_TASK_KIND_COUNT; k-- > 0;) {
         const double y = pl->top + 60 + 14 * (SW_TH_TASK_KIND_COUNT - 1 - k);
         const sw_rt_prof_col c = (sw_rt_prof_col)(SW_RT_COL_POOL_FIRST_MS + k);
@@ -709,7 +709,9 @@ static void print_pool_summary(FILE *f, const sw_rt_profile *p)
                 s->mean, tasks, s->mean * p->n_rows);
     }
     const sw_rt_prof_stat *q = &p->summary[SW_RT_COL_POOL_QUEUED];
-    fprintf(f, "  %-14s %9.0f %9.0f %9.0f %9.0f %9.1f  tasks waiting at frame ends, %.0f at the last\n",
+    fprintf(f,
+            "  %-14s %9.0f %9.0f %9.0f %9.0f %9.1f  tasks waiting at frame ends, %.0f at the "
+            "last\n",
             "queued", q->median, q->p90, q->p99, q->max, q->mean,
             p->n_rows ? p->rows[p->n_rows - 1].v[SW_RT_COL_POOL_QUEUED] : 0.0);
     q = &p->summary[SW_RT_COL_POOL_INJECT_PEAK];

@@ -67,8 +67,8 @@
     X(ATLAS_PAGES, "atlas_pages", COUNT, "trim-atlas pages after the frame")                       \
     X(FALLBACK_DRAWS, "fallback_draws", COUNT, "walkthrough: drawn coarser than asked, queued")    \
     X(POOL_WAITS, "pool_waits", COUNT, "times the frame waited for the worker pool")               \
-    X(GPU_MS, "gpu_ms", GPU, "GPU time of trim + draw (GL timer query; overlaps them)")         \
-    X(STATIC_DRAWN, "static_drawn", COUNT, "super-surface instances drawn from static LODs")        \
+    X(GPU_MS, "gpu_ms", GPU, "GPU time of trim + draw (GL timer query; overlaps them)")            \
+    X(STATIC_DRAWN, "static_drawn", COUNT, "super-surface instances drawn from static LODs")       \
     X(STATIC_FACES, "static_faces", COUNT, "face instances they cover (of faces_drawn)")           \
     X(STATIC_TRIANGLES, "static_triangles", COUNT, "their triangles (of triangles)")               \
     X(STATIC_REQUESTS, "static_requests", COUNT, "walkthrough: static LOD builds queued")          \
@@ -77,7 +77,7 @@
     X(POOL_QUEUED, "pool_queued", COUNT,                                                           \
       "pool tasks waiting at the frame's end (injection queues and workers' deques)")              \
     X(POOL_INJECT_PEAK, "pool_inject_peak", COUNT,                                                 \
-      "longest the pool's injection queue grew during the frame (requests from other threads)")   \
+      "longest the pool's injection queue grew during the frame (requests from other threads)")    \
     X(RESIDENT_BYTES, "resident_bytes", COUNT,                                                     \
       "resident memory after the frame (/proc/self/statm)")                                        \
     X(CAPTURED, "captured", INDEX, "1 if the frame was written as PNG")
