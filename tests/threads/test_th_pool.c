@@ -576,6 +576,82 @@ static void test_kind_timing_nested(void **state)
     sw_th_pool_destroy(pool);
 }
 
+/* A binary tree of tasks whose kind is its depth mod the kind count: level d of a tree of depth
+ * TREE_DEPTH holds 2^(TREE_DEPTH - d) tasks. Roots come through the injection queue, the rest
+ * through the workers' deques. */
+enum { TREE_DEPTH = 9, TREE_ROOTS = 40 };
+
+typedef struct kind_level {
+    sw_th_pool *pool;
+    sw_th_group *group;
+    sw_th_task_kind kind;     /* of this level's tasks */
+    struct kind_level *below; /* NULL at depth 0 */
+} kind_level;
+
+static void kind_tree_fn(void *ctx)
+{
+    kind_level *l = ctx;
+    for (int i = 0; l->below && i < 2; i++) {
+        sw_th_task t = {
+            .fn = kind_tree_fn, .ctx = l->below, .group = l->group, .kind = l->below->kind};
+        assert_int_equal(sw_th_pool_submit(l->pool, &t), SW_OK);
+    }
+}
+
+/* Three timed workers run 40 trees of mixed kinds while this thread samples the statistics: every
+ * sample's per-kind counts and times only grow and the queue is never negative; at the end each
+ * kind counts exactly its tasks (single-writer counters lose nothing), and under TSan the
+ * samplers' reads race with nothing. */
+static void test_kind_counts_concurrent(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc d = {.worker_count = 3, .time_tasks = 1};
+    assert_int_equal(sw_th_pool_create(&d, &pool), SW_OK);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    kind_level levels[TREE_DEPTH + 1];
+    uint64_t want[SW_TH_TASK_KIND_COUNT] = {0};
+    for (int depth = 0; depth <= TREE_DEPTH; depth++) {
+        levels[depth] = (kind_level){pool, &grp, (sw_th_task_kind)(depth % SW_TH_TASK_KIND_COUNT),
+                                     depth ? &levels[depth - 1] : NULL};
+        want[depth % SW_TH_TASK_KIND_COUNT] += (uint64_t)TREE_ROOTS << (TREE_DEPTH - depth);
+    }
+    for (int r = 0; r < TREE_ROOTS; r++) {
+        sw_th_task t = {.fn = kind_tree_fn,
+                        .ctx = &levels[TREE_DEPTH],
+                        .group = &grp,
+                        .kind = levels[TREE_DEPTH].kind};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    }
+    sw_th_pool_stats prev = {0};
+    int samples = 0;
+    while (sw_th_group_pending(&grp) > 0) { /* polls: stats only, no helping */
+        sw_th_pool_stats st;
+        sw_th_pool_stats_get(pool, &st);
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+            assert_true(st.executed_by_kind[k] >= prev.executed_by_kind[k]);
+            assert_true(st.ns_by_kind[k] >= prev.ns_by_kind[k]);
+        }
+        assert_true(sw_th_pool_queued(pool, NULL) >= 0);
+        assert_true(sw_th_pool_inject_peak_take(pool) <= TREE_ROOTS);
+        prev = st;
+        samples++;
+    }
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    uint64_t all = 0;
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        assert_int_equal(st.executed_by_kind[k], want[k]);
+        all += want[k];
+    }
+    assert_int_equal(st.executed, all);
+    assert_int_equal(sw_th_pool_queued(pool, NULL), 0);
+    print_message("%d samples while %llu tasks of %d kinds ran\n", samples, (unsigned long long)all,
+                  (int)SW_TH_TASK_KIND_COUNT);
+    sw_th_pool_destroy(pool);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -584,7 +660,7 @@ int main(void)
         cmocka_unit_test(test_group_wait_helps),   cmocka_unit_test(test_fork_join),
         cmocka_unit_test(test_shutdown_drains),    cmocka_unit_test(test_no_lost_wakeup),
         cmocka_unit_test(test_idle_workers_sleep), cmocka_unit_test(test_kinds_and_queue),
-        cmocka_unit_test(test_kind_timing_nested),
+        cmocka_unit_test(test_kind_timing_nested), cmocka_unit_test(test_kind_counts_concurrent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
