@@ -73,7 +73,14 @@ typedef struct worker {
     /* Written by the owner only (load + store), read by sw_th_pool_stats_get. */
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t executed;
     _Atomic uint64_t cancelled, steals, stolen, sleeps;
-    _Atomic uint64_t kind_executed[SW_TH_TASK_KIND_COUNT], kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic uint64_t kind_executed[SW_TH_TASK_KIND_COUNT];
+    /* Timed tasks' own time: kind_ns (ended segments) and the segment running now (seg_kind,
+     * SW_TH_TASK_KIND_COUNT for none, since seg_start), under the seqlock seg_seq (odd while the
+     * owner updates them) so that a reader adds the running segment to a consistent total. */
+    _Atomic uint64_t seg_seq;
+    _Atomic uint64_t kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic uint32_t seg_kind;
+    _Atomic uint64_t seg_start;
 } worker;
 
 struct sw_th_pool {
@@ -100,9 +107,10 @@ struct sw_th_pool {
 
 static _Thread_local worker *tls_worker;
 static _Thread_local uint64_t tls_rng;
-/* Time of the timed tasks that ran nested in the calling thread's current task (in
- * sw_th_group_wait), subtracted from its own; see timed_run. */
-static _Thread_local uint64_t tls_nested_ns;
+/* The calling thread's running segment of timed task time: the kind of its innermost timed task
+ * (SW_TH_TASK_KIND_COUNT: none) and since when it runs uninterrupted by a nested task. */
+static _Thread_local uint32_t tls_seg_kind = SW_TH_TASK_KIND_COUNT;
+static _Thread_local uint64_t tls_seg_start;
 
 static void cpu_relax(void)
 {
@@ -426,36 +434,63 @@ static uint64_t now_ns(void)
     return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
 }
 
-/* Runs t and returns its own time: its wall time minus that of the timed tasks it ran nested
- * (a task waiting on a group runs others meanwhile), so that the kinds' times add up to the
- * thread's busy time instead of counting nested work twice. */
-static uint64_t timed_run(const sw_th_task *t)
+/* Ends the calling thread's running segment (its time goes to the segment's kind) and starts one
+ * of kind `to` (SW_TH_TASK_KIND_COUNT: none). A worker publishes both under its seqlock; a thread
+ * outside the pool (waiting on a group) adds the ended segment to the pool's shared totals.
+ * Writer side of the seqlock: the odd store, then release stores of the data (a reader that
+ * acquires any of them also sees the odd count), then the even store (release). The clock is
+ * read after the odd store, so that a reader that saw the old state consistently read its own
+ * clock before this segment's end, up to a store buffer's delay. */
+static void switch_segment(sw_th_pool *pool, worker *w, uint32_t to)
 {
-    const uint64_t outer = tls_nested_ns;
-    tls_nested_ns = 0;
-    const uint64_t t0 = now_ns();
+    const uint32_t from = tls_seg_kind;
+    if (!w) {
+        const uint64_t now = now_ns();
+        if (from < SW_TH_TASK_KIND_COUNT)
+            atomic_fetch_add_explicit(&pool->ext_kind_ns[from], now - tls_seg_start,
+                                      memory_order_relaxed);
+        tls_seg_kind = to;
+        tls_seg_start = now;
+        return;
+    }
+    const uint64_t seq = atomic_load_explicit(&w->seg_seq, memory_order_relaxed);
+    atomic_store_explicit(&w->seg_seq, seq + 1, memory_order_relaxed);
+    const uint64_t now = now_ns();
+    if (from < SW_TH_TASK_KIND_COUNT)
+        atomic_store_explicit(&w->kind_ns[from],
+                              atomic_load_explicit(&w->kind_ns[from], memory_order_relaxed) + now -
+                                  tls_seg_start,
+                              memory_order_release);
+    atomic_store_explicit(&w->seg_kind, to, memory_order_release);
+    atomic_store_explicit(&w->seg_start, now, memory_order_release);
+    atomic_store_explicit(&w->seg_seq, seq + 2, memory_order_release);
+    tls_seg_kind = to;
+    tls_seg_start = now;
+}
+
+/* Runs t timed. Its time is counted in segments: a task that runs others nested (waiting on a
+ * group) pauses its own for theirs, so the kinds add up to the thread's busy time instead of
+ * counting nested work twice; and a reader sees a running task's time so far, not only once it
+ * ends (a static LOD build takes seconds: its time shows in the frames it spans). */
+static void timed_run(sw_th_pool *pool, worker *w, const sw_th_task *t)
+{
+    const uint32_t outer = tls_seg_kind;
+    switch_segment(pool, w, (uint32_t)t->kind);
     t->fn(t->ctx);
-    const uint64_t wall = now_ns() - t0;
-    const uint64_t own = wall > tls_nested_ns ? wall - tls_nested_ns : 0;
-    tls_nested_ns = outer + wall;
-    return own;
+    switch_segment(pool, w, outer);
 }
 
 /* Counts a task that ran: on the worker's single-writer counters, or (a thread outside the pool
  * waiting on a group) on the pool's shared ones. */
-static void count_executed(sw_th_pool *pool, worker *w, sw_th_task_kind kind, uint64_t ns)
+static void count_executed(sw_th_pool *pool, worker *w, sw_th_task_kind kind)
 {
     if (w) {
         bump(&w->executed, 1);
         bump(&w->kind_executed[kind], 1);
-        if (ns)
-            bump(&w->kind_ns[kind], ns);
         return;
     }
     atomic_fetch_add_explicit(&pool->ext_executed, 1, memory_order_relaxed);
     atomic_fetch_add_explicit(&pool->ext_kind_executed[kind], 1, memory_order_relaxed);
-    if (ns)
-        atomic_fetch_add_explicit(&pool->ext_kind_ns[kind], ns, memory_order_relaxed);
 }
 
 static void run_node(sw_th_pool *pool, worker *w, node *n)
@@ -471,13 +506,12 @@ static void run_node(sw_th_pool *pool, worker *w, node *n)
         else
             atomic_fetch_add_explicit(&pool->ext_cancelled, 1, memory_order_relaxed);
     } else {
-        uint64_t ns = 0;
         /* relaxed: a switch; a task that starts just after it flips may go either way */
         if (atomic_load_explicit(&pool->time_tasks, memory_order_relaxed))
-            ns = timed_run(&t);
+            timed_run(pool, w, &t);
         else
             t.fn(t.ctx);
-        count_executed(pool, w, t.kind, ns);
+        count_executed(pool, w, t.kind);
     }
     if (t.group)
         group_release(pool, t.group);
@@ -657,6 +691,7 @@ static sw_result pool_init_workers(sw_th_pool *pool, const sw_th_pool_desc *d)
         worker *w = &pool->workers[i];
         w->pool = pool;
         w->index = i;
+        atomic_store_explicit(&w->seg_kind, SW_TH_TASK_KIND_COUNT, memory_order_relaxed);
         w->rng = (uint64_t)d->seed * 0x9e3779b97f4a7c15u + i + 1;
         for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++)
             if (sw_th_deque_init_owner(&w->deques[p], d->deque_capacity) != SW_OK)
@@ -810,6 +845,33 @@ int sw_th_pool_current_worker(const sw_th_pool *pool)
     return w ? (int)w->index : -1;
 }
 
+/* Adds worker w's timed task time to ns[]: its ended segments and the one running now. Reader
+ * side of the seqlock (switch_segment): an even count, acquire loads of the data, the count
+ * again (the acquire loads keep it after them); retried only while the owner is mid-update. */
+static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_COUNT])
+{
+    uint64_t total[SW_TH_TASK_KIND_COUNT], start, seq;
+    uint32_t kind;
+    for (;;) {
+        seq = atomic_load_explicit(&w->seg_seq, memory_order_acquire);
+        if (seq & 1) {
+            cpu_relax();
+            continue;
+        }
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+            total[k] = atomic_load_explicit(&w->kind_ns[k], memory_order_acquire);
+        kind = atomic_load_explicit(&w->seg_kind, memory_order_acquire);
+        start = atomic_load_explicit(&w->seg_start, memory_order_acquire);
+        if (atomic_load_explicit(&w->seg_seq, memory_order_relaxed) == seq)
+            break;
+    }
+    const uint64_t now = now_ns();
+    if (kind < SW_TH_TASK_KIND_COUNT && now > start)
+        total[kind] += now - start;
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+        ns[k] += total[k];
+}
+
 void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out)
 {
     memset(out, 0, sizeof *out);
@@ -820,11 +882,10 @@ void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out)
         out->steals += atomic_load_explicit(&w->steals, memory_order_relaxed);
         out->stolen_tasks += atomic_load_explicit(&w->stolen, memory_order_relaxed);
         out->sleeps += atomic_load_explicit(&w->sleeps, memory_order_relaxed);
-        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
             out->executed_by_kind[k] +=
                 atomic_load_explicit(&w->kind_executed[k], memory_order_relaxed);
-            out->ns_by_kind[k] += atomic_load_explicit(&w->kind_ns[k], memory_order_relaxed);
-        }
+        add_task_time(w, out->ns_by_kind);
     }
     for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
         out->executed_by_kind[k] +=

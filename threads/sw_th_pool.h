@@ -110,8 +110,10 @@ typedef struct sw_th_pool_stats {
     uint64_t sleeps;       /* times a worker blocked for lack of work */
     uint64_t executed_by_kind[SW_TH_TASK_KIND_COUNT]; /* of executed, by sw_th_task.kind */
     /* Time in the tasks of each kind while timing was on, ns: a task's own time, without that of
-     * the tasks it ran nested (in sw_th_group_wait), so the kinds add up to the busy time. Counted
-     * when a task ends. Includes tasks run by non-worker threads waiting on a group. */
+     * the tasks it ran nested (in sw_th_group_wait), so the kinds add up to the busy time. A
+     * worker's running task counts up to the call (each sample is, up to a store buffer's delay,
+     * at least the one before); a thread outside the pool that runs tasks while waiting on a
+     * group adds its time when each of its task segments ends. */
     uint64_t ns_by_kind[SW_TH_TASK_KIND_COUNT];
 } sw_th_pool_stats;
 

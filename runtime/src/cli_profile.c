@@ -340,6 +340,11 @@ static void sample_pool(sw_renderer renderer, sw_th_pool_stats *prev, sw_rt_prof
         queued = sw_th_pool_queued(pool, NULL);
         peak = sw_th_pool_inject_peak_take(pool);
     }
+    /* a running task's time may read a few ns ahead of what its end then records
+     * (sw_th_pool_stats.ns_by_kind): the totals are kept from going back */
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+        if (now.ns_by_kind[k] < prev->ns_by_kind[k])
+            now.ns_by_kind[k] = prev->ns_by_kind[k];
     sw_rt_profile_row_pool(prev, &now, queued, peak, row);
     *prev = now;
 }

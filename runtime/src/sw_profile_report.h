@@ -9,10 +9,10 @@
  *
  * The worker pool's share of a frame is beside them, like the visibility thread's and the GPU's:
  * pool_<kind>_ms and pool_<kind>_tasks per task kind (sw_th_pool.h), the differences of the
- * pool's counters between the end of the previous frame and the end of this one (a task counts
- * in the frame in which it ends), pool_queued, the tasks waiting at the frame's end, and
- * pool_inject_peak, the longest the injection queue (tasks submitted by the visibility thread and
- * the frame's) grew during the frame.
+ * pool's counters between the end of the previous frame and the end of this one (a worker's
+ * running task counts in the frames it spans), pool_queued, the tasks waiting at the frame's end,
+ * and pool_inject_peak, the longest the injection queue (tasks submitted by the visibility thread
+ * and the frame's) grew during the frame.
  */
 #ifndef SW_PROFILE_REPORT_H
 #define SW_PROFILE_REPORT_H
