@@ -43,6 +43,13 @@ typedef struct sw_gpu_camera {
     double fovy_deg; /* vertical field of view */
 } sw_gpu_camera;
 
+/* The camera presets of `splinewalk render --view` (and sw_camera_fit), fitted to a world box (min
+ * xyz, max xyz): fovy 40°, target = box centre, distance = diagonal / (2 tan 20°) × 1.1, looking
+ * from direction `from` (not zero; (1,1,1) is the iso view) with `up`. A point-sized or empty box
+ * gets a unit diagonal. */
+void sw_gpu_camera_fit_box(const double box[6], const double from[3], const double up[3],
+                           sw_gpu_camera *out);
+
 typedef struct sw_gpu_frame_desc {
     int32_t width, height; /* 0 = 1280 x 720 */
     double error_px;       /* screen-space error bound ε_img in pixels; 0 = 0.5 */
