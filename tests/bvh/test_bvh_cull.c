@@ -246,13 +246,15 @@ static shape tree_shape(const sw_sg_bvh *t)
 /* ---- one camera ------------------------------------------------------------------------------ */
 typedef struct sink {
     unsigned char *seen;
+    unsigned char *cls; /* the class reported with each item */
     uint32_t last;
     int64_t n, out_of_order;
 } sink;
 
-static int take(void *ctx, uint32_t item)
+static int take(void *ctx, uint32_t item, sw_sg_cull_class cls)
 {
     sink *s = ctx;
+    s->cls[item] = (unsigned char)cls;
     s->out_of_order += s->n > 0 && item <= s->last;
     s->seen[item] = 1;
     s->last = item;
