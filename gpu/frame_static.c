@@ -287,8 +287,41 @@ static sw_result hand_faces(instance_taker *t, const sw_lod_static_instance *in,
     return SW_OK;
 }
 
-/* A visible instance drawn at a static level: the level once, and the fat borders of its visible
- * faces that are not back-facing on their own (those the per-frame path would draw). */
+enum { FACE_OUTSIDE = 0, FACE_BACK = 1, FACE_SHOWN = 2 };
+
+/* Whether face occurrence k of an instance is outside the frustum (only tested when the instance
+ * is partly visible), back-facing on its own (with cones), or shown; o is set unless outside. */
+static int face_shown(const instance_taker *t, const sw_lod_static_instance *in,
+                      const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls, occurrence *o)
+{
+    double wb[6], eb[6];
+    if (!instance_face(t, in, it, k, cls, o, wb))
+        return FACE_OUTSIDE;
+    for (int a = 0; a < 3; ++a) {
+        eb[a] = wb[a] - t->f->view.eye[a];
+        eb[3 + a] = wb[3 + a] - t->f->view.eye[a];
+    }
+    return t->fc && sw__fr_face_back_facing(t->fc, o, eb) ? FACE_BACK : FACE_SHOWN;
+}
+
+/* Culls an instance none of whose faces is shown (the faces' BVH and back-patch test would have
+ * dropped them all, and with them the instance: no level is chosen, asked for or drawn). */
+static int culled_by_faces(instance_taker *t, const sw_lod_static_instance *in,
+                           const sw_sg_bvh_item *it, sw_sg_cull_class cls)
+{
+    occurrence o;
+    for (uint32_t k = 0; k < in->n_occ; ++k)
+        if (face_shown(t, in, it, k, cls, &o) == FACE_SHOWN)
+            return 0;
+    for (uint32_t k = 0; k < in->n_occ; ++k) {
+        t->f->st.faces_backculled += face_shown(t, in, it, k, cls, &o) == FACE_BACK;
+        t->f->st.faces_culled++;
+    }
+    return 1;
+}
+
+/* A visible instance drawn at a static level: the level once, and the fat borders of its faces
+ * that are shown (those the per-frame path would draw). */
 static sw_result draw_static(instance_taker *t, const sw_lod_static_instance *in,
                              const sw_sg_bvh_item *it, sw_sg_cull_class cls,
                              const sw_lod_static_chain *chain, int32_t level, double extent_px)
@@ -302,17 +335,9 @@ static sw_result draw_static(instance_taker *t, const sw_lod_static_instance *in
     f->st.static_levels_used |= 1u << (level < 31 ? level : 31);
     for (uint32_t k = 0; k < in->n_occ && r == SW_OK; ++k) {
         occurrence o;
-        double wb[6], eb[6];
-        if (!instance_face(t, in, it, k, cls, &o, wb)) {
-            f->st.faces_culled++;
-            continue;
-        }
-        for (int a = 0; a < 3; ++a) {
-            eb[a] = wb[a] - f->view.eye[a];
-            eb[3 + a] = wb[3 + a] - f->view.eye[a];
-        }
-        if (t->fc && sw__fr_face_back_facing(t->fc, &o, eb)) {
-            f->st.faces_backculled++;
+        const int shown = face_shown(t, in, it, k, cls, &o);
+        f->st.faces_backculled += shown == FACE_BACK;
+        if (shown != FACE_SHOWN) {
             f->st.faces_culled++;
             continue;
         }
@@ -344,6 +369,8 @@ static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
             f->st.faces_culled += in->n_occ;
             return 0;
         }
+        if (culled_by_faces(t, in, it, cls))
+            return 0;
         level = choose_level(f, in->unit, it->world, &chain, &extent_px);
     }
     t->r = level >= 0 ? draw_static(t, in, it, cls, chain, level, extent_px)
