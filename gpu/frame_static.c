@@ -1,7 +1,9 @@
 /* The merge of Kumar et al. 1997 with the per-frame path: per visible unit (a super-surface of
  * whole faces, lod/sw_lod_static_set.h) and instance, the static LOD level whose declared ε_k meets
  * the object-space tolerance its nearest point needs, else the faces' own per-frame path (the
- * trim-texture tessellation of their hierarchies).
+ * trim-texture tessellation of their hierarchies). The visible instances, their class and the
+ * back-facing ones come from the set's BVH of unit instances (Kumar §4.4; the section "the
+ * unit-instance BVH" below), which replaces the faces' BVH in frames with static LODs.
  *
  * The tolerance. A displacement d of a point at depth z (along the view axis) and off-axis
  * tangents (t_x, t_y) moves its image by at most focal_px |d| sqrt(1 + t_x^2 + t_y^2) / z pixels
@@ -257,8 +259,8 @@ static int instance_back_facing(const frame *f, const sw_lod_static_unit *un,
 /* Face occurrence k of an instance: its occurrence and world box; 0 when the instance is partly
  * visible and the face's box is outside the frustum. */
 static int instance_face(const instance_taker *t, const sw_lod_static_instance *in,
-                         const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls,
-                         occurrence *o, double world_box[6])
+                         const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls, occurrence *o,
+                         double world_box[6])
 {
     const sw_lod_static_occ *oc = &t->in->occs[in->first_occ + k];
     sw_sg_box_transform(it->world, t->in->face_boxes + 6 * (size_t)oc->face, world_box);

@@ -399,8 +399,9 @@ static sw_result finish_instances(sw_lod_static_set *s, inst_build *b, sw_status
     sw_result r = sw_sg_bvh_build_items(b->items, (uint32_t)b->n_items, &s->bvh, status);
     if (r != SW_OK)
         return r;
-    s->in = (sw_lod_static_instances){s->bvh,         s->instances, (uint32_t)b->n_items, s->occs,
-                                      (uint32_t)b->n_occ, s->face_boxes, {0}};
+    s->in = (sw_lod_static_instances){s->bvh,  s->instances,       (uint32_t)b->n_items,
+                                      s->occs, (uint32_t)b->n_occ, s->face_boxes,
+                                      {0}};
     memcpy(s->in.scene_box, sb, sizeof s->in.scene_box);
     return SW_OK;
 }
@@ -420,11 +421,11 @@ static sw_result make_instances(sw_lod_static_set *s, sw_status *status)
         r = finish_instances(s, &b, status);
     } else {
         free(b.items);
-        r = b.failed == 2 ? sw__fail(status, SW_ERR_LIMIT,
-                                     "static LODs: %zu face occurrences or more (at most 2^31 - 1)",
-                                     b.n_occ)
-                          : sw__fail(status, SW_ERR_OUT_OF_MEMORY,
-                                     "static LODs: %zu face occurrences: out of memory", b.n_occ);
+        r = b.failed == 2
+                ? sw__fail(status, SW_ERR_LIMIT,
+                           "static LODs: %zu face occurrences or more (at most 2^31 - 1)", b.n_occ)
+                : sw__fail(status, SW_ERR_OUT_OF_MEMORY,
+                           "static LODs: %zu face occurrences: out of memory", b.n_occ);
     }
     free(b.inst);
     free(b.occ);

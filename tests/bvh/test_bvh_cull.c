@@ -271,9 +271,10 @@ static int take(void *ctx, uint32_t item, sw_sg_cull_class cls)
 }
 
 typedef struct result {
-    uint64_t visible, inside, visited, wasted; /* wasted: visited nodes with no visible item below */
-    uint64_t frontier;                 /* visited nodes inside, or partly visible leaves with a
-                                          visible item: where the traversal stops on the set */
+    uint64_t visible, inside, visited,
+        wasted;        /* wasted: visited nodes with no visible item below */
+    uint64_t frontier; /* visited nodes inside, or partly visible leaves with a
+                          visible item: where the traversal stops on the set */
 } result;
 
 typedef struct work {
@@ -435,16 +436,16 @@ static void run_bvh(const sw_sg_bvh *t, const char *name)
             add_sum(&sums[cls], &r, log2n);
         }
         const class_sum *c = &sums[cls];
-        printf(
-            "  %-19s %2d cameras: visible %llu..%llu (mean %.0f: %.0f wholly, %.0f partly, %.0f "
-            "not), visited %llu..%llu (mean %.0f), wasted <= %llu, visited / (visible + log2 n) "
-            "<= %.2f (c = %d)\n",
-            k_class_name[cls], c->cameras, (unsigned long long)c->visible_min,
-            (unsigned long long)c->visible_max, c->visible_sum / c->cameras,
-            (double)c->inside_sum / c->cameras, (c->visible_sum - (double)c->inside_sum) / c->cameras,
-            t->n_items - c->visible_sum / c->cameras,
-            (unsigned long long)c->visited_min, (unsigned long long)c->visited_max,
-            c->visited_sum / c->cameras, (unsigned long long)c->wasted_max, c->ratio_max, GUARD);
+        printf("  %-19s %2d cameras: visible %llu..%llu (mean %.0f: %.0f wholly, %.0f partly, %.0f "
+               "not), visited %llu..%llu (mean %.0f), wasted <= %llu, visited / (visible + log2 n) "
+               "<= %.2f (c = %d)\n",
+               k_class_name[cls], c->cameras, (unsigned long long)c->visible_min,
+               (unsigned long long)c->visible_max, c->visible_sum / c->cameras,
+               (double)c->inside_sum / c->cameras,
+               (c->visible_sum - (double)c->inside_sum) / c->cameras,
+               t->n_items - c->visible_sum / c->cameras, (unsigned long long)c->visited_min,
+               (unsigned long long)c->visited_max, c->visited_sum / c->cameras,
+               (unsigned long long)c->wasted_max, c->ratio_max, GUARD);
     }
     free(reported);
     free(w.seen);
@@ -579,8 +580,8 @@ static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *s
         const sw_lod_static_instance *ins = &in->instances[i];
         const sw_sg_bvh_item *it = &in->bvh->items[of_item[i]];
         for (uint32_t k = 0; k < ins->n_occ; ++k)
-            misplaced += sw_lod_static_set_unit_of(set, in->occs[ins->first_occ + k].face) !=
-                         ins->unit;
+            misplaced +=
+                sw_lod_static_set_unit_of(set, in->occs[ins->first_occ + k].face) != ins->unit;
         double box[6];
         const double *local = ins->unit != SW_LOD_STATIC_NO_UNIT
                                   ? sw_lod_static_set_unit(set, ins->unit)->box
@@ -615,8 +616,11 @@ static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *s
           "%s: %llu occurrences misplaced, %llu bad leaf boxes, %llu (unit, transform) pairs twice",
           name, (unsigned long long)misplaced, (unsigned long long)bad_box,
           (unsigned long long)twice);
-    printf("%s: %u units, %u face occurrences in %u unit instances\n", name,
-           sw_lod_static_set_unit_count(set), in->n_occs, in->n_instances);
+    const size_t bytes = sw_sg_bvh_memory(in->bvh) + in->n_instances * sizeof *in->instances +
+                         in->n_occs * sizeof *in->occs +
+                         sw_sg_scene_view_ptr(scene)->n_faces * 6 * sizeof(double);
+    printf("%s: %u units, %u face occurrences in %u unit instances (%zu bytes with their BVH)\n",
+           name, sw_lod_static_set_unit_count(set), in->n_occs, in->n_instances, bytes);
     free(used);
     free(of_item);
     free(l.face);
