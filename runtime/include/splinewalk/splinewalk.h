@@ -265,6 +265,9 @@ typedef struct sw_frame_stats {
     uint64_t static_faces;     /* face instances they cover (of faces_drawn) */
     uint64_t static_triangles; /* their triangles (of triangles) */
     uint64_t static_requests;  /* walkthrough: builds queued instead of waited for */
+    /* triangle meshes (sw_nodes.h MESH nodes) */
+    uint64_t meshes_drawn, meshes_culled; /* mesh occurrences inside / outside the frustum */
+    uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so
