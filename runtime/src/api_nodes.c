@@ -533,24 +533,26 @@ static sw_result check_mesh_desc(const sw_mesh_desc *d, sw_status *status)
     return SW_OK;
 }
 
-/* The normals scaled to unit length, pushed; SW_SG_NO_NORMALS when the mesh has none. */
-static uint64_t push_unit_normals(sw_sg_builder *b, const sw_mesh_desc *d)
+/* The normals scaled to unit length, pushed (*at = SW_SG_NO_NORMALS when the mesh has none);
+ * 0 when out of memory. */
+static int push_unit_normals(sw_sg_builder *b, const sw_mesh_desc *d, uint64_t *at)
 {
+    *at = SW_SG_NO_NORMALS;
     if (!d->normals)
-        return SW_SG_NO_NORMALS;
+        return 1;
     const size_t n = 3 * (size_t)d->vertex_count;
     double *unit = malloc(n * sizeof *unit);
     if (!unit)
-        return UINT64_MAX;
+        return 0;
     for (size_t i = 0; i < n; i += 3) {
         const double *v = d->normals + i;
         const double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         for (int k = 0; k < 3; k++)
             unit[i + k] = v[k] / len;
     }
-    uint64_t at = sw_sg_builder_push_doubles(b, unit, n);
+    *at = sw_sg_builder_push_doubles(b, unit, n);
     free(unit);
-    return at;
+    return *at != UINT64_MAX;
 }
 
 /* A private scene of one mesh drawn by one MESH node under its root. */
@@ -567,10 +569,10 @@ static sw_result mesh_geom(const sw_mesh_desc *d, sw_sg_scene **out, sw_status *
     rec.n_vertices = d->vertex_count;
     rec.n_triangles = d->triangle_count;
     rec.positions = sw_sg_builder_push_doubles(b, d->positions, 3 * (size_t)d->vertex_count);
-    rec.normals = push_unit_normals(b, d);
+    const int normals_ok = push_unit_normals(b, d, &rec.normals);
     rec.indices = sw_sg_builder_push_indices(b, d->indices, 3 * (size_t)d->triangle_count);
     uint32_t mesh = SW_SG_NONE;
-    if (rec.positions != UINT64_MAX && rec.normals != UINT64_MAX && rec.indices != UINT64_MAX)
+    if (rec.positions != UINT64_MAX && normals_ok && rec.indices != UINT64_MAX)
         mesh = sw_sg_builder_add_mesh(b, &rec);
     if (mesh == SW_SG_NONE ||
         sw_sg_builder_add_node(b, SW_SG_NODE_MESH, 0, mesh, NULL, NULL, NULL) == SW_SG_NONE) {
