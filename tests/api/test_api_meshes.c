@@ -12,9 +12,11 @@
  *   the box hits the plate; a ray into the sphere hits within its tessellation's distance of the
  *   exact sphere. sw_node_set_mesh moves the hit; bad input (NaN position, out-of-range index,
  *   zero normal, huge counts, NULL arrays, a MESH edit of a NURBS node) fails with the index named
- *   in the message and changes nothing (revision and pick unchanged). Save / load: the reloaded
+ *   in the message and changes nothing (revision and pick unchanged). sw_camera_fit frames a
+ *   mesh-only scene on its centre. Save / load: the reloaded
  *   scene has the same counts and bit-identical picks, saving it again gives the same bytes, the
- *   file has 11 sections (a scene without meshes still 8). The checked loader rejects a truncated
+ *   file has 11 sections (a scene without meshes still 8); imported under an IMPORT node the file
+ *   brings its meshes, and hits name that node. The checked loader rejects a truncated
  *   file, a MESHES table entry whose size does not match its count, and an index out of range in
  *   INDICES (checksums recomputed by the test's own CRC-32C, so validation is what catches it),
  *   each with the file and a byte offset in the message.
@@ -494,6 +496,20 @@ static void test_save_reload(built *b)
     free(fa);
     free(fb);
     sw_scene_destroy(loaded);
+    /* The file imported under a node: its meshes come along, hits name the IMPORT node. */
+    sw_scene host;
+    EXPECT_RESULT(sw_scene_create(NULL, &host, NULL), SW_OK);
+    sw_node_desc im = {.kind = SW_NODE_IMPORT, .import_path = path};
+    sw_node imported;
+    CHECK(sw_node_add(host, &im, &imported, &st) == SW_OK, "import: %s", st.message);
+    check_info(host, "imported");
+    sw_node_info ni;
+    EXPECT_RESULT(sw_node_get_info(host, imported, &ni, NULL), SW_OK);
+    CHECK(ni.triangles == 12 + SPHERE_T && ni.faces == 1, "import node: %u triangles, %u faces",
+          ni.triangles, ni.faces);
+    sw_pick_hit h = pick_down(host, 5.3, 0.4);
+    check_box_hit(&h, imported, 1.0, "imported");
+    sw_scene_destroy(host);
     /* Without meshes the file keeps the 8 sections older readers know. */
     EXPECT_RESULT(sw_node_remove(b->scene, b->copy, NULL), SW_OK);
     EXPECT_RESULT(sw_node_remove(b->scene, b->box, NULL), SW_OK);
@@ -506,9 +522,28 @@ static void test_save_reload(built *b)
     test_damaged_files(path);
 }
 
+/* A scene of one mesh: the camera presets frame its box (sw_camera_fit: target = box centre). */
+static void test_camera_fit(sphere_mesh *sm)
+{
+    sw_scene s;
+    EXPECT_RESULT(sw_scene_create(NULL, &s, NULL), SW_OK);
+    sw_mesh_desc sd = sphere(sm, k_ball_c, 1.0);
+    sw_node n;
+    EXPECT_RESULT(sw_node_add_mesh(s, NULL, &sd, &n, NULL), SW_OK);
+    sw_camera cam;
+    sw_status st = {0};
+    CHECK(sw_camera_fit(s, SW_VIEW_TOP, &cam, &st) == SW_OK, "camera_fit: %s", st.message);
+    CHECK(fabs(cam.target[0] - k_ball_c[0]) < 1e-9 && fabs(cam.target[1] - k_ball_c[1]) < 1e-9 &&
+              fabs(cam.target[2] - k_ball_c[2]) < 1e-9 && cam.eye[2] > 1.0,
+          "camera_fit of a mesh: target (%g, %g, %g), eye z %g", cam.target[0], cam.target[1],
+          cam.target[2], cam.eye[2]);
+    sw_scene_destroy(s);
+}
+
 static void test_meshes(void)
 {
     sphere_mesh *sm = malloc(sizeof *sm);
+    test_camera_fit(sm);
     built b = build(sm);
     check_info(b.scene, "node scene");
     sw_node_info ni;
