@@ -160,10 +160,10 @@ void sw__fr_lod_color(int32_t level, float out[4]);
 /* ---- frame_mesh.c ---- */
 /* Triangles in object space for sw__fr_append_triangles. */
 typedef struct sw__fr_triangles {
-    const double *positions;  /* 3 per vertex */
-    const float *normals_f;   /* 3 per vertex, or NULL */
-    const double *normals_d;  /* 3 per vertex, or NULL; both NULL: flat, a normal per triangle */
-    double normal_matrix[9];  /* row-major 3x3 mapping normals to the world (with normals) */
+    const double *positions; /* 3 per vertex */
+    const float *normals_f;  /* 3 per vertex, or NULL */
+    const double *normals_d; /* 3 per vertex, or NULL; both NULL: flat, a normal per triangle */
+    double normal_matrix[9]; /* row-major 3x3 mapping normals to the world (with normals) */
     uint32_t n_vertices, n_triangles;
     const uint32_t *triangles; /* 3 per triangle */
 } sw__fr_triangles;

@@ -131,8 +131,7 @@ static int collect_mesh(void *ctx, uint32_t mesh, uint32_t node, const double wo
     return 0;
 }
 
-sw_result sw__fr_meshes_collect(frame *f, sw__fr_meshes *fm, double scene_box[6],
-                                sw_status *status)
+sw_result sw__fr_meshes_collect(frame *f, sw__fr_meshes *fm, double scene_box[6], sw_status *status)
 {
     memset(fm, 0, sizeof *fm);
     if (f->sv->n_meshes == 0)

@@ -162,9 +162,12 @@ static sw_result append_level(frame *f, const occurrence *o, const sw_lod_static
 {
     const double *m = o->world;
     /* rigid and similarity transforms keep normals along M n; shading is two-sided */
-    sw__fr_triangles t = {lv->positions, lv->normals, NULL,
-                          {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]},
-                          lv->n_vertices, lv->n_triangles, lv->triangles};
+    sw__fr_triangles t = {.positions = lv->positions,
+                          .normals_f = lv->normals,
+                          .normal_matrix = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]},
+                          .n_vertices = lv->n_vertices,
+                          .n_triangles = lv->n_triangles,
+                          .triangles = lv->triangles};
     occurrence shown = *o;
     if (f->lod_colors)
         sw__fr_lod_color(level, shown.color);

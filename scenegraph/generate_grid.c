@@ -28,8 +28,7 @@ static void lattice(uint32_t n, int32_t dims, uint32_t out[3])
 
 /* The model's meshes, their offsets shifted by pool (where its pool went) and by where its
  * indices go; *first = the index of its first mesh in b. */
-static int copy_meshes(const sw_sg_scene_view *v, sw_sg_builder *b, uint64_t pool,
-                       uint32_t *first)
+static int copy_meshes(const sw_sg_scene_view *v, sw_sg_builder *b, uint64_t pool, uint32_t *first)
 {
     *first = 0;
     if (!v->n_meshes)

@@ -396,9 +396,9 @@ static int mesh_visit(void *ctx, uint32_t mesh, uint32_t node, const double worl
     return 0;
 }
 
-static sw_result pick_meshes(const sw_sg_scene *scene, const double origin[3],
-                             const double dir[3], const double inv_d[3], double *best,
-                             sw_sg_pick_hit *hit, sw_status *status)
+static sw_result pick_meshes(const sw_sg_scene *scene, const double origin[3], const double dir[3],
+                             const double inv_d[3], double *best, sw_sg_pick_hit *hit,
+                             sw_status *status)
 {
     mesh_job job = {scene, origin, dir, inv_d, *best, hit, 0};
     if (sw_sg_scene_traverse_meshes(scene, mesh_visit, &job) != SW_OK)

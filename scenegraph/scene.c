@@ -13,8 +13,8 @@
 #include <sys/mman.h>
 
 const char *const sw__sg_section_names[SW__SG_SEC_COUNT] = {
-    "FACES", "LOOPS", "CURVES", "NODES", "ADJACENCY", "POOL", "STRINGS", "META", "LODS", "MESHES",
-    "INDICES",
+    "FACES",   "LOOPS", "CURVES", "NODES",  "ADJACENCY", "POOL",
+    "STRINGS", "META",  "LODS",   "MESHES", "INDICES",
 };
 const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT] = {
     sizeof(sw_sg_face_rec),
@@ -106,7 +106,8 @@ sw_sg_builder *sw_sg_builder_create(void)
         return NULL;
     const size_t rec_max = (size_t)SW_SG_NONE - 1; /* SW_SG_NONE itself is never an index */
     for (int s = 0; s < SW__SG_SEC_COUNT; s++)
-        vec_init(&b->vec[s], sw__sg_section_record_size[s], sw__sg_is_array_section(s) ? rec_max : 0);
+        vec_init(&b->vec[s], sw__sg_section_record_size[s],
+                 sw__sg_is_array_section(s) ? rec_max : 0);
     vec_init(&b->vec[SW__SG_SEC_POOL], sizeof(double), SIZE_MAX / sizeof(double));
     vec_init(&b->vec[SW__SG_SEC_INDICES], sizeof(uint32_t), SIZE_MAX / sizeof(uint32_t));
     vec_init(&b->last_child, sizeof(uint32_t), rec_max);

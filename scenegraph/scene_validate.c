@@ -333,10 +333,11 @@ static sw_result check_mesh(const vctx *c, uint32_t i, const sw_sg_mesh_rec *m)
                             idx[k], m->n_vertices);
     const double *p = v->pool + m->positions;
     for (uint64_t k = 0; k < nv3; k++)
-        if (!isfinite(p[k]) || (m->normals != SW_SG_NO_NORMALS && !isfinite(v->pool[m->normals + k])))
+        if (!isfinite(p[k]) ||
+            (m->normals != SW_SG_NO_NORMALS && !isfinite(v->pool[m->normals + k])))
             return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
-                            "%s: mesh %u%s: vertex %llu: non-finite position or normal", c->what,
-                            i, at, (unsigned long long)(k / 3));
+                            "%s: mesh %u%s: vertex %llu: non-finite position or normal", c->what, i,
+                            at, (unsigned long long)(k / 3));
     double box[6];
     sw_sg_mesh_box(p, m->n_vertices, box);
     if (memcmp(box, m->box, sizeof box) != 0)

@@ -36,7 +36,7 @@ typedef struct sw_sg_pick_hit {
                         sw_sg_scene_traverse_meshes order */
     uint32_t mesh;   /* SW_SG_NONE: no mesh hit (face and mesh are never both set) */
     uint32_t triangle, node; /* a mesh hit: the triangle in the mesh, the MESH node */
-    double bary[3];  /* a mesh hit: the weights of the triangle's three vertices */
+    double bary[3];          /* a mesh hit: the weights of the triangle's three vertices */
 } sw_sg_pick_hit;
 
 /* The nearest hit with t in (0, t_max] (t_max <= 0: unbounded) of the ray origin + t * dir

@@ -268,12 +268,12 @@ typedef struct sw_sg_scene_stats {
     uint32_t nodes, instances;
     uint64_t face_occurrences; /* faces drawn after instance expansion */
     uint32_t adjacency;
-    double bbox[6];            /* world box of the faces sampled over their trim boxes, and of
-                                  the meshes' vertices */
+    double bbox[6]; /* world box of the faces sampled over their trim boxes, and of
+                       the meshes' vertices */
     size_t memory_bytes;
     uint32_t meshes;
-    uint64_t mesh_triangles;   /* of the meshes, each counted once */
-    uint64_t mesh_occurrences; /* meshes drawn after instance expansion */
+    uint64_t mesh_triangles;       /* of the meshes, each counted once */
+    uint64_t mesh_occurrences;     /* meshes drawn after instance expansion */
     uint64_t triangle_occurrences; /* their triangles, instances expanded */
 } sw_sg_scene_stats;
 /* Precondition: SW_SG_SEC_ALL required. Returns SW_OK or SW_ERR_OUT_OF_MEMORY (traversal). */

@@ -71,9 +71,9 @@ _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/bin
 #define SWS_ENTRY_SIZE 40u
 #define SWS_ALIGN 16u
 #define SWS_HEADER_CRC_AT 60u
-#define SWS_SEC_LODS SW__SG_SEC_LODS /* id of the optional cache section */
-#define SWS_CORE_SECTIONS 8u          /* FACES .. META: every file has them */
-#define SWS_LODS_SECTIONS 9u          /* and LODS */
+#define SWS_SEC_LODS SW__SG_SEC_LODS      /* id of the optional cache section */
+#define SWS_CORE_SECTIONS 8u              /* FACES .. META: every file has them */
+#define SWS_LODS_SECTIONS 9u              /* and LODS */
 #define SWS_MAX_SECTIONS SW__SG_SEC_COUNT /* and MESHES, INDICES (LODS then possibly empty) */
 
 typedef struct sws_header {
@@ -198,7 +198,8 @@ static int section_count_ok(uint32_t n)
 static sw_result check_header(const char *path, const unsigned char *p, uint64_t size,
                               const sws_header *h, sw_status *status)
 {
-    const uint32_t n_sec = section_count_ok(h->section_count) ? h->section_count : SWS_CORE_SECTIONS;
+    const uint32_t n_sec =
+        section_count_ok(h->section_count) ? h->section_count : SWS_CORE_SECTIONS;
     const uint64_t table_bytes = (uint64_t)n_sec * SWS_ENTRY_SIZE;
     if (h->table_offset < SWS_HEADER_SIZE || h->table_offset % SWS_ALIGN ||
         h->table_offset > h->file_size || table_bytes > h->file_size - h->table_offset)
@@ -263,11 +264,11 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
                         path, name, (unsigned long long)ent_off, (unsigned long long)off,
                         (unsigned long long)sz, (unsigned long long)data_start,
                         (unsigned long long)file_size);
-    uint64_t max_count = id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS ||
-                                 id == SW__SG_SEC_INDICES || lods
-                             ? UINT64_MAX
-                         : id == SW__SG_SEC_META                           ? 1
-                                                                           : SW_SG_NONE - 1;
+    uint64_t max_count =
+        id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS || id == SW__SG_SEC_INDICES || lods
+            ? UINT64_MAX
+        : id == SW__SG_SEC_META ? 1
+                                : SW_SG_NONE - 1;
     if (count > max_count || count > UINT64_MAX / rec || count * rec != sz ||
         (id == SW__SG_SEC_META && count != 1))
         return sw__fail(status, SW_ERR_FORMAT,
@@ -290,8 +291,7 @@ static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec
                 return sw__fail(status, SW_ERR_FORMAT,
                                 "%s: section %s at offset %llu overlaps section %s at offset %llu",
                                 path, sw__sg_section_names[a], (unsigned long long)x->offset,
-                                sw__sg_section_names[b],
-                                (unsigned long long)y->offset);
+                                sw__sg_section_names[b], (unsigned long long)y->offset);
         }
     return SW_OK;
 }
@@ -560,15 +560,16 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
     sw_result r = sw_sg_scene_require(scene, SW_SG_SEC_ALL, status);
     if (r != SW_OK)
         return r;
-    const uint32_t n_sec = scene->view.n_meshes    ? SWS_MAX_SECTIONS
-                           : lods && lods_size ? SWS_LODS_SECTIONS
-                                               : SWS_CORE_SECTIONS;
+    const uint32_t n_sec = scene->view.n_meshes ? SWS_MAX_SECTIONS
+                           : lods && lods_size  ? SWS_LODS_SECTIONS
+                                                : SWS_CORE_SECTIONS;
     enum { HEAD = SWS_HEADER_SIZE + SWS_MAX_SECTIONS * SWS_ENTRY_SIZE };
     const uint64_t head_bytes = SWS_HEADER_SIZE + (uint64_t)n_sec * SWS_ENTRY_SIZE;
     unsigned char head[HEAD], meta[16];
     const void *ptr[SWS_MAX_SECTIONS];
     uint64_t file_size;
-    build_header(&scene->view, n_sec, lods, lods ? lods_size : 0, ptr, meta, head, head_bytes, &file_size);
+    build_header(&scene->view, n_sec, lods, lods ? lods_size : 0, ptr, meta, head, head_bytes,
+                 &file_size);
 
     size_t tlen = strlen(path) + 32;
     char *tmp = malloc(tlen);

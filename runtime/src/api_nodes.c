@@ -504,11 +504,11 @@ static sw_result import_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status
 static sw_result check_mesh_desc(const sw_mesh_desc *d, sw_status *status)
 {
     const char *fn = "mesh";
-    if (d->vertex_count < 3 || d->vertex_count > SW__NODES_MAX_MESH ||
-        d->triangle_count < 1 || d->triangle_count > SW__NODES_MAX_MESH)
-        return sw__fail(status, SW_ERR_LIMIT,
-                        "%s: %u vertices and %u triangles (3..%u and 1..%u)", fn, d->vertex_count,
-                        d->triangle_count, SW__NODES_MAX_MESH, SW__NODES_MAX_MESH);
+    if (d->vertex_count < 3 || d->vertex_count > SW__NODES_MAX_MESH || d->triangle_count < 1 ||
+        d->triangle_count > SW__NODES_MAX_MESH)
+        return sw__fail(status, SW_ERR_LIMIT, "%s: %u vertices and %u triangles (3..%u and 1..%u)",
+                        fn, d->vertex_count, d->triangle_count, SW__NODES_MAX_MESH,
+                        SW__NODES_MAX_MESH);
     if (!d->positions || !d->indices)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL positions or indices", fn);
     for (uint32_t i = 0; i < d->vertex_count; i++) {

@@ -78,8 +78,7 @@ static sw_result append_geometry(compile_state *cs, const rt_node *n, uint32_t *
     cs->n_meshes += v->n_meshes;
     if (!note_records(&cs->face_nodes, &cs->n_face_nodes, &cs->cap_face_nodes,
                       sw_sg_builder_face_count(cs->b), n->id) ||
-        !note_records(&cs->mesh_nodes, &cs->n_mesh_nodes, &cs->cap_mesh_nodes, cs->n_meshes,
-                      n->id))
+        !note_records(&cs->mesh_nodes, &cs->n_mesh_nodes, &cs->cap_mesh_nodes, cs->n_meshes, n->id))
         cs->oom = 1;
     return SW_OK;
 }

@@ -184,13 +184,13 @@ static void check_info(sw_scene s, const char *what)
     sw_scene_info info;
     sw_status st = {0};
     CHECK(sw_scene_get_info(s, &info, &st) == SW_OK, "%s: info: %s", what, st.message);
-    CHECK(info.meshes == 2 && info.mesh_triangles == 12 + SPHERE_T &&
-              info.mesh_occurrences == 3 && info.triangle_occurrences == 24 + SPHERE_T &&
-              info.faces == 1 && info.face_occurrences == 1,
-          "%s: %u meshes, %llu triangles, %llu occurrences, %llu drawn triangles, %u faces",
-          what, info.meshes, (unsigned long long)info.mesh_triangles,
-          (unsigned long long)info.mesh_occurrences,
-          (unsigned long long)info.triangle_occurrences, info.faces);
+    CHECK(info.meshes == 2 && info.mesh_triangles == 12 + SPHERE_T && info.mesh_occurrences == 3 &&
+              info.triangle_occurrences == 24 + SPHERE_T && info.faces == 1 &&
+              info.face_occurrences == 1,
+          "%s: %u meshes, %llu triangles, %llu occurrences, %llu drawn triangles, %u faces", what,
+          info.meshes, (unsigned long long)info.mesh_triangles,
+          (unsigned long long)info.mesh_occurrences, (unsigned long long)info.triangle_occurrences,
+          info.faces);
     /* sphere x >= -11, y, z in [-1, 1]; boxes x in [5, 7], y up to 12; plate z = 3 */
     const double lo[3] = {-11, -1, -1}, hi[3] = {8, 12, 3};
     for (int k = 0; k < 3; k++)
@@ -227,14 +227,13 @@ static void check_picks(built *b, const char *what)
     sw_pick_hit p = pick_down(b->scene, 7.0, 1.0);
     CHECK(p.hit && p.surface == 0 && p.mesh == UINT32_MAX && fabs(p.t - 7.0) < 1e-9 &&
               p.node.id == b->plate.id,
-          "%s: plate over the box: hit %d surface %u mesh %u t %g node %#x", what, p.hit,
-          p.surface, p.mesh, p.t, p.node.id);
+          "%s: plate over the box: hit %d surface %u mesh %u t %g node %#x", what, p.hit, p.surface,
+          p.mesh, p.t, p.node.id);
     /* Into the sphere from +x: within the inscribed tessellation's distance of the sphere. */
     const double o[3] = {-5, 0.123, 0.05}, d[3] = {-1, 0, 0};
     sw_pick_hit s;
     sw_status st = {0};
-    CHECK(sw_scene_pick(b->scene, o, d, &s, &st) == SW_OK, "%s: sphere pick: %s", what,
-          st.message);
+    CHECK(sw_scene_pick(b->scene, o, d, &s, &st) == SW_OK, "%s: sphere pick: %s", what, st.message);
     double r2 = 0.0;
     for (int k = 0; k < 3; k++)
         r2 += (s.point[k] - k_ball_c[k]) * (s.point[k] - k_ball_c[k]);
@@ -655,8 +654,8 @@ static coverage compare_traced(const tracer *t, const char *png)
             int behind = 0, first = -1, same = 1;
             for (int s = 0; s < 9 && same; s++) {
                 int bh;
-                const int c = trace(t, x + 0.5 + 1.5 * (s % 3 - 1), y + 0.5 + 1.5 * (s / 3 - 1),
-                                    &bh);
+                const int c =
+                    trace(t, x + 0.5 + 1.5 * (s % 3 - 1), y + 0.5 + 1.5 * (s / 3 - 1), &bh);
                 if (s == 4)
                     behind = bh;
                 same = first < 0 || c == first;
@@ -675,8 +674,8 @@ static coverage compare_traced(const tracer *t, const char *png)
     return cv;
 }
 
-static void draw(sw_renderer r, sw_scene s, const sw_camera *cam, int walkthrough,
-                 const char *name, char *path, sw_frame_stats *fs)
+static void draw(sw_renderer r, sw_scene s, const sw_camera *cam, int walkthrough, const char *name,
+                 char *path, sw_frame_stats *fs)
 {
     snprintf(path, 1024, "%s/%s.png", g_work, name);
     sw_frame_desc f = {.scene = s, .camera = *cam, .width = W, .height = H, .output_path = path};
@@ -752,9 +751,10 @@ static void check_against_trace(const char *png, double radius, const char *what
           "%s: %ld of %ld certain pixels wrong; mesh in front of the plate at %ld, plate in front "
           "of the mesh at %ld",
           what, cv.wrong, cv.certain, cv.mesh_in_front, cv.plate_in_front);
-    printf("%s: %ld of %ld certain pixels differ from the ray-traced exact sphere and plate "
-           "(%ld mesh pixels; mesh occludes the plate at %ld, the plate occludes the mesh at %ld)\n",
-           what, cv.wrong, cv.certain, cv.green, cv.mesh_in_front, cv.plate_in_front);
+    printf(
+        "%s: %ld of %ld certain pixels differ from the ray-traced exact sphere and plate "
+        "(%ld mesh pixels; mesh occludes the plate at %ld, the plate occludes the mesh at %ld)\n",
+        what, cv.wrong, cv.certain, cv.green, cv.mesh_in_front, cv.plate_in_front);
 }
 
 static void test_occlusion(sw_renderer r, sphere_mesh *sm)

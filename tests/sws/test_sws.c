@@ -916,8 +916,8 @@ static sw_sg_builder *mesh_builder(void)
     m.normals = SW_SG_NO_NORMALS;
     m.indices = sw_sg_builder_push_indices(b, quad_t, 6);
     const uint32_t m1 = sw_sg_builder_add_mesh(b, &m);
-    const double t[12] = {2, 0, 0, 1, 0, 2, 0, 0, 0, 0, 2, 0}, shift[12] = {1, 0, 0, 0, 0, 1, 0, 7,
-                                                                            0, 0, 1, 0};
+    const double t[12] = {2, 0, 0, 1, 0, 2, 0, 0, 0, 0, 2, 0},
+                 shift[12] = {1, 0, 0, 0, 0, 1, 0, 7, 0, 0, 1, 0};
     const uint32_t g = sw_sg_builder_add_node(b, SW_SG_NODE_TRANSFORM, 0, 0, t, sws_red, "tet");
     sw_sg_builder_add_node(b, SW_SG_NODE_MESH, g, m0, NULL, NULL, NULL);
     sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, g, shift, sws_green, NULL);
