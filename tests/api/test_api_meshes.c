@@ -26,6 +26,8 @@
  *   the plate), the plate where that is nearer (it occludes the mesh), background elsewhere; 0
  *   wrong pixels allowed, and both occlusion cases must occur. A plate drawn as a mesh matches the
  *   same plate drawn as NURBS (one-pixel distance). A mesh behind the camera is culled (stats).
+ *   Instances of a detached mesh draw it at their places in their colours, a mesh's own colour
+ *   winning over its instance's.
  *   Saved and reloaded, the scene renders to the same image (0 pixels differ); walkthrough and
  *   split frames of a mesh scene equal its converged frame; after sw_node_set_mesh the frame
  *   shows the new sphere (ray-traced check again).
@@ -866,6 +868,76 @@ static void test_mesh_vs_nurbs(sw_renderer r)
     sw_scene_destroy(b);
 }
 
+/* The pixel where world point p shows (the tracer's camera). */
+static void project(const tracer *t, const double p[3], int *x, int *y)
+{
+    double rel[3], r = 0.0, u = 0.0, z = 0.0;
+    for (int k = 0; k < 3; k++)
+        rel[k] = p[k] - t->eye[k];
+    for (int k = 0; k < 3; k++) {
+        r += rel[k] * t->right[k];
+        u += rel[k] * t->up[k];
+        z += rel[k] * t->fwd[k];
+    }
+    *x = (int)floor(W / 2.0 + t->focal * r / z);
+    *y = (int)floor(H / 2.0 - t->focal * u / z);
+}
+
+/* Instances place a detached mesh prototype with their transforms and colours; a mesh's own
+ * colour wins over its instance's (sw_nodes.h, Colours). Checked at each box's projected centre
+ * and beside it (background). */
+static void test_instances(sw_renderer r)
+{
+    sw_scene s;
+    EXPECT_RESULT(sw_scene_create(NULL, &s, NULL), SW_OK);
+    sw_mesh_desc bm = box_mesh(1.0);
+    sw_node plain, blue;
+    sw_node_desc proto = {.detached = 1};
+    EXPECT_RESULT(sw_node_add_mesh(s, &proto, &bm, &plain, NULL), SW_OK);
+    set_color(proto.color, 0.1f, 0.2f, 0.9f);
+    EXPECT_RESULT(sw_node_add_mesh(s, &proto, &bm, &blue, NULL), SW_OK);
+    const struct {
+        double x;
+        sw_node of;
+        float c[3];
+    } inst[3] = {{-6, plain, {0.9f, 0.1f, 0.1f}}, {-1, plain, {0.1f, 0.8f, 0.2f}},
+                 {4, blue, {0.9f, 0.1f, 0.1f}}};
+    for (int k = 0; k < 3; k++) {
+        sw_node_desc d = {.kind = SW_NODE_INSTANCE, .instance_of = inst[k].of};
+        translation(d.transform, inst[k].x, -1, 0);
+        set_color(d.color, inst[k].c[0], inst[k].c[1], inst[k].c[2]);
+        sw_node n;
+        EXPECT_RESULT(sw_node_add(s, &d, &n, NULL), SW_OK);
+    }
+    const sw_camera cam = {{0, 0, 20}, {0, 0, 0}, {0, 1, 0}, 40};
+    char path[1024];
+    sw_frame_stats fs;
+    memset(&fs, 0, sizeof fs);
+    draw(r, s, &cam, 0, "instances", path, &fs);
+    CHECK(fs.meshes_drawn == 3, "instances: %llu mesh occurrences drawn",
+          (unsigned long long)fs.meshes_drawn);
+    tracer t;
+    tracer_camera(&t, &cam);
+    int w = 0, h = 0;
+    unsigned char *img = sw_test_read_rgba(path, &w, &h);
+    CHECK(img && w == W && h == H, "read %s", path);
+    const int want[3] = {0, 1, 2}; /* dominant channel: red, green, blue (the mesh's own) */
+    for (int k = 0; img && w == W && h == H && k < 3; k++) {
+        const double c[3] = {inst[k].x + 1.0, 0.0, 1.0}, beside[3] = {inst[k].x + 1.0, 2.5, 0.0};
+        int x, y, bx, by;
+        project(&t, c, &x, &y);
+        project(&t, beside, &bx, &by);
+        const unsigned char *p = img + 4 * ((size_t)y * W + x), *q = img + 4 * ((size_t)by * W + bx);
+        int dom = p[0] >= p[1] && p[0] >= p[2] ? 0 : p[1] >= p[2] ? 1 : 2;
+        CHECK(dom == want[k] && q[0] >= 250 && q[1] >= 250 && q[2] >= 250,
+              "instance %d: pixel (%d, %d) = (%u, %u, %u), dominant %d (want %d); beside it "
+              "(%u, %u, %u)",
+              k, x, y, p[0], p[1], p[2], dom, want[k], q[0], q[1], q[2]);
+    }
+    free(img);
+    sw_scene_destroy(s);
+}
+
 static void test_render(void)
 {
     sw_renderer r;
@@ -877,6 +949,7 @@ static void test_render(void)
     sphere_mesh *sm = malloc(sizeof *sm);
     test_occlusion(r, sm);
     test_mesh_vs_nurbs(r);
+    test_instances(r);
     free(sm);
     sw_renderer_destroy(r);
 }
