@@ -900,7 +900,8 @@ static void test_instances(sw_renderer r)
         double x;
         sw_node of;
         float c[3];
-    } inst[3] = {{-6, plain, {0.9f, 0.1f, 0.1f}}, {-1, plain, {0.1f, 0.8f, 0.2f}},
+    } inst[3] = {{-6, plain, {0.9f, 0.1f, 0.1f}},
+                 {-1, plain, {0.1f, 0.8f, 0.2f}},
                  {4, blue, {0.9f, 0.1f, 0.1f}}};
     for (int k = 0; k < 3; k++) {
         sw_node_desc d = {.kind = SW_NODE_INSTANCE, .instance_of = inst[k].of};
@@ -927,7 +928,8 @@ static void test_instances(sw_renderer r)
         int x, y, bx, by;
         project(&t, c, &x, &y);
         project(&t, beside, &bx, &by);
-        const unsigned char *p = img + 4 * ((size_t)y * W + x), *q = img + 4 * ((size_t)by * W + bx);
+        const unsigned char *p = img + 4 * ((size_t)y * W + x),
+                            *q = img + 4 * ((size_t)by * W + bx);
         int dom = p[0] >= p[1] && p[0] >= p[2] ? 0 : p[1] >= p[2] ? 1 : 2;
         CHECK(dom == want[k] && q[0] >= 250 && q[1] >= 250 && q[2] >= 250,
               "instance %d: pixel (%d, %d) = (%u, %u, %u), dominant %d (want %d); beside it "
