@@ -28,8 +28,8 @@
  *   same plate drawn as NURBS (one-pixel distance). A mesh behind the camera is culled (stats).
  *   Instances of a detached mesh draw it at their places in their colours, a mesh's own colour
  *   winning over its instance's.
- *   Saved and reloaded, the scene renders to the same image (0 pixels differ); walkthrough and
- *   split frames of a mesh scene equal its converged frame; after sw_node_set_mesh the frame
+ *   Saved and reloaded, the scene renders to the same image (0 pixels differ); walkthrough,
+ *   split and eval_exact frames of a mesh scene equal its converged frame; after sw_node_set_mesh the frame
  *   shows the new sphere (ray-traced check again).
  */
 #include <splinewalk/sw_nodes.h>
@@ -800,7 +800,7 @@ static void test_occlusion(sw_renderer r, sphere_mesh *sm)
            dr);
     sw_scene_destroy(loaded);
 
-    /* A mesh-only scene: walkthrough and split frames draw it as the converged frame does. */
+    /* A mesh-only scene: walkthrough, split and exact frames draw it as a converged one does. */
     EXPECT_RESULT(sw_node_set_visible(s, pl, 0, NULL), SW_OK);
     draw(r, s, &k_top, 0, "mesh_only", conv, NULL);
     draw(r, s, &k_top, 1, "mesh_only_walk", walk, &fs);
@@ -814,11 +814,19 @@ static void test_occlusion(sw_renderer r, sphere_mesh *sm)
     CHECK(sw_renderer_submit(r, &fs, &st) == SW_OK, "submit: %s", st.message);
     CHECK(fs.meshes_drawn == 1, "split frame: %llu meshes drawn",
           (unsigned long long)fs.meshes_drawn);
-    const double dw = differing_percent(conv, walk), ds = differing_percent(conv, split);
-    CHECK(dw == 0.0 && ds == 0.0, "walkthrough %.4f %%, split %.4f %% differ from converged", dw,
-          ds);
-    printf("mesh only: walkthrough %.4f %%, split frame %.4f %% of pixels differ from converged\n",
-           dw, ds);
+    char exact[1024];
+    snprintf(exact, sizeof exact, "%s/mesh_only_exact.png", g_work);
+    sw_frame_desc fe = {.scene = s, .camera = k_top, .width = W, .height = H, .output_path = exact};
+    fe.eval_exact = 1;
+    CHECK(sw_renderer_draw(r, &fe, NULL, &st) == SW_OK, "exact: %s", st.message);
+    const double dw = differing_percent(conv, walk), ds = differing_percent(conv, split),
+                 de = differing_percent(conv, exact);
+    CHECK(dw == 0.0 && ds == 0.0 && de == 0.0,
+          "walkthrough %.4f %%, split %.4f %%, eval_exact %.4f %% differ from converged", dw, ds,
+          de);
+    printf("mesh only: walkthrough %.4f %%, split frame %.4f %%, eval_exact %.4f %% of pixels "
+           "differ from converged\n",
+           dw, ds, de);
 
     /* A live edit: a smaller sphere, the plate back. */
     EXPECT_RESULT(sw_node_set_visible(s, pl, 1, NULL), SW_OK);
