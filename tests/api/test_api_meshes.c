@@ -29,8 +29,8 @@
  *   Instances of a detached mesh draw it at their places in their colours, a mesh's own colour
  *   winning over its instance's.
  *   Saved and reloaded, the scene renders to the same image (0 pixels differ); walkthrough,
- *   split and eval_exact frames of a mesh scene equal its converged frame; after sw_node_set_mesh the frame
- *   shows the new sphere (ray-traced check again).
+ *   split and eval_exact frames of a mesh scene equal its converged frame; after sw_node_set_mesh
+ * the frame shows the new sphere (ray-traced check again).
  */
 #include <splinewalk/sw_nodes.h>
 
