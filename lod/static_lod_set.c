@@ -363,7 +363,8 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
     if (job) {
         *job = (build_job){s, unit};
         /* in the slot's group: converged frames and destroy wait on it */
-        const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group};
+        const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group,
+                                 SW_TH_TASK_STATIC_BUILD};
         if (sw_th_pool_submit(s->pool, &task) == SW_OK)
             return SW_OK;
         free(job);

@@ -334,7 +334,10 @@ static void compile_task(void *ctx)
     pthread_mutex_lock(&m->edit_lock);
     int again = m->revision != revision;
     if (again) {
-        sw_th_task t = {.fn = compile_task, .ctx = m, .priority = SW_TH_PRIORITY_BACKGROUND};
+        sw_th_task t = {.fn = compile_task,
+                        .ctx = m,
+                        .priority = SW_TH_PRIORITY_BACKGROUND,
+                        .kind = SW_TH_TASK_COMPILE};
         again = sw_th_pool_submit(m->pool, &t) == SW_OK;
     }
     m->compile_queued = again;
@@ -348,7 +351,10 @@ static void schedule_compile(sw_rt_model *m)
 {
     if (m->compile_queued)
         return;
-    sw_th_task t = {.fn = compile_task, .ctx = m, .priority = SW_TH_PRIORITY_BACKGROUND};
+    sw_th_task t = {.fn = compile_task,
+                    .ctx = m,
+                    .priority = SW_TH_PRIORITY_BACKGROUND,
+                    .kind = SW_TH_TASK_COMPILE};
     m->compile_queued = sw_th_pool_submit(m->pool, &t) == SW_OK;
 }
 

@@ -111,5 +111,12 @@ int sw_rt_view_parse(const char *text, sw_view_preset *out);
  * 0 with the outputs set, -1 for a stale handle or another thread. */
 int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *pages,
                               int32_t *side);
+/* The renderer's worker pool, borrowed until the renderer is destroyed, for the profile's
+ * per-frame pool statistics (sw_th_pool_stats_get, sw_th_pool_queued: any thread). NULL before
+ * the first frame made it, for a stale handle or another thread than the owner. */
+struct sw_th_pool *sw_rt_renderer_pool_ptr(sw_renderer renderer);
+/* Times the pool's tasks by kind (sw_th_pool_desc.time_tasks) from now on: the pool's, or the
+ * one the first frame makes. Owner thread; 0, or -1 for a stale handle or another thread. */
+int sw_rt_renderer_time_pool_tasks(sw_renderer renderer, int on);
 
 #endif
