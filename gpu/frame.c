@@ -1085,6 +1085,11 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     } else {
         r = collect_all(f, &boxes, scene_box, status);
     }
+    sw__fr_meshes meshes;
+    if (r == SW_OK)
+        r = sw__fr_meshes_collect(f, &meshes, scene_box, status);
+    else
+        memset(&meshes, 0, sizeof meshes);
     static const double k_origin[3] = {0.0, 0.0, 0.0};
     double near_plane =
         scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
@@ -1111,6 +1116,9 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
         r = hierarchy ? sw__fr_hlod_draw_face(f, &f->occ[i], status)
                       : sw__fr_draw_face(f, &f->occ[i], status);
     }
+    if (r == SW_OK)
+        r = sw__fr_meshes_draw(f, &meshes, status);
+    sw__fr_meshes_free(&meshes);
     free(boxes);
     return r;
 }

@@ -177,4 +177,37 @@ sw_result sw__fr_static_collect(frame *f, const sw_lod_face_cones *fc, double **
 /* LOD colouring: static level k (fine -> coarse), or -1 for the per-frame path. */
 void sw__fr_lod_color(int32_t level, float out[4]);
 
+/* ---- frame_mesh.c ---- */
+/* Triangles in object space for sw__fr_append_triangles. */
+typedef struct sw__fr_triangles {
+    const double *positions; /* 3 per vertex */
+    const float *normals_f;  /* 3 per vertex, or NULL */
+    const double *normals_d; /* 3 per vertex, or NULL; both NULL: flat, a normal per triangle */
+    double normal_matrix[9]; /* row-major 3x3 mapping normals to the world (with normals) */
+    uint32_t n_vertices, n_triangles;
+    const uint32_t *triangles; /* 3 per triangle */
+} sw__fr_triangles;
+/* Appends the triangles under the occurrence's transform (eye-relative, float) to the frame's
+ * mesh as one untrimmed draw of o->color: the one triangle path of static LODs and meshes. */
+sw_result sw__fr_append_triangles(frame *f, const occurrence *o, const sw__fr_triangles *t,
+                                  sw_status *status);
+
+typedef struct sw__fr_mesh_occ {
+    uint32_t mesh;
+    double world[12];
+    float color[4];
+    double box[6]; /* eye-relative */
+} sw__fr_mesh_occ;
+typedef struct sw__fr_meshes {
+    sw__fr_mesh_occ *occ;
+    size_t n, cap;
+} sw__fr_meshes;
+/* The scene's mesh occurrences with their eye-relative boxes, which also grow scene_box (the
+ * near plane is chosen from it). Before the view is set; needs f->view.eye. */
+sw_result sw__fr_meshes_collect(frame *f, sw__fr_meshes *fm, double scene_box[6],
+                                sw_status *status);
+/* Draws the collected occurrences inside the frustum (after the view is set). */
+sw_result sw__fr_meshes_draw(frame *f, const sw__fr_meshes *fm, sw_status *status);
+void sw__fr_meshes_free(sw__fr_meshes *fm);
+
 #endif

@@ -162,31 +162,18 @@ static int32_t choose_level(frame *f, uint32_t unit, const double m[12],
 static sw_result append_level(frame *f, const occurrence *o, const sw_lod_static_level *lv,
                               int32_t level, sw_status *status)
 {
-    sw_result r = sw__gpu_mesh_reserve(&f->mesh, lv->n_vertices, 3 * (size_t)lv->n_triangles, status);
-    if (r != SW_OK)
-        return r;
-    const size_t base = f->mesh.n_v, first = f->mesh.n_idx;
     const double *m = o->world;
-    for (uint32_t i = 0; i < lv->n_vertices; ++i) {
-        const double *p = lv->positions + 3 * i;
-        const float *n = lv->normals + 3 * i;
-        sw__gpu_vertex *v = &f->mesh.v[f->mesh.n_v++];
-        for (int a = 0; a < 3; ++a) {
-            v->pos[a] = (float)(m[4 * a] * p[0] + m[4 * a + 1] * p[1] + m[4 * a + 2] * p[2] +
-                                (m[4 * a + 3] - f->view.eye[a]));
-            /* rigid and similarity transforms keep normals along M n; shading is two-sided */
-            v->nrm[a] = (float)(m[4 * a] * n[0] + m[4 * a + 1] * n[1] + m[4 * a + 2] * n[2]);
-        }
-        v->st[0] = v->st[1] = 0.0f;
-    }
-    for (uint32_t t = 0; t < 3 * lv->n_triangles; ++t)
-        f->mesh.idx[f->mesh.n_idx++] = (uint32_t)base + lv->triangles[t];
-    trim_need none = {0.0, 0.0};
-    const double cell[2] = {0.0, 0.0};
+    /* rigid and similarity transforms keep normals along M n; shading is two-sided */
+    sw__fr_triangles t = {.positions = lv->positions,
+                          .normals_f = lv->normals,
+                          .normal_matrix = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]},
+                          .n_vertices = lv->n_vertices,
+                          .n_triangles = lv->n_triangles,
+                          .triangles = lv->triangles};
     occurrence shown = *o;
     if (f->lod_colors)
         sw__fr_lod_color(level, shown.color);
-    r = sw__fr_add_draw(f, &shown, first, 0, &none, cell, status);
+    sw_result r = sw__fr_append_triangles(f, &shown, &t, status);
     f->st.static_triangles += lv->n_triangles;
     return r;
 }

@@ -306,6 +306,9 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->static_drawn = g->static_units_drawn;
     out->static_faces = g->static_faces;
     out->static_triangles = g->static_triangles;
+    out->meshes_drawn = g->meshes_drawn;
+    out->meshes_culled = g->meshes_culled;
+    out->mesh_triangles = g->mesh_triangles;
     out->static_requests = g->static_requests;
 }
 

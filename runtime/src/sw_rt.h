@@ -65,6 +65,7 @@ typedef struct sw_rt_scene {
     const struct sw_sg_bvh *prebuilt_bvh;     /* = pick_bvh of a version; NULL otherwise */
     struct sw_lod_face_cones *prebuilt_cones; /* owned */
     uint32_t *face_nodes;                     /* owned; n_faces entries */
+    uint32_t *mesh_nodes;                     /* owned; n_meshes entries (NULL: none) */
 } sw_rt_scene;
 
 /* A new scene holding sg (one reference, the caller's; NULL on failure, sg then freed). */
