@@ -200,6 +200,11 @@ sw_result sw__fr_add_draw(frame *f, const occurrence *o, size_t first_idx, int t
     d->n_idx = f->mesh.n_idx - first_idx;
     memcpy(d->color, o->color, sizeof d->color);
     d->trim_entry = -1;
+    /* the face's grids and static meshes carry st over its uv box (fat borders: sw__fr_fat_border) */
+    const double *ub = f->sv->faces[o->face].uv_box;
+    const float uv_map[4] = {(float)ub[0], (float)ub[2], (float)(ub[1] - ub[0]),
+                             (float)(ub[3] - ub[2])};
+    memcpy(d->uv_map, uv_map, sizeof uv_map);
     if (trimmed)
         f->trims[f->n_trims++] = (pending_trim){f->n_draws,
                                                 o->face,
@@ -332,6 +337,8 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
     double bw = ub[1] - ub[0], bh = ub[3] - ub[2];
     float map[4] = {(float)((pt->u0 - ub[0]) / bw), (float)((pt->u1 - pt->u0) / bw),
                     (float)((pt->v0 - ub[2]) / bh), (float)((pt->v1 - pt->v0) / bh)};
+    const float uv_map[4] = {(float)pt->u0, (float)pt->v0, (float)(pt->u1 - pt->u0),
+                             (float)(pt->v1 - pt->v0)};
     for (int32_t b = 0; b < kv; ++b) {
         for (int32_t a = 0; a < ku; ++a) {
             sw__gpu_patch_rec *rec = &f->recs[f->n_recs++];
@@ -348,6 +355,7 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
             rec->draw = draw;
             rec->level_u = lu;
             rec->level_v = lv;
+            memcpy(rec->uv_map, uv_map, sizeof uv_map);
             if (f->ctx->patch_hook)
                 sw__fr_report_patch(f, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
                                     sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1,
@@ -431,6 +439,12 @@ sw_result sw__fr_fat_border(frame *f, const occurrence *o, const double *uv, siz
         trim_need none = {0.0, 0.0};
         size_t draw = f->n_draws;
         r = sw__fr_add_draw(f, o, first, 0, &none, cell, status);
+        if (r == SW_OK) { /* its st spans st_box, or is 0 without one: uv then the box's corner */
+            const double *b = st_box ? st_box : f->sv->faces[o->face].uv_box;
+            const float uv_map[4] = {(float)b[0], (float)b[2], st_box ? (float)(b[1] - b[0]) : 0.0f,
+                                     st_box ? (float)(b[3] - b[2]) : 0.0f};
+            memcpy(f->draws[draw].uv_map, uv_map, sizeof uv_map);
+        }
         f->st.triangles += (f->mesh.n_idx - first) / 3;
         f->border_triangles += (f->mesh.n_idx - first) / 3;
         if (r == SW_OK && st_box) {
@@ -928,9 +942,18 @@ static void screen_view_init(frame *f)
 /* Collects occurrences, sets the view (near plane from the scene's box) and tessellates. */
 /* Every occurrence, with its eye-relative control-net box (the scene traversal, all control points
  * transformed: the path without a BVH). */
-static sw_result collect_all(frame *f, double **boxes_out, double scene_box[6], sw_status *status)
+static sw_result collect_all(frame *f, const sw_gpu_frame_desc *desc, double **boxes_out,
+                             double scene_box[6], sw_status *status)
 {
-    if (sw_sg_scene_traverse(f->scene, collect, f) != SW_OK || f->oom)
+    for (size_t i = 0; desc->occurrences && i < desc->n_occurrences && !f->oom; ++i) {
+        const sw_gpu_occurrence *o = &desc->occurrences[i];
+        if (o->face >= f->sv->n_faces)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                            "frame: occurrence %zu names face %u of %u", i, o->face,
+                            f->sv->n_faces);
+        collect(f, o->face, o->world, o->color);
+    }
+    if ((!desc->occurrences && sw_sg_scene_traverse(f->scene, collect, f) != SW_OK) || f->oom)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
     double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes);
     if (!boxes)
@@ -1036,12 +1059,13 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
     double *boxes = NULL, scene_box[6];
     sw_result r = SW_OK;
-    if (desc->bvh) {
+    const sw_sg_bvh *bvh = desc->occurrences ? NULL : desc->bvh;
+    if (bvh) {
         sw__fr_box_empty(scene_box);
-        if (desc->bvh->n_nodes)
-            eye_box(f, desc->bvh->nodes[0].box, scene_box);
+        if (bvh->n_nodes)
+            eye_box(f, bvh->nodes[0].box, scene_box);
     } else {
-        r = collect_all(f, &boxes, scene_box, status);
+        r = collect_all(f, desc, &boxes, scene_box, status);
     }
     static const double k_origin[3] = {0.0, 0.0, 0.0};
     double near_plane =
@@ -1049,8 +1073,8 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     if (r == SW_OK)
         r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane,
                               status);
-    if (r == SW_OK && desc->bvh)
-        r = collect_bvh(f, desc->bvh, &boxes, status);
+    if (r == SW_OK && bvh)
+        r = collect_bvh(f, bvh, &boxes, status);
     if (r == SW_OK && desc->face_cones && boxes)
         r = cull_back_faces(f, desc->face_cones, boxes, status);
     screen_view_init(f);
