@@ -433,16 +433,19 @@ sw_result sw__fr_fat_border(frame *f, const occurrence *o, const double *uv, siz
     sw_sg_surface srf;
     sw_sg_scene_face_surface(f->scene, o->face, &srf);
     size_t first = f->mesh.n_idx;
+    /* st over the face's uv box when the ribbon is drawn untrimmed: no lookup reads it, but the
+     * shading's uv (u_uv_map) does */
+    const double *st_rect = st_box ? st_box : f->sv->faces[o->face].uv_box;
     sw_result r = sw__gpu_fat_border(&f->view, &srf, o->world, uv, n, left_inside, cell[0], cell[1],
-                                     2.0 * f->eps_px, st_box, &f->mesh, status);
+                                     2.0 * f->eps_px, st_rect, &f->mesh, status);
     if (r == SW_OK && f->mesh.n_idx > first) {
         trim_need none = {0.0, 0.0};
         size_t draw = f->n_draws;
         r = sw__fr_add_draw(f, o, first, 0, &none, cell, status);
-        if (r == SW_OK) { /* its st spans st_box, or is 0 without one: uv then the box's corner */
-            const double *b = st_box ? st_box : f->sv->faces[o->face].uv_box;
-            const float uv_map[4] = {(float)b[0], (float)b[2], st_box ? (float)(b[1] - b[0]) : 0.0f,
-                                     st_box ? (float)(b[3] - b[2]) : 0.0f};
+        if (r == SW_OK) {
+            const double *b = st_rect;
+            const float uv_map[4] = {(float)b[0], (float)b[2], (float)(b[1] - b[0]),
+                                     (float)(b[3] - b[2])};
             memcpy(f->draws[draw].uv_map, uv_map, sizeof uv_map);
         }
         f->st.triangles += (f->mesh.n_idx - first) / 3;
