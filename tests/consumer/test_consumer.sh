@@ -63,6 +63,16 @@ cc "${flags[@]}" "$work/embed_minimal.c" $(pkg-config --cflags --libs splinewalk
    $(env -u PKG_CONFIG_LIBDIR pkg-config --cflags --libs glfw3) -lm -Wl,-rpath,"$libdir" \
    -o "$work/embed_minimal" || fail "embed_minimal does not build against the installed package"
 
+step "build samples/embed_custom_shader.c (an EGL host with its own shading) through pkg-config"
+cp "$src/samples/embed_custom_shader.c" "$work/embed_custom_shader.c"
+# shellcheck disable=SC2046
+cc "${flags[@]}" "$work/embed_custom_shader.c" $(pkg-config --cflags --libs splinewalk) \
+   $(env -u PKG_CONFIG_LIBDIR pkg-config --cflags --libs egl opengl) -lm -Wl,-rpath,"$libdir" \
+   -o "$work/embed_custom_shader" || fail "embed_custom_shader does not build against the installed package"
+"$work/embed_custom_shader" "$work/custom_shader.png" > "$work/custom_shader.log" ||
+  fail "embed_custom_shader: $(cat "$work/custom_shader.log")"
+[ -s "$work/custom_shader.png" ] || fail "embed_custom_shader wrote no PNG"
+
 for b in "$bin_cmake" "$bin_pc"; do
   deps=$(ldd "$b")
   grep -q "libsplinewalk.so.0 => $prefix/" <<<"$deps" ||
