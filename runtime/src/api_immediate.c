@@ -404,7 +404,15 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
     const sw_rt_frame_extra extra = {im->occ, n_occ,
                                      im->has_shading && !desc->library_shading ? &im->shading
                                                                                : NULL};
+    /* The frame binds the trim atlas on the active texture unit: unit 0, so that the host's
+     * textures on units 1 and up stay bound (sw_immediate.h, Bindings); the host's choice of
+     * active unit is given back. */
+    sw__gpu_make_current(gpu);
+    GLint active = GL_TEXTURE0;
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &active);
+    glActiveTexture(GL_TEXTURE0);
     r = sw__rt_renderer_draw_scene(renderer, fn, im->scene, &fd, &extra, stats, status);
+    glActiveTexture((GLenum)active);
     if (r == SW_OK)
         sw__status_ok(status);
     return r;

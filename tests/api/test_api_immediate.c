@@ -16,7 +16,8 @@
  *   (u, v) of the point the pixel's ray meets (analytic), within 3/255; pixels inside the hole
  *   are background (trimmed before shading). The normal as colour: (0.5, 0.5, 1) for the plane,
  *   (0.5, 0.5, 0) for the same plane with reversed = 1. A host uniform (glProgramUniform4f on the
- *   listed programs) times sw_shade_library: the library's colour scaled per channel.
+ *   listed programs) times sw_shade_library: the library's colour scaled per channel. A host
+ *   texture on unit 1 is what its shading samples, and stays bound (the active unit too).
  *   library_shading = 1 draws the library's image again, byte for byte.
  * misuse: NULL desc, no draws, NULL draws, a stale sw_nurbs in the list (nothing drawn), stale
  *   update and double destroy, NaN control point, decreasing knots, a degenerate trim loop (all
@@ -298,6 +299,12 @@ static const char *const k_shade_tint =
     "  return vec4(c.rgb * host_tint.rgb, c.a);\n"
     "}\n";
 
+static const char *const k_shade_texture =
+    "layout(binding = 1) uniform sampler2D host_texture;\n"
+    "vec4 sw_shade(vec3 pos, vec3 normal, vec2 uv, vec4 color) {\n"
+    "  return texture(host_texture, uv);\n"
+    "}\n";
+
 /* The plane seen straight from above: eye (5, 5, 20), 40° (square pixels). */
 static sw_camera top_camera(void)
 {
@@ -427,7 +434,34 @@ static void test_normal_and_uniform(sw_renderer r, const objects *o)
               tinted[2] == 0,
           "tinted (%d, %d, %d) from (%d, %d, %d)", tinted[0], tinted[1], tinted[2], lib[0],
           lib[1], lib[2]);
-    /* a source that does not compile: refused with its log, the tint stays */
+    /* a host texture on unit 1 (the host's unit active during the draw): sampled by the host's
+     * shading, still bound afterwards, and the active unit given back */
+    static const unsigned char k_texel[4] = {40, 200, 90, 255};
+    GLuint tex = 0;
+    glGenTextures(1, &tex);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, 1, 1, 0, GL_RGBA, GL_UNSIGNED_BYTE, k_texel);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    CHECK(sw_renderer_set_shading(r, k_shade_texture, &st) == SW_OK, "texture: %s", st.message);
+    EXPECT_RESULT(sw_renderer_shading_programs(r, progs, NULL), SW_OK);
+    for (int k = 0; k < 3; k++)
+        glProgramUniform1i(progs[k], glGetUniformLocation(progs[k], "host_texture"), 1);
+    unsigned char sampled[3];
+    draw_immediate(r, &d, 1, &cam, "shade_texture", 0);
+    center_pixel("shade_texture", sampled);
+    GLint active = 0, bound = 0;
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &active);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &bound);
+    printf("host texture on unit 1: (%d, %d, %d); active unit after the draw %#x, bound %d\n",
+           sampled[0], sampled[1], sampled[2], (unsigned)active, bound);
+    CHECK(memcmp(sampled, k_texel, 3) == 0, "host texture sampled as (%d, %d, %d)", sampled[0],
+          sampled[1], sampled[2]);
+    CHECK(active == GL_TEXTURE1 && bound == (GLint)tex, "host texture state not kept");
+    glActiveTexture(GL_TEXTURE0);
+    glDeleteTextures(1, &tex);
+    /* a source that does not compile: refused with its log, the shading before stays */
     EXPECT_RESULT(sw_renderer_set_shading(r, "vec4 sw_shade(float x) { return y; }", &st),
                   SW_ERR_INVALID_ARGUMENT);
     CHECK(strstr(st.message, "compile") || strstr(st.message, "link"), "message: %s", st.message);

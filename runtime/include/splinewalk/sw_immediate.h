@@ -49,9 +49,11 @@
  * shading). Names starting with sw_, u_, v_ and o_ are the library's.
  * Bindings: the library uses texture unit 0 (the trim atlas, sampler u_trim) and shader storage
  * bindings 0-5; a host shader samples its own textures from units 1 and up, bound by the host
- * before the draw (the library does not touch other units). Host uniforms are set with
- * glProgramUniform* on the programs sw_renderer_shading_programs lists; they keep their values
- * across draws until the shading is replaced.
+ * before the draw (the library does not touch other units, and gives the active unit back).
+ * Host uniforms are set with glProgramUniform* on the programs sw_renderer_shading_programs
+ * lists; they keep their values across draws until the shading is replaced. Other GL state
+ * (program, vertex array, buffers, depth and blend state) is the renderer's after a draw, as
+ * after sw_renderer_draw: set yours again; the framebuffer bindings and viewport are restored.
  */
 #ifndef SPLINEWALK_SW_IMMEDIATE_H
 #define SPLINEWALK_SW_IMMEDIATE_H
