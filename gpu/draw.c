@@ -156,8 +156,8 @@ static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
         glDisableVertexAttribArray(a);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->grid_ibo);
     glUseProgram(batch->exact ? ctx->surf.exact : ctx->surf.eval);
-    glUniformMatrix4fv(batch->exact ? ctx->surf.loc_exact_view_proj : ctx->surf.loc_eval_view_proj, 1,
-                       GL_FALSE, view->view_proj);
+    glUniformMatrix4fv(batch->exact ? ctx->surf.loc_exact_view_proj : ctx->surf.loc_eval_view_proj,
+                       1, GL_FALSE, view->view_proj);
     glUniform1i(batch->exact ? ctx->surf.loc_exact_trim : ctx->surf.loc_eval_trim, 0);
     if (!batch->exact)
         capture_begin(ctx);

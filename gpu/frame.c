@@ -200,7 +200,7 @@ sw_result sw__fr_add_draw(frame *f, const occurrence *o, size_t first_idx, int t
     d->n_idx = f->mesh.n_idx - first_idx;
     memcpy(d->color, o->color, sizeof d->color);
     d->trim_entry = -1;
-    /* the face's grids and static meshes carry st over its uv box (fat borders: sw__fr_fat_border) */
+    /* grids and static meshes carry st over the face's uv box (fat borders: sw__fr_fat_border) */
     const double *ub = f->sv->faces[o->face].uv_box;
     const float uv_map[4] = {(float)ub[0], (float)ub[2], (float)(ub[1] - ub[0]),
                              (float)(ub[3] - ub[2])};

@@ -124,7 +124,7 @@ struct sw_gpu_context {
     GLuint fbo, rb_color, rb_depth;
     int32_t fbo_w, fbo_h;
     GLuint trim_fbo, trim_vbo;
-    GLuint mesh_vbo, mesh_ibo; /* per-frame streaming buffers */
+    GLuint mesh_vbo, mesh_ibo;   /* per-frame streaming buffers */
     struct sw__gpu_atlas *atlas; /* trim-texture atlas kept across frames (trim_atlas.c) */
     int32_t atlas_max_side;      /* page side limit (tests); 0 = the default; set between frames */
     /* predefined grids of the Bézier evaluation (§4.2; grid_set.c) */

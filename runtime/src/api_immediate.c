@@ -170,9 +170,9 @@ static sw_result immediate_state(sw_renderer renderer, const char *fn, struct sw
 /* One draw's objects, resolved under g_nurbs_lock: per draw its object index, and the objects
  * (first appearance first). */
 typedef struct draw_set {
-    uint32_t *object_of;  /* per draw */
-    rt_nurbs **objects;   /* n_objects */
-    uint64_t *serials;    /* n_objects */
+    uint32_t *object_of; /* per draw */
+    rt_nurbs **objects;  /* n_objects */
+    uint64_t *serials;   /* n_objects */
     uint32_t n_objects;
 } draw_set;
 
@@ -188,8 +188,8 @@ static uint32_t slot_of(uint32_t id)
     return (id & 0xffffu) - 1u; /* handle_pool.c: (generation << 16) | (slot + 1) */
 }
 
-static sw_result resolve_draws(struct sw_rt_immediate *im, const sw_immediate_desc *d,
-                               draw_set *s, sw_status *status)
+static sw_result resolve_draws(struct sw_rt_immediate *im, const sw_immediate_desc *d, draw_set *s,
+                               sw_status *status)
 {
     const char *fn = "sw_renderer_draw_nurbs";
     s->object_of = malloc(d->draw_count * sizeof *s->object_of);
@@ -360,8 +360,8 @@ static sw_result check_immediate_desc(const sw_immediate_desc *d, sw_status *sta
     if (!d)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL desc", fn);
     if (d->draw_count < 1 || d->draw_count > SW__IMMEDIATE_MAX_DRAWS || !d->draws)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: %u draws (1..%u, non-NULL draws)",
-                        fn, d->draw_count, SW__IMMEDIATE_MAX_DRAWS);
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: %u draws (1..%u, non-NULL draws)", fn,
+                        d->draw_count, SW__IMMEDIATE_MAX_DRAWS);
     return SW_OK;
 }
 
@@ -401,9 +401,8 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
     fd.output_path = desc->output_path;
     fd.walkthrough = desc->walkthrough;
     fd.present = desc->present;
-    const sw_rt_frame_extra extra = {im->occ, n_occ,
-                                     im->has_shading && !desc->library_shading ? &im->shading
-                                                                               : NULL};
+    const sw_rt_frame_extra extra = {
+        im->occ, n_occ, im->has_shading && !desc->library_shading ? &im->shading : NULL};
     /* The frame binds the trim atlas on the active texture unit: unit 0, so that the host's
      * textures on units 1 and up stay bound (sw_immediate.h, Bindings); the host's choice of
      * active unit is given back. */
@@ -423,12 +422,12 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
 
 const char *sw_glsl_source_ptr(sw_glsl_kind kind)
 {
-    _Static_assert((int)SW_GLSL_KIND_COUNT == (int)SW__GPU_GLSL_KINDS, "sw_glsl_kind mirrors shaders.c");
+    _Static_assert((int)SW_GLSL_KIND_COUNT == (int)SW__GPU_GLSL_KINDS,
+                   "sw_glsl_kind mirrors shaders.c");
     return sw__gpu_glsl_source((int)kind);
 }
 
-sw_result sw_renderer_set_shading(sw_renderer renderer, const char *shade_source,
-                                  sw_status *status)
+sw_result sw_renderer_set_shading(sw_renderer renderer, const char *shade_source, sw_status *status)
 {
     const char *fn = "sw_renderer_set_shading";
     struct sw_rt_immediate *im = NULL;

@@ -285,9 +285,10 @@ static void test_scene_match(sw_renderer r, objects *o)
 
 /* ---- host shading -----------------------------------------------------------------------------
  */
-static const char *const k_shade_uv = "vec4 sw_shade(vec3 pos, vec3 normal, vec2 uv, vec4 color) {\n"
-                                      "  return vec4(uv, 0.0, 1.0);\n"
-                                      "}\n";
+static const char *const k_shade_uv =
+    "vec4 sw_shade(vec3 pos, vec3 normal, vec2 uv, vec4 color) {\n"
+    "  return vec4(uv, 0.0, 1.0);\n"
+    "}\n";
 static const char *const k_shade_normal =
     "vec4 sw_shade(vec3 pos, vec3 normal, vec2 uv, vec4 color) {\n"
     "  return vec4(0.5 * normal + 0.5, 1.0);\n"
@@ -366,8 +367,7 @@ static void test_uv_shading(sw_renderer r, const objects *o)
     printf("uv shading: %d pixels checked against the analytic (u, v), worst %d/255; %d of %d "
            "hole pixels background\n",
            checked, worst, hole_bg, holes);
-    CHECK(checked > 200 && worst <= 3, "uv as colour: worst %d/255 over %d pixels", worst,
-          checked);
+    CHECK(checked > 200 && worst <= 3, "uv as colour: worst %d/255 over %d pixels", worst, checked);
     CHECK(holes > 0 && hole_bg == holes, "hole: %d of %d pixels trimmed", hole_bg, holes);
     free(img);
     /* the library's shading on request, and again after NULL: byte for byte the same */
@@ -432,8 +432,8 @@ static void test_normal_and_uniform(sw_renderer r, const objects *o)
            lib[2], tinted[0], tinted[1], tinted[2]);
     CHECK(tinted[0] == lib[0] && abs((int)tinted[1] - (int)lround(lib[1] * 0.5)) <= 1 &&
               tinted[2] == 0,
-          "tinted (%d, %d, %d) from (%d, %d, %d)", tinted[0], tinted[1], tinted[2], lib[0],
-          lib[1], lib[2]);
+          "tinted (%d, %d, %d) from (%d, %d, %d)", tinted[0], tinted[1], tinted[2], lib[0], lib[1],
+          lib[2]);
     /* a host texture on unit 1 (the host's unit active during the draw): sampled by the host's
      * shading, still bound afterwards, and the active unit given back */
     static const unsigned char k_texel[4] = {40, 200, 90, 255};
@@ -481,8 +481,7 @@ static void test_glsl_parts(void)
     for (int k = 0; k < SW_GLSL_KIND_COUNT; k++)
         CHECK(sw_glsl_source_ptr((sw_glsl_kind)k) != NULL, "GLSL kind %d is NULL", k);
     CHECK(sw_glsl_source_ptr(SW_GLSL_KIND_COUNT) == NULL, "out of range kind not NULL");
-    CHECK(strstr(sw_glsl_source_ptr(SW_GLSL_FRAGMENT_LIBRARY), "sw_trim_inside"),
-          "no trim lookup");
+    CHECK(strstr(sw_glsl_source_ptr(SW_GLSL_FRAGMENT_LIBRARY), "sw_trim_inside"), "no trim lookup");
     const char *fs[4] = {sw_glsl_source_ptr(SW_GLSL_FRAGMENT_INTERFACE),
                          sw_glsl_source_ptr(SW_GLSL_FRAGMENT_LIBRARY), k_shade_uv,
                          sw_glsl_source_ptr(SW_GLSL_FRAGMENT_MAIN)};

@@ -119,16 +119,16 @@ SW_API sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate
 
 /* ---- GLSL for host shaders ------------------------------------------------------------------- */
 typedef enum sw_glsl_kind {
-    SW_GLSL_FRAGMENT_INTERFACE = 0, /* #version 430 core, the inputs v_rel, v_nrm, v_st, v_uv,
-                                       v_color, v_trim_rect, v_trim_layer, sampler u_trim, output
-                                       o_color */
-    SW_GLSL_FRAGMENT_LIBRARY = 1,   /* sw_trim_inside (§4.3) and sw_shade_library */
+    SW_GLSL_FRAGMENT_INTERFACE = 0,     /* #version 430 core, the inputs v_rel, v_nrm, v_st, v_uv,
+                                           v_color, v_trim_rect, v_trim_layer, sampler u_trim, output
+                                           o_color */
+    SW_GLSL_FRAGMENT_LIBRARY = 1,       /* sw_trim_inside (§4.3) and sw_shade_library */
     SW_GLSL_FRAGMENT_DEFAULT_SHADE = 2, /* the sw_shade used without a host's */
-    SW_GLSL_FRAGMENT_MAIN = 3,      /* main: trim (discard), then o_color = sw_shade(...) */
-    SW_GLSL_VERTEX_BEZIER = 4,      /* the rational bicubic Bézier evaluation on predefined grids
-                                       (§4.2): patch records and homogeneous control points in
-                                       storage buffers 0 and 1 */
-    SW_GLSL_VERTEX_EXACT = 5,       /* NURBS evaluation from knots and control points (double) */
+    SW_GLSL_FRAGMENT_MAIN = 3,          /* main: trim (discard), then o_color = sw_shade(...) */
+    SW_GLSL_VERTEX_BEZIER = 4, /* the rational bicubic Bézier evaluation on predefined grids
+                                  (§4.2): patch records and homogeneous control points in
+                                  storage buffers 0 and 1 */
+    SW_GLSL_VERTEX_EXACT = 5,  /* NURBS evaluation from knots and control points (double) */
     SW_GLSL_KIND_COUNT
 } sw_glsl_kind;
 
