@@ -401,6 +401,7 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
     fd.output_path = desc->output_path;
     fd.walkthrough = desc->walkthrough;
     fd.present = desc->present;
+    fd.eval_exact = desc->eval_exact;
     const sw_rt_frame_extra extra = {
         im->occ, n_occ, im->has_shading && !desc->library_shading ? &im->shading : NULL};
     /* The frame binds the trim atlas on the active texture unit: unit 0, so that the host's

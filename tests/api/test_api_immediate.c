@@ -11,7 +11,8 @@
  *   check can fail). Drawn again with a matrix changed and then back: the renderer kept its
  *   scene (same image as the first). sw_nurbs_update of the plane to a tilted one changes the
  *   image as the node scene with the tilted plane does.
- * shading: a host sw_shade returning the fragment's uv as colour, on the plane
+ * shading: a host sw_shade returning the fragment's uv as colour (Bézier and exact paths), on the
+ *   plane
  *   S(u, v) = (10u, 10v, 0) seen from above: at sampled pixel centres the colour is
  *   (u, v) of the point the pixel's ray meets (analytic), within 3/255; pixels inside the hole
  *   are background (trimmed before shading). The normal as colour: (0.5, 0.5, 1) for the plane,
@@ -25,6 +26,7 @@
  *   matrix, a negative colour, calls from another thread (SW_ERR_INVALID_ARGUMENT), a shading
  *   source that does not compile (SW_ERR_INVALID_ARGUMENT, the shading before stays), the GLSL
  *   parts (every kind non-NULL, out of range NULL) and a host vertex stage built from them.
+ * threads: another thread updates, creates and destroys objects while this one draws them.
  */
 #define GL_GLEXT_PROTOTYPES
 #include <GL/glcorearb.h>
@@ -149,6 +151,8 @@ static void path_of(const char *name, char *path)
     snprintf(path, 1024, "%s/%s.png", g_work, name);
 }
 
+static int g_exact; /* draws evaluated by the exact path (eval_exact) */
+
 static int draw_immediate(sw_renderer r, const sw_nurbs_draw *draws, uint32_t n,
                           const sw_camera *cam, const char *name, int library_shading)
 {
@@ -162,6 +166,7 @@ static int draw_immediate(sw_renderer r, const sw_nurbs_draw *draws, uint32_t n,
     d.height = H;
     d.output_path = path;
     d.library_shading = library_shading;
+    d.eval_exact = g_exact;
     sw_status st = {0};
     sw_result res = sw_renderer_draw_nurbs(r, &d, NULL, &st);
     CHECK(res == SW_OK, "immediate %s: %s", name, st.message);
@@ -332,16 +337,15 @@ static unsigned char *read_image(const char *name)
     return p && w == W && h == H ? p : (free(p), NULL);
 }
 
-static void test_uv_shading(sw_renderer r, const objects *o)
+/* uv as colour on the plane, by the Bézier path or (g_exact) the exact one */
+static void check_uv_image(sw_renderer r, const objects *o, const char *name)
 {
-    sw_status st = {0};
-    CHECK(sw_renderer_set_shading(r, k_shade_uv, &st) == SW_OK, "uv shading: %s", st.message);
     sw_camera cam = top_camera();
     sw_nurbs_draw d;
     set_draw(&d, o->plane, k_identity, k_colors[0]);
-    if (!draw_immediate(r, &d, 1, &cam, "shade_uv", 0))
+    if (!draw_immediate(r, &d, 1, &cam, name, 0))
         return;
-    unsigned char *img = read_image("shade_uv");
+    unsigned char *img = read_image(name);
     if (!img)
         return;
     int checked = 0, worst = 0, holes = 0, hole_bg = 0;
@@ -364,12 +368,25 @@ static void test_uv_shading(sw_renderer r, const objects *o)
             }
         }
     }
-    printf("uv shading: %d pixels checked against the analytic (u, v), worst %d/255; %d of %d "
-           "hole pixels background\n",
-           checked, worst, hole_bg, holes);
+    printf("uv shading (%s): %d pixels checked against the analytic (u, v), worst %d/255; %d "
+           "of %d hole pixels background\n",
+           g_exact ? "exact path" : "Bezier path", checked, worst, hole_bg, holes);
     CHECK(checked > 200 && worst <= 3, "uv as colour: worst %d/255 over %d pixels", worst, checked);
     CHECK(holes > 0 && hole_bg == holes, "hole: %d of %d pixels trimmed", hole_bg, holes);
     free(img);
+}
+
+static void test_uv_shading(sw_renderer r, const objects *o)
+{
+    sw_status st = {0};
+    CHECK(sw_renderer_set_shading(r, k_shade_uv, &st) == SW_OK, "uv shading: %s", st.message);
+    check_uv_image(r, o, "shade_uv");
+    g_exact = 1;
+    check_uv_image(r, o, "shade_uv_exact");
+    g_exact = 0;
+    sw_camera cam = top_camera();
+    sw_nurbs_draw d;
+    set_draw(&d, o->plane, k_identity, k_colors[0]);
     /* the library's shading on request, and again after NULL: byte for byte the same */
     draw_immediate(r, &d, 1, &cam, "shade_library_flag", 1);
     CHECK(sw_renderer_set_shading(r, NULL, &st) == SW_OK, "NULL shading: %s", st.message);
@@ -622,6 +639,59 @@ static void test_misuse(sw_renderer r, objects *o)
     CHECK(progs[0] == 0, "another thread's set_shading took effect");
 }
 
+/* Another thread updates, creates and destroys objects while this one draws them (walkthrough
+ * frames): every call returns SW_OK, and the objects stay usable (run under TSan / ASan too). */
+typedef struct editor {
+    const objects *o;
+    const sw_nurbs_desc *shapes[2];
+    int edits, failures;
+} editor;
+
+static void *edit_objects(void *arg)
+{
+    editor *e = arg;
+    for (int i = 0; i < 120; i++) {
+        sw_nurbs scratch;
+        e->failures += sw_nurbs_update(e->o->plane, e->shapes[i % 2], NULL) != SW_OK;
+        e->failures += sw_nurbs_create(&e->o->cyl_d, &scratch, NULL) != SW_OK;
+        e->failures += sw_nurbs_destroy(scratch) != SW_OK;
+        e->edits++;
+    }
+    return NULL;
+}
+
+static void test_concurrent_edits(sw_renderer r, objects *o)
+{
+    sw_nurbs_desc tilted = plane_desc(g_tilted, 0.3);
+    o->plane_d = plane_desc(g_plane, 0.0);
+    editor e = {o, {&tilted, &o->plane_d}, 0, 0};
+    sw_nurbs_draw d[4];
+    four_draws(o, d);
+    sw_immediate_desc desc = {0};
+    desc.draws = d;
+    desc.draw_count = 4;
+    desc.camera = scene_camera();
+    desc.width = W;
+    desc.height = H;
+    desc.walkthrough = 1;
+    pthread_t t;
+    pthread_create(&t, NULL, edit_objects, &e);
+    int frames = 0, failed = 0;
+    for (; frames < 20; frames++) {
+        sw_status st = {0};
+        if (sw_renderer_draw_nurbs(r, &desc, NULL, &st) != SW_OK) {
+            failed++;
+            printf("  concurrent frame %d: %s\n", frames, st.message);
+        }
+    }
+    pthread_join(t, NULL);
+    printf("concurrent edits: %d frames drawn while another thread made %d edits\n", frames,
+           e.edits);
+    CHECK(failed == 0 && e.failures == 0, "%d frames and %d edits failed", failed, e.failures);
+    sw_status st = {0};
+    CHECK(sw_nurbs_update(o->plane, &o->plane_d, &st) == SW_OK, "update: %s", st.message);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -643,6 +713,7 @@ int main(int argc, char **argv)
     test_normal_and_uniform(r, &o);
     test_glsl_parts();
     test_misuse(r, &o);
+    test_concurrent_edits(r, &o);
     EXPECT_RESULT(sw_nurbs_destroy(o.plane), SW_OK);
     EXPECT_RESULT(sw_nurbs_destroy(o.cyl), SW_OK);
     EXPECT_RESULT(sw_nurbs_destroy(o.bumps), SW_OK);

@@ -102,6 +102,8 @@ typedef struct sw_immediate_desc {
     const char *output_path;    /* .png or .exr; NULL = none */
     int32_t walkthrough;        /* as sw_frame_desc.walkthrough (0: converged) */
     int32_t library_shading;    /* 1: the library's shading even when the renderer has a host's */
+    int32_t eval_exact;         /* 1: evaluated from knots and control points in the vertex shader
+                                   (sw_frame_desc.eval_exact; degree <= 15); host shading too */
 } sw_immediate_desc;
 
 /* Draws the objects through the renderer (owner thread; its context current — the host's with
