@@ -9,11 +9,10 @@
  *   surfaces as NURBS nodes under the same transforms and colours, same camera: at most 0.1 % of
  *   pixels differ at all. Moving one draw by 10 % of its size differs in more than 0.5 % (the
  *   check can fail). Drawn again with a matrix changed and then back: the renderer kept its
- *   scene (same image as the first). sw_nurbs_update of the plane to a tilted one changes the
- *   image as the node scene with the tilted plane does.
- * shading: a host sw_shade returning the fragment's uv as colour (Bézier and exact paths), on the
- *   plane
- *   S(u, v) = (10u, 10v, 0) seen from above: at sampled pixel centres the colour is
+ *   scene (same image as the first). A zero camera fits the drawn objects. sw_nurbs_update of
+ *   the plane to a tilted one changes the image as the node scene with the tilted plane does.
+ * shading: a host sw_shade returning the fragment's uv as colour (Bézier and exact paths), on
+ *   the plane S(u, v) = (10u, 10v, 0) seen from above: at sampled pixel centres the colour is
  *   (u, v) of the point the pixel's ray meets (analytic), within 3/255; pixels inside the hole
  *   are background (trimmed before shading). The normal as colour: (0.5, 0.5, 1) for the plane,
  *   (0.5, 0.5, 0) for the same plane with reversed = 1. A host uniform (glProgramUniform4f on the
@@ -193,6 +192,16 @@ static double differ_percent(const char *name_a, const char *name_b)
     return percent;
 }
 
+static unsigned char *read_image(const char *name)
+{
+    char path[1024];
+    path_of(name, path);
+    int w = 0, h = 0;
+    unsigned char *p = sw_test_read_rgba(path, &w, &h);
+    CHECK(p && w == W && h == H, "read %s", path);
+    return p && w == W && h == H ? p : (free(p), NULL);
+}
+
 /* The reference: a node scene with one NURBS node per draw. */
 static void draw_reference(sw_renderer r, const sw_nurbs_desc *const *descs, const double *const *m,
                            const float (*colors)[4], int n, const sw_camera *cam, const char *name)
@@ -270,6 +279,19 @@ static void test_scene_match(sw_renderer r, objects *o)
     double again = differ_percent("imm_again", "imm");
     CHECK(again == 0.0, "the same draws again differ in %.4f %% of pixels", again);
 
+    /* a zero camera: the iso preset fitted to the drawn objects, which then cover the frame's
+     * middle (their box's centre is the target) */
+    sw_camera zero = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}, 0};
+    if (draw_immediate(r, d, 4, &zero, "imm_fitted", 0)) {
+        unsigned char *img = read_image("imm_fitted");
+        size_t covered = 0;
+        for (size_t i = 0; img && i < (size_t)W * H; i++)
+            covered += img[4 * i] != 255 || img[4 * i + 1] != 255 || img[4 * i + 2] != 255;
+        printf("fitted camera: %.1f %% of the frame covered\n", 100.0 * covered / (W * H));
+        CHECK(covered > (size_t)W * H / 20, "fitted camera: %zu pixels covered", covered);
+        free(img);
+    }
+
     /* update: the plane becomes a tilted one, in both of its draws */
     sw_nurbs_desc tilted = plane_desc(g_tilted, 0.3);
     sw_status st = {0};
@@ -325,16 +347,6 @@ static void pixel_uv(int x, int y, double uv[2])
     double nx = (x + 0.5) / W * 2.0 - 1.0, ny = 1.0 - (y + 0.5) / H * 2.0;
     uv[0] = (5.0 + 20.0 * nx * tx) / 10.0;
     uv[1] = (5.0 + 20.0 * ny * ty) / 10.0;
-}
-
-static unsigned char *read_image(const char *name)
-{
-    char path[1024];
-    path_of(name, path);
-    int w = 0, h = 0;
-    unsigned char *p = sw_test_read_rgba(path, &w, &h);
-    CHECK(p && w == W && h == H, "read %s", path);
-    return p && w == W && h == H ? p : (free(p), NULL);
 }
 
 /* uv as colour on the plane, by the Bézier path or (g_exact) the exact one */
