@@ -151,11 +151,12 @@ void sw__rt_immediate_free(struct sw_rt_immediate *im, sw_gpu_context *gpu)
     free(im);
 }
 
-static sw_result immediate_state(sw_renderer renderer, const char *fn, struct sw_rt_immediate **out,
-                                 sw_gpu_context **gpu, sw_status *status)
+static sw_result immediate_state(sw_renderer renderer, const char *fn, int drawing,
+                                 struct sw_rt_immediate **out, sw_gpu_context **gpu,
+                                 sw_status *status)
 {
     struct sw_rt_immediate **slot = NULL;
-    sw_result r = sw__rt_renderer_immediate(renderer, fn, &slot, gpu, status);
+    sw_result r = sw__rt_renderer_immediate(renderer, fn, drawing, &slot, gpu, status);
     if (r != SW_OK)
         return r;
     if (!*slot && !(*slot = calloc(1, sizeof **slot)))
@@ -373,7 +374,7 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
     sw_gpu_context *gpu = NULL;
     sw_result r = check_immediate_desc(desc, status);
     if (r == SW_OK)
-        r = immediate_state(renderer, fn, &im, &gpu, status);
+        r = immediate_state(renderer, fn, 1, &im, &gpu, status);
     if (r != SW_OK)
         return r;
     draw_set s = {0};
@@ -433,7 +434,7 @@ sw_result sw_renderer_set_shading(sw_renderer renderer, const char *shade_source
     const char *fn = "sw_renderer_set_shading";
     struct sw_rt_immediate *im = NULL;
     sw_gpu_context *gpu = NULL;
-    sw_result r = immediate_state(renderer, fn, &im, &gpu, status);
+    sw_result r = immediate_state(renderer, fn, 0, &im, &gpu, status);
     if (r != SW_OK)
         return r;
     sw__gpu_surface_programs p = {0};
@@ -456,7 +457,7 @@ sw_result sw_renderer_shading_programs(sw_renderer renderer, uint32_t out[3], sw
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL out", fn);
     struct sw_rt_immediate *im = NULL;
     sw_gpu_context *gpu = NULL;
-    sw_result r = immediate_state(renderer, fn, &im, &gpu, status);
+    sw_result r = immediate_state(renderer, fn, 0, &im, &gpu, status);
     if (r != SW_OK)
         return r;
     out[0] = im->has_shading ? im->shading.mesh : 0u;

@@ -595,7 +595,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     return res;
 }
 
-sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn,
+sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
                                     struct sw_rt_immediate ***slot, sw_gpu_context **gpu,
                                     sw_status *status)
 {
@@ -603,6 +603,9 @@ sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn,
     sw_result res = owned_renderer(handle, fn, &r, status);
     if (res != SW_OK)
         return res;
+    if (drawing && r->in_flight)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "%s: %u prepared frames wait; submit them first", fn, r->in_flight);
     *slot = &r->immediate;
     *gpu = r->gpu;
     return SW_OK;

@@ -118,9 +118,10 @@ typedef struct sw_rt_frame_extra {
     size_t n_occurrences;
     const struct sw__gpu_surface_programs *shading;
 } sw_rt_frame_extra;
-/* The renderer's immediate-state slot and GL context, for its owner thread. Errors:
- * SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT (another thread), both naming fn. */
-sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn,
+/* The renderer's immediate-state slot and GL context, for its owner thread (`drawing`: also
+ * refused while prepared frames wait, before the draw changes any state). Errors:
+ * SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT (another thread; frames waiting), naming fn. */
+sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
                                     struct sw_rt_immediate ***slot, sw_gpu_context **gpu,
                                     sw_status *status);
 /* Draws `scene` (a reference the caller holds; not behind a handle) as sw_renderer_draw draws a

@@ -22,9 +22,10 @@
  * misuse: NULL desc, no draws, NULL draws, a stale sw_nurbs in the list (nothing drawn), stale
  *   update and double destroy, NaN control point, decreasing knots, a degenerate trim loop (all
  *   SW_ERR_INVALID_GEOMETRY with nothing changed: the object draws as before), a singular model
- *   matrix, a negative colour, calls from another thread (SW_ERR_INVALID_ARGUMENT), a shading
- *   source that does not compile (SW_ERR_INVALID_ARGUMENT, the shading before stays), the GLSL
- *   parts (every kind non-NULL, out of range NULL) and a host vertex stage built from them.
+ *   matrix, a negative colour, a draw while a prepared frame waits and calls from another
+ *   thread (SW_ERR_INVALID_ARGUMENT), a shading source that does not compile
+ *   (SW_ERR_INVALID_ARGUMENT, the shading before stays), the GLSL parts (every kind non-NULL,
+ *   out of range NULL) and a host vertex stage built from them.
  * threads: another thread updates, creates and destroys objects while this one draws them.
  */
 #define GL_GLEXT_PROTOTYPES
@@ -634,9 +635,26 @@ static void test_misuse(sw_renderer r, objects *o)
     sw_nurbs never = {0};
     EXPECT_RESULT(sw_nurbs_destroy(never), SW_ERR_STALE_HANDLE);
 
-    /* another thread */
+    /* a prepared frame waits: refused before anything changes, then drawn as before */
     desc.draws = &d;
     desc.draw_count = 1;
+    sw_scene ns;
+    CHECK(sw_scene_create(NULL, &ns, &st) == SW_OK, "scene: %s", st.message);
+    sw_node_desc nd = {0};
+    nd.kind = SW_NODE_NURBS;
+    nd.nurbs = &o->cyl_d;
+    sw_node node;
+    CHECK(sw_node_add(ns, &nd, &node, &st) == SW_OK, "node: %s", st.message);
+    sw_frame_desc pf = {.scene = ns, .camera = cam, .width = W, .height = H};
+    CHECK(sw_renderer_prepare(r, &pf, &st) == SW_OK, "prepare: %s", st.message);
+    EXPECT_RESULT(sw_renderer_draw_nurbs(r, &desc, NULL, NULL), SW_ERR_INVALID_ARGUMENT);
+    CHECK(sw_renderer_submit(r, NULL, &st) == SW_OK, "submit: %s", st.message);
+    sw_scene_destroy(ns);
+    draw_immediate(r, &d, 1, &cam, "misuse_after_prepare", 0);
+    CHECK(differ_percent("misuse_before", "misuse_after_prepare") == 0.0,
+          "a refused draw changed what the next one draws");
+
+    /* another thread */
     thread_call c = {r, &desc, SW_OK, SW_OK};
     pthread_t t;
     pthread_create(&t, NULL, other_thread, &c);
