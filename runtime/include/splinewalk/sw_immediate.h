@@ -55,10 +55,11 @@
  * (program, vertex array, buffers, depth and blend state) is the renderer's after a draw, as
  * after sw_renderer_draw: set yours again; the framebuffer bindings and viewport are restored.
  */
-#ifndef SPLINEWALK_SW_IMMEDIATE_H
+#include <splinewalk/sw_nodes.h>
+/* Its body once sw_nodes.h is complete (it includes this header at its end): a program may include
+ * splinewalk.h, sw_nodes.h or this header first. */
+#if !defined(SPLINEWALK_SW_IMMEDIATE_H) && defined(SPLINEWALK_SW_NODES_COMPLETE)
 #define SPLINEWALK_SW_IMMEDIATE_H
-
-#include <splinewalk/splinewalk.h>
 
 #ifdef __cplusplus
 extern "C" {
