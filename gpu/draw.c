@@ -79,7 +79,7 @@ static void upload_exact(sw_gpu_context *ctx, const sw__gpu_patch_batch *batch)
 /* Debug capture: a zeroed counter plus room for capture_max vertices (two vec4 each). */
 static void capture_begin(sw_gpu_context *ctx)
 {
-    glUniform1i(ctx->loc_eval_capture, (GLint)ctx->capture_max);
+    glUniform1i(ctx->surf.loc_eval_capture, (GLint)ctx->capture_max);
     if (ctx->capture_max == 0)
         return;
     if (!ctx->capture_ssbo)
@@ -145,20 +145,20 @@ static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                  batch->cps, GL_STREAM_DRAW);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ctx->patch_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx->cp_ssbo);
-    GLint loc_grid = ctx->loc_eval_grid, loc_base = ctx->loc_eval_base;
+    GLint loc_grid = ctx->surf.loc_eval_grid, loc_base = ctx->surf.loc_eval_base;
     if (batch->exact) {
         upload_exact(ctx, batch);
-        loc_grid = ctx->loc_exact_grid;
-        loc_base = ctx->loc_exact_base;
+        loc_grid = ctx->surf.loc_exact_grid;
+        loc_base = ctx->surf.loc_exact_base;
     }
     glBindVertexArray(ctx->vao);
     for (GLuint a = 0; a < 3; ++a)
         glDisableVertexAttribArray(a);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->grid_ibo);
-    glUseProgram(batch->exact ? ctx->prog_exact : ctx->prog_eval);
-    glUniformMatrix4fv(batch->exact ? ctx->loc_exact_view_proj : ctx->loc_eval_view_proj, 1,
-                       GL_FALSE, view->view_proj);
-    glUniform1i(batch->exact ? ctx->loc_exact_trim : ctx->loc_eval_trim, 0);
+    glUseProgram(batch->exact ? ctx->surf.exact : ctx->surf.eval);
+    glUniformMatrix4fv(batch->exact ? ctx->surf.loc_exact_view_proj : ctx->surf.loc_eval_view_proj,
+                       1, GL_FALSE, view->view_proj);
+    glUniform1i(batch->exact ? ctx->surf.loc_exact_trim : ctx->surf.loc_eval_trim, 0);
     if (!batch->exact)
         capture_begin(ctx);
     for (int b = 0; b < SW__GPU_GRID_CLASSES; ++b) {
@@ -198,20 +198,21 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     if (desc->wireframe)
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     bind_mesh(ctx, mesh);
-    glUseProgram(ctx->prog_mesh);
-    glUniformMatrix4fv(ctx->loc_view_proj, 1, GL_FALSE, view->view_proj);
-    glUniform1i(ctx->loc_trim, 0);
+    glUseProgram(ctx->surf.mesh);
+    glUniformMatrix4fv(ctx->surf.loc_view_proj, 1, GL_FALSE, view->view_proj);
+    glUniform1i(ctx->surf.loc_trim, 0);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, sw__gpu_atlas_texture(ctx));
     for (size_t d = 0; d < n_draws; ++d) {
         if (draws[d].n_idx == 0)
             continue;
-        glUniform4fv(ctx->loc_color, 1, draws[d].color);
+        glUniform4fv(ctx->surf.loc_color, 1, draws[d].color);
+        glUniform4fv(ctx->surf.loc_uv_map, 1, draws[d].uv_map);
         sw__gpu_trim_rect tr = {0, 0, 0, 0, 0};
         if (draws[d].trim_entry >= 0)
             sw__gpu_atlas_rect(ctx, draws[d].trim_entry, &tr);
-        glUniform4f(ctx->loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
-        glUniform1f(ctx->loc_trim_layer, (float)tr.layer);
+        glUniform4f(ctx->surf.loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
+        glUniform1f(ctx->surf.loc_trim_layer, (float)tr.layer);
         glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
                        (const void *)(draws[d].first_idx * sizeof(uint32_t)));
     }
@@ -368,7 +369,7 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
     sw__gpu_mesh mesh = {0};
     if (r == SW_OK)
         r = triangles_to_mesh(positions, n_vertices, indices, n_indices, view.eye, &mesh, status);
-    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1};
+    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1, {0.0f, 0.0f, 0.0f, 0.0f}};
     if (r == SW_OK)
         r = sw__gpu_draw_frame(ctx, &view, &desc, &mesh, &draw, 1, NULL, status);
     sw__gpu_mesh_free(&mesh);

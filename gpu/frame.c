@@ -205,6 +205,15 @@ sw_result sw__fr_add_draw(frame *f, const occurrence *o, size_t first_idx, int t
     d->n_idx = f->mesh.n_idx - first_idx;
     memcpy(d->color, o->color, sizeof d->color);
     d->trim_entry = -1;
+    /* a face's CPU grids carry st over its uv box (fat borders: sw__fr_fat_border; triangle
+     * meshes and static levels, st = 0: sw__fr_append_triangles) */
+    memset(d->uv_map, 0, sizeof d->uv_map);
+    if (o->face < f->sv->n_faces) {
+        const double *ub = f->sv->faces[o->face].uv_box;
+        const float uv_map[4] = {(float)ub[0], (float)ub[2], (float)(ub[1] - ub[0]),
+                                 (float)(ub[3] - ub[2])};
+        memcpy(d->uv_map, uv_map, sizeof uv_map);
+    }
     if (trimmed)
         f->trims[f->n_trims++] = (pending_trim){f->n_draws,
                                                 o->face,
@@ -337,6 +346,8 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
     double bw = ub[1] - ub[0], bh = ub[3] - ub[2];
     float map[4] = {(float)((pt->u0 - ub[0]) / bw), (float)((pt->u1 - pt->u0) / bw),
                     (float)((pt->v0 - ub[2]) / bh), (float)((pt->v1 - pt->v0) / bh)};
+    const float uv_map[4] = {(float)pt->u0, (float)pt->v0, (float)(pt->u1 - pt->u0),
+                             (float)(pt->v1 - pt->v0)};
     for (int32_t b = 0; b < kv; ++b) {
         for (int32_t a = 0; a < ku; ++a) {
             sw__gpu_patch_rec *rec = &f->recs[f->n_recs++];
@@ -353,6 +364,7 @@ sw_result sw__fr_gpu_patch(frame *f, const occurrence *o, const sw__gpu_patch *p
             rec->draw = draw;
             rec->level_u = lu;
             rec->level_v = lv;
+            memcpy(rec->uv_map, uv_map, sizeof uv_map);
             if (f->ctx->patch_hook)
                 sw__fr_report_patch(f, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
                                     sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1,
@@ -430,12 +442,21 @@ sw_result sw__fr_fat_border(frame *f, const occurrence *o, const double *uv, siz
     sw_sg_surface srf;
     sw_sg_scene_face_surface(f->scene, o->face, &srf);
     size_t first = f->mesh.n_idx;
+    /* st over the face's uv box when the ribbon is drawn untrimmed: no lookup reads it, but the
+     * shading's uv (u_uv_map) does */
+    const double *st_rect = st_box ? st_box : f->sv->faces[o->face].uv_box;
     sw_result r = sw__gpu_fat_border(&f->view, &srf, o->world, uv, n, left_inside, cell[0], cell[1],
-                                     2.0 * f->eps_px, st_box, &f->mesh, status);
+                                     2.0 * f->eps_px, st_rect, &f->mesh, status);
     if (r == SW_OK && f->mesh.n_idx > first) {
         trim_need none = {0.0, 0.0};
         size_t draw = f->n_draws;
         r = sw__fr_add_draw(f, o, first, 0, &none, cell, status);
+        if (r == SW_OK) {
+            const double *b = st_rect;
+            const float uv_map[4] = {(float)b[0], (float)b[2], (float)(b[1] - b[0]),
+                                     (float)(b[3] - b[2])};
+            memcpy(f->draws[draw].uv_map, uv_map, sizeof uv_map);
+        }
         f->st.triangles += (f->mesh.n_idx - first) / 3;
         f->border_triangles += (f->mesh.n_idx - first) / 3;
         if (r == SW_OK && st_box) {
@@ -933,9 +954,18 @@ static void screen_view_init(frame *f)
 /* Collects occurrences, sets the view (near plane from the scene's box) and tessellates. */
 /* Every occurrence, with its eye-relative control-net box (the scene traversal, all control points
  * transformed: the path without a BVH). */
-static sw_result collect_all(frame *f, double **boxes_out, double scene_box[6], sw_status *status)
+static sw_result collect_all(frame *f, const sw_gpu_frame_desc *desc, double **boxes_out,
+                             double scene_box[6], sw_status *status)
 {
-    if (sw_sg_scene_traverse(f->scene, collect, f) != SW_OK || f->oom)
+    for (size_t i = 0; desc->occurrences && i < desc->n_occurrences && !f->oom; ++i) {
+        const sw_gpu_occurrence *o = &desc->occurrences[i];
+        if (o->face >= f->sv->n_faces)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                            "frame: occurrence %zu names face %u of %u", i, o->face,
+                            f->sv->n_faces);
+        collect(f, o->face, o->world, o->color);
+    }
+    if ((!desc->occurrences && sw_sg_scene_traverse(f->scene, collect, f) != SW_OK) || f->oom)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
     double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes);
     if (!boxes)
@@ -1072,18 +1102,21 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
     double *boxes = NULL, scene_box[6];
     sw_result r = SW_OK;
-    /* with static LODs the unit-instance BVH culls (frame_static.c); its scene box is the face
-     * BVH's root box, so both give the same near plane */
-    const sw_lod_static_instances *units =
-        f->statics && !f->exact ? sw_lod_static_set_instances(f->statics) : NULL;
-    if (desc->bvh || units) {
+    /* immediate draws (desc.occurrences) bring their own occurrences: no BVH culls them. With
+     * static LODs the unit-instance BVH culls (frame_static.c); its scene box is the face BVH's
+     * root box, so both give the same near plane */
+    const sw_sg_bvh *bvh = desc->occurrences ? NULL : desc->bvh;
+    const sw_lod_static_instances *units = f->statics && !f->exact && !desc->occurrences
+                                               ? sw_lod_static_set_instances(f->statics)
+                                               : NULL;
+    if (bvh || units) {
         sw__fr_box_empty(scene_box);
-        if (desc->bvh && desc->bvh->n_nodes)
-            eye_box(f, desc->bvh->nodes[0].box, scene_box);
-        else if (!desc->bvh && units->n_occs)
+        if (bvh && bvh->n_nodes)
+            eye_box(f, bvh->nodes[0].box, scene_box);
+        else if (!bvh && units->n_occs)
             eye_box(f, units->scene_box, scene_box);
     } else {
-        r = collect_all(f, &boxes, scene_box, status);
+        r = collect_all(f, desc, &boxes, scene_box, status);
     }
     sw__fr_meshes meshes;
     if (r == SW_OK)
@@ -1099,8 +1132,8 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     screen_view_init(f);
     if (r == SW_OK && units)
         r = sw__fr_static_collect(f, desc->face_cones, &boxes, status);
-    else if (r == SW_OK && desc->bvh)
-        r = collect_bvh(f, desc->bvh, &boxes, status);
+    else if (r == SW_OK && bvh)
+        r = collect_bvh(f, bvh, &boxes, status);
     if (r == SW_OK && desc->face_cones && boxes)
         r = cull_back_faces(f, desc->face_cones, boxes, status);
     for (size_t i = 0; f->lod_colors && i < f->n_occ; ++i)

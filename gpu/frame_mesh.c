@@ -93,7 +93,10 @@ sw_result sw__fr_append_triangles(frame *f, const occurrence *o, const sw__fr_tr
     }
     const trim_need none = {0.0, 0.0};
     const double cell[2] = {0.0, 0.0};
-    return sw__fr_add_draw(f, o, first, 0, &none, cell, status);
+    r = sw__fr_add_draw(f, o, first, 0, &none, cell, status);
+    if (r == SW_OK) /* no surface parameters: host shading sees uv = 0 (sw_immediate.h) */
+        memset(f->draws[f->n_draws - 1].uv_map, 0, sizeof f->draws[0].uv_map);
+    return r;
 }
 
 /* ---- the scene's mesh occurrences ----------------------------------------------------------- */

@@ -9,6 +9,7 @@
 #include "sw_status_util.h"
 
 #include <GL/glcorearb.h>
+#include <string.h>
 
 static const char *const k_mesh_vs =
     "#version 430 core\n"
@@ -19,9 +20,11 @@ static const char *const k_mesh_vs =
     "uniform vec4 u_color;\n"
     "uniform vec4 u_trim_rect;\n"
     "uniform float u_trim_layer;\n"
+    "uniform vec4 u_uv_map;\n" /* face parameters of the draw: uv = xy + st * zw */
     "out vec3 v_rel;\n"
     "out vec3 v_nrm;\n"
     "out vec2 v_st;\n"
+    "out vec2 v_uv;\n"
     "flat out vec4 v_color;\n"
     "flat out vec4 v_trim_rect;\n"
     "flat out float v_trim_layer;\n"
@@ -29,39 +32,58 @@ static const char *const k_mesh_vs =
     "  v_rel = a_pos;\n"
     "  v_nrm = a_nrm;\n"
     "  v_st = a_st;\n"
+    "  v_uv = u_uv_map.xy + a_st * u_uv_map.zw;\n"
     "  v_color = u_color;\n"
     "  v_trim_rect = u_trim_rect;\n"
     "  v_trim_layer = u_trim_layer;\n"
     "  gl_Position = u_view_proj * vec4(a_pos, 1.0);\n"
     "}\n";
 
-/* Shared by every surface program. The trim lookup (§4.3) reads the face's rectangle of the atlas
- * (§4.4; rect = x0, y0, w, h in texels, w = 0 untrimmed), clamped half a texel inside the
- * rectangle so that a parameter on the box's edge reads the edge texel and never the gutter
- * (PLATFORM.md: trim parity exactness). Shading is two-sided: the headlight lights whichever side
- * faces the eye. Output is gamma-encoded. */
-static const char *const k_surface_fs =
+/* The fragment stage of every surface program, in four parts linked as one shader (and handed to
+ * hosts by sw__gpu_glsl_source, sw_immediate.h): the interface (inputs from the library's vertex
+ * stages, the atlas sampler, the output), the trim lookup (§4.3), a shading function sw_shade —
+ * the library's (sw_shade_library) or a host's — and main, which trims and then shades.
+ * The trim lookup reads the face's rectangle of the atlas (§4.4; rect = x0, y0, w, h in texels,
+ * w = 0 untrimmed), clamped half a texel inside the rectangle so that a parameter on the box's
+ * edge reads the edge texel and never the gutter (PLATFORM.md: trim parity exactness). The
+ * library's shading is two-sided: the headlight lights whichever side faces the eye. Output is
+ * gamma-encoded. */
+static const char *const k_surface_fs_interface =
     "#version 430 core\n"
     "in vec3 v_rel;\n"
     "in vec3 v_nrm;\n"
     "in vec2 v_st;\n"
+    "in vec2 v_uv;\n"
     "flat in vec4 v_color;\n"
     "flat in vec4 v_trim_rect;\n"
     "flat in float v_trim_layer;\n"
     "uniform sampler2DArray u_trim;\n"
-    "layout(location = 0) out vec4 o_color;\n"
-    "void main() {\n"
-    "  if (v_trim_rect.z > 0.0) {\n"
-    "    vec2 size = v_trim_rect.zw;\n"
-    "    vec2 t = v_trim_rect.xy + clamp(v_st * size, vec2(0.5), size - vec2(0.5));\n"
-    "    if (texelFetch(u_trim, ivec3(ivec2(t), int(v_trim_layer)), 0).r < 0.5) discard;\n"
-    "  }\n"
-    "  vec3 n = v_nrm;\n"
-    "  float ln = length(n);\n"
+    "layout(location = 0) out vec4 o_color;\n";
+
+static const char *const k_surface_fs_trim =
+    "bool sw_trim_inside(sampler2DArray atlas, vec2 st, vec4 rect, float layer) {\n"
+    "  if (rect.z <= 0.0) return true;\n"
+    "  vec2 size = rect.zw;\n"
+    "  vec2 t = rect.xy + clamp(st * size, vec2(0.5), size - vec2(0.5));\n"
+    "  return texelFetch(atlas, ivec3(ivec2(t), int(layer)), 0).r >= 0.5;\n"
+    "}\n"
+    "vec4 sw_shade_library(vec3 pos, vec3 normal, vec2 uv, vec4 color) {\n"
     "  float lambert = 1.0;\n"
-    "  if (ln > 0.0) lambert = abs(dot(n / ln, normalize(-v_rel)));\n"
-    "  vec3 c = v_color.rgb * (0.2 + 0.8 * lambert);\n"
-    "  o_color = vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)), v_color.a);\n"
+    "  if (dot(normal, normal) > 0.0) lambert = abs(dot(normal, normalize(-pos)));\n"
+    "  vec3 c = color.rgb * (0.2 + 0.8 * lambert);\n"
+    "  return vec4(pow(clamp(c, 0.0, 1.0), vec3(1.0 / 2.2)), color.a);\n"
+    "}\n";
+
+static const char *const k_surface_fs_default_shade =
+    "vec4 sw_shade(vec3 pos, vec3 normal, vec2 uv, vec4 color) {\n"
+    "  return sw_shade_library(pos, normal, uv, color);\n"
+    "}\n";
+
+static const char *const k_surface_fs_main =
+    "void main() {\n"
+    "  if (!sw_trim_inside(u_trim, v_st, v_trim_rect, v_trim_layer)) discard;\n"
+    "  float ln = length(v_nrm);\n"
+    "  o_color = sw_shade(v_rel, ln > 0.0 ? v_nrm / ln : vec3(0.0), v_uv, v_color);\n"
     "}\n";
 
 /* Vertex-shader evaluation of rational Bézier patches of degree <= 3 x 3 on a predefined grid
@@ -78,6 +100,7 @@ static const char *const k_eval_vs =
     "  vec4 st; vec4 trim_map; vec4 trim_rect; vec4 color;\n"
     "  uint cp; int deg_u; int deg_v; float layer;\n"
     "  float nsign; int draw; int level_u; int level_v;\n"
+    "  vec4 uv_map;\n"
     "};\n"
     "layout(std430, binding = 0) readonly buffer Patches { PatchRec recs[]; };\n"
     "layout(std430, binding = 1) readonly buffer ControlPoints { vec4 cps[]; };\n"
@@ -89,6 +112,7 @@ static const char *const k_eval_vs =
     "out vec3 v_rel;\n"
     "out vec3 v_nrm;\n"
     "out vec2 v_st;\n"
+    "out vec2 v_uv;\n"
     "flat out vec4 v_color;\n"
     "flat out vec4 v_trim_rect;\n"
     "flat out float v_trim_layer;\n"
@@ -150,6 +174,7 @@ static const char *const k_eval_vs =
     "  v_nrm = ln > 0.0 ? p.nsign * n / ln : vec3(0.0);\n"
     "  v_rel = pos;\n"
     "  v_st = vec2(p.trim_map.x + s * p.trim_map.y, p.trim_map.z + t * p.trim_map.w);\n"
+    "  v_uv = p.uv_map.xy + vec2(s, t) * p.uv_map.zw;\n"
     "  v_color = p.color;\n"
     "  v_trim_rect = p.trim_rect;\n"
     "  v_trim_layer = p.layer;\n"
@@ -176,6 +201,7 @@ static const char *const k_exact_vs =
     "  vec4 st; vec4 trim_map; vec4 trim_rect; vec4 color;\n"
     "  uint cp; int deg_u; int deg_v; float layer;\n"
     "  float nsign; int draw; int level_u; int level_v;\n"
+    "  vec4 uv_map;\n"
     "};\n"
     "struct Piece {\n"
     "  double u0, u1, v0, v1;\n"
@@ -191,6 +217,7 @@ static const char *const k_exact_vs =
     "out vec3 v_rel;\n"
     "out vec3 v_nrm;\n"
     "out vec2 v_st;\n"
+    "out vec2 v_uv;\n"
     "flat out vec4 v_color;\n"
     "flat out vec4 v_trim_rect;\n"
     "flat out float v_trim_layer;\n"
@@ -270,6 +297,7 @@ static const char *const k_exact_vs =
     "  v_nrm = ln > 0.0LF ? p.nsign * vec3(n / ln) : vec3(0.0);\n"
     "  v_rel = pos;\n"
     "  v_st = vec2(p.trim_map.x + s * p.trim_map.y, p.trim_map.z + t * p.trim_map.w);\n"
+    "  v_uv = vec2(u, v);\n"
     "  v_color = p.color;\n"
     "  v_trim_rect = p.trim_rect;\n"
     "  v_trim_layer = p.layer;\n"
@@ -302,17 +330,28 @@ static sw_result compile(GLenum type, const char *src, const char *what, GLuint 
     return SW_OK;
 }
 
-static sw_result link(const char *vs, const char *fs, const char *what, GLuint *out,
-                      sw_status *status)
+/* Links a vertex stage with the surface fragment stage, assembled from its parts around the
+ * shading function `shade` (the library's, or a host's: its compile errors are the host's, hence
+ * SW_ERR_INVALID_ARGUMENT). */
+static sw_result link_parts(const char *vs, const char *const *fs, GLsizei n_fs, const char *what,
+                            sw_result fail, GLuint *out, sw_status *status)
 {
-    GLuint v = 0, f = 0;
+    GLuint v = 0, f = glCreateShader(GL_FRAGMENT_SHADER);
     sw_result r = compile(GL_VERTEX_SHADER, vs, what, &v, status);
-    if (r != SW_OK)
-        return r;
-    r = compile(GL_FRAGMENT_SHADER, fs, what, &f, status);
     if (r != SW_OK) {
-        glDeleteShader(v);
+        glDeleteShader(f);
         return r;
+    }
+    glShaderSource(f, n_fs, fs, NULL);
+    glCompileShader(f);
+    GLint ok = 0;
+    glGetShaderiv(f, GL_COMPILE_STATUS, &ok);
+    char log[400];
+    if (!ok) {
+        glGetShaderInfoLog(f, sizeof log, NULL, log);
+        glDeleteShader(v);
+        glDeleteShader(f);
+        return sw__fail(status, fail, "fragment shader of %s does not compile: %s", what, log);
     }
     GLuint p = glCreateProgram();
     glAttachShader(p, v);
@@ -320,54 +359,104 @@ static sw_result link(const char *vs, const char *fs, const char *what, GLuint *
     glLinkProgram(p);
     glDeleteShader(v);
     glDeleteShader(f);
-    GLint ok = 0;
     glGetProgramiv(p, GL_LINK_STATUS, &ok);
     if (!ok) {
-        char log[400];
         glGetProgramInfoLog(p, sizeof log, NULL, log);
         glDeleteProgram(p);
-        return sw__fail(status, SW_ERR_GL, "program %s does not link: %s", what, log);
+        return sw__fail(status, fail, "program %s does not link: %s", what, log);
     }
     *out = p;
     return SW_OK;
 }
 
+static sw_result link(const char *vs, const char *fs, const char *what, GLuint *out,
+                      sw_status *status)
+{
+    return link_parts(vs, &fs, 1, what, SW_ERR_GL, out, status);
+}
+
+/* The three surface programs around one shading function; on failure none is left. */
+static sw_result link_surfaces(const char *shade, sw_result fail, sw__gpu_surface_programs *p,
+                               sw_status *status)
+{
+    memset(p, 0, sizeof *p);
+    const char *fs[4] = {k_surface_fs_interface, k_surface_fs_trim, shade, k_surface_fs_main};
+    sw_result r = link_parts(k_mesh_vs, fs, 4, "mesh", fail, &p->mesh, status);
+    if (r == SW_OK)
+        r = link_parts(k_eval_vs, fs, 4, "patch evaluation", fail, &p->eval, status);
+    if (r == SW_OK)
+        r = link_parts(k_exact_vs, fs, 4, "exact evaluation", fail, &p->exact, status);
+    if (r != SW_OK) {
+        glDeleteProgram(p->mesh);
+        glDeleteProgram(p->eval);
+        glDeleteProgram(p->exact);
+        memset(p, 0, sizeof *p);
+        return r;
+    }
+    p->loc_view_proj = glGetUniformLocation(p->mesh, "u_view_proj");
+    p->loc_color = glGetUniformLocation(p->mesh, "u_color");
+    p->loc_trim_rect = glGetUniformLocation(p->mesh, "u_trim_rect");
+    p->loc_trim_layer = glGetUniformLocation(p->mesh, "u_trim_layer");
+    p->loc_trim = glGetUniformLocation(p->mesh, "u_trim");
+    p->loc_uv_map = glGetUniformLocation(p->mesh, "u_uv_map");
+    p->loc_eval_view_proj = glGetUniformLocation(p->eval, "u_view_proj");
+    p->loc_eval_grid = glGetUniformLocation(p->eval, "u_grid");
+    p->loc_eval_base = glGetUniformLocation(p->eval, "u_base");
+    p->loc_eval_trim = glGetUniformLocation(p->eval, "u_trim");
+    p->loc_eval_capture = glGetUniformLocation(p->eval, "u_capture");
+    p->loc_exact_view_proj = glGetUniformLocation(p->exact, "u_view_proj");
+    p->loc_exact_grid = glGetUniformLocation(p->exact, "u_grid");
+    p->loc_exact_base = glGetUniformLocation(p->exact, "u_base");
+    p->loc_exact_trim = glGetUniformLocation(p->exact, "u_trim");
+    return SW_OK;
+}
+
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
 {
-    sw_result r = link(k_mesh_vs, k_surface_fs, "mesh", &ctx->prog_mesh, status);
+    sw_result r = link_surfaces(k_surface_fs_default_shade, SW_ERR_GL, &ctx->surf, status);
     if (r != SW_OK)
         return r;
     r = link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
     if (r != SW_OK)
         return r;
-    r = link(k_eval_vs, k_surface_fs, "patch evaluation", &ctx->prog_eval, status);
-    if (r != SW_OK)
-        return r;
-    ctx->loc_eval_view_proj = glGetUniformLocation(ctx->prog_eval, "u_view_proj");
-    ctx->loc_eval_grid = glGetUniformLocation(ctx->prog_eval, "u_grid");
-    ctx->loc_eval_base = glGetUniformLocation(ctx->prog_eval, "u_base");
-    ctx->loc_eval_trim = glGetUniformLocation(ctx->prog_eval, "u_trim");
-    ctx->loc_eval_capture = glGetUniformLocation(ctx->prog_eval, "u_capture");
-    r = link(k_exact_vs, k_surface_fs, "exact evaluation", &ctx->prog_exact, status);
-    if (r != SW_OK)
-        return r;
-    ctx->loc_exact_view_proj = glGetUniformLocation(ctx->prog_exact, "u_view_proj");
-    ctx->loc_exact_grid = glGetUniformLocation(ctx->prog_exact, "u_grid");
-    ctx->loc_exact_base = glGetUniformLocation(ctx->prog_exact, "u_base");
-    ctx->loc_exact_trim = glGetUniformLocation(ctx->prog_exact, "u_trim");
-    ctx->loc_view_proj = glGetUniformLocation(ctx->prog_mesh, "u_view_proj");
-    ctx->loc_color = glGetUniformLocation(ctx->prog_mesh, "u_color");
-    ctx->loc_trim_rect = glGetUniformLocation(ctx->prog_mesh, "u_trim_rect");
-    ctx->loc_trim_layer = glGetUniformLocation(ctx->prog_mesh, "u_trim_layer");
-    ctx->loc_trim = glGetUniformLocation(ctx->prog_mesh, "u_trim");
     return sw__gpu_check(status, "program set-up");
+}
+
+void sw__gpu_shading_free(sw_gpu_context *ctx, sw__gpu_surface_programs *p)
+{
+    (void)ctx; /* the context is current: its programs are deleted with it */
+    glDeleteProgram(p->mesh);
+    glDeleteProgram(p->eval);
+    glDeleteProgram(p->exact);
+    memset(p, 0, sizeof *p);
 }
 
 void sw__gpu_programs_free(sw_gpu_context *ctx)
 {
-    glDeleteProgram(ctx->prog_mesh);
+    sw__gpu_shading_free(ctx, &ctx->surf);
     glDeleteProgram(ctx->prog_trim);
-    glDeleteProgram(ctx->prog_eval);
-    glDeleteProgram(ctx->prog_exact);
-    ctx->prog_mesh = ctx->prog_trim = ctx->prog_eval = ctx->prog_exact = 0;
+    ctx->prog_trim = 0;
+}
+
+sw_result sw__gpu_shading_create(sw_gpu_context *ctx, const char *shade_source,
+                                 sw__gpu_surface_programs *out, sw_status *status)
+{
+    sw__gpu_make_current(ctx);
+    while (glGetError() != GL_NO_ERROR) /* the host's errors before the call are not ours */
+        ;
+    sw_result r = link_surfaces(shade_source, SW_ERR_INVALID_ARGUMENT, out, status);
+    if (r == SW_OK && (r = sw__gpu_check(status, "host shading set-up")) != SW_OK)
+        sw__gpu_shading_free(ctx, out);
+    return r;
+}
+
+/* Indexed by sw_glsl_kind (sw_immediate.h). The vertex stages are whole shaders; the fragment
+ * parts are what a host's sw_shade is linked between. */
+const char *sw__gpu_glsl_source(int kind)
+{
+    static const char *const *const k_parts[SW__GPU_GLSL_KINDS] = {
+        &k_surface_fs_interface, &k_surface_fs_trim, &k_surface_fs_default_shade,
+        &k_surface_fs_main,      &k_eval_vs,         &k_exact_vs,
+    };
+    return kind >= 0 && kind < SW__GPU_GLSL_KINDS ? *k_parts[kind] : NULL;
 }

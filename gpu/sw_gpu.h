@@ -43,6 +43,14 @@ typedef struct sw_gpu_camera {
     double fovy_deg; /* vertical field of view */
 } sw_gpu_camera;
 
+/* A face occurrence given by the caller (immediate draws): face record, world transform (3 x 4
+ * row-major), linear RGBA colour (color[3] < 0: the default grey). */
+typedef struct sw_gpu_occurrence {
+    uint32_t face;
+    double world[12];
+    float color[4];
+} sw_gpu_occurrence;
+
 /* The camera presets of `splinewalk render --view` (and sw_camera_fit), fitted to a world box (min
  * xyz, max xyz): fovy 40°, target = box centre, distance = diagonal / (2 tan 20°) × 1.1, looking
  * from direction `from` (not zero; (1,1,1) is the iso view) with `up`. A point-sized or empty box
@@ -94,6 +102,10 @@ typedef struct sw_gpu_frame_desc {
                              each good enough, and beside the trim-texture path. 0: the
                              coarsest good level */
     int32_t lod_colors;   /* 1: each draw coloured by its representation (sw__fr_lod_color) */
+    const sw_gpu_occurrence *occurrences; /* NULL: the scene's traversal (or bvh); else exactly
+                              these occurrences of the scene's faces, culled one by one (bvh
+                              ignored); read during prepare only */
+    size_t n_occurrences;
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */

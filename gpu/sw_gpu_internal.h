@@ -32,7 +32,7 @@ typedef enum sw__gpu_eval_mode {
 void sw__gpu_set_eval_mode(sw_gpu_context *ctx, sw__gpu_eval_mode mode);
 
 /* One instance of a predefined grid: a rational Bézier patch (or a piece of its domain) evaluated
- * by the vertex shader. std430 layout, mirrored by the GLSL struct in shaders.c (96 bytes). */
+ * by the vertex shader. std430 layout, mirrored by the GLSL struct in shaders.c (112 bytes). */
 typedef struct sw__gpu_patch_rec {
     float st[4];        /* s0, s1, t0, t1: the part of the local domain [0,1]^2 sampled */
     float trim_map[4];  /* trim lookup: (m0 + s m1, m2 + t m3) in the face's uv box's [0,1]^2 */
@@ -44,6 +44,7 @@ typedef struct sw__gpu_patch_rec {
     float normal_sign;
     int32_t draw;             /* CPU side: the frame draw holding the colour and the trim entry */
     int32_t level_u, level_v; /* grid class: sw__gpu_grid_segments[level] segments */
+    float uv_map[4]; /* the face's parameters: (u, v) = (m0 + s m2, m1 + t m3), for shading */
 } sw__gpu_patch_rec;
 
 /* Exact evaluation (eval_exact): what a record's cp indexes instead of Bézier control points —
@@ -95,6 +96,18 @@ typedef void (*sw__gpu_patch_hook)(void *user, const sw__gpu_drawn_patch *p);
 /* Installs (fn != NULL) or removes the hook; called on the GL thread during sw_gpu_render_scene. */
 void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *user);
 
+/* The three surface programs (mesh, Bézier evaluation, exact evaluation) and their uniform
+ * locations. They share one fragment stage whose shading function is the library's or a host's
+ * (sw__gpu_shading_create); the context draws with ctx->surf. */
+typedef struct sw__gpu_surface_programs {
+    GLuint mesh; /* grids and plain triangles */
+    GLint loc_view_proj, loc_color, loc_trim, loc_trim_rect, loc_trim_layer, loc_uv_map;
+    GLuint eval; /* vertex-shader evaluation of rational Bézier patches (§4.2) */
+    GLint loc_eval_view_proj, loc_eval_grid, loc_eval_base, loc_eval_trim, loc_eval_capture;
+    GLuint exact; /* exact evaluation from knots and control points (eval_exact) */
+    GLint loc_exact_view_proj, loc_exact_grid, loc_exact_base, loc_exact_trim;
+} sw__gpu_surface_programs;
+
 struct sw_gpu_context {
     void *egl_display, *egl_context; /* EGLDisplay, EGLContext; NULL when adopted */
     int32_t gl_ready;                /* GL objects made: free deletes them */
@@ -103,9 +116,7 @@ struct sw_gpu_context {
                                 tests include this header, and the token is a C11 atomic) */
     char description[256];
     GLint max_texture_size;
-    /* grid / triangle program */
-    GLuint prog_mesh;
-    GLint loc_view_proj, loc_color, loc_trim;
+    sw__gpu_surface_programs surf; /* the surface programs frames draw with */
     /* trim-texture program: 2D positions in clip space, constant colour */
     GLuint prog_trim;
     GLuint vao;
@@ -113,14 +124,10 @@ struct sw_gpu_context {
     GLuint fbo, rb_color, rb_depth;
     int32_t fbo_w, fbo_h;
     GLuint trim_fbo, trim_vbo;
-    GLuint mesh_vbo, mesh_ibo; /* per-frame streaming buffers */
-    GLint loc_trim_rect;       /* mesh program: atlas rectangle (x0, y0, w, h), w = 0 untrimmed */
-    GLint loc_trim_layer;
+    GLuint mesh_vbo, mesh_ibo;   /* per-frame streaming buffers */
     struct sw__gpu_atlas *atlas; /* trim-texture atlas kept across frames (trim_atlas.c) */
     int32_t atlas_max_side;      /* page side limit (tests); 0 = the default; set between frames */
-    /* vertex-shader evaluation of rational Bézier patches (§4.2; shaders.c, grid_set.c) */
-    GLuint prog_eval;
-    GLint loc_eval_view_proj, loc_eval_grid, loc_eval_base, loc_eval_trim;
+    /* predefined grids of the Bézier evaluation (§4.2; grid_set.c) */
     GLuint grid_ibo; /* every grid class's triangles, one after another */
     uint32_t grid_first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* [level v][level u] */
     uint32_t grid_count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
@@ -132,12 +139,9 @@ struct sw_gpu_context {
     int32_t crack_fill_off;        /* 1: no fat borders (§7.1) */
     sw__gpu_patch_hook patch_hook; /* debug hook, NULL = none */
     void *patch_hook_user;
-    /* exact evaluation from knots and control points (eval_exact; shaders.c) */
-    GLuint prog_exact;
-    GLint loc_exact_view_proj, loc_exact_grid, loc_exact_base, loc_exact_trim;
+    /* exact evaluation from knots and control points (eval_exact) */
     GLuint piece_ssbo, knot_ssbo, dcp_ssbo; /* per-frame pieces, knots, control points */
     /* debug capture of the Bézier vertex shader's output (sw__gpu_set_capture) */
-    GLint loc_eval_capture;
     GLuint capture_ssbo;
     uint32_t capture_max; /* vertices; 0 = off */
     uint32_t *rec_source; /* sorted record -> record in append (patch hook) order */
@@ -152,6 +156,18 @@ void sw__gpu_make_current(sw_gpu_context *ctx);
 /* Compiles the programs (shaders.c). */
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status);
 void sw__gpu_programs_free(sw_gpu_context *ctx);
+
+/* ---- host shading (shaders.c; Guthe et al. 2005 §8's custom shaders) ------------------------ */
+/* The surface programs linked with a host's shading function `shade_source` (GLSL defining
+ * vec4 sw_shade(vec3 pos, vec3 normal, vec2 uv, vec4 color), and whatever uniforms it reads) in
+ * place of the library's. The context's thread. Errors: SW_ERR_INVALID_ARGUMENT (the source does
+ * not compile or link with the library's stages: the GLSL log in the message), SW_ERR_GL. */
+sw_result sw__gpu_shading_create(sw_gpu_context *ctx, const char *shade_source,
+                                 sw__gpu_surface_programs *out, sw_status *status);
+void sw__gpu_shading_free(sw_gpu_context *ctx, sw__gpu_surface_programs *p);
+/* The library's GLSL by part (the values of sw_glsl_kind, sw_immediate.h); NULL out of range. */
+const char *sw__gpu_glsl_source(int kind);
+enum { SW__GPU_GLSL_KINDS = 6 };
 /* (Re)allocates the RGBA8 + 32F depth render target (context_egl.c). */
 sw_result sw__gpu_target_ensure(sw_gpu_context *ctx, int32_t w, int32_t h, sw_status *status);
 double sw__gpu_now_ms(void);
@@ -321,6 +337,8 @@ typedef struct sw__gpu_draw {
     size_t first_idx, n_idx;
     float color[4];
     int32_t trim_entry; /* atlas entry, -1 = untrimmed */
+    float uv_map[4];    /* the vertices' st to the face's parameters: (u, v) = (m0 + st.x m2,
+                           m1 + st.y m3); zero: uv = 0 */
 } sw__gpu_draw;
 
 /* The frame's GPU-evaluated patches: records sorted by grid class, control points. */

@@ -292,8 +292,10 @@ static int place(struct sw__gpu_atlas *a, entry *e, int32_t max_pages)
     if (fw > a->side || fh > a->side)
         return 0;
     for (int32_t l = 0; l < max_pages; ++l) {
-        if (l == a->n_pages) {
-            memset(&a->pages[l], 0, sizeof a->pages[l]);
+        if (l == a->n_pages) { /* an empty page; its shelf array is kept for reuse (freed with
+                                  the atlas): zeroing the page would leak it after a reset */
+            a->pages[l].n_shelves = 0;
+            a->pages[l].top = 0;
             a->n_pages++;
         }
         int32_t x, y;

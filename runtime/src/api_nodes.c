@@ -338,6 +338,7 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
     char what[64];
     snprintf(what, sizeof what, "NURBS surface, trim loop %u", index);
     double *pool = sw_sg_builder_pool_ptr(b); /* stable until the next push */
+    double own[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
     for (uint32_t c = 0; r == SW_OK && c < nc; c++) {
         const sw_trim_curve *tc = &lp->curves[c];
         sw_sg_curve curve = {(int32_t)tc->degree, counts[c], 3, pool + kn[c], pool + cp[c]};
@@ -345,9 +346,19 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
         ptrs[c] = pool + cp[c];
         for (uint32_t i = 0; r == SW_OK && i < tc->count; i++) {
             double u = tc->points[2 * i], v = tc->points[2 * i + 1];
-            box[0] = fmin(box[0], u), box[1] = fmax(box[1], u);
-            box[2] = fmin(box[2], v), box[3] = fmax(box[3], v);
+            own[0] = fmin(own[0], u), own[1] = fmax(own[1], u);
+            own[2] = fmin(own[2], v), own[3] = fmax(own[3], v);
         }
+    }
+    /* A loop whose control points (the curves' hull) span no width or no height encloses no area:
+     * its trim texture would be empty, so the caller meant something else. */
+    if (r == SW_OK && !(own[1] - own[0] > max_gap && own[3] - own[2] > max_gap))
+        r = sw__fail(status, SW_ERR_INVALID_GEOMETRY,
+                     "%s: degenerate, its curves span [%g, %g] x [%g, %g] (no area)", what, own[0],
+                     own[1], own[2], own[3]);
+    if (r == SW_OK) {
+        box[0] = fmin(box[0], own[0]), box[1] = fmax(box[1], own[1]);
+        box[2] = fmin(box[2], own[2]), box[3] = fmax(box[3], own[3]);
     }
     if (r == SW_OK)
         r = sw_sg_trim_snap_loop((int32_t)nc, ptrs, counts, max_gap, what, status);
@@ -419,7 +430,7 @@ static sw_result fill_loops(sw_sg_builder *b, const sw_nurbs_desc *d, sw_sg_face
     return SW_OK;
 }
 
-static sw_result nurbs_geom(const sw_nurbs_desc *d, sw_sg_scene **out, sw_status *status)
+sw_result sw__rt_nurbs_geom(const sw_nurbs_desc *d, sw_sg_scene **out, sw_status *status)
 {
     sw_result r = check_nurbs_desc(d, status);
     if (r != SW_OK)
@@ -599,7 +610,7 @@ static sw_result make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *
     case SW_NODE_NURBS:
         if (!d->nurbs)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: NURBS without nurbs");
-        return nurbs_geom(d->nurbs, out, status);
+        return sw__rt_nurbs_geom(d->nurbs, out, status);
     case SW_NODE_TSPLINE:
         if (!d->tspline)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
@@ -967,7 +978,7 @@ sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_desc *d
     if (!desc)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_nurbs: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_NURBS, "sw_node_set_nurbs"};
-    return set_geometry(scene, node, &swap, nurbs_geom(desc, &swap.geom, status), status);
+    return set_geometry(scene, node, &swap, sw__rt_nurbs_geom(desc, &swap.geom, status), status);
 }
 
 sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_desc *desc,
@@ -1103,4 +1114,18 @@ sw_result sw_scene_flush(sw_scene scene, sw_status *status)
     if (r == SW_OK)
         sw__status_ok(status);
     return r;
+}
+
+/* ---- shared with api_immediate.c ---------------------------------------------------------------
+ */
+
+sw_result sw__rt_read_transform(const double in[12], const char *fn, double out[12],
+                                sw_status *status)
+{
+    return read_transform(in, fn, out, status);
+}
+
+sw_result sw__rt_read_color(const float in[4], const char *fn, float out[4], sw_status *status)
+{
+    return read_color(in, fn, out, status);
 }

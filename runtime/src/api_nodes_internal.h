@@ -59,6 +59,18 @@ typedef struct sw_rt_model {
     sw_status compile_status;
 } sw_rt_model;
 
+/* A private one-face scene of a checked NURBS desc (api_nodes.c): the one check and conversion
+ * of sw_nurbs_desc, shared by NURBS nodes and immediate objects (api_immediate.c). Errors:
+ * SW_ERR_INVALID_ARGUMENT, SW_ERR_INVALID_GEOMETRY, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__rt_nurbs_geom(const sw_nurbs_desc *d, sw_sg_scene **out, sw_status *status);
+
+/* The node API's checks of a desc's transform (all zero: identity; else finite, invertible) and
+ * colour (finite, >= 0; color[3] == 0: inherit, stored as -1), for the immediate draws. Errors:
+ * SW_ERR_INVALID_ARGUMENT naming fn. */
+sw_result sw__rt_read_transform(const double in[12], const char *fn, double out[12],
+                                sw_status *status);
+sw_result sw__rt_read_color(const float in[4], const char *fn, float out[4], sw_status *status);
+
 /* Compiles the tree as it is now into a version (the edit lock held by the caller for the copy
  * only: it is released before the builder is finished when `unlock` is set). */
 sw_result sw__rt_model_compile(sw_rt_model *m, int unlock, sw_rt_scene **out, uint64_t *revision,

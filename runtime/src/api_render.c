@@ -3,6 +3,8 @@
 #include "sw_rt.h"
 #include "sw_rt_pipeline.h"
 
+#include "sw_gpu_internal.h"
+
 #include "sw_lod_cache.h"
 #include "sw_lod_face_cones.h"
 #include "sw_lod_static_set.h"
@@ -41,6 +43,7 @@ typedef struct sw_rt_renderer {
     sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
     uint32_t in_flight;       /* prepared frames not submitted yet */
     uint64_t frames_prepared;
+    struct sw_rt_immediate *immediate; /* api_immediate.c; NULL until the first immediate call */
 } sw_rt_renderer;
 
 /* A prepared frame: the job V works on, and what its submission needs. */
@@ -212,6 +215,7 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
         rr->in_flight--;
     }
     sw_rt_pipeline_stop(rr->pipeline);
+    sw__rt_immediate_free(rr->immediate, rr->gpu);
     drop_cache(rr);
     sw_th_pool_destroy(rr->pool);
     sw_gpu_context_free(rr->gpu);
@@ -461,9 +465,11 @@ static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
     return res;
 }
 
-/* Renders and writes the frame of a checked desc on the renderer's thread. */
+/* Renders and writes the frame of a checked desc on the renderer's thread; extra (NULL: none)
+ * gives an immediate frame's occurrences and surface programs. */
 static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
-                            sw_frame_stats *stats, sw_status *status)
+                            const sw_rt_frame_extra *extra, sw_frame_stats *stats,
+                            sw_status *status)
 {
     double t0 = now_ms();
     sw_gpu_frame_desc frame = {0};
@@ -472,7 +478,15 @@ static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_fram
         return res;
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
+    const sw__gpu_surface_programs library = r->gpu->surf;
+    if (extra) {
+        frame.occurrences = extra->occurrences;
+        frame.n_occurrences = extra->n_occurrences;
+        if (extra->shading)
+            r->gpu->surf = *extra->shading; /* this frame only (Guthe §8's special program) */
+    }
     res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);
+    r->gpu->surf = library;
     if (res != SW_OK)
         return res;
     return finish_frame(&image, desc->output_path, &gstats, t0, stats, status);
@@ -601,7 +615,40 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &scene, status);
     if (res != SW_OK)
         return res;
-    res = draw_frame(r, scene, desc, stats, status);
+    res = draw_frame(r, scene, desc, NULL, stats, status);
     sw_rt_scene_release(scene);
+    return res;
+}
+
+sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
+                                    struct sw_rt_immediate ***slot, sw_gpu_context **gpu,
+                                    sw_status *status)
+{
+    sw_rt_renderer *r;
+    sw_result res = owned_renderer(handle, fn, &r, status);
+    if (res != SW_OK)
+        return res;
+    if (drawing && r->in_flight)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "%s: %u prepared frames wait; submit them first", fn, r->in_flight);
+    *slot = &r->immediate;
+    *gpu = r->gpu;
+    return SW_OK;
+}
+
+sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_scene *scene,
+                                     const sw_frame_desc *desc, const sw_rt_frame_extra *extra,
+                                     sw_frame_stats *stats, sw_status *status)
+{
+    sw_rt_renderer *r;
+    sw_result res = owned_renderer(handle, fn, &r, status);
+    if (res != SW_OK)
+        return res;
+    if (r->in_flight)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "%s: %u prepared frames wait; submit them first", fn, r->in_flight);
+    res = check_frame_desc(desc, status);
+    if (res == SW_OK)
+        res = draw_frame(r, scene, desc, extra, stats, status);
     return res;
 }

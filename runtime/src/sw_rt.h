@@ -107,6 +107,30 @@ void sw_rt_camera_fit_box(const double bbox[6], sw_view_preset view, sw_camera *
 /* Parses "iso|front|top|right"; returns 0 on success. */
 int sw_rt_view_parse(const char *text, sw_view_preset *out);
 
+/* ---- immediate draws (api_immediate.c, sw_immediate.h) --------------------------------------- */
+struct sw_rt_immediate;          /* a renderer's immediate state: its object scene and shading */
+struct sw__gpu_surface_programs; /* gpu/sw_gpu_internal.h */
+/* Frees a renderer's immediate state (NULL allowed): its owner thread, its context current. */
+void sw__rt_immediate_free(struct sw_rt_immediate *im, sw_gpu_context *gpu);
+/* What an immediate frame changes in a scene's frame: the occurrences drawn (instead of the
+ * scene's traversal) and the surface programs (NULL: the library's). */
+typedef struct sw_rt_frame_extra {
+    const sw_gpu_occurrence *occurrences;
+    size_t n_occurrences;
+    const struct sw__gpu_surface_programs *shading;
+} sw_rt_frame_extra;
+/* The renderer's immediate-state slot and GL context, for its owner thread (`drawing`: also
+ * refused while prepared frames wait, before the draw changes any state). Errors:
+ * SW_ERR_STALE_HANDLE, SW_ERR_INVALID_ARGUMENT (another thread; frames waiting), naming fn. */
+sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
+                                    struct sw_rt_immediate ***slot, sw_gpu_context **gpu,
+                                    sw_status *status);
+/* Draws `scene` (a reference the caller holds; not behind a handle) as sw_renderer_draw draws a
+ * scene's frame, with `extra`. Errors: those of sw_renderer_draw. */
+sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_scene *scene,
+                                     const sw_frame_desc *desc, const sw_rt_frame_extra *extra,
+                                     sw_frame_stats *stats, sw_status *status);
+
 /* The renderer's trim atlas (sw_gpu_trim_atlas_info), for the viewer's overlay. Owner thread;
  * 0 with the outputs set, -1 for a stale handle or another thread. */
 int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *pages,

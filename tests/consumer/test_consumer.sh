@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The consumer test of issue 7: install splinewalk to a temporary prefix, build
-# samples/embed_headless.c against the installed package through find_package and through
+# samples/embed_headless.c (and samples/embed_custom_shader.c, run once per build: the immediate
+# API with a host shading function) against the installed package through find_package and through
 # pkg-config (a copy of the sample, so nothing but the installed headers can be seen), run both
 # headlessly, and compare their frames with `splinewalk render` of the same scene and camera:
 # at most 0.1 % of pixels may differ. Negative controls prove the comparison sees a different
@@ -40,10 +41,12 @@ diff <(echo "$exported") <(echo "$declared") || fail "exported symbols differ fr
 echo "$(echo "$exported" | wc -l) functions"
 
 cp "$src/samples/embed_headless.c" "$work/embed_headless.c"
+cp "$src/samples/embed_custom_shader.c" "$work/embed_custom_shader.c"
 
 step "build through find_package(splinewalk)"
 cmake -S "$src/tests/consumer/find_package" -B "$work/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" \
-      -DSW_SAMPLE="$work/embed_headless.c" -DCMAKE_BUILD_TYPE=Release \
+      -DSW_SAMPLE="$work/embed_headless.c" -DSW_SAMPLE_GL="$work/embed_custom_shader.c" \
+      -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_C_FLAGS="${flags[*]}" >/dev/null
 cmake --build "$work/cmake-build" >/dev/null
 bin_cmake=$work/cmake-build/embed_headless
@@ -62,6 +65,19 @@ cp "$src/samples/embed_minimal.c" "$work/embed_minimal.c"
 cc "${flags[@]}" "$work/embed_minimal.c" $(pkg-config --cflags --libs splinewalk) \
    $(env -u PKG_CONFIG_LIBDIR pkg-config --cflags --libs glfw3) -lm -Wl,-rpath,"$libdir" \
    -o "$work/embed_minimal" || fail "embed_minimal does not build against the installed package"
+
+step "build samples/embed_custom_shader.c (an EGL host with its own shading) through pkg-config"
+# shellcheck disable=SC2046
+cc "${flags[@]}" "$work/embed_custom_shader.c" $(pkg-config --cflags --libs splinewalk) \
+   $(env -u PKG_CONFIG_LIBDIR pkg-config --cflags --libs egl opengl) -lm -Wl,-rpath,"$libdir" \
+   -o "$work/embed_custom_shader" || fail "embed_custom_shader does not build against the installed package"
+"$work/embed_custom_shader" "$work/custom_shader.png" > "$work/custom_shader.log" ||
+  fail "embed_custom_shader: $(cat "$work/custom_shader.log")"
+[ -s "$work/custom_shader.png" ] || fail "embed_custom_shader wrote no PNG"
+"$work/cmake-build/embed_custom_shader" "$work/custom_shader_cmake.png" > "$work/custom_shader_cmake.log" ||
+  fail "embed_custom_shader (find_package build): $(cat "$work/custom_shader_cmake.log")"
+"$png_diff" "$work/custom_shader.png" "$work/custom_shader_cmake.png" 0.1 ||
+  fail "the two builds of embed_custom_shader draw different frames"
 
 for b in "$bin_cmake" "$bin_pc"; do
   deps=$(ldd "$b")

@@ -312,4 +312,5 @@ SW_API sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats,
 #endif
 
 #include <splinewalk/sw_nodes.h>
+#include <splinewalk/sw_immediate.h>
 #endif

@@ -250,4 +250,7 @@ SW_API sw_result sw_node_get_camera(sw_scene scene, sw_node node, sw_camera *out
 #ifdef __cplusplus
 }
 #endif
+/* sw_immediate.h needs this header's descs whichever of the headers a program includes first */
+#define SPLINEWALK_SW_NODES_COMPLETE
+#include <splinewalk/sw_immediate.h>
 #endif
