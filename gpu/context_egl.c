@@ -4,6 +4,7 @@
  * into an FBO with RGBA8 colour and 32-bit float depth for reversed-Z.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_th_pool.h"
 #include "sw_status_util.h"
 
@@ -212,11 +213,11 @@ static sw_result context_create(sw_result (*make)(sw_gpu_context *, sw_status *)
                                 sw_gpu_context **out, sw_status *status)
 {
     *out = NULL;
-    sw_gpu_context *ctx = calloc(1, sizeof *ctx);
+    sw_gpu_context *ctx = sw__calloc(1, sizeof *ctx);
     if (ctx)
-        ctx->walk_token = calloc(1, sizeof *ctx->walk_token);
+        ctx->walk_token = sw__calloc(1, sizeof *ctx->walk_token);
     if (!ctx || !ctx->walk_token) {
-        free(ctx);
+        sw__free(ctx);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
     }
     sw_th_token_init(ctx->walk_token);
@@ -274,8 +275,8 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         eglMakeCurrent(ctx->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(ctx->egl_display, ctx->egl_context);
     }
-    free(ctx->walk_token);
-    free(ctx);
+    sw__free(ctx->walk_token);
+    sw__free(ctx);
 }
 
 const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx)

@@ -26,6 +26,7 @@
  * between two sides each within ε_img (gpu/crack_fill.c argues the width). The overlap is sized
  * from both sides' errors because both are bounded by the same ε_img. */
 #include "frame_internal.h"
+#include "sw_hooks.h"
 #include "sw_lod_static_set.h"
 #include "sw_status_util.h"
 
@@ -266,7 +267,7 @@ sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status)
     group_map gm = {NULL, 16};
     while (gm.cap < 2 * f->n_occ)
         gm.cap *= 2;
-    gm.slots = malloc(gm.cap * sizeof *gm.slots);
+    gm.slots = sw__malloc(gm.cap * sizeof *gm.slots);
     if (!gm.slots)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     for (size_t i = 0; i < gm.cap; ++i)
@@ -295,7 +296,7 @@ sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status)
         f->st.static_faces++;
         f->st.faces_drawn++;
     }
-    free(gm.slots);
+    sw__free(gm.slots);
     if (r == SW_OK)
         f->n_occ = kept;
     return r;

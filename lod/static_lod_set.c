@@ -1,6 +1,7 @@
 /* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
  * units are formed and how slots are published). */
 #include "sw_lod_static_set.h"
+#include "sw_hooks.h"
 
 #include "sw_sg_geom.h"
 #include "sw_status_util.h"
@@ -49,7 +50,7 @@ typedef struct build_job {
  * are consecutive). Faces without patches get SW_LOD_STATIC_NO_UNIT. */
 static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint32_t *home)
 {
-    uint32_t *best = calloc(n_faces ? n_faces : 1, sizeof *best);
+    uint32_t *best = sw__calloc(n_faces ? n_faces : 1, sizeof *best);
     if (!best)
         return 0;
     for (uint32_t f = 0; f < n_faces; ++f)
@@ -67,7 +68,7 @@ static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint3
             home[face] = c;
         }
     }
-    free(best);
+    sw__free(best);
     return 1;
 }
 
@@ -86,11 +87,11 @@ static int patch_cmp(const void *a, const void *b)
 static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_status *status)
 {
     const sw_lod_supersurfaces *ss = s->ss;
-    uint32_t *unit_of_cluster = malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
-    uint32_t *count = calloc(ss->n_clusters + 1, sizeof(uint32_t));
+    uint32_t *unit_of_cluster = sw__malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
+    uint32_t *count = sw__calloc(ss->n_clusters + 1, sizeof(uint32_t));
     if (!unit_of_cluster || !count) {
-        free(unit_of_cluster);
-        free(count);
+        sw__free(unit_of_cluster);
+        sw__free(count);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     for (uint32_t f = 0; f < s->n_faces; ++f)
@@ -98,12 +99,12 @@ static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_statu
             count[home[f]]++;
     for (uint32_t c = 0; c < ss->n_clusters; ++c)
         unit_of_cluster[c] = count[c] ? s->n_units++ : SW_LOD_STATIC_NO_UNIT;
-    free(count);
-    s->units = calloc(s->n_units ? s->n_units : 1, sizeof *s->units);
-    s->faces = malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->faces);
-    s->patches = malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *s->patches);
+    sw__free(count);
+    s->units = sw__calloc(s->n_units ? s->n_units : 1, sizeof *s->units);
+    s->faces = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->faces);
+    s->patches = sw__malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *s->patches);
     if (!s->units || !s->faces || !s->patches) {
-        free(unit_of_cluster);
+        sw__free(unit_of_cluster);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     for (uint32_t f = 0; f < s->n_faces; ++f) {
@@ -141,7 +142,7 @@ static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_statu
     for (uint32_t u = 0; u < s->n_units; ++u)
         qsort(s->patches + s->units[u].first_patch, s->units[u].n_patches, sizeof *s->patches,
               patch_cmp);
-    free(unit_of_cluster);
+    sw__free(unit_of_cluster);
     return SW_OK;
 }
 
@@ -188,7 +189,7 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
 {
     assert(scene && pool && out);
     *out = NULL;
-    sw_lod_static_set *s = calloc(1, sizeof *s);
+    sw_lod_static_set *s = sw__calloc(1, sizeof *s);
     if (!s)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     s->scene = scene;
@@ -199,17 +200,17 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     sw_result r = sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
     uint32_t *home = NULL;
     if (r == SW_OK) {
-        home = malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);
-        s->unit_of_face = malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->unit_of_face);
+        home = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);
+        s->unit_of_face = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->unit_of_face);
         if (!home || !s->unit_of_face || !home_clusters(s->ss, s->n_faces, home))
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     if (r == SW_OK)
         r = form_units(s, home, status);
-    free(home);
+    sw__free(home);
     if (r == SW_OK)
         r = unit_boxes(s, status);
-    if (r == SW_OK && !(s->slots = calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
+    if (r == SW_OK && !(s->slots = sw__calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     if (r != SW_OK) {
         sw_lod_static_set_destroy(s);
@@ -235,13 +236,13 @@ void sw_lod_static_set_destroy(sw_lod_static_set *s)
             sw_lod_static_free(atomic_load(&s->slots[u].chain));
         }
     }
-    free(s->slots);
-    free(s->units);
-    free(s->faces);
-    free(s->patches);
-    free(s->unit_of_face);
+    sw__free(s->slots);
+    sw__free(s->units);
+    sw__free(s->faces);
+    sw__free(s->patches);
+    sw__free(s->unit_of_face);
     sw_lod_supersurfaces_free(s->ss);
-    free(s);
+    sw__free(s);
 }
 
 /* ---- lookups ---------------------------------------------------------------------------------- */
@@ -331,7 +332,7 @@ static void build_task(void *ctx)
     sw_lod_static_set *s = job->set;
     const sw_lod_static_unit *un = &s->units[job->unit];
     slot *sl = &s->slots[job->unit];
-    free(job);
+    sw__free(job);
     if (atomic_load_explicit(&s->cancelled, memory_order_acquire))
         return; /* the slot stays QUEUED: nobody reads it any more */
     const uint64_t t0 = now_ns();
@@ -359,14 +360,14 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
     if (atomic_load_explicit(&sl->state, memory_order_acquire) != SW_LOD_STATIC_EMPTY ||
         !atomic_compare_exchange_strong(&sl->state, &expect, SW_LOD_STATIC_QUEUED))
         return SW_OK;
-    build_job *job = malloc(sizeof *job);
+    build_job *job = sw__malloc(sizeof *job);
     if (job) {
         *job = (build_job){s, unit};
         /* in the slot's group: converged frames and destroy wait on it */
         const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group};
         if (sw_th_pool_submit(s->pool, &task) == SW_OK)
             return SW_OK;
-        free(job);
+        sw__free(job);
     }
     atomic_store(&sl->state, SW_LOD_STATIC_EMPTY);
     return SW_ERR_OUT_OF_MEMORY;

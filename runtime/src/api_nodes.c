@@ -2,6 +2,7 @@
  * asks api_nodes_compile.c for a new version; geometry descs are checked and turned into small
  * private scenes here, outside the edit lock, so a slow import never holds the scene up. */
 #include "api_nodes_internal.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_face_cones.h"
 #include "sw_sg_tspline.h"
@@ -29,8 +30,8 @@ static void free_node(rt_node *n)
         free_node(c);
     }
     sw_sg_scene_free(n->geom);
-    free(n->name);
-    free(n);
+    sw__free(n->name);
+    sw__free(n);
 }
 
 static void free_children(rt_node *sentinel)
@@ -50,14 +51,14 @@ static void model_free(sw_rt_model *m)
         sw_rt_scene_release(v); /* frames still drawing it keep their references */
     free_children(&m->root);
     free_children(&m->detached);
-    free(m->name);
-    free(m->nodes.items);
-    free(m->nodes.generations);
+    sw__free(m->name);
+    sw__free(m->nodes.items);
+    sw__free(m->nodes.generations);
     pthread_mutex_destroy(&m->nodes.lock);
     pthread_mutex_destroy(&m->edit_lock);
     pthread_mutex_destroy(&m->pub_lock);
     pthread_cond_destroy(&m->pub_cond);
-    free(m);
+    sw__free(m);
 }
 
 void sw_rt_nodes_scene_free(sw_rt_scene *scene)
@@ -65,7 +66,7 @@ void sw_rt_nodes_scene_free(sw_rt_scene *scene)
     if (scene->model)
         model_free(scene->model);
     sw_lod_face_cones_free(scene->prebuilt_cones);
-    free(scene->face_nodes);
+    sw__free(scene->face_nodes);
 }
 
 static void init_sentinel(rt_node *n, sw_node_kind kind)
@@ -80,9 +81,9 @@ static atomic_uint_fast64_t g_model_serial;
 
 static sw_rt_model *model_create(const sw_scene_desc *desc, sw_status *status)
 {
-    sw_rt_model *m = calloc(1, sizeof *m);
-    if (!m || (desc && desc->name && !(m->name = strdup(desc->name)))) {
-        free(m);
+    sw_rt_model *m = sw__calloc(1, sizeof *m);
+    if (!m || (desc && desc->name && !(m->name = sw__strdup(desc->name)))) {
+        sw__free(m);
         sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_scene_create: out of memory");
         return NULL;
     }
@@ -250,7 +251,7 @@ static sw_result check_camera(const sw_camera *c, const char *fn, sw_status *sta
 
 static double *homogeneous(const double *points, const double *weights, uint32_t n, int dim)
 {
-    double *cpw = malloc((size_t)n * (size_t)(dim + 1) * sizeof *cpw);
+    double *cpw = sw__malloc((size_t)n * (size_t)(dim + 1) * sizeof *cpw);
     if (!cpw)
         return NULL;
     for (uint32_t i = 0; i < n; i++) {
@@ -267,7 +268,7 @@ static uint64_t push_homogeneous(sw_sg_builder *b, const double *points, const d
 {
     double *cpw = homogeneous(points, weights, n, dim);
     uint64_t at = cpw ? sw_sg_builder_push_doubles(b, cpw, (size_t)n * (dim + 1)) : UINT64_MAX;
-    free(cpw);
+    sw__free(cpw);
     return at;
 }
 
@@ -319,9 +320,9 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
                           double box[4], uint32_t *loop_out, sw_status *status)
 {
     uint32_t nc = lp->curve_count;
-    uint64_t *kn = malloc(nc * sizeof *kn), *cp = malloc(nc * sizeof *cp);
-    double **ptrs = malloc(nc * sizeof *ptrs);
-    int32_t *counts = malloc(nc * sizeof *counts);
+    uint64_t *kn = sw__malloc(nc * sizeof *kn), *cp = sw__malloc(nc * sizeof *cp);
+    double **ptrs = sw__malloc(nc * sizeof *ptrs);
+    int32_t *counts = sw__malloc(nc * sizeof *counts);
     sw_result r = kn && cp && ptrs && counts ? SW_OK : SW_ERR_OUT_OF_MEMORY;
     for (uint32_t c = 0; r == SW_OK && c < nc; c++) {
         const sw_trim_curve *tc = &lp->curves[c];
@@ -361,10 +362,10 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
     }
     if (r == SW_OK && (*loop_out = sw_sg_builder_add_loop(b, &rec)) == SW_SG_NONE)
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "NURBS surface: out of memory");
-    free(kn);
-    free(cp);
-    free(ptrs);
-    free(counts);
+    sw__free(kn);
+    sw__free(cp);
+    sw__free(ptrs);
+    sw__free(counts);
     return r;
 }
 
@@ -462,7 +463,7 @@ static sw_result tspline_from_arrays(const sw_tspline_desc *d, sw_sg_tspline **t
                              d->knots_v,
                              {d->domain[0], d->domain[1], d->domain[2], d->domain[3]}};
     sw_result r = sw_sg_tspline_create(&td, "T-spline", ts, status);
-    free(cpw);
+    sw__free(cpw);
     return r;
 }
 
@@ -604,7 +605,7 @@ static sw_result new_node(const sw_node_desc *d, rt_node **out, sw_status *statu
                         (int)d->kind);
     if (d->kind == SW_NODE_CAMERA && !d->camera)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: CAMERA without camera", fn);
-    rt_node *n = calloc(1, sizeof *n);
+    rt_node *n = sw__calloc(1, sizeof *n);
     if (!n)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     n->kind = d->kind;
@@ -617,7 +618,7 @@ static sw_result new_node(const sw_node_desc *d, rt_node **out, sw_status *statu
     if (r == SW_OK && d->kind == SW_NODE_CAMERA &&
         (r = check_camera(d->camera, fn, status)) == SW_OK)
         n->camera = *d->camera;
-    if (r == SW_OK && d->name && !(n->name = strdup(d->name)))
+    if (r == SW_OK && d->name && !(n->name = sw__strdup(d->name)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     if (r == SW_OK)
         r = make_geom(d, &n->geom, status);

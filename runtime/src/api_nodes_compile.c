@@ -5,6 +5,7 @@
  * is reclaimed after a grace period"). The compile task runs in the model's one-worker pool, so
  * walkthrough frames, which only read the published pointer, never wait for it. */
 #include "api_nodes_internal.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_face_cones.h"
 #include "sw_sg_bvh.h"
@@ -34,7 +35,7 @@ static int note_faces(compile_state *cs, uint32_t node_id)
         uint32_t cap = cs->cap_face_nodes ? cs->cap_face_nodes : 16;
         while (cap < n)
             cap *= 2;
-        uint32_t *grown = realloc(cs->face_nodes, cap * sizeof *grown);
+        uint32_t *grown = sw__realloc(cs->face_nodes, cap * sizeof *grown);
         if (!grown)
             return 0;
         cs->face_nodes = grown;
@@ -122,7 +123,7 @@ static int pending_push(pending *p, rt_node *n)
 {
     if (p->count == p->cap) {
         uint32_t cap = p->cap ? p->cap * 2 : 16;
-        rt_node **grown = realloc(p->items, cap * sizeof *grown);
+        rt_node **grown = sw__realloc(p->items, cap * sizeof *grown);
         if (!grown)
             return 0;
         p->items = grown;
@@ -194,7 +195,7 @@ static sw_result copy_tree(sw_rt_model *m, compile_state *cs, sw_status *status)
         compile_instances(cs, &p);
     for (uint32_t i = 0; i < p.count; i++)
         p.items[i]->mark = 0;
-    free(p.items);
+    sw__free(p.items);
     if (r == SW_OK && cs->oom)
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "node scene: out of memory compiling");
     return r;
@@ -207,7 +208,7 @@ static sw_result finish_version(sw_sg_scene *sg, uint32_t *face_nodes, uint64_t 
 {
     sw_rt_scene *v = sw_rt_scene_alloc(sg);
     if (!v) {
-        free(face_nodes);
+        sw__free(face_nodes);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "node scene: out of memory");
     }
     v->face_nodes = face_nodes;
@@ -241,13 +242,13 @@ sw_result sw__rt_model_compile(sw_rt_model *m, int unlock, sw_rt_scene **out, ui
         pthread_mutex_unlock(&m->edit_lock);
     if (r != SW_OK) {
         sw_sg_builder_free(cs.b);
-        free(cs.face_nodes);
+        sw__free(cs.face_nodes);
         return r;
     }
     sw_sg_scene *sg = NULL;
     r = sw_sg_builder_finish(cs.b, &sg, status);
     if (r != SW_OK) {
-        free(cs.face_nodes);
+        sw__free(cs.face_nodes);
         return r;
     }
     return finish_version(sg, cs.face_nodes, m->serial, *revision, out, status);

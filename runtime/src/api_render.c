@@ -1,6 +1,7 @@
 /* Public rendering API: a headless renderer owns a GL context on its creating thread and draws
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
 #include "sw_rt.h"
+#include "sw_hooks.h"
 #include "sw_rt_pipeline.h"
 
 #include "sw_lod_cache.h"
@@ -68,7 +69,7 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
     const uint32_t workers = desc ? desc->worker_threads : 0;
     if (workers > 1024)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "worker_threads %u above 1024", workers);
-    sw_rt_renderer *r = calloc(1, sizeof *r);
+    sw_rt_renderer *r = sw__calloc(1, sizeof *r);
     if (!r)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
     r->worker_threads = workers;
@@ -76,14 +77,14 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
                         ? sw_gpu_context_adopt_current(&r->gpu, status)
                         : sw_gpu_context_create_headless(&r->gpu, status);
     if (res != SW_OK) {
-        free(r);
+        sw__free(r);
         return res;
     }
     r->owner = pthread_self();
     out->id = sw_rt_pool_add(&g_renderers, r);
     if (!out->id) {
         sw_gpu_context_free(r->gpu);
-        free(r);
+        sw__free(r);
         return sw__fail(status, SW_ERR_LIMIT, "too many renderers");
     }
     return SW_OK;
@@ -123,7 +124,7 @@ static void retire_statics_task(void *ctx)
     retired_statics *rs = ctx;
     sw_lod_static_set_destroy(rs->set); /* waits for its running builds, runs pool tasks */
     sw_rt_scene_release(rs->scene);
-    free(rs);
+    sw__free(rs);
 }
 
 /* The scene's static LODs, given up (another scene, a new version of a node scene, the renderer
@@ -139,7 +140,7 @@ static void retire_statics(sw_rt_renderer *r)
     if (!set)
         return;
     sw_lod_static_set_cancel(set);
-    retired_statics *rs = malloc(sizeof *rs);
+    retired_statics *rs = sw__malloc(sizeof *rs);
     if (rs) {
         *rs = (retired_statics){set, r->cache_scene};
         sw_rt_scene_retain(r->cache_scene);
@@ -147,7 +148,7 @@ static void retire_statics(sw_rt_renderer *r)
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;
         sw_rt_scene_release(r->cache_scene);
-        free(rs);
+        sw__free(rs);
     }
     sw_lod_static_set_destroy(set); /* out of memory: here, waiting */
 }
@@ -212,7 +213,7 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     drop_cache(rr);
     sw_th_pool_destroy(rr->pool);
     sw_gpu_context_free(rr->gpu);
-    free(rr);
+    sw__free(rr);
     return SW_OK;
 }
 
@@ -458,14 +459,14 @@ static void job_free(rt_job *j)
     sw_gpu_frame_plan_free(j->job.plan);
     if (j->scene)
         sw_rt_scene_release(j->scene);
-    free(j->output_path);
-    free(j);
+    sw__free(j->output_path);
+    sw__free(j);
 }
 
 /* A new job for a checked desc, its scene acquired; NULL with *status set on failure. */
 static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_status *status)
 {
-    rt_job *j = calloc(1, sizeof *j);
+    rt_job *j = sw__calloc(1, sizeof *j);
     if (!j) {
         sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
         return NULL;
@@ -484,7 +485,7 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
         res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                        "sw_renderer_prepare: frames of another scene are prepared; submit them "
                        "before preparing one of this scene");
-    if (res == SW_OK && desc->output_path && !(j->output_path = strdup(desc->output_path)))
+    if (res == SW_OK && desc->output_path && !(j->output_path = sw__strdup(desc->output_path)))
         res = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
     if (res == SW_OK)
         res = gpu_frame(r, j->scene, desc, &j->job.desc, status);

@@ -1,5 +1,6 @@
 /* Public scene API: load (.sws mapped, or imported through OCCT), save, describe, fit cameras. */
 #include "sw_rt.h"
+#include "sw_hooks.h"
 
 #include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
@@ -32,7 +33,7 @@ static int is_cad_file(const char *path)
 
 sw_rt_scene *sw_rt_scene_alloc(sw_sg_scene *sg)
 {
-    sw_rt_scene *scene = calloc(1, sizeof *scene);
+    sw_rt_scene *scene = sw__calloc(1, sizeof *scene);
     if (!scene) {
         sw_sg_scene_free(sg);
         return NULL;
@@ -210,7 +211,7 @@ void sw_rt_scene_release(sw_rt_scene *scene)
     sw_sg_bvh_free(scene->pick_bvh);
     sw_sg_scene_free(scene->sg);
     pthread_mutex_destroy(&scene->once_lock);
-    free(scene);
+    sw__free(scene);
 }
 
 /* Verifies every section and computes the stats, exactly once per scene. Locks once_lock, which

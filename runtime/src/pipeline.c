@@ -11,6 +11,7 @@
  * The pool T keeps working beside both (hierarchy builds and refinements).
  */
 #include "sw_rt_pipeline.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -53,7 +54,7 @@ static void *visibility_thread(void *arg)
 sw_result sw_rt_pipeline_start(sw_gpu_context *gpu, sw_rt_pipeline **out, sw_status *status)
 {
     *out = NULL;
-    sw_rt_pipeline *p = calloc(1, sizeof *p);
+    sw_rt_pipeline *p = sw__calloc(1, sizeof *p);
     if (!p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visibility thread: out of memory");
     p->gpu = gpu;
@@ -100,5 +101,5 @@ void sw_rt_pipeline_stop(sw_rt_pipeline *p)
     }
     sw_th_spsc_destroy(&p->jobs);
     sw_th_spsc_destroy(&p->done);
-    free(p);
+    sw__free(p);
 }

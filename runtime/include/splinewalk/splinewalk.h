@@ -31,6 +31,7 @@
 #define SPLINEWALK_H
 
 #include <splinewalk/sw_result.h>
+#include <splinewalk/sw_setup.h>
 #include <stddef.h>
 #include <stdint.h>
 
