@@ -113,7 +113,7 @@ static sw_rt_model *model_create(const sw_scene_desc *desc, sw_status *status)
 sw_result sw_scene_create(const sw_scene_desc *desc, sw_scene *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_create: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_create: NULL out");
     out->id = 0;
     sw_rt_model *m = model_create(desc, status);
     if (!m)
@@ -169,7 +169,7 @@ static sw_result find_node(sw_rt_model *m, sw_node node, const char *fn, rt_node
 {
     void *item = NULL;
     if (sw_rt_pool_get_checked(&m->nodes, node.id, accept_node, NULL, &item) != SW_OK)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid", fn,
+        return SW__MISUSE(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid", fn,
                         node.id);
     *out = item;
     return SW_OK;
@@ -287,9 +287,9 @@ static sw_result check_nurbs_desc(const sw_nurbs_desc *d, sw_status *status)
         return sw__fail(status, SW_ERR_LIMIT, "%s: %u x %u control points (at most %u)", fn,
                         d->count_u, d->count_v, SW__NODES_MAX_POINTS);
     if (!d->knots_u || !d->knots_v || !d->points)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL knots or points", fn);
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL knots or points", fn);
     if (d->loop_count && !d->loops)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn,
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn,
                         d->loop_count);
     if (d->loop_count > SW__NODES_MAX_LOOPS)
         return sw__fail(status, SW_ERR_LIMIT, "%s: %u trim loops (at most %u)", fn, d->loop_count,
@@ -453,7 +453,7 @@ static sw_result tspline_from_arrays(const sw_tspline_desc *d, sw_sg_tspline **t
         return sw__fail(status, SW_ERR_LIMIT, "T-spline: %u points (1..%u)", d->point_count,
                         SW__NODES_MAX_POINTS);
     if (!d->points || !d->knots_u || !d->knots_v)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "T-spline: NULL points or knots");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "T-spline: NULL points or knots");
     double *cpw = homogeneous(d->points, d->weights, d->point_count, 3);
     if (!cpw)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "T-spline: out of memory");
@@ -661,7 +661,7 @@ sw_result sw_node_add(sw_scene scene, const sw_node_desc *desc, sw_node *out, sw
     if (out)
         out->id = 0;
     if (!desc || !out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: NULL desc or out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: NULL desc or out");
     rt_node *n = NULL;
     sw_result r = new_node(desc, &n, status); /* a slow import runs here, unlocked */
     if (r != SW_OK)
@@ -825,7 +825,7 @@ sw_result sw_node_set_transform(sw_scene scene, sw_node node, const double trans
                                 sw_status *status)
 {
     if (!transform)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_transform: NULL transform");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_transform: NULL transform");
     return edit_node(scene, node, "sw_node_set_transform", edit_transform, transform, status);
 }
 
@@ -844,7 +844,7 @@ sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_desc *d
                             sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_nurbs: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_nurbs: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_NURBS, "sw_node_set_nurbs"};
     return set_geometry(scene, node, &swap, nurbs_geom(desc, &swap.geom, status), status);
 }
@@ -853,7 +853,7 @@ sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_des
                               sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_tspline: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_tspline: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_TSPLINE, "sw_node_set_tspline"};
     return set_geometry(scene, node, &swap, tspline_geom(desc, &swap.geom, status), status);
 }
@@ -864,7 +864,7 @@ sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_des
 sw_result sw_node_get_info(sw_scene scene, sw_node node, sw_node_info *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_info: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_info: NULL out");
     sw_rt_scene *c;
     sw_result r = begin_edit(scene, "sw_node_get_info", &c, status);
     if (r != SW_OK)
@@ -911,7 +911,7 @@ static void map_point(const double m[12], const double p[3], double w, double ou
 sw_result sw_node_get_camera(sw_scene scene, sw_node node, sw_camera *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_camera: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_camera: NULL out");
     sw_rt_scene *c;
     sw_result r = begin_edit(scene, "sw_node_get_camera", &c, status);
     if (r != SW_OK)
@@ -941,7 +941,7 @@ sw_result sw_node_get_camera(sw_scene scene, sw_node node, sw_camera *out, sw_st
 sw_result sw_scene_get_revisions(sw_scene scene, sw_scene_revisions *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_revisions: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_revisions: NULL out");
     sw_rt_scene *c;
     sw_result r = begin_edit(scene, "sw_scene_get_revisions", &c, status);
     if (r != SW_OK)

@@ -64,7 +64,7 @@ static double now_ms(void)
 sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_create: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_create: NULL out");
     out->id = 0;
     const uint32_t workers = desc ? desc->worker_threads : 0;
     if (workers > 1024)
@@ -87,6 +87,8 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
         sw__free(r);
         return sw__fail(status, SW_ERR_LIMIT, "too many renderers");
     }
+    sw__log(SW_LOG_INFO, "renderer %#x: %s%s", out->id, sw_gpu_context_description_ptr(r->gpu),
+            desc && desc->use_current_context ? " (the host's context)" : "");
     return SW_OK;
 }
 
@@ -108,9 +110,9 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
     sw_result r = sw_rt_pool_get_checked(&g_renderers, handle.id, check_owner, NULL, &item);
     *out = item;
     if (r == SW_ERR_STALE_HANDLE)
-        return sw__fail(status, r, "%s: renderer handle %#x is stale or invalid", fn, handle.id);
+        return SW__MISUSE(status, r, "%s: renderer handle %#x is stale or invalid", fn, handle.id);
     if (r != SW_OK)
-        return sw__fail(status, r, "%s: called from a thread that does not own the renderer", fn);
+        return SW__MISUSE(status, r, "%s: called from a thread that does not own the renderer", fn);
     return SW_OK;
 }
 
@@ -202,8 +204,12 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
 {
     void *item;
     sw_result r = sw_rt_pool_remove_checked(&g_renderers, renderer.id, check_owner, NULL, &item);
-    if (r != SW_OK)
-        return r; /* stale, or another thread's context: left untouched */
+    if (r == SW_ERR_STALE_HANDLE) /* left untouched */
+        return SW__MISUSE(NULL, r, "sw_renderer_destroy: renderer handle %#x is stale or invalid",
+                          renderer.id);
+    if (r != SW_OK) /* another thread's context: left untouched */
+        return SW__MISUSE(NULL, r, "sw_renderer_destroy: called from a thread that does not own "
+                                   "the renderer");
     sw_rt_renderer *rr = item;
     while (rr->in_flight) { /* prepared, never submitted: V finishes them, nobody draws them */
         job_free((rt_job *)sw_rt_pipeline_pop(rr->pipeline));
@@ -500,7 +506,7 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
 sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_prepare: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_prepare: NULL desc");
     sw_rt_renderer *r;
     sw_result res = owned_renderer(renderer, "sw_renderer_prepare", &r, status);
     if (res == SW_OK)
@@ -561,7 +567,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
                            sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
     sw_rt_renderer *r;
     sw_result res = owned_renderer(renderer, "sw_renderer_draw", &r, status);
     if (res != SW_OK)

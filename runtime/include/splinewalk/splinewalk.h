@@ -26,6 +26,12 @@
  * Results: every function returning sw_result may also be given status == NULL; on failure the
  * status (when given) holds the result and a message naming the file, position or argument.
  * Outputs (`out`) are zeroed on failure where the documentation says so, untouched otherwise.
+ *
+ * Misuse: a NULL desc or required pointer, a stale handle (also a second destroy), a call from a
+ * thread that does not own the renderer are programming mistakes. They return the documented
+ * result and change nothing, and their message goes to the log hook at SW_LOG_ERROR (sw_setup.h);
+ * a library built with SW_MISUSE_ASSERT (CMake option, on by default in Debug builds) aborts with
+ * that message on stderr instead.
  */
 #ifndef SPLINEWALK_H
 #define SPLINEWALK_H
