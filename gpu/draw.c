@@ -224,20 +224,6 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     return sw__gpu_check(status, "frame draw");
 }
 
-void sw__gpu_host_state_save(sw__gpu_host_state *s)
-{
-    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fb);
-    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &s->read_fb);
-    glGetIntegerv(GL_VIEWPORT, s->viewport);
-}
-
-void sw__gpu_host_state_restore(const sw__gpu_host_state *s)
-{
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)s->draw_fb);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)s->read_fb);
-    glViewport(s->viewport[0], s->viewport[1], s->viewport[2], s->viewport[3]);
-}
-
 sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
                           const sw__gpu_host_state *host, sw_status *status)
 {

@@ -1427,7 +1427,8 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
                                 : sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                                            "frame: the plan was prepared for another context");
     sw__gpu_host_state host;
-    if (desc->present)
+    const int host_state = desc->present || sw__gpu_context_adopted(ctx);
+    if (host_state)
         sw__gpu_host_state_save(&host);
     double t1 = sw__gpu_now_ms();
     /* GPU time of the trim textures and the draw, by two GL_TIMESTAMP queries (the second one
@@ -1455,7 +1456,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
         r = sw__gpu_present(ctx, &f->view, &host, status);
     if (r == SW_OK && !desc->no_readback)
         r = sw__gpu_readback(ctx, &f->view, desc->want_depth, out, status);
-    if (desc->present)
+    if (host_state)
         sw__gpu_host_state_restore(&host);
     double t4 = sw__gpu_now_ms();
 
