@@ -711,9 +711,11 @@ sw_result sw_lod_cache_create(const sw_sg_scene *scene, sw_th_pool *pool,
     if (d.max_readers > MAX_READERS)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "lod cache: %u readers (at most %d)",
                         (unsigned)d.max_readers, MAX_READERS);
-    sw_lod_cache *c = sw__calloc(1, sizeof *c);
+    /* Over-aligned (its epoch has a cache line of its own): not malloc's alignment. */
+    sw_lod_cache *c = sw__aligned_alloc(alignof(sw_lod_cache), sizeof *c);
     if (!c)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "lod cache");
+    memset(c, 0, sizeof *c);
     c->scene = scene;
     c->pool = pool;
     c->desc = d;
@@ -724,7 +726,7 @@ sw_result sw_lod_cache_create(const sw_sg_scene *scene, sw_th_pool *pool,
     if (!c->slots || !c->readers || pthread_mutex_init(&c->retire_lock, NULL) != 0) {
         sw__free(c->slots);
         sw__aligned_free(c->readers);
-        sw__free(c);
+        sw__aligned_free(c);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "lod cache: %u faces",
                         (unsigned)sw_sg_scene_view_ptr(scene)->n_faces);
     }
@@ -772,7 +774,7 @@ void sw_lod_cache_destroy(sw_lod_cache *c)
     pthread_mutex_destroy(&c->retire_lock);
     sw__free(c->slots);
     sw__aligned_free(c->readers);
-    sw__free(c);
+    sw__aligned_free(c);
 }
 
 size_t sw_lod_cache_memory(const sw_lod_cache *c)

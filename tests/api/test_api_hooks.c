@@ -12,6 +12,11 @@
  *       allocation of loading the T-spline scene and of loading its .sws copy: each load fails
  *       with SW_ERR_OUT_OF_MEMORY (or succeeds once N is past its last allocation), leaves *out =
  *       {0} and frees everything it made (counts back to where they were; ASan in CI).
+ *   test_api_hooks oom_render SCENE.tsm WORKDIR
+ *       the same for a renderer's life (create, a converged frame, destroy), allocation N failing
+ *       for N = 0..15 and then every (allocations / 60)-th: each call fails with
+ *       SW_ERR_OUT_OF_MEMORY or succeeds, the renderer draws again once memory is back, and its
+ *       destruction frees everything.
  */
 #include <splinewalk/splinewalk.h>
 
@@ -305,15 +310,91 @@ static int run_oom(void)
     return 0;
 }
 
+/* One renderer's life (create, a converged frame, destroy) with allocation N failing: create and
+ * draw fail with SW_ERR_OUT_OF_MEMORY or succeed (a pool task that met the failure may leave its
+ * face to a coarser path), a second frame without failures draws, and nothing is left behind.
+ * Returns the allocations of a life without failures. */
+static long long g_sticky; /* lives whose second frame still met the first one's failure */
+
+static long long renderer_life(sw_scene scene, long long fail_at, int check, int *bad)
+{
+    long long blocks0, bytes0;
+    snapshot(&blocks0, &bytes0);
+    long long base = atomic_load(&g_counts.allocs);
+    atomic_store(&g_counts.failed, 0);
+    atomic_store(&g_counts.fail_from, fail_at >= 0 ? base + fail_at : -1);
+    sw_renderer renderer = {0};
+    sw_renderer_desc rdesc = {.worker_threads = 2};
+    sw_status status = {0};
+    sw_result created = sw_renderer_create(&rdesc, &renderer, &status);
+    sw_frame_desc frame = {.scene = scene, .width = 96, .height = 72};
+    sw_result drawn = created == SW_OK ? sw_renderer_draw(renderer, &frame, NULL, &status) : SW_OK;
+    atomic_store(&g_counts.fail_from, -1);
+    long long used = atomic_load(&g_counts.allocs) - base;
+    sw_result again = created == SW_OK ? sw_renderer_draw(renderer, &frame, NULL, NULL) : SW_OK;
+    if (created == SW_OK)
+        EXPECT_RESULT(sw_renderer_destroy(renderer), SW_OK);
+    long long blocks, bytes;
+    snapshot(&blocks, &bytes);
+    /* A hierarchy build that met the failure stays failed for this renderer and scene (the
+     * cache builds a face once), so the second frame may report it again; a new renderer does
+     * not (the next life). Any other result, or memory left, is wrong. */
+    if (again == SW_ERR_OUT_OF_MEMORY && drawn == SW_ERR_OUT_OF_MEMORY)
+        g_sticky++;
+    int ok = (created == SW_OK || created == SW_ERR_OUT_OF_MEMORY) &&
+             (drawn == SW_OK || drawn == SW_ERR_OUT_OF_MEMORY) &&
+             (again == SW_OK || (again == SW_ERR_OUT_OF_MEMORY && drawn == SW_ERR_OUT_OF_MEMORY)) &&
+             (!check || (blocks == blocks0 && bytes == bytes0));
+    if (!ok) {
+        fprintf(stderr, "renderer life, allocation %lld failing: create %s, draw %s (%s), "
+                        "draw after %s, %lld blocks / %lld bytes left\n",
+                fail_at, sw_result_id_str(created), sw_result_id_str(drawn), status.message,
+                sw_result_id_str(again), blocks - blocks0, bytes - bytes0);
+        g_failures++;
+        *bad += 1;
+    }
+    return used;
+}
+
+static int run_oom_render(void)
+{
+    sw_setup_desc setup = {.allocator = {count_alloc, count_realloc, count_free, &g_counts}};
+    EXPECT_RESULT(sw_setup(&setup, NULL), SW_OK);
+    sw_scene scene = {0};
+    sw_scene_load_desc load = {.path = g_scene_path};
+    EXPECT_RESULT(sw_scene_load(&load, &scene, NULL), SW_OK);
+    sw_scene_info info;
+    EXPECT_RESULT(sw_scene_get_info(scene, &info, NULL), SW_OK);
+    int bad = 0;
+    renderer_life(scene, -1, 0, &bad); /* the renderer table exists from here on */
+    long long total = renderer_life(scene, -1, 1, &bad);
+    long long step = total / 60 > 1 ? total / 60 : 1, lives = 0;
+    for (long long n = 0; n < total && bad < 5; n += n < 16 ? 1 : step, lives++) {
+        renderer_life(scene, n, 1, &bad);
+        long long sticky = g_sticky;
+        renderer_life(scene, -1, 1, &bad); /* a new renderer draws again */
+        EXPECT(g_sticky == sticky);
+    }
+    EXPECT_RESULT(sw_scene_destroy(scene), SW_OK);
+    printf("failing allocator: %lld renderer lives (create + converged frame + destroy, %lld "
+           "allocations each) with allocation 0..15 and every %lld-th failing: %d wrong; %lld "
+           "whose second frame met the first one's hierarchy failure again\n",
+           lives, total, step, bad, g_sticky);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 4) {
-        fprintf(stderr, "usage: %s count|oom SCENE.tsm WORKDIR\n", argv[0]);
+        fprintf(stderr, "usage: %s count|oom|oom_render SCENE.tsm WORKDIR\n", argv[0]);
         return 2;
     }
     g_scene_path = argv[2];
     g_work = argv[3];
-    int r = strcmp(argv[1], "count") == 0 ? run_count() : strcmp(argv[1], "oom") == 0 ? run_oom() : 2;
+    int r = strcmp(argv[1], "count") == 0        ? run_count()
+            : strcmp(argv[1], "oom") == 0        ? run_oom()
+            : strcmp(argv[1], "oom_render") == 0 ? run_oom_render()
+                                                 : 2;
     if (r == 2) {
         fprintf(stderr, "unknown mode %s\n", argv[1]);
         return 2;
