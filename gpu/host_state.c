@@ -7,8 +7,8 @@
  * mask, depth range, polygon mode, sampler object or clip control would otherwise change what the
  * renderer uploads and draws. On exit all of it is put back. Saved: bindings (program, vertex
  * array and its element buffer, the generic buffer targets, the indexed uniform and shader
- * storage ranges below SW__GPU_HOST_INDEXED, renderbuffer, draw / read framebuffers, texture unit 0's
- * textures of every target and its sampler, the active unit), the capabilities in k_caps,
+ * storage ranges below SW__GPU_HOST_INDEXED, renderbuffer, draw / read framebuffers, texture unit
+ * 0's textures of every target and its sampler, the active unit), the capabilities in k_caps,
  * viewport and scissor box, blend, depth, stencil, colour and clear state, rasterisation (cull,
  * front face, polygon mode and offset, line width, point size, provoking vertex, primitive
  * restart index, patch vertices, logic op), clip control and pixel pack / unpack parameters. The
@@ -79,8 +79,7 @@ _Static_assert(sizeof k_buffers / sizeof k_buffers[0] == SW__GPU_HOST_BUFFERS,
 
 /* The indexed targets: binding, start and size queries. */
 static const GLenum k_indexed[][4] = {
-    {GL_UNIFORM_BUFFER, GL_UNIFORM_BUFFER_BINDING, GL_UNIFORM_BUFFER_START,
-     GL_UNIFORM_BUFFER_SIZE},
+    {GL_UNIFORM_BUFFER, GL_UNIFORM_BUFFER_BINDING, GL_UNIFORM_BUFFER_START, GL_UNIFORM_BUFFER_SIZE},
     {GL_SHADER_STORAGE_BUFFER, GL_SHADER_STORAGE_BUFFER_BINDING, GL_SHADER_STORAGE_BUFFER_START,
      GL_SHADER_STORAGE_BUFFER_SIZE},
 };
@@ -103,9 +102,9 @@ _Static_assert(sizeof k_textures / sizeof k_textures[0] == SW__GPU_HOST_TEXTURES
 
 /* Pixel store parameters, pack then unpack; alignment 4 by default, the rest 0. */
 static const GLenum k_pixel_store[] = {
-    GL_PACK_ALIGNMENT,     GL_PACK_ROW_LENGTH,    GL_PACK_SKIP_ROWS,     GL_PACK_SKIP_PIXELS,
-    GL_PACK_IMAGE_HEIGHT,  GL_PACK_SKIP_IMAGES,   GL_PACK_SWAP_BYTES,    GL_PACK_LSB_FIRST,
-    GL_UNPACK_ALIGNMENT,   GL_UNPACK_ROW_LENGTH,  GL_UNPACK_SKIP_ROWS,   GL_UNPACK_SKIP_PIXELS,
+    GL_PACK_ALIGNMENT,      GL_PACK_ROW_LENGTH,    GL_PACK_SKIP_ROWS,    GL_PACK_SKIP_PIXELS,
+    GL_PACK_IMAGE_HEIGHT,   GL_PACK_SKIP_IMAGES,   GL_PACK_SWAP_BYTES,   GL_PACK_LSB_FIRST,
+    GL_UNPACK_ALIGNMENT,    GL_UNPACK_ROW_LENGTH,  GL_UNPACK_SKIP_ROWS,  GL_UNPACK_SKIP_PIXELS,
     GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_IMAGES, GL_UNPACK_SWAP_BYTES, GL_UNPACK_LSB_FIRST,
 };
 _Static_assert(sizeof k_pixel_store / sizeof k_pixel_store[0] == SW__GPU_HOST_PIXEL_STORE,

@@ -165,11 +165,16 @@ int sw__log_enabled(sw_log_level level)
 static const char *level_name(sw_log_level level)
 {
     switch (level) {
-    case SW_LOG_DEBUG: return "debug";
-    case SW_LOG_INFO: return "info";
-    case SW_LOG_WARN: return "warning";
-    case SW_LOG_ERROR: return "error";
-    default: return "log";
+    case SW_LOG_DEBUG:
+        return "debug";
+    case SW_LOG_INFO:
+        return "info";
+    case SW_LOG_WARN:
+        return "warning";
+    case SW_LOG_ERROR:
+        return "error";
+    default:
+        return "log";
     }
 }
 

@@ -19,6 +19,7 @@
 sw_result sw__misuse(int abort_after, sw_status *status, sw_result result, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
-#define SW__MISUSE(status, result, ...) sw__misuse(SW_MISUSE_ASSERT, (status), (result), __VA_ARGS__)
+#define SW__MISUSE(status, result, ...)                                                            \
+    sw__misuse(SW_MISUSE_ASSERT, (status), (result), __VA_ARGS__)
 
 #endif

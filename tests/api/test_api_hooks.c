@@ -5,18 +5,16 @@
  *       a counting allocator without realloc (the library emulates it): every block the library
  *       allocates while it loads, describes, picks, saves, renders and destroys a scene is freed
  *       again (blocks and bytes balance exactly against the count before the cycle); what stays
- *       after a warm-up (a scene and a renderer made and destroyed) is the handle tables only; the log hook gets the renderer's info
- *       line, the failures' debug lines and (without SW_MISUSE_ASSERT) the misuse's error line.
- *   test_api_hooks oom SCENE.tsm WORKDIR
- *       an allocator (with realloc) that fails from its N-th allocation on, N swept over every
- *       allocation of loading the T-spline scene and of loading its .sws copy: each load fails
- *       with SW_ERR_OUT_OF_MEMORY (or succeeds once N is past its last allocation), leaves *out =
- *       {0} and frees everything it made (counts back to where they were; ASan in CI).
- *   test_api_hooks oom_render SCENE.tsm WORKDIR
- *       the same for a renderer's life (create, a converged frame, destroy), allocation N failing
- *       for N = 0..15 and then every (allocations / 60)-th: each call fails with
- *       SW_ERR_OUT_OF_MEMORY or succeeds, the renderer draws again once memory is back, and its
- *       destruction frees everything.
+ *       after a warm-up (a scene and a renderer made and destroyed) is the handle tables only; the
+ * log hook gets the renderer's info line, the failures' debug lines and (without SW_MISUSE_ASSERT)
+ * the misuse's error line. test_api_hooks oom SCENE.tsm WORKDIR an allocator (with realloc) that
+ * fails from its N-th allocation on, N swept over every allocation of loading the T-spline scene
+ * and of loading its .sws copy: each load fails with SW_ERR_OUT_OF_MEMORY (or succeeds once N is
+ * past its last allocation), leaves *out = {0} and frees everything it made (counts back to where
+ * they were; ASan in CI). test_api_hooks oom_render SCENE.tsm WORKDIR the same for a renderer's
+ * life (create, a converged frame, destroy), allocation N failing for N = 0..15 and then every
+ * (allocations / 60)-th: each call fails with SW_ERR_OUT_OF_MEMORY or succeeds, the renderer draws
+ * again once memory is back, and its destruction frees everything.
  */
 #include <splinewalk/splinewalk.h>
 
@@ -50,7 +48,8 @@ static int g_failures;
     } while (0)
 
 /* ---- a counting allocator with its own size header (the library's calls come from several
- * threads: the renderer's pool, its visibility thread) ------------------------------------------ */
+ * threads: the renderer's pool, its visibility thread) ------------------------------------------
+ */
 typedef struct counts {
     atomic_llong allocs, frees, live_blocks, live_bytes, peak_bytes;
     atomic_llong fail_from; /* allocations numbered >= this fail; -1: none */
@@ -109,7 +108,8 @@ static void *count_realloc(void *user_data, void *ptr, size_t size)
     return fresh;
 }
 
-/* ---- a log hook that keeps the lines ----------------------------------------------------------- */
+/* ---- a log hook that keeps the lines -----------------------------------------------------------
+ */
 typedef struct log_lines {
     pthread_mutex_t lock;
     int count[SW_LOG_ERROR + 1];
@@ -224,8 +224,7 @@ static int run_count(void)
     long long allocs2 = atomic_load(&g_counts.allocs) - allocs1;
     printf("load + info + pick + save + 3 frames + destroy: %lld allocations, peak %lld bytes; "
            "live after it %lld blocks, %lld bytes (before it %lld, %lld)\n",
-           allocs2, (long long)atomic_load(&g_counts.peak_bytes), blocks2, bytes2, blocks1,
-           bytes1);
+           allocs2, (long long)atomic_load(&g_counts.peak_bytes), blocks2, bytes2, blocks1, bytes1);
     EXPECT(allocs2 > 1000); /* the allocator sees the library's work, not a handful of calls */
     EXPECT(blocks2 == blocks1 && bytes2 == bytes1);
     EXPECT(atomic_load(&g_counts.allocs) - atomic_load(&g_counts.frees) == blocks2);
@@ -362,8 +361,9 @@ static long long renderer_life(sw_scene scene, long long fail_at, int check, int
              (again == SW_OK || (again == SW_ERR_OUT_OF_MEMORY && drawn == SW_ERR_OUT_OF_MEMORY)) &&
              (!check || (blocks == blocks0 && bytes == bytes0));
     if (!ok) {
-        fprintf(stderr, "renderer life, allocation %lld failing: create %s, draw %s (%s), "
-                        "draw after %s, %lld blocks / %lld bytes left\n",
+        fprintf(stderr,
+                "renderer life, allocation %lld failing: create %s, draw %s (%s), "
+                "draw after %s, %lld blocks / %lld bytes left\n",
                 fail_at, sw_result_id_str(created), sw_result_id_str(drawn), status.message,
                 sw_result_id_str(again), blocks - blocks0, bytes - bytes0);
         g_failures++;

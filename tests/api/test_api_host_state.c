@@ -44,10 +44,12 @@ static int g_failures;
 
 enum { W = 200, H = 150 };
 
-/* ---- the host's context ------------------------------------------------------------------------ */
+/* ---- the host's context ------------------------------------------------------------------------
+ */
 static int make_host_context(void)
 {
-    EGLDisplay dpy = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+    EGLDisplay dpy =
+        eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
     if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, NULL, NULL) || !eglBindAPI(EGL_OPENGL_API))
         return -1;
     const EGLint attrs[] = {EGL_CONTEXT_MAJOR_VERSION,
@@ -217,7 +219,8 @@ static void set_odd_state(const host_objects *o)
     glPixelStorei(GL_UNPACK_SKIP_IMAGES, 1);
 }
 
-/* ---- the snapshot: the test's own list of queries ---------------------------------------------- */
+/* ---- the snapshot: the test's own list of queries ----------------------------------------------
+ */
 enum kind { INT, FLOAT, DOUBLE, BOOL, CAP, INT_I, INT64_I, UNIT_INT, VAO_ATTRIB };
 typedef struct query {
     const char *name;
@@ -227,26 +230,43 @@ typedef struct query {
     int count;    /* values */
 } query;
 
-#define Q(kind, pname, index, count) {#pname "[" #index "]", kind, pname, index, count}
+#define Q(kind, pname, index, count)                                                               \
+    {                                                                                              \
+#pname "[" #index "]", kind, pname, index, count                                           \
+    }
 static const query k_queries[] = {
-    Q(INT, GL_DRAW_FRAMEBUFFER_BINDING, 0, 1), Q(INT, GL_READ_FRAMEBUFFER_BINDING, 0, 1),
-    Q(INT, GL_RENDERBUFFER_BINDING, 0, 1), Q(INT, GL_CURRENT_PROGRAM, 0, 1),
-    Q(INT, GL_VERTEX_ARRAY_BINDING, 0, 1), Q(INT, GL_ELEMENT_ARRAY_BUFFER_BINDING, 0, 1),
-    Q(INT, GL_ARRAY_BUFFER_BINDING, 0, 1), Q(INT, GL_UNIFORM_BUFFER_BINDING, 0, 1),
-    Q(INT, GL_SHADER_STORAGE_BUFFER_BINDING, 0, 1), Q(INT, GL_PIXEL_PACK_BUFFER_BINDING, 0, 1),
-    Q(INT, GL_PIXEL_UNPACK_BUFFER_BINDING, 0, 1), Q(INT, GL_COPY_READ_BUFFER_BINDING, 0, 1),
-    Q(INT, GL_COPY_WRITE_BUFFER_BINDING, 0, 1), Q(INT, GL_DRAW_INDIRECT_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_DRAW_FRAMEBUFFER_BINDING, 0, 1),
+    Q(INT, GL_READ_FRAMEBUFFER_BINDING, 0, 1),
+    Q(INT, GL_RENDERBUFFER_BINDING, 0, 1),
+    Q(INT, GL_CURRENT_PROGRAM, 0, 1),
+    Q(INT, GL_VERTEX_ARRAY_BINDING, 0, 1),
+    Q(INT, GL_ELEMENT_ARRAY_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_ARRAY_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_UNIFORM_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_SHADER_STORAGE_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_PIXEL_PACK_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_PIXEL_UNPACK_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_COPY_READ_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_COPY_WRITE_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_DRAW_INDIRECT_BUFFER_BINDING, 0, 1),
     Q(INT, GL_DISPATCH_INDIRECT_BUFFER_BINDING, 0, 1),
-    Q(INT_I, GL_UNIFORM_BUFFER_BINDING, 0, 1), Q(INT64_I, GL_UNIFORM_BUFFER_START, 0, 1),
-    Q(INT64_I, GL_UNIFORM_BUFFER_SIZE, 0, 1), Q(INT_I, GL_UNIFORM_BUFFER_BINDING, 2, 1),
-    Q(INT64_I, GL_UNIFORM_BUFFER_SIZE, 2, 1), Q(INT_I, GL_SHADER_STORAGE_BUFFER_BINDING, 0, 1),
+    Q(INT_I, GL_UNIFORM_BUFFER_BINDING, 0, 1),
+    Q(INT64_I, GL_UNIFORM_BUFFER_START, 0, 1),
+    Q(INT64_I, GL_UNIFORM_BUFFER_SIZE, 0, 1),
+    Q(INT_I, GL_UNIFORM_BUFFER_BINDING, 2, 1),
+    Q(INT64_I, GL_UNIFORM_BUFFER_SIZE, 2, 1),
+    Q(INT_I, GL_SHADER_STORAGE_BUFFER_BINDING, 0, 1),
     Q(INT64_I, GL_SHADER_STORAGE_BUFFER_START, 0, 1),
-    Q(INT64_I, GL_SHADER_STORAGE_BUFFER_SIZE, 0, 1), Q(INT_I, GL_SHADER_STORAGE_BUFFER_BINDING, 1, 1),
+    Q(INT64_I, GL_SHADER_STORAGE_BUFFER_SIZE, 0, 1),
+    Q(INT_I, GL_SHADER_STORAGE_BUFFER_BINDING, 1, 1),
     Q(INT_I, GL_SHADER_STORAGE_BUFFER_BINDING, 5, 1),
     Q(INT64_I, GL_SHADER_STORAGE_BUFFER_START, 5, 1),
-    Q(INT64_I, GL_SHADER_STORAGE_BUFFER_SIZE, 5, 1), Q(INT, GL_ACTIVE_TEXTURE, 0, 1),
-    Q(UNIT_INT, GL_TEXTURE_BINDING_2D, 0, 1), Q(UNIT_INT, GL_TEXTURE_BINDING_2D_ARRAY, 0, 1),
-    Q(UNIT_INT, GL_SAMPLER_BINDING, 0, 1), Q(UNIT_INT, GL_TEXTURE_BINDING_2D, 3, 1),
+    Q(INT64_I, GL_SHADER_STORAGE_BUFFER_SIZE, 5, 1),
+    Q(INT, GL_ACTIVE_TEXTURE, 0, 1),
+    Q(UNIT_INT, GL_TEXTURE_BINDING_2D, 0, 1),
+    Q(UNIT_INT, GL_TEXTURE_BINDING_2D_ARRAY, 0, 1),
+    Q(UNIT_INT, GL_SAMPLER_BINDING, 0, 1),
+    Q(UNIT_INT, GL_TEXTURE_BINDING_2D, 3, 1),
     Q(UNIT_INT, GL_TEXTURE_BINDING_2D_ARRAY, 3, 1),
     Q(VAO_ATTRIB, GL_VERTEX_ATTRIB_ARRAY_ENABLED, 0, 1),
     Q(VAO_ATTRIB, GL_VERTEX_ATTRIB_ARRAY_ENABLED, 1, 1),
@@ -254,38 +274,76 @@ static const query k_queries[] = {
     Q(VAO_ATTRIB, GL_VERTEX_ATTRIB_ARRAY_ENABLED, 3, 1),
     Q(VAO_ATTRIB, GL_VERTEX_ATTRIB_ARRAY_SIZE, 3, 1),
     Q(VAO_ATTRIB, GL_VERTEX_ATTRIB_ARRAY_BUFFER_BINDING, 0, 1),
-    Q(CAP, GL_BLEND, 0, 1), Q(CAP, GL_CULL_FACE, 0, 1), Q(CAP, GL_DEPTH_TEST, 0, 1),
-    Q(CAP, GL_SCISSOR_TEST, 0, 1), Q(CAP, GL_STENCIL_TEST, 0, 1), Q(CAP, GL_COLOR_LOGIC_OP, 0, 1),
-    Q(CAP, GL_POLYGON_OFFSET_FILL, 0, 1), Q(CAP, GL_PRIMITIVE_RESTART, 0, 1),
-    Q(CAP, GL_PROGRAM_POINT_SIZE, 0, 1), Q(CAP, GL_DITHER, 0, 1), Q(CAP, GL_DEPTH_CLAMP, 0, 1),
-    Q(CAP, GL_CLIP_DISTANCE2, 0, 1), Q(CAP, GL_FRAMEBUFFER_SRGB, 0, 1),
-    Q(CAP, GL_SAMPLE_ALPHA_TO_COVERAGE, 0, 1), Q(CAP, GL_TEXTURE_CUBE_MAP_SEAMLESS, 0, 1),
-    Q(CAP, GL_RASTERIZER_DISCARD, 0, 1), Q(CAP, GL_MULTISAMPLE, 0, 1),
-    Q(INT, GL_BLEND_SRC_RGB, 0, 1), Q(INT, GL_BLEND_DST_RGB, 0, 1),
-    Q(INT, GL_BLEND_SRC_ALPHA, 0, 1), Q(INT, GL_BLEND_DST_ALPHA, 0, 1),
-    Q(INT, GL_BLEND_EQUATION_RGB, 0, 1), Q(INT, GL_BLEND_EQUATION_ALPHA, 0, 1),
-    Q(FLOAT, GL_BLEND_COLOR, 0, 4), Q(INT, GL_DEPTH_FUNC, 0, 1), Q(BOOL, GL_DEPTH_WRITEMASK, 0, 1),
-    Q(DOUBLE, GL_DEPTH_RANGE, 0, 2), Q(DOUBLE, GL_DEPTH_CLEAR_VALUE, 0, 1),
-    Q(INT, GL_CULL_FACE_MODE, 0, 1), Q(INT, GL_FRONT_FACE, 0, 1), Q(INT, GL_SCISSOR_BOX, 0, 4),
-    Q(INT, GL_VIEWPORT, 0, 4), Q(INT, GL_STENCIL_FUNC, 0, 1), Q(INT, GL_STENCIL_REF, 0, 1),
-    Q(INT, GL_STENCIL_VALUE_MASK, 0, 1), Q(INT, GL_STENCIL_FAIL, 0, 1),
-    Q(INT, GL_STENCIL_PASS_DEPTH_FAIL, 0, 1), Q(INT, GL_STENCIL_PASS_DEPTH_PASS, 0, 1),
-    Q(INT, GL_STENCIL_WRITEMASK, 0, 1), Q(INT, GL_STENCIL_BACK_FUNC, 0, 1),
-    Q(INT, GL_STENCIL_BACK_REF, 0, 1), Q(INT, GL_STENCIL_BACK_VALUE_MASK, 0, 1),
-    Q(INT, GL_STENCIL_BACK_FAIL, 0, 1), Q(INT, GL_STENCIL_BACK_PASS_DEPTH_FAIL, 0, 1),
-    Q(INT, GL_STENCIL_BACK_PASS_DEPTH_PASS, 0, 1), Q(INT, GL_STENCIL_BACK_WRITEMASK, 0, 1),
-    Q(INT, GL_STENCIL_CLEAR_VALUE, 0, 1), Q(BOOL, GL_COLOR_WRITEMASK, 0, 4),
-    Q(FLOAT, GL_COLOR_CLEAR_VALUE, 0, 4), Q(INT, GL_POLYGON_MODE, 0, 1),
-    Q(FLOAT, GL_POLYGON_OFFSET_FACTOR, 0, 1), Q(FLOAT, GL_POLYGON_OFFSET_UNITS, 0, 1),
-    Q(FLOAT, GL_LINE_WIDTH, 0, 1), Q(FLOAT, GL_POINT_SIZE, 0, 1),
-    Q(INT, GL_PRIMITIVE_RESTART_INDEX, 0, 1), Q(INT, GL_LOGIC_OP_MODE, 0, 1),
-    Q(INT, GL_PROVOKING_VERTEX, 0, 1), Q(INT, GL_PATCH_VERTICES, 0, 1),
-    Q(INT, GL_CLIP_ORIGIN, 0, 1), Q(INT, GL_CLIP_DEPTH_MODE, 0, 1),
-    Q(INT, GL_PACK_ALIGNMENT, 0, 1), Q(INT, GL_PACK_ROW_LENGTH, 0, 1),
-    Q(INT, GL_PACK_SKIP_ROWS, 0, 1), Q(INT, GL_PACK_SKIP_PIXELS, 0, 1),
-    Q(INT, GL_UNPACK_ALIGNMENT, 0, 1), Q(INT, GL_UNPACK_ROW_LENGTH, 0, 1),
-    Q(INT, GL_UNPACK_SKIP_ROWS, 0, 1), Q(INT, GL_UNPACK_SKIP_PIXELS, 0, 1),
-    Q(INT, GL_UNPACK_IMAGE_HEIGHT, 0, 1), Q(INT, GL_UNPACK_SKIP_IMAGES, 0, 1),
+    Q(CAP, GL_BLEND, 0, 1),
+    Q(CAP, GL_CULL_FACE, 0, 1),
+    Q(CAP, GL_DEPTH_TEST, 0, 1),
+    Q(CAP, GL_SCISSOR_TEST, 0, 1),
+    Q(CAP, GL_STENCIL_TEST, 0, 1),
+    Q(CAP, GL_COLOR_LOGIC_OP, 0, 1),
+    Q(CAP, GL_POLYGON_OFFSET_FILL, 0, 1),
+    Q(CAP, GL_PRIMITIVE_RESTART, 0, 1),
+    Q(CAP, GL_PROGRAM_POINT_SIZE, 0, 1),
+    Q(CAP, GL_DITHER, 0, 1),
+    Q(CAP, GL_DEPTH_CLAMP, 0, 1),
+    Q(CAP, GL_CLIP_DISTANCE2, 0, 1),
+    Q(CAP, GL_FRAMEBUFFER_SRGB, 0, 1),
+    Q(CAP, GL_SAMPLE_ALPHA_TO_COVERAGE, 0, 1),
+    Q(CAP, GL_TEXTURE_CUBE_MAP_SEAMLESS, 0, 1),
+    Q(CAP, GL_RASTERIZER_DISCARD, 0, 1),
+    Q(CAP, GL_MULTISAMPLE, 0, 1),
+    Q(INT, GL_BLEND_SRC_RGB, 0, 1),
+    Q(INT, GL_BLEND_DST_RGB, 0, 1),
+    Q(INT, GL_BLEND_SRC_ALPHA, 0, 1),
+    Q(INT, GL_BLEND_DST_ALPHA, 0, 1),
+    Q(INT, GL_BLEND_EQUATION_RGB, 0, 1),
+    Q(INT, GL_BLEND_EQUATION_ALPHA, 0, 1),
+    Q(FLOAT, GL_BLEND_COLOR, 0, 4),
+    Q(INT, GL_DEPTH_FUNC, 0, 1),
+    Q(BOOL, GL_DEPTH_WRITEMASK, 0, 1),
+    Q(DOUBLE, GL_DEPTH_RANGE, 0, 2),
+    Q(DOUBLE, GL_DEPTH_CLEAR_VALUE, 0, 1),
+    Q(INT, GL_CULL_FACE_MODE, 0, 1),
+    Q(INT, GL_FRONT_FACE, 0, 1),
+    Q(INT, GL_SCISSOR_BOX, 0, 4),
+    Q(INT, GL_VIEWPORT, 0, 4),
+    Q(INT, GL_STENCIL_FUNC, 0, 1),
+    Q(INT, GL_STENCIL_REF, 0, 1),
+    Q(INT, GL_STENCIL_VALUE_MASK, 0, 1),
+    Q(INT, GL_STENCIL_FAIL, 0, 1),
+    Q(INT, GL_STENCIL_PASS_DEPTH_FAIL, 0, 1),
+    Q(INT, GL_STENCIL_PASS_DEPTH_PASS, 0, 1),
+    Q(INT, GL_STENCIL_WRITEMASK, 0, 1),
+    Q(INT, GL_STENCIL_BACK_FUNC, 0, 1),
+    Q(INT, GL_STENCIL_BACK_REF, 0, 1),
+    Q(INT, GL_STENCIL_BACK_VALUE_MASK, 0, 1),
+    Q(INT, GL_STENCIL_BACK_FAIL, 0, 1),
+    Q(INT, GL_STENCIL_BACK_PASS_DEPTH_FAIL, 0, 1),
+    Q(INT, GL_STENCIL_BACK_PASS_DEPTH_PASS, 0, 1),
+    Q(INT, GL_STENCIL_BACK_WRITEMASK, 0, 1),
+    Q(INT, GL_STENCIL_CLEAR_VALUE, 0, 1),
+    Q(BOOL, GL_COLOR_WRITEMASK, 0, 4),
+    Q(FLOAT, GL_COLOR_CLEAR_VALUE, 0, 4),
+    Q(INT, GL_POLYGON_MODE, 0, 1),
+    Q(FLOAT, GL_POLYGON_OFFSET_FACTOR, 0, 1),
+    Q(FLOAT, GL_POLYGON_OFFSET_UNITS, 0, 1),
+    Q(FLOAT, GL_LINE_WIDTH, 0, 1),
+    Q(FLOAT, GL_POINT_SIZE, 0, 1),
+    Q(INT, GL_PRIMITIVE_RESTART_INDEX, 0, 1),
+    Q(INT, GL_LOGIC_OP_MODE, 0, 1),
+    Q(INT, GL_PROVOKING_VERTEX, 0, 1),
+    Q(INT, GL_PATCH_VERTICES, 0, 1),
+    Q(INT, GL_CLIP_ORIGIN, 0, 1),
+    Q(INT, GL_CLIP_DEPTH_MODE, 0, 1),
+    Q(INT, GL_PACK_ALIGNMENT, 0, 1),
+    Q(INT, GL_PACK_ROW_LENGTH, 0, 1),
+    Q(INT, GL_PACK_SKIP_ROWS, 0, 1),
+    Q(INT, GL_PACK_SKIP_PIXELS, 0, 1),
+    Q(INT, GL_UNPACK_ALIGNMENT, 0, 1),
+    Q(INT, GL_UNPACK_ROW_LENGTH, 0, 1),
+    Q(INT, GL_UNPACK_SKIP_ROWS, 0, 1),
+    Q(INT, GL_UNPACK_SKIP_PIXELS, 0, 1),
+    Q(INT, GL_UNPACK_IMAGE_HEIGHT, 0, 1),
+    Q(INT, GL_UNPACK_SKIP_IMAGES, 0, 1),
 };
 #define N_QUERIES (sizeof k_queries / sizeof k_queries[0])
 
@@ -304,12 +362,24 @@ static void take(snapshot *s)
         GLdouble d4[4] = {0};
         GLboolean b4[4] = {0};
         switch (k->kind) {
-        case INT: glGetIntegerv(k->pname, i4); break;
-        case FLOAT: glGetFloatv(k->pname, f4); break;
-        case DOUBLE: glGetDoublev(k->pname, d4); break;
-        case BOOL: glGetBooleanv(k->pname, b4); break;
-        case CAP: i4[0] = glIsEnabled(k->pname); break;
-        case INT_I: glGetIntegeri_v(k->pname, k->index, i4); break;
+        case INT:
+            glGetIntegerv(k->pname, i4);
+            break;
+        case FLOAT:
+            glGetFloatv(k->pname, f4);
+            break;
+        case DOUBLE:
+            glGetDoublev(k->pname, d4);
+            break;
+        case BOOL:
+            glGetBooleanv(k->pname, b4);
+            break;
+        case CAP:
+            i4[0] = glIsEnabled(k->pname);
+            break;
+        case INT_I:
+            glGetIntegeri_v(k->pname, k->index, i4);
+            break;
         case INT64_I:
             glGetInteger64i_v(k->pname, k->index, &i64);
             i4[0] = (GLint)i64;
@@ -322,7 +392,9 @@ static void take(snapshot *s)
             glActiveTexture((GLenum)active);
             break;
         }
-        case VAO_ATTRIB: glGetVertexAttribiv(k->index, k->pname, i4); break;
+        case VAO_ATTRIB:
+            glGetVertexAttribiv(k->index, k->pname, i4);
+            break;
         }
         for (int c = 0; c < k->count; c++)
             s->v[q][c] = k->kind == FLOAT    ? f4[c]
@@ -339,8 +411,8 @@ static int compare(const snapshot *before, const snapshot *after, const char *wh
     for (size_t q = 0; q < N_QUERIES; q++)
         for (int c = 0; c < k_queries[q].count; c++)
             if (before->v[q][c] != after->v[q][c]) {
-                fprintf(stderr, "after %s: %s value %d is %g, was %g\n", when, k_queries[q].name,
-                        c, after->v[q][c], before->v[q][c]);
+                fprintf(stderr, "after %s: %s value %d is %g, was %g\n", when, k_queries[q].name, c,
+                        after->v[q][c], before->v[q][c]);
                 differ++;
             }
     g_failures += differ;
@@ -440,7 +512,7 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < (size_t)W * H; i++)
         drawn += memcmp(reference + 4 * i, "\xff\x00\xff\xff", 4) != 0;
     EXPECT(drawn == (size_t)W * H); /* the presented frame covers the framebuffer */
-    size_t unlike_corner = 0; /* the scene is in the picture, not only the background */
+    size_t unlike_corner = 0;       /* the scene is in the picture, not only the background */
     for (size_t i = 0; i < (size_t)W * H; i++)
         unlike_corner += memcmp(reference + 4 * i, reference, 4) != 0;
     EXPECT(unlike_corner > (size_t)W * H / 20);

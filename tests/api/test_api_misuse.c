@@ -227,8 +227,7 @@ static int run_case(const misuse_case *c)
         printf("%-24s killed by %s%s\n", c->name, strsignal(WTERMSIG(status)),
                ok ? "" : "  <-- FAILED");
     else
-        printf("%-24s exit status %d%s\n", c->name, WEXITSTATUS(status),
-               ok ? "" : "  <-- FAILED");
+        printf("%-24s exit status %d%s\n", c->name, WEXITSTATUS(status), ok ? "" : "  <-- FAILED");
     if (!ok)
         fprintf(stderr, "%s: child's stderr:\n%s\n", c->name, err);
     return ok ? 0 : -1;

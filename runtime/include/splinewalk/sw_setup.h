@@ -56,7 +56,7 @@ typedef enum sw_log_level {
 typedef void (*sw_log_fn)(void *user_data, sw_log_level level, const char *message);
 
 typedef struct sw_logger {
-    sw_log_fn fn;           /* NULL: stderr ("splinewalk: warning: ...") */
+    sw_log_fn fn; /* NULL: stderr ("splinewalk: warning: ...") */
     void *user_data;
     sw_log_level min_level; /* lines below it are not formatted; 0 = SW_LOG_WARN */
 } sw_logger;
