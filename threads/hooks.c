@@ -187,6 +187,9 @@ void sw__log(sw_log_level level, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
+    size_t n = strlen(line); /* one line: a message's own newline (OCCT's) goes */
+    while (n > 0 && (line[n - 1] == '\n' || line[n - 1] == '\r'))
+        line[--n] = '\0';
     if (hooked() && g_desc.logger.fn)
         g_desc.logger.fn(g_desc.logger.user_data, level, line);
     else
