@@ -123,3 +123,21 @@ float sw__gpu_depth_to_eye(const sw__gpu_view *v, float d)
         return INFINITY;
     return (float)(v->near_plane / (double)d);
 }
+
+void sw_gpu_camera_fit_box(const double box[6], const double from[3], const double up[3],
+                           sw_gpu_camera *out)
+{
+    double diag2 = 0.0;
+    for (int k = 0; k < 3; k++)
+        diag2 += (box[3 + k] - box[k]) * (box[3 + k] - box[k]);
+    const double diag = diag2 > 0.0 ? sqrt(diag2) : 1.0;
+    const double fovy = 40.0, distance = diag / (2.0 * tan(fovy * M_PI / 360.0)) * 1.1;
+    const double len = sqrt(dot3(from, from));
+    memset(out, 0, sizeof *out);
+    for (int k = 0; k < 3; k++) {
+        out->target[k] = 0.5 * (box[k] + box[3 + k]);
+        out->eye[k] = out->target[k] + from[k] / len * distance;
+        out->up[k] = up[k];
+    }
+    out->fovy_deg = fovy;
+}

@@ -28,6 +28,15 @@
 #include "sw_lod_static_set.h"
 #include "sw_sg_bvh.h"
 
+void sw__fr_occurrence_init(occurrence *o, uint32_t face, const double world[12],
+                            const float color[4])
+{
+    o->face = face;
+    memcpy(o->world, world, sizeof o->world);
+    static const float k_default[4] = {0.72f, 0.72f, 0.76f, 1.0f};
+    memcpy(o->color, color && color[3] >= 0.0f ? color : k_default, sizeof o->color);
+}
+
 static int collect(void *user, uint32_t face, const double world[12], const float color[4])
 {
     frame *f = user;
@@ -35,11 +44,7 @@ static int collect(void *user, uint32_t face, const double world[12], const floa
         f->oom = 1;
         return 1;
     }
-    occurrence *o = &f->occ[f->n_occ++];
-    o->face = face;
-    memcpy(o->world, world, sizeof o->world);
-    static const float k_default[4] = {0.72f, 0.72f, 0.76f, 1.0f};
-    memcpy(o->color, color && color[3] >= 0.0f ? color : k_default, sizeof o->color);
+    sw__fr_occurrence_init(&f->occ[f->n_occ++], face, world, color);
     return 0;
 }
 
@@ -956,6 +961,35 @@ static void eye_box(const frame *f, const double world[6], double out[6])
     }
 }
 
+int sw__fr_take_occurrence(frame *f, uint32_t face, const double world[12], const float color[4],
+                           const double world_box[6], double **boxes, size_t *cap_boxes)
+{
+    const size_t at = f->n_occ;
+    if (collect(f, face, world, color) != 0 ||
+        !sw__gpu_grow((void **)boxes, cap_boxes, 6 * (at + 1), sizeof **boxes))
+        return 0;
+    eye_box(f, world_box, *boxes + 6 * at);
+    return 1;
+}
+
+void sw__fr_frustum(const frame *f, sw_sg_frustum *fr)
+{
+    memcpy(fr->origin, f->view.eye, sizeof fr->origin);
+    memcpy(fr->planes, f->view.planes, sizeof f->view.planes);
+    fr->n_planes = (int32_t)(sizeof f->view.planes / sizeof f->view.planes[0]);
+}
+
+void sw__fr_bvh_stats(frame *f, const sw_sg_bvh_cull_stats *cs)
+{
+    f->st.bvh_nodes_visited += cs->nodes_visited;
+    f->st.bvh_nodes_inside += cs->nodes_inside;
+    f->st.bvh_nodes_partly += cs->nodes_partly;
+    f->st.bvh_nodes_outside += cs->nodes_outside;
+    f->st.bvh_items_tested += cs->items_tested;
+    f->st.bvh_items_visible += cs->items_visible;
+    f->st.bvh_items_inside += cs->items_inside;
+}
+
 typedef struct bvh_taker {
     frame *f;
     const sw_sg_bvh *bvh;
@@ -964,16 +998,13 @@ typedef struct bvh_taker {
 } bvh_taker;
 
 /* Appends one visible BVH item as an occurrence with its eye-relative box. */
-static int bvh_take(void *ctx, uint32_t item)
+static int bvh_take(void *ctx, uint32_t item, sw_sg_cull_class cls)
 {
+    (void)cls;
     bvh_taker *t = ctx;
     const sw_sg_bvh_item *it = &t->bvh->items[item];
-    size_t at = t->f->n_occ;
-    if (collect(t->f, it->face, it->world, it->color) != 0 ||
-        !sw__gpu_grow((void **)t->boxes, &t->cap_boxes, 6 * (at + 1), sizeof **t->boxes))
-        return 1;
-    eye_box(t->f, it->box, *t->boxes + 6 * at);
-    return 0;
+    return !sw__fr_take_occurrence(t->f, it->face, it->world, it->color, it->box, t->boxes,
+                                   &t->cap_boxes);
 }
 
 /* Kumar §4.4: the occurrences whose boxes may meet the frustum, by the BVH (sw_sg_bvh_cull: a node
@@ -981,21 +1012,30 @@ static int bvh_take(void *ctx, uint32_t item)
 static sw_result collect_bvh(frame *f, const sw_sg_bvh *bvh, double **boxes, sw_status *status)
 {
     sw_sg_frustum fr;
-    memcpy(fr.origin, f->view.eye, sizeof fr.origin);
-    memcpy(fr.planes, f->view.planes, sizeof f->view.planes);
-    fr.n_planes = (int32_t)(sizeof f->view.planes / sizeof f->view.planes[0]);
+    sw__fr_frustum(f, &fr);
     bvh_taker t = {f, bvh, boxes, 0};
     sw_sg_bvh_cull_stats cs;
     const int stopped = sw_sg_bvh_cull(bvh, &fr, bvh_take, &t, &cs);
     f->st.faces_culled += bvh->n_items - cs.items_visible;
-    f->st.bvh_nodes_visited += cs.nodes_visited;
-    f->st.bvh_nodes_inside += cs.nodes_inside;
-    f->st.bvh_nodes_partly += cs.nodes_partly;
-    f->st.bvh_nodes_outside += cs.nodes_outside;
-    f->st.bvh_items_tested += cs.items_tested;
-    f->st.bvh_items_visible += cs.items_visible;
+    sw__fr_bvh_stats(f, &cs);
     if (stopped)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    return SW_OK;
+}
+
+int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6])
+{
+    sw_lod_cone w;
+    return sw_lod_cone_to_world(&fc->cones[o->face], o->world, &w) &&
+           sw_lod_cone_back_facing(&w, box);
+}
+
+sw_result sw__fr_check_cones(const frame *f, const sw_lod_face_cones *fc, sw_status *status)
+{
+    if (fc->n_faces != f->sv->n_faces)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "frame: face cones of %u faces for a scene of %u", fc->n_faces,
+                        f->sv->n_faces);
     return SW_OK;
 }
 
@@ -1006,16 +1046,12 @@ static sw_result collect_bvh(frame *f, const sw_sg_bvh *bvh, double **boxes, sw_
 static sw_result cull_back_faces(frame *f, const sw_lod_face_cones *fc, double *boxes,
                                  sw_status *status)
 {
-    if (fc->n_faces != f->sv->n_faces)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "frame: face cones of %u faces for a scene of %u", fc->n_faces,
-                        f->sv->n_faces);
+    sw_result r = sw__fr_check_cones(f, fc, status);
+    if (r != SW_OK)
+        return r;
     size_t k = 0;
     for (size_t i = 0; i < f->n_occ; ++i) {
-        const occurrence *o = &f->occ[i];
-        sw_lod_cone w;
-        if (sw_lod_cone_to_world(&fc->cones[o->face], o->world, &w) &&
-            sw_lod_cone_back_facing(&w, boxes + 6 * i)) {
+        if (sw__fr_face_back_facing(fc, &f->occ[i], boxes + 6 * i)) {
             f->st.faces_backculled++;
             f->st.faces_culled++;
             continue;
@@ -1037,28 +1073,39 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     memcpy(f->view.eye, desc->camera.eye, sizeof f->view.eye);
     double *boxes = NULL, scene_box[6];
     sw_result r = SW_OK;
-    if (desc->bvh) {
+    /* with static LODs the unit-instance BVH culls (frame_static.c); its scene box is the face
+     * BVH's root box, so both give the same near plane */
+    const sw_lod_static_instances *units =
+        f->statics && !f->exact ? sw_lod_static_set_instances(f->statics) : NULL;
+    if (desc->bvh || units) {
         sw__fr_box_empty(scene_box);
-        if (desc->bvh->n_nodes)
+        if (desc->bvh && desc->bvh->n_nodes)
             eye_box(f, desc->bvh->nodes[0].box, scene_box);
+        else if (!desc->bvh && units->n_occs)
+            eye_box(f, units->scene_box, scene_box);
     } else {
         r = collect_all(f, &boxes, scene_box, status);
     }
+    sw__fr_meshes meshes;
+    if (r == SW_OK)
+        r = sw__fr_meshes_collect(f, &meshes, scene_box, status);
+    else
+        memset(&meshes, 0, sizeof meshes);
     static const double k_origin[3] = {0.0, 0.0, 0.0};
     double near_plane =
         scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
     if (r == SW_OK)
         r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane,
                               status);
-    if (r == SW_OK && desc->bvh)
+    screen_view_init(f);
+    if (r == SW_OK && units)
+        r = sw__fr_static_collect(f, desc->face_cones, &boxes, status);
+    else if (r == SW_OK && desc->bvh)
         r = collect_bvh(f, desc->bvh, &boxes, status);
     if (r == SW_OK && desc->face_cones && boxes)
         r = cull_back_faces(f, desc->face_cones, boxes, status);
-    screen_view_init(f);
     for (size_t i = 0; f->lod_colors && i < f->n_occ; ++i)
         sw__fr_lod_color(-1, f->occ[i].color);
-    if (r == SW_OK && boxes)
-        r = sw__fr_static_draw(f, boxes, status);
     int hierarchy = f->cache && !f->exact;
     if (r == SW_OK && hierarchy)
         r = sw__fr_hlod_prepare(f, boxes, desc->walkthrough, status);
@@ -1070,6 +1117,9 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
         r = hierarchy ? sw__fr_hlod_draw_face(f, &f->occ[i], status)
                       : sw__fr_draw_face(f, &f->occ[i], status);
     }
+    if (r == SW_OK)
+        r = sw__fr_meshes_draw(f, &meshes, status);
+    sw__fr_meshes_free(&meshes);
     sw__free(boxes);
     return r;
 }

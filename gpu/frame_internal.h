@@ -6,7 +6,9 @@
 
 #include "sw_gpu_internal.h"
 #include "sw_lod_cache.h"
+#include "sw_lod_face_cones.h"
 #include "sw_lod_sampling.h"
+#include "sw_sg_bvh.h"
 #include "sw_sg_trim.h"
 
 #include <stddef.h>
@@ -110,7 +112,22 @@ typedef struct trim_need {
     double u, v;
 } trim_need;
 
-/* ---- frame.c, for frame_hlod.c ---- */
+/* ---- frame.c, for frame_hlod.c and frame_static.c ---- */
+/* An occurrence as the frame draws it: the colour resolved (none or unset: the default grey). */
+void sw__fr_occurrence_init(occurrence *o, uint32_t face, const double world[12],
+                            const float color[4]);
+/* Appends a visible occurrence to f->occ and its world box, eye-relative, to *boxes (6 per
+ * occurrence, grown). 0: out of memory. */
+int sw__fr_take_occurrence(frame *f, uint32_t face, const double world[12], const float color[4],
+                           const double world_box[6], double **boxes, size_t *cap_boxes);
+/* The view's frustum for sw_sg_bvh_cull (planes relative to the eye). */
+void sw__fr_frustum(const frame *f, sw_sg_frustum *fr);
+/* Adds one BVH traversal's counts to the frame's bvh_* stats. */
+void sw__fr_bvh_stats(frame *f, const sw_sg_bvh_cull_stats *cs);
+/* Kumar §4.4's back-patch test of one face occurrence with its eye-relative box. */
+int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6]);
+/* SW_ERR_INVALID_ARGUMENT unless the cones are the scene's (one per face). */
+sw_result sw__fr_check_cones(const frame *f, const sw_lod_face_cones *fc, sw_status *status);
 /* Homogeneous control point mapped to eye-relative world space: w x' = R (w x) + w (t - eye). */
 void sw__fr_xform_h(const double m[12], const double eye[3], const double in[4], double out[4]);
 void sw__fr_box_empty(double box[6]);
@@ -150,11 +167,47 @@ sw_result sw__fr_hlod_prepare(frame *f, const double *boxes, int walkthrough, sw
 sw_result sw__fr_hlod_draw_face(frame *f, const occurrence *o, sw_status *status);
 
 /* ---- frame_static.c ---- */
-/* Kumar §4's static LODs merged into the frame: draws the visible occurrences whose unit has a
- * level fine enough for the view (their fat borders too) and removes them, with their boxes, from
- * f->occ; the rest stay for the per-frame path. No-op without desc.static_lods. */
-sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status);
+/* Kumar §4.4 and §4 with static LODs (f->statics, not exact): culls the set's unit-instance BVH,
+ * back-culls whole unit instances by their units' cones (fc may be NULL: no back culling), draws
+ * the visible instances whose unit has a level fine enough for the view (their fat borders too),
+ * and appends the face occurrences of the others, with their eye-relative boxes (*boxes, grown),
+ * to f->occ for the per-frame path. */
+sw_result sw__fr_static_collect(frame *f, const sw_lod_face_cones *fc, double **boxes,
+                                sw_status *status);
 /* LOD colouring: static level k (fine -> coarse), or -1 for the per-frame path. */
 void sw__fr_lod_color(int32_t level, float out[4]);
+
+/* ---- frame_mesh.c ---- */
+/* Triangles in object space for sw__fr_append_triangles. */
+typedef struct sw__fr_triangles {
+    const double *positions; /* 3 per vertex */
+    const float *normals_f;  /* 3 per vertex, or NULL */
+    const double *normals_d; /* 3 per vertex, or NULL; both NULL: flat, a normal per triangle */
+    double normal_matrix[9]; /* row-major 3x3 mapping normals to the world (with normals) */
+    uint32_t n_vertices, n_triangles;
+    const uint32_t *triangles; /* 3 per triangle */
+} sw__fr_triangles;
+/* Appends the triangles under the occurrence's transform (eye-relative, float) to the frame's
+ * mesh as one untrimmed draw of o->color: the one triangle path of static LODs and meshes. */
+sw_result sw__fr_append_triangles(frame *f, const occurrence *o, const sw__fr_triangles *t,
+                                  sw_status *status);
+
+typedef struct sw__fr_mesh_occ {
+    uint32_t mesh;
+    double world[12];
+    float color[4];
+    double box[6]; /* eye-relative */
+} sw__fr_mesh_occ;
+typedef struct sw__fr_meshes {
+    sw__fr_mesh_occ *occ;
+    size_t n, cap;
+} sw__fr_meshes;
+/* The scene's mesh occurrences with their eye-relative boxes, which also grow scene_box (the
+ * near plane is chosen from it). Before the view is set; needs f->view.eye. */
+sw_result sw__fr_meshes_collect(frame *f, sw__fr_meshes *fm, double scene_box[6],
+                                sw_status *status);
+/* Draws the collected occurrences inside the frustum (after the view is set). */
+sw_result sw__fr_meshes_draw(frame *f, const sw__fr_meshes *fm, sw_status *status);
+void sw__fr_meshes_free(sw__fr_meshes *fm);
 
 #endif

@@ -1,7 +1,9 @@
 /* The merge of Kumar et al. 1997 with the per-frame path: per visible unit (a super-surface of
  * whole faces, lod/sw_lod_static_set.h) and instance, the static LOD level whose declared ε_k meets
  * the object-space tolerance its nearest point needs, else the faces' own per-frame path (the
- * trim-texture tessellation of their hierarchies).
+ * trim-texture tessellation of their hierarchies). The visible instances, their class and the
+ * back-facing ones come from the set's BVH of unit instances (Kumar §4.4; the section "the
+ * unit-instance BVH" below), which replaces the faces' BVH in frames with static LODs.
  *
  * The tolerance. A displacement d of a point at depth z (along the view axis) and off-axis
  * tangents (t_x, t_y) moves its image by at most focal_px |d| sqrt(1 + t_x^2 + t_y^2) / z pixels
@@ -161,31 +163,18 @@ static int32_t choose_level(frame *f, uint32_t unit, const double m[12],
 static sw_result append_level(frame *f, const occurrence *o, const sw_lod_static_level *lv,
                               int32_t level, sw_status *status)
 {
-    sw_result r = sw__gpu_mesh_reserve(&f->mesh, lv->n_vertices, 3 * (size_t)lv->n_triangles, status);
-    if (r != SW_OK)
-        return r;
-    const size_t base = f->mesh.n_v, first = f->mesh.n_idx;
     const double *m = o->world;
-    for (uint32_t i = 0; i < lv->n_vertices; ++i) {
-        const double *p = lv->positions + 3 * i;
-        const float *n = lv->normals + 3 * i;
-        sw__gpu_vertex *v = &f->mesh.v[f->mesh.n_v++];
-        for (int a = 0; a < 3; ++a) {
-            v->pos[a] = (float)(m[4 * a] * p[0] + m[4 * a + 1] * p[1] + m[4 * a + 2] * p[2] +
-                                (m[4 * a + 3] - f->view.eye[a]));
-            /* rigid and similarity transforms keep normals along M n; shading is two-sided */
-            v->nrm[a] = (float)(m[4 * a] * n[0] + m[4 * a + 1] * n[1] + m[4 * a + 2] * n[2]);
-        }
-        v->st[0] = v->st[1] = 0.0f;
-    }
-    for (uint32_t t = 0; t < 3 * lv->n_triangles; ++t)
-        f->mesh.idx[f->mesh.n_idx++] = (uint32_t)base + lv->triangles[t];
-    trim_need none = {0.0, 0.0};
-    const double cell[2] = {0.0, 0.0};
+    /* rigid and similarity transforms keep normals along M n; shading is two-sided */
+    sw__fr_triangles t = {.positions = lv->positions,
+                          .normals_f = lv->normals,
+                          .normal_matrix = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]},
+                          .n_vertices = lv->n_vertices,
+                          .n_triangles = lv->n_triangles,
+                          .triangles = lv->triangles};
     occurrence shown = *o;
     if (f->lod_colors)
         sw__fr_lod_color(level, shown.color);
-    r = sw__fr_add_draw(f, &shown, first, 0, &none, cell, status);
+    sw_result r = sw__fr_append_triangles(f, &shown, &t, status);
     f->st.static_triangles += lv->n_triangles;
     return r;
 }
@@ -214,90 +203,191 @@ static sw_result face_borders(frame *f, const occurrence *o, double extent_px, s
     return r;
 }
 
-/* ---- (unit, instance) groups of the visible occurrences ------------------------------------- */
+/* ---- the unit-instance BVH (Kumar §4.4) ------------------------------------------------------
+ * With static LODs the frame culls the set's BVH whose leaves are unit instances
+ * (lod/sw_lod_static_set.h: the face occurrences grouped by (unit, transform) once, when the set
+ * was made), not the faces' BVH: an instance is what gets a level, so its classification, its
+ * back-patch test and its level are decided once, at its leaf. A visible instance is then drawn
+ * at a static level, or hands its face occurrences to the per-frame path. Partly visible, each of
+ * them is classified against the frustum by its own box (the box and test of the faces' BVH, so
+ * the per-frame path gets the faces it got from that BVH and asks no hierarchy for the others).
+ * Wholly inside, none is tested: each face's drawn surface lies in the unit's box, so inside the
+ * frustum, and the face's control-net box holds that surface, so no plane can have the box wholly
+ * behind it — the test could only answer "not outside". */
 
-typedef struct group {
-    uint32_t unit;
-    int32_t level; /* -1: per-frame path */
-    int drawn;     /* the level's triangles are in the frame */
-    double extent_px; /* the unit's size on screen, bounded */
-    double world[12];
-    const sw_lod_static_chain *chain;
-} group;
+typedef struct instance_taker {
+    frame *f;
+    const sw_lod_static_instances *in;
+    const sw_lod_face_cones *fc; /* NULL: no back-patch culling */
+    sw_sg_frustum fr;
+    double **boxes;
+    size_t cap_boxes;
+    uint64_t occs_seen; /* face occurrences of the instances reported */
+    sw_result r;
+    sw_status *status;
+} instance_taker;
 
-typedef struct group_map {
-    group *slots;
-    size_t cap; /* power of two */
-} group_map;
-
-static uint64_t group_hash(uint32_t unit, const double m[12])
+/* Kumar §4.4 back-patch culling of a whole instance: the unit's outward cone in the world faces
+ * away from every view direction into the instance's box (sound for an eye outside the solids, as
+ * the face test is; the cone is the full one unless the unit is part of a closed shell). */
+static int instance_back_facing(const frame *f, const sw_lod_static_unit *un,
+                                const sw_sg_bvh_item *it)
 {
-    uint64_t h = 1469598103934665603ull ^ unit;
-    const unsigned char *b = (const unsigned char *)m;
-    for (size_t i = 0; i < 12 * sizeof *m; ++i)
-        h = (h ^ b[i]) * 1099511628211ull;
-    return h;
-}
-
-/* The group of (unit, the transform of occurrence occ), made (level chosen) on first sight. The
- * transform is copied: the list is compacted while it is walked. */
-static group *group_of(frame *f, group_map *gm, uint32_t unit, size_t occ)
-{
-    const double *m = f->occ[occ].world;
-    for (size_t i = group_hash(unit, m) & (gm->cap - 1);; i = (i + 1) & (gm->cap - 1)) {
-        group *g = &gm->slots[i];
-        if (g->unit == SW_LOD_STATIC_NO_UNIT) {
-            g->unit = unit;
-            g->drawn = 0;
-            memcpy(g->world, m, sizeof g->world);
-            g->level = choose_level(f, unit, m, &g->chain, &g->extent_px);
-            return g;
-        }
-        if (g->unit == unit && memcmp(g->world, m, sizeof g->world) == 0)
-            return g;
+    sw_lod_cone w;
+    if (!sw_lod_cone_to_world(&un->cone, it->world, &w))
+        return 0;
+    double eb[6];
+    for (int k = 0; k < 3; ++k) {
+        eb[k] = it->box[k] - f->view.eye[k];
+        eb[3 + k] = it->box[3 + k] - f->view.eye[k];
     }
+    return sw_lod_cone_back_facing(&w, eb);
 }
 
-/* Draws the statically chosen occurrences and removes them (and their boxes) from the frame's
- * list, so the per-frame path asks no hierarchy for them. */
-sw_result sw__fr_static_draw(frame *f, double *boxes, sw_status *status)
+/* Face occurrence k of an instance: its occurrence and world box; 0 when the instance is partly
+ * visible and the face's box is outside the frustum. */
+static int instance_face(const instance_taker *t, const sw_lod_static_instance *in,
+                         const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls, occurrence *o,
+                         double world_box[6])
 {
-    if (!f->statics || f->exact || f->n_occ == 0)
-        return SW_OK;
-    group_map gm = {NULL, 16};
-    while (gm.cap < 2 * f->n_occ)
-        gm.cap *= 2;
-    gm.slots = sw__malloc(gm.cap * sizeof *gm.slots);
-    if (!gm.slots)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
-    for (size_t i = 0; i < gm.cap; ++i)
-        gm.slots[i].unit = SW_LOD_STATIC_NO_UNIT;
-    sw_result r = SW_OK;
-    size_t kept = 0;
-    for (size_t i = 0; i < f->n_occ && r == SW_OK; ++i) {
-        const uint32_t unit = sw_lod_static_set_unit_of(f->statics, f->occ[i].face);
-        group *g = unit == SW_LOD_STATIC_NO_UNIT ? NULL : group_of(f, &gm, unit, i);
-        if (!g || g->level < 0) {
-            if (kept != i) {
-                f->occ[kept] = f->occ[i];
-                memcpy(boxes + 6 * kept, boxes + 6 * i, 6 * sizeof *boxes);
-            }
-            kept++;
+    const sw_lod_static_occ *oc = &t->in->occs[in->first_occ + k];
+    sw_sg_box_transform(it->world, t->in->face_boxes + 6 * (size_t)oc->face, world_box);
+    if (cls != SW_SG_CULL_INSIDE && sw_sg_frustum_classify(&t->fr, world_box) == SW_SG_CULL_OUTSIDE)
+        return 0;
+    sw__fr_occurrence_init(o, oc->face, it->world, oc->color);
+    return 1;
+}
+
+/* The per-frame path's share of a visible instance: its visible face occurrences. */
+static sw_result hand_faces(instance_taker *t, const sw_lod_static_instance *in,
+                            const sw_sg_bvh_item *it, sw_sg_cull_class cls)
+{
+    frame *f = t->f;
+    for (uint32_t k = 0; k < in->n_occ; ++k) {
+        occurrence o;
+        double wb[6];
+        if (!instance_face(t, in, it, k, cls, &o, wb)) {
+            f->st.faces_culled++;
             continue;
         }
-        if (!g->drawn) {
-            r = append_level(f, &f->occ[i], &g->chain->levels[g->level], g->level, status);
-            g->drawn = 1;
-            f->st.static_units_drawn++;
-            f->st.static_levels_used |= 1u << (g->level < 31 ? g->level : 31);
+        const sw_lod_static_occ *oc = &t->in->occs[in->first_occ + k];
+        if (!sw__fr_take_occurrence(f, oc->face, it->world, oc->color, wb, t->boxes, &t->cap_boxes))
+            return sw__fail(t->status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    }
+    return SW_OK;
+}
+
+enum { FACE_OUTSIDE = 0, FACE_BACK = 1, FACE_SHOWN = 2 };
+
+/* Whether face occurrence k of an instance is outside the frustum (only tested when the instance
+ * is partly visible), back-facing on its own (with cones), or shown; o is set unless outside. */
+static int face_shown(const instance_taker *t, const sw_lod_static_instance *in,
+                      const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls, occurrence *o)
+{
+    double wb[6], eb[6];
+    if (!instance_face(t, in, it, k, cls, o, wb))
+        return FACE_OUTSIDE;
+    for (int a = 0; a < 3; ++a) {
+        eb[a] = wb[a] - t->f->view.eye[a];
+        eb[3 + a] = wb[3 + a] - t->f->view.eye[a];
+    }
+    return t->fc && sw__fr_face_back_facing(t->fc, o, eb) ? FACE_BACK : FACE_SHOWN;
+}
+
+/* Culls an instance none of whose faces is shown (the faces' BVH and back-patch test would have
+ * dropped them all, and with them the instance: no level is chosen, asked for or drawn). */
+static int culled_by_faces(instance_taker *t, const sw_lod_static_instance *in,
+                           const sw_sg_bvh_item *it, sw_sg_cull_class cls)
+{
+    occurrence o;
+    for (uint32_t k = 0; k < in->n_occ; ++k)
+        if (face_shown(t, in, it, k, cls, &o) == FACE_SHOWN)
+            return 0;
+    for (uint32_t k = 0; k < in->n_occ; ++k) {
+        t->f->st.faces_backculled += face_shown(t, in, it, k, cls, &o) == FACE_BACK;
+        t->f->st.faces_culled++;
+    }
+    return 1;
+}
+
+/* A visible instance drawn at a static level: the level once, and the fat borders of its faces
+ * that are shown (those the per-frame path would draw). */
+static sw_result draw_static(instance_taker *t, const sw_lod_static_instance *in,
+                             const sw_sg_bvh_item *it, sw_sg_cull_class cls,
+                             const sw_lod_static_chain *chain, int32_t level, double extent_px)
+{
+    frame *f = t->f;
+    occurrence first;
+    sw__fr_occurrence_init(&first, t->in->occs[in->first_occ].face, it->world,
+                           t->in->occs[in->first_occ].color);
+    sw_result r = append_level(f, &first, &chain->levels[level], level, t->status);
+    f->st.static_units_drawn++;
+    f->st.static_levels_used |= 1u << (level < 31 ? level : 31);
+    for (uint32_t k = 0; k < in->n_occ && r == SW_OK; ++k) {
+        occurrence o;
+        const int shown = face_shown(t, in, it, k, cls, &o);
+        f->st.faces_backculled += shown == FACE_BACK;
+        if (shown != FACE_SHOWN) {
+            f->st.faces_culled++;
+            continue;
         }
-        if (r == SW_OK)
-            r = face_borders(f, &f->occ[i], g->extent_px, status);
+        if (f->lod_colors)
+            sw__fr_lod_color(-1, o.color); /* borders as the per-frame path colours its faces */
+        r = face_borders(f, &o, extent_px, t->status);
         f->st.static_faces++;
         f->st.faces_drawn++;
     }
-    sw__free(gm.slots);
-    if (r == SW_OK)
-        f->n_occ = kept;
     return r;
+}
+
+/* One visible instance (sw_sg_bvh_cull's callback): back-culled, drawn statically, or handed to
+ * the per-frame path. */
+static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
+{
+    instance_taker *t = ctx;
+    frame *f = t->f;
+    const sw_sg_bvh_item *it = &t->in->bvh->items[item];
+    const sw_lod_static_instance *in = &t->in->instances[it->face];
+    t->occs_seen += in->n_occ;
+    int32_t level = -1;
+    const sw_lod_static_chain *chain = NULL;
+    double extent_px = 0.0;
+    if (in->unit != SW_LOD_STATIC_NO_UNIT) {
+        const sw_lod_static_unit *un = sw_lod_static_set_unit(f->statics, in->unit);
+        if (t->fc && instance_back_facing(f, un, it)) {
+            f->st.faces_backculled += in->n_occ;
+            f->st.faces_culled += in->n_occ;
+            return 0;
+        }
+        if (culled_by_faces(t, in, it, cls))
+            return 0;
+        level = choose_level(f, in->unit, it->world, &chain, &extent_px);
+    }
+    t->r = level >= 0 ? draw_static(t, in, it, cls, chain, level, extent_px)
+                      : hand_faces(t, in, it, cls);
+    return t->r != SW_OK;
+}
+
+sw_result sw__fr_static_collect(frame *f, const sw_lod_face_cones *fc, double **boxes,
+                                sw_status *status)
+{
+    if (fc) {
+        sw_result r = sw__fr_check_cones(f, fc, status);
+        if (r != SW_OK)
+            return r;
+    }
+    instance_taker t;
+    memset(&t, 0, sizeof t);
+    t.f = f;
+    t.in = sw_lod_static_set_instances(f->statics);
+    t.fc = fc;
+    t.boxes = boxes;
+    t.status = status;
+    sw__fr_frustum(f, &t.fr);
+    sw_sg_bvh_cull_stats cs;
+    sw_sg_bvh_cull(t.in->bvh, &t.fr, take_instance, &t, &cs);
+    sw__fr_bvh_stats(f, &cs);
+    if (t.r == SW_OK)
+        f->st.faces_culled += t.in->n_occs - t.occs_seen; /* in instances outside the frustum */
+    return t.r;
 }

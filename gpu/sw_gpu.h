@@ -43,6 +43,13 @@ typedef struct sw_gpu_camera {
     double fovy_deg; /* vertical field of view */
 } sw_gpu_camera;
 
+/* The camera presets of `splinewalk render --view` (and sw_camera_fit), fitted to a world box (min
+ * xyz, max xyz): fovy 40°, target = box centre, distance = diagonal / (2 tan 20°) × 1.1, looking
+ * from direction `from` (not zero; (1,1,1) is the iso view) with `up`. A point-sized or empty box
+ * gets a unit diagonal. */
+void sw_gpu_camera_fit_box(const double box[6], const double from[3], const double up[3],
+                           sw_gpu_camera *out);
+
 typedef struct sw_gpu_frame_desc {
     int32_t width, height; /* 0 = 1280 x 720 */
     double error_px;       /* screen-space error bound ε_img in pixels; 0 = 0.5 */
@@ -73,9 +80,11 @@ typedef struct sw_gpu_frame_desc {
     const struct sw_lod_face_cones *face_cones; /* NULL: no back-patch culling; else the
                               scene's per-face outward normal cones (sw_lod_face_cones.h, built once
                               per scene): an occurrence of a SW_SG_FACE_CLOSED_SHELL face facing
-                              away from the eye over its whole box is culled (Kumar §4.4) */
+                              away from the eye over its whole box is culled (Kumar §4.4); with
+                              static_lods, whole super-surface instances by their units' cones too */
     struct sw_lod_static_set *static_lods; /* NULL: no static LODs; else the scene's set
-                              (lod/sw_lod_static_set.h): a visible unit is drawn at the coarsest
+                              (lod/sw_lod_static_set.h), whose BVH of unit instances then culls
+                              instead of desc.bvh: a visible unit is drawn at the coarsest
                               level within the view's tolerance at its nearest point, built in
                               the pool on first need (walkthrough: queued, drawn per frame
                               meanwhile; converged: waited for). Ignored with eval_exact */
@@ -118,10 +127,12 @@ typedef struct sw_gpu_frame_stats {
     uint64_t hlod_waits;           /* times the frame waited for the pool (0 in walkthrough) */
     uint64_t hlod_refine_requests; /* walkthrough: refinements asked for, not waited for */
     double ms_hierarchy;           /* waiting for hierarchy builds and refinements */
-    /* BVH culling (desc.bvh; sw_sg_bvh_cull_stats): nodes classified against the frustum, of them
-     * wholly inside, partly inside and outside; items classified one by one; items kept */
+    /* BVH culling (sw_sg_bvh_cull_stats) by desc.bvh, or with desc.static_lods by the static set's
+     * BVH of super-surface instances (items = unit instances): nodes classified against the
+     * frustum, of them wholly inside, partly inside and outside; items classified one by one;
+     * items kept, and of those the ones wholly inside */
     uint64_t bvh_nodes_visited, bvh_nodes_inside, bvh_nodes_partly, bvh_nodes_outside;
-    uint64_t bvh_items_tested, bvh_items_visible;
+    uint64_t bvh_items_tested, bvh_items_visible, bvh_items_inside;
     uint64_t faces_backculled; /* of faces_culled: back-facing closed-shell occurrences */
     /* static LODs (desc.static_lods) */
     uint64_t static_units_drawn; /* (unit, instance) pairs drawn from a static level */
@@ -130,6 +141,9 @@ typedef struct sw_gpu_frame_stats {
     uint64_t static_requests;    /* walkthrough: unit builds queued, not waited for */
     uint64_t static_waits;       /* converged: units the frame waited for */
     uint32_t static_levels_used; /* bit k: some unit drawn at level k (31: 31 and beyond) */
+    /* triangle meshes (SW_SG_NODE_MESH occurrences; gpu/frame_mesh.c) */
+    uint64_t meshes_drawn, meshes_culled; /* occurrences inside / outside the frustum */
+    uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -224,33 +224,35 @@ void sw_lod_bez_mul_add(int32_t dim, int32_t au, int32_t av, const double *a, in
                         int32_t bv, const double *b, double scale, double *out)
 {
     check_net(au + bu, av + bv, dim);
-    double cau[SW_LOD_BEZ_MAX_DEGREE + 1], cav[SW_LOD_BEZ_MAX_DEGREE + 1];
-    double cbu[SW_LOD_BEZ_MAX_DEGREE + 1], cbv[SW_LOD_BEZ_MAX_DEGREE + 1];
-    double cou[SW_LOD_BEZ_MAX_DEGREE + 1], cov[SW_LOD_BEZ_MAX_DEGREE + 1];
-    sw_lod_binomial_row(au, cau);
-    sw_lod_binomial_row(av, cav);
-    sw_lod_binomial_row(bu, cbu);
-    sw_lod_binomial_row(bv, cbv);
-    sw_lod_binomial_row(au + bu, cou);
-    sw_lod_binomial_row(av + bv, cov);
+    sw_lod_bez_product_weights w;
+    sw_lod_bez_product_weights_init(&w, au, av, bu, bv);
     const size_t ou = (size_t)(au + bu + 1);
     for (int32_t j2 = 0; j2 <= bv; ++j2)
         for (int32_t i2 = 0; i2 <= bu; ++i2) {
-            const double bc =
-                b[(size_t)j2 * (size_t)(bu + 1) + (size_t)i2] * scale * cbu[i2] * cbv[j2];
+            const double bc = b[(size_t)j2 * (size_t)(bu + 1) + (size_t)i2] * scale;
             if (bc == 0.0)
                 continue;
             for (int32_t j1 = 0; j1 <= av; ++j1)
                 for (int32_t i1 = 0; i1 <= au; ++i1) {
-                    const int32_t i = i1 + i2, j = j1 + j2;
-                    const double f = bc * cau[i1] * cav[j1] / (cou[i] * cov[j]);
+                    const double f = bc * sw_lod_bez_product_weight(&w, i1, j1, i2, j2);
                     const double *ac =
                         a + ((size_t)j1 * (size_t)(au + 1) + (size_t)i1) * (size_t)dim;
-                    double *o = out + ((size_t)j * ou + (size_t)i) * (size_t)dim;
+                    double *o = out + ((size_t)(j1 + j2) * ou + (size_t)(i1 + i2)) * (size_t)dim;
                     for (int32_t k = 0; k < dim; ++k)
                         o[k] += f * ac[k];
                 }
         }
+}
+
+void sw_lod_bez_product_weights_init(sw_lod_bez_product_weights *w, int32_t au, int32_t av,
+                                     int32_t bu, int32_t bv)
+{
+    sw_lod_binomial_row(au, w->au);
+    sw_lod_binomial_row(av, w->av);
+    sw_lod_binomial_row(bu, w->bu);
+    sw_lod_binomial_row(bv, w->bv);
+    sw_lod_binomial_row(au + bu, w->ou);
+    sw_lod_binomial_row(av + bv, w->ov);
 }
 
 void sw_lod_bez_component(int32_t deg_u, int32_t deg_v, int32_t dim, const double *cpw,

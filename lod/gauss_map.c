@@ -91,25 +91,17 @@ static void norms(size_t count, const double *net, double *out)
 static void cross_net(int32_t au, int32_t av, const double *a, int32_t bu, int32_t bv,
                       const double *b, double *out)
 {
-    double cau[SW_LOD_BEZ_MAX_DEGREE + 1], cav[SW_LOD_BEZ_MAX_DEGREE + 1];
-    double cbu[SW_LOD_BEZ_MAX_DEGREE + 1], cbv[SW_LOD_BEZ_MAX_DEGREE + 1];
-    double cou[SW_LOD_BEZ_MAX_DEGREE + 1], cov[SW_LOD_BEZ_MAX_DEGREE + 1];
-    sw_lod_binomial_row(au, cau);
-    sw_lod_binomial_row(av, cav);
-    sw_lod_binomial_row(bu, cbu);
-    sw_lod_binomial_row(bv, cbv);
-    sw_lod_binomial_row(au + bu, cou);
-    sw_lod_binomial_row(av + bv, cov);
+    sw_lod_bez_product_weights w;
+    sw_lod_bez_product_weights_init(&w, au, av, bu, bv);
     const size_t ou = (size_t)(au + bu + 1);
     for (int32_t j2 = 0; j2 <= bv; ++j2)
         for (int32_t i2 = 0; i2 <= bu; ++i2) {
             const double *bc = b + ((size_t)j2 * (size_t)(bu + 1) + (size_t)i2) * 4;
             for (int32_t j1 = 0; j1 <= av; ++j1)
                 for (int32_t i1 = 0; i1 <= au; ++i1) {
-                    const int32_t i = i1 + i2, j = j1 + j2;
-                    const double f = cau[i1] * cav[j1] * cbu[i2] * cbv[j2] / (cou[i] * cov[j]);
+                    const double f = sw_lod_bez_product_weight(&w, i1, j1, i2, j2);
                     const double *ac = a + ((size_t)j1 * (size_t)(au + 1) + (size_t)i1) * 4;
-                    double *o = out + ((size_t)j * ou + (size_t)i) * 3;
+                    double *o = out + ((size_t)(j1 + j2) * ou + (size_t)(i1 + i2)) * 3;
                     o[0] += f * (ac[1] * bc[2] - ac[2] * bc[1]);
                     o[1] += f * (ac[2] * bc[0] - ac[0] * bc[2]);
                     o[2] += f * (ac[0] * bc[1] - ac[1] * bc[0]);

@@ -33,6 +33,12 @@ struct sw_lod_static_set {
     sw_lod_static_unit *units;
     uint32_t n_units;
     slot *slots;
+    /* unit instances (Kumar §4.4's BVH leaves): made once, read by every frame */
+    sw_lod_static_instances in;
+    sw_sg_bvh *bvh;
+    sw_lod_static_instance *instances;
+    sw_lod_static_occ *occs;
+    double *face_boxes;
     _Atomic uint64_t n_builds, n_adopted;
     _Atomic uint64_t build_ns;
     _Atomic int cancelled; /* builds not started yet return at once (the set is going away) */
@@ -183,6 +189,250 @@ static sw_result unit_boxes(sw_lod_static_set *s, sw_status *status)
     return SW_OK;
 }
 
+/* Each unit's outward cone (Kumar §4.4): its patches' pseudo-Gauss cones from the clustering
+ * (outward already: negated for reversed faces), enclosed; the full cone when a face of the unit
+ * is not in a closed shell of consistent orientation (seen from both sides). */
+static sw_result unit_cones(sw_lod_static_set *s, sw_status *status)
+{
+    const sw_lod_supersurfaces *ss = s->ss;
+    const sw_sg_face_rec *faces = sw_sg_scene_view_ptr(s->scene)->faces;
+    uint32_t *first = sw__calloc((size_t)s->n_units + 1, sizeof *first);
+    sw_lod_cone *cones = sw__malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *cones);
+    unsigned char *open = sw__calloc(s->n_units ? s->n_units : 1, 1);
+    if (!first || !cones || !open) {
+        sw__free(first);
+        sw__free(cones);
+        sw__free(open);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    }
+    for (uint32_t u = 0; u < s->n_units; ++u)
+        first[u + 1] = first[u] + s->units[u].n_patches;
+    for (uint32_t k = 0; k < ss->n_patches; ++k) { /* grouped by unit, as form_units counted */
+        const uint32_t f = ss->patches[k].face;
+        const uint32_t u = f < s->n_faces ? s->unit_of_face[f] : SW_LOD_STATIC_NO_UNIT;
+        if (u == SW_LOD_STATIC_NO_UNIT)
+            continue;
+        cones[first[u]++] = ss->patch_cones[k];
+        open[u] |= !(faces[f].flags & SW_SG_FACE_CLOSED_SHELL);
+    }
+    for (uint32_t u = 0; u < s->n_units; ++u) {
+        sw_lod_static_unit *un = &s->units[u];
+        sw_lod_cone *c = &un->cone;
+        if (open[u] || un->n_patches == 0) {
+            c->axis[0] = 0.0, c->axis[1] = 0.0, c->axis[2] = 1.0;
+            sw_lod_cone_set_angle(c, M_PI);
+        } else {
+            sw_lod_cone_enclose(cones + first[u] - un->n_patches, un->n_patches, c);
+        }
+    }
+    sw__free(first);
+    sw__free(cones);
+    sw__free(open);
+    return SW_OK;
+}
+
+/* ---- unit instances: the leaves of Kumar §4.4's BVH ------------------------------------------ */
+
+typedef struct pending_occ {
+    sw_lod_static_occ occ;
+    uint32_t instance;
+} pending_occ;
+
+typedef struct inst_build {
+    const sw_lod_static_set *s;
+    uint32_t *map; /* open addressing: (unit, transform) -> instance + 1; 0 empty */
+    size_t cap_map;
+    sw_sg_bvh_item *items; /* per instance: its transform; face = its index */
+    size_t n_items, cap_items;
+    sw_lod_static_instance *inst;
+    size_t cap_inst;
+    pending_occ *occ; /* traversal order */
+    size_t n_occ, cap_occ;
+    int failed; /* 1: out of memory, 2: over the limit */
+} inst_build;
+
+static int grow(void **p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return 1;
+    size_t c = *cap ? 2 * *cap : 256;
+    while (c < need)
+        c *= 2;
+    void *q = sw__realloc(*p, c * size);
+    if (!q)
+        return 0;
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
+static uint64_t instance_hash(uint32_t unit, const double m[12])
+{
+    uint64_t h = 1469598103934665603ull ^ unit;
+    const unsigned char *b = (const unsigned char *)m;
+    for (size_t i = 0; i < 12 * sizeof *m; ++i)
+        h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+/* Doubles the map and inserts every instance of a unit again (load stays below 1/2). */
+static int grow_map(inst_build *b)
+{
+    const size_t cap = b->cap_map ? 2 * b->cap_map : 1024;
+    uint32_t *map = sw__calloc(cap, sizeof *map);
+    if (!map)
+        return 0;
+    for (size_t i = 0; i < b->n_items; ++i) {
+        if (b->inst[i].unit == SW_LOD_STATIC_NO_UNIT)
+            continue;
+        size_t k = instance_hash(b->inst[i].unit, b->items[i].world) & (cap - 1);
+        while (map[k])
+            k = (k + 1) & (cap - 1);
+        map[k] = (uint32_t)i + 1;
+    }
+    sw__free(b->map);
+    b->map = map;
+    b->cap_map = cap;
+    return 1;
+}
+
+static int new_instance(inst_build *b, uint32_t unit, const double world[12], size_t *out)
+{
+    if (b->n_items >= INT32_MAX ||
+        !grow((void **)&b->items, &b->cap_items, b->n_items + 1, sizeof *b->items) ||
+        !grow((void **)&b->inst, &b->cap_inst, b->n_items + 1, sizeof *b->inst))
+        return 0;
+    sw_sg_bvh_item *it = &b->items[b->n_items];
+    memset(it, 0, sizeof *it);
+    memcpy(it->world, world, sizeof it->world);
+    for (int k = 0; k < 4; ++k)
+        it->color[k] = -1.0f;
+    it->face = (uint32_t)b->n_items;
+    b->inst[b->n_items] = (sw_lod_static_instance){unit, 0, 0};
+    *out = b->n_items++;
+    return 1;
+}
+
+/* The instance of (unit, transform), made on first sight; a face without a unit is one alone. */
+static int instance_of(inst_build *b, uint32_t unit, const double world[12], size_t *out)
+{
+    if (unit == SW_LOD_STATIC_NO_UNIT)
+        return new_instance(b, unit, world, out);
+    if (2 * (b->n_items + 1) > b->cap_map && !grow_map(b))
+        return 0;
+    size_t k = instance_hash(unit, world) & (b->cap_map - 1);
+    for (; b->map[k]; k = (k + 1) & (b->cap_map - 1)) {
+        const size_t i = b->map[k] - 1;
+        if (b->inst[i].unit == unit &&
+            memcmp(b->items[i].world, world, sizeof b->items[i].world) == 0) {
+            *out = i;
+            return 1;
+        }
+    }
+    if (!new_instance(b, unit, world, out))
+        return 0;
+    b->map[k] = (uint32_t)*out + 1;
+    return 1;
+}
+
+static int visit_occurrence(void *ctx, uint32_t face, const double world[12], const float color[4])
+{
+    inst_build *b = ctx;
+    size_t i;
+    if (b->n_occ >= INT32_MAX) {
+        b->failed = 2;
+        return 1;
+    }
+    if (!grow((void **)&b->occ, &b->cap_occ, b->n_occ + 1, sizeof *b->occ) ||
+        !instance_of(b, sw_lod_static_set_unit_of(b->s, face), world, &i)) {
+        b->failed = b->n_items >= INT32_MAX ? 2 : 1;
+        return 1;
+    }
+    static const float k_none[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+    pending_occ *o = &b->occ[b->n_occ++];
+    o->occ.face = face;
+    memcpy(o->occ.color, color ? color : k_none, sizeof o->occ.color);
+    o->instance = (uint32_t)i;
+    b->inst[i].n_occ++;
+    return 0;
+}
+
+/* Groups the occurrences by instance (traversal order inside), boxes the instances and the scene
+ * and builds the BVH; takes b's arrays. */
+static sw_result finish_instances(sw_lod_static_set *s, inst_build *b, sw_status *status)
+{
+    s->occs = sw__malloc((b->n_occ ? b->n_occ : 1) * sizeof *s->occs);
+    s->instances = b->inst;
+    b->inst = NULL;
+    if (!s->occs) {
+        sw__free(b->items);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    }
+    uint32_t at = 0;
+    for (size_t i = 0; i < b->n_items; ++i) {
+        s->instances[i].first_occ = at;
+        at += s->instances[i].n_occ;
+        s->instances[i].n_occ = 0;
+    }
+    double sb[6];
+    for (int a = 0; a < 3; ++a) {
+        sb[a] = INFINITY;
+        sb[3 + a] = -INFINITY;
+    }
+    for (size_t k = 0; k < b->n_occ; ++k) {
+        sw_lod_static_instance *in = &s->instances[b->occ[k].instance];
+        s->occs[in->first_occ + in->n_occ++] = b->occ[k].occ;
+        double box[6];
+        sw_sg_box_transform(b->items[b->occ[k].instance].world,
+                            s->face_boxes + 6 * (size_t)b->occ[k].occ.face, box);
+        for (int a = 0; a < 3; ++a) {
+            sb[a] = fmin(sb[a], box[a]);
+            sb[3 + a] = fmax(sb[3 + a], box[3 + a]);
+        }
+    }
+    for (size_t i = 0; i < b->n_items; ++i) {
+        const sw_lod_static_instance *in = &s->instances[i];
+        const double *local = in->unit != SW_LOD_STATIC_NO_UNIT
+                                  ? s->units[in->unit].box
+                                  : s->face_boxes + 6 * (size_t)s->occs[in->first_occ].face;
+        sw_sg_box_transform(b->items[i].world, local, b->items[i].box);
+    }
+    sw_result r = sw_sg_bvh_build_items(b->items, (uint32_t)b->n_items, &s->bvh, status);
+    if (r != SW_OK)
+        return r;
+    s->in = (sw_lod_static_instances){s->bvh,  s->instances,       (uint32_t)b->n_items,
+                                      s->occs, (uint32_t)b->n_occ, s->face_boxes,
+                                      {0}};
+    memcpy(s->in.scene_box, sb, sizeof s->in.scene_box);
+    return SW_OK;
+}
+
+/* The scene's face occurrences grouped into unit instances and their BVH (see the header). */
+static sw_result make_instances(sw_lod_static_set *s, sw_status *status)
+{
+    s->face_boxes = sw__malloc((s->n_faces ? s->n_faces : 1) * 6 * sizeof *s->face_boxes);
+    if (!s->face_boxes)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
+    for (uint32_t f = 0; f < s->n_faces; ++f)
+        sw_sg_bvh_face_box(s->scene, f, s->face_boxes + 6 * (size_t)f);
+    inst_build b = {s, NULL, 0, NULL, 0, 0, NULL, 0, NULL, 0, 0, 0};
+    sw_result r = sw_sg_scene_traverse(s->scene, visit_occurrence, &b);
+    sw__free(b.map);
+    if (r == SW_OK && !b.failed) {
+        r = finish_instances(s, &b, status);
+    } else {
+        sw__free(b.items);
+        r = b.failed == 2
+                ? sw__fail(status, SW_ERR_LIMIT,
+                           "static LODs: %zu face occurrences or more (at most 2^31 - 1)", b.n_occ)
+                : sw__fail(status, SW_ERR_OUT_OF_MEMORY,
+                           "static LODs: %zu face occurrences: out of memory", b.n_occ);
+    }
+    sw__free(b.inst);
+    sw__free(b.occ);
+    return r;
+}
+
 sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
                                    const sw_lod_static_set_desc *desc, sw_lod_static_set **out,
                                    sw_status *status)
@@ -210,6 +460,10 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     sw__free(home);
     if (r == SW_OK)
         r = unit_boxes(s, status);
+    if (r == SW_OK)
+        r = unit_cones(s, status);
+    if (r == SW_OK)
+        r = make_instances(s, status);
     if (r == SW_OK && !(s->slots = sw__calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     if (r != SW_OK) {
@@ -241,6 +495,10 @@ void sw_lod_static_set_destroy(sw_lod_static_set *s)
     sw__free(s->faces);
     sw__free(s->patches);
     sw__free(s->unit_of_face);
+    sw_sg_bvh_free(s->bvh);
+    sw__free(s->instances);
+    sw__free(s->occs);
+    sw__free(s->face_boxes);
     sw_lod_supersurfaces_free(s->ss);
     sw__free(s);
 }
@@ -285,6 +543,11 @@ const sw_lod_static_patch *sw_lod_static_set_patches(const sw_lod_static_set *s)
 const sw_lod_supersurfaces *sw_lod_static_set_supersurfaces(const sw_lod_static_set *s)
 {
     return s->ss;
+}
+
+const sw_lod_static_instances *sw_lod_static_set_instances(const sw_lod_static_set *s)
+{
+    return &s->in;
 }
 
 sw_lod_static_state sw_lod_static_set_state(const sw_lod_static_set *s, uint32_t unit)
@@ -364,7 +627,8 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
     if (job) {
         *job = (build_job){s, unit};
         /* in the slot's group: converged frames and destroy wait on it */
-        const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group};
+        const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group,
+                                 SW_TH_TASK_STATIC_BUILD};
         if (sw_th_pool_submit(s->pool, &task) == SW_OK)
             return SW_OK;
         sw__free(job);

@@ -65,6 +65,24 @@ void sw_lod_bez_component(int32_t deg_u, int32_t deg_v, int32_t dim, const doubl
 /* Row `n` of Pascal's triangle: row[k] = C(n, k), k = 0..n (n <= 2 * SW_LOD_BEZ_MAX_DEGREE). */
 void sw_lod_binomial_row(int32_t n, double *row);
 
+/* The weights of a Bernstein product of nets of degrees (au, av) and (bu, bv): coefficient
+ * (i1, j1) of A times (i2, j2) of B goes to (i1 + i2, j1 + j2) of the product with weight
+ * C(au,i1) C(av,j1) C(bu,i2) C(bv,j2) / (C(au+bu, i1+i2) C(av+bv, j1+j2)). */
+typedef struct sw_lod_bez_product_weights {
+    double au[SW_LOD_BEZ_MAX_DEGREE + 1], av[SW_LOD_BEZ_MAX_DEGREE + 1];
+    double bu[SW_LOD_BEZ_MAX_DEGREE + 1], bv[SW_LOD_BEZ_MAX_DEGREE + 1];
+    double ou[2 * SW_LOD_BEZ_MAX_DEGREE + 1], ov[2 * SW_LOD_BEZ_MAX_DEGREE + 1];
+} sw_lod_bez_product_weights;
+
+void sw_lod_bez_product_weights_init(sw_lod_bez_product_weights *w, int32_t au, int32_t av,
+                                     int32_t bu, int32_t bv);
+
+static inline double sw_lod_bez_product_weight(const sw_lod_bez_product_weights *w, int32_t i1,
+                                               int32_t j1, int32_t i2, int32_t j2)
+{
+    return w->au[i1] * w->av[j1] * w->bu[i2] * w->bv[j2] / (w->ou[i1 + i2] * w->ov[j1 + j2]);
+}
+
 #ifdef __cplusplus
 }
 #endif

@@ -16,6 +16,11 @@
  * Builds are not cancelled when the camera moves on: a static LOD does not depend on the view, so
  * a build once asked for is used by every later frame that looks that way.
  *
+ * Instances (Kumar §4.4: "the leaves of the hierarchy are super-surfaces"). A frame culls, picks
+ * levels and back-culls per unit and instance transform, so the set groups the scene's face
+ * occurrences by (unit, transform) once, when it is created, and builds a BVH whose leaves are
+ * these unit instances (sw_lod_static_set_instances); frames never regroup.
+ *
  * Threads: every function but create and destroy may be called from any thread at any time.
  */
 #ifndef SW_LOD_STATIC_SET_H
@@ -23,6 +28,7 @@
 
 #include "sw_lod_static.h"
 #include "sw_lod_supersurface.h"
+#include "sw_sg_bvh.h"
 #include "sw_th_pool.h"
 
 #include <splinewalk/sw_result.h>
@@ -49,7 +55,41 @@ typedef struct sw_lod_static_unit {
     uint32_t first_patch, n_patches;  /* into sw_lod_static_set_patches() */
     double box[6];                    /* object-space box of its cut Bézier nets: lo xyz, hi xyz */
     double delta;                     /* δ its level 0 is built with (known before the build) */
+    sw_lod_cone cone; /* outward normals of its patches (their pseudo-Gauss cones enclosed, Kumar
+                         §4.4), object space; the full cone unless every face of the unit is in a
+                         closed shell of consistent orientation (SW_SG_FACE_CLOSED_SHELL), as
+                         sw_lod_face_cones bounds faces: an open sheet is seen from both sides */
 } sw_lod_static_unit;
+
+/* One face occurrence of a unit instance: the face and its resolved colour as the scene's
+ * traversal gives it ({-1, -1, -1, -1} when it gives none). */
+typedef struct sw_lod_static_occ {
+    uint32_t face;
+    float color[4];
+} sw_lod_static_occ;
+
+/* One unit under one instance transform (or, with unit SW_LOD_STATIC_NO_UNIT, one occurrence of a
+ * face that has no unit: every face occurrence of the scene is in exactly one instance). */
+typedef struct sw_lod_static_instance {
+    uint32_t unit;
+    uint32_t first_occ, n_occ; /* its face occurrences, in traversal order, in occs[] */
+} sw_lod_static_instance;
+
+/* The unit instances and their BVH (sw_sg_bvh.h). bvh->items[k] is instance
+ * instances[bvh->items[k].face] with its transform (world) and box: the unit's box, or the lone
+ * face's control-net box (sw_sg_bvh_face_box), through the transform (sw_sg_box_transform);
+ * colour unset. face_boxes: sw_sg_bvh_face_box of every face (6 doubles each), so that a frame
+ * boxes an occurrence exactly as the face-occurrence BVH (sw_sg_bvh_build) does. scene_box: the
+ * world box of every face occurrence so boxed, the root box of that BVH. */
+typedef struct sw_lod_static_instances {
+    const sw_sg_bvh *bvh;
+    const sw_lod_static_instance *instances;
+    uint32_t n_instances;
+    const sw_lod_static_occ *occs;
+    uint32_t n_occs;
+    const double *face_boxes;
+    double scene_box[6];
+} sw_lod_static_instances;
 
 /* Zero fields take the defaults of each part. */
 typedef struct sw_lod_static_set_desc {
@@ -65,9 +105,10 @@ typedef struct sw_lod_static_set_stats {
     size_t memory_bytes; /* the chains' memory */
 } sw_lod_static_set_stats;
 
-/* Clusters the scene (§3) and forms the units; builds no LOD. scene: FACES, LOOPS, CURVES,
- * ADJACENCY and POOL required and validated; it and pool outlive the set. desc may be NULL.
- * Errors: those of sw_lod_supersurfaces_build, SW_ERR_OUT_OF_MEMORY. */
+/* Clusters the scene (§3), forms the units and their instances with the instances' BVH; builds no
+ * LOD. scene: FACES, LOOPS, CURVES, ADJACENCY, NODES and POOL required and validated; it and pool
+ * outlive the set. desc may be NULL. Errors: those of sw_lod_supersurfaces_build,
+ * SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (2^31 face occurrences or more). */
 sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
                                    const sw_lod_static_set_desc *desc, sw_lod_static_set **out,
                                    sw_status *status);
@@ -89,6 +130,8 @@ const sw_lod_static_unit *sw_lod_static_set_unit(const sw_lod_static_set *set, u
 const uint32_t *sw_lod_static_set_faces(const sw_lod_static_set *set);
 const sw_lod_static_patch *sw_lod_static_set_patches(const sw_lod_static_set *set);
 const sw_lod_supersurfaces *sw_lod_static_set_supersurfaces(const sw_lod_static_set *set);
+/* The unit instances and their BVH (borrowed, immutable, valid as long as the set). */
+const sw_lod_static_instances *sw_lod_static_set_instances(const sw_lod_static_set *set);
 
 sw_lod_static_state sw_lod_static_set_state(const sw_lod_static_set *set, uint32_t unit);
 /* The unit's chain once READY, else NULL. No lock (acquire load). */

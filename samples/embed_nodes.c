@@ -1,9 +1,10 @@
 /* embed_nodes: a scene built from nodes instead of a file, edited live. It makes a node scene
- * with a trimmed bicubic NURBS sheet (a round hole cut by four rational quarter circles) and two
- * instances of it, draws walkthrough frames while it moves the sheet's control points (each
- * edit is compiled in the scene's worker while the frames keep drawing the version before), then
- * picks a point of the first instance and writes the last frame, converged, as PNG. Written only
- * against the installed public API:
+ * with a trimmed bicubic NURBS sheet (a round hole cut by four rational quarter circles), two
+ * instances of it and a floor under them given as a triangle mesh, draws walkthrough frames
+ * while it moves the sheet's control points (each edit is compiled in the scene's worker while
+ * the frames keep drawing the version before), then picks a point of the first instance and one
+ * of the floor and writes the last frame, converged, as PNG. Written only against the installed
+ * public API:
  *
  *   cc embed_nodes.c $(pkg-config --cflags --libs splinewalk) -lm
  *
@@ -49,6 +50,10 @@ static sw_nurbs_desc sheet(sw_trim_curve curves[5], sw_trim_loop loops[2])
     return d;
 }
 
+/* The floor: two triangles below the sheets, shaded flat (no normals given). */
+static const double floor_points[12] = {-3, -3, -2.5, 37, -3, -2.5, 37, 13, -2.5, -3, 13, -2.5};
+static const uint32_t floor_triangles[6] = {0, 1, 2, 0, 2, 3};
+
 static int fail(const char *what, const sw_status *st)
 {
     fprintf(stderr, "embed_nodes: %s: %s\n", what, st->message);
@@ -60,7 +65,7 @@ int main(void)
     sw_status st = {0};
     sw_scene scene;
     sw_renderer renderer;
-    sw_node surface, copy;
+    sw_node surface, copy, ground;
     sw_trim_curve curves[5];
     sw_trim_loop loops[2];
     wave(0.0);
@@ -79,6 +84,10 @@ int main(void)
         if (sw_node_add(scene, &c, &copy, &st) != SW_OK)
             return fail("instance", &st);
     }
+    sw_mesh_desc floor_mesh = {4, floor_points, NULL, 2, floor_triangles};
+    sw_node_desc f = {.color = {0.55f, 0.55f, 0.5f, 1}}; /* under the root, identity */
+    if (sw_node_add_mesh(scene, &f, &floor_mesh, &ground, &st) != SW_OK)
+        return fail("floor", &st);
     if (sw_renderer_create(NULL, &renderer, &st) != SW_OK)
         return fail("renderer", &st);
     sw_camera cam = {{16, -22, 18}, {16, 5, 0}, {0, 0, 1}, 45};
@@ -107,6 +116,16 @@ int main(void)
            "%s node %#x (u, v) = (%.3f, %.3f)\n",
            (unsigned long long)waits, hit.hit ? "hit" : "no hit", hit.node.id, hit.uv[0],
            hit.uv[1]);
+    /* A ray towards (35, -2, -2.5), in front of the sheets: the floor mesh. */
+    double down[3] = {35 - cam.eye[0], -2 - cam.eye[1], -2.5 - cam.eye[2]};
+    if (sw_scene_pick(scene, cam.eye, down, &hit, &st) != SW_OK)
+        return fail("pick", &st);
+    printf("the ray to (35, -2, -2.5): %s node %#x (the floor: %#x), triangle %u\n",
+           hit.hit ? "hit" : "no hit", hit.node.id, ground.id, hit.triangle);
+    if (!hit.hit || hit.node.id != ground.id) {
+        fprintf(stderr, "embed_nodes: the ray to the floor missed it\n");
+        return 1;
+    }
     sw_renderer_destroy(renderer);
     sw_scene_destroy(scene);
     return 0;

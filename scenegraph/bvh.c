@@ -1,4 +1,4 @@
-/* The BVH over face occurrences (sw_sg_bvh.h). */
+/* The BVH over face occurrences or caller-made items (sw_sg_bvh.h). */
 #include "sw_sg_bvh.h"
 #include "sw_hooks.h"
 
@@ -16,7 +16,7 @@ typedef struct build {
     int oom;
 } build;
 
-static void local_box(const sw_sg_scene *scene, uint32_t face, double box[6])
+void sw_sg_bvh_face_box(const sw_sg_scene *scene, uint32_t face, double box[6])
 {
     sw_sg_surface s;
     sw_sg_scene_face_surface(scene, face, &s);
@@ -33,8 +33,7 @@ static void local_box(const sw_sg_scene *scene, uint32_t face, double box[6])
         }
 }
 
-/* The world box of a local box under a 3 x 4 transform (its eight corners). */
-static void world_box(const double m[12], const double b[6], double out[6])
+void sw_sg_box_transform(const double m[12], const double b[6], double out[6])
 {
     for (int k = 0; k < 3; ++k) {
         out[k] = INFINITY;
@@ -65,10 +64,10 @@ static int visit(void *ctx, uint32_t face, const double world[12], const float c
     }
     double *lb = b->face_box + 6 * (size_t)face;
     if (isnan(lb[0]))
-        local_box(b->scene, face, lb);
+        sw_sg_bvh_face_box(b->scene, face, lb);
     sw_sg_bvh_item *it = &b->items[b->n_items++];
     memcpy(it->world, world, sizeof it->world);
-    world_box(world, lb, it->box);
+    sw_sg_box_transform(world, lb, it->box);
     static const float k_none[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
     memcpy(it->color, color ? color : k_none, sizeof it->color);
     it->face = face;
@@ -194,6 +193,17 @@ sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *
     return finish(b.items, b.n_items, out, status);
 }
 
+sw_result sw_sg_bvh_build_items(sw_sg_bvh_item *items, uint32_t n, sw_sg_bvh **out,
+                                sw_status *status)
+{
+    *out = NULL;
+    if (n > INT32_MAX) {
+        sw__free(items);
+        return sw__fail(status, SW_ERR_LIMIT, "BVH: %u items (at most 2^31 - 1)", n);
+    }
+    return finish(items, n, out, status);
+}
+
 sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out, sw_status *status)
 {
     *out = NULL;
@@ -210,7 +220,7 @@ sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out
             items[i].color[k] = -1.0f;
         items[i].face = i;
     }
-    return finish(items, n, out, status);
+    return sw_sg_bvh_build_items(items, n, out, status);
 }
 
 void sw_sg_bvh_free(sw_sg_bvh *bvh)
@@ -274,12 +284,13 @@ typedef struct cull {
     sw_sg_bvh_cull_stats st;
 } cull;
 
-/* Reports items [first, first + count) untested (stop = the callback's value). */
+/* Reports items [first, first + count) untested, as inside (stop = the callback's value). */
 static int report_all(cull *c, uint32_t first, uint32_t count)
 {
     for (uint32_t i = first; i < first + count; ++i) {
         c->st.items_visible++;
-        int stop = c->fn(c->ctx, i);
+        c->st.items_inside++;
+        int stop = c->fn(c->ctx, i, SW_SG_CULL_INSIDE);
         if (stop)
             return stop;
     }
@@ -291,10 +302,12 @@ static int report_tested(cull *c, uint32_t first, uint32_t count)
 {
     for (uint32_t i = first; i < first + count; ++i) {
         c->st.items_tested++;
-        if (sw_sg_frustum_classify(c->fr, c->bvh->items[i].box) == SW_SG_CULL_OUTSIDE)
+        const sw_sg_cull_class k = sw_sg_frustum_classify(c->fr, c->bvh->items[i].box);
+        if (k == SW_SG_CULL_OUTSIDE)
             continue;
         c->st.items_visible++;
-        int stop = c->fn(c->ctx, i);
+        c->st.items_inside += k == SW_SG_CULL_INSIDE;
+        int stop = c->fn(c->ctx, i, k);
         if (stop)
             return stop;
     }

@@ -27,9 +27,33 @@ static void lattice(uint32_t n, int32_t dims, uint32_t out[3])
     out[2] = (uint32_t)((n + nx * ny - 1) / (nx * ny));
 }
 
+/* The model's meshes, their offsets shifted by pool (where its pool went) and by where its
+ * indices go; *first = the index of its first mesh in b. */
+static int copy_meshes(const sw_sg_scene_view *v, sw_sg_builder *b, uint64_t pool, uint32_t *first)
+{
+    *first = 0;
+    if (!v->n_meshes)
+        return 1;
+    const uint64_t idx = sw_sg_builder_push_indices(b, v->indices, v->n_indices);
+    int ok = idx != UINT64_MAX;
+    for (uint32_t i = 0; ok && i < v->n_meshes; ++i) {
+        sw_sg_mesh_rec m = v->meshes[i];
+        m.positions += pool;
+        if (m.normals != SW_SG_NO_NORMALS)
+            m.normals += pool;
+        m.indices += idx;
+        const uint32_t got = sw_sg_builder_add_mesh(b, &m);
+        if (i == 0)
+            *first = got;
+        ok = got != SW_SG_NONE && got == *first + i;
+    }
+    return ok;
+}
+
 /* Appends the geometry records of the model to `b` with indices and pool offsets shifted by what
- * `b` already holds (names come with the nodes); base[0..2] = face, loop, curve index bases. */
-static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base[3],
+ * `b` already holds (names come with the nodes); base[0..3] = face, loop, curve, mesh index
+ * bases. */
+static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base[4],
                              sw_status *status)
 {
     const uint64_t pool = v->n_pool ? sw_sg_builder_push_doubles(b, v->pool, v->n_pool) : 0;
@@ -64,6 +88,7 @@ static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32
     for (uint32_t i = 0; ok && i < v->n_adjacency; ++i)
         ok = sw_sg_builder_add_adjacency(b, base[0] + v->adjacency[i].face_a,
                                          base[0] + v->adjacency[i].face_b) != SW_SG_NONE;
+    ok = ok && copy_meshes(v, b, pool, &base[3]);
     if (!ok)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     return SW_OK;
@@ -109,7 +134,8 @@ static sw_result node_order(const sw_sg_scene_view *v, uint32_t base, uint32_t *
 
 /* Adds the model's nodes as detached nodes of the builder (the prototype), refs remapped. */
 static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base,
-                            uint32_t face_base, uint32_t *proto, sw_status *status)
+                            uint32_t face_base, uint32_t mesh_base, uint32_t *proto,
+                            sw_status *status)
 {
     uint32_t *order = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *order);
     uint32_t *map = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *map);
@@ -121,6 +147,7 @@ static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_
         const uint32_t parent = s->parent == SW_SG_NONE ? SW_SG_NONE : map[s->parent];
         const uint32_t ref = s->kind == SW_SG_NODE_INSTANCE  ? map[s->ref]
                              : s->kind == SW_SG_NODE_SURFACE ? face_base + s->ref
+                             : s->kind == SW_SG_NODE_MESH    ? mesh_base + s->ref
                                                              : s->ref;
         const char *name = s->name == SW_SG_NONE ? NULL : v->strings + s->name;
         const uint32_t got = sw_sg_builder_add_node(b, (sw_sg_node_kind)s->kind, parent, ref,
@@ -137,9 +164,9 @@ static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_
 sw_result sw__sg_append_model(sw_sg_builder *b, const sw_sg_scene_view *model, uint32_t node_base,
                               uint32_t *proto, sw_status *status)
 {
-    uint32_t base[3];
+    uint32_t base[4];
     sw_result r = copy_arrays(model, b, base, status);
-    return r == SW_OK ? copy_nodes(model, b, node_base, base[0], proto, status) : r;
+    return r == SW_OK ? copy_nodes(model, b, node_base, base[0], base[3], proto, status) : r;
 }
 
 static sw_result check_desc(const sw_sg_grid_desc *d, sw_status *status)

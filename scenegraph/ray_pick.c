@@ -282,10 +282,9 @@ static double ray_box(const double o[3], const double inv_d[3], const double box
     return t0 <= t1 ? t0 : INFINITY;
 }
 
-/* The item's ray in the face's frame (inverse of world = M x + T); 0 for a singular transform. */
-static int item_ray(const sw_sg_bvh_item *it, const double o[3], const double d[3], local_ray *r)
+/* The ray in an occurrence's frame (inverse of world = M x + T); 0 for a singular transform. */
+static int world_ray(const double m[12], const double o[3], const double d[3], local_ray *r)
 {
-    const double *m = it->world;
     double a[9] = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]};
     double inv[9] = {
         a[4] * a[8] - a[5] * a[7], a[2] * a[7] - a[1] * a[8], a[1] * a[5] - a[2] * a[4],
@@ -303,24 +302,131 @@ static int item_ray(const sw_sg_bvh_item *it, const double o[3], const double d[
     return 1;
 }
 
+/* ---- meshes ------------------------------------------------------------------------------------
+ */
+
+static void cross3(const double a[3], const double b[3], double out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Möller-Trumbore: t of the ray's crossing of triangle (a, b, c), both sides, with the weights of
+ * b and c in *u, *v; INFINITY when it misses (or runs parallel). */
+static double ray_triangle(const local_ray *r, const double *a, const double *b, const double *c,
+                           double *u, double *v)
+{
+    double e1[3], e2[3], pv[3], tv[3], qv[3];
+    for (int k = 0; k < 3; ++k) {
+        e1[k] = b[k] - a[k];
+        e2[k] = c[k] - a[k];
+        tv[k] = r->o[k] - a[k];
+    }
+    cross3(r->d, e2, pv);
+    const double det = dot3(e1, pv);
+    if (!(fabs(det) > 0.0))
+        return INFINITY;
+    const double inv = 1.0 / det;
+    *u = dot3(tv, pv) * inv;
+    if (!(*u >= 0.0 && *u <= 1.0))
+        return INFINITY;
+    cross3(tv, e1, qv);
+    *v = dot3(r->d, qv) * inv;
+    if (!(*v >= 0.0 && *u + *v <= 1.0))
+        return INFINITY;
+    const double t = dot3(e2, qv) * inv;
+    return t > 0.0 ? t : INFINITY;
+}
+
+typedef struct mesh_job {
+    const sw_sg_scene *scene;
+    const double *origin, *dir, *inv_d;
+    double best;
+    sw_sg_pick_hit *hit;
+    uint32_t occurrence;
+} mesh_job;
+
+/* One mesh occurrence: its world box (the box corners' images bound an affine map's image of
+ * the box) against the ray, then every triangle in the mesh's frame. */
+static int mesh_visit(void *ctx, uint32_t mesh, uint32_t node, const double world[12],
+                      const float color[4])
+{
+    (void)color;
+    mesh_job *job = ctx;
+    const uint32_t occ = job->occurrence++;
+    const sw_sg_mesh_rec *m = &sw_sg_scene_view_ptr(job->scene)->meshes[mesh];
+    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
+    for (int c = 0; c < 8; ++c) {
+        const double q[3] = {m->box[(c & 1) ? 3 : 0], m->box[(c & 2) ? 4 : 1],
+                             m->box[(c & 4) ? 5 : 2]};
+        for (int k = 0; k < 3; ++k) {
+            const double *w = world + 4 * k;
+            const double x = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3];
+            box[k] = fmin(box[k], x);
+            box[3 + k] = fmax(box[3 + k], x);
+        }
+    }
+    local_ray lr;
+    if (ray_box(job->origin, job->inv_d, box, job->best) == INFINITY ||
+        !world_ray(world, job->origin, job->dir, &lr))
+        return 0;
+    const double *pos, *nrm;
+    const uint32_t *idx;
+    sw_sg_scene_mesh(job->scene, mesh, &pos, &nrm, &idx);
+    for (uint32_t t = 0; t < m->n_triangles; ++t) {
+        const uint32_t *tri = idx + 3 * (size_t)t;
+        double u = 0.0, v = 0.0;
+        const double th = ray_triangle(&lr, pos + 3 * (size_t)tri[0], pos + 3 * (size_t)tri[1],
+                                       pos + 3 * (size_t)tri[2], &u, &v);
+        if (th < job->best) {
+            job->best = th;
+            sw_sg_pick_hit *h = job->hit;
+            h->face = SW_SG_NONE;
+            h->mesh = mesh;
+            h->node = node;
+            h->triangle = t;
+            h->item = occ;
+            h->t = th;
+            h->bary[0] = 1.0 - u - v;
+            h->bary[1] = u;
+            h->bary[2] = v;
+            h->uv[0] = h->uv[1] = 0.0;
+        }
+    }
+    return 0;
+}
+
+static sw_result pick_meshes(const sw_sg_scene *scene, const double origin[3], const double dir[3],
+                             const double inv_d[3], double *best, sw_sg_pick_hit *hit,
+                             sw_status *status)
+{
+    mesh_job job = {scene, origin, dir, inv_d, *best, hit, 0};
+    if (sw_sg_scene_traverse_meshes(scene, mesh_visit, &job) != SW_OK)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "pick: out of memory walking the meshes");
+    *best = job.best;
+    return SW_OK;
+}
+
 sw_result sw_sg_pick(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const double origin[3],
                      const double dir[3], double t_max, sw_sg_pick_hit *hit, sw_status *status)
 {
     memset(hit, 0, sizeof *hit);
     hit->face = SW_SG_NONE;
+    hit->mesh = SW_SG_NONE;
+    hit->node = SW_SG_NONE;
     double dd = dot3(dir, dir);
     if (!(dd > 0.0) || !isfinite(dd) || !isfinite(dot3(origin, origin)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "pick: zero or non-finite ray");
     double best = t_max > 0.0 ? t_max : INFINITY, inv_d[3];
     for (int k = 0; k < 3; ++k)
         inv_d[k] = 1.0 / dir[k];
-    if (bvh->n_nodes == 0)
-        return SW_OK;
     int32_t *stack = sw__malloc(((size_t)bvh->n_nodes + 1) * sizeof *stack);
     if (!stack)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "pick: out of memory");
     size_t top = 0;
-    stack[top++] = 0;
+    if (bvh->n_nodes)
+        stack[top++] = 0;
     sw_result r = SW_OK;
     while (top > 0 && r == SW_OK) {
         const sw_sg_bvh_node *n = &bvh->nodes[stack[--top]];
@@ -339,7 +445,7 @@ sw_result sw_sg_pick(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const doubl
             const sw_sg_bvh_item *it = &bvh->items[i];
             local_ray lr;
             if (ray_box(origin, inv_d, it->box, best) == INFINITY ||
-                !item_ray(it, origin, dir, &lr))
+                !world_ray(it->world, origin, dir, &lr))
                 continue;
             int found = 0;
             r = face_pick(scene, it->face, &lr, &best, hit->uv, &found, status);
@@ -351,7 +457,9 @@ sw_result sw_sg_pick(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const doubl
         }
     }
     sw__free(stack);
-    if (r == SW_OK && hit->face != SW_SG_NONE)
+    if (r == SW_OK && sw_sg_scene_view_ptr(scene)->n_meshes)
+        r = pick_meshes(scene, origin, dir, inv_d, &best, hit, status);
+    if (r == SW_OK && (hit->face != SW_SG_NONE || hit->mesh != SW_SG_NONE))
         for (int k = 0; k < 3; ++k)
             hit->point[k] = origin[k] + hit->t * dir[k];
     return r;

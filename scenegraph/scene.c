@@ -8,12 +8,14 @@
 #include "sw_status_util.h"
 
 #include <assert.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
 
 const char *const sw__sg_section_names[SW__SG_SEC_COUNT] = {
-    "FACES", "LOOPS", "CURVES", "NODES", "ADJACENCY", "POOL", "STRINGS", "META",
+    "FACES",   "LOOPS", "CURVES", "NODES",  "ADJACENCY", "POOL",
+    "STRINGS", "META",  "LODS",   "MESHES", "INDICES",
 };
 const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT] = {
     sizeof(sw_sg_face_rec),
@@ -24,6 +26,9 @@ const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT] = {
     sizeof(double),
     1,
     16,
+    1, /* LODS: opaque bytes */
+    sizeof(sw_sg_mesh_rec),
+    sizeof(uint32_t),
 };
 
 static const double identity12[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -49,7 +54,7 @@ typedef struct sw__vec {
 } sw__vec;
 
 struct sw_sg_builder {
-    sw__vec vec[SW__SG_SEC_META]; /* indexed by SW__SG_SEC_* */
+    sw__vec vec[SW__SG_SEC_COUNT]; /* indexed by SW__SG_SEC_* (META and LODS unused) */
     sw__vec last_child;           /* uint32 per node: O(1) append of a child */
     uint32_t root;
 };
@@ -101,9 +106,11 @@ sw_sg_builder *sw_sg_builder_create(void)
     if (!b)
         return NULL;
     const size_t rec_max = (size_t)SW_SG_NONE - 1; /* SW_SG_NONE itself is never an index */
-    for (int s = 0; s < SW__SG_SEC_META; s++)
-        vec_init(&b->vec[s], sw__sg_section_record_size[s], rec_max);
+    for (int s = 0; s < SW__SG_SEC_COUNT; s++)
+        vec_init(&b->vec[s], sw__sg_section_record_size[s],
+                 sw__sg_is_array_section(s) ? rec_max : 0);
     vec_init(&b->vec[SW__SG_SEC_POOL], sizeof(double), SIZE_MAX / sizeof(double));
+    vec_init(&b->vec[SW__SG_SEC_INDICES], sizeof(uint32_t), SIZE_MAX / sizeof(uint32_t));
     vec_init(&b->last_child, sizeof(uint32_t), rec_max);
     b->root = 0;
     if (sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, SW_SG_NONE, SW_SG_NONE, NULL, NULL, NULL) !=
@@ -118,7 +125,7 @@ void sw_sg_builder_free(sw_sg_builder *b)
 {
     if (!b)
         return;
-    for (int s = 0; s < SW__SG_SEC_META; s++)
+    for (int s = 0; s < SW__SG_SEC_COUNT; s++)
         sw__free(b->vec[s].data);
     sw__free(b->last_child.data);
     sw__free(b);
@@ -165,6 +172,27 @@ uint32_t sw_sg_builder_add_adjacency(sw_sg_builder *b, uint32_t face_a, uint32_t
 {
     sw_sg_adjacency_rec r = {face_a, face_b};
     return vec_push(&b->vec[SW__SG_SEC_ADJACENCY], &r);
+}
+
+uint64_t sw_sg_builder_push_indices(sw_sg_builder *b, const uint32_t *indices, size_t count)
+{
+    sw__vec *v = &b->vec[SW__SG_SEC_INDICES];
+    size_t i = vec_grow(v, count);
+    if (i == SIZE_MAX)
+        return UINT64_MAX;
+    if (count)
+        memcpy(v->data + i * sizeof(uint32_t), indices, count * sizeof(uint32_t));
+    return i;
+}
+
+uint32_t sw_sg_builder_add_mesh(sw_sg_builder *b, const sw_sg_mesh_rec *mesh)
+{
+    sw_sg_mesh_rec r = *mesh;
+    const double *p = (const double *)b->vec[SW__SG_SEC_POOL].data + r.positions;
+    assert(r.positions <= b->vec[SW__SG_SEC_POOL].n &&
+           3 * (uint64_t)r.n_vertices <= b->vec[SW__SG_SEC_POOL].n - r.positions);
+    sw_sg_mesh_box(p, r.n_vertices, r.box);
+    return vec_push(&b->vec[SW__SG_SEC_MESHES], &r);
 }
 
 uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind, uint32_t parent,
@@ -235,7 +263,9 @@ void sw_sg_builder_set_root(sw_sg_builder *b, uint32_t node)
 /* Moves the builder's arrays into `scene` (shrunk to size). */
 static void builder_move_arrays(sw_sg_builder *b, sw_sg_scene *scene)
 {
-    for (int s = 0; s < SW__SG_SEC_META; s++) {
+    for (int s = 0; s < SW__SG_SEC_COUNT; s++) {
+        if (!sw__sg_is_array_section(s))
+            continue;
         sw__vec *v = &b->vec[s];
         if (v->n && v->n < v->cap) {
             unsigned char *d = sw__realloc(v->data, v->n * v->elem);
@@ -262,6 +292,10 @@ static void builder_move_arrays(sw_sg_builder *b, sw_sg_scene *scene)
     w->n_pool = b->vec[SW__SG_SEC_POOL].n;
     w->n_strings = b->vec[SW__SG_SEC_STRINGS].n;
     w->root = b->root;
+    w->meshes = scene->owned[SW__SG_SEC_MESHES];
+    w->indices = scene->owned[SW__SG_SEC_INDICES];
+    w->n_meshes = (uint32_t)b->vec[SW__SG_SEC_MESHES].n;
+    w->n_indices = b->vec[SW__SG_SEC_INDICES].n;
 }
 
 sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *status)
@@ -329,6 +363,12 @@ const void *sw__sg_view_section(const sw_sg_scene_view *view, int s, uint64_t *b
     case SW__SG_SEC_STRINGS:
         p = view->strings, n = view->n_strings;
         break;
+    case SW__SG_SEC_MESHES:
+        p = view->meshes, n = view->n_meshes;
+        break;
+    case SW__SG_SEC_INDICES:
+        p = view->indices, n = view->n_indices;
+        break;
     default:
         assert(!"not an array section");
     }
@@ -360,6 +400,30 @@ void sw_sg_scene_curve(const sw_sg_scene *scene, uint32_t curve, sw_sg_curve *ou
     out->dim = 3;
     out->knots = scene->view.pool + c->knots;
     out->cpw = scene->view.pool + c->cpw;
+}
+
+void sw_sg_mesh_box(const double *positions, uint32_t n, double box[6])
+{
+    for (int k = 0; k < 3; k++) {
+        box[k] = INFINITY;
+        box[3 + k] = -INFINITY;
+    }
+    for (uint32_t i = 0; i < n; i++)
+        for (int k = 0; k < 3; k++) {
+            const double x = positions[3 * (size_t)i + k];
+            box[k] = x < box[k] ? x : box[k];
+            box[3 + k] = x > box[3 + k] ? x : box[3 + k];
+        }
+}
+
+void sw_sg_scene_mesh(const sw_sg_scene *scene, uint32_t mesh, const double **positions,
+                      const double **normals, const uint32_t **indices)
+{
+    assert(mesh < scene->view.n_meshes);
+    const sw_sg_mesh_rec *m = &scene->view.meshes[mesh];
+    *positions = scene->view.pool + m->positions;
+    *normals = m->normals == SW_SG_NO_NORMALS ? NULL : scene->view.pool + m->normals;
+    *indices = scene->view.indices + m->indices;
 }
 
 size_t sw_sg_scene_memory(const sw_sg_scene *scene)
@@ -432,8 +496,9 @@ static int trav_push(trav_stack *st, uint32_t node, uint32_t depth, int follow,
 
 /* Iterative depth-first walk (no recursion: CAD assemblies nest deeply). The depth guard only
  * matters for an unvalidated scene: a validated one has no cycle, so no path is longer than
- * n_nodes. */
-sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx)
+ * n_nodes. One of the visitors is set: faces or meshes. */
+static sw_result traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit,
+                          sw_sg_mesh_visit_fn visit_mesh, void *ctx)
 {
     const sw_sg_scene_view *v = &scene->view;
     if (v->root >= v->n_nodes)
@@ -451,8 +516,12 @@ sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, v
         double world[12];
         compose(e.world, nd->xform, world);
         const float *color = nd->color[3] < 0.0f ? e.color : nd->color;
-        if (nd->kind == SW_SG_NODE_SURFACE && nd->ref < v->n_faces) {
+        if (visit && nd->kind == SW_SG_NODE_SURFACE && nd->ref < v->n_faces) {
             if (visit(ctx, nd->ref, world, color))
+                break;
+        }
+        if (visit_mesh && nd->kind == SW_SG_NODE_MESH && nd->ref < v->n_meshes) {
+            if (visit_mesh(ctx, nd->ref, e.node, world, color))
                 break;
         }
         if (ok && nd->first_child != SW_SG_NONE)
@@ -463,4 +532,15 @@ sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, v
     if (st.e != st.local)
         sw__free(st.e);
     return ok ? SW_OK : SW_ERR_OUT_OF_MEMORY;
+}
+
+sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx)
+{
+    return traverse(scene, visit, NULL, ctx);
+}
+
+sw_result sw_sg_scene_traverse_meshes(const sw_sg_scene *scene, sw_sg_mesh_visit_fn visit,
+                                      void *ctx)
+{
+    return traverse(scene, NULL, visit, ctx);
 }

@@ -85,6 +85,29 @@ static int stats_visit(void *ctx, uint32_t face, const double world[12], const f
     return 0;
 }
 
+/* Grows the world box by the mesh's box corners placed in the world (an affine map's image of a
+ * box lies in the box of its corners' images). */
+static int stats_visit_mesh(void *ctx, uint32_t mesh, uint32_t node, const double world[12],
+                            const float color[4])
+{
+    (void)node;
+    (void)color;
+    stats_ctx *c = ctx;
+    const sw_sg_mesh_rec *m = &c->scene->view.meshes[mesh];
+    for (int k = 0; k < 8; k++) {
+        double q[3] = {m->box[(k & 1) ? 3 : 0], m->box[(k & 2) ? 4 : 1], m->box[(k & 4) ? 5 : 2]};
+        double p[3];
+        for (int r = 0; r < 3; r++) {
+            const double *w = world + 4 * r;
+            p[r] = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3];
+        }
+        box_add(c->out->bbox, p);
+    }
+    c->out->mesh_occurrences++;
+    c->out->triangle_occurrences += m->n_triangles;
+    return 0;
+}
+
 static void face_stats(const sw_sg_scene_view *v, sw_sg_scene_stats *out)
 {
     for (uint32_t i = 0; i < v->n_faces; i++) {
@@ -132,7 +155,12 @@ sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats 
         face_sample_box(scene, i, c.face_boxes + (size_t)i * 6);
     sw_result r = sw_sg_scene_traverse(scene, stats_visit, &c);
     sw__free(c.face_boxes);
-    if (out->face_occurrences == 0)
+    out->meshes = v->n_meshes;
+    for (uint32_t i = 0; i < v->n_meshes; i++)
+        out->mesh_triangles += v->meshes[i].n_triangles;
+    if (r == SW_OK && v->n_meshes)
+        r = sw_sg_scene_traverse_meshes(scene, stats_visit_mesh, &c);
+    if (out->face_occurrences == 0 && out->mesh_occurrences == 0)
         memset(out->bbox, 0, sizeof out->bbox); /* nothing drawn: an empty box at the origin */
     out->memory_bytes = sw_sg_scene_memory(scene);
     return r;

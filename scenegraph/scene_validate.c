@@ -175,8 +175,9 @@ static sw_result check_node_records(const vctx *c)
         where(c, SW__SG_SEC_NODES, i, at);
         int ref_ok = nd->kind == SW_SG_NODE_SURFACE    ? nd->ref < v->n_faces
                      : nd->kind == SW_SG_NODE_INSTANCE ? nd->ref < v->n_nodes
+                     : nd->kind == SW_SG_NODE_MESH     ? nd->ref < v->n_meshes
                                                        : 1;
-        if (nd->kind > SW_SG_NODE_SURFACE || !ref_ok)
+        if (nd->kind > SW_SG_NODE_MESH || !ref_ok)
             return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: kind %u, ref %u", c->what, i,
                             at, nd->kind, nd->ref);
         if (!node_link_ok(nd->parent, v->n_nodes) || !node_link_ok(nd->first_child, v->n_nodes) ||
@@ -302,6 +303,61 @@ static sw_result check_nodes(const vctx *c)
     return r;
 }
 
+/* A mesh's ranges, flags, indices (each below its vertex count), finite positions and normals,
+ * and its stored box (exactly the positions' box: culling and picking trust it). */
+static sw_result check_mesh(const vctx *c, uint32_t i, const sw_sg_mesh_rec *m)
+{
+    const sw_sg_scene_view *v = c->v;
+    char at[48];
+    where(c, SW__SG_SEC_MESHES, i, at);
+    const uint64_t nv3 = 3 * (uint64_t)m->n_vertices, ni = 3 * (uint64_t)m->n_triangles;
+    if (m->n_vertices < 3 || m->n_triangles < 1 || m->flags || m->reserved)
+        return sw__fail(c->status, SW_ERR_FORMAT,
+                        "%s: mesh %u%s: %u vertices, %u triangles, flags 0x%x, reserved %u "
+                        "(at least 3 and 1, zero flags)",
+                        c->what, i, at, m->n_vertices, m->n_triangles, m->flags, m->reserved);
+    if (!pool_range_ok(v, m->positions, nv3) ||
+        (m->normals != SW_SG_NO_NORMALS && !pool_range_ok(v, m->normals, nv3)) ||
+        m->indices > v->n_indices || ni > v->n_indices - m->indices)
+        return sw__fail(c->status, SW_ERR_FORMAT,
+                        "%s: mesh %u%s: positions %llu, normals %llu or indices %llu outside the "
+                        "pool (%llu doubles) or INDICES (%llu)",
+                        c->what, i, at, (unsigned long long)m->positions,
+                        (unsigned long long)m->normals, (unsigned long long)m->indices,
+                        (unsigned long long)v->n_pool, (unsigned long long)v->n_indices);
+    const uint32_t *idx = v->indices + m->indices;
+    for (uint64_t k = 0; k < ni; k++)
+        if (idx[k] >= m->n_vertices)
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: mesh %u%s: index %llu (triangle %llu) is %u of %u vertices",
+                            c->what, i, at, (unsigned long long)k, (unsigned long long)(k / 3),
+                            idx[k], m->n_vertices);
+    const double *p = v->pool + m->positions;
+    for (uint64_t k = 0; k < nv3; k++)
+        if (!isfinite(p[k]) ||
+            (m->normals != SW_SG_NO_NORMALS && !isfinite(v->pool[m->normals + k])))
+            return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
+                            "%s: mesh %u%s: vertex %llu: non-finite position or normal", c->what, i,
+                            at, (unsigned long long)(k / 3));
+    double box[6];
+    sw_sg_mesh_box(p, m->n_vertices, box);
+    if (memcmp(box, m->box, sizeof box) != 0)
+        return sw__fail(c->status, SW_ERR_FORMAT,
+                        "%s: mesh %u%s: stored box is not the box of its positions", c->what, i,
+                        at);
+    return SW_OK;
+}
+
+static sw_result check_meshes(const vctx *c)
+{
+    for (uint32_t i = 0; i < c->v->n_meshes; i++) {
+        sw_result r = check_mesh(c, i, &c->v->meshes[i]);
+        if (r != SW_OK)
+            return r;
+    }
+    return SW_OK;
+}
+
 static sw_result check_misc(const vctx *c)
 {
     const sw_sg_scene_view *v = c->v;
@@ -335,6 +391,8 @@ sw_result sw__sg_scene_validate_at(const sw_sg_scene_view *view, const char *wha
         r = check_faces(&c);
     if (r == SW_OK)
         r = check_curves(&c);
+    if (r == SW_OK)
+        r = check_meshes(&c);
     if (r == SW_OK)
         sw__status_ok(status);
     return r;

@@ -1,10 +1,12 @@
-/* splinewalk scenegraph/: a bounding-volume hierarchy over a scene's face occurrences (Kumar et
- * al. 1997 §4.4; its leaves will be super-surface instances once issue 4's clustering exists, face
- * occurrences until then). Built once per scene (instances expanded), median split along the
- * longest axis of the centroids' box, at most SW_SG_BVH_LEAF items per leaf. Each item's box is its
- * face's control-net box (computed once per face, shared by instances) mapped through the
- * occurrence transform: eight corners, so it bounds the surface however the transform rotates.
- * A finished BVH is immutable and may be read from any thread.
+/* splinewalk scenegraph/: a bounding-volume hierarchy (Kumar et al. 1997 §4.4). Its leaves are a
+ * scene's face occurrences (sw_sg_bvh_build: frames without static LODs), or items a caller made
+ * (sw_sg_bvh_build_items: lod/'s super-surface instances, the leaves §4.4 names, for frames with
+ * static LODs; sw_sg_bvh_build_boxes: pieces of one face). Built once per scene (instances
+ * expanded), median split along the longest axis of the centroids' box, at most SW_SG_BVH_LEAF
+ * items per leaf. A face occurrence's box is its face's control-net box (computed once per face,
+ * shared by instances) mapped through the occurrence transform: eight corners, so it bounds the
+ * surface however the transform rotates. A finished BVH is immutable and may be read from any
+ * thread.
  */
 #ifndef SW_SG_BVH_H
 #define SW_SG_BVH_H
@@ -24,7 +26,7 @@ typedef struct sw_sg_bvh_item {
     double world[12]; /* occurrence transform, row-major 3 x 4 */
     double box[6];    /* world box: min xyz, max xyz */
     float color[4];
-    uint32_t face;
+    uint32_t face; /* the face (sw_sg_bvh_build), else the caller's id of the item */
 } sw_sg_bvh_item;
 
 typedef struct sw_sg_bvh_node {
@@ -49,7 +51,19 @@ sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *
  * (e.g. one face's Bézier patches) for callers that cull their own pieces. Errors as above. */
 sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out,
                                 sw_status *status);
+/* The same hierarchy over n items the caller made (world, box, colour, face = its own id); takes
+ * `items` (malloc'ed; freed on failure too) and reorders them into leaf order. Errors as above. */
+sw_result sw_sg_bvh_build_items(sw_sg_bvh_item *items, uint32_t n, sw_sg_bvh **out,
+                                sw_status *status);
 void sw_sg_bvh_free(sw_sg_bvh *bvh); /* NULL allowed */
+
+/* The object-space box of a face as its occurrences are boxed: its whole control net (Euclidean
+ * points), min xyz, max xyz. Precondition: FACES and POOL required. */
+void sw_sg_bvh_face_box(const sw_sg_scene *scene, uint32_t face, double box[6]);
+/* The world box of an object box under a row-major 3 x 4 transform (its eight corners), as
+ * sw_sg_bvh_build boxes an occurrence: a caller that boxes occurrences itself gets the same
+ * doubles. */
+void sw_sg_box_transform(const double m[12], const double box[6], double out[6]);
 size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh);
 
 /* ---- view-frustum culling (Kumar §4.4) --------------------------------------------------------
@@ -84,14 +98,17 @@ typedef struct sw_sg_bvh_cull_stats {
     uint64_t nodes_inside, nodes_partly, nodes_outside;
     uint64_t items_tested;  /* items classified one by one (those of partly-visible leaves) */
     uint64_t items_visible; /* items reported */
+    uint64_t items_inside;  /* of those, reported as SW_SG_CULL_INSIDE */
 } sw_sg_bvh_cull_stats;
 
-/* Receives the index (into bvh->items) of an item whose box may meet the frustum; non-zero stops
- * the traversal. */
-typedef int (*sw_sg_bvh_cull_fn)(void *ctx, uint32_t item);
+/* Receives the index (into bvh->items) of an item whose box may meet the frustum and the item's
+ * own class: SW_SG_CULL_INSIDE (under a node inside, or tested inside) or SW_SG_CULL_PARTLY;
+ * non-zero stops the traversal. */
+typedef int (*sw_sg_bvh_cull_fn)(void *ctx, uint32_t item, sw_sg_cull_class cls);
 
-/* Reports every item whose box is not outside the frustum, in increasing index order: a node
- * outside is dropped with its subtree, a node inside reports its subtree untested, a partly
+/* Reports every item whose box is not outside the frustum, in increasing index order, with its
+ * class: a node outside is dropped with its subtree, a node inside reports its subtree untested
+ * (as inside), a partly
  * visible node is opened (its leaf items classified one by one). The reported set is exactly the
  * items whose own box classifies as not outside (a box inside its parent's box classifies at
  * least as inside, in floating point too: every step of the test is monotone). `stats` may be

@@ -1,5 +1,6 @@
 /* splinewalk scene: faces (trimmed NURBS surfaces), trim loops of 2D rational B-spline curves,
- * a node tree (group, transform, instance, surface) with colours, and face adjacency.
+ * triangle meshes, a node tree (group, transform, instance, surface, mesh) with colours, and face
+ * adjacency.
  *
  * The scene is a set of flat arrays of fixed-size records that reference one pool of doubles by
  * offset. The same arrays are built in memory (sw_sg_builder, used by importers and generators) or
@@ -85,11 +86,28 @@ typedef struct sw_sg_curve_rec {
     uint64_t knots, cpw; /* pool offsets: n+degree+1 and n*3 doubles */
 } sw_sg_curve_rec;
 
+/* A triangle mesh given as such (issue 7's mesh nodes): drawn as it is, not tessellated, so it has
+ * no error bound of its own. Offsets: positions and normals in the double pool, indices in the
+ * INDICES section (u32 each). */
+#define SW_SG_NO_NORMALS UINT64_MAX
+typedef struct sw_sg_mesh_rec {
+    uint32_t n_vertices, n_triangles;
+    uint64_t positions; /* pool offset of n_vertices * 3 doubles (x, y, z) */
+    uint64_t normals;   /* pool offset of n_vertices * 3 doubles, or SW_SG_NO_NORMALS: each
+                           triangle is shaded flat with its own normal */
+    uint64_t indices;   /* INDICES offset of n_triangles * 3 vertex indices, each < n_vertices;
+                           counter-clockwise seen from the front */
+    uint32_t flags;     /* zero (none is defined) */
+    uint32_t reserved;  /* zero */
+    double box[6];      /* min xyz, max xyz of the positions, exactly (validated) */
+} sw_sg_mesh_rec;
+
 typedef enum sw_sg_node_kind {
     SW_SG_NODE_GROUP = 0,     /* children, identity transform */
     SW_SG_NODE_TRANSFORM = 1, /* children under xform */
     SW_SG_NODE_INSTANCE = 2,  /* draws the subtree of node `ref` under xform */
     SW_SG_NODE_SURFACE = 3,   /* draws face `ref` under xform */
+    SW_SG_NODE_MESH = 4,      /* draws mesh `ref` under xform */
 } sw_sg_node_kind;
 
 typedef struct sw_sg_node_rec {
@@ -115,7 +133,10 @@ typedef enum sw_sg_section {
     SW_SG_SEC_ADJACENCY = 1u << 4,
     SW_SG_SEC_POOL = 1u << 5,
     SW_SG_SEC_STRINGS = 1u << 6,
-    SW_SG_SEC_ALL = (1u << 7) - 1,
+    /* bits 7 and 8 are META and LODS, which have none */
+    SW_SG_SEC_MESHES = 1u << 9,
+    SW_SG_SEC_INDICES = 1u << 10,
+    SW_SG_SEC_ALL = ((1u << 7) - 1) | SW_SG_SEC_MESHES | SW_SG_SEC_INDICES,
 } sw_sg_section;
 
 typedef struct sw_sg_scene sw_sg_scene; /* opaque; arrays read through the accessors below */
@@ -132,6 +153,10 @@ typedef struct sw_sg_scene_view {
     uint32_t n_faces, n_loops, n_curves, n_nodes, n_adjacency;
     uint64_t n_pool, n_strings;
     uint32_t root; /* node the scene is drawn from */
+    const sw_sg_mesh_rec *meshes;
+    const uint32_t *indices;
+    uint32_t n_meshes;
+    uint64_t n_indices;
 } sw_sg_scene_view;
 
 const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene);
@@ -165,6 +190,18 @@ typedef int (*sw_sg_visit_fn)(void *ctx, uint32_t face, const double world[12],
  * SW_OK (also when the visitor stopped it) or SW_ERR_OUT_OF_MEMORY when its stack could not grow,
  * in which case some occurrences were not visited. */
 sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx);
+/* The same walk for mesh occurrences: `node` is the MESH node drawing mesh `mesh`. Returns as
+ * sw_sg_scene_traverse. Costs a walk of every node: callers skip it when n_meshes is 0. */
+typedef int (*sw_sg_mesh_visit_fn)(void *ctx, uint32_t mesh, uint32_t node, const double world[12],
+                                   const float color[4]);
+sw_result sw_sg_scene_traverse_meshes(const sw_sg_scene *scene, sw_sg_mesh_visit_fn visit,
+                                      void *ctx);
+/* The box (min xyz, max xyz) of n points (3 doubles each); n = 0 gives an empty box (min > max). */
+void sw_sg_mesh_box(const double *positions, uint32_t n, double box[6]);
+/* Borrowed arrays of mesh `mesh` (index valid): positions (3 per vertex), normals (NULL: flat)
+ * and its 3 * n_triangles indices. */
+void sw_sg_scene_mesh(const sw_sg_scene *scene, uint32_t mesh, const double **positions,
+                      const double **normals, const uint32_t **indices);
 
 /* ---- building -------------------------------------------------------------------------------- */
 typedef struct sw_sg_builder sw_sg_builder;
@@ -180,6 +217,12 @@ uint32_t sw_sg_builder_add_face(sw_sg_builder *b, const sw_sg_face_rec *face);
 uint32_t sw_sg_builder_add_loop(sw_sg_builder *b, const sw_sg_loop_rec *loop);
 uint32_t sw_sg_builder_add_curve(sw_sg_builder *b, const sw_sg_curve_rec *curve);
 uint32_t sw_sg_builder_add_adjacency(sw_sg_builder *b, uint32_t face_a, uint32_t face_b);
+/* Appends vertex indices to the INDICES section; returns their offset, or UINT64_MAX. */
+uint64_t sw_sg_builder_push_indices(sw_sg_builder *b, const uint32_t *indices, size_t count);
+/* A mesh whose arrays were pushed: its box is computed here from the positions (rec->box is
+ * ignored). Returns the new index, or SW_SG_NONE when out of memory. Offsets are checked by
+ * sw_sg_builder_finish (precondition here: the positions lie inside the pool). */
+uint32_t sw_sg_builder_add_mesh(sw_sg_builder *b, const sw_sg_mesh_rec *mesh);
 /* Adds a node as the last child of `parent` (SW_SG_NONE: a detached node, e.g. a prototype);
  * links parent/first_child/next_sibling itself. xform NULL = identity, color NULL = inherit. */
 uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind, uint32_t parent,
@@ -225,8 +268,13 @@ typedef struct sw_sg_scene_stats {
     uint32_t nodes, instances;
     uint64_t face_occurrences; /* faces drawn after instance expansion */
     uint32_t adjacency;
-    double bbox[6];            /* world box of the faces sampled over their trim boxes */
+    double bbox[6]; /* world box of the faces sampled over their trim boxes, and of
+                       the meshes' vertices */
     size_t memory_bytes;
+    uint32_t meshes;
+    uint64_t mesh_triangles;       /* of the meshes, each counted once */
+    uint64_t mesh_occurrences;     /* meshes drawn after instance expansion */
+    uint64_t triangle_occurrences; /* their triangles, instances expanded */
 } sw_sg_scene_stats;
 /* Precondition: SW_SG_SEC_ALL required. Returns SW_OK or SW_ERR_OUT_OF_MEMORY (traversal). */
 sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out);

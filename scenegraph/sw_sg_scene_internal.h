@@ -8,7 +8,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Sections in .sws order; index i is bit (1 << i) of sw_sg_section, META has no bit. */
+/* Sections in .sws order (the index is the file's section id); index i is bit (1 << i) of
+ * sw_sg_section. META and LODS are no arrays of the view and have no bit: META is read at open,
+ * LODS is an opaque cache (sws_file.c). */
 enum {
     SW__SG_SEC_FACES,
     SW__SG_SEC_LOOPS,
@@ -18,8 +20,17 @@ enum {
     SW__SG_SEC_POOL,
     SW__SG_SEC_STRINGS,
     SW__SG_SEC_META,
+    SW__SG_SEC_LODS,
+    SW__SG_SEC_MESHES,
+    SW__SG_SEC_INDICES,
     SW__SG_SEC_COUNT
 };
+
+/* Whether section s is one of the view's arrays (all but META and LODS). */
+static inline int sw__sg_is_array_section(int s)
+{
+    return s != SW__SG_SEC_META && s != SW__SG_SEC_LODS;
+}
 
 /* Names and record sizes of the sections, indexed as above. */
 extern const char *const sw__sg_section_names[SW__SG_SEC_COUNT];
@@ -37,8 +48,8 @@ struct sw_sg_scene {
     size_t owned_bytes;
     void *map; /* mapped file, NULL in memory */
     size_t map_size;
-    sw__sg_section_info sec[SW__SG_SEC_COUNT]; /* mapped only */
-    sw__sg_section_info lods;  /* mapped only: the optional LODS section (size 0: none) */
+    sw__sg_section_info sec[SW__SG_SEC_COUNT]; /* mapped only; sec[SW__SG_SEC_LODS] is the
+                                                  optional LODS section (size 0: none) */
     uint32_t verified;         /* sections whose checksum matched (sw_sg_section bits) */
     int validated;             /* 1 once sw_sg_scene_validate passed, -1 once it failed */
     sw_status validate_status; /* the failure, repeated to later callers */
@@ -49,7 +60,7 @@ struct sw_sg_scene {
 sw_result sw__sg_scene_validate_at(const sw_sg_scene_view *view, const char *what,
                                    const sw__sg_section_info *sec, sw_status *status);
 
-/* Pointer and byte size of section s of a view (s < SW__SG_SEC_META). */
+/* Pointer and byte size of array section s of a view (sw__sg_is_array_section). */
 const void *sw__sg_view_section(const sw_sg_scene_view *view, int s, uint64_t *bytes,
                                 uint64_t *count);
 

@@ -8,7 +8,7 @@
  *   0       8     magic "SWSCENE\0"
  *   8       4     version = 1
  *   12      4     flags = 0
- *   16      4     section count = 8, or 9 with the optional LODS section
+ *   16      4     section count = 8, 9 with the optional LODS section, 11 with meshes
  *   20      4     header size = 64
  *   24      8     total file size in bytes
  *   32      8     offset of the section table (16-byte aligned, >= 64)
@@ -19,7 +19,8 @@
  *   section table entry (40 bytes):
  *   0  u32 id (0 FACES, 1 LOOPS, 2 CURVES, 3 NODES, 4 ADJACENCY, 5 POOL, 6 STRINGS, 7 META,
  *            8 LODS: optional, the static-LOD cache, opaque bytes with their own format owned by
- *            lod/static_lod_io.c; only when the count is 9)
+ *            lod/static_lod_io.c; only when the count is 9 or 11, and may be empty with 11;
+ *            9 MESHES, 10 INDICES: triangle meshes, only when the count is 11)
  *   4  u32 reserved, zero
  *   8  u64 offset of the section (16-byte aligned, after the table, sections do not overlap)
  *   16 u64 size in bytes = element count * record size
@@ -28,7 +29,9 @@
  *   36 u32 reserved, zero
  *
  *   record sizes: FACES 96 (sw_sg_face_rec), LOOPS 16, CURVES 24, NODES 136, ADJACENCY 8,
- *   POOL 8 (double), STRINGS 1 (char; the last one NUL), META 16 (u32 root node, 12 zero bytes).
+ *   POOL 8 (double), STRINGS 1 (char; the last one NUL), META 16 (u32 root node, 12 zero bytes),
+ *   MESHES 88 (sw_sg_mesh_rec), INDICES 4 (u32). A scene without meshes is written with 8 or 9
+ *   sections, byte for byte as before the mesh sections existed.
  *   Padding between sections is zero. The file ends where its last section ends.
  *
  * Open checks everything up to the section table (and META, 16 bytes) and that the file is as
@@ -59,6 +62,8 @@ _Static_assert(sizeof(sw_sg_curve_rec) == 24, "curve record layout is part of th
 _Static_assert(sizeof(sw_sg_node_rec) == 136 && offsetof(sw_sg_node_rec, xform) == 40,
                "node record layout is part of the .sws format");
 _Static_assert(sizeof(sw_sg_adjacency_rec) == 8, "adjacency layout is part of the .sws format");
+_Static_assert(sizeof(sw_sg_mesh_rec) == 88 && offsetof(sw_sg_mesh_rec, box) == 40,
+               "mesh record layout is part of the .sws format");
 _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/binary32");
 
 #define SWS_MAGIC "SWSCENE"
@@ -67,8 +72,10 @@ _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/bin
 #define SWS_ENTRY_SIZE 40u
 #define SWS_ALIGN 16u
 #define SWS_HEADER_CRC_AT 60u
-#define SWS_SEC_LODS SW__SG_SEC_COUNT       /* id of the optional section */
-#define SWS_MAX_SECTIONS (SW__SG_SEC_COUNT + 1)
+#define SWS_SEC_LODS SW__SG_SEC_LODS      /* id of the optional cache section */
+#define SWS_CORE_SECTIONS 8u              /* FACES .. META: every file has them */
+#define SWS_LODS_SECTIONS 9u              /* and LODS */
+#define SWS_MAX_SECTIONS SW__SG_SEC_COUNT /* and MESHES, INDICES (LODS then possibly empty) */
 
 typedef struct sws_header {
     uint32_t version, flags, section_count, header_size;
@@ -114,9 +121,9 @@ sw_result sw_sg_scene_require(sw_sg_scene *scene, uint32_t sections, sw_status *
         sw__status_ok(status);
         return SW_OK;
     }
-    for (int s = 0; s < SW__SG_SEC_META; s++) {
+    for (int s = 0; s < SW__SG_SEC_COUNT; s++) {
         uint32_t bit = 1u << s;
-        if (!(sections & bit) || (scene->verified & bit))
+        if (!sw__sg_is_array_section(s) || !(sections & bit) || (scene->verified & bit))
             continue;
         const sw__sg_section_info *e = &scene->sec[s];
         uint32_t crc = sw__crc32c(0, (const unsigned char *)scene->map + e->offset, e->size);
@@ -184,11 +191,16 @@ static void read_header(const unsigned char *p, sws_header *h)
 
 /* The table's place in the file, the header checksum (before the other fields, so a flipped
  * header byte reads as corruption), the fields, then the file size. */
+static int section_count_ok(uint32_t n)
+{
+    return n == SWS_CORE_SECTIONS || n == SWS_LODS_SECTIONS || n == SWS_MAX_SECTIONS;
+}
+
 static sw_result check_header(const char *path, const unsigned char *p, uint64_t size,
                               const sws_header *h, sw_status *status)
 {
     const uint32_t n_sec =
-        h->section_count == SWS_MAX_SECTIONS ? SWS_MAX_SECTIONS : SW__SG_SEC_COUNT;
+        section_count_ok(h->section_count) ? h->section_count : SWS_CORE_SECTIONS;
     const uint64_t table_bytes = (uint64_t)n_sec * SWS_ENTRY_SIZE;
     if (h->table_offset < SWS_HEADER_SIZE || h->table_offset % SWS_ALIGN ||
         h->table_offset > h->file_size || table_bytes > h->file_size - h->table_offset)
@@ -210,13 +222,13 @@ static sw_result check_header(const char *path, const unsigned char *p, uint64_t
                         "0x%08x)",
                         path, h->header_crc, crc);
     if (h->flags != 0 || h->header_size != SWS_HEADER_SIZE || h->entry_size != SWS_ENTRY_SIZE ||
-        (h->section_count != SW__SG_SEC_COUNT && h->section_count != SWS_MAX_SECTIONS) ||
-        !h->reserved_zero)
+        !section_count_ok(h->section_count) || !h->reserved_zero)
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: header at offset 12: flags 0x%x, %u sections, header size %u, entry "
-                        "size %u (expected 0, %u or %u, %u, %u, reserved zero)",
+                        "size %u (expected 0, %u, %u or %u, %u, %u, reserved zero)",
                         path, h->flags, h->section_count, h->header_size, h->entry_size,
-                        SW__SG_SEC_COUNT, SWS_MAX_SECTIONS, SWS_HEADER_SIZE, SWS_ENTRY_SIZE);
+                        SWS_CORE_SECTIONS, SWS_LODS_SECTIONS, SWS_MAX_SECTIONS, SWS_HEADER_SIZE,
+                        SWS_ENTRY_SIZE);
     if (h->file_size > size)
         return sw__fail(status, SW_ERR_TRUNCATED,
                         "%s: offset %llu: file is %llu bytes, its section table says %llu", path,
@@ -237,14 +249,15 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
 {
     uint32_t id = rd32(ent);
     uint64_t off = rd64(ent + 8), sz = rd64(ent + 16), count = rd64(ent + 24);
-    /* ids below n_sec, each once: with 8 sections the core ones, with 9 also LODS */
+    /* ids below n_sec, each once: with 8 sections the core ones, with 9 also LODS, with 11 also
+     * MESHES and INDICES */
     if (id >= n_sec || (*seen & (1u << id)) || rd32(ent + 4) || rd32(ent + 36))
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: section table entry at offset %llu: unknown or repeated id %u", path,
                         (unsigned long long)ent_off, id);
     const int lods = id == SWS_SEC_LODS;
-    const char *name = lods ? "LODS" : sw__sg_section_names[id];
-    const uint64_t rec = lods ? 1 : sw__sg_section_record_size[id];
+    const char *name = sw__sg_section_names[id];
+    const uint64_t rec = sw__sg_section_record_size[id];
     if (off % SWS_ALIGN || off < data_start || off > file_size || sz > file_size - off)
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: section %s (table entry at offset %llu): offset %llu, size %llu "
@@ -252,9 +265,11 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
                         path, name, (unsigned long long)ent_off, (unsigned long long)off,
                         (unsigned long long)sz, (unsigned long long)data_start,
                         (unsigned long long)file_size);
-    uint64_t max_count = id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS || lods ? UINT64_MAX
-                         : id == SW__SG_SEC_META                           ? 1
-                                                                           : SW_SG_NONE - 1;
+    uint64_t max_count =
+        id == SW__SG_SEC_POOL || id == SW__SG_SEC_STRINGS || id == SW__SG_SEC_INDICES || lods
+            ? UINT64_MAX
+        : id == SW__SG_SEC_META ? 1
+                                : SW_SG_NONE - 1;
     if (count > max_count || count > UINT64_MAX / rec || count * rec != sz ||
         (id == SW__SG_SEC_META && count != 1))
         return sw__fail(status, SW_ERR_FORMAT,
@@ -276,10 +291,8 @@ static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec
                 y->offset < x->offset + x->size)
                 return sw__fail(status, SW_ERR_FORMAT,
                                 "%s: section %s at offset %llu overlaps section %s at offset %llu",
-                                path, a == SWS_SEC_LODS ? "LODS" : sw__sg_section_names[a],
-                                (unsigned long long)x->offset,
-                                b == SWS_SEC_LODS ? "LODS" : sw__sg_section_names[b],
-                                (unsigned long long)y->offset);
+                                path, sw__sg_section_names[a], (unsigned long long)x->offset,
+                                sw__sg_section_names[b], (unsigned long long)y->offset);
         }
     return SW_OK;
 }
@@ -302,7 +315,8 @@ static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status 
     if (r != SW_OK)
         return r;
     memcpy(scene->sec, sec, sizeof scene->sec);
-    scene->lods = sec[SWS_SEC_LODS];
+    if (n_sec < SWS_MAX_SECTIONS) /* a file without meshes: the empty sections need no check */
+        scene->verified |= SW_SG_SEC_MESHES | SW_SG_SEC_INDICES;
     /* META is 16 bytes: verified here, as the root is part of the view. */
     const sw__sg_section_info *m = &scene->sec[SW__SG_SEC_META];
     uint32_t crc = sw__crc32c(0, p + m->offset, m->size);
@@ -337,6 +351,10 @@ static void map_view(sw_sg_scene *scene)
     v->n_adjacency = (uint32_t)s[SW__SG_SEC_ADJACENCY].count;
     v->n_pool = s[SW__SG_SEC_POOL].count;
     v->n_strings = s[SW__SG_SEC_STRINGS].count;
+    v->meshes = (const sw_sg_mesh_rec *)(const void *)(p + s[SW__SG_SEC_MESHES].offset);
+    v->indices = (const uint32_t *)(const void *)(p + s[SW__SG_SEC_INDICES].offset);
+    v->n_meshes = (uint32_t)s[SW__SG_SEC_MESHES].count;
+    v->n_indices = s[SW__SG_SEC_INDICES].count;
 }
 
 /* open + fstat + mmap; the descriptor is closed before returning. */
@@ -422,7 +440,8 @@ static int write_all(int fd, const void *data, uint64_t n)
     return 1;
 }
 
-/* Header, table and META for a scene's view and n_sec sections (the 9th: lods, lods_bytes);
+/* Header, table and META for a scene's view and n_sec sections (the 9th: lods, lods_bytes, maybe
+ * empty when there are 11);
  * fills the section offsets and the file size. */
 static void build_header(const sw_sg_scene_view *v, uint32_t n_sec, const void *lods,
                          uint64_t lods_bytes, const void *ptr[SWS_MAX_SECTIONS],
@@ -506,7 +525,7 @@ sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *
 {
     *data = NULL;
     *size = 0;
-    const sw__sg_section_info *e = &scene->lods;
+    const sw__sg_section_info *e = &scene->sec[SWS_SEC_LODS];
     if (!scene->map || e->size == 0)
         return sw__fail(status, SW_ERR_NOT_FOUND, "%s: no LODS section", scene->path);
     const unsigned char *p = (const unsigned char *)scene->map + e->offset;
@@ -526,7 +545,7 @@ sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *stat
 {
     const void *lods = NULL;
     size_t lods_size = 0;
-    if (scene->map && scene->lods.size) {
+    if (scene->map && scene->sec[SWS_SEC_LODS].size) {
         sw_result r = sw_sg_scene_lods(scene, &lods, &lods_size, status);
         if (r != SW_OK)
             return r; /* a corrupt LODS section is not rewritten with a fresh checksum either */
@@ -542,13 +561,16 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
     sw_result r = sw_sg_scene_require(scene, SW_SG_SEC_ALL, status);
     if (r != SW_OK)
         return r;
-    const uint32_t n_sec = lods && lods_size ? SWS_MAX_SECTIONS : SW__SG_SEC_COUNT;
+    const uint32_t n_sec = scene->view.n_meshes ? SWS_MAX_SECTIONS
+                           : lods && lods_size  ? SWS_LODS_SECTIONS
+                                                : SWS_CORE_SECTIONS;
     enum { HEAD = SWS_HEADER_SIZE + SWS_MAX_SECTIONS * SWS_ENTRY_SIZE };
     const uint64_t head_bytes = SWS_HEADER_SIZE + (uint64_t)n_sec * SWS_ENTRY_SIZE;
     unsigned char head[HEAD], meta[16];
     const void *ptr[SWS_MAX_SECTIONS];
     uint64_t file_size;
-    build_header(&scene->view, n_sec, lods, lods_size, ptr, meta, head, head_bytes, &file_size);
+    build_header(&scene->view, n_sec, lods, lods ? lods_size : 0, ptr, meta, head, head_bytes,
+                 &file_size);
 
     size_t tlen = strlen(path) + 32;
     char *tmp = sw__malloc(tlen);

@@ -31,6 +31,7 @@
 #include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 enum {
@@ -73,6 +74,14 @@ typedef struct worker {
     /* Written by the owner only (load + store), read by sw_th_pool_stats_get. */
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t executed;
     _Atomic uint64_t cancelled, steals, stolen, sleeps;
+    _Atomic uint64_t kind_executed[SW_TH_TASK_KIND_COUNT];
+    /* Timed tasks' own time: kind_ns (ended segments) and the segment running now (seg_kind,
+     * SW_TH_TASK_KIND_COUNT for none, since seg_start), under the seqlock seg_seq (odd while the
+     * owner updates them) so that a reader adds the running segment to a consistent total. */
+    _Atomic uint64_t seg_seq;
+    _Atomic uint64_t kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic uint32_t seg_kind;
+    _Atomic uint64_t seg_start;
 } worker;
 
 struct sw_th_pool {
@@ -88,6 +97,10 @@ struct sw_th_pool {
     alignas(SW_TH_CACHE_LINE) _Atomic(node *) spare[SPARE_SLOTS];
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t ext_executed;
     _Atomic uint64_t ext_cancelled, ext_steals;
+    _Atomic uint64_t ext_kind_executed[SW_TH_TASK_KIND_COUNT], ext_kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic int time_tasks;      /* read per task (relaxed): a switch, it orders nothing */
+    _Atomic int64_t inject_peak; /* longest injection queue a submission made since the last
+                                    sw_th_pool_inject_peak_take */
     pthread_mutex_t lock;
     pthread_cond_t wake_cond;
     int wakes; /* under lock */
@@ -95,6 +108,10 @@ struct sw_th_pool {
 
 static _Thread_local worker *tls_worker;
 static _Thread_local uint64_t tls_rng;
+/* The calling thread's running segment of timed task time: the kind of its innermost timed task
+ * (SW_TH_TASK_KIND_COUNT: none) and since when it runs uninterrupted by a nested task. */
+static _Thread_local uint32_t tls_seg_kind = SW_TH_TASK_KIND_COUNT;
+static _Thread_local uint64_t tls_seg_start;
 
 static void cpu_relax(void)
 {
@@ -196,12 +213,26 @@ static void inject_link(inject_queue *q, node *n)
     atomic_store_explicit(&prev->next, n, memory_order_release);
 }
 
-static void inject_push(inject_queue *q, node *n)
+/* Returns the queue's length with n (its count just after the increment). */
+static int64_t inject_push(inject_queue *q, node *n)
 {
     /* seq_cst, and before linking: a worker about to sleep that sees count > 0 keeps searching
      * (the Dekker pair of the sleep protocol, file comment). */
-    atomic_fetch_add_explicit(&q->count, 1, memory_order_seq_cst);
+    const int64_t len = atomic_fetch_add_explicit(&q->count, 1, memory_order_seq_cst) + 1;
     inject_link(q, n);
+    return len;
+}
+
+/* Raises inject_peak to len. relaxed: a statistic; the load first, so a submitter writes the
+ * shared line only while the queue grows past the mark. */
+static void record_inject_peak(sw_th_pool *pool, int64_t len)
+{
+    int64_t peak = atomic_load_explicit(&pool->inject_peak, memory_order_relaxed);
+    while (len > peak &&
+           !atomic_compare_exchange_weak_explicit(&pool->inject_peak, &peak, len,
+                                                  memory_order_relaxed, memory_order_relaxed)) {
+        /* the failed CAS reloaded peak */
+    }
 }
 
 /* Holder of q->busy only. NULL when empty or while a producer is between exchange and link. */
@@ -290,7 +321,7 @@ static bool work_visible(sw_th_pool *pool)
 static void push_or_inject(sw_th_pool *pool, worker *w, int prio, node *n)
 {
     if (sw_th_deque_push_owner(&w->deques[prio], n) != SW_OK)
-        inject_push(&pool->inject[prio], n);
+        (void)inject_push(&pool->inject[prio], n);
 }
 
 static node *take_injected(sw_th_pool *pool, worker *w, int prio)
@@ -397,6 +428,72 @@ static void group_release(sw_th_pool *pool, sw_th_group *g)
     pthread_mutex_unlock(&pool->lock);
 }
 
+static uint64_t now_ns(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
+}
+
+/* Ends the calling thread's running segment (its time goes to the segment's kind) and starts one
+ * of kind `to` (SW_TH_TASK_KIND_COUNT: none). A worker publishes both under its seqlock; a thread
+ * outside the pool (waiting on a group) adds the ended segment to the pool's shared totals.
+ * Writer side of the seqlock: the odd store, then release stores of the data (a reader that
+ * acquires any of them also sees the odd count), then the even store (release). The clock is
+ * read after the odd store, so that a reader that saw the old state consistently read its own
+ * clock before this segment's end, up to a store buffer's delay. */
+static void switch_segment(sw_th_pool *pool, worker *w, uint32_t to)
+{
+    const uint32_t from = tls_seg_kind;
+    if (!w) {
+        const uint64_t now = now_ns();
+        if (from < SW_TH_TASK_KIND_COUNT)
+            atomic_fetch_add_explicit(&pool->ext_kind_ns[from], now - tls_seg_start,
+                                      memory_order_relaxed);
+        tls_seg_kind = to;
+        tls_seg_start = now;
+        return;
+    }
+    const uint64_t seq = atomic_load_explicit(&w->seg_seq, memory_order_relaxed);
+    atomic_store_explicit(&w->seg_seq, seq + 1, memory_order_relaxed);
+    const uint64_t now = now_ns();
+    if (from < SW_TH_TASK_KIND_COUNT)
+        atomic_store_explicit(&w->kind_ns[from],
+                              atomic_load_explicit(&w->kind_ns[from], memory_order_relaxed) + now -
+                                  tls_seg_start,
+                              memory_order_release);
+    atomic_store_explicit(&w->seg_kind, to, memory_order_release);
+    atomic_store_explicit(&w->seg_start, now, memory_order_release);
+    atomic_store_explicit(&w->seg_seq, seq + 2, memory_order_release);
+    tls_seg_kind = to;
+    tls_seg_start = now;
+}
+
+/* Runs t timed. Its time is counted in segments: a task that runs others nested (waiting on a
+ * group) pauses its own for theirs, so the kinds add up to the thread's busy time instead of
+ * counting nested work twice; and a reader sees a running task's time so far, not only once it
+ * ends (a static LOD build takes seconds: its time shows in the frames it spans). */
+static void timed_run(sw_th_pool *pool, worker *w, const sw_th_task *t)
+{
+    const uint32_t outer = tls_seg_kind;
+    switch_segment(pool, w, (uint32_t)t->kind);
+    t->fn(t->ctx);
+    switch_segment(pool, w, outer);
+}
+
+/* Counts a task that ran: on the worker's single-writer counters, or (a thread outside the pool
+ * waiting on a group) on the pool's shared ones. */
+static void count_executed(sw_th_pool *pool, worker *w, sw_th_task_kind kind)
+{
+    if (w) {
+        bump(&w->executed, 1);
+        bump(&w->kind_executed[kind], 1);
+        return;
+    }
+    atomic_fetch_add_explicit(&pool->ext_executed, 1, memory_order_relaxed);
+    atomic_fetch_add_explicit(&pool->ext_kind_executed[kind], 1, memory_order_relaxed);
+}
+
 static void run_node(sw_th_pool *pool, worker *w, node *n)
 {
     sw_th_task t = n->task;
@@ -404,13 +501,19 @@ static void run_node(sw_th_pool *pool, worker *w, node *n)
     /* acquire: pairs with the release increment in sw_th_token_cancel. */
     bool stale =
         t.token && atomic_load_explicit(&t.token->generation, memory_order_acquire) != t.generation;
-    if (!stale)
-        t.fn(t.ctx);
-    if (w)
-        bump(stale ? &w->cancelled : &w->executed, 1);
-    else
-        atomic_fetch_add_explicit(stale ? &pool->ext_cancelled : &pool->ext_executed, 1,
-                                  memory_order_relaxed);
+    if (stale) {
+        if (w)
+            bump(&w->cancelled, 1);
+        else
+            atomic_fetch_add_explicit(&pool->ext_cancelled, 1, memory_order_relaxed);
+    } else {
+        /* relaxed: a switch; a task that starts just after it flips may go either way */
+        if (atomic_load_explicit(&pool->time_tasks, memory_order_relaxed))
+            timed_run(pool, w, &t);
+        else
+            t.fn(t.ctx);
+        count_executed(pool, w, t.kind);
+    }
     if (t.group)
         group_release(pool, t.group);
 }
@@ -589,6 +692,7 @@ static sw_result pool_init_workers(sw_th_pool *pool, const sw_th_pool_desc *d)
         worker *w = &pool->workers[i];
         w->pool = pool;
         w->index = i;
+        atomic_store_explicit(&w->seg_kind, SW_TH_TASK_KIND_COUNT, memory_order_relaxed);
         w->rng = (uint64_t)d->seed * 0x9e3779b97f4a7c15u + i + 1;
         for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++)
             if (sw_th_deque_init_owner(&w->deques[p], d->deque_capacity) != SW_OK)
@@ -619,6 +723,7 @@ sw_result sw_th_pool_create(const sw_th_pool_desc *desc, sw_th_pool **out)
     pool->count = d.worker_count;
     pool->mode = d.steal_mode;
     pool->spin_rounds = d.spin_rounds;
+    atomic_store_explicit(&pool->time_tasks, d.time_tasks != 0, memory_order_relaxed);
     for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++) {
         inject_queue *q = &pool->inject[p];
         atomic_init(&q->head, &q->stub);
@@ -657,6 +762,7 @@ sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task)
 {
     assert(pool && task && task->fn);
     assert((unsigned)task->priority < SW_TH_PRIORITY_COUNT);
+    assert((unsigned)task->kind < SW_TH_TASK_KIND_COUNT);
     worker *w = own_worker(pool);
     node *n = node_alloc(pool, w);
     if (!n)
@@ -674,7 +780,7 @@ sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task)
             return SW_ERR_OUT_OF_MEMORY;
         }
     } else {
-        inject_push(&pool->inject[task->priority], n);
+        record_inject_peak(pool, inject_push(&pool->inject[task->priority], n));
     }
     notify(pool);
     return SW_OK;
@@ -740,6 +846,33 @@ int sw_th_pool_current_worker(const sw_th_pool *pool)
     return w ? (int)w->index : -1;
 }
 
+/* Adds worker w's timed task time to ns[]: its ended segments and the one running now. Reader
+ * side of the seqlock (switch_segment): an even count, acquire loads of the data, the count
+ * again (the acquire loads keep it after them); retried only while the owner is mid-update. */
+static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_COUNT])
+{
+    uint64_t total[SW_TH_TASK_KIND_COUNT], start, seq;
+    uint32_t kind;
+    for (;;) {
+        seq = atomic_load_explicit(&w->seg_seq, memory_order_acquire);
+        if (seq & 1) {
+            cpu_relax();
+            continue;
+        }
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+            total[k] = atomic_load_explicit(&w->kind_ns[k], memory_order_acquire);
+        kind = atomic_load_explicit(&w->seg_kind, memory_order_acquire);
+        start = atomic_load_explicit(&w->seg_start, memory_order_acquire);
+        if (atomic_load_explicit(&w->seg_seq, memory_order_relaxed) == seq)
+            break;
+    }
+    const uint64_t now = now_ns();
+    if (kind < SW_TH_TASK_KIND_COUNT && now > start)
+        total[kind] += now - start;
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+        ns[k] += total[k];
+}
+
 void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out)
 {
     memset(out, 0, sizeof *out);
@@ -750,9 +883,56 @@ void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out)
         out->steals += atomic_load_explicit(&w->steals, memory_order_relaxed);
         out->stolen_tasks += atomic_load_explicit(&w->stolen, memory_order_relaxed);
         out->sleeps += atomic_load_explicit(&w->sleeps, memory_order_relaxed);
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+            out->executed_by_kind[k] +=
+                atomic_load_explicit(&w->kind_executed[k], memory_order_relaxed);
+        add_task_time(w, out->ns_by_kind);
+    }
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        out->executed_by_kind[k] +=
+            atomic_load_explicit(&pool->ext_kind_executed[k], memory_order_relaxed);
+        out->ns_by_kind[k] += atomic_load_explicit(&pool->ext_kind_ns[k], memory_order_relaxed);
     }
     out->executed += atomic_load_explicit(&pool->ext_executed, memory_order_relaxed);
     out->cancelled += atomic_load_explicit(&pool->ext_cancelled, memory_order_relaxed);
     out->steals += atomic_load_explicit(&pool->ext_steals, memory_order_relaxed);
     out->stolen_tasks += atomic_load_explicit(&pool->ext_steals, memory_order_relaxed);
+}
+
+void sw_th_pool_set_task_timing(sw_th_pool *pool, int on)
+{
+    atomic_store_explicit(&pool->time_tasks, on != 0, memory_order_relaxed);
+}
+
+int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRIORITY_COUNT])
+{
+    int64_t total = 0;
+    for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++) {
+        /* relaxed: a statistic; the count of an injection queue may run ahead of its links
+         * (incremented before linking), which is what "submitted, not yet taken" means */
+        int64_t n = atomic_load_explicit(&pool->inject[p].count, memory_order_relaxed);
+        n = n > 0 ? n : 0;
+        for (uint32_t i = 0; i < pool->count; i++)
+            n += sw_th_deque_size_estimate(&pool->workers[i].deques[p]);
+        if (by_priority)
+            by_priority[p] = n;
+        total += n;
+    }
+    return total;
+}
+
+int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool)
+{
+    /* relaxed: a statistic; a submission racing with the reset counts in one period or the next */
+    return atomic_exchange_explicit(&pool->inject_peak, 0, memory_order_relaxed);
+}
+
+const char *sw_th_task_kind_name(sw_th_task_kind kind)
+{
+    static const char *const names[SW_TH_TASK_KIND_COUNT] = {
+#define SW_TH__KIND_NAME(a, id, name, what) name,
+        SW_TH_TASK_KINDS(SW_TH__KIND_NAME, ~)
+#undef SW_TH__KIND_NAME
+    };
+    return (unsigned)kind < SW_TH_TASK_KIND_COUNT ? names[kind] : "?";
 }

@@ -13,6 +13,14 @@
  * workers') before BACKGROUND ones. Cancellation: a task names a token and the token generation
  * it belongs to; sw_th_token_cancel bumps the generation, and a task whose generation went stale
  * is skipped (not run), counted, and still completes its group.
+ *
+ * Accounting (issue 5's profile): every task names a kind (what the renderer submits: hierarchy
+ * builds, refinements, static-LOD clustering, builds and retirement, scene compiles). Each worker
+ * counts the tasks of each kind it ran and, when timing is on (the desc's time_tasks or
+ * sw_th_pool_set_task_timing: two CLOCK_MONOTONIC reads per task, measurable on tasks of ~0.1 us,
+ * bench/steal --timing), the time it spent in them; single-writer counters, summed by any thread
+ * like the other statistics. sw_th_pool_queued counts the tasks waiting, and
+ * sw_th_pool_inject_peak_take the longest the injection queues grew.
  */
 #ifndef SPLINEWALK_SW_TH_POOL_H
 #define SPLINEWALK_SW_TH_POOL_H
@@ -53,6 +61,27 @@ typedef struct sw_th_group {
 
 typedef void (*sw_th_task_fn)(void *ctx);
 
+/* What a task does, for the pool's per-kind accounting only (scheduling ignores it). The table
+ * calls X(A, id, name, what) per kind, A passed through (a table nested in another's, like the
+ * profile's columns). The first, OTHER, is the zero default. */
+#define SW_TH_TASK_KINDS(X, A)                                                                     \
+    X(A, OTHER, "other", "tasks of no other kind")                                                 \
+    X(A, HIERARCHY, "hierarchy", "bicubic hierarchy builds (lod/hierarchy_cache.c)")               \
+    X(A, HIERARCHY_WAIT, "hierarchy_wait",                                                         \
+      "converged frames' tasks waiting for a hierarchy build (their own time, waits included)")    \
+    X(A, REFINE, "refine", "refinements below a hierarchy's leaves")                               \
+    X(A, STATIC_CLUSTER, "static_cluster", "super-surface clustering of a scene (static LODs)")    \
+    X(A, STATIC_BUILD, "static_build", "static LOD builds of one super-surface")                   \
+    X(A, STATIC_RETIRE, "static_retire", "freeing a retired set of static LODs")                   \
+    X(A, COMPILE, "compile", "node scenes' compile tasks")
+
+typedef enum sw_th_task_kind {
+#define SW_TH__KIND_ENUM(a, id, name, what) SW_TH_TASK_##id,
+    SW_TH_TASK_KINDS(SW_TH__KIND_ENUM, ~)
+#undef SW_TH__KIND_ENUM
+        SW_TH_TASK_KIND_COUNT
+} sw_th_task_kind;
+
 /* Copied at submission. Zero means default for every field but fn. */
 typedef struct sw_th_task {
     sw_th_task_fn fn;        /* required */
@@ -61,6 +90,7 @@ typedef struct sw_th_task {
     sw_th_token *token;      /* NULL: never stale. Else must outlive the task */
     uint64_t generation;     /* the token generation the task belongs to (sw_th_token_current) */
     sw_th_group *group;      /* NULL: none. Counted at submission, released after fn */
+    sw_th_task_kind kind;    /* 0 = OTHER; accounting only */
 } sw_th_task;
 
 typedef struct sw_th_pool_desc {
@@ -69,6 +99,7 @@ typedef struct sw_th_pool_desc {
     uint32_t spin_rounds;        /* failed searches before sleeping; 0: 64 */
     uint32_t deque_capacity;     /* initial slots per deque; 0: 256 */
     uint32_t seed;               /* victim selection; 0: 1 */
+    uint32_t time_tasks;         /* 1: time every task (sw_th_pool_stats.ns_by_kind); 0: off */
 } sw_th_pool_desc;
 
 typedef struct sw_th_pool_stats {
@@ -77,6 +108,13 @@ typedef struct sw_th_pool_stats {
     uint64_t steals;       /* successful steal operations (one or a batch) */
     uint64_t stolen_tasks; /* tasks moved by them */
     uint64_t sleeps;       /* times a worker blocked for lack of work */
+    uint64_t executed_by_kind[SW_TH_TASK_KIND_COUNT]; /* of executed, by sw_th_task.kind */
+    /* Time in the tasks of each kind while timing was on, ns: a task's own time, without that of
+     * the tasks it ran nested (in sw_th_group_wait), so the kinds add up to the busy time. A
+     * worker's running task counts up to the call (each sample is, up to a store buffer's delay,
+     * at least the one before); a thread outside the pool that runs tasks while waiting on a
+     * group adds its time when each of its task segments ends. */
+    uint64_t ns_by_kind[SW_TH_TASK_KIND_COUNT];
 } sw_th_pool_stats;
 
 /* Token. cancel makes every task of the older generations stale; returns the new generation. */
@@ -113,6 +151,19 @@ SW_API uint32_t sw_th_pool_worker_count(const sw_th_pool *pool);
 SW_API int sw_th_pool_current_worker(const sw_th_pool *pool);
 /* Sums of the workers' counters; approximate while tasks run, exact once the pool is idle. */
 SW_API void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out);
+/* Any thread: times the tasks that start from now on (on = 1) or stops timing them (0). */
+SW_API void sw_th_pool_set_task_timing(sw_th_pool *pool, int on);
+/* Any thread: tasks submitted and not yet taken to run (the injection queues and every worker's
+ * deques), in total and per priority into by_priority (may be NULL). A snapshot of counters
+ * read one after the other: approximate while tasks move, exact when the pool is quiescent. */
+SW_API int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRIORITY_COUNT]);
+/* Any thread: the longest an injection queue (tasks submitted from outside the pool, one queue
+ * per priority) grew by a submission since the previous call (or the pool's creation); resets
+ * it. A backlog the end-of-frame snapshot of sw_th_pool_queued misses when the workers catch up
+ * within the frame. */
+SW_API int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool);
+/* "hierarchy", ...; "?" for a value out of range. */
+SW_API const char *sw_th_task_kind_name(sw_th_task_kind kind);
 
 #ifdef __cplusplus
 }

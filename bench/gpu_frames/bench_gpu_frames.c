@@ -33,16 +33,9 @@ static double median(double *v, int n)
 
 static sw_gpu_camera iso_camera(const double b[6])
 {
+    static const double from[3] = {1, 1, 1}, up[3] = {0, 0, 1};
     sw_gpu_camera c;
-    memset(&c, 0, sizeof c);
-    double diag = sqrt(pow(b[3] - b[0], 2) + pow(b[4] - b[1], 2) + pow(b[5] - b[2], 2));
-    double dist = diag / (2.0 * tan(20.0 * M_PI / 180.0)) * 1.1;
-    for (int k = 0; k < 3; ++k) {
-        c.target[k] = 0.5 * (b[k] + b[3 + k]);
-        c.eye[k] = c.target[k] + dist / sqrt(3.0);
-    }
-    c.up[2] = 1.0;
-    c.fovy_deg = 40.0;
+    sw_gpu_camera_fit_box(b, from, up, &c);
     return c;
 }
 

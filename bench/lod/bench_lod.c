@@ -4,7 +4,9 @@
  * one process, each mode on its own renderer. Both are warmed up first: one converged pass with
  * static LODs (every level the path needs is built: static LOD building is preprocessing, as
  * `build-lod` does it) and one walkthrough pass each (hierarchies built, trim atlas filled). Prints
- * per mode the median and p99 frame time, triangles and static draws per frame, and the ratios.
+ * per mode the median and p99 frame time, the visibility thread's median time per frame (culling:
+ * with static LODs by the BVH of super-surface instances, level choice, tessellation), triangles
+ * and static draws per frame, and the ratios.
  *
  * usage: bench_lod [SCENE] [--frames N] [--passes P] [--size WxH] [--distance F]
  * SCENE defaults to the built-in default scene (occt-misc data); the path is an orbit fitted to
@@ -27,7 +29,7 @@ typedef struct bench {
 } bench;
 
 typedef struct mode_result {
-    double *ms;
+    double *ms, *vis; /* per frame: the submitting thread's time, the visibility thread's */
     int n;
     uint64_t triangles, static_drawn, static_faces, faces, fallbacks, waits;
 } mode_result;
@@ -45,8 +47,9 @@ static sw_frame_desc frame_at(const bench *b, int i, int statics, int walkthroug
     return f;
 }
 
-static void account(mode_result *res, const sw_frame_stats *fs)
+static void account(mode_result *res, int frame, const sw_frame_stats *fs)
 {
+    res->vis[res->n + frame] = fs->ms_visibility;
     res->triangles += fs->triangles;
     res->static_drawn += fs->static_drawn;
     res->static_faces += fs->static_faces;
@@ -75,7 +78,7 @@ static int pass(const bench *b, sw_renderer r, int statics, double *ms, mode_res
             goto fail;
         if (ms) {
             ms[i] = bench_now_ms() - t0;
-            account(res, &fs);
+            account(res, i, &fs);
         }
     }
     return 0;
@@ -109,9 +112,11 @@ static int build_static(const bench *b, sw_renderer r)
 static void report(const char *name, mode_result *res)
 {
     const double n = res->n > 0 ? res->n : 1;
-    printf("%-12s frames %d: median %.2f ms, p99 %.2f ms; per frame %.0f triangles, %.1f "
-           "super-surfaces static (%.1f of %.1f faces), fallback draws %.1f, pool waits %llu\n",
+    printf("%-12s frames %d: median %.2f ms, p99 %.2f ms (visibility thread median %.2f ms); per "
+           "frame %.0f triangles, %.1f super-surfaces static (%.1f of %.1f faces), fallback draws "
+           "%.1f, pool waits %llu\n",
            name, res->n, bench_quantile(res->ms, res->n, 0.5), bench_quantile(res->ms, res->n, 0.99),
+           bench_quantile(res->vis, res->n, 0.5),
            res->triangles / n, res->static_drawn / n, res->static_faces / n, res->faces / n,
            res->fallbacks / n, (unsigned long long)res->waits);
 }
@@ -125,7 +130,8 @@ static int run(bench *b)
     const size_t cap = (size_t)b->frames * (size_t)b->passes;
     for (int m = 0; m < 2; ++m) {
         res[m].ms = calloc(cap, sizeof(double));
-        if (!res[m].ms || sw_renderer_create(NULL, &r[m], &st) != SW_OK) {
+        res[m].vis = calloc(cap, sizeof(double));
+        if (!res[m].ms || !res[m].vis || sw_renderer_create(NULL, &r[m], &st) != SW_OK) {
             fprintf(stderr, "bench_lod: %s\n", st.message[0] ? st.message : "out of memory");
             return 1;
         }
@@ -145,6 +151,7 @@ static int run(bench *b)
         p99[m] = bench_quantile(res[m].ms, res[m].n, 0.99);
         sw_renderer_destroy(r[m]);
         free(res[m].ms);
+        free(res[m].vis);
     }
     printf("static on / off: median %.3f, p99 %.3f, triangles %.3f\n", median[0] / median[1],
            p99[0] / p99[1], (double)res[0].triangles / (double)(res[1].triangles ? res[1].triangles : 1));

@@ -4,15 +4,18 @@
  *  - fine:   a recursive binary tree of tasks (each spawns two children) with ~0.1 µs of work each;
  *  - coarse: one task spawning a flat loop of tasks with ~20 µs of work each (all work starts in
  *            one deque, so thieves must spread it).
- * Prints the median tasks/s over the repetitions.
+ * Prints the median tasks/s over the repetitions. With --timing the two columns are instead
+ * half-steal pools without and with per-task timing (sw_th_pool_desc.time_tasks: two
+ * CLOCK_MONOTONIC reads per task), the cost of the profile's pool_<kind>_ms columns.
  *
- * usage: bench_steal [MAX_WORKERS (default: 2 × cores)] [REPEATS (default 7)]
+ * usage: bench_steal [MAX_WORKERS (default: 2 × cores)] [REPEATS (default 7)] [--timing]
  */
 #include "sw_th_pool.h"
 
 #include <stdalign.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/resource.h>
 #include <time.h>
 #include <unistd.h>
@@ -123,14 +126,16 @@ static double median(double *v, int n)
 
 /* Median tasks/s of each mode. The two modes' runs alternate (each on its own pool; the idle one
  * sleeps), so that load from other processes falls on both alike. */
-static void measure(int coarse, uint32_t workers, int repeats, double rate[2], double cpu[2],
-                    double steals[2])
+static void measure(int coarse, uint32_t workers, int repeats, int timing, double rate[2],
+                    double cpu[2], double steals[2])
 {
     sw_th_pool *pools[2];
     double runs[2][64], cpus[2][64];
     for (int m = 0; m < 2; m++) {
         sw_th_pool_desc d = {.worker_count = workers,
-                             .steal_mode = m ? SW_TH_STEAL_MODE_HALF : SW_TH_STEAL_MODE_ONE};
+                             .steal_mode =
+                                 m || timing ? SW_TH_STEAL_MODE_HALF : SW_TH_STEAL_MODE_ONE,
+                             .time_tasks = timing && m};
         if (sw_th_pool_create(&d, &pools[m]) != SW_OK) {
             fprintf(stderr, "pool creation failed\n");
             exit(1);
@@ -162,10 +167,13 @@ int main(int argc, char **argv)
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int max_workers = argc > 1 ? atoi(argv[1]) : (int)(2 * (cores > 0 ? cores : 1));
     int repeats = argc > 2 ? atoi(argv[2]) : 7;
-    if (max_workers < 1 || max_workers > 256 || repeats < 1 || repeats > 64) {
-        fprintf(stderr, "usage: %s [MAX_WORKERS 1..256] [REPEATS 1..64]\n", argv[0]);
+    const int timing = argc > 3 && strcmp(argv[3], "--timing") == 0;
+    if (max_workers < 1 || max_workers > 256 || repeats < 1 || repeats > 64 ||
+        (argc > 3 && !timing) || argc > 4) {
+        fprintf(stderr, "usage: %s [MAX_WORKERS 1..256] [REPEATS 1..64] [--timing]\n", argv[0]);
         return 2;
     }
+    const char *a = timing ? "untimed" : "one", *b = timing ? "timed" : "half";
     printf("bench_steal: %ld cores, median of %d runs; the calling thread only polls\n", cores,
            repeats);
     printf("fine = binary task tree of depth %d (%u tasks, ~%d LCG steps each); "
@@ -173,12 +181,14 @@ int main(int argc, char **argv)
            FINE_DEPTH, (2u << FINE_DEPTH) - 1, FINE_WORK, COARSE_TASKS, COARSE_WORK);
     printf("%-8s %7s %10s %10s %8s | %10s %10s | %8s %8s\n", "", "", "tasks/s", "[M/s]", "",
            "CPU ns", "per task", "steals", "per run");
-    printf("%-8s %7s %10s %10s %8s | %10s %10s | %8s %8s\n", "workload", "workers", "one", "half",
-           "half/one", "one", "half", "one", "half");
+    if (timing)
+        printf("--timing: both columns steal half; 'timed' times every task (time_tasks = 1)\n");
+    printf("%-8s %7s %10s %10s %8s | %10s %10s | %8s %8s\n", "workload", "workers", a, b,
+           timing ? "timed/un" : "half/one", a, b, a, b);
     for (int coarse = 0; coarse <= 1; coarse++) {
         for (int w = 1; w <= max_workers; w++) {
             double rate[2], cpu[2], steals[2];
-            measure(coarse, (uint32_t)w, repeats, rate, cpu, steals);
+            measure(coarse, (uint32_t)w, repeats, timing, rate, cpu, steals);
             double one = rate[0], half = rate[1], s1 = steals[0], s2 = steals[1];
             printf("%-8s %7d %10.3f %10.3f %8.2f | %10.1f %10.1f | %8.0f %8.0f\n",
                    coarse ? "coarse" : "fine", w, 1e-6 * one, 1e-6 * half, half / one, cpu[0],

@@ -18,6 +18,7 @@ static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
 #define SW__NODES_MAX_POINTS (1u << 20)
 #define SW__NODES_MAX_LOOPS 65536u
+#define SW__NODES_MAX_MESH (1u << 24) /* vertices, and triangles, of one mesh */
 
 /* ---- the model's life --------------------------------------------------------------------------
  */
@@ -67,6 +68,7 @@ void sw_rt_nodes_scene_free(sw_rt_scene *scene)
         model_free(scene->model);
     sw_lod_face_cones_free(scene->prebuilt_cones);
     sw__free(scene->face_nodes);
+    sw__free(scene->mesh_nodes);
 }
 
 static void init_sentinel(rt_node *n, sw_node_kind kind)
@@ -498,6 +500,99 @@ static sw_result import_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status
     return r;
 }
 
+/* ---- meshes ---- */
+
+static sw_result check_mesh_desc(const sw_mesh_desc *d, sw_status *status)
+{
+    const char *fn = "mesh";
+    if (d->vertex_count < 3 || d->vertex_count > SW__NODES_MAX_MESH || d->triangle_count < 1 ||
+        d->triangle_count > SW__NODES_MAX_MESH)
+        return sw__fail(status, SW_ERR_LIMIT, "%s: %u vertices and %u triangles (3..%u and 1..%u)",
+                        fn, d->vertex_count, d->triangle_count, SW__NODES_MAX_MESH,
+                        SW__NODES_MAX_MESH);
+    if (!d->positions || !d->indices)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL positions or indices", fn);
+    for (uint32_t i = 0; i < d->vertex_count; i++) {
+        const double *p = d->positions + 3 * (size_t)i;
+        if (!all_finite(p, 3))
+            return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
+                            "%s: vertex %u: position (%g, %g, %g) is not finite", fn, i, p[0], p[1],
+                            p[2]);
+        const double *n = d->normals ? d->normals + 3 * (size_t)i : NULL;
+        if (n && (!all_finite(n, 3) || !(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.0)))
+            return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
+                            "%s: vertex %u: normal (%g, %g, %g) is not finite and non-zero", fn, i,
+                            n[0], n[1], n[2]);
+    }
+    const size_t n_idx = 3 * (size_t)d->triangle_count;
+    for (size_t k = 0; k < n_idx; k++)
+        if (d->indices[k] >= d->vertex_count)
+            return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
+                            "%s: index %zu (triangle %zu, corner %zu) is %u, not below the %u "
+                            "vertices",
+                            fn, k, k / 3, k % 3, d->indices[k], d->vertex_count);
+    return SW_OK;
+}
+
+/* The normals scaled to unit length, pushed (*at = SW_SG_NO_NORMALS when the mesh has none);
+ * 0 when out of memory. */
+static int push_unit_normals(sw_sg_builder *b, const sw_mesh_desc *d, uint64_t *at)
+{
+    *at = SW_SG_NO_NORMALS;
+    if (!d->normals)
+        return 1;
+    const size_t n = 3 * (size_t)d->vertex_count;
+    double *unit = sw__malloc(n * sizeof *unit);
+    if (!unit)
+        return 0;
+    for (size_t i = 0; i < n; i += 3) {
+        const double *v = d->normals + i;
+        const double len = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        for (int k = 0; k < 3; k++)
+            unit[i + k] = v[k] / len;
+    }
+    *at = sw_sg_builder_push_doubles(b, unit, n);
+    sw__free(unit);
+    return *at != UINT64_MAX;
+}
+
+/* A private scene of one mesh drawn by one MESH node under its root. */
+static sw_result mesh_geom(const sw_mesh_desc *d, sw_sg_scene **out, sw_status *status)
+{
+    sw_result r = check_mesh_desc(d, status);
+    if (r != SW_OK)
+        return r;
+    sw_sg_builder *b = sw_sg_builder_create();
+    if (!b)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "mesh: out of memory");
+    sw_sg_mesh_rec rec;
+    memset(&rec, 0, sizeof rec);
+    rec.n_vertices = d->vertex_count;
+    rec.n_triangles = d->triangle_count;
+    rec.positions = sw_sg_builder_push_doubles(b, d->positions, 3 * (size_t)d->vertex_count);
+    const int normals_ok = push_unit_normals(b, d, &rec.normals);
+    rec.indices = sw_sg_builder_push_indices(b, d->indices, 3 * (size_t)d->triangle_count);
+    uint32_t mesh = SW_SG_NONE;
+    if (rec.positions != UINT64_MAX && normals_ok && rec.indices != UINT64_MAX)
+        mesh = sw_sg_builder_add_mesh(b, &rec);
+    if (mesh == SW_SG_NONE ||
+        sw_sg_builder_add_node(b, SW_SG_NODE_MESH, 0, mesh, NULL, NULL, NULL) == SW_SG_NONE) {
+        sw_sg_builder_free(b);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "mesh: out of memory");
+    }
+    return sw_sg_builder_finish(b, out, status);
+}
+
+/* Triangles of a geometry scene's meshes (each once). */
+static uint32_t geom_triangles(const sw_sg_scene *geom)
+{
+    const sw_sg_scene_view *v = sw_sg_scene_view_ptr(geom);
+    uint64_t n = 0;
+    for (uint32_t i = 0; i < v->n_meshes; i++)
+        n += v->meshes[i].n_triangles;
+    return n > UINT32_MAX ? UINT32_MAX : (uint32_t)n;
+}
+
 static sw_result make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *status)
 {
     *out = NULL;
@@ -516,6 +611,10 @@ static sw_result make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                             "sw_node_add: IMPORT without import_path");
         return import_geom(d, out, status);
+    case SW_NODE_MESH:
+        if (!d->mesh)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: MESH without mesh");
+        return mesh_geom(d->mesh, out, status);
     default:
         return SW_OK;
     }
@@ -626,8 +725,10 @@ static sw_result new_node(const sw_node_desc *d, rt_node **out, sw_status *statu
         free_node(n);
         return r;
     }
-    if (n->geom)
+    if (n->geom) {
         n->geom_faces = sw_sg_scene_view_ptr(n->geom)->n_faces;
+        n->geom_triangles = geom_triangles(n->geom);
+    }
     *out = n;
     return SW_OK;
 }
@@ -679,6 +780,23 @@ sw_result sw_node_add(sw_scene scene, const sw_node_desc *desc, sw_node *out, sw
     else
         sw__status_ok(status);
     return r;
+}
+
+sw_result sw_node_add_mesh(sw_scene scene, const sw_node_desc *node, const sw_mesh_desc *mesh,
+                           sw_node *out, sw_status *status)
+{
+    if (out)
+        out->id = 0;
+    if (!mesh)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add_mesh: NULL mesh");
+    sw_node_desc d;
+    if (node)
+        d = *node;
+    else
+        memset(&d, 0, sizeof d);
+    d.kind = SW_NODE_MESH;
+    d.mesh = mesh;
+    return sw_node_add(scene, &d, out, status);
 }
 
 /* Counts, in each node's mark, the instances inside the subtree of `n` that draw it. */
@@ -803,10 +921,14 @@ static sw_result edit_geometry(rt_node *n, const void *arg, sw_status *status)
     geometry_swap *swap = (geometry_swap *)arg;
     if (n->kind != swap->kind)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: node %#x is not a %s node", swap->fn,
-                        n->id, swap->kind == SW_NODE_NURBS ? "NURBS" : "TSPLINE");
+                        n->id,
+                        swap->kind == SW_NODE_NURBS     ? "NURBS"
+                        : swap->kind == SW_NODE_TSPLINE ? "TSPLINE"
+                                                        : "MESH");
     sw_sg_scene *old = n->geom;
     n->geom = swap->geom;
     n->geom_faces = sw_sg_scene_view_ptr(n->geom)->n_faces;
+    n->geom_triangles = geom_triangles(n->geom);
     swap->geom = old;
     return SW_OK;
 }
@@ -858,6 +980,15 @@ sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_des
     return set_geometry(scene, node, &swap, tspline_geom(desc, &swap.geom, status), status);
 }
 
+sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *desc,
+                           sw_status *status)
+{
+    if (!desc)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_mesh: NULL desc");
+    geometry_swap swap = {NULL, SW_NODE_MESH, "sw_node_set_mesh"};
+    return set_geometry(scene, node, &swap, mesh_geom(desc, &swap.geom, status), status);
+}
+
 /* ---- queries -----------------------------------------------------------------------------------
  */
 
@@ -883,6 +1014,7 @@ sw_result sw_node_get_info(sw_scene scene, sw_node node, sw_node_info *out, sw_s
             out->color[3] = 0.0f;
         memcpy(out->transform, n->xform, sizeof out->transform);
         out->faces = n->geom_faces;
+        out->triangles = n->geom_triangles;
         sw__status_ok(status);
     }
     end_edit(c);

@@ -25,24 +25,27 @@ typedef struct compile_state {
     uint32_t n_nodes;     /* nodes in b (sw__sg_append_model needs the count) */
     uint32_t *face_nodes; /* node handle id per builder face */
     uint32_t n_face_nodes, cap_face_nodes;
+    uint32_t *mesh_nodes; /* node handle id per builder mesh */
+    uint32_t n_mesh_nodes, cap_mesh_nodes, n_meshes;
     int oom;
 } compile_state;
 
-static int note_faces(compile_state *cs, uint32_t node_id)
+/* ids[count..n) = node_id (the records a geometry node's scene just appended). */
+static int note_records(uint32_t **ids, uint32_t *count, uint32_t *cap, uint32_t n,
+                        uint32_t node_id)
 {
-    uint32_t n = sw_sg_builder_face_count(cs->b);
-    if (n > cs->cap_face_nodes) {
-        uint32_t cap = cs->cap_face_nodes ? cs->cap_face_nodes : 16;
-        while (cap < n)
-            cap *= 2;
-        uint32_t *grown = sw__realloc(cs->face_nodes, cap * sizeof *grown);
+    if (n > *cap) {
+        uint32_t c = *cap ? *cap : 16;
+        while (c < n)
+            c *= 2;
+        uint32_t *grown = sw__realloc(*ids, c * sizeof *grown);
         if (!grown)
             return 0;
-        cs->face_nodes = grown;
-        cs->cap_face_nodes = cap;
+        *ids = grown;
+        *cap = c;
     }
-    while (cs->n_face_nodes < n)
-        cs->face_nodes[cs->n_face_nodes++] = node_id;
+    while (*count < n)
+        (*ids)[(*count)++] = node_id;
     return 1;
 }
 
@@ -73,7 +76,10 @@ static sw_result append_geometry(compile_state *cs, const rt_node *n, uint32_t *
     if (r != SW_OK)
         return r;
     cs->n_nodes += v->n_nodes;
-    if (!note_faces(cs, n->id))
+    cs->n_meshes += v->n_meshes;
+    if (!note_records(&cs->face_nodes, &cs->n_face_nodes, &cs->cap_face_nodes,
+                      sw_sg_builder_face_count(cs->b), n->id) ||
+        !note_records(&cs->mesh_nodes, &cs->n_mesh_nodes, &cs->cap_mesh_nodes, cs->n_meshes, n->id))
         cs->oom = 1;
     return SW_OK;
 }
@@ -203,15 +209,17 @@ static sw_result copy_tree(sw_rt_model *m, compile_state *cs, sw_status *status)
 
 /* The version's extras, made before it is published: stats (ready), the BVH renderers cull with
  * and picks use, the back-patch cones. */
-static sw_result finish_version(sw_sg_scene *sg, uint32_t *face_nodes, uint64_t lineage,
+static sw_result finish_version(sw_sg_scene *sg, compile_state *cs, uint64_t lineage,
                                 uint64_t revision, sw_rt_scene **out, sw_status *status)
 {
     sw_rt_scene *v = sw_rt_scene_alloc(sg);
     if (!v) {
-        sw__free(face_nodes);
+        sw__free(cs->face_nodes);
+        sw__free(cs->mesh_nodes);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "node scene: out of memory");
     }
-    v->face_nodes = face_nodes;
+    v->face_nodes = cs->face_nodes;
+    v->mesh_nodes = cs->mesh_nodes;
     v->lineage = lineage;
     v->revision = revision;
     sw_result r = sw_sg_scene_compute_stats(sg, &v->stats);
@@ -243,15 +251,17 @@ sw_result sw__rt_model_compile(sw_rt_model *m, int unlock, sw_rt_scene **out, ui
     if (r != SW_OK) {
         sw_sg_builder_free(cs.b);
         sw__free(cs.face_nodes);
+        sw__free(cs.mesh_nodes);
         return r;
     }
     sw_sg_scene *sg = NULL;
     r = sw_sg_builder_finish(cs.b, &sg, status);
     if (r != SW_OK) {
         sw__free(cs.face_nodes);
+        sw__free(cs.mesh_nodes);
         return r;
     }
-    return finish_version(sg, cs.face_nodes, m->serial, *revision, out, status);
+    return finish_version(sg, &cs, m->serial, *revision, out, status);
 }
 
 /* ---- publication and grace period ---------------------------------------------------------- */
@@ -325,7 +335,10 @@ static void compile_task(void *ctx)
     pthread_mutex_lock(&m->edit_lock);
     int again = m->revision != revision;
     if (again) {
-        sw_th_task t = {.fn = compile_task, .ctx = m, .priority = SW_TH_PRIORITY_BACKGROUND};
+        sw_th_task t = {.fn = compile_task,
+                        .ctx = m,
+                        .priority = SW_TH_PRIORITY_BACKGROUND,
+                        .kind = SW_TH_TASK_COMPILE};
         again = sw_th_pool_submit(m->pool, &t) == SW_OK;
     }
     m->compile_queued = again;
@@ -339,7 +352,10 @@ static void schedule_compile(sw_rt_model *m)
 {
     if (m->compile_queued)
         return;
-    sw_th_task t = {.fn = compile_task, .ctx = m, .priority = SW_TH_PRIORITY_BACKGROUND};
+    sw_th_task t = {.fn = compile_task,
+                    .ctx = m,
+                    .priority = SW_TH_PRIORITY_BACKGROUND,
+                    .kind = SW_TH_TASK_COMPILE};
     m->compile_queued = sw_th_pool_submit(m->pool, &t) == SW_OK;
 }
 

@@ -19,8 +19,9 @@ struct rt_node {
     double xform[12];       /* identity where the kind has none */
     rt_node *target;        /* INSTANCE */
     uint32_t instance_refs; /* INSTANCE nodes whose target this is */
-    sw_sg_scene *geom;      /* NURBS, TSPLINE, IMPORT: a private immutable scene, its root drawn */
-    uint32_t geom_faces;
+    sw_sg_scene *geom;      /* NURBS, TSPLINE, IMPORT, MESH: a private immutable scene, its root
+                               drawn */
+    uint32_t geom_faces, geom_triangles;
     sw_camera camera; /* CAMERA */
     char *name;
     /* scratch of one operation under the edit lock (compile, remove, cycle test) */

@@ -38,6 +38,7 @@ typedef struct sw_rt_renderer {
     sw_status statics_failure;
     sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
+    int time_pool_tasks;      /* sw_rt_renderer_time_pool_tasks: the pool times its tasks */
     sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
     uint32_t in_flight;       /* prepared frames not submitted yet */
     uint64_t frames_prepared;
@@ -146,7 +147,8 @@ static void retire_statics(sw_rt_renderer *r)
     if (rs) {
         *rs = (retired_statics){set, r->cache_scene};
         sw_rt_scene_retain(r->cache_scene);
-        const sw_th_task task = {retire_statics_task, rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL};
+        const sw_th_task task = {retire_statics_task, rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
+                                 NULL, SW_TH_TASK_STATIC_RETIRE};
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;
         sw_rt_scene_release(r->cache_scene);
@@ -182,6 +184,7 @@ static sw_result renderer_cache(sw_rt_renderer *r, sw_rt_scene *scene, sw_status
     if (!r->pool) {
         sw_th_pool_desc pd = {0};
         pd.worker_count = r->worker_threads;
+        pd.time_tasks = r->time_pool_tasks != 0;
         if (sw_th_pool_create(&pd, &r->pool) != SW_OK)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
     }
@@ -232,6 +235,25 @@ int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *
     if (owned_renderer(renderer, "sw_rt_renderer_trim_atlas", &r, NULL) != SW_OK)
         return -1;
     sw_gpu_trim_atlas_info(r->gpu, texture, pages, side);
+    return 0;
+}
+
+sw_th_pool *sw_rt_renderer_pool_ptr(sw_renderer renderer)
+{
+    sw_rt_renderer *r;
+    if (owned_renderer(renderer, "sw_rt_renderer_pool_ptr", &r, NULL) != SW_OK)
+        return NULL;
+    return r->pool;
+}
+
+int sw_rt_renderer_time_pool_tasks(sw_renderer renderer, int on)
+{
+    sw_rt_renderer *r;
+    if (owned_renderer(renderer, "sw_rt_renderer_time_pool_tasks", &r, NULL) != SW_OK)
+        return -1;
+    r->time_pool_tasks = on != 0;
+    if (r->pool)
+        sw_th_pool_set_task_timing(r->pool, on);
     return 0;
 }
 
@@ -291,6 +313,9 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->static_drawn = g->static_units_drawn;
     out->static_faces = g->static_faces;
     out->static_triangles = g->static_triangles;
+    out->meshes_drawn = g->meshes_drawn;
+    out->meshes_culled = g->meshes_culled;
+    out->mesh_triangles = g->mesh_triangles;
     out->static_requests = g->static_requests;
 }
 
@@ -387,7 +412,7 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
     int expect = 0;
     if (atomic_compare_exchange_strong(&r->statics_state, &expect, 1)) {
         const sw_th_task task = {statics_task, r, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
-                                 &r->statics_group};
+                                 &r->statics_group, SW_TH_TASK_STATIC_CLUSTER};
         if (sw_th_pool_submit(r->pool, &task) != SW_OK) {
             atomic_store(&r->statics_state, 0);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: could not submit");

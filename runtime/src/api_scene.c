@@ -330,6 +330,10 @@ sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *stat
     memcpy(out->bbox_min, s->bbox, sizeof out->bbox_min);
     memcpy(out->bbox_max, s->bbox + 3, sizeof out->bbox_max);
     out->memory_bytes = sw_sg_scene_memory(scene->sg);
+    out->meshes = s->meshes;
+    out->mesh_triangles = s->mesh_triangles;
+    out->mesh_occurrences = s->mesh_occurrences;
+    out->triangle_occurrences = s->triangle_occurrences;
     sw_rt_scene_release(scene);
     return SW_OK;
 }
@@ -377,15 +381,22 @@ sw_result sw_scene_pick(sw_scene handle, const double origin[3], const double di
     r = pick_bvh(scene, &bvh, status);
     if (r == SW_OK)
         r = sw_sg_pick(scene->sg, bvh, origin, direction, 0.0, &hit, status);
-    if (r == SW_OK && hit.face != SW_SG_NONE) {
+    if (r == SW_OK && (hit.face != SW_SG_NONE || hit.mesh != SW_SG_NONE)) {
         out->hit = 1;
-        out->surface = hit.face;
+        out->surface = hit.face == SW_SG_NONE ? UINT32_MAX : hit.face;
+        out->mesh = hit.mesh == SW_SG_NONE ? UINT32_MAX : hit.mesh;
         out->t = hit.t;
         memcpy(out->point, hit.point, sizeof out->point);
         memcpy(out->uv, hit.uv, sizeof out->uv);
         out->occurrence = hit.item;
-        if (scene->face_nodes)
+        if (hit.face != SW_SG_NONE && scene->face_nodes)
             out->node.id = scene->face_nodes[hit.face];
+        if (hit.mesh != SW_SG_NONE) {
+            out->triangle = hit.triangle;
+            memcpy(out->barycentric, hit.bary, sizeof out->barycentric);
+            if (scene->mesh_nodes)
+                out->node.id = scene->mesh_nodes[hit.mesh];
+        }
     }
     sw_rt_scene_release(scene);
     return r;

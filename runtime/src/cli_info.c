@@ -42,11 +42,15 @@ static void print_json(const char *path, const sw_scene_info *in)
            "\"bezier_patches\": %llu, \"max_degree_u\": %u, \"max_degree_v\": %u, "
            "\"max_trim_curve_degree\": %u, \"control_points\": %llu, \"nodes\": %u, "
            "\"instances\": %u, \"face_occurrences\": %llu, \"adjacent_face_pairs\": %u, "
+           "\"meshes\": %u, \"mesh_triangles\": %llu, \"mesh_occurrences\": %llu, "
+           "\"triangle_occurrences\": %llu, "
            "\"bbox\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g], \"memory_bytes\": %zu}\n",
            in->trimmed_faces, in->loops, in->curves, (unsigned long long)in->bezier_patches,
            in->max_degree_u, in->max_degree_v, in->max_curve_degree,
            (unsigned long long)in->control_points, in->nodes, in->instances,
-           (unsigned long long)in->face_occurrences, in->adjacent_face_pairs, in->bbox_min[0],
+           (unsigned long long)in->face_occurrences, in->adjacent_face_pairs, in->meshes,
+           (unsigned long long)in->mesh_triangles, (unsigned long long)in->mesh_occurrences,
+           (unsigned long long)in->triangle_occurrences, in->bbox_min[0],
            in->bbox_min[1], in->bbox_min[2], in->bbox_max[0], in->bbox_max[1], in->bbox_max[2],
            in->memory_bytes);
 }
@@ -71,6 +75,10 @@ static void print_text(const char *path, const sw_scene_info *in)
     printf("  nodes           %u, instances %u, surfaces drawn %llu\n", in->nodes, in->instances,
            (unsigned long long)in->face_occurrences);
     printf("  adjacency       %u face pairs share an edge\n", in->adjacent_face_pairs);
+    if (in->meshes)
+        printf("  meshes          %u (%llu triangles); drawn %llu (%llu triangles)\n", in->meshes,
+               (unsigned long long)in->mesh_triangles, (unsigned long long)in->mesh_occurrences,
+               (unsigned long long)in->triangle_occurrences);
     printf("  bounding box    [%g %g %g] - [%g %g %g]\n", in->bbox_min[0], in->bbox_min[1],
            in->bbox_min[2], in->bbox_max[0], in->bbox_max[1], in->bbox_max[2]);
     printf("  memory          %.2f MiB\n", (double)in->memory_bytes / (1024.0 * 1024.0));

@@ -5,6 +5,7 @@
 
 #include "sw_camera_path.h"
 #include "sw_profile_report.h"
+#include "sw_rt.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
@@ -29,11 +30,14 @@ static const char k_usage[] =
     "is one call on this thread and hierarchy (waiting for the pool) and tessellate are among its\n"
     "stages. Writes into\n"
     "DIR: profile.csv and profile.json (one row per frame with the stage times, patches,\n"
-    "triangles, trim textures and texels, atlas pages, fallback draws, pool waits and resident\n"
-    "memory; the JSON adds the run and a summary: median, p90, p99, max, mean per column),\n"
-    "frametime.svg (frame time and the stage stack along the path), report.html, and PNGs of\n"
-    "the first, middle and last frame. Everything is written aside and renamed into DIR at the\n"
-    "end: a failed run leaves DIR as it was. Prints the summary; a progress bar on a terminal.\n"
+    "triangles, trim textures and texels, atlas pages, fallback draws, pool waits, the worker\n"
+    "pool's time and task count per task kind (pool_<kind>_ms, pool_<kind>_tasks: its threads,\n"
+    "beside frame_ms) and queue length at the frame's end (pool_queued), and resident memory;\n"
+    "the JSON adds the run and a summary: median, p90, p99, max, mean per column),\n"
+    "frametime.svg (frame time and the stage stack along the path; below, the pool's time per\n"
+    "task kind and its queue), report.html, and PNGs of the first, middle and last frame.\n"
+    "Everything is written aside and renamed into DIR at the end: a failed run leaves DIR as it\n"
+    "was. Prints the summary; a progress bar on a terminal.\n"
     "\n"
     "options:\n"
     "  --path PATH       camera path file (required)\n"
@@ -323,6 +327,28 @@ static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camer
     return r == SW_OK ? sw_renderer_submit(renderer, stats, status) : r;
 }
 
+/* The pool columns of frame `row`: what the renderer's pool did since the previous frame's end
+ * (*prev, updated), its queue now and its injection queue's peak since then. No pool yet
+ * (nothing asked for one): zeros. */
+static void sample_pool(sw_renderer renderer, sw_th_pool_stats *prev, sw_rt_prof_row *row)
+{
+    sw_th_pool *pool = sw_rt_renderer_pool_ptr(renderer);
+    sw_th_pool_stats now = {0};
+    int64_t queued = 0, peak = 0;
+    if (pool) {
+        sw_th_pool_stats_get(pool, &now);
+        queued = sw_th_pool_queued(pool, NULL);
+        peak = sw_th_pool_inject_peak_take(pool);
+    }
+    /* a running task's time may read a few ns ahead of what its end then records
+     * (sw_th_pool_stats.ns_by_kind): the totals are kept from going back */
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+        if (now.ns_by_kind[k] < prev->ns_by_kind[k])
+            now.ns_by_kind[k] = prev->ns_by_kind[k];
+    sw_rt_profile_row_pool(prev, &now, queued, peak, row);
+    *prev = now;
+}
+
 /* Draws the n frames; each row's frame_ms is this thread's wall time for its frame. */
 static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_camera_path *path,
                             uint32_t n, sw_frame_desc *frame, staging *st, sw_rt_profile *p,
@@ -331,6 +357,7 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
     const int tty = isatty(STDERR_FILENO);
     char file[4200];
     sw_result r = SW_OK;
+    sw_th_pool_stats pool_prev = {0};
     if (threaded) {
         set_frame(path, 0, n, st, p, frame, file);
         r = sw_renderer_prepare(renderer, frame, status);
@@ -349,6 +376,7 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
         }
         sw_rt_prof_row row;
         sw_rt_profile_row(&stats, i, t, ms, resident_bytes(), is_capture(p, i), &row);
+        sample_pool(renderer, &pool_prev, &row);
         if (sw_rt_profile_push(p, &row) != 0)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
         if (tty)
@@ -394,6 +422,8 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
     sw_result r = sw_renderer_create(&rd, &renderer, status);
     if (r != SW_OK)
         return r;
+    /* pool_<kind>_ms: two clock reads per task, nothing next to a hierarchy build's cost */
+    sw_rt_renderer_time_pool_tasks(renderer, 1);
     fill_meta(a, renderer, p);
     staging st = {0};
     r = make_staging(a->out, &st, status);

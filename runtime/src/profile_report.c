@@ -24,6 +24,18 @@ static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#
                                              "#f28e2b", "#e15759", "#b07aa1", "#a0a0a0"};
 #define FIRST_STAGE SW_RT_COL_HIERARCHY_MS
 #define N_STAGES (SW_RT_COL_OTHER_MS - SW_RT_COL_HIERARCHY_MS + 1)
+/* The pool's columns come from one table of task kinds: one ms and one tasks column per kind, in
+ * the kinds' order. */
+#define SW_RT_COL_POOL_FIRST_MS SW_RT_COL_POOL_OTHER_MS
+#define SW_RT_COL_POOL_FIRST_TASKS SW_RT_COL_POOL_OTHER_TASKS
+_Static_assert(SW_RT_COL_POOL_FIRST_TASKS - SW_RT_COL_POOL_FIRST_MS == SW_TH_TASK_KIND_COUNT &&
+                   SW_RT_COL_POOL_QUEUED - SW_RT_COL_POOL_FIRST_TASKS == SW_TH_TASK_KIND_COUNT,
+               "one ms and one tasks column per pool task kind, in order");
+/* Pool kinds' colours (same order as the kinds). */
+static const char *const k_pool_colour[] = {"#a0a0a0", "#4c8bd6", "#9ecae9", "#8e6bbf",
+                                            "#59a14f", "#edc948", "#f28e2b", "#e15759"};
+_Static_assert(sizeof k_pool_colour / sizeof k_pool_colour[0] == SW_TH_TASK_KIND_COUNT,
+               "one colour per pool task kind");
 
 _Static_assert(sizeof k_stage_colour / sizeof k_stage_colour[0] == N_STAGES,
                "one colour per stage");
@@ -86,6 +98,19 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_STATIC_REQUESTS] = (double)st->static_requests;
     v[SW_RT_COL_RESIDENT_BYTES] = resident_bytes;
     v[SW_RT_COL_CAPTURED] = captured ? 1.0 : 0.0;
+}
+
+void sw_rt_profile_row_pool(const sw_th_pool_stats *before, const sw_th_pool_stats *now,
+                            int64_t queued, int64_t inject_peak, sw_rt_prof_row *row)
+{
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        row->v[SW_RT_COL_POOL_FIRST_MS + k] =
+            1e-6 * (double)(now->ns_by_kind[k] - before->ns_by_kind[k]);
+        row->v[SW_RT_COL_POOL_FIRST_TASKS + k] =
+            (double)(now->executed_by_kind[k] - before->executed_by_kind[k]);
+    }
+    row->v[SW_RT_COL_POOL_QUEUED] = (double)queued;
+    row->v[SW_RT_COL_POOL_INJECT_PEAK] = (double)inject_peak;
 }
 
 int sw_rt_profile_push(sw_rt_profile *p, const sw_rt_prof_row *row)
@@ -222,8 +247,8 @@ static void json_string(FILE *f, const char *s)
 
 static const char *kind_name(sw_rt_prof_kind k)
 {
-    static const char *const names[] = {"index", "seconds",          "frame",
-                                        "stage", "visibility stage", "gpu",   "count"};
+    static const char *const names[] = {"index", "seconds", "frame", "stage", "visibility stage",
+                                        "gpu",   "pool",    "count"};
     _Static_assert(sizeof names / sizeof names[0] == SW_RT_KIND_COUNT + 1,
                    "a name per kind (SW_RT_KIND_COUNT, the count kind, is the last)");
     return names[k];
@@ -367,17 +392,35 @@ static double py(const plot *pl, double ms)
     return pl->top + pl->height * (1.0 - fmin(fmax(ms, 0.0), pl->ymax) / pl->ymax);
 }
 
-/* Cumulative top of the stage stack up to stage s (inclusive) at frame i; negative "other" (a
- * clock's rounding) counts as 0. */
-static double stack_top(const sw_rt_profile *p, uint32_t i, int s)
+/* A stack of areas: columns first .. first + n - 1 (stage or pool-kind times), a colour each. */
+typedef struct stack {
+    int first, n;
+    const char *const *colour;
+} stack;
+
+static const stack k_stages = {FIRST_STAGE, N_STAGES, k_stage_colour};
+static const stack k_pool = {SW_RT_COL_POOL_FIRST_MS, SW_TH_TASK_KIND_COUNT, k_pool_colour};
+
+/* Cumulative top of a stack up to its layer s (inclusive) at frame i; negative values (a clock's
+ * rounding in "other") count as 0. */
+static double stack_top(const sw_rt_profile *p, uint32_t i, const stack *st, int s)
 {
     double sum = 0.0;
     for (int k = 0; k <= s; k++)
-        sum += fmax(0.0, p->rows[i].v[FIRST_STAGE + k]);
+        sum += fmax(0.0, p->rows[i].v[st->first + k]);
     return sum;
 }
 
-static void svg_axes(FILE *f, const sw_rt_profile *p, const plot *pl, double ystep)
+static double stack_max(const sw_rt_profile *p, const stack *st)
+{
+    double m = 0.0;
+    for (uint32_t i = 0; i < p->n_rows; i++)
+        m = fmax(m, stack_top(p, i, st, st->n - 1));
+    return m;
+}
+
+static void svg_axes(FILE *f, const sw_rt_profile *p, const plot *pl, double ystep,
+                     const char *ylabel)
 {
     fprintf(f, "<g font-family=\"sans-serif\" font-size=\"11\" fill=\"#333\">\n");
     for (double y = 0.0; y <= pl->ymax + 1e-9 * pl->ymax; y += ystep) {
@@ -406,29 +449,39 @@ static void svg_axes(FILE *f, const sw_rt_profile *p, const plot *pl, double yst
             p->rows[p->n_rows - 1].v[SW_RT_COL_T]);
     fprintf(f,
             "<text x=\"14\" y=\"%.1f\" text-anchor=\"middle\" transform=\"rotate(-90 14 %.1f)\">"
-            "milliseconds</text>\n",
-            pl->top + 0.5 * pl->height, pl->top + 0.5 * pl->height);
+            "%s</text>\n",
+            pl->top + 0.5 * pl->height, pl->top + 0.5 * pl->height, ylabel);
     fprintf(f,
             "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
             "stroke=\"#666\"/>\n</g>\n",
             pl->left, pl->top, pl->width, pl->height);
 }
 
-static void svg_stack(FILE *f, const sw_rt_profile *p, const plot *pl)
+static void svg_areas(FILE *f, const sw_rt_profile *p, const plot *pl, const stack *st)
 {
-    for (int s = 0; s < N_STAGES; s++) {
+    for (int s = 0; s < st->n; s++) {
         fprintf(f, "<polygon fill=\"%s\" fill-opacity=\"0.85\" stroke=\"none\" points=\"",
-                k_stage_colour[s]);
+                st->colour[s]);
         for (uint32_t i = 0; i < p->n_rows; i++)
-            fprintf(f, "%.2f,%.2f ", px(pl, i), py(pl, stack_top(p, i, s)));
+            fprintf(f, "%.2f,%.2f ", px(pl, i), py(pl, stack_top(p, i, st, s)));
         for (uint32_t i = p->n_rows; i-- > 0;)
-            fprintf(f, "%.2f,%.2f ", px(pl, i), py(pl, s ? stack_top(p, i, s - 1) : 0.0));
+            fprintf(f, "%.2f,%.2f ", px(pl, i), py(pl, s ? stack_top(p, i, st, s - 1) : 0.0));
         fputs("\"/>\n", f);
     }
-    fputs("<polyline fill=\"none\" stroke=\"#111\" stroke-width=\"1.5\" points=\"", f);
+}
+
+/* A column as a line, scaled so that `vmax` is the plot's top. */
+static void svg_line(FILE *f, const sw_rt_profile *p, const plot *pl, sw_rt_prof_col c, double vmax,
+                     const char *style)
+{
+    fprintf(f, "<polyline fill=\"none\" %s points=\"", style);
     for (uint32_t i = 0; i < p->n_rows; i++)
-        fprintf(f, "%.2f,%.2f ", px(pl, i), py(pl, p->rows[i].v[SW_RT_COL_FRAME_MS]));
+        fprintf(f, "%.2f,%.2f ", px(pl, i), py(pl, p->rows[i].v[c] * pl->ymax / vmax));
     fputs("\"/>\n", f);
+}
+
+static void svg_captures(FILE *f, const sw_rt_profile *p, const plot *pl)
+{
     for (uint32_t c = 0; c < p->n_captures; c++) {
         const double xx = px(pl, p->captures[c]);
         fprintf(f,
@@ -438,6 +491,19 @@ static void svg_stack(FILE *f, const sw_rt_profile *p, const plot *pl)
     }
 }
 
+/* Legend keys: a swatch of an area's colour, or a stretch of a line's style. */
+static void svg_swatch(FILE *f, double x, double y, const char *fill)
+{
+    fprintf(f, "<rect x=\"%.1f\" y=\"%.1f\" width=\"14\" height=\"10\" fill=\"%s\"/>", x, y - 5,
+            fill);
+}
+
+static void svg_line_key(FILE *f, double x, double y, const char *style)
+{
+    fprintf(f, "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" %s/>", x, y, x + 14, y,
+            style);
+}
+
 static void svg_legend(FILE *f, const sw_rt_profile *p, const plot *pl)
 {
     const double x = pl->left + pl->width + 16;
@@ -445,34 +511,64 @@ static void svg_legend(FILE *f, const sw_rt_profile *p, const plot *pl)
             "<g font-family=\"sans-serif\" font-size=\"11\" fill=\"#333\">\n"
             "<text x=\"%.1f\" y=\"%.1f\" font-weight=\"bold\">median ms</text>\n",
             x, pl->top + 4);
-    fprintf(f,
-            "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#111\" "
-            "stroke-width=\"1.5\"/><text x=\"%.1f\" y=\"%.1f\">frame %.2f</text>\n",
-            x, pl->top + 22, x + 14, pl->top + 22, x + 20, pl->top + 26,
+    svg_line_key(f, x, pl->top + 22, "stroke=\"#111\" stroke-width=\"1.5\"");
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">frame %.2f</text>\n", x + 20, pl->top + 26,
             p->summary[SW_RT_COL_FRAME_MS].median);
     for (int s = N_STAGES; s-- > 0;) { /* top of the stack first, as drawn */
         const double y = pl->top + 42 + 18 * (N_STAGES - 1 - s);
         const char *name = k_cols[FIRST_STAGE + s].name;
         const int len = (int)(strlen(name) - 3); /* without "_ms" */
-        fprintf(f,
-                "<rect x=\"%.1f\" y=\"%.1f\" width=\"14\" height=\"10\" fill=\"%s\"/>"
-                "<text x=\"%.1f\" y=\"%.1f\">%.*s %.2f</text>\n",
-                x, y - 5, k_stage_colour[s], x + 20, y + 4, len, name,
+        svg_swatch(f, x, y, k_stage_colour[s]);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">%.*s %.2f</text>\n", x + 20, y + 4, len, name,
                 p->summary[FIRST_STAGE + s].median);
     }
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">dashed: captured</text>\n</g>\n", x,
             pl->top + 60 + 18 * N_STAGES);
 }
 
+/* The pool panel's legend: each kind's time over the whole run (pool work is bursty: most
+ * frames' median is 0), and the queue's largest length. */
+static void svg_pool_legend(FILE *f, const sw_rt_profile *p, const plot *pl)
+{
+    const double x = pl->left + pl->width + 16;
+    fprintf(f,
+            "<g font-family=\"sans-serif\" font-size=\"11\" fill=\"#333\">\n"
+            "<text x=\"%.1f\" y=\"%.1f\" font-weight=\"bold\">pool ms, whole run</text>\n",
+            x, pl->top + 4);
+    svg_line_key(f, x, pl->top + 22, "stroke=\"#111\" stroke-dasharray=\"5,2\"");
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">queued at end, max %.0f</text>\n", x + 20, pl->top + 26,
+            p->summary[SW_RT_COL_POOL_QUEUED].max);
+    svg_line_key(f, x, pl->top + 40, "stroke=\"#d62728\" stroke-dasharray=\"1,2\"");
+    fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">inject peak, max %.0f</text>\n", x + 20, pl->top + 44,
+            p->summary[SW_RT_COL_POOL_INJECT_PEAK].max);
+    for (int k = SW_TH_TASK_KIND_COUNT; k-- > 0;) {
+        const double y = pl->top + 60 + 14 * (SW_TH_TASK_KIND_COUNT - 1 - k);
+        const sw_rt_prof_col c = (sw_rt_prof_col)(SW_RT_COL_POOL_FIRST_MS + k);
+        svg_swatch(f, x, y, k_pool_colour[k]);
+        fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">%s %.1f</text>\n", x + 20, y + 4,
+                sw_th_task_kind_name((sw_th_task_kind)k), p->summary[c].mean * p->n_rows);
+    }
+    fputs("</g>\n", f);
+}
+
+/* A plot's y range: a nice step for about five lines and the top at a multiple of it. */
+static double fit_y(plot *pl, double maxv)
+{
+    const double ystep = nice_step(maxv / 5.0);
+    pl->ymax = fmax(ystep, ystep * ceil(maxv / ystep));
+    return ystep;
+}
+
 int sw_rt_profile_write_svg(FILE *f, const sw_rt_profile *p)
 {
-    enum { W = 960, H = 400 };
-    plot pl = {64, 34, W - 64 - 180, H - 34 - 56, 1.0, p->n_rows};
-    double maxv = 0.0;
+    enum { W = 960, H1 = 400, H2 = 300, H = H1 + H2 };
+    plot pl = {64, 34, W - 64 - 180, H1 - 34 - 56, 1.0, p->n_rows};
+    plot pool = {64, H1 + 30, W - 64 - 180, H2 - 30 - 56, 1.0, p->n_rows};
+    double maxv = stack_max(p, &k_stages);
     for (uint32_t i = 0; i < p->n_rows; i++)
-        maxv = fmax(maxv, fmax(p->rows[i].v[SW_RT_COL_FRAME_MS], stack_top(p, i, N_STAGES - 1)));
-    const double ystep = nice_step(maxv / 5.0);
-    pl.ymax = fmax(ystep, ystep * ceil(maxv / ystep));
+        maxv = fmax(maxv, p->rows[i].v[SW_RT_COL_FRAME_MS]);
+    const double ystep = fit_y(&pl, maxv);
+    const double pool_step = fit_y(&pool, stack_max(p, &k_pool));
     fprintf(f,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" "
             "viewBox=\"0 0 %d %d\">\n<rect width=\"%d\" height=\"%d\" fill=\"#fff\"/>\n"
@@ -482,10 +578,28 @@ int sw_rt_profile_write_svg(FILE *f, const sw_rt_profile *p)
     xml_text(f, p->meta.scene);
     fprintf(f, " (%dx%d, %s, %u frames)</text>\n", p->meta.width, p->meta.height, p->meta.mode,
             p->n_rows);
+    fprintf(f,
+            "<text x=\"64\" y=\"%d\" font-family=\"sans-serif\" font-size=\"13\" "
+            "font-weight=\"bold\">worker pool: its threads' ms per task kind (beside frame_ms, not "
+            "in it); queue lengths (lines) on their own scale, max at the top</text>\n",
+            H1 + 16);
     if (p->n_rows > 0) {
-        svg_stack(f, p, &pl);
-        svg_axes(f, p, &pl, ystep);
+        svg_areas(f, p, &pl, &k_stages);
+        svg_line(f, p, &pl, SW_RT_COL_FRAME_MS, pl.ymax, "stroke=\"#111\" stroke-width=\"1.5\"");
+        svg_captures(f, p, &pl);
+        svg_axes(f, p, &pl, ystep, "milliseconds");
         svg_legend(f, p, &pl);
+        svg_areas(f, p, &pool, &k_pool);
+        /* the queue on its own scale: its largest length at the top */
+        const double qmax = fmax(1.0, fmax(p->summary[SW_RT_COL_POOL_QUEUED].max,
+                                           p->summary[SW_RT_COL_POOL_INJECT_PEAK].max));
+        svg_line(f, p, &pool, SW_RT_COL_POOL_QUEUED, qmax,
+                 "stroke=\"#111\" stroke-dasharray=\"5,2\"");
+        svg_line(f, p, &pool, SW_RT_COL_POOL_INJECT_PEAK, qmax,
+                 "stroke=\"#d62728\" stroke-dasharray=\"1,2\"");
+        svg_captures(f, p, &pool);
+        svg_axes(f, p, &pool, pool_step, "pool milliseconds");
+        svg_pool_legend(f, p, &pool);
     }
     fputs("</svg>\n", f);
     return ferror(f) ? -1 : 0;
@@ -532,7 +646,8 @@ static void html_summary(FILE *f, const sw_rt_profile *p)
             continue;
         const sw_rt_prof_stat *s = &p->summary[c];
         const int ms = k_cols[c].kind == SW_RT_KIND_STAGE || k_cols[c].kind == SW_RT_KIND_FRAME ||
-                       k_cols[c].kind == SW_RT_KIND_VSTAGE || k_cols[c].kind == SW_RT_KIND_GPU;
+                       k_cols[c].kind == SW_RT_KIND_VSTAGE || k_cols[c].kind == SW_RT_KIND_GPU ||
+                       k_cols[c].kind == SW_RT_KIND_POOL;
         const char *fmt = ms ? "<td>%.2f</td>" : "<td>%.0f</td>";
         fprintf(f, "<tr><td>%s</td>", k_cols[c].name);
         const double v[5] = {s->median, s->p90, s->p99, s->max, s->mean};
@@ -581,6 +696,30 @@ int sw_rt_profile_write_html(FILE *f, const sw_rt_profile *p, const char *svg)
     return ferror(f) ? -1 : 0;
 }
 
+/* The pool's rows of the summary: the kinds that ran at all, then the queue. */
+static void print_pool_summary(FILE *f, const sw_rt_profile *p)
+{
+    fputs("pool, all threads (beside frame_ms):\n", f);
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        const sw_rt_prof_stat *s = &p->summary[SW_RT_COL_POOL_FIRST_MS + k];
+        const double tasks = p->summary[SW_RT_COL_POOL_FIRST_TASKS + k].mean * p->n_rows;
+        if (!(tasks > 0.0))
+            continue;
+        fprintf(f, "  %-14s %9.2f %9.2f %9.2f %9.2f %9.2f  %.0f tasks, %.1f ms in all\n",
+                sw_th_task_kind_name((sw_th_task_kind)k), s->median, s->p90, s->p99, s->max,
+                s->mean, tasks, s->mean * p->n_rows);
+    }
+    const sw_rt_prof_stat *q = &p->summary[SW_RT_COL_POOL_QUEUED];
+    fprintf(f,
+            "  %-14s %9.0f %9.0f %9.0f %9.0f %9.1f  tasks waiting at frame ends, %.0f at the "
+            "last\n",
+            "queued", q->median, q->p90, q->p99, q->max, q->mean,
+            p->n_rows ? p->rows[p->n_rows - 1].v[SW_RT_COL_POOL_QUEUED] : 0.0);
+    q = &p->summary[SW_RT_COL_POOL_INJECT_PEAK];
+    fprintf(f, "  %-14s %9.0f %9.0f %9.0f %9.0f %9.1f  longest injection queue during a frame\n",
+            "inject_peak", q->median, q->p90, q->p99, q->max, q->mean);
+}
+
 void sw_rt_profile_print_summary(FILE *f, const sw_rt_profile *p)
 {
     fprintf(f, "%-16s %9s %9s %9s %9s %9s\n", "ms", "median", "p90", "p99", "max", "mean");
@@ -591,6 +730,7 @@ void sw_rt_profile_print_summary(FILE *f, const sw_rt_profile *p)
                 c == SW_RT_COL_FRAME_MS ? 16 : 14, (int)strlen(name) - 3, name, s->median, s->p90,
                 s->p99, s->max, s->mean);
     }
+    print_pool_summary(f, p);
     double fallbacks = 0.0, waits = 0.0;
     for (uint32_t i = 0; i < p->n_rows; i++) {
         fallbacks += p->rows[i].v[SW_RT_COL_FALLBACK_DRAWS];

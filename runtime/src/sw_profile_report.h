@@ -6,14 +6,30 @@
  * measured stages: whatever the frame call spent outside them (setup, bookkeeping, the first
  * frame's pool and cache creation). Keeping "other" small is what shows that the stages account
  * for the frame (issue 5).
+ *
+ * The worker pool's share of a frame is beside them, like the visibility thread's and the GPU's:
+ * pool_<kind>_ms and pool_<kind>_tasks per task kind (sw_th_pool.h), the differences of the
+ * pool's counters between the end of the previous frame and the end of this one (a worker's
+ * running task counts in the frames it spans), pool_queued, the tasks waiting at the frame's end,
+ * and pool_inject_peak, the longest the injection queue (tasks submitted by the visibility thread
+ * and the frame's) grew during the frame.
  */
 #ifndef SW_PROFILE_REPORT_H
 #define SW_PROFILE_REPORT_H
 
 #include <splinewalk/splinewalk.h>
 
+#include "sw_th_pool.h"
+
 #include <stdint.h>
 #include <stdio.h>
+
+/* Per task kind of the pool (sw_th_pool.h's table): the time the pool's threads spent in the
+ * kind's tasks during the frame and how many ran. */
+#define SW_RT__POOL_MS_COLUMN(X, id, name, what)                                                   \
+    X(POOL_##id##_MS, "pool_" name "_ms", POOL, "pool threads' ms in " what)
+#define SW_RT__POOL_TASKS_COLUMN(X, id, name, what)                                                \
+    X(POOL_##id##_TASKS, "pool_" name "_tasks", COUNT, "pool tasks run: " what)
 
 /* Every per-frame column: enum, name (CSV header and JSON key), kind, what it is. */
 #define SW_RT_PROFILE_COLUMNS(X)                                                                   \
@@ -51,11 +67,17 @@
     X(ATLAS_PAGES, "atlas_pages", COUNT, "trim-atlas pages after the frame")                       \
     X(FALLBACK_DRAWS, "fallback_draws", COUNT, "walkthrough: drawn coarser than asked, queued")    \
     X(POOL_WAITS, "pool_waits", COUNT, "times the frame waited for the worker pool")               \
-    X(GPU_MS, "gpu_ms", GPU, "GPU time of trim + draw (GL timer query; overlaps them)")         \
-    X(STATIC_DRAWN, "static_drawn", COUNT, "super-surface instances drawn from static LODs")        \
+    X(GPU_MS, "gpu_ms", GPU, "GPU time of trim + draw (GL timer query; overlaps them)")            \
+    X(STATIC_DRAWN, "static_drawn", COUNT, "super-surface instances drawn from static LODs")       \
     X(STATIC_FACES, "static_faces", COUNT, "face instances they cover (of faces_drawn)")           \
     X(STATIC_TRIANGLES, "static_triangles", COUNT, "their triangles (of triangles)")               \
     X(STATIC_REQUESTS, "static_requests", COUNT, "walkthrough: static LOD builds queued")          \
+    SW_TH_TASK_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \
+    SW_TH_TASK_KINDS(SW_RT__POOL_TASKS_COLUMN, X)                                                  \
+    X(POOL_QUEUED, "pool_queued", COUNT,                                                           \
+      "pool tasks waiting at the frame's end (injection queues and workers' deques)")              \
+    X(POOL_INJECT_PEAK, "pool_inject_peak", COUNT,                                                 \
+      "longest the pool's injection queue grew during the frame (requests from other threads)")    \
     X(RESIDENT_BYTES, "resident_bytes", COUNT,                                                     \
       "resident memory after the frame (/proc/self/statm)")                                        \
     X(CAPTURED, "captured", INDEX, "1 if the frame was written as PNG")
@@ -74,6 +96,7 @@ typedef enum sw_rt_prof_kind {
     SW_RT_KIND_STAGE,  /* on the submitting thread: the stages add up to frame_ms */
     SW_RT_KIND_VSTAGE, /* on the visibility thread (threaded runs): beside frame_ms, not in it */
     SW_RT_KIND_GPU,    /* ms on the GPU (timer queries): overlaps the submitting thread's stages */
+    SW_RT_KIND_POOL,   /* ms in pool tasks, summed over the pool's threads: beside frame_ms */
     SW_RT_KIND_COUNT
 } sw_rt_prof_kind;
 
@@ -114,6 +137,12 @@ typedef struct sw_rt_profile {
  * columns, a frame drawn in one call in the stage columns. */
 void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, double frame_ms,
                        double resident_bytes, int captured, sw_rt_prof_row *out);
+/* The pool columns of a row: per kind, `now` minus `before` (two samples of the pool's
+ * statistics, at the end of the previous frame and of this one; zeros before the pool exists),
+ * the tasks queued at this frame's end (sw_th_pool_queued) and the injection queue's peak
+ * during it (sw_th_pool_inject_peak_take). */
+void sw_rt_profile_row_pool(const sw_th_pool_stats *before, const sw_th_pool_stats *now,
+                            int64_t queued, int64_t inject_peak, sw_rt_prof_row *row);
 /* Appends a row. Returns 0, or -1 when out of memory. */
 int sw_rt_profile_push(sw_rt_profile *p, const sw_rt_prof_row *row);
 void sw_rt_profile_free(sw_rt_profile *p);

@@ -66,6 +66,7 @@ typedef struct sw_rt_scene {
     const struct sw_sg_bvh *prebuilt_bvh;     /* = pick_bvh of a version; NULL otherwise */
     struct sw_lod_face_cones *prebuilt_cones; /* owned */
     uint32_t *face_nodes;                     /* owned; n_faces entries */
+    uint32_t *mesh_nodes;                     /* owned; n_meshes entries (NULL: none) */
 } sw_rt_scene;
 
 /* A new scene holding sg (one reference, the caller's; NULL on failure, sg then freed). */
@@ -111,5 +112,12 @@ int sw_rt_view_parse(const char *text, sw_view_preset *out);
  * 0 with the outputs set, -1 for a stale handle or another thread. */
 int sw_rt_renderer_trim_atlas(sw_renderer renderer, uint32_t *texture, int32_t *pages,
                               int32_t *side);
+/* The renderer's worker pool, borrowed until the renderer is destroyed, for the profile's
+ * per-frame pool statistics (sw_th_pool_stats_get, sw_th_pool_queued: any thread). NULL before
+ * the first frame made it, for a stale handle or another thread than the owner. */
+struct sw_th_pool *sw_rt_renderer_pool_ptr(sw_renderer renderer);
+/* Times the pool's tasks by kind (sw_th_pool_desc.time_tasks) from now on: the pool's, or the
+ * one the first frame makes. Owner thread; 0, or -1 for a stale handle or another thread. */
+int sw_rt_renderer_time_pool_tasks(sw_renderer renderer, int on);
 
 #endif

@@ -5,13 +5,20 @@
  *  - the same face at a finer granularity: a BVH over its Bézier patches' control-net boxes
  *    (sw_sg_bvh_build_boxes);
  *  - grids of >= 10,000 terrain instances made by sw_sg_generate_grid (the library behind
- *    `splinewalk generate grid`), 3D and 2D: a BVH over instance occurrences.
+ *    `splinewalk generate grid`), 3D and 2D: a BVH over instance occurrences;
+ *  - with static LODs (lod/sw_lod_static_set.h), the static set's BVH whose leaves are
+ *    super-surface (unit) instances, on terrain.brep, on a grid of 10,000 terrain instances and on
+ *    a grid of 400 CrankArms (25 units each: 10,000 unit instances). First the instances
+ *    themselves: every face occurrence of the scene's traversal in exactly one instance, of its
+ *    face's unit and transform, no (unit, transform) twice, each leaf's box the unit's box
+ *    through the transform (checked against a traversal of our own).
  * For random cameras of six classes (inside the model, outside looking at it, outside looking
  * away, looking along the grid's rows from its side, seeing a corner of it, a narrow field of
  * view) with and without a far plane:
  *  - the visible set is exactly the set of items whose own box a brute-force test finds not
  *    outside the frustum (every item, every plane, all eight corners: independent of the
- *    nearest/farthest-corner code under test);
+ *    nearest/farthest-corner code under test), and the class reported with each item (wholly or
+ *    partly inside) is the brute-force class of its own box;
  *  - the traversal's counts are exactly what a brute-force classification of every node implies:
  *    a node is visited iff all its ancestors are partly visible internal nodes, so
  *    visited = 1 + 2 x (partly visible internal nodes visited), and the items tested one by one
@@ -19,8 +26,9 @@
  *    stopped at partly visible ones, breaks these);
  *  - visited <= 2 x frontier - 1 + 2 x wasted exactly, and visited <= 16 (visible + log2 n): see
  *    bound_holds() for why the second is a guard and not a theorem.
- * Usage: test_bvh_cull TERRAIN.brep
+ * Usage: test_bvh_cull TERRAIN.brep CRANKARM.brep
  */
+#include "sw_lod_static_set.h"
 #include "sw_sg_bvh.h"
 #include "sw_sg_generate.h"
 #include "sw_sg_import.h"
@@ -246,13 +254,15 @@ static shape tree_shape(const sw_sg_bvh *t)
 /* ---- one camera ------------------------------------------------------------------------------ */
 typedef struct sink {
     unsigned char *seen;
+    unsigned char *cls; /* the class reported with each item */
     uint32_t last;
     int64_t n, out_of_order;
 } sink;
 
-static int take(void *ctx, uint32_t item)
+static int take(void *ctx, uint32_t item, sw_sg_cull_class cls)
 {
     sink *s = ctx;
+    s->cls[item] = (unsigned char)cls;
     s->out_of_order += s->n > 0 && item <= s->last;
     s->seen[item] = 1;
     s->last = item;
@@ -261,9 +271,10 @@ static int take(void *ctx, uint32_t item)
 }
 
 typedef struct result {
-    uint64_t visible, visited, wasted; /* wasted: visited nodes with no visible item below */
-    uint64_t frontier;                 /* visited nodes inside, or partly visible leaves with a
-                                          visible item: where the traversal stops on the set */
+    uint64_t visible, inside, visited,
+        wasted;        /* wasted: visited nodes with no visible item below */
+    uint64_t frontier; /* visited nodes inside, or partly visible leaves with a
+                          visible item: where the traversal stops on the set */
 } result;
 
 typedef struct work {
@@ -289,6 +300,16 @@ static void check_items(const sw_sg_bvh *t, const sw_sg_frustum *fr, const char 
           extra, (long long)s->n, vis);
     CHECK(s->out_of_order == 0, "%s: %lld items out of increasing order", what,
           (long long)s->out_of_order);
+    uint32_t wrong_class = 0;
+    for (uint32_t i = 0; i < t->n_items; ++i)
+        wrong_class += w->seen[i] && s->cls[i] != (unsigned char)brute_class(fr, t->items[i].box);
+    CHECK(wrong_class == 0, "%s: %u items reported with another class than their box's", what,
+          wrong_class);
+    uint64_t inside = 0;
+    for (uint32_t i = 0; i < t->n_items; ++i)
+        inside += w->seen[i] && s->cls[i] == SW_SG_CULL_INSIDE;
+    CHECK(st->items_inside == inside, "%s: %llu items counted inside, %llu reported so", what,
+          (unsigned long long)st->items_inside, (unsigned long long)inside);
 }
 
 /* The traversal's counts from a brute-force classification of every node. */
@@ -330,6 +351,7 @@ static void check_nodes(const sw_sg_bvh *t, const shape *sh, const sw_sg_frustum
           what, (unsigned long long)st->items_tested, (unsigned long long)tested);
     r->visited = st->nodes_visited;
     r->visible = st->items_visible;
+    r->inside = st->items_inside;
 }
 
 /* The output-sensitive bound. The visited nodes with a visible item below form a tree whose leaves
@@ -360,7 +382,7 @@ static int bound_holds(const result *r, double log2n)
 /* ---- per hierarchy --------------------------------------------------------------------------- */
 typedef struct class_sum {
     int cameras;
-    uint64_t visible_min, visible_max, visited_min, visited_max, wasted_max;
+    uint64_t visible_min, visible_max, visited_min, visited_max, wasted_max, inside_sum;
     double visible_sum, visited_sum, ratio_max; /* ratio: visited / (visible + log2 n) */
 } class_sum;
 
@@ -376,6 +398,7 @@ static void add_sum(class_sum *c, const result *r, double log2n)
     c->visited_max = r->visited > c->visited_max ? r->visited : c->visited_max;
     c->wasted_max = r->wasted > c->wasted_max ? r->wasted : c->wasted_max;
     c->visible_sum += (double)r->visible;
+    c->inside_sum += r->inside;
     c->visited_sum += (double)r->visited;
     const double ratio = (double)r->visited / ((double)r->visible + log2n);
     c->ratio_max = ratio > c->ratio_max ? ratio : c->ratio_max;
@@ -389,6 +412,7 @@ static void run_bvh(const sw_sg_bvh *t, const char *name)
            t->n_nodes, sh.n_leaves, sh.depth, log2n);
     work w = {calloc(t->n_items + 1, 1), calloc(t->n_items + 1, 1), calloc(t->n_nodes + 1, 1),
               calloc(t->n_nodes + 1, 1), calloc(t->n_items + 1, sizeof(uint32_t))};
+    unsigned char *reported = calloc(t->n_items + 1, 1);
     class_sum sums[N_CLASSES];
     memset(sums, 0, sizeof sums);
     for (int cls = 0; cls < N_CLASSES; ++cls) {
@@ -399,10 +423,10 @@ static void run_bvh(const sw_sg_bvh *t, const char *name)
             char what[96];
             snprintf(what, sizeof what, "%s, %s camera %d", name, k_class_name[cls], k);
             memset(w.seen, 0, t->n_items + 1);
-            sink s = {w.seen, 0, 0, 0};
+            sink s = {w.seen, reported, 0, 0, 0};
             sw_sg_bvh_cull_stats st;
             CHECK(sw_sg_bvh_cull(t, &fr, take, &s, &st) == 0, "%s: traversal stopped", what);
-            result r = {0, 0, 0, 0};
+            result r = {0, 0, 0, 0, 0};
             check_items(t, &fr, what, &w, &s, &st);
             check_nodes(t, &sh, &fr, what, &w, &st, &r);
             CHECK(bound_holds(&r, log2n),
@@ -412,14 +436,18 @@ static void run_bvh(const sw_sg_bvh *t, const char *name)
             add_sum(&sums[cls], &r, log2n);
         }
         const class_sum *c = &sums[cls];
-        printf(
-            "  %-19s %2d cameras: visible %llu..%llu (mean %.0f), visited %llu..%llu (mean %.0f), "
-            "wasted <= %llu, visited / (visible + log2 n) <= %.2f\n",
-            k_class_name[cls], c->cameras, (unsigned long long)c->visible_min,
-            (unsigned long long)c->visible_max, c->visible_sum / c->cameras,
-            (unsigned long long)c->visited_min, (unsigned long long)c->visited_max,
-            c->visited_sum / c->cameras, (unsigned long long)c->wasted_max, c->ratio_max);
+        printf("  %-19s %2d cameras: visible %llu..%llu (mean %.0f: %.0f wholly, %.0f partly, %.0f "
+               "not), visited %llu..%llu (mean %.0f), wasted <= %llu, visited / (visible + log2 n) "
+               "<= %.2f (c = %d)\n",
+               k_class_name[cls], c->cameras, (unsigned long long)c->visible_min,
+               (unsigned long long)c->visible_max, c->visible_sum / c->cameras,
+               (double)c->inside_sum / c->cameras,
+               (c->visible_sum - (double)c->inside_sum) / c->cameras,
+               t->n_items - c->visible_sum / c->cameras, (unsigned long long)c->visited_min,
+               (unsigned long long)c->visited_max, c->visited_sum / c->cameras,
+               (unsigned long long)c->wasted_max, c->ratio_max, GUARD);
     }
+    free(reported);
     free(w.seen);
     free(w.brute);
     free(w.cls);
@@ -511,10 +539,133 @@ static void grid(const sw_sg_scene *terrain, uint32_t count, int32_t dims)
     sw_sg_scene_free(g);
 }
 
+/* ---- super-surface (unit) instances ---------------------------------------------------------- */
+typedef struct occ_list {
+    uint32_t *face;
+    double (*world)[12];
+    size_t n, cap;
+} occ_list;
+
+static int list_occurrence(void *ctx, uint32_t face, const double world[12], const float color[4])
+{
+    (void)color;
+    occ_list *l = ctx;
+    if (l->n == l->cap) {
+        l->cap = l->cap ? 2 * l->cap : 1024;
+        l->face = realloc(l->face, l->cap * sizeof *l->face);
+        l->world = realloc(l->world, l->cap * sizeof *l->world);
+    }
+    l->face[l->n] = face;
+    memcpy(l->world[l->n++], world, sizeof *l->world);
+    return 0;
+}
+
+/* The instances partition the traversal's occurrences by (unit, transform), and each leaf box is
+ * the unit's (or the lone face's) box through the transform. */
+static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *set,
+                            const char *name)
+{
+    const sw_lod_static_instances *in = sw_lod_static_set_instances(set);
+    occ_list l = {NULL, NULL, 0, 0};
+    sw_sg_scene_traverse(scene, list_occurrence, &l);
+    CHECK(in->n_occs == l.n && in->bvh->n_items == in->n_instances,
+          "%s: %u occurrences in instances, %zu traversed; %u leaves, %u instances", name,
+          in->n_occs, l.n, in->bvh->n_items, in->n_instances);
+    /* every traversed occurrence found once in the instance of its unit and transform */
+    uint32_t *of_item = malloc((in->n_instances + 1) * sizeof *of_item);
+    for (uint32_t k = 0; k < in->bvh->n_items; ++k)
+        of_item[in->bvh->items[k].face] = k;
+    uint64_t misplaced = 0, bad_box = 0, twice = 0;
+    for (uint32_t i = 0; i < in->n_instances; ++i) {
+        const sw_lod_static_instance *ins = &in->instances[i];
+        const sw_sg_bvh_item *it = &in->bvh->items[of_item[i]];
+        for (uint32_t k = 0; k < ins->n_occ; ++k)
+            misplaced +=
+                sw_lod_static_set_unit_of(set, in->occs[ins->first_occ + k].face) != ins->unit;
+        double box[6];
+        const double *local = ins->unit != SW_LOD_STATIC_NO_UNIT
+                                  ? sw_lod_static_set_unit(set, ins->unit)->box
+                                  : in->face_boxes + 6 * (size_t)in->occs[ins->first_occ].face;
+        sw_sg_box_transform(it->world, local, box);
+        bad_box += memcmp(box, it->box, sizeof box) != 0 || ins->n_occ == 0 ||
+                   (ins->unit == SW_LOD_STATIC_NO_UNIT && ins->n_occ != 1);
+    }
+    /* occurrences matched to instances by (face, transform): each exactly once */
+    unsigned char *used = calloc(in->n_occs + 1, 1);
+    for (size_t j = 0; j < l.n; ++j) {
+        int found = 0;
+        const uint32_t unit = sw_lod_static_set_unit_of(set, l.face[j]);
+        for (uint32_t i = 0; i < in->n_instances && !found; ++i) {
+            const sw_lod_static_instance *ins = &in->instances[i];
+            if (ins->unit != unit ||
+                memcmp(in->bvh->items[of_item[i]].world, l.world[j], sizeof l.world[j]) != 0)
+                continue;
+            for (uint32_t k = 0; k < ins->n_occ && !found; ++k)
+                if (in->occs[ins->first_occ + k].face == l.face[j] && !used[ins->first_occ + k])
+                    found = used[ins->first_occ + k] = 1;
+        }
+        misplaced += !found;
+    }
+    for (uint32_t i = 0; i + 1 < in->n_instances && in->n_instances < 20000; ++i)
+        for (uint32_t j = i + 1; j < in->n_instances; ++j)
+            twice += in->instances[i].unit != SW_LOD_STATIC_NO_UNIT &&
+                     in->instances[i].unit == in->instances[j].unit &&
+                     memcmp(in->bvh->items[of_item[i]].world, in->bvh->items[of_item[j]].world,
+                            sizeof(double[12])) == 0;
+    CHECK(misplaced == 0 && bad_box == 0 && twice == 0,
+          "%s: %llu occurrences misplaced, %llu bad leaf boxes, %llu (unit, transform) pairs twice",
+          name, (unsigned long long)misplaced, (unsigned long long)bad_box,
+          (unsigned long long)twice);
+    const size_t bytes = sw_sg_bvh_memory(in->bvh) + in->n_instances * sizeof *in->instances +
+                         in->n_occs * sizeof *in->occs +
+                         sw_sg_scene_view_ptr(scene)->n_faces * 6 * sizeof(double);
+    printf("%s: %u units, %u face occurrences in %u unit instances (%zu bytes with their BVH)\n",
+           name, sw_lod_static_set_unit_count(set), in->n_occs, in->n_instances, bytes);
+    free(used);
+    free(of_item);
+    free(l.face);
+    free(l.world);
+}
+
+/* The static set of `scene` (clustering, units, instances; no LOD built) and its BVH culled. */
+static void unit_instances(const sw_sg_scene *scene, const char *name, uint32_t min_instances)
+{
+    sw_th_pool_desc pd = {0};
+    pd.worker_count = 1;
+    sw_th_pool *pool = NULL;
+    sw_lod_static_set *set = NULL;
+    sw_status st = {0};
+    if (sw_th_pool_create(&pd, &pool) != SW_OK ||
+        sw_lod_static_set_create(scene, pool, NULL, &set, &st) != SW_OK) {
+        CHECK(0, "%s: static set: %s", name, st.message);
+        sw_th_pool_destroy(pool);
+        return;
+    }
+    check_instances(scene, set, name);
+    const sw_lod_static_instances *in = sw_lod_static_set_instances(set);
+    CHECK(in->n_instances >= min_instances, "%s: %u unit instances, %u wanted", name,
+          in->n_instances, min_instances);
+    char what[128];
+    snprintf(what, sizeof what, "%s, super-surface instances", name);
+    run_bvh(in->bvh, what);
+    sw_lod_static_set_destroy(set);
+    sw_th_pool_destroy(pool);
+}
+
+static sw_sg_scene *grid_of(const sw_sg_scene *model, uint32_t count, int32_t dims)
+{
+    sw_sg_grid_desc d = {count, dims, 0.0, NULL, NULL};
+    sw_sg_scene *g = NULL;
+    sw_status st = {0};
+    if (sw_sg_generate_grid(model, &d, &g, NULL, &st) != SW_OK)
+        CHECK(0, "grid of %u: %s", count, st.message);
+    return g;
+}
+
 int main(int argc, char **argv)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: %s TERRAIN.brep\n", argv[0]);
+    if (argc != 3) {
+        fprintf(stderr, "usage: %s TERRAIN.brep CRANKARM.brep\n", argv[0]);
         return 2;
     }
     sw_sg_import_desc id = {argv[1], NULL, NULL, NULL};
@@ -528,6 +679,23 @@ int main(int argc, char **argv)
     terrain_patches(terrain);
     grid(terrain, 10000, 3);
     grid(terrain, 16384, 2);
+    unit_instances(terrain, "terrain.brep", 1);
+    sw_sg_scene *g = grid_of(terrain, 10000, 3);
+    if (g)
+        unit_instances(g, "grid of 10000 terrain instances", 10000);
+    sw_sg_scene_free(g);
+    sw_sg_import_desc cd = {argv[2], NULL, NULL, NULL};
+    sw_sg_scene *crank = NULL;
+    if (sw_sg_import_file(&cd, &crank, NULL, &st) != SW_OK) {
+        CHECK(0, "import %s: %s", argv[2], st.message);
+    } else {
+        unit_instances(crank, "CrankArm.brep", 1);
+        g = grid_of(crank, 400, 3);
+        if (g)
+            unit_instances(g, "grid of 400 CrankArms", 10000);
+        sw_sg_scene_free(g);
+    }
+    sw_sg_scene_free(crank);
     sw_sg_scene_free(terrain);
     puts(g_failures ? "FAIL" : "PASS");
     return g_failures ? 1 : 0;

@@ -42,6 +42,7 @@ model=$data/occ/Motor-c.brep
 "$sw" info motor.sws --json >info_sws.json || fail "info motor.sws"
 "$sw" info "$model" --json >info_brep.json || fail "info Motor-c.brep"
 grep -q '"faces": 223' info_sws.json || fail "info: Motor-c should have 223 faces: $(cat info_sws.json)"
+grep -q '"meshes": 0, "mesh_triangles": 0' info_sws.json || fail "info: Motor-c has no meshes: $(cat info_sws.json)"
 a=$(sed 's/"file": "[^"]*", //; s/"memory_bytes": [0-9]*//' info_sws.json)
 b=$(sed 's/"file": "[^"]*", //; s/"memory_bytes": [0-9]*//' info_brep.json)
 [ "$a" = "$b" ] || fail "info of the .sws differs from info of its source: $a vs $b"

@@ -13,19 +13,9 @@
 
 static inline sw_gpu_camera sw_test_view_camera(const double b[6], int iso)
 {
+    static const double iso_from[3] = {1, 1, 1}, front_from[3] = {0, -1, 0}, up[3] = {0, 0, 1};
     sw_gpu_camera c;
-    memset(&c, 0, sizeof c);
-    double diag = sqrt(pow(b[3] - b[0], 2) + pow(b[4] - b[1], 2) + pow(b[5] - b[2], 2));
-    double dist = diag / (2.0 * tan(20.0 * M_PI / 180.0)) * 1.1;
-    double dir[3] = {0.0, -1.0, 0.0};
-    if (iso)
-        dir[0] = dir[1] = dir[2] = 1.0 / sqrt(3.0);
-    for (int k = 0; k < 3; ++k) {
-        c.target[k] = 0.5 * (b[k] + b[3 + k]);
-        c.eye[k] = c.target[k] + dir[k] * dist;
-    }
-    c.up[2] = 1.0;
-    c.fovy_deg = 40.0;
+    sw_gpu_camera_fit_box(b, iso ? iso_from : front_from, up, &c);
     return c;
 }
 

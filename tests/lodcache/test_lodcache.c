@@ -308,7 +308,8 @@ static void hold_workers(sw_th_pool *pool, hold *h)
     atomic_store(&h->go, 0);
     sw_th_group_init(&h->group);
     for (uint32_t i = 0; i < n; ++i) {
-        const sw_th_task t = {hold_task, h, SW_TH_PRIORITY_FRAME, NULL, 0, &h->group};
+        const sw_th_task t = {hold_task, h, SW_TH_PRIORITY_FRAME, NULL, 0, &h->group,
+                              SW_TH_TASK_OTHER};
         sw_th_pool_submit(pool, &t);
     }
     while (atomic_load(&h->arrived) < (int)n)

@@ -18,7 +18,7 @@ for tool in xmllint jq awk; do
   command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
 done
 
-columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,resident_bytes,captured"
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
 
 # ---- help and usage ---------------------------------------------------------------------------
 "$sw" --help | grep -q '^  profile' || fail "splinewalk --help does not list profile"
@@ -40,6 +40,8 @@ pass "help texts, usage errors, documented columns"
 # ---- paths on the default scene -----------------------------------------------------------------
 "$sw" demo -o demo --data "$data" --size 64x48 >demo.txt 2>&1 || { fail "demo"; cat demo.txt; exit 1; }
 scene=demo/default.sws
+surfaces=$("$sw" info $scene | awk '$1 == "surfaces" { print $2 }')
+[ "$surfaces" -gt 0 ] 2>/dev/null || fail "splinewalk info: no surface count"
 "$sw" path orbit $scene -o orbit.path --frames 40 --seconds 8 >path.txt 2>&1 || { fail "path orbit"; cat path.txt; }
 "$sw" path fly $scene -o fly.path --frames 8 >>path.txt 2>&1 || { fail "path fly"; cat path.txt; }
 head -1 orbit.path | grep -qx 'splinewalk-path 1' || fail "orbit.path header: $(head -1 orbit.path)"
@@ -55,7 +57,7 @@ check_run() {
   local dir=$1 n=$2
   [ "$(head -1 "$dir/profile.csv")" = "$columns" ] || fail "$dir: CSV header: $(head -1 "$dir/profile.csv")"
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
-  awk -F, -v n=35 'NR > 1 {
+  awk -F, -v n=53 'NR > 1 {
       if (NF != n) { print "row " NR ": " NF " fields"; bad = 1 }
       for (i = 1; i <= NF; i++) if ($i !~ /^-?[0-9]+(\.[0-9]+)?$/) { print "row " NR " field " i ": " $i; bad = 1 }
       if ($1 != NR - 2) { print "row " NR ": frame " $1; bad = 1 }
@@ -72,7 +74,7 @@ check_run() {
   med_json=$(jq '.summary.frame_ms.median' "$dir/profile.json")
   awk -v a="$med_csv" -v b="$med_json" 'BEGIN { exit !(a - b < 0.001 && b - a < 0.001) }' ||
     fail "$dir: JSON median frame_ms $med_json, CSV gives $med_csv"
-  for s in hierarchy tessellate wait_visibility trim draw readback write other vis vis_hierarchy vis_tessellate; do
+  for s in hierarchy tessellate wait_visibility trim draw readback write other vis vis_hierarchy vis_tessellate pool_hierarchy pool_refine; do
     jq -e ".summary.${s}_ms | has(\"median\") and has(\"p90\") and has(\"p99\") and has(\"max\")" \
       "$dir/profile.json" >/dev/null || fail "$dir: summary lacks ${s}_ms"
   done
@@ -80,7 +82,7 @@ check_run() {
   xmllint --noout "$dir/report.html" 2>xml.txt || { fail "$dir: report.html not well-formed"; cat xml.txt; }
   grep -q '<svg' "$dir/report.html" || fail "$dir: report.html holds no SVG"
   local caps
-  caps=$(awk -F, 'NR > 1 && $35 == 1 { printf "%s ", $1 }' "$dir/profile.csv")
+  caps=$(awk -F, 'NR > 1 && $NF == 1 { printf "%s ", $1 }' "$dir/profile.csv")
   [ "$caps" = "0 $((n / 2)) $((n - 1)) " ] || fail "$dir: captured frames '$caps'"
   for f in $caps; do
     local png
@@ -90,6 +92,49 @@ check_run() {
   done
   [ "$(ls "$dir"/*.png | wc -l)" -eq 3 ] || fail "$dir: more PNGs than captures"
   ls -a "$dir" | grep -q '^\.profile-' && fail "$dir: staging directory left behind"
+  check_pool "$dir"
+}
+
+# check_pool DIR: the pool columns. Every task the renderer submits names its kind (no "other");
+# the first frame, which sees the scene first, ran hierarchy builds for some time; each face's
+# hierarchy is built once (builds <= surfaces); the pool's threads (the workers, plus the frame's
+# thread while a converged frame waits) cannot have spent more than (workers + 1) x the run's wall
+# time in tasks — in walkthrough mode, where only the workers run tasks and a running task's time
+# counts in the frames it spans, not even in any one frame (workers x frame_ms, plus 1 ms each for
+# the bookkeeping between frames); the visibility thread's requests went through the injection
+# queue in the first frame (peak > 0).
+check_pool() {
+  local dir=$1 workers wall
+  [ "$(column "$dir" pool_other_tasks | sort -u)" = 0 ] || fail "$dir: pool tasks of no kind"
+  column "$dir" pool_hierarchy_tasks | head -1 | awk '{ exit !($1 > 0) }' ||
+    fail "$dir: no hierarchy build in the first frame"
+  column "$dir" pool_hierarchy_ms | head -1 | awk '{ exit !($1 > 0) }' ||
+    fail "$dir: no hierarchy build time in the first frame"
+  column "$dir" pool_hierarchy_tasks | awk -v s="$surfaces" '{ n += $1 } END { exit !(n >= 1 && n <= s) }' ||
+    fail "$dir: $(column "$dir" pool_hierarchy_tasks | awk '{ n += $1 } END { print n }') hierarchy builds for $surfaces surfaces"
+  workers=$(jq .worker_threads "$dir/profile.json") wall=$(jq .wall_s "$dir/profile.json")
+  tail -n +2 "$dir/profile.csv" | awk -F, -v w="$workers" -v wall="$wall" '{
+      for (i = 34; i <= 41; i++) ms += $i }
+    END { printf "pool %.1f ms in a %.1f ms run on %d workers\n", ms, 1e3 * wall, w
+          exit !(ms > 0 && ms <= (w + 1) * 1e3 * wall * 1.01 + 1) }' >pool.txt ||
+    fail "$dir: pool time out of bounds: $(cat pool.txt)"
+  if [ "$(jq -r .mode "$dir/profile.json")" = walkthrough ]; then
+    tail -n +2 "$dir/profile.csv" | awk -F, -v w="$workers" '{
+        ms = 0; for (i = 34; i <= 41; i++) ms += $i
+        if (ms > w * ($3 + 1)) { printf "frame %d: pool %.2f ms in a %.2f ms frame\n", $1, ms, $3; bad = 1 } }
+      END { exit bad }' >frames.txt || fail "$dir: pool time above workers x frame: $(head -3 frames.txt)"
+  fi
+  column "$dir" pool_inject_peak | head -1 | awk '{ exit !($1 > 0) }' ||
+    fail "$dir: the first frame's requests did not show in pool_inject_peak"
+}
+
+# settled DIR: a run along the closed orbit comes round to where it started: in its last 4
+# frames every face in view has its hierarchy, so nothing is built, queued or injected any more.
+settled() {
+  for c in pool_queued pool_inject_peak pool_hierarchy_tasks; do
+    [ "$(column "$1" $c | tail -4 | sort -u)" = 0 ] ||
+      fail "$1: $c not 0 in the last 4 frames: $(column "$1" $c | tail -4 | tr '\n' ' ')"
+  done
 }
 
 # column VALUE of DIR: every row's value of a column, one a line.
@@ -112,6 +157,9 @@ check_run walk 40
 [ "$(column walk hierarchy_ms | sort -u)" = 0.0000 ] || fail "walkthrough: hierarchy waits"
 [ "$(column walk vis_hierarchy_ms | sort -u)" = 0.0000 ] || fail "walkthrough: hierarchy waits on the visibility thread"
 [ "$(column walk tessellate_ms | sort -u)" = 0.0000 ] || fail "threaded: tessellation counted on the submitting thread"
+[ "$(column walk pool_hierarchy_wait_tasks | sort -u)" = 0 ] || fail "walkthrough: a pool task waited for a build"
+settled walk
+pass "walkthrough pool: $(cat pool.txt); queue peak $(column walk pool_inject_peak | head -1) in frame 0, 0 at the end"
 column walk vis_ms | awk '!($1 > 0) { bad = 1 } END { exit bad }' || fail "threaded: a frame without visibility-thread time"
 stages_add_up walk 20 >median.txt || fail "threaded: the submitting thread's stages do not add up: $(cat median.txt)"
 pass "threaded: $(cat median.txt)"
@@ -125,6 +173,10 @@ pass "walkthrough: 40 frames, $(sed -n 's/^frame *\([0-9.]*\).*/\1/p' walk.txt) 
   >conv.txt 2>&1 || { fail "profile --converged"; cat conv.txt; }
 check_run conv 40
 [ "$(column conv fallback_draws | sort -u)" = 0 ] || fail "converged: fallback draws"
+column conv pool_hierarchy_wait_tasks | awk '{ n += $1 } END { exit !(n > 0) }' ||
+  fail "converged: no pool task waited for a hierarchy build"
+settled conv
+pass "converged pool: $(cat pool.txt)"
 stages_add_up conv 20 >median.txt || fail "converged: stages do not add up on the median frame: $(cat median.txt)"
 pass "converged: $(cat median.txt)"
 

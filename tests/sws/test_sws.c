@@ -1,8 +1,10 @@
 /* Tests of the scene container and the .sws file (scene.c, scene_validate.c, sws_file.c,
  * scene_stats.c): a round trip that must be bit-identical, traversal against transforms composed
  * independently here, and hostile files (truncated, flipped bytes, huge offsets, bad indices,
- * cycles) that must fail with the right result id and no crash. Run with `--write-seed DIR` it
- * only saves the test scene to DIR/scene.sws (the fuzzer's seed corpus). */
+ * cycles) that must fail with the right result id and no crash; triangle meshes round-tripped
+ * through the MESHES and INDICES sections, their occurrences, stats and the checks on them. Run
+ * with `--write-seed DIR` it only saves the test scenes to DIR/scene.sws and DIR/meshes.sws (the
+ * fuzzer's seed corpus). */
 #include "sws_test_scene.h"
 #include "sw_crc32c.h"
 
@@ -890,6 +892,192 @@ static void test_builder_rejects(void **state)
     assert_string_equal(sw_sg_surface_kind_str(999), "unknown");
 }
 
+/* ---- triangle meshes (sections MESHES and INDICES) ------------------------------------------ */
+
+/* A scene with a tetrahedron mesh (normals) under a transform and, drawn by an instance of its
+ * group, again; a flat quad mesh (no normals) at the root; one face (the file must hold both). */
+static sw_sg_builder *mesh_builder(void)
+{
+    sw_sg_builder *b = sw_sg_builder_create();
+    static const double tet[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const double tet_n[12] = {-1, -1, -1, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    static const uint32_t tet_t[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    static const double quad[12] = {-2, -2, 5, 2, -2, 5, 2, 2, 5, -2, 2, 5.5};
+    static const uint32_t quad_t[6] = {0, 1, 2, 0, 2, 3};
+    sw_sg_mesh_rec m;
+    memset(&m, 0, sizeof m);
+    m.n_vertices = 4, m.n_triangles = 4;
+    m.positions = sw_sg_builder_push_doubles(b, tet, 12);
+    m.normals = sw_sg_builder_push_doubles(b, tet_n, 12);
+    m.indices = sw_sg_builder_push_indices(b, tet_t, 12);
+    const uint32_t m0 = sw_sg_builder_add_mesh(b, &m);
+    m.n_triangles = 2;
+    m.positions = sw_sg_builder_push_doubles(b, quad, 12);
+    m.normals = SW_SG_NO_NORMALS;
+    m.indices = sw_sg_builder_push_indices(b, quad_t, 6);
+    const uint32_t m1 = sw_sg_builder_add_mesh(b, &m);
+    const double t[12] = {2, 0, 0, 1, 0, 2, 0, 0, 0, 0, 2, 0},
+                 shift[12] = {1, 0, 0, 0, 0, 1, 0, 7, 0, 0, 1, 0};
+    const uint32_t g = sw_sg_builder_add_node(b, SW_SG_NODE_TRANSFORM, 0, 0, t, sws_red, "tet");
+    sw_sg_builder_add_node(b, SW_SG_NODE_MESH, g, m0, NULL, NULL, NULL);
+    sw_sg_builder_add_node(b, SW_SG_NODE_INSTANCE, 0, g, shift, sws_green, NULL);
+    sw_sg_builder_add_node(b, SW_SG_NODE_MESH, 0, m1, NULL, NULL, "quad");
+    const uint32_t f = sws_test_face(b, 4, 0, 0, 0, SW_SG_KIND_OTHER);
+    sw_sg_builder_add_node(b, SW_SG_NODE_SURFACE, 0, f, NULL, NULL, NULL);
+    return b;
+}
+
+typedef struct mesh_occs {
+    uint32_t mesh[8], node[8];
+    double world[8][12];
+    float color[8][4];
+    int n;
+} mesh_occs;
+
+static int collect_mesh(void *ctx, uint32_t mesh, uint32_t node, const double world[12],
+                        const float color[4])
+{
+    mesh_occs *o = ctx;
+    if (o->n == 8)
+        return 1;
+    o->mesh[o->n] = mesh, o->node[o->n] = node;
+    memcpy(o->world[o->n], world, sizeof o->world[0]);
+    memcpy(o->color[o->n], color, sizeof o->color[0]);
+    o->n++;
+    return 0;
+}
+
+static void test_mesh_sections(void **state)
+{
+    (void)state;
+    sw_sg_scene *mem = NULL, *file = NULL;
+    sw_status st = {0};
+    assert_int_equal(sw_sg_builder_finish(mesh_builder(), &mem, &st), SW_OK);
+    char path[300], path2[300];
+    snprintf(path, sizeof path, "%s/meshes.sws", g_dir);
+    snprintf(path2, sizeof path2, "%s/meshes2.sws", g_dir);
+    assert_int_equal(sw_sg_scene_save(mem, path, &st), SW_OK);
+    assert_int_equal(sw_sg_scene_open(path, &file, &st), SW_OK);
+    assert_int_equal(sw_sg_scene_require(file, SW_SG_SEC_ALL, &st), SW_OK);
+    const sw_sg_scene_view *a = sw_sg_scene_view_ptr(mem), *b = sw_sg_scene_view_ptr(file);
+    assert_views_identical(a, b);
+    assert_int_equal(b->n_meshes, 2);
+    assert_int_equal(b->n_indices, 18);
+    assert_memory_equal(a->meshes, b->meshes, 2 * sizeof *a->meshes);
+    assert_memory_equal(a->indices, b->indices, 18 * sizeof *a->indices);
+    /* the boxes the builder computed are the positions' */
+    const double quad_box[6] = {-2, -2, 5, 2, 2, 5.5};
+    assert_memory_equal(b->meshes[1].box, quad_box, sizeof quad_box);
+    /* layout per docs/sws-format.md: 11 sections, MESHES id 9 of 88-byte records, INDICES id 10 */
+    size_t len = 0;
+    unsigned char *img = read_all(path, &len);
+    assert_non_null(img);
+    assert_int_equal(rd32(img + 16), 11);
+    const uint64_t table = rd64(img + HDR_TABLE);
+    assert_int_equal(rd32(img + table + 9 * ENTRY), 9);
+    assert_int_equal(rd64(img + table + 9 * ENTRY + 16), 2 * 88);
+    assert_int_equal(rd32(img + table + 10 * ENTRY), 10);
+    assert_int_equal(rd64(img + table + 10 * ENTRY + 24), 18);
+    /* re-saving the mapped scene writes the same bytes */
+    assert_int_equal(sw_sg_scene_save(file, path2, &st), SW_OK);
+    size_t len2 = 0;
+    unsigned char *img2 = read_all(path2, &len2);
+    assert_int_equal(len, len2);
+    assert_memory_equal(img, img2, len);
+    /* occurrences: the tetrahedron under T and under shift * T, the quad at the root */
+    mesh_occs o = {0};
+    assert_int_equal(sw_sg_scene_traverse_meshes(file, collect_mesh, &o), SW_OK);
+    assert_int_equal(o.n, 3);
+    int seen_shifted = 0, seen_quad = 0;
+    for (int k = 0; k < o.n; k++) {
+        if (o.mesh[k] == 1) {
+            seen_quad++;
+            assert_true(o.world[k][0] == 1.0 && o.world[k][3] == 0.0);
+        } else if (o.world[k][7] == 7.0) {
+            seen_shifted++;
+            assert_true(o.world[k][0] == 2.0 && o.world[k][3] == 1.0);
+        } else {
+            assert_true(o.world[k][0] == 2.0 && o.world[k][3] == 1.0 && o.world[k][7] == 0.0);
+        }
+        assert_int_equal(b->nodes[o.node[k]].kind, SW_SG_NODE_MESH);
+    }
+    assert_int_equal(seen_shifted, 1);
+    assert_int_equal(seen_quad, 1);
+    sw_sg_scene_stats stats;
+    assert_int_equal(sw_sg_scene_compute_stats(file, &stats), SW_OK);
+    assert_int_equal(stats.meshes, 2);
+    assert_int_equal(stats.mesh_triangles, 6);
+    assert_int_equal(stats.mesh_occurrences, 3);
+    assert_int_equal(stats.triangle_occurrences, 10);
+    assert_true(stats.bbox[5] == 5.5 && stats.bbox[4] == 9.0); /* quad's top; shifted tet's y */
+
+    /* a flipped byte in MESHES is a checksum error naming it */
+    unsigned char *bad = malloc(len);
+    memcpy(bad, img, len);
+    bad[rd64(img + table + 9 * ENTRY + 8) + 3] ^= 1;
+    sw_sg_scene *s = NULL;
+    char p[300];
+    assert_int_equal(open_image(bad, len, &s, &st, p), SW_OK);
+    assert_int_equal(sw_sg_scene_require(s, SW_SG_SEC_ALL, &st), SW_ERR_CHECKSUM);
+    assert_non_null(strstr(st.message, "section MESHES at offset"));
+    sw_sg_scene_free(s);
+    /* a stored box that is not the positions' box, checksums made right: a format error */
+    memcpy(bad, img, len);
+    const uint64_t mo = rd64(img + table + 9 * ENTRY + 8);
+    double big = 100.0;
+    memcpy(bad + mo + 88 + 40 + 3 * 8, &big, 8); /* mesh 1, box max x */
+    wr32(bad + table + 9 * ENTRY + 32, sw__crc32c(0, bad + mo, 176));
+    uint32_t crc = sw__crc32c(0, bad, HDR_CRC);
+    wr32(bad + HDR_CRC, sw__crc32c(crc, bad + table, 11 * ENTRY));
+    assert_int_equal(open_image(bad, len, &s, &st, p), SW_OK);
+    assert_int_equal(sw_sg_scene_require(s, SW_SG_SEC_ALL, &st), SW_ERR_FORMAT);
+    char want[64];
+    snprintf(want, sizeof want, "mesh 1 at offset %llu", (unsigned long long)(mo + 88));
+    assert_non_null(strstr(st.message, want));
+    sw_sg_scene_free(s);
+    /* cut inside INDICES: truncated */
+    assert_int_equal(open_image(img, len - 12, &s, &st, p), SW_ERR_TRUNCATED);
+    free(bad);
+    free(img);
+    free(img2);
+    sw_sg_scene_free(mem);
+    sw_sg_scene_free(file);
+}
+
+static void test_mesh_builder_rejects(void **state)
+{
+    (void)state;
+    static const double pts[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const uint32_t bad_tri[3] = {0, 1, 3};
+    sw_status st = {0};
+    sw_sg_scene *s = NULL;
+    /* an index past the vertices */
+    sw_sg_builder *b = sw_sg_builder_create();
+    sw_sg_mesh_rec m;
+    memset(&m, 0, sizeof m);
+    m.n_vertices = 3, m.n_triangles = 1;
+    m.positions = sw_sg_builder_push_doubles(b, pts, 9);
+    m.normals = SW_SG_NO_NORMALS;
+    m.indices = sw_sg_builder_push_indices(b, bad_tri, 3);
+    sw_sg_builder_add_node(b, SW_SG_NODE_MESH, 0, sw_sg_builder_add_mesh(b, &m), NULL, NULL, NULL);
+    assert_int_equal(sw_sg_builder_finish(b, &s, &st), SW_ERR_FORMAT);
+    assert_non_null(strstr(st.message, "mesh 0: index 2 (triangle 0) is 3 of 3 vertices"));
+    /* a mesh node naming a mesh that does not exist */
+    b = sw_sg_builder_create();
+    sw_sg_builder_add_node(b, SW_SG_NODE_MESH, 0, 0, NULL, NULL, NULL);
+    assert_int_equal(sw_sg_builder_finish(b, &s, &st), SW_ERR_FORMAT);
+    /* a non-finite position */
+    b = sw_sg_builder_create();
+    const double nan_pts[9] = {0, 0, 0, 1, NAN, 0, 0, 1, 0};
+    static const uint32_t tri[3] = {0, 1, 2};
+    m.positions = sw_sg_builder_push_doubles(b, nan_pts, 9);
+    m.indices = sw_sg_builder_push_indices(b, tri, 3);
+    sw_sg_builder_add_mesh(b, &m);
+    assert_int_equal(sw_sg_builder_finish(b, &s, &st), SW_ERR_INVALID_GEOMETRY);
+    assert_non_null(strstr(st.message, "mesh 0: vertex 1"));
+    assert_null(s);
+}
+
 static int write_seed(const char *dir)
 {
     char p[4096];
@@ -898,6 +1086,14 @@ static int write_seed(const char *dir)
     sw_sg_scene *s = NULL;
     sw_status st = {0};
     if (sw_sg_builder_finish(sws_test_builder(), &s, &st) != SW_OK ||
+        sw_sg_scene_save(s, p, &st) != SW_OK) {
+        fprintf(stderr, "%s\n", st.message);
+        return 1;
+    }
+    sw_sg_scene_free(s);
+    /* and one with meshes: the fuzzer starts from the MESHES and INDICES sections too */
+    snprintf(p, sizeof p, "%s/meshes.sws", dir);
+    if (sw_sg_builder_finish(mesh_builder(), &s, &st) != SW_OK ||
         sw_sg_scene_save(s, p, &st) != SW_OK) {
         fprintf(stderr, "%s\n", st.message);
         return 1;
@@ -925,6 +1121,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_missing_file),
         cmocka_unit_test(test_failed_saves),
         cmocka_unit_test(test_builder_rejects),
+        cmocka_unit_test(test_mesh_sections),
+        cmocka_unit_test(test_mesh_builder_rejects),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }

@@ -1,6 +1,7 @@
 /* tests/threads: worker-pool behaviour (threads/sw_th_pool.h) — cancellation of stale requests,
- * priorities, group waiters that help, fork-join from tasks, shutdown that drains, and idle
- * workers that sleep instead of spinning. */
+ * priorities, group waiters that help, fork-join from tasks, shutdown that drains, idle
+ * workers that sleep instead of spinning, and the accounting by task kind (counts, own time of
+ * nested tasks, time of running tasks, queue lengths, the injection peak). */
 #include "sw_th_pool.h"
 
 #include <sched.h>
@@ -432,14 +433,276 @@ static void test_idle_workers_sleep(void **state)
     sw_th_pool_destroy(h.pool);
 }
 
+/* ---- accounting: kinds, queue lengths, timing ----------------------------------------------- */
+
+typedef struct kind_spawner {
+    sw_th_pool *pool;
+    sw_th_group *group;
+    gate *g;
+    _Atomic int children_ran;
+} kind_spawner;
+
+static void child_fn(void *ctx)
+{
+    kind_spawner *sp = ctx;
+    atomic_fetch_add(&sp->children_ran, 1);
+}
+
+/* Submits 4 HIERARCHY children to its worker's own deque, then holds the worker until opened. */
+static void hold_after_spawning_fn(void *ctx)
+{
+    kind_spawner *sp = ctx;
+    for (int i = 0; i < 4; i++) {
+        sw_th_task t = {
+            .fn = child_fn, .ctx = sp, .group = sp->group, .kind = SW_TH_TASK_HIERARCHY};
+        assert_int_equal(sw_th_pool_submit(sp->pool, &t), SW_OK);
+    }
+    gate_fn(sp->g);
+}
+
+/* One worker held by a COMPILE task that queued 4 children in its deque; 5 FRAME tasks and 3
+ * BACKGROUND ones injected from here: the queue holds exactly 12 (9 + 3 by priority) while
+ * nothing can move, the injection peak is the 5 of the FRAME queue (the children never went
+ * through it), and once everything ran each kind counts exactly its own tasks, untimed. */
+static void test_kinds_and_queue(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = pool_with(1);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    gate g = {0};
+    kind_spawner sp = {.pool = pool, .group = &grp, .g = &g};
+    sw_th_task hold = {
+        .fn = hold_after_spawning_fn, .ctx = &sp, .group = &grp, .kind = SW_TH_TASK_COMPILE};
+    assert_int_equal(sw_th_pool_submit(pool, &hold), SW_OK);
+    while (!atomic_load(&g.running))
+        sched_yield();
+    assert_int_equal(sw_th_pool_inject_peak_take(pool), 1); /* the hold task itself */
+    for (int i = 0; i < 8; i++) {
+        sw_th_task t = {.fn = child_fn,
+                        .ctx = &sp,
+                        .group = &grp,
+                        .priority = i < 5 ? SW_TH_PRIORITY_FRAME : SW_TH_PRIORITY_BACKGROUND,
+                        .kind = i < 5 ? SW_TH_TASK_REFINE : SW_TH_TASK_STATIC_BUILD};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    }
+    int64_t by[SW_TH_PRIORITY_COUNT] = {0};
+    assert_int_equal(sw_th_pool_queued(pool, by), 12);
+    assert_int_equal(by[SW_TH_PRIORITY_FRAME], 9);
+    assert_int_equal(by[SW_TH_PRIORITY_BACKGROUND], 3);
+    assert_int_equal(sw_th_pool_inject_peak_take(pool), 5);
+    assert_int_equal(sw_th_pool_inject_peak_take(pool), 0);
+    atomic_store(&g.open, 1);
+    sw_th_group_wait(pool, &grp);
+    assert_int_equal(atomic_load(&sp.children_ran), 12);
+    assert_int_equal(sw_th_pool_queued(pool, NULL), 0);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    const uint64_t want[SW_TH_TASK_KIND_COUNT] = {[SW_TH_TASK_COMPILE] = 1,
+                                                  [SW_TH_TASK_HIERARCHY] = 4,
+                                                  [SW_TH_TASK_REFINE] = 5,
+                                                  [SW_TH_TASK_STATIC_BUILD] = 3};
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        assert_int_equal(st.executed_by_kind[k], want[k]);
+        assert_int_equal(st.ns_by_kind[k], 0); /* timing is off by default */
+    }
+    assert_int_equal(st.executed, 13);
+    sw_th_pool_destroy(pool);
+    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_STATIC_BUILD), "static_build");
+    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_KIND_COUNT), "?");
+}
+
+enum { NAP_MS = 30 };
+
+static void nap_fn(void *ctx)
+{
+    (void)ctx;
+    sleep_ms(NAP_MS);
+}
+
+typedef struct waiter {
+    sw_th_pool *pool;
+} waiter;
+
+/* Runs two naps in a group and waits for them: on a one-worker pool it runs them itself,
+ * nested in sw_th_group_wait. */
+static void wait_for_naps_fn(void *ctx)
+{
+    waiter *w = ctx;
+    sw_th_group naps;
+    sw_th_group_init(&naps);
+    for (int i = 0; i < 2; i++) {
+        sw_th_task t = {.fn = nap_fn, .group = &naps, .kind = SW_TH_TASK_HIERARCHY};
+        assert_int_equal(sw_th_pool_submit(w->pool, &t), SW_OK);
+    }
+    sw_th_group_wait(w->pool, &naps);
+}
+
+/* Timed: the two nested naps count >= 2 x 30 ms under HIERARCHY, and the waiting task only its
+ * own time (not the naps again: well under one nap). Untimed again: a further nap is counted
+ * but adds no time. */
+static void test_kind_timing_nested(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc d = {.worker_count = 1, .time_tasks = 1};
+    assert_int_equal(sw_th_pool_create(&d, &pool), SW_OK);
+    waiter w = {pool};
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    sw_th_task t = {
+        .fn = wait_for_naps_fn, .ctx = &w, .group = &grp, .kind = SW_TH_TASK_HIERARCHY_WAIT};
+    assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    while (sw_th_group_pending(&grp) > 0) /* polls: a helping caller could take a nap itself */
+        sleep_ms(1);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    print_message("naps %.3f ms, their waiter's own time %.3f ms\n",
+                  1e-6 * (double)st.ns_by_kind[SW_TH_TASK_HIERARCHY],
+                  1e-6 * (double)st.ns_by_kind[SW_TH_TASK_HIERARCHY_WAIT]);
+    assert_int_equal(st.executed_by_kind[SW_TH_TASK_HIERARCHY], 2);
+    assert_int_equal(st.executed_by_kind[SW_TH_TASK_HIERARCHY_WAIT], 1);
+    assert_true(st.ns_by_kind[SW_TH_TASK_HIERARCHY] >= 2u * NAP_MS * 1000000u);
+    assert_true(st.ns_by_kind[SW_TH_TASK_HIERARCHY_WAIT] < NAP_MS * 1000000u);
+    sw_th_pool_set_task_timing(pool, 0);
+    sw_th_task nap = {.fn = nap_fn, .group = &grp, .kind = SW_TH_TASK_HIERARCHY};
+    assert_int_equal(sw_th_pool_submit(pool, &nap), SW_OK);
+    while (sw_th_group_pending(&grp) > 0)
+        sleep_ms(1);
+    sw_th_pool_stats st2;
+    sw_th_pool_stats_get(pool, &st2);
+    assert_int_equal(st2.executed_by_kind[SW_TH_TASK_HIERARCHY], 3);
+    assert_int_equal(st2.ns_by_kind[SW_TH_TASK_HIERARCHY], st.ns_by_kind[SW_TH_TASK_HIERARCHY]);
+    sw_th_pool_destroy(pool);
+}
+
+/* A timed task's time shows while it runs, not only once it ends: half way through a 200 ms
+ * STATIC_BUILD task the pool reports >= 90 ms of it and none ended; after it, >= 200 ms. */
+static void test_kind_time_while_running(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc d = {.worker_count = 1, .time_tasks = 1};
+    assert_int_equal(sw_th_pool_create(&d, &pool), SW_OK);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    gate g = {0};
+    sw_th_task hold = {.fn = gate_fn, .ctx = &g, .group = &grp, .kind = SW_TH_TASK_STATIC_BUILD};
+    assert_int_equal(sw_th_pool_submit(pool, &hold), SW_OK);
+    while (!atomic_load(&g.running))
+        sched_yield();
+    sleep_ms(100);
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    const double half = 1e-6 * (double)st.ns_by_kind[SW_TH_TASK_STATIC_BUILD];
+    assert_int_equal(st.executed_by_kind[SW_TH_TASK_STATIC_BUILD], 0);
+    assert_true(half >= 90.0);
+    sleep_ms(100);
+    atomic_store(&g.open, 1);
+    while (sw_th_group_pending(&grp) > 0)
+        sleep_ms(1);
+    sw_th_pool_stats_get(pool, &st);
+    const double whole = 1e-6 * (double)st.ns_by_kind[SW_TH_TASK_STATIC_BUILD];
+    print_message("a 200 ms task: %.1f ms half way, %.1f ms at its end\n", half, whole);
+    assert_int_equal(st.executed_by_kind[SW_TH_TASK_STATIC_BUILD], 1);
+    assert_true(whole >= 200.0 && whole >= half);
+    sw_th_pool_destroy(pool);
+}
+
+/* A binary tree of tasks whose kind is its depth mod the kind count: level d of a tree of depth
+ * TREE_DEPTH holds 2^(TREE_DEPTH - d) tasks. Roots come through the injection queue, the rest
+ * through the workers' deques. */
+enum { TREE_DEPTH = 9, TREE_ROOTS = 40 };
+
+typedef struct kind_level {
+    sw_th_pool *pool;
+    sw_th_group *group;
+    sw_th_task_kind kind;     /* of this level's tasks */
+    struct kind_level *below; /* NULL at depth 0 */
+} kind_level;
+
+static void kind_tree_fn(void *ctx)
+{
+    kind_level *l = ctx;
+    for (int i = 0; l->below && i < 2; i++) {
+        sw_th_task t = {
+            .fn = kind_tree_fn, .ctx = l->below, .group = l->group, .kind = l->below->kind};
+        assert_int_equal(sw_th_pool_submit(l->pool, &t), SW_OK);
+    }
+}
+
+/* Three timed workers run 40 trees of mixed kinds while this thread samples the statistics: every
+ * sample's per-kind counts and times only grow and the queue is never negative; at the end each
+ * kind counts exactly its tasks (single-writer counters lose nothing), and under TSan the
+ * samplers' reads race with nothing. */
+static void test_kind_counts_concurrent(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = NULL;
+    sw_th_pool_desc d = {.worker_count = 3, .time_tasks = 1};
+    assert_int_equal(sw_th_pool_create(&d, &pool), SW_OK);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    kind_level levels[TREE_DEPTH + 1];
+    uint64_t want[SW_TH_TASK_KIND_COUNT] = {0};
+    for (int depth = 0; depth <= TREE_DEPTH; depth++) {
+        levels[depth] = (kind_level){pool, &grp, (sw_th_task_kind)(depth % SW_TH_TASK_KIND_COUNT),
+                                     depth ? &levels[depth - 1] : NULL};
+        want[depth % SW_TH_TASK_KIND_COUNT] += (uint64_t)TREE_ROOTS << (TREE_DEPTH - depth);
+    }
+    for (int r = 0; r < TREE_ROOTS; r++) {
+        sw_th_task t = {.fn = kind_tree_fn,
+                        .ctx = &levels[TREE_DEPTH],
+                        .group = &grp,
+                        .kind = levels[TREE_DEPTH].kind};
+        assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    }
+    sw_th_pool_stats prev = {0};
+    int samples = 0;
+    while (sw_th_group_pending(&grp) > 0) { /* polls: stats only, no helping */
+        sw_th_pool_stats st;
+        sw_th_pool_stats_get(pool, &st);
+        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+            assert_true(st.executed_by_kind[k] >= prev.executed_by_kind[k]);
+            /* a running task's time so far may run ahead of its end by a store buffer's delay
+             * (sw_th_pool_stats.ns_by_kind): 100 us is thousands of times that */
+            assert_true(st.ns_by_kind[k] + 100000u >= prev.ns_by_kind[k]);
+        }
+        assert_true(sw_th_pool_queued(pool, NULL) >= 0);
+        assert_true(sw_th_pool_inject_peak_take(pool) <= TREE_ROOTS);
+        prev = st;
+        samples++;
+    }
+    sw_th_pool_stats st;
+    sw_th_pool_stats_get(pool, &st);
+    uint64_t all = 0;
+    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        assert_int_equal(st.executed_by_kind[k], want[k]);
+        all += want[k];
+    }
+    assert_int_equal(st.executed, all);
+    assert_int_equal(sw_th_pool_queued(pool, NULL), 0);
+    print_message("%d samples while %llu tasks of %d kinds ran\n", samples, (unsigned long long)all,
+                  (int)SW_TH_TASK_KIND_COUNT);
+    sw_th_pool_destroy(pool);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_cancel_external),    cmocka_unit_test(test_cancel_from_task),
-        cmocka_unit_test(test_priority_external),  cmocka_unit_test(test_priority_local),
-        cmocka_unit_test(test_group_wait_helps),   cmocka_unit_test(test_fork_join),
-        cmocka_unit_test(test_shutdown_drains),    cmocka_unit_test(test_no_lost_wakeup),
+        cmocka_unit_test(test_cancel_external),
+        cmocka_unit_test(test_cancel_from_task),
+        cmocka_unit_test(test_priority_external),
+        cmocka_unit_test(test_priority_local),
+        cmocka_unit_test(test_group_wait_helps),
+        cmocka_unit_test(test_fork_join),
+        cmocka_unit_test(test_shutdown_drains),
+        cmocka_unit_test(test_no_lost_wakeup),
         cmocka_unit_test(test_idle_workers_sleep),
+        cmocka_unit_test(test_kinds_and_queue),
+        cmocka_unit_test(test_kind_timing_nested),
+        cmocka_unit_test(test_kind_counts_concurrent),
+        cmocka_unit_test(test_kind_time_while_running),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

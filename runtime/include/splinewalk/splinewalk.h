@@ -110,8 +110,12 @@ typedef struct sw_scene_info {
     uint32_t nodes, instances;
     uint64_t face_occurrences; /* faces drawn, instances expanded */
     uint32_t adjacent_face_pairs;
-    double bbox_min[3], bbox_max[3];
+    double bbox_min[3], bbox_max[3]; /* of the surfaces and the meshes */
     size_t memory_bytes;
+    uint32_t meshes;               /* triangle meshes (sw_nodes.h MESH nodes; .sws MESHES) */
+    uint64_t mesh_triangles;       /* their triangles, each mesh once */
+    uint64_t mesh_occurrences;     /* meshes drawn, instances expanded */
+    uint64_t triangle_occurrences; /* their triangles, instances expanded */
 } sw_scene_info;
 
 /* Describes the scene (the first call on a scene verifies it and walks it once). Any thread.
@@ -129,13 +133,19 @@ typedef struct sw_pick_hit {
     double t;            /* point = origin + t * direction, t > 0 */
     double point[3];     /* world */
     double uv[2];        /* the surface's parameters at the point (inside its trim loops) */
-    sw_node node;        /* node scenes (sw_nodes.h): the NURBS, TSPLINE or IMPORT node holding
-                            the surface, as it was when the picked version was compiled; {0} for
-                            scenes loaded from files */
+    sw_node node;        /* node scenes (sw_nodes.h): the NURBS, TSPLINE, IMPORT or MESH node
+                            holding the surface or mesh, as it was when the picked version was
+                            compiled; {0} for scenes loaded from files */
+    /* A mesh hit (surface = UINT32_MAX then, uv zero): the mesh as counted by
+     * sw_scene_info.meshes, the triangle's index in it and the barycentric weights of its three
+     * vertices at the point. mesh = UINT32_MAX for a surface hit. */
+    uint32_t mesh, triangle;
+    double barycentric[3];
 } sw_pick_hit;
 
 /* The nearest point where the ray origin + t direction (t > 0; direction not unit, not zero) meets
- * a trimmed surface of the scene, through a BVH over the scene's surface occurrences (built by the
+ * a trimmed surface or a mesh triangle of the scene (meshes: each occurrence's box, then its
+ * triangles, Möller-Trumbore), through a BVH over the scene's surface occurrences (built by the
  * first pick and kept with the scene), Bézier subdivision and Newton's method on the exact NURBS
  * surface. A ray tangent to a surface may miss it. Any thread. Errors: SW_ERR_INVALID_ARGUMENT
  * (NULL pointer, zero or non-finite ray), SW_ERR_STALE_HANDLE, SW_ERR_OUT_OF_MEMORY,
@@ -271,6 +281,9 @@ typedef struct sw_frame_stats {
     uint64_t static_faces;     /* face instances they cover (of faces_drawn) */
     uint64_t static_triangles; /* their triangles (of triangles) */
     uint64_t static_requests;  /* walkthrough: builds queued instead of waited for */
+    /* triangle meshes (sw_nodes.h MESH nodes) */
+    uint64_t meshes_drawn, meshes_culled; /* mesh occurrences inside / outside the frustum */
+    uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so

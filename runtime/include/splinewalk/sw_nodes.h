@@ -2,8 +2,9 @@
  *
  * A node scene is an sw_scene like a loaded one (sw_renderer_draw, sw_scene_save, sw_scene_pick,
  * sw_scene_get_info and sw_camera_fit take its handle), whose content the host builds and edits:
- * groups, transforms, instances of node subtrees, trimmed NURBS surfaces, T-splines, cameras, and
- * files imported under a node (OpenCASCADE for STEP / IGES / BREP, or .sws / .tsm).
+ * groups, transforms, instances of node subtrees, trimmed NURBS surfaces, T-splines, triangle
+ * meshes, cameras, and files imported under a node (OpenCASCADE for STEP / IGES / BREP, or .sws /
+ * .tsm).
  *
  * Versions. The node tree is the mutable model; what is drawn is an immutable compiled version
  * (the scene graph's own scene, its BVH and its back-patch cones), made in the scene's worker
@@ -35,8 +36,11 @@
  *
  * Ownership. Descs and the arrays they point at are read during the call only (copied).
  *
- * Not here yet: triangle-mesh nodes. The renderer draws trimmed NURBS surfaces only (its triangle
- * path is the static LODs it derives itself), so a mesh node could not be drawn as given.
+ * Meshes. A MESH node's triangles are drawn as given (the renderer's triangle path, the one its
+ * static LODs take): depth-tested with the surfaces, coloured and lit like them, culled by their
+ * box, but with no screen-space error bound of their own — a mesh is as exact as its author made
+ * it. sw_scene_save writes them into the .sws file (docs/sws-format.md, sections MESHES and
+ * INDICES), sw_scene_pick hits them (the triangle and its barycentric weights).
  */
 #ifndef SPLINEWALK_SW_NODES_H
 #define SPLINEWALK_SW_NODES_H
@@ -119,6 +123,17 @@ typedef struct sw_tspline_desc {
     double domain[4];      /* u0, u1, v0, v1 (u0 < u1, v0 < v1); required with the arrays */
 } sw_tspline_desc;
 
+/* A triangle mesh. Counter-clockwise triangles face their front (shading is two-sided: both sides
+ * are lit alike). */
+typedef struct sw_mesh_desc {
+    uint32_t vertex_count;   /* 3..2^24 */
+    const double *positions; /* vertex_count * 3 (x, y, z), finite */
+    const double *normals;   /* vertex_count * 3, finite and non-zero (normalised when copied);
+                                NULL: each triangle shaded flat with its own normal */
+    uint32_t triangle_count; /* 1..2^24 */
+    const uint32_t *indices; /* triangle_count * 3 vertex indices, each < vertex_count */
+} sw_mesh_desc;
+
 /* ---- nodes ----------------------------------------------------------------------------------- */
 typedef enum sw_node_kind {
     SW_NODE_GROUP = 0,     /* children under the parent's frame */
@@ -128,6 +143,7 @@ typedef enum sw_node_kind {
     SW_NODE_TSPLINE = 4,   /* a T-spline (`tspline`) under `transform` */
     SW_NODE_CAMERA = 5,    /* a camera (`camera`) in the parent's frame; draws nothing */
     SW_NODE_IMPORT = 6,    /* the content of `import_path` under `transform` */
+    SW_NODE_MESH = 7,      /* a triangle mesh (`mesh`) under `transform` */
     SW_NODE_KIND_COUNT
 } sw_node_kind;
 
@@ -140,7 +156,7 @@ typedef struct sw_node_desc {
     int32_t hidden;       /* 1: the node and its subtree are not drawn, nor are instances of it */
     float color[4];       /* linear RGBA; color[3] == 0 (all zero): the parent's colour */
     double transform[12]; /* row-major 3x4, local to parent; all zero: identity. Read for
-                             TRANSFORM, INSTANCE, NURBS, TSPLINE and IMPORT */
+                             TRANSFORM, INSTANCE, NURBS, TSPLINE, IMPORT and MESH */
     sw_node instance_of;  /* INSTANCE: the node whose subtree it draws (not one of its own
                              ancestors, nor a subtree that instances them) */
     const sw_nurbs_desc *nurbs;     /* NURBS: required */
@@ -150,6 +166,7 @@ typedef struct sw_node_desc {
                                        or .tsm; read once, during sw_node_add */
     sw_warning_fn import_warning;   /* IMPORT: faces that could not be converted; NULL: none */
     void *user_data;                /* passed to import_warning, on the calling thread */
+    const sw_mesh_desc *mesh;       /* MESH: required */
 } sw_node_desc;
 
 /* Adds a node as the last child of desc->parent (or detached). Any thread; an IMPORT reads and
@@ -158,10 +175,20 @@ typedef struct sw_node_desc {
  * out of range; a parent that is not a GROUP or TRANSFORM; a missing kind-specific pointer; an
  * instance that would draw itself; a non-finite transform, colour or camera),
  * SW_ERR_STALE_HANDLE (scene, parent or instance_of), SW_ERR_INVALID_GEOMETRY (the surface,
- * T-spline or trim loops, with the index at fault), SW_ERR_LIMIT (65,535 nodes per scene; sizes),
- * SW_ERR_OUT_OF_MEMORY, and those of sw_scene_load for IMPORT and a .tsm path. */
+ * T-spline, trim loops or mesh, with the index at fault), SW_ERR_LIMIT (65,535 nodes per scene;
+ * sizes), SW_ERR_OUT_OF_MEMORY, and those of sw_scene_load for IMPORT and a .tsm path. */
 SW_API sw_result sw_node_add(sw_scene scene, const sw_node_desc *desc, sw_node *out,
                              sw_status *status);
+
+/* Adds a MESH node: sw_node_add with desc->kind = SW_NODE_MESH and desc->mesh = mesh (node may be
+ * NULL: a visible mesh under the root, identity transform, inherited colour; its kind and mesh
+ * fields are ignored). Any thread. *out = {0} on failure, and the scene is unchanged. Errors: as
+ * sw_node_add, and for the mesh: SW_ERR_INVALID_ARGUMENT (NULL mesh, positions or indices),
+ * SW_ERR_LIMIT (vertex_count or triangle_count out of range), SW_ERR_INVALID_GEOMETRY (a
+ * non-finite position, a non-finite or zero normal, an index >= vertex_count: the message names
+ * the vertex or the index and its triangle). */
+SW_API sw_result sw_node_add_mesh(sw_scene scene, const sw_node_desc *node,
+                                  const sw_mesh_desc *mesh, sw_node *out, sw_status *status);
 
 /* Removes the node and its subtree; their handles go stale. Any thread. Errors:
  * SW_ERR_STALE_HANDLE (scene or node: also a node removed before — a double remove),
@@ -191,6 +218,11 @@ SW_API sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_
  * for a node that is not TSPLINE), and those of reading a .tsm file. */
 SW_API sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_desc *desc,
                                      sw_status *status);
+/* The same for a MESH node: new vertices and triangles (any counts). Errors: as
+ * sw_node_set_nurbs (SW_ERR_INVALID_ARGUMENT for a node that is not MESH), and those of the mesh
+ * as sw_node_add_mesh lists them; the node keeps its mesh then. */
+SW_API sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *desc,
+                                  sw_status *status);
 
 typedef struct sw_node_info {
     sw_node_kind kind;
@@ -201,6 +233,8 @@ typedef struct sw_node_info {
     double transform[12]; /* local (identity for GROUP and CAMERA) */
     uint32_t faces;       /* surfaces the node holds itself (NURBS 1, TSPLINE its Bézier
                              patches, IMPORT the file's faces; 0 otherwise) */
+    uint32_t triangles;   /* mesh triangles the node holds itself (MESH its mesh's, IMPORT a
+                             .sws file's meshes'; 0 otherwise) */
 } sw_node_info;
 
 /* Any thread; never waits. Errors: SW_ERR_INVALID_ARGUMENT (NULL out, a loaded scene),
