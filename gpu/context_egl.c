@@ -4,6 +4,7 @@
  * into an FBO with RGBA8 colour and 32-bit float depth for reversed-Z.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_th_pool.h"
 #include "sw_status_util.h"
 
@@ -192,7 +193,8 @@ static sw_result make_context(sw_gpu_context *ctx, sw_status *status)
 }
 
 /* The objects every frame uses, in the current context. Reversed-Z needs zero-to-one clip depth:
- * an adopted context is switched too (and stays so: a host drawing with reversed-Z wants it). */
+ * an owned context keeps it from here on; an adopted one gets it back (with the rest of the host's
+ * state) after this and has it set again for every frame (host_state.c). */
 static sw_result make_gl_objects(sw_gpu_context *ctx, sw_status *status)
 {
     ctx->gl_ready = 1;
@@ -212,17 +214,24 @@ static sw_result context_create(sw_result (*make)(sw_gpu_context *, sw_status *)
                                 sw_gpu_context **out, sw_status *status)
 {
     *out = NULL;
-    sw_gpu_context *ctx = calloc(1, sizeof *ctx);
+    sw_gpu_context *ctx = sw__calloc(1, sizeof *ctx);
     if (ctx)
-        ctx->walk_token = calloc(1, sizeof *ctx->walk_token);
+        ctx->walk_token = sw__calloc(1, sizeof *ctx->walk_token);
     if (!ctx || !ctx->walk_token) {
-        free(ctx);
+        sw__free(ctx);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
     }
     sw_th_token_init(ctx->walk_token);
     sw_result r = make(ctx, status);
-    if (r == SW_OK)
+    if (r == SW_OK) {
+        sw__gpu_host_state host; /* an adopted context: the host's state stays as it was */
+        const int adopted = sw__gpu_context_adopted(ctx);
+        if (adopted)
+            sw__gpu_host_state_save(&host);
         r = make_gl_objects(ctx, status);
+        if (adopted)
+            sw__gpu_host_state_restore(&host);
+    }
     if (r != SW_OK) {
         sw_gpu_context_free(ctx);
         return r;
@@ -260,6 +269,10 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
     if (!ctx)
         return;
     sw__gpu_make_current(ctx); /* its objects are deleted in its own context */
+    sw__gpu_host_state host;
+    const int adopted = ctx->gl_ready && sw__gpu_context_adopted(ctx);
+    if (adopted) /* deleting may bind on the way: the host's bindings come back */
+        sw__gpu_host_state_save(&host);
     if (ctx->gl_ready) {
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);
@@ -270,12 +283,14 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         glDeleteRenderbuffers(1, &ctx->rb_color);
         glDeleteRenderbuffers(1, &ctx->rb_depth);
     }
+    if (adopted)
+        sw__gpu_host_state_restore(&host);
     if (ctx->egl_context) {
         eglMakeCurrent(ctx->egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(ctx->egl_display, ctx->egl_context);
     }
-    free(ctx->walk_token);
-    free(ctx);
+    sw__free(ctx->walk_token);
+    sw__free(ctx);
 }
 
 const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx)

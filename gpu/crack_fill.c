@@ -40,6 +40,7 @@
  * width_px beyond the face.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -246,7 +247,7 @@ static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
         gr->cell[k] = hi[k] > gr->lo[k] ? (hi[k] - gr->lo[k]) / side : 1.0;
     }
     size_t cells = (size_t)gr->g[0] * (size_t)gr->g[1];
-    gr->start = calloc(cells + 1, sizeof *gr->start);
+    gr->start = sw__calloc(cells + 1, sizeof *gr->start);
     if (!gr->start)
         return 0;
     size_t total = 0;
@@ -264,7 +265,7 @@ static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
         }
         if (pass == 0) {
             if (total > UINT32_MAX ||
-                !(gr->items = malloc((total ? total : 1) * sizeof *gr->items)))
+                !(gr->items = sw__malloc((total ? total : 1) * sizeof *gr->items)))
                 return 0;
             for (size_t c = 0; c < cells; ++c)
                 gr->start[c + 1] += gr->start[c];
@@ -278,8 +279,8 @@ static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
 
 static void loop_grid_free(loop_grid *gr)
 {
-    free(gr->start);
-    free(gr->items);
+    sw__free(gr->start);
+    sw__free(gr->items);
 }
 
 /* Smallest s in (0, s_max] at which p + s r crosses a loop segment; s_max if none. Crossings at
@@ -459,10 +460,10 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
     sw_result r = sw__gpu_mesh_reserve(mesh, 4 * m, 6 * m, status);
     if (r != SW_OK)
         return r;
-    border_point *bp = malloc(m * sizeof *bp);
+    border_point *bp = sw__malloc(m * sizeof *bp);
     loop_grid grid = {0};
     if (!bp || !loop_grid_build(&grid, uv, n)) {
-        free(bp);
+        sw__free(bp);
         loop_grid_free(&grid);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "fat border: out of memory");
     }
@@ -484,6 +485,6 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
     ribbon_ctx c = {v, srf, world, &grid, left_inside ? 1.0 : -1.0, width_px, st_box};
     emit_ribbon(&c, bp, thin_samples(v, bp, m, 0.25 * width_px), mesh);
     loop_grid_free(&grid);
-    free(bp);
+    sw__free(bp);
     return SW_OK;
 }

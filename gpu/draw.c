@@ -4,6 +4,7 @@
  * depth. Also sw_gpu_render_triangles, the path an independent reference mesh is drawn with.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -109,11 +110,11 @@ sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->capture_ssbo);
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof count, &count);
     size_t m = count < ctx->capture_max ? count : ctx->capture_max;
-    float *raw = malloc((m ? m : 1) * 8 * sizeof *raw);
-    sw__gpu_capture_vertex *v = malloc((m ? m : 1) * sizeof *v);
+    float *raw = sw__malloc((m ? m : 1) * 8 * sizeof *raw);
+    sw__gpu_capture_vertex *v = sw__malloc((m ? m : 1) * sizeof *v);
     if (!raw || !v) {
-        free(raw);
-        free(v);
+        sw__free(raw);
+        sw__free(v);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "capture: out of memory");
     }
     glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 16, (GLsizeiptr)(m * 32), raw);
@@ -125,7 +126,7 @@ sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out
         v[i].t = raw[8 * i + 2];
         memcpy(v[i].pos, &raw[8 * i + 4], sizeof v[i].pos);
     }
-    free(raw);
+    sw__free(raw);
     *out = v;
     *n = m;
     *total = count;
@@ -224,20 +225,6 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     return sw__gpu_check(status, "frame draw");
 }
 
-void sw__gpu_host_state_save(sw__gpu_host_state *s)
-{
-    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fb);
-    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &s->read_fb);
-    glGetIntegerv(GL_VIEWPORT, s->viewport);
-}
-
-void sw__gpu_host_state_restore(const sw__gpu_host_state *s)
-{
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)s->draw_fb);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)s->read_fb);
-    glViewport(s->viewport[0], s->viewport[1], s->viewport[2], s->viewport[3]);
-}
-
 sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
                           const sw__gpu_host_state *host, sw_status *status)
 {
@@ -261,11 +248,11 @@ sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int wa
     size_t n = (size_t)w * (size_t)h;
     memset(out, 0, sizeof *out);
     _Static_assert(sizeof(float) == 4, "RGBA8 and float depth share the readback buffer");
-    uint8_t *tmp = malloc(n * 4);
-    out->rgba = malloc(n * 4);
-    out->depth = want_depth ? malloc(n * sizeof *out->depth) : NULL;
+    uint8_t *tmp = sw__malloc(n * 4);
+    out->rgba = sw__malloc(n * 4);
+    out->depth = want_depth ? sw__malloc(n * sizeof *out->depth) : NULL;
     if (!tmp || !out->rgba || (want_depth && !out->depth)) {
-        free(tmp);
+        sw__free(tmp);
         sw_gpu_image_free(out);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame readback: out of memory");
     }
@@ -281,7 +268,7 @@ sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int wa
         for (size_t i = 0; i < n; ++i)
             out->depth[i] = sw__gpu_depth_to_eye(view, out->depth[i]);
     }
-    free(tmp);
+    sw__free(tmp);
     sw_result r = sw__gpu_check(status, "frame readback");
     if (r != SW_OK)
         sw_gpu_image_free(out);
@@ -292,8 +279,8 @@ void sw_gpu_image_free(sw_gpu_image *img)
 {
     if (!img)
         return;
-    free(img->rgba);
-    free(img->depth);
+    sw__free(img->rgba);
+    sw__free(img->depth);
     img->rgba = NULL;
     img->depth = NULL;
 }

@@ -12,6 +12,7 @@
  * texture generation, waited for), draw (upload and draw until glFinish), readback.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_lod_bezier.h"
 #include "sw_lod_face_cones.h"
 #include "sw_lod_sampling.h"
@@ -113,7 +114,7 @@ static sw_result face_bezier(frame *f, uint32_t face, const sw_sg_bezier_set **o
                              sw_status *status)
 {
     if (!f->bez[face]) {
-        sw_sg_bezier_set *set = calloc(1, sizeof *set);
+        sw_sg_bezier_set *set = sw__calloc(1, sizeof *set);
         if (!set)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", face);
         const double *b = f->sv->faces[face].uv_box;
@@ -121,7 +122,7 @@ static sw_result face_bezier(frame *f, uint32_t face, const sw_sg_bezier_set **o
         sw_sg_scene_face_surface(f->scene, face, &s);
         sw_result r = sw_sg_surface_extract_bezier_in(&s, b[0], b[1], b[2], b[3], set, status);
         if (r != SW_OK) {
-            free(set);
+            sw__free(set);
             return r;
         }
         f->bez[face] = set;
@@ -652,7 +653,7 @@ static int cell_key_cmp(const void *a, const void *b)
 /* Unifies nu over every cell of a refined column (dir 0) or nv over a row (dir 1). */
 static int unify_cells(tiling *t, int dir)
 {
-    cell_key *k = malloc((t->n_cells ? t->n_cells : 1) * sizeof *k);
+    cell_key *k = sw__malloc((t->n_cells ? t->n_cells : 1) * sizeof *k);
     if (!k)
         return 0;
     size_t m = 0;
@@ -677,7 +678,7 @@ static int unify_cells(tiling *t, int dir)
         for (; a < b; ++a)
             *(dir ? &t->cells[k[a].cell].nv : &t->cells[k[a].cell].nu) = mx;
     }
-    free(k);
+    sw__free(k);
     return 1;
 }
 
@@ -690,7 +691,7 @@ sw_result sw__fr_face_loops(frame *f, uint32_t face, double tol, int64_t *index,
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     face_loops *fl = &f->loops[f->n_loops];
     fl->n = 0;
-    fl->loops = calloc(rec->n_loops ? rec->n_loops : 1, sizeof *fl->loops);
+    fl->loops = sw__calloc(rec->n_loops ? rec->n_loops : 1, sizeof *fl->loops);
     if (!fl->loops)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     *index = (int64_t)f->n_loops++;
@@ -811,7 +812,7 @@ static sw_result tiled_face(frame *f, const occurrence *o, const sw_sg_bezier_se
         md = md > (set->patches[p].deg_u + 1) * (set->patches[p].deg_v + 1)
                  ? md
                  : (set->patches[p].deg_u + 1) * (set->patches[p].deg_v + 1);
-    t.scratch = malloc((size_t)md * 4 * sizeof *t.scratch);
+    t.scratch = sw__malloc((size_t)md * 4 * sizeof *t.scratch);
     int ok = t.scratch != NULL;
     while (ok && !find_tiles(&t, 0, t.ku, 0, t.kv) && t.n_tiles >= MAX_TILES_PER_FACE) {
         t.n_tiles = 0; /* too many visible tiles: coarser ones */
@@ -825,9 +826,9 @@ static sw_result tiled_face(frame *f, const occurrence *o, const sw_sg_bezier_se
     sw_result r =
         ok ? tiled_draws(&t, sign, on_gpu, status)
            : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u tiles: out of memory", o->face);
-    free(t.scratch);
-    free(t.tiles);
-    free(t.cells);
+    sw__free(t.scratch);
+    sw__free(t.tiles);
+    sw__free(t.cells);
     return r;
 }
 
@@ -850,11 +851,11 @@ sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status)
     size_t n = (size_t)n_cols * (size_t)n_rows, n_cp = 0;
     for (size_t p = 0; p < n; ++p)
         n_cp += (size_t)(set->patches[p].deg_u + 1) * (size_t)(set->patches[p].deg_v + 1);
-    sw__gpu_patch *pt = calloc(n ? n : 1, sizeof *pt);
-    double *cpw = malloc((n_cp ? n_cp : 1) * 4 * sizeof *cpw);
+    sw__gpu_patch *pt = sw__calloc(n ? n : 1, sizeof *pt);
+    double *cpw = sw__malloc((n_cp ? n_cp : 1) * 4 * sizeof *cpw);
     if (!pt || !cpw) {
-        free(pt);
-        free(cpw);
+        sw__free(pt);
+        sw__free(cpw);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     }
     trim_need need = {1.0, 1.0};
@@ -912,8 +913,8 @@ sw_result sw__fr_draw_face(frame *f, const occurrence *o, sw_status *status)
     } else {
         f->st.faces_culled++;
     }
-    free(pt);
-    free(cpw);
+    sw__free(pt);
+    sw__free(cpw);
     if (r == SW_OK && (double)f->mesh.n_v + f->gpu_vertices > k_max_frame_vertices)
         r = sw__fail(status, SW_ERR_LIMIT,
                      "frame needs more than %.0f grid vertices (error %g px too small for this "
@@ -967,7 +968,7 @@ static sw_result collect_all(frame *f, const sw_gpu_frame_desc *desc, double **b
     }
     if ((!desc->occurrences && sw_sg_scene_traverse(f->scene, collect, f) != SW_OK) || f->oom)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
-    double *boxes = malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes);
+    double *boxes = sw__malloc((f->n_occ ? f->n_occ : 1) * 6 * sizeof *boxes);
     if (!boxes)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
     sw__fr_box_empty(scene_box);
@@ -1152,7 +1153,7 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     if (r == SW_OK)
         r = sw__fr_meshes_draw(f, &meshes, status);
     sw__fr_meshes_free(&meshes);
-    free(boxes);
+    sw__free(boxes);
     return r;
 }
 
@@ -1208,7 +1209,7 @@ static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, s
     const face_loops *fl = &f->loops[t->loops];
     double mu = (r[1] - r[0]) / w, mv = (r[3] - r[2]) / h;
     const double g[4] = {r[0] - mu, r[1] + mu, r[2] - mv, r[3] + mv};
-    sw_sg_polyline *clipped = calloc(fl->n ? fl->n : 1, sizeof *clipped);
+    sw_sg_polyline *clipped = sw__calloc(fl->n ? fl->n : 1, sizeof *clipped);
     if (!clipped)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->face);
     sw_result res = sw__gpu_trim_clip_loops(fl->loops, fl->n, g, clipped, status);
@@ -1218,7 +1219,7 @@ static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, s
         for (uint32_t k = 0; k < fl->n; ++k)
             sw_sg_polyline_free(&clipped[k]);
     }
-    free(clipped);
+    sw__free(clipped);
     return res;
 }
 
@@ -1239,7 +1240,7 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     if (id >= 0 && !border)
         return SW_OK;
     double tol = 0.5 * fmin((ub[1] - ub[0]) / w, (ub[3] - ub[2]) / h);
-    sw_sg_polyline *loops = calloc(rec->n_loops, sizeof *loops);
+    sw_sg_polyline *loops = sw__calloc(rec->n_loops, sizeof *loops);
     if (!loops)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", t->face);
     sw_result r = SW_OK;
@@ -1256,7 +1257,7 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
                               status);
     for (uint32_t k = 0; k < rec->n_loops; ++k)
         sw_sg_polyline_free(&loops[k]);
-    free(loops);
+    sw__free(loops);
     return r;
 }
 
@@ -1385,26 +1386,26 @@ static void frame_free(frame *f)
         for (uint32_t i = 0; i < f->sv->n_faces; ++i) {
             if (f->bez[i]) {
                 sw_sg_bezier_set_free(f->bez[i]);
-                free(f->bez[i]);
+                sw__free(f->bez[i]);
             }
         }
     }
-    free(f->bez);
-    free(f->occ);
-    free(f->draws);
-    free(f->trims);
+    sw__free(f->bez);
+    sw__free(f->occ);
+    sw__free(f->draws);
+    sw__free(f->trims);
     for (size_t i = 0; i < f->n_loops; ++i) {
         for (uint32_t k = 0; k < f->loops[i].n; ++k)
             sw_sg_polyline_free(&f->loops[i].loops[k]);
-        free(f->loops[i].loops);
+        sw__free(f->loops[i].loops);
     }
-    free(f->loops);
-    free(f->pieces);
-    free(f->knots);
-    free(f->dcps);
-    free(f->shares);
-    free(f->recs);
-    free(f->cps);
+    sw__free(f->loops);
+    sw__free(f->pieces);
+    sw__free(f->knots);
+    sw__free(f->dcps);
+    sw__free(f->shares);
+    sw__free(f->recs);
+    sw__free(f->cps);
     sw__gpu_mesh_free(&f->mesh);
 }
 
@@ -1433,7 +1434,7 @@ void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan)
         return;
     plan_release_reader(plan);
     frame_free(&plan->f);
-    free(plan);
+    sw__free(plan);
 }
 
 double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan)
@@ -1458,7 +1459,7 @@ static sw_result plan_init(sw_gpu_frame_plan *p, sw_gpu_context *ctx, const sw_s
     if (f->statics && sw_lod_static_set_scene(f->statics) != scene)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "frame: the static LODs belong to another scene");
-    f->bez = calloc(f->sv->n_faces ? f->sv->n_faces : 1, sizeof *f->bez);
+    f->bez = sw__calloc(f->sv->n_faces ? f->sv->n_faces : 1, sizeof *f->bez);
     if (!f->bez)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
     if (!p->desc.hierarchies)
@@ -1481,7 +1482,7 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
 {
     *out = NULL;
     double t0 = sw__gpu_now_ms();
-    sw_gpu_frame_plan *p = calloc(1, sizeof *p);
+    sw_gpu_frame_plan *p = sw__calloc(1, sizeof *p);
     if (!p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
     sw__gpu_desc_defaults(desc, &p->desc);
@@ -1509,7 +1510,8 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
                                 : sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                                            "frame: the plan was prepared for another context");
     sw__gpu_host_state host;
-    if (desc->present)
+    const int host_state = desc->present || sw__gpu_context_adopted(ctx);
+    if (host_state)
         sw__gpu_host_state_save(&host);
     double t1 = sw__gpu_now_ms();
     /* GPU time of the trim textures and the draw, by two GL_TIMESTAMP queries (the second one
@@ -1537,7 +1539,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
         r = sw__gpu_present(ctx, &f->view, &host, status);
     if (r == SW_OK && !desc->no_readback)
         r = sw__gpu_readback(ctx, &f->view, desc->want_depth, out, status);
-    if (desc->present)
+    if (host_state)
         sw__gpu_host_state_restore(&host);
     double t4 = sw__gpu_now_ms();
 

@@ -22,6 +22,7 @@
  * not show in trimmed-away parts.
  */
 #include "frame_internal.h"
+#include "sw_hooks.h"
 #include "sw_lod_bezier.h"
 #include "sw_status_util.h"
 
@@ -277,10 +278,10 @@ static void hl_face_init(hl_face *hf, frame *f, const occurrence *o, const sw_lo
 
 static void hl_face_free(hl_face *hf)
 {
-    free(hf->stack);
-    free(hf->chosen);
-    free(hf->refine_nodes);
-    free(hf->refine_tol);
+    sw__free(hf->stack);
+    sw__free(hf->chosen);
+    sw__free(hf->refine_nodes);
+    sw__free(hf->refine_tol);
 }
 
 /* ---- converged mode: build and refine before drawing ------------------------------------------ */
@@ -654,7 +655,7 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
     if (sw__fr_det3(o->world) < 0.0)
         sign = -sign;
     int on_gpu = f->ctx->eval_mode == SW__GPU_EVAL_AUTO;
-    sw__gpu_patch *pts = malloc((hf->n_chosen ? hf->n_chosen : 1) * sizeof *pts);
+    sw__gpu_patch *pts = sw__malloc((hf->n_chosen ? hf->n_chosen : 1) * sizeof *pts);
     if (!pts)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     double cell[2] = {INFINITY, INFINITY};
@@ -677,7 +678,7 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
     } else {
         f->st.faces_culled++;
     }
-    free(pts);
+    sw__free(pts);
     return r;
 }
 

@@ -10,6 +10,7 @@
  * no screen-space error bound applies to it. Its boxes join the scene box before the view is set,
  * so the near plane leaves a mesh close to the eye in front of it. */
 #include "frame_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <stdlib.h>
@@ -175,6 +176,6 @@ sw_result sw__fr_meshes_draw(frame *f, const sw__fr_meshes *fm, sw_status *statu
 
 void sw__fr_meshes_free(sw__fr_meshes *fm)
 {
-    free(fm->occ);
+    sw__free(fm->occ);
     memset(fm, 0, sizeof *fm);
 }

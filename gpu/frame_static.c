@@ -28,6 +28,7 @@
  * between two sides each within ε_img (gpu/crack_fill.c argues the width). The overlap is sized
  * from both sides' errors because both are bounded by the same ε_img. */
 #include "frame_internal.h"
+#include "sw_hooks.h"
 #include "sw_lod_static_set.h"
 #include "sw_status_util.h"
 

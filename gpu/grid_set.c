@@ -7,6 +7,7 @@
  * so a grid is only connectivity. Triangles split each cell like patch_grid.c's CPU grids.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <stdlib.h>
@@ -33,7 +34,7 @@ sw_result sw__gpu_grids_create(sw_gpu_context *ctx, sw_status *status)
         for (int a = 0; a < SW__GPU_GRID_CLASSES; ++a)
             total +=
                 (size_t)6 * (size_t)sw__gpu_grid_segments[a] * (size_t)sw__gpu_grid_segments[b];
-    uint32_t *idx = malloc(total * sizeof *idx);
+    uint32_t *idx = sw__malloc(total * sizeof *idx);
     if (!idx)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid set: out of memory");
     uint32_t *o = idx;
@@ -49,7 +50,7 @@ sw_result sw__gpu_grids_create(sw_gpu_context *ctx, sw_status *status)
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->grid_ibo);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(total * sizeof *idx), idx, GL_STATIC_DRAW);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, 0);
-    free(idx);
+    sw__free(idx);
     glGenBuffers(1, &ctx->patch_ssbo);
     glGenBuffers(1, &ctx->cp_ssbo);
     glGenBuffers(1, &ctx->piece_ssbo);
@@ -69,11 +70,11 @@ void sw__gpu_grids_free(sw_gpu_context *ctx)
     ctx->piece_ssbo = ctx->knot_ssbo = ctx->dcp_ssbo = 0;
     glDeleteBuffers(1, &ctx->capture_ssbo);
     ctx->capture_ssbo = 0;
-    free(ctx->rec_source);
+    sw__free(ctx->rec_source);
     ctx->rec_source = NULL;
     ctx->cap_rec_source = 0;
     ctx->grid_ibo = ctx->patch_ssbo = ctx->cp_ssbo = 0;
-    free(ctx->recs_sorted);
+    sw__free(ctx->recs_sorted);
     ctx->recs_sorted = NULL;
     ctx->cap_recs_sorted = 0;
 }

@@ -6,6 +6,7 @@
  * Positions leave in float relative to the eye (ARCHITECTURE.md: precision).
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -14,8 +15,8 @@
 
 void sw__gpu_mesh_free(sw__gpu_mesh *m)
 {
-    free(m->v);
-    free(m->idx);
+    sw__free(m->v);
+    sw__free(m->idx);
     memset(m, 0, sizeof *m);
 }
 
@@ -26,7 +27,7 @@ int sw__gpu_grow(void **p, size_t *cap, size_t need, size_t elem)
     size_t c = *cap ? *cap * 2 : 64;
     while (c < need)
         c *= 2;
-    void *q = realloc(*p, c * elem);
+    void *q = sw__realloc(*p, c * elem);
     if (!q)
         return 0;
     *p = q;
@@ -185,7 +186,7 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
     sw_result r = sw__gpu_mesh_reserve(mesh, need_v, need_i, status);
     if (r != SW_OK)
         return r;
-    uint32_t **idx = calloc(n ? n : 1, sizeof *idx);
+    uint32_t **idx = sw__calloc(n ? n : 1, sizeof *idx);
     if (!idx)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid indices: out of memory");
     for (int32_t b = 0; b < n_rows && r == SW_OK; ++b) {
@@ -194,7 +195,7 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
             const sw__gpu_patch *pt = &patches[p];
             if (!pt->visible)
                 continue;
-            idx[p] = malloc((size_t)(pt->nu + 1) * (size_t)(pt->nv + 1) * sizeof **idx);
+            idx[p] = sw__malloc((size_t)(pt->nu + 1) * (size_t)(pt->nv + 1) * sizeof **idx);
             if (!idx[p]) {
                 r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid indices: out of memory");
                 break;
@@ -208,7 +209,7 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
         }
     }
     for (size_t p = 0; p < n; ++p)
-        free(idx[p]);
-    free(idx);
+        sw__free(idx[p]);
+    sw__free(idx);
     return r;
 }

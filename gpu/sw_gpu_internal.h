@@ -376,13 +376,44 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
                              const sw__gpu_draw *draws, size_t n_draws,
                              const sw__gpu_patch_batch *batch, sw_status *status);
-/* The caller's framebuffer bindings and viewport, saved when a presenting frame begins
- * (desc.present) and restored when it ends. */
+/* The host's GL state (host_state.c says which), saved and set to GL's defaults when the
+ * renderer starts working in an adopted context or on a presenting frame (desc.present), and
+ * restored when it ends. */
+#define SW__GPU_HOST_CAPS 33
+#define SW__GPU_HOST_BUFFERS 11
+#define SW__GPU_HOST_TEXTURES 11
+#define SW__GPU_HOST_PIXEL_STORE 16
+#define SW__GPU_HOST_INDEXED 16 /* uniform and shader storage ranges saved (and fewer if the
+                                   context has fewer) */
+typedef struct sw__gpu_host_range {
+    GLint buffer;
+    GLint64 start, size;
+} sw__gpu_host_range;
 typedef struct sw__gpu_host_state {
     GLint draw_fb, read_fb, viewport[4];
+    GLint renderbuffer, program, vao, element_buffer, buffers[SW__GPU_HOST_BUFFERS];
+    GLint n_indexed[2];
+    sw__gpu_host_range indexed[2][SW__GPU_HOST_INDEXED]; /* uniform, shader storage */
+    GLint active_texture, textures[SW__GPU_HOST_TEXTURES], sampler; /* unit 0's */
+    GLboolean caps[SW__GPU_HOST_CAPS];
+    GLint scissor[4], blend[6];
+    GLfloat blend_color[4];
+    GLint depth_func;
+    GLboolean depth_mask;
+    GLdouble depth_clear, depth_range[2];
+    GLint stencil[2][7], stencil_clear; /* front, back: func ref mask fail zfail zpass write */
+    GLboolean color_mask[4];
+    GLfloat color_clear[4];
+    GLint cull_face, front_face, polygon_mode;
+    GLfloat polygon_offset[2], line_width, point_size;
+    GLint provoking_vertex, restart_index, patch_vertices, logic_op;
+    GLint clip_origin, clip_depth_mode;
+    GLint pixel_store[SW__GPU_HOST_PIXEL_STORE];
 } sw__gpu_host_state;
 void sw__gpu_host_state_save(sw__gpu_host_state *s);
 void sw__gpu_host_state_restore(const sw__gpu_host_state *s);
+/* 1 for a context adopted from the host (sw_gpu_context_adopt_current). */
+int sw__gpu_context_adopted(const sw_gpu_context *ctx);
 /* Copies the frame into the host's draw framebuffer (saved in `host`) at its origin. */
 sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
                           const sw__gpu_host_state *host, sw_status *status);

@@ -27,6 +27,7 @@
  * inside the rectangle, shaders.c).
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -118,7 +119,7 @@ static sw_result table_rebuild(struct sw__gpu_atlas *a, sw_status *status)
     while (size < 2u * (uint32_t)a->n_entries + 2u)
         size *= 2;
     if (size != a->table_size) {
-        int32_t *t = realloc(a->table, size * sizeof *t);
+        int32_t *t = sw__realloc(a->table, size * sizeof *t);
         if (!t)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
         a->table = t;
@@ -138,7 +139,7 @@ static sw_result table_rebuild(struct sw__gpu_atlas *a, sw_status *status)
 static struct sw__gpu_atlas *atlas_get(sw_gpu_context *ctx)
 {
     if (!ctx->atlas)
-        ctx->atlas = calloc(1, sizeof *ctx->atlas);
+        ctx->atlas = sw__calloc(1, sizeof *ctx->atlas);
     return ctx->atlas;
 }
 
@@ -197,8 +198,8 @@ static int store_loops(entry *e, const sw_sg_polyline *loops, uint32_t n_loops)
     size_t n = 0;
     for (uint32_t k = 0; k < n_loops; ++k)
         n += loops[k].count;
-    e->xy = malloc((n ? n : 1) * 2 * sizeof *e->xy);
-    e->counts = malloc((n_loops ? n_loops : 1) * sizeof *e->counts);
+    e->xy = sw__malloc((n ? n : 1) * 2 * sizeof *e->xy);
+    e->counts = sw__malloc((n_loops ? n_loops : 1) * sizeof *e->counts);
     if (!e->xy || !e->counts)
         return 0;
     const double *b = e->key.uv_box;
@@ -240,8 +241,8 @@ sw_result sw__gpu_atlas_add(sw_gpu_context *ctx, const sw__gpu_trim_key *key, in
     e->layer = -1;
     e->used_frame = a->frame;
     if (!store_loops(e, loops, n_loops)) {
-        free(e->xy);
-        free(e->counts);
+        sw__free(e->xy);
+        sw__free(e->counts);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     }
     a->n_entries++;
@@ -339,8 +340,8 @@ static sw_result collect(struct sw__gpu_atlas *a, int all_used, int32_t *n_out, 
 
 static void free_entry(entry *e)
 {
-    free(e->xy);
-    free(e->counts);
+    sw__free(e->xy);
+    sw__free(e->counts);
     e->xy = NULL;
     e->counts = NULL;
 }
@@ -680,13 +681,13 @@ void sw__gpu_atlas_free(sw_gpu_context *ctx)
     for (int32_t i = 0; i < a->n_entries; ++i)
         free_entry(&a->entries[i]);
     for (int32_t l = 0; l < MAX_PAGES; ++l)
-        free(a->pages[l].shelves);
-    free(a->entries);
-    free(a->table);
-    free(a->order);
-    free(a->clip);
-    free(a->first);
-    free(a->count);
-    free(a);
+        sw__free(a->pages[l].shelves);
+    sw__free(a->entries);
+    sw__free(a->table);
+    sw__free(a->order);
+    sw__free(a->clip);
+    sw__free(a->first);
+    sw__free(a->count);
+    sw__free(a);
     ctx->atlas = NULL;
 }

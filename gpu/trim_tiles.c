@@ -10,6 +10,7 @@
  *    can cut chords across the rectangle.
  */
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -94,18 +95,18 @@ static sw_result clip_loop(const sw_sg_polyline *l, const double r[4], sw_sg_pol
                            sw_status *status)
 {
     size_t n = l->count;
-    double *a = malloc((2 * n + 2) * sizeof *a);
+    double *a = sw__malloc((2 * n + 2) * sizeof *a);
     if (!a)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim tile: out of memory");
     memcpy(a, l->uv, 2 * n * sizeof *a);
     for (int side = 0; side < 4; ++side) {
-        double *b = malloc((4 * n + 2) * sizeof *b);
+        double *b = sw__malloc((4 * n + 2) * sizeof *b);
         if (!b) {
-            free(a);
+            sw__free(a);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim tile: out of memory");
         }
         n = clip_side(a, n, side / 2, r[side], side % 2 ? -1.0 : 1.0, b);
-        free(a);
+        sw__free(a);
         a = b;
     }
     out->uv = a;

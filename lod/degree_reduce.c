@@ -24,6 +24,7 @@
  * original and the final bicubic (not per direction: u then v would add two errors).
  */
 #include "sw_lod_reduce.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_bezier.h"
 #include "sw_status_util.h"
@@ -316,7 +317,7 @@ static sw_result tree_rec(const tree_walk *w, const double *piece, const double 
     if (node.leaf)
         return SW_OK;
     const size_t n = sw_lod_bez_count(w->deg_u, w->deg_v, 4);
-    double *halves = malloc(2 * n * sizeof *halves);
+    double *halves = sw__malloc(2 * n * sizeof *halves);
     if (!halves)
         return sw__fail(w->status, SW_ERR_OUT_OF_MEMORY, "degree reduction: %zu doubles", 2 * n);
     sw_lod_bez_subdivide(w->deg_u, w->deg_v, 4, piece, node.split_dir, 0.5, halves, halves + n);
@@ -327,7 +328,7 @@ static sw_result tree_rec(const tree_walk *w, const double *piece, const double 
         r[k + (h ? 0 : 1)] = mid;
         res = tree_rec(w, halves + (size_t)h * n, r, depth + 1, handle);
     }
-    free(halves);
+    sw__free(halves);
     return res;
 }
 
@@ -358,7 +359,7 @@ static int32_t collect_leaf(void *ctx, const sw_lod_reduce_node *node)
         return 0;
     if (s->count == s->cap) {
         int32_t cap = s->cap ? 2 * s->cap : 8;
-        sw_lod_bicubic_leaf *grown = realloc(s->leaves, (size_t)cap * sizeof *grown);
+        sw_lod_bicubic_leaf *grown = sw__realloc(s->leaves, (size_t)cap * sizeof *grown);
         if (!grown)
             return -1;
         s->leaves = grown;
@@ -386,6 +387,6 @@ void sw_lod_leaf_set_free(sw_lod_leaf_set *set)
 {
     if (!set)
         return;
-    free(set->leaves);
+    sw__free(set->leaves);
     memset(set, 0, sizeof *set);
 }

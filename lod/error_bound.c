@@ -32,6 +32,7 @@
  * the centre from the origin), scaled by the weights' spread, is added to the bound.
  */
 #include "sw_lod_error.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_bezier.h"
 #include "sw_status_util.h"
@@ -237,11 +238,11 @@ sw_result sw_lod_error_bound(int32_t dim, int32_t pa, int32_t qa, const double *
     const size_t na = sw_lod_bez_count(pa, qa, dim), nb = sw_lod_bez_count(pb, qb, dim);
     const size_t ne = sw_lod_bez_count(P, Q, dim);
     const size_t heap_cap = 4 * (size_t)max_pieces + 8;
-    double *mem = malloc((na + nb + 3 * ne + (na + nb) / (size_t)dim) * sizeof *mem);
-    piece *hv = malloc(heap_cap * sizeof *hv);
+    double *mem = sw__malloc((na + nb + 3 * ne + (na + nb) / (size_t)dim) * sizeof *mem);
+    piece *hv = sw__malloc(heap_cap * sizeof *hv);
     if (!mem || !hv) {
-        free(mem);
-        free(hv);
+        sw__free(mem);
+        sw__free(hv);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "error bound: %zu coefficients", ne);
     }
     double *ca = mem, *cb = ca + na, *e = cb + nb, *tmp = e + ne, *work = tmp + ne;
@@ -261,8 +262,8 @@ sw_result sw_lod_error_bound(int32_t dim, int32_t pa, int32_t qa, const double *
     out->bound = isfinite(bound) ? bound + s.noise : INFINITY;
     out->found = s.found;
     out->pieces = s.pieces;
-    free(mem);
-    free(hv);
+    sw__free(mem);
+    sw__free(hv);
     sw__status_ok(status);
     return SW_OK;
 }

@@ -1,6 +1,7 @@
 /* Per-face outward normal cones and the back-patch test (Kumar et al. 1997 §4.4); see
  * sw_lod_face_cones.h. */
 #include "sw_lod_face_cones.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -28,7 +29,7 @@ static sw_result face_cone(const sw_sg_scene *scene, uint32_t face, double **scr
         return r;
     const size_t np = (size_t)set.n_u * (size_t)set.n_v;
     if (np > *cap_pc) {
-        sw_lod_cone *g = realloc(*pc, np * sizeof *g);
+        sw_lod_cone *g = sw__realloc(*pc, np * sizeof *g);
         if (!g) {
             sw_sg_bezier_set_free(&set);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face cones: out of memory");
@@ -42,7 +43,7 @@ static sw_result face_cone(const sw_sg_scene *scene, uint32_t face, double **scr
         const size_t need = sw_lod_gauss_scratch_bound(bp->deg_u, bp->deg_v);
         if (bp->deg_u <= SW_LOD_GAUSS_MAX_DEGREE && bp->deg_v <= SW_LOD_GAUSS_MAX_DEGREE &&
             need > *cap) {
-            double *g = realloc(*scratch, need * sizeof *g);
+            double *g = sw__realloc(*scratch, need * sizeof *g);
             if (!g) {
                 sw_sg_bezier_set_free(&set);
                 return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face cones: out of memory");
@@ -65,9 +66,9 @@ sw_result sw_lod_face_cones_build(const sw_sg_scene *scene, sw_lod_face_cones **
 {
     *out = NULL;
     const sw_sg_scene_view *v = sw_sg_scene_view_ptr(scene);
-    sw_lod_face_cones *fc = calloc(1, sizeof *fc);
+    sw_lod_face_cones *fc = sw__calloc(1, sizeof *fc);
     if (fc)
-        fc->cones = malloc((v->n_faces ? v->n_faces : 1) * sizeof *fc->cones);
+        fc->cones = sw__malloc((v->n_faces ? v->n_faces : 1) * sizeof *fc->cones);
     if (!fc || !fc->cones) {
         sw_lod_face_cones_free(fc);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face cones: out of memory");
@@ -84,8 +85,8 @@ sw_result sw_lod_face_cones_build(const sw_sg_scene *scene, sw_lod_face_cones **
         r = face_cone(scene, i, &scratch, &cap, &pc, &cap_pc, &fc->cones[i], status);
         fc->n_bounded += r == SW_OK && fc->cones[i].half_angle < M_PI;
     }
-    free(scratch);
-    free(pc);
+    sw__free(scratch);
+    sw__free(pc);
     if (r != SW_OK) {
         sw_lod_face_cones_free(fc);
         return r;
@@ -98,8 +99,8 @@ void sw_lod_face_cones_free(sw_lod_face_cones *fc)
 {
     if (!fc)
         return;
-    free(fc->cones);
-    free(fc);
+    sw__free(fc->cones);
+    sw__free(fc);
 }
 
 int sw_lod_cone_to_world(const sw_lod_cone *c, const double m[12], sw_lod_cone *out)

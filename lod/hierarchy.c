@@ -12,6 +12,7 @@
  * are not joined: the node keeps only its rectangle and children, and the renderer descends.
  */
 #include "sw_lod_hierarchy.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_bezier.h"
 #include "sw_lod_reduce.h"
@@ -37,7 +38,7 @@ static int32_t new_node(builder *b)
     sw_lod_hierarchy *h = b->h;
     if (h->n_nodes == b->cap) {
         int32_t cap = b->cap ? 2 * b->cap : 64;
-        sw_lod_hnode *grown = realloc(h->nodes, (size_t)cap * sizeof *grown);
+        sw_lod_hnode *grown = sw__realloc(h->nodes, (size_t)cap * sizeof *grown);
         if (!grown)
             return -1;
         h->nodes = grown;
@@ -252,8 +253,8 @@ static sw_result cut_patches(builder *b)
 {
     const sw_sg_bezier_set *set = b->set;
     const int32_t np = set->n_u * set->n_v;
-    b->rects = malloc((size_t)np * sizeof *b->rects);
-    b->nets = calloc((size_t)np, sizeof *b->nets);
+    b->rects = sw__malloc((size_t)np * sizeof *b->rects);
+    b->nets = sw__calloc((size_t)np, sizeof *b->nets);
     if (!b->rects || !b->nets)
         return sw__fail(b->status, SW_ERR_OUT_OF_MEMORY, "hierarchy: %d patches", (int)np);
     for (int32_t k = 0; k < np; ++k) {
@@ -285,7 +286,7 @@ sw_result sw_lod_hierarchy_build(const sw_sg_surface *s, const sw_lod_hierarchy_
         sw_sg_bezier_set_free(&set);
         return res;
     }
-    sw_lod_hierarchy *h = calloc(1, sizeof *h);
+    sw_lod_hierarchy *h = sw__calloc(1, sizeof *h);
     builder b = {h, 0, &d, &set, NULL, NULL, {0.0, 1.0, 0.0, 1.0}, status};
     if (!h)
         res = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "hierarchy");
@@ -298,8 +299,8 @@ sw_result sw_lod_hierarchy_build(const sw_sg_surface *s, const sw_lod_hierarchy_
     }
     if (res == SW_OK)
         res = build_block(&b, 0, set.n_u, 0, set.n_v, &h->root);
-    free(b.rects);
-    free(b.nets);
+    sw__free(b.rects);
+    sw__free(b.nets);
     sw_sg_bezier_set_free(&set);
     if (res != SW_OK) {
         sw_lod_hierarchy_free(h);
@@ -314,6 +315,6 @@ void sw_lod_hierarchy_free(sw_lod_hierarchy *h)
 {
     if (!h)
         return;
-    free(h->nodes);
-    free(h);
+    sw__free(h->nodes);
+    sw__free(h);
 }

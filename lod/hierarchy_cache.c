@@ -18,6 +18,7 @@
  * themselves.
  */
 #include "sw_lod_cache.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -138,7 +139,7 @@ static bool queued_stale(slot *s, uint64_t w)
 static void publish_failure(slot *s, uint64_t ticket, sw_result res, const sw_status *st)
 {
     s->result = res;
-    s->message = st->message[0] ? strdup(st->message) : NULL;
+    s->message = st->message[0] ? sw__strdup(st->message) : NULL;
     count(&s->cache->failed);
     /* release: pairs with the acquire loads of the word; result and message are visible first */
     atomic_store_explicit(&s->word, make_word(SW_LOD_CACHE_FAILED, ticket), memory_order_release);
@@ -156,7 +157,7 @@ static sw_result build_face(sw_lod_cache *c, uint32_t face, sw_lod_hierarchy **o
     if (res != SW_OK)
         return res;
     /* the builder grows its array by doubling: give the slack back, the version lives long */
-    sw_lod_hnode *fit = realloc((*out)->nodes, (size_t)(*out)->n_nodes * sizeof *fit);
+    sw_lod_hnode *fit = sw__realloc((*out)->nodes, (size_t)(*out)->n_nodes * sizeof *fit);
     if (fit)
         (*out)->nodes = fit;
     return SW_OK;
@@ -281,7 +282,7 @@ static void follow_task(void *ctx)
         if (!settled(w) && sw_th_group_pending(&s->group) == 0)
             sched_yield(); /* a requester is between its claim and its submission */
     }
-    free(f);
+    sw__free(f);
 }
 
 sw_result sw_lod_cache_request_group(sw_lod_cache *c, uint32_t face, const sw_lod_cache_req *req,
@@ -293,14 +294,14 @@ sw_result sw_lod_cache_request_group(sw_lod_cache *c, uint32_t face, const sw_lo
     if (res != SW_OK || req_stale(r) ||
         settled(atomic_load_explicit(&c->slots[face].word, memory_order_acquire)))
         return res;
-    follow *f = malloc(sizeof *f);
+    follow *f = sw__malloc(sizeof *f);
     if (!f)
         return SW_ERR_OUT_OF_MEMORY;
     *f = (follow){c, face, *r};
     const sw_th_task task = {
         follow_task, f, r->priority, NULL, 0, group, SW_TH_TASK_HIERARCHY_WAIT};
     if (sw_th_pool_submit(c->pool, &task) != SW_OK) {
-        free(f);
+        sw__free(f);
         return SW_ERR_OUT_OF_MEMORY;
     }
     return SW_OK;
@@ -433,7 +434,7 @@ size_t sw_lod_cache_collect(sw_lod_cache *c)
     while (done) {
         retired *next = done->next;
         free_version(c, done->h);
-        free(done);
+        sw__free(done);
         done = next;
     }
     return left;
@@ -443,7 +444,7 @@ size_t sw_lod_cache_collect(sw_lod_cache *c)
  * replaces it meanwhile) and retires the old one. */
 static sw_result publish_version(sw_lod_cache *c, slot *s, sw_lod_hierarchy *h)
 {
-    retired *r = malloc(sizeof *r);
+    retired *r = sw__malloc(sizeof *r);
     if (!r)
         return SW_ERR_OUT_OF_MEMORY;
     atomic_fetch_add_explicit(&c->bytes, hierarchy_bytes(h) + sizeof *r, memory_order_relaxed);
@@ -477,11 +478,11 @@ static sw_lod_hierarchy *merge_subtree(const sw_lod_hierarchy *old, int32_t leaf
                                        const sw_lod_hierarchy *sub)
 {
     const int32_t base = old->n_nodes, n = old->n_nodes + sub->n_nodes - 1;
-    sw_lod_hierarchy *h = malloc(sizeof *h);
-    sw_lod_hnode *nodes = malloc((size_t)n * sizeof *nodes);
+    sw_lod_hierarchy *h = sw__malloc(sizeof *h);
+    sw_lod_hnode *nodes = sw__malloc((size_t)n * sizeof *nodes);
     if (!h || !nodes) {
-        free(h);
-        free(nodes);
+        sw__free(h);
+        sw__free(nodes);
         return NULL;
     }
     *h = *old;
@@ -521,11 +522,11 @@ static sw_lod_hierarchy *merge_subtree(const sw_lod_hierarchy *old, int32_t leaf
 static sw_lod_hierarchy *replace_leaf(const sw_lod_hierarchy *old, int32_t leaf,
                                       const sw_lod_hnode *better)
 {
-    sw_lod_hierarchy *h = malloc(sizeof *h);
-    sw_lod_hnode *nodes = malloc((size_t)old->n_nodes * sizeof *nodes);
+    sw_lod_hierarchy *h = sw__malloc(sizeof *h);
+    sw_lod_hnode *nodes = sw__malloc((size_t)old->n_nodes * sizeof *nodes);
     if (!h || !nodes) {
-        free(h);
-        free(nodes);
+        sw__free(h);
+        sw__free(nodes);
         return NULL;
     }
     *h = *old;
@@ -606,7 +607,7 @@ static void refine_task(void *ctx)
             sw_lod_hierarchy_free(h);
     }
     release_refining(s);
-    free(j);
+    sw__free(j);
     sw_lod_cache_collect(c);
 }
 
@@ -630,7 +631,7 @@ static sw_result refine_check(slot *s, const int32_t *nodes, const double *toler
 static refine_job *refine_job_new(sw_lod_cache *c, uint32_t face, const int32_t *nodes,
                                   const double *tolerance, uint32_t n, const sw_lod_cache_req *r)
 {
-    refine_job *j = malloc(sizeof *j + (size_t)n * (sizeof *j->tolerance + sizeof *j->nodes));
+    refine_job *j = sw__malloc(sizeof *j + (size_t)n * (sizeof *j->tolerance + sizeof *j->nodes));
     if (!j)
         return NULL;
     j->cache = c;
@@ -681,7 +682,7 @@ sw_result sw_lod_cache_refine_leaves(sw_lod_cache *c, uint32_t face, const int32
             SW_TH_TASK_REFINE};
         res = sw_th_pool_submit(c->pool, &task);
         if (res != SW_OK)
-            free(j);
+            sw__free(j);
     }
     if (res != SW_OK || *oc != SW_LOD_REFINE_SUBMITTED) {
         if (res != SW_OK)
@@ -713,20 +714,22 @@ sw_result sw_lod_cache_create(const sw_sg_scene *scene, sw_th_pool *pool,
     if (d.max_readers > MAX_READERS)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "lod cache: %u readers (at most %d)",
                         (unsigned)d.max_readers, MAX_READERS);
-    sw_lod_cache *c = calloc(1, sizeof *c);
+    /* Over-aligned (its epoch has a cache line of its own): not malloc's alignment. */
+    sw_lod_cache *c = sw__aligned_alloc(alignof(sw_lod_cache), sizeof *c);
     if (!c)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "lod cache");
+    memset(c, 0, sizeof *c);
     c->scene = scene;
     c->pool = pool;
     c->desc = d;
     c->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     c->n_readers = d.max_readers ? d.max_readers : 64;
-    c->slots = calloc(c->n_faces ? c->n_faces : 1, sizeof *c->slots);
-    c->readers = aligned_alloc(alignof(reader), (size_t)c->n_readers * sizeof *c->readers);
+    c->slots = sw__calloc(c->n_faces ? c->n_faces : 1, sizeof *c->slots);
+    c->readers = sw__aligned_alloc(alignof(reader), (size_t)c->n_readers * sizeof *c->readers);
     if (!c->slots || !c->readers || pthread_mutex_init(&c->retire_lock, NULL) != 0) {
-        free(c->slots);
-        free(c->readers);
-        free(c);
+        sw__free(c->slots);
+        sw__aligned_free(c->readers);
+        sw__aligned_free(c);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "lod cache: %u faces",
                         (unsigned)sw_sg_scene_view_ptr(scene)->n_faces);
     }
@@ -764,17 +767,17 @@ void sw_lod_cache_destroy(sw_lod_cache *c)
         sw_th_group_wait(c->pool, &c->slots[i].group);
     for (uint32_t i = 0; i < c->n_faces; ++i) {
         sw_lod_hierarchy_free(atomic_load_explicit(&c->slots[i].current, memory_order_relaxed));
-        free(c->slots[i].message);
+        sw__free(c->slots[i].message);
     }
     for (retired *r = c->retired, *next; r; r = next) {
         next = r->next;
         sw_lod_hierarchy_free(r->h);
-        free(r);
+        sw__free(r);
     }
     pthread_mutex_destroy(&c->retire_lock);
-    free(c->slots);
-    free(c->readers);
-    free(c);
+    sw__free(c->slots);
+    sw__aligned_free(c->readers);
+    sw__aligned_free(c);
 }
 
 size_t sw_lod_cache_memory(const sw_lod_cache *c)

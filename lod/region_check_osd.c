@@ -1,5 +1,6 @@
 /* The OpenSubdiv cross-check of uniform bicubic regions (sw_lod_osd_check.h). */
 #include "sw_lod_osd_check.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_osd.h"
 #include "sw_status_util.h"
@@ -90,8 +91,8 @@ typedef struct region_list {
 static sw_result list_regions(const sw_sg_surface *s, region_list *out, sw_status *status)
 {
     size_t cap = (size_t)(s->n_u - 3) * (size_t)(s->n_v - 3);
-    out->ku = malloc(cap * sizeof *out->ku);
-    out->kv = malloc(cap * sizeof *out->kv);
+    out->ku = sw__malloc(cap * sizeof *out->ku);
+    out->kv = sw__malloc(cap * sizeof *out->kv);
     out->count = 0;
     if (!out->ku || !out->kv)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory listing regions");
@@ -149,9 +150,9 @@ static sw_result check_surface(const sw_sg_surface *s, int per_region, uint64_t 
     sw_result r = list_regions(s, &rl, status);
     size_t n = (size_t)s->n_u * (size_t)s->n_v;
     size_t count = rl.count * (size_t)per_region;
-    double *verts = r == SW_OK ? malloc(n * 3 * sizeof *verts) : NULL;
-    double *pos = r == SW_OK ? malloc((count ? count : 1) * 3 * sizeof *pos) : NULL;
-    sw_lod_osd_sample *samples = r == SW_OK ? malloc((count ? count : 1) * sizeof *samples) : NULL;
+    double *verts = r == SW_OK ? sw__malloc(n * 3 * sizeof *verts) : NULL;
+    double *pos = r == SW_OK ? sw__malloc((count ? count : 1) * 3 * sizeof *pos) : NULL;
+    sw_lod_osd_sample *samples = r == SW_OK ? sw__malloc((count ? count : 1) * sizeof *samples) : NULL;
     if (r == SW_OK && (!verts || !pos || !samples))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory for %zu OSD samples", count);
     if (r == SW_OK && rl.count) {
@@ -173,11 +174,11 @@ static sw_result check_surface(const sw_sg_surface *s, int per_region, uint64_t 
             report->faces_checked++;
         }
     }
-    free(verts);
-    free(pos);
-    free(samples);
-    free(rl.ku);
-    free(rl.kv);
+    sw__free(verts);
+    sw__free(pos);
+    sw__free(samples);
+    sw__free(rl.ku);
+    sw__free(rl.kv);
     return r;
 }
 
@@ -196,9 +197,9 @@ sw_result sw_lod_osd_check_generated(int32_t nx, int32_t ny, int samples_per_reg
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "generated net %dx%d out of 4..4096", nx,
                         ny);
     size_t n = (size_t)nx * (size_t)ny;
-    double *cpw = malloc(n * 4 * sizeof *cpw);
-    double *ku = malloc((size_t)(nx + 4) * sizeof *ku);
-    double *kv = malloc((size_t)(ny + 4) * sizeof *kv);
+    double *cpw = sw__malloc(n * 4 * sizeof *cpw);
+    double *ku = sw__malloc((size_t)(nx + 4) * sizeof *ku);
+    double *kv = sw__malloc((size_t)(ny + 4) * sizeof *kv);
     sw_result r = SW_OK;
     if (!cpw || !ku || !kv) {
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory for a %dx%d net", nx, ny);
@@ -221,8 +222,8 @@ sw_result sw_lod_osd_check_generated(int32_t nx, int32_t ny, int samples_per_reg
         sw_sg_surface s = {3, 3, nx, ny, ku, kv, cpw};
         r = check_surface(&s, samples_per_region, seed, report, status);
     }
-    free(cpw);
-    free(ku);
-    free(kv);
+    sw__free(cpw);
+    sw__free(ku);
+    sw__free(kv);
     return r;
 }

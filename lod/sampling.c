@@ -47,6 +47,7 @@
  * M_st)).
  */
 #include "sw_lod_sampling.h"
+#include "sw_hooks.h"
 
 #include <math.h>
 #include <stddef.h>
@@ -271,7 +272,7 @@ static int product_bounds(int32_t p, int32_t q, const double *cpw, const double 
     /* 17 polynomials, none of degree above (3p, 3q), at most 3 doubles per coefficient */
     a.cap = 17 * (size_t)(3 * p + 1) * (size_t)(3 * q + 1) * 3;
     a.used = 0;
-    a.mem = a.cap <= ARENA_STACK ? stack_mem : malloc(a.cap * sizeof *a.mem);
+    a.mem = a.cap <= ARENA_STACK ? stack_mem : sw__malloc(a.cap * sizeof *a.mem);
     if (!a.mem)
         return 0;
     double bp[PRODUCT_MAX_DEGREE + 1], bq[PRODUCT_MAX_DEGREE + 1];
@@ -307,7 +308,7 @@ static int product_bounds(int32_t p, int32_t q, const double *cpw, const double 
         out[k].d2[2] = bp_max_norm(&ktt, masks[k]) / m3;
     }
     if (a.mem != stack_mem)
-        free(a.mem);
+        sw__free(a.mem);
     return 1;
 }
 
@@ -565,7 +566,7 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
 {
     size_t n = (size_t)(deg_u + 1) * (size_t)(deg_v + 1);
     double small[3 * 4 * SMALL_NET],
-        *mem = n <= SMALL_NET ? small : malloc(3 * 4 * n * sizeof *mem);
+        *mem = n <= SMALL_NET ? small : sw__malloc(3 * 4 * n * sizeof *mem);
     out->nu = out->nv = allowed[n_allowed - 1];
     out->eps_obj = 0.0;
     if (!mem)
@@ -610,6 +611,6 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
         out->nv = guess[1];
     }
     if (mem != small)
-        free(mem);
+        sw__free(mem);
     return found;
 }

@@ -39,6 +39,7 @@
  * sampled; ours are sampled for δ_trim in object space.
  */
 #include "sw_lod_static.h"
+#include "sw_hooks.h"
 #include "sw_lod_supersurface.h"
 
 #include "sw_lod_bezier.h"
@@ -88,8 +89,8 @@ typedef struct strip_classifier {
 
 static void strips_free(strip_classifier *c)
 {
-    free(c->start);
-    free(c->seg);
+    sw__free(c->start);
+    sw__free(c->seg);
     memset(c, 0, sizeof *c);
 }
 
@@ -118,7 +119,7 @@ static int strips_build(strip_classifier *c, const sw_sg_polyline *loops, uint32
     c->n_strips = (uint32_t)fmin(4096.0, fmax(1.0, sqrt((double)n_seg)));
     c->v0 = lo;
     c->inv_h = hi > lo ? (double)c->n_strips / (hi - lo) : 0.0;
-    uint32_t *count = calloc((size_t)c->n_strips + 1, sizeof *count);
+    uint32_t *count = sw__calloc((size_t)c->n_strips + 1, sizeof *count);
     if (!count)
         return 0;
     for (int pass = 0; pass < 2; ++pass) {
@@ -138,13 +139,13 @@ static int strips_build(strip_classifier *c, const sw_sg_polyline *loops, uint32
             }
         }
         if (pass == 0) {
-            c->start = malloc(((size_t)c->n_strips + 1) * sizeof *c->start);
+            c->start = sw__malloc(((size_t)c->n_strips + 1) * sizeof *c->start);
             size_t total = 0;
             for (uint32_t s = 0; s < c->n_strips; ++s)
                 total += count[s];
-            c->seg = malloc((total ? total : 1) * 4 * sizeof *c->seg);
+            c->seg = sw__malloc((total ? total : 1) * 4 * sizeof *c->seg);
             if (!c->start || !c->seg || total > UINT32_MAX) {
-                free(count);
+                sw__free(count);
                 strips_free(c);
                 return 0;
             }
@@ -154,7 +155,7 @@ static int strips_build(strip_classifier *c, const sw_sg_polyline *loops, uint32
             memset(count, 0, ((size_t)c->n_strips + 1) * sizeof *count);
         }
     }
-    free(count);
+    sw__free(count);
     return 1;
 }
 
@@ -200,16 +201,16 @@ typedef struct face_dom {
 static void face_dom_free(face_dom *fd)
 {
     sw_sg_bezier_set_free(&fd->set);
-    free(fd->pub);
-    free(fd->pvb);
-    free(fd->psel);
-    free(fd->ub);
-    free(fd->vb);
-    free(fd->sel);
-    free(fd->scale);
+    sw__free(fd->pub);
+    sw__free(fd->pvb);
+    sw__free(fd->psel);
+    sw__free(fd->ub);
+    sw__free(fd->vb);
+    sw__free(fd->sel);
+    sw__free(fd->scale);
     for (uint32_t l = 0; l < fd->n_loops; ++l)
         sw_sg_polyline_free(&fd->loops[l]);
-    free(fd->loops);
+    sw__free(fd->loops);
     strips_free(&fd->cls);
     memset(fd, 0, sizeof *fd);
 }
@@ -313,12 +314,12 @@ static void cell_bounds(const face_dom *fd, int32_t sub, double c, double *scale
 /* Sets the cell grid of the face to sub x sub cells per patch. */
 static int set_cells(face_dom *fd, int32_t sub, double *scale)
 {
-    free(fd->ub), free(fd->vb), free(fd->sel), free(fd->scale);
+    sw__free(fd->ub), sw__free(fd->vb), sw__free(fd->sel), sw__free(fd->scale);
     fd->sub = sub;
     fd->nu = fd->pnu * sub, fd->nv = fd->pnv * sub;
-    fd->ub = malloc(((size_t)fd->nu + 1) * sizeof *fd->ub);
-    fd->vb = malloc(((size_t)fd->nv + 1) * sizeof *fd->vb);
-    fd->sel = malloc((size_t)fd->nu * fd->nv);
+    fd->ub = sw__malloc(((size_t)fd->nu + 1) * sizeof *fd->ub);
+    fd->vb = sw__malloc(((size_t)fd->nv + 1) * sizeof *fd->vb);
+    fd->sel = sw__malloc((size_t)fd->nu * fd->nv);
     fd->scale = scale;
     if (!fd->ub || !fd->vb || !fd->sel || !scale)
         return 0;
@@ -355,7 +356,7 @@ static int face_dom_refine(face_dom *fd, double c)
             break;
         est = e2, best = sub;
     }
-    double *scale = calloc(2 * (size_t)fd->pnu * fd->pnv * best * best, sizeof *scale);
+    double *scale = sw__calloc(2 * (size_t)fd->pnu * fd->pnv * best * best, sizeof *scale);
     if (scale)
         cell_bounds(fd, best, c, scale, NULL, &fd->grad, &fd->au, &fd->av);
     return set_cells(fd, best, scale);
@@ -378,9 +379,9 @@ static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_pat
         return r;
     fd->pnu = fd->set.n_u, fd->pnv = fd->set.n_v;
     const size_t np = (size_t)fd->pnu * fd->pnv;
-    fd->pub = malloc(((size_t)fd->pnu + 1) * sizeof *fd->pub);
-    fd->pvb = malloc(((size_t)fd->pnv + 1) * sizeof *fd->pvb);
-    fd->psel = calloc(np, 1);
+    fd->pub = sw__malloc(((size_t)fd->pnu + 1) * sizeof *fd->pub);
+    fd->pvb = sw__malloc(((size_t)fd->pnv + 1) * sizeof *fd->pvb);
+    fd->psel = sw__calloc(np, 1);
     if (!fd->pub || !fd->pvb || !fd->psel)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", face);
     for (int32_t i = 0; i < fd->pnu; ++i) {
@@ -416,7 +417,7 @@ static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_pat
         }
     fd->has_loops = fr->n_loops > 0;
     fd->outside_sel = fd->has_loops && fd->n_sel == np;
-    double *scale = calloc(2 * np, sizeof *scale);
+    double *scale = sw__calloc(2 * np, sizeof *scale);
     if (scale)
         cell_bounds(fd, 1, 0.0, scale, NULL, &fd->grad, &fd->au, &fd->av);
     if (!set_cells(fd, 1, scale))
@@ -456,10 +457,10 @@ static sw_result face_dom_flatten(const sw_sg_scene *scene, face_dom *fd, double
     const sw_sg_face_rec *fr = &sw_sg_scene_view_ptr(scene)->faces[fd->face];
     for (uint32_t l = 0; l < fd->n_loops; ++l)
         sw_sg_polyline_free(&fd->loops[l]);
-    free(fd->loops);
+    sw__free(fd->loops);
     strips_free(&fd->cls);
     fd->n_loops = 0;
-    fd->loops = calloc(fr->n_loops ? fr->n_loops : 1, sizeof *fd->loops);
+    fd->loops = sw__calloc(fr->n_loops ? fr->n_loops : 1, sizeof *fd->loops);
     if (!fd->loops)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", fd->face);
     for (uint32_t l = 0; l < fr->n_loops; ++l) {
@@ -489,8 +490,8 @@ static void patch_set_free(patch_set *ps)
 {
     for (uint32_t f = 0; f < ps->n_faces; ++f)
         face_dom_free(&ps->faces[f]);
-    free(ps->faces);
-    free(ps->p);
+    sw__free(ps->faces);
+    sw__free(ps->p);
     memset(ps, 0, sizeof *ps);
 }
 
@@ -515,7 +516,7 @@ static sw_result patch_set_init(const sw_sg_scene *scene, const sw_lod_static_pa
         if (patches[k].face >= view->n_faces)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: patch %u: face %u of %u",
                             k, patches[k].face, view->n_faces);
-    ps->p = malloc((size_t)n * sizeof *ps->p);
+    ps->p = sw__malloc((size_t)n * sizeof *ps->p);
     if (!ps->p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: %u patches", n);
     memcpy(ps->p, patches, (size_t)n * sizeof *ps->p);
@@ -527,7 +528,7 @@ static sw_result patch_set_init(const sw_sg_scene *scene, const sw_lod_static_pa
             ps->p[m++] = ps->p[k];
         }
     ps->n = m;
-    ps->faces = calloc(nf, sizeof *ps->faces);
+    ps->faces = sw__calloc(nf, sizeof *ps->faces);
     if (!ps->faces)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: %u faces", nf);
     for (int c = 0; c < 3; ++c)
@@ -577,7 +578,7 @@ typedef struct mesh_buf {
 
 static void mesh_buf_free(mesh_buf *m)
 {
-    free(m->pos), free(m->uv), free(m->nrm), free(m->face), free(m->corner), free(m->tri);
+    sw__free(m->pos), sw__free(m->uv), sw__free(m->nrm), sw__free(m->face), sw__free(m->corner), sw__free(m->tri);
     memset(m, 0, sizeof *m);
 }
 
@@ -588,7 +589,7 @@ static int grow(void **p, uint32_t *cap, uint32_t need, size_t elem)
     uint32_t c = *cap ? *cap : 1024;
     while (c < need)
         c = c > UINT32_MAX / 2 ? need : 2 * c;
-    void *q = realloc(*p, (size_t)c * elem);
+    void *q = sw__realloc(*p, (size_t)c * elem);
     if (!q)
         return 0;
     *p = q;
@@ -620,7 +621,7 @@ typedef struct pts {
 
 static void pts_free(pts *p)
 {
-    free(p->uv), free(p->tag), free(p->id);
+    sw__free(p->uv), sw__free(p->tag), sw__free(p->id);
     memset(p, 0, sizeof *p);
 }
 
@@ -663,17 +664,17 @@ typedef struct grid {
 
 static void grid_free(grid *g)
 {
-    free(g->n_col), free(g->n_row), free(g->gu), free(g->gv), free(g->first_u), free(g->first_v);
+    sw__free(g->n_col), sw__free(g->n_row), sw__free(g->gu), sw__free(g->gv), sw__free(g->first_u), sw__free(g->first_v);
     memset(g, 0, sizeof *g);
 }
 
 static int grid_build(const face_dom *fd, double c, grid *g)
 {
     memset(g, 0, sizeof *g);
-    g->n_col = calloc((size_t)fd->nu, sizeof *g->n_col);
-    g->n_row = calloc((size_t)fd->nv, sizeof *g->n_row);
-    g->first_u = malloc(((size_t)fd->nu + 1) * sizeof *g->first_u);
-    g->first_v = malloc(((size_t)fd->nv + 1) * sizeof *g->first_v);
+    g->n_col = sw__calloc((size_t)fd->nu, sizeof *g->n_col);
+    g->n_row = sw__calloc((size_t)fd->nv, sizeof *g->n_row);
+    g->first_u = sw__malloc(((size_t)fd->nu + 1) * sizeof *g->first_u);
+    g->first_v = sw__malloc(((size_t)fd->nv + 1) * sizeof *g->first_v);
     if (!g->n_col || !g->n_row || !g->first_u || !g->first_v)
         return 0;
     for (int32_t j = 0; j < fd->nv; ++j)
@@ -692,8 +693,8 @@ static int grid_build(const face_dom *fd, double c, grid *g)
     for (int32_t j = 0; j < fd->nv; ++j)
         g->first_v[j] = (int32_t)tv, tv += (size_t)(g->n_row[j] ? g->n_row[j] : 1);
     g->first_u[fd->nu] = (int32_t)tu, g->first_v[fd->nv] = (int32_t)tv;
-    g->gu = malloc((tu + 1) * sizeof *g->gu);
-    g->gv = malloc((tv + 1) * sizeof *g->gv);
+    g->gu = sw__malloc((tu + 1) * sizeof *g->gu);
+    g->gv = sw__malloc((tv + 1) * sizeof *g->gv);
     if (!g->gu || !g->gv)
         return 0;
     for (int32_t i = 0; i < fd->nu; ++i) {
@@ -877,7 +878,7 @@ static void surface_normal(const face_dom *fd, double u, double v, float out[3])
 static sw_result emit_face(const face_dom *fd, const sw_lod_cdt_mesh *cm, mesh_buf *m,
                            uint32_t max_vertices, sw_status *status)
 {
-    uint32_t *map = malloc((cm->n_vertices ? cm->n_vertices : 1) * sizeof *map);
+    uint32_t *map = sw__malloc((cm->n_vertices ? cm->n_vertices : 1) * sizeof *map);
     if (!map)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", fd->face);
     for (uint32_t k = 0; k < cm->n_vertices; ++k)
@@ -925,7 +926,7 @@ static sw_result emit_face(const face_dom *fd, const sw_lod_cdt_mesh *cm, mesh_b
         o[1] = fd->reversed ? out[2] : out[1];
         o[2] = fd->reversed ? out[1] : out[2];
     }
-    free(map);
+    sw__free(map);
     return r;
 }
 
@@ -1034,7 +1035,7 @@ done:
     sw_lod_cdt_mesh_free(&cm);
     sw_lod_cdt_free(cdt);
     pts_free(&p);
-    free(cons.v);
+    sw__free(cons.v);
     grid_free(&g);
     return r;
 }
@@ -1404,7 +1405,7 @@ sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_pa
 
 static void level_free(sw_lod_static_level *l)
 {
-    free(l->positions), free(l->normals), free(l->uv), free(l->face), free(l->triangles);
+    sw__free(l->positions), sw__free(l->normals), sw__free(l->uv), sw__free(l->face), sw__free(l->triangles);
     memset(l, 0, sizeof *l);
 }
 
@@ -1414,8 +1415,8 @@ void sw_lod_static_free(sw_lod_static_chain *chain)
         return;
     for (int32_t k = 0; k < chain->n_levels; ++k)
         level_free(&chain->levels[k]);
-    free(chain->levels);
-    free(chain);
+    sw__free(chain->levels);
+    sw__free(chain);
 }
 
 size_t sw_lod_static_memory(const sw_lod_static_chain *chain)
@@ -1437,7 +1438,7 @@ static int level_from(const mesh_buf *m, const uint32_t *tri, uint32_t n_tri,
                       sw_lod_static_level *l)
 {
     memset(l, 0, sizeof *l);
-    uint32_t *map = malloc((m->n_v ? m->n_v : 1) * sizeof *map);
+    uint32_t *map = sw__malloc((m->n_v ? m->n_v : 1) * sizeof *map);
     if (!map)
         return 0;
     for (uint32_t v = 0; v < m->n_v; ++v)
@@ -1446,13 +1447,13 @@ static int level_from(const mesh_buf *m, const uint32_t *tri, uint32_t n_tri,
     for (size_t k = 0; k < 3 * (size_t)n_tri; ++k)
         if (map[tri[k]] == UINT32_MAX)
             map[tri[k]] = nv++;
-    l->positions = malloc(((size_t)nv ? nv : 1) * 3 * sizeof(double));
-    l->normals = malloc(((size_t)nv ? nv : 1) * 3 * sizeof(float));
-    l->uv = malloc(((size_t)nv ? nv : 1) * 2 * sizeof(double));
-    l->face = malloc(((size_t)nv ? nv : 1) * sizeof(uint32_t));
-    l->triangles = malloc(((size_t)n_tri ? n_tri : 1) * 3 * sizeof(uint32_t));
+    l->positions = sw__malloc(((size_t)nv ? nv : 1) * 3 * sizeof(double));
+    l->normals = sw__malloc(((size_t)nv ? nv : 1) * 3 * sizeof(float));
+    l->uv = sw__malloc(((size_t)nv ? nv : 1) * 2 * sizeof(double));
+    l->face = sw__malloc(((size_t)nv ? nv : 1) * sizeof(uint32_t));
+    l->triangles = sw__malloc(((size_t)n_tri ? n_tri : 1) * 3 * sizeof(uint32_t));
     if (!l->positions || !l->normals || !l->uv || !l->face || !l->triangles) {
-        free(map);
+        sw__free(map);
         level_free(l);
         return 0;
     }
@@ -1469,7 +1470,7 @@ static int level_from(const mesh_buf *m, const uint32_t *tri, uint32_t n_tri,
         l->triangles[k] = map[tri[k]];
     l->n_vertices = nv;
     l->n_triangles = n_tri;
-    free(map);
+    sw__free(map);
     return 1;
 }
 
@@ -1481,7 +1482,7 @@ static void repair_normals(mesh_buf *m)
         const float *n = m->nrm + 3 * (size_t)v;
         if (n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.5f)
             continue;
-        if (!acc && !(acc = calloc(3 * (size_t)m->n_v, sizeof *acc)))
+        if (!acc && !(acc = sw__calloc(3 * (size_t)m->n_v, sizeof *acc)))
             return;
         break;
     }
@@ -1508,7 +1509,7 @@ static void repair_normals(mesh_buf *m)
         for (int q = 0; q < 3; ++q)
             n[q] = l > 0.0 ? (float)(a[q] / l) : (q == 2 ? 1.0f : 0.0f);
     }
-    free(acc);
+    sw__free(acc);
 }
 
 typedef struct build_ctx {
@@ -1625,9 +1626,9 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                      "is empty");
     if (r == SW_OK) {
         repair_normals(&m);
-        chain = calloc(1, sizeof *chain);
+        chain = sw__calloc(1, sizeof *chain);
         if (chain)
-            chain->levels = calloc((size_t)d.n_levels + 1, sizeof *chain->levels);
+            chain->levels = sw__calloc((size_t)d.n_levels + 1, sizeof *chain->levels);
         if (!chain || !chain->levels || !level_from(&m, m.tri, m.n_t, &chain->levels[0]))
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: chain");
     }
@@ -1639,7 +1640,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         chain->seconds[0] = now_seconds() - t0;
         build_ctx b = {scene, &ps, &m, chain, &d, SW_OK, status, 0.0};
         if (d.n_levels > 0) {
-            double *tol = malloc((size_t)d.n_levels * sizeof *tol);
+            double *tol = sw__malloc((size_t)d.n_levels * sizeof *tol);
             if (!tol)
                 r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: levels");
             for (int32_t k = 0; r == SW_OK && k < d.n_levels; ++k) /* against level 0 */
@@ -1651,7 +1652,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                 r = sw_lod_static_decimate(&in, on_level, &b, status);
             if (r == SW_OK)
                 r = b.r;
-            free(tol);
+            sw__free(tol);
             chain->seconds[1] = now_seconds() - t0 - b.t_measure;
         }
         /* level 0's bound is rigorous; its measurement is a check, kept for the report */

@@ -3,6 +3,7 @@
  * before anything is allocated, every value against what a chain may hold, and the whole string
  * is parsed into new chains before the first one is adopted. */
 #include "sw_lod_static_set.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -64,7 +65,7 @@ static void put(writer *w, const void *data, size_t n)
         size_t cap = w->cap ? w->cap : 4096;
         while (cap < w->n + n)
             cap *= 2;
-        unsigned char *g = realloc(w->p, cap);
+        unsigned char *g = sw__realloc(w->p, cap);
         if (!g) {
             w->oom = 1;
             return;
@@ -118,7 +119,7 @@ sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, 
             put_level(&w, &c->levels[k]);
     }
     if (w.oom) {
-        free(w.p);
+        sw__free(w.p);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LOD cache: out of memory");
     }
     *out = w.p;
@@ -155,7 +156,7 @@ static void *take_array(reader *r, uint64_t count, size_t elem)
 {
     if (count > (r->n - r->at) / elem)
         return NULL;
-    void *a = malloc(count ? (size_t)count * elem : 1);
+    void *a = sw__malloc(count ? (size_t)count * elem : 1);
     if (a)
         take(r, a, (size_t)count * elem);
     return a;
@@ -223,7 +224,7 @@ static sw_result read_level(reader *r, const sw_lod_static_set *set, const sw_lo
 static sw_result read_chain(reader *r, const sw_lod_static_set *set, uint32_t unit,
                             sw_lod_static_chain **out)
 {
-    sw_lod_static_chain *c = calloc(1, sizeof *c);
+    sw_lod_static_chain *c = sw__calloc(1, sizeof *c);
     if (!c)
         return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
     *out = c;
@@ -235,7 +236,7 @@ static sw_result read_chain(reader *r, const sw_lod_static_set *set, uint32_t un
         !(c->delta > 0.0) || !isfinite(c->delta))
         return bad(r, "a chain's level count, patch count or δ does not fit its super-surface",
                    NULL);
-    if (!(c->levels = calloc((size_t)n_levels, sizeof *c->levels)))
+    if (!(c->levels = sw__calloc((size_t)n_levels, sizeof *c->levels)))
         return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
     for (int32_t k = 0; k < n_levels; ++k) {
         c->n_levels = k + 1; /* what sw_lod_static_free frees */
@@ -250,7 +251,7 @@ static void free_chains(sw_lod_static_chain **chains, uint32_t n)
 {
     for (uint32_t u = 0; u < n; ++u)
         sw_lod_static_free(chains[u]);
-    free(chains);
+    sw__free(chains);
 }
 
 sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_t size,
@@ -274,7 +275,7 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
                         "%s: the static LOD cache was made for other super-surfaces or settings "
                         "(%u units, this scene has %u): run `splinewalk build-lod` again",
                         what, n, sw_lod_static_set_unit_count(set));
-    sw_lod_static_chain **chains = calloc(n ? n : 1, sizeof *chains);
+    sw_lod_static_chain **chains = sw__calloc(n ? n : 1, sizeof *chains);
     if (!chains)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
     sw_result res = SW_OK;
@@ -297,6 +298,6 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
             (*adopted)++;
         chains[u] = NULL;
     }
-    free(chains);
+    sw__free(chains);
     return SW_OK;
 }

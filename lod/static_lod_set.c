@@ -1,6 +1,7 @@
 /* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
  * units are formed and how slots are published). */
 #include "sw_lod_static_set.h"
+#include "sw_hooks.h"
 
 #include "sw_sg_geom.h"
 #include "sw_status_util.h"
@@ -55,7 +56,7 @@ typedef struct build_job {
  * are consecutive). Faces without patches get SW_LOD_STATIC_NO_UNIT. */
 static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint32_t *home)
 {
-    uint32_t *best = calloc(n_faces ? n_faces : 1, sizeof *best);
+    uint32_t *best = sw__calloc(n_faces ? n_faces : 1, sizeof *best);
     if (!best)
         return 0;
     for (uint32_t f = 0; f < n_faces; ++f)
@@ -73,7 +74,7 @@ static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint3
             home[face] = c;
         }
     }
-    free(best);
+    sw__free(best);
     return 1;
 }
 
@@ -92,11 +93,11 @@ static int patch_cmp(const void *a, const void *b)
 static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_status *status)
 {
     const sw_lod_supersurfaces *ss = s->ss;
-    uint32_t *unit_of_cluster = malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
-    uint32_t *count = calloc(ss->n_clusters + 1, sizeof(uint32_t));
+    uint32_t *unit_of_cluster = sw__malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
+    uint32_t *count = sw__calloc(ss->n_clusters + 1, sizeof(uint32_t));
     if (!unit_of_cluster || !count) {
-        free(unit_of_cluster);
-        free(count);
+        sw__free(unit_of_cluster);
+        sw__free(count);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     for (uint32_t f = 0; f < s->n_faces; ++f)
@@ -104,12 +105,12 @@ static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_statu
             count[home[f]]++;
     for (uint32_t c = 0; c < ss->n_clusters; ++c)
         unit_of_cluster[c] = count[c] ? s->n_units++ : SW_LOD_STATIC_NO_UNIT;
-    free(count);
-    s->units = calloc(s->n_units ? s->n_units : 1, sizeof *s->units);
-    s->faces = malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->faces);
-    s->patches = malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *s->patches);
+    sw__free(count);
+    s->units = sw__calloc(s->n_units ? s->n_units : 1, sizeof *s->units);
+    s->faces = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->faces);
+    s->patches = sw__malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *s->patches);
     if (!s->units || !s->faces || !s->patches) {
-        free(unit_of_cluster);
+        sw__free(unit_of_cluster);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     for (uint32_t f = 0; f < s->n_faces; ++f) {
@@ -147,7 +148,7 @@ static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_statu
     for (uint32_t u = 0; u < s->n_units; ++u)
         qsort(s->patches + s->units[u].first_patch, s->units[u].n_patches, sizeof *s->patches,
               patch_cmp);
-    free(unit_of_cluster);
+    sw__free(unit_of_cluster);
     return SW_OK;
 }
 
@@ -195,13 +196,13 @@ static sw_result unit_cones(sw_lod_static_set *s, sw_status *status)
 {
     const sw_lod_supersurfaces *ss = s->ss;
     const sw_sg_face_rec *faces = sw_sg_scene_view_ptr(s->scene)->faces;
-    uint32_t *first = calloc((size_t)s->n_units + 1, sizeof *first);
-    sw_lod_cone *cones = malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *cones);
-    unsigned char *open = calloc(s->n_units ? s->n_units : 1, 1);
+    uint32_t *first = sw__calloc((size_t)s->n_units + 1, sizeof *first);
+    sw_lod_cone *cones = sw__malloc((ss->n_patches ? ss->n_patches : 1) * sizeof *cones);
+    unsigned char *open = sw__calloc(s->n_units ? s->n_units : 1, 1);
     if (!first || !cones || !open) {
-        free(first);
-        free(cones);
-        free(open);
+        sw__free(first);
+        sw__free(cones);
+        sw__free(open);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     for (uint32_t u = 0; u < s->n_units; ++u)
@@ -224,9 +225,9 @@ static sw_result unit_cones(sw_lod_static_set *s, sw_status *status)
             sw_lod_cone_enclose(cones + first[u] - un->n_patches, un->n_patches, c);
         }
     }
-    free(first);
-    free(cones);
-    free(open);
+    sw__free(first);
+    sw__free(cones);
+    sw__free(open);
     return SW_OK;
 }
 
@@ -257,7 +258,7 @@ static int grow(void **p, size_t *cap, size_t need, size_t size)
     size_t c = *cap ? 2 * *cap : 256;
     while (c < need)
         c *= 2;
-    void *q = realloc(*p, c * size);
+    void *q = sw__realloc(*p, c * size);
     if (!q)
         return 0;
     *p = q;
@@ -278,7 +279,7 @@ static uint64_t instance_hash(uint32_t unit, const double m[12])
 static int grow_map(inst_build *b)
 {
     const size_t cap = b->cap_map ? 2 * b->cap_map : 1024;
-    uint32_t *map = calloc(cap, sizeof *map);
+    uint32_t *map = sw__calloc(cap, sizeof *map);
     if (!map)
         return 0;
     for (size_t i = 0; i < b->n_items; ++i) {
@@ -289,7 +290,7 @@ static int grow_map(inst_build *b)
             k = (k + 1) & (cap - 1);
         map[k] = (uint32_t)i + 1;
     }
-    free(b->map);
+    sw__free(b->map);
     b->map = map;
     b->cap_map = cap;
     return 1;
@@ -360,11 +361,11 @@ static int visit_occurrence(void *ctx, uint32_t face, const double world[12], co
  * and builds the BVH; takes b's arrays. */
 static sw_result finish_instances(sw_lod_static_set *s, inst_build *b, sw_status *status)
 {
-    s->occs = malloc((b->n_occ ? b->n_occ : 1) * sizeof *s->occs);
+    s->occs = sw__malloc((b->n_occ ? b->n_occ : 1) * sizeof *s->occs);
     s->instances = b->inst;
     b->inst = NULL;
     if (!s->occs) {
-        free(b->items);
+        sw__free(b->items);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     uint32_t at = 0;
@@ -409,26 +410,26 @@ static sw_result finish_instances(sw_lod_static_set *s, inst_build *b, sw_status
 /* The scene's face occurrences grouped into unit instances and their BVH (see the header). */
 static sw_result make_instances(sw_lod_static_set *s, sw_status *status)
 {
-    s->face_boxes = malloc((s->n_faces ? s->n_faces : 1) * 6 * sizeof *s->face_boxes);
+    s->face_boxes = sw__malloc((s->n_faces ? s->n_faces : 1) * 6 * sizeof *s->face_boxes);
     if (!s->face_boxes)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     for (uint32_t f = 0; f < s->n_faces; ++f)
         sw_sg_bvh_face_box(s->scene, f, s->face_boxes + 6 * (size_t)f);
     inst_build b = {s, NULL, 0, NULL, 0, 0, NULL, 0, NULL, 0, 0, 0};
     sw_result r = sw_sg_scene_traverse(s->scene, visit_occurrence, &b);
-    free(b.map);
+    sw__free(b.map);
     if (r == SW_OK && !b.failed) {
         r = finish_instances(s, &b, status);
     } else {
-        free(b.items);
+        sw__free(b.items);
         r = b.failed == 2
                 ? sw__fail(status, SW_ERR_LIMIT,
                            "static LODs: %zu face occurrences or more (at most 2^31 - 1)", b.n_occ)
                 : sw__fail(status, SW_ERR_OUT_OF_MEMORY,
                            "static LODs: %zu face occurrences: out of memory", b.n_occ);
     }
-    free(b.inst);
-    free(b.occ);
+    sw__free(b.inst);
+    sw__free(b.occ);
     return r;
 }
 
@@ -438,7 +439,7 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
 {
     assert(scene && pool && out);
     *out = NULL;
-    sw_lod_static_set *s = calloc(1, sizeof *s);
+    sw_lod_static_set *s = sw__calloc(1, sizeof *s);
     if (!s)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     s->scene = scene;
@@ -449,21 +450,21 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     sw_result r = sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
     uint32_t *home = NULL;
     if (r == SW_OK) {
-        home = malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);
-        s->unit_of_face = malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->unit_of_face);
+        home = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);
+        s->unit_of_face = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *s->unit_of_face);
         if (!home || !s->unit_of_face || !home_clusters(s->ss, s->n_faces, home))
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     if (r == SW_OK)
         r = form_units(s, home, status);
-    free(home);
+    sw__free(home);
     if (r == SW_OK)
         r = unit_boxes(s, status);
     if (r == SW_OK)
         r = unit_cones(s, status);
     if (r == SW_OK)
         r = make_instances(s, status);
-    if (r == SW_OK && !(s->slots = calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
+    if (r == SW_OK && !(s->slots = sw__calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     if (r != SW_OK) {
         sw_lod_static_set_destroy(s);
@@ -489,17 +490,17 @@ void sw_lod_static_set_destroy(sw_lod_static_set *s)
             sw_lod_static_free(atomic_load(&s->slots[u].chain));
         }
     }
-    free(s->slots);
-    free(s->units);
-    free(s->faces);
-    free(s->patches);
-    free(s->unit_of_face);
+    sw__free(s->slots);
+    sw__free(s->units);
+    sw__free(s->faces);
+    sw__free(s->patches);
+    sw__free(s->unit_of_face);
     sw_sg_bvh_free(s->bvh);
-    free(s->instances);
-    free(s->occs);
-    free(s->face_boxes);
+    sw__free(s->instances);
+    sw__free(s->occs);
+    sw__free(s->face_boxes);
     sw_lod_supersurfaces_free(s->ss);
-    free(s);
+    sw__free(s);
 }
 
 /* ---- lookups ---------------------------------------------------------------------------------- */
@@ -594,7 +595,7 @@ static void build_task(void *ctx)
     sw_lod_static_set *s = job->set;
     const sw_lod_static_unit *un = &s->units[job->unit];
     slot *sl = &s->slots[job->unit];
-    free(job);
+    sw__free(job);
     if (atomic_load_explicit(&s->cancelled, memory_order_acquire))
         return; /* the slot stays QUEUED: nobody reads it any more */
     const uint64_t t0 = now_ns();
@@ -622,7 +623,7 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
     if (atomic_load_explicit(&sl->state, memory_order_acquire) != SW_LOD_STATIC_EMPTY ||
         !atomic_compare_exchange_strong(&sl->state, &expect, SW_LOD_STATIC_QUEUED))
         return SW_OK;
-    build_job *job = malloc(sizeof *job);
+    build_job *job = sw__malloc(sizeof *job);
     if (job) {
         *job = (build_job){s, unit};
         /* in the slot's group: converged frames and destroy wait on it */
@@ -630,7 +631,7 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
                                  SW_TH_TASK_STATIC_BUILD};
         if (sw_th_pool_submit(s->pool, &task) == SW_OK)
             return SW_OK;
-        free(job);
+        sw__free(job);
     }
     atomic_store(&sl->state, SW_LOD_STATIC_EMPTY);
     return SW_ERR_OUT_OF_MEMORY;

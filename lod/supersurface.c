@@ -37,6 +37,7 @@
  * cluster connected.
  */
 #include "sw_lod_hierarchy.h"
+#include "sw_hooks.h"
 #include "sw_lod_supersurface.h"
 #include "sw_sg_trim.h"
 #include "sw_status_util.h"
@@ -131,7 +132,7 @@ static int push_pair(state *st, uint32_t a, uint32_t b)
         return 1;
     if (st->n_pairs == st->cap_pairs) {
         const size_t cap = st->cap_pairs ? 2 * st->cap_pairs : 1024;
-        sw_lod_ss_pair *g = realloc(st->pairs, cap * sizeof *g);
+        sw_lod_ss_pair *g = sw__realloc(st->pairs, cap * sizeof *g);
         if (!g)
             return 0;
         st->pairs = g, st->cap_pairs = cap;
@@ -180,7 +181,7 @@ static sw_result face_patches(state *st, uint32_t f, sw_sg_bezier_set *set, doub
             const size_t need = sw_lod_gauss_scratch_bound(p->deg_u, p->deg_v);
             if (p->deg_u <= SW_LOD_GAUSS_MAX_DEGREE && p->deg_v <= SW_LOD_GAUSS_MAX_DEGREE &&
                 need > *cap) {
-                double *grown = realloc(*scratch, need * sizeof *grown);
+                double *grown = sw__realloc(*scratch, need * sizeof *grown);
                 if (!grown)
                     return oom(st, "Gauss-map scratch");
                 *scratch = grown, *cap = need;
@@ -234,7 +235,7 @@ static int push_sample(state *st, const sw_sg_surface *s, const sw_sg_bezier_set
 {
     if (st->n_samples == st->cap_samples) {
         const size_t cap = st->cap_samples ? 2 * st->cap_samples : 4096;
-        bsample *g = realloc(st->samples, cap * sizeof *g);
+        bsample *g = sw__realloc(st->samples, cap * sizeof *g);
         if (!g)
             return 0;
         st->samples = g, st->cap_samples = cap;
@@ -279,7 +280,7 @@ static int sample_polyline(state *st, const sw_sg_surface *s, const sw_sg_bezier
                            uint32_t first_patch, const double *uv, uint32_t count, double h)
 {
     const size_t start = st->n_samples;
-    double *ts = malloc(((size_t)SW__SAMPLES_PER_FACE + (size_t)set->n_u + (size_t)set->n_v + 1) *
+    double *ts = sw__malloc(((size_t)SW__SAMPLES_PER_FACE + (size_t)set->n_u + (size_t)set->n_v + 1) *
                         sizeof *ts);
     if (!ts)
         return 0;
@@ -296,11 +297,11 @@ static int sample_polyline(state *st, const sw_sg_surface *s, const sw_sg_bezier
         for (size_t i = 0; i < n; ++i)
             if (!push_sample(st, s, set, first_patch, a[0] + ts[i] * (b[0] - a[0]),
                              a[1] + ts[i] * (b[1] - a[1]))) {
-                free(ts);
+                sw__free(ts);
                 return 0;
             }
     }
-    free(ts);
+    sw__free(ts);
     const size_t n = st->n_samples - start;
     for (size_t k = 0; k < n; ++k) {
         bsample *c = &st->samples[start + k];
@@ -442,15 +443,15 @@ static sw_result build_adjacency(state *st)
         if (n == 0 || cmp_pair(&st->pairs[n - 1], &st->pairs[k]) != 0)
             st->pairs[n++] = st->pairs[k];
     st->n_pairs = n;
-    st->adj_first = calloc((size_t)st->n_patches + 1, sizeof *st->adj_first);
-    st->adj = malloc((2 * n + 1) * sizeof *st->adj);
+    st->adj_first = sw__calloc((size_t)st->n_patches + 1, sizeof *st->adj_first);
+    st->adj = sw__malloc((2 * n + 1) * sizeof *st->adj);
     if (!st->adj_first || !st->adj)
         return oom(st, "adjacency lists");
     for (size_t k = 0; k < n; ++k)
         ++st->adj_first[st->pairs[k].a + 1], ++st->adj_first[st->pairs[k].b + 1];
     for (uint32_t p = 0; p < st->n_patches; ++p)
         st->adj_first[p + 1] += st->adj_first[p];
-    uint32_t *fill = malloc(((size_t)st->n_patches + 1) * sizeof *fill);
+    uint32_t *fill = sw__malloc(((size_t)st->n_patches + 1) * sizeof *fill);
     if (!fill)
         return oom(st, "adjacency lists");
     memcpy(fill, st->adj_first, (size_t)st->n_patches * sizeof *fill);
@@ -458,7 +459,7 @@ static sw_result build_adjacency(state *st)
         st->adj[fill[st->pairs[k].a]++] = st->pairs[k].b;
         st->adj[fill[st->pairs[k].b]++] = st->pairs[k].a;
     }
-    free(fill);
+    sw__free(fill);
     return SW_OK;
 }
 
@@ -477,7 +478,7 @@ static int heap_push(heap *h, heap_item it)
 {
     if (h->n == h->cap) {
         const size_t cap = h->cap ? 2 * h->cap : 256;
-        heap_item *g = realloc(h->items, cap * sizeof *g);
+        heap_item *g = sw__realloc(h->items, cap * sizeof *g);
         if (!g)
             return 0;
         h->items = g, h->cap = cap;
@@ -693,22 +694,22 @@ static int all_closed_shell(const sw_sg_scene *scene, const sw_lod_supersurfaces
 static sw_result make_output(state *st, cl *c, uint32_t n_cl, const uint32_t *cluster_of,
                              sw_lod_supersurfaces **out)
 {
-    sw_lod_supersurfaces *ss = calloc(1, sizeof *ss);
+    sw_lod_supersurfaces *ss = sw__calloc(1, sizeof *ss);
     if (!ss)
         return oom(st, "output");
     *out = ss;
     const uint32_t np = st->n_patches;
-    uint32_t *out_index = malloc((size_t)n_cl * sizeof *out_index);
-    uint32_t *pos = malloc((size_t)np * sizeof *pos);
-    ss->patches = malloc((size_t)np * sizeof *ss->patches);
-    ss->patch_cones = malloc((size_t)np * sizeof *ss->patch_cones);
-    ss->cluster_of = malloc((size_t)np * sizeof *ss->cluster_of);
-    ss->clusters = calloc((size_t)n_cl, sizeof *ss->clusters);
-    ss->adjacency = malloc((st->n_pairs + 1) * sizeof *ss->adjacency);
+    uint32_t *out_index = sw__malloc((size_t)n_cl * sizeof *out_index);
+    uint32_t *pos = sw__malloc((size_t)np * sizeof *pos);
+    ss->patches = sw__malloc((size_t)np * sizeof *ss->patches);
+    ss->patch_cones = sw__malloc((size_t)np * sizeof *ss->patch_cones);
+    ss->cluster_of = sw__malloc((size_t)np * sizeof *ss->cluster_of);
+    ss->clusters = sw__calloc((size_t)n_cl, sizeof *ss->clusters);
+    ss->adjacency = sw__malloc((st->n_pairs + 1) * sizeof *ss->adjacency);
     if (!out_index || !pos || !ss->patches || !ss->patch_cones || !ss->cluster_of ||
         !ss->clusters || !ss->adjacency) {
-        free(out_index);
-        free(pos);
+        sw__free(out_index);
+        sw__free(pos);
         return oom(st, "output");
     }
     /* clusters numbered by their smallest patch, i.e. in order of first appearance */
@@ -765,8 +766,8 @@ static sw_result make_output(state *st, cl *c, uint32_t n_cl, const uint32_t *cl
     ss->n_clusters = n_out;
     ss->alpha = st->alpha;
     ss->merge_alpha = st->merge_alpha;
-    free(out_index);
-    free(pos);
+    sw__free(out_index);
+    sw__free(pos);
     return SW_OK;
 }
 
@@ -787,9 +788,9 @@ static sw_result collect_patches(state *st)
                 break;
             }
             st->n_patches = (uint32_t)total;
-            st->patch = malloc((total + 1) * sizeof *st->patch);
-            st->cone = malloc((total + 1) * sizeof *st->cone);
-            st->box = malloc((total + 1) * sizeof *st->box);
+            st->patch = sw__malloc((total + 1) * sizeof *st->patch);
+            st->cone = sw__malloc((total + 1) * sizeof *st->cone);
+            st->box = sw__malloc((total + 1) * sizeof *st->box);
             if (!st->patch || !st->cone || !st->box) {
                 res = oom(st, "patches");
                 break;
@@ -817,7 +818,7 @@ static sw_result collect_patches(state *st)
             sw_sg_bezier_set_free(&set);
         }
     }
-    free(scratch);
+    sw__free(scratch);
     return res;
 }
 
@@ -851,10 +852,10 @@ static sw_result cluster(state *st, sw_lod_supersurfaces **out)
 {
     const uint32_t np = st->n_patches;
     grow g = {0};
-    g.cluster_of = malloc((np + 1) * sizeof *g.cluster_of);
-    g.members = malloc((np + 1) * sizeof *g.members);
-    g.scratch_cones = malloc((np + 1) * sizeof *g.scratch_cones);
-    cl *c = malloc((np + 1) * sizeof *c);
+    g.cluster_of = sw__malloc((np + 1) * sizeof *g.cluster_of);
+    g.members = sw__malloc((np + 1) * sizeof *g.members);
+    g.scratch_cones = sw__malloc((np + 1) * sizeof *g.scratch_cones);
+    cl *c = sw__malloc((np + 1) * sizeof *c);
     sw_result res = SW_OK;
     if (!g.cluster_of || !g.members || !g.scratch_cones || !c)
         res = oom(st, "clusters");
@@ -883,8 +884,8 @@ static sw_result cluster(state *st, sw_lod_supersurfaces **out)
     }
     members_csr mem = {NULL, NULL};
     if (res == SW_OK) {
-        mem.first = calloc((size_t)n_cl + 2, sizeof *mem.first);
-        mem.patches = malloc((np + 1) * sizeof *mem.patches);
+        mem.first = sw__calloc((size_t)n_cl + 2, sizeof *mem.first);
+        mem.patches = sw__malloc((np + 1) * sizeof *mem.patches);
         if (!mem.first || !mem.patches)
             res = oom(st, "cluster members");
     }
@@ -901,13 +902,13 @@ static sw_result cluster(state *st, sw_lod_supersurfaces **out)
         }
         res = make_output(st, c, n_cl, g.cluster_of, out);
     }
-    free(mem.first);
-    free(mem.patches);
-    free(g.cluster_of);
-    free(g.members);
-    free(g.scratch_cones);
-    free(g.frontier.items);
-    free(c);
+    sw__free(mem.first);
+    sw__free(mem.patches);
+    sw__free(g.cluster_of);
+    sw__free(g.members);
+    sw__free(g.scratch_cones);
+    sw__free(g.frontier.items);
+    sw__free(c);
     return res;
 }
 
@@ -930,7 +931,7 @@ sw_result sw_lod_supersurfaces_build(const sw_sg_scene *scene, const sw_lod_ss_d
     st.view = sw_sg_scene_view_ptr(scene);
     st.alpha = st.desc.alpha_deg * M_PI / 180.0;
     st.merge_alpha = st.desc.merge_alpha_deg * M_PI / 180.0;
-    st.faces = calloc((size_t)st.view->n_faces + 1, sizeof *st.faces);
+    st.faces = sw__calloc((size_t)st.view->n_faces + 1, sizeof *st.faces);
     sw_result res = st.faces ? SW_OK : oom(&st, "faces");
     if (res == SW_OK)
         res = collect_patches(&st);
@@ -940,14 +941,14 @@ sw_result sw_lod_supersurfaces_build(const sw_sg_scene *scene, const sw_lod_ss_d
         res = build_adjacency(&st);
     if (res == SW_OK)
         res = cluster(&st, out);
-    free(st.faces);
-    free(st.patch);
-    free(st.cone);
-    free(st.box);
-    free(st.samples);
-    free(st.pairs);
-    free(st.adj_first);
-    free(st.adj);
+    sw__free(st.faces);
+    sw__free(st.patch);
+    sw__free(st.cone);
+    sw__free(st.box);
+    sw__free(st.samples);
+    sw__free(st.pairs);
+    sw__free(st.adj_first);
+    sw__free(st.adj);
     if (res != SW_OK) {
         sw_lod_supersurfaces_free(*out);
         *out = NULL;
@@ -961,10 +962,10 @@ void sw_lod_supersurfaces_free(sw_lod_supersurfaces *ss)
 {
     if (!ss)
         return;
-    free(ss->patches);
-    free(ss->patch_cones);
-    free(ss->cluster_of);
-    free(ss->clusters);
-    free(ss->adjacency);
-    free(ss);
+    sw__free(ss->patches);
+    sw__free(ss->patch_cones);
+    sw__free(ss->cluster_of);
+    sw__free(ss->clusters);
+    sw__free(ss->adjacency);
+    sw__free(ss);
 }

@@ -5,6 +5,7 @@
  * when its degree is <= 3, and halved until the bound of error_bound.c meets the tolerance.
  */
 #include "sw_lod_reduce.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_bezier.h"
 #include "sw_status_util.h"
@@ -30,17 +31,17 @@ static sw_result refine_to_bezier(const sw_sg_curve *c, double **knots_io, doubl
             continue;
         }
         const int32_t times = p - mult, n = *n_io;
-        double *nk = malloc((size_t)(n + p + 1 + times) * sizeof *nk);
-        double *nc = malloc((size_t)(n + times) * (size_t)dim * sizeof *nc);
+        double *nk = sw__malloc((size_t)(n + p + 1 + times) * sizeof *nk);
+        double *nc = sw__malloc((size_t)(n + times) * (size_t)dim * sizeof *nc);
         if (!nk || !nc) {
-            free(nk);
-            free(nc);
+            sw__free(nk);
+            sw__free(nc);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim curve: knot insertion");
         }
         const sw_sg_curve cur = {p, n, dim, *knots_io, *cpw_io};
         sw_sg_curve_insert_knot(&cur, t, times, nk, nc);
-        free(*knots_io);
-        free(*cpw_io);
+        sw__free(*knots_io);
+        sw__free(*cpw_io);
         *knots_io = nk;
         *cpw_io = nc;
         *n_io = n + times;
@@ -54,14 +55,14 @@ sw_result sw_lod_curve_bezier_segments(const sw_sg_curve *c, double **cpw_out, d
 {
     const int32_t p = c->degree, dim = c->dim;
     int32_t n = c->n;
-    double *kn = malloc((size_t)(n + p + 1) * sizeof *kn);
-    double *cp = malloc((size_t)n * (size_t)dim * sizeof *cp);
+    double *kn = sw__malloc((size_t)(n + p + 1) * sizeof *kn);
+    double *cp = sw__malloc((size_t)n * (size_t)dim * sizeof *cp);
     *cpw_out = NULL;
     *breaks_out = NULL;
     *n_seg = 0;
     if (!kn || !cp) {
-        free(kn);
-        free(cp);
+        sw__free(kn);
+        sw__free(cp);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim curve: %d control points", (int)n);
     }
     memcpy(kn, c->knots, (size_t)(n + p + 1) * sizeof *kn);
@@ -69,8 +70,8 @@ sw_result sw_lod_curve_bezier_segments(const sw_sg_curve *c, double **cpw_out, d
     sw_result res = refine_to_bezier(c, &kn, &cp, &n, status);
     double *seg = NULL, *brk = NULL;
     if (res == SW_OK) {
-        seg = malloc((size_t)n * (size_t)(p + 1) * (size_t)dim * sizeof *seg);
-        brk = malloc((size_t)(n + 1) * sizeof *brk);
+        seg = sw__malloc((size_t)n * (size_t)(p + 1) * (size_t)dim * sizeof *seg);
+        brk = sw__malloc((size_t)(n + 1) * sizeof *brk);
         if (!seg || !brk)
             res = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim curve: segments");
     }
@@ -84,11 +85,11 @@ sw_result sw_lod_curve_bezier_segments(const sw_sg_curve *c, double **cpw_out, d
         brk[count + 1] = kn[k + 1];
         ++count;
     }
-    free(kn);
-    free(cp);
+    sw__free(kn);
+    sw__free(cp);
     if (res != SW_OK) {
-        free(seg);
-        free(brk);
+        sw__free(seg);
+        sw__free(brk);
         return res;
     }
     *cpw_out = seg;
@@ -102,7 +103,7 @@ static sw_result push_piece(sw_lod_cubic_set *s, const sw_lod_cubic_piece *p, sw
 {
     if (s->count == s->cap) {
         int32_t cap = s->cap ? 2 * s->cap : 16;
-        sw_lod_cubic_piece *grown = realloc(s->pieces, (size_t)cap * sizeof *grown);
+        sw_lod_cubic_piece *grown = sw__realloc(s->pieces, (size_t)cap * sizeof *grown);
         if (!grown)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim curve: %d pieces", (int)cap);
         s->pieces = grown;
@@ -156,8 +157,8 @@ sw_result sw_lod_trim_curve_to_cubics(const sw_sg_curve *c, const sw_lod_reduce_
     for (int32_t k = 0; k < n_seg && res == SW_OK; ++k)
         res = approx_segment(c->degree, seg + (size_t)k * stride, brk[k], brk[k + 1], 0, desc,
                              max_depth, out, status);
-    free(seg);
-    free(brk);
+    sw__free(seg);
+    sw__free(brk);
     if (res == SW_OK)
         sw__status_ok(status);
     return res;
@@ -167,6 +168,6 @@ void sw_lod_cubic_set_free(sw_lod_cubic_set *set)
 {
     if (!set)
         return;
-    free(set->pieces);
+    sw__free(set->pieces);
     memset(set, 0, sizeof *set);
 }

@@ -8,6 +8,7 @@
  * costs O(p^3) per row and only the patches a trim box needs are ever computed.
  */
 #include "sw_sg_geom.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -114,8 +115,8 @@ sw_result sw_sg_surface_extract_bezier_in(const sw_sg_surface *s, double u0, dou
     if (count > SIZE_MAX / sizeof(sw_sg_bezier_patch) || count > SIZE_MAX / sizeof(double) / per)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "Bézier extraction: %d x %d patches", (int)nu,
                         (int)nv);
-    out->patches = calloc(count, sizeof *out->patches);
-    out->storage = malloc(count * per * sizeof(double));
+    out->patches = sw__calloc(count, sizeof *out->patches);
+    out->storage = sw__malloc(count * per * sizeof(double));
     if (!out->patches || !out->storage) {
         sw_sg_bezier_set_free(out);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY,
@@ -167,8 +168,8 @@ void sw_sg_bezier_set_free(sw_sg_bezier_set *set)
 {
     if (!set)
         return;
-    free(set->patches);
-    free(set->storage);
+    sw__free(set->patches);
+    sw__free(set->storage);
     memset(set, 0, sizeof *set);
 }
 

@@ -1,5 +1,6 @@
 /* The BVH over face occurrences or caller-made items (sw_sg_bvh.h). */
 #include "sw_sg_bvh.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -53,7 +54,7 @@ static int visit(void *ctx, uint32_t face, const double world[12], const float c
     build *b = ctx;
     if (b->n_items == b->cap_items) {
         size_t cap = b->cap_items ? 2 * b->cap_items : 256;
-        sw_sg_bvh_item *p = cap <= INT32_MAX ? realloc(b->items, cap * sizeof *p) : NULL;
+        sw_sg_bvh_item *p = cap <= INT32_MAX ? sw__realloc(b->items, cap * sizeof *p) : NULL;
         if (!p) {
             b->oom = 1;
             return 1;
@@ -155,15 +156,15 @@ static uint32_t build_node(sw_sg_bvh *t, uint32_t lo, uint32_t hi)
 /* Takes `items` (n of them, malloc'ed; freed on failure) and builds the hierarchy over them. */
 static sw_result finish(sw_sg_bvh_item *items, size_t n, sw_sg_bvh **out, sw_status *status)
 {
-    sw_sg_bvh *t = calloc(1, sizeof *t);
+    sw_sg_bvh *t = sw__calloc(1, sizeof *t);
     if (t) {
         t->items = items;
         t->n_items = (uint32_t)n;
-        t->nodes = malloc((n ? 2 * n : 1) * sizeof *t->nodes);
+        t->nodes = sw__malloc((n ? 2 * n : 1) * sizeof *t->nodes);
     }
     if (!t || !t->nodes) {
         if (!t)
-            free(items);
+            sw__free(items);
         sw_sg_bvh_free(t);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
     }
@@ -177,15 +178,15 @@ sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *
 {
     *out = NULL;
     const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    build b = {scene, malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), NULL, 0, 0, 0};
+    build b = {scene, sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), NULL, 0, 0, 0};
     if (!b.face_box)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
     for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
         b.face_box[i] = NAN;
     sw_result r = sw_sg_scene_traverse(scene, visit, &b);
-    free(b.face_box);
+    sw__free(b.face_box);
     if (r != SW_OK || b.oom) {
-        free(b.items);
+        sw__free(b.items);
         return sw__fail(status, b.cap_items >= INT32_MAX / 2 ? SW_ERR_LIMIT : SW_ERR_OUT_OF_MEMORY,
                         "BVH: %zu occurrences: out of memory", b.n_items);
     }
@@ -197,7 +198,7 @@ sw_result sw_sg_bvh_build_items(sw_sg_bvh_item *items, uint32_t n, sw_sg_bvh **o
 {
     *out = NULL;
     if (n > INT32_MAX) {
-        free(items);
+        sw__free(items);
         return sw__fail(status, SW_ERR_LIMIT, "BVH: %u items (at most 2^31 - 1)", n);
     }
     return finish(items, n, out, status);
@@ -208,7 +209,7 @@ sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out
     *out = NULL;
     if (n > INT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "BVH: %u boxes (at most 2^31 - 1)", n);
-    sw_sg_bvh_item *items = malloc((n ? n : 1) * sizeof *items);
+    sw_sg_bvh_item *items = sw__malloc((n ? n : 1) * sizeof *items);
     if (!items)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: %u boxes: out of memory", n);
     static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -226,9 +227,9 @@ void sw_sg_bvh_free(sw_sg_bvh *bvh)
 {
     if (!bvh)
         return;
-    free(bvh->items);
-    free(bvh->nodes);
-    free(bvh);
+    sw__free(bvh->items);
+    sw__free(bvh->nodes);
+    sw__free(bvh);
 }
 
 size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh)

@@ -18,6 +18,7 @@
  * Randomness comes from a hash of (seed, room, wall), never from the order of the calls.
  */
 #include "generate_common.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -450,16 +451,16 @@ static sw_result plan_rooms(gb *g, uint64_t want, plan *out, sw_status *status)
 {
     const uint64_t per = (uint64_t)g->nx * g->ny;
     size_t cap = 1024;
-    uint64_t *roofc = malloc(cap * sizeof *roofc), *northc = malloc(cap * sizeof *northc);
+    uint64_t *roofc = sw__malloc(cap * sizeof *roofc), *northc = sw__malloc(cap * sizeof *northc);
     uint64_t roof_sum = 0, north_sum = 0;
     out->rooms = out->total = 0;
     int oom = !roofc || !northc;
     for (uint64_t k = 0; !oom; ++k) {
         if (k == cap) {
             cap *= 2;
-            uint64_t *a = realloc(roofc, cap * sizeof *roofc);
+            uint64_t *a = sw__realloc(roofc, cap * sizeof *roofc);
             roofc = a ? a : roofc;
-            uint64_t *b = a ? realloc(northc, cap * sizeof *northc) : NULL;
+            uint64_t *b = a ? sw__realloc(northc, cap * sizeof *northc) : NULL;
             northc = b ? b : northc;
             if (!a || !b) {
                 oom = 1;
@@ -482,8 +483,8 @@ static sw_result plan_rooms(gb *g, uint64_t want, plan *out, sw_status *status)
         if (g->d->progress && (k & 0x3fffu) == 0)
             g->d->progress(g->d->user_data, 0.2 * (double)g->c.occ / (double)want, "planning");
     }
-    free(roofc);
-    free(northc);
+    sw__free(roofc);
+    sw__free(northc);
     if (oom)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "building: out of memory while planning");
     return SW_OK;
@@ -532,7 +533,7 @@ sw_result sw_sg_generate_building(const sw_sg_building_desc *desc, sw_sg_scene *
     if (r != SW_OK)
         return r;
     layout(&g, desc->surfaces);
-    g.c.face = malloc(sizeof *g.c.face);
+    g.c.face = sw__malloc(sizeof *g.c.face);
     gb dry = g;
     plan pl = {0, 0};
     r = g.c.face ? plan_rooms(&dry, desc->surfaces, &pl, status)
@@ -552,7 +553,7 @@ sw_result sw_sg_generate_building(const sw_sg_building_desc *desc, sw_sg_scene *
         else if (g.c.oom)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "building: out of memory");
     }
-    free(g.c.face);
+    sw__free(g.c.face);
     if (r != SW_OK) {
         sw_sg_builder_free(g.c.b);
         return r;

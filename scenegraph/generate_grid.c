@@ -1,5 +1,6 @@
 /* The grid generator (sw_sg_generate.h). */
 #include "sw_sg_bvh.h"
+#include "sw_hooks.h"
 #include "sw_sg_generate.h"
 
 #include "sw_status_util.h"
@@ -99,7 +100,7 @@ static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32
 static sw_result node_order(const sw_sg_scene_view *v, uint32_t base, uint32_t *order,
                             uint32_t *map, sw_status *status)
 {
-    uint32_t *stack = malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *stack);
+    uint32_t *stack = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *stack);
     if (!stack)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     uint32_t n = 0;
@@ -124,7 +125,7 @@ static sw_result node_order(const sw_sg_scene_view *v, uint32_t base, uint32_t *
             }
         }
     }
-    free(stack);
+    sw__free(stack);
     if (n != v->n_nodes) /* validation rules this out; the copy loop relies on it */
         return sw__fail(status, SW_ERR_FORMAT, "copying a model: %u of its %u nodes unreachable",
                         v->n_nodes - n, v->n_nodes);
@@ -136,8 +137,8 @@ static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_
                             uint32_t face_base, uint32_t mesh_base, uint32_t *proto,
                             sw_status *status)
 {
-    uint32_t *order = malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *order);
-    uint32_t *map = malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *map);
+    uint32_t *order = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *order);
+    uint32_t *map = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *map);
     sw_result r = order && map
                       ? node_order(v, base, order, map, status)
                       : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
@@ -155,8 +156,8 @@ static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     }
     *proto = r == SW_OK ? map[v->root] : SW_SG_NONE;
-    free(order);
-    free(map);
+    sw__free(order);
+    sw__free(map);
     return r;
 }
 

@@ -13,6 +13,7 @@
  * the unique faces. Parking bollards make up the exact count.
  */
 #include "generate_common.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
@@ -374,10 +375,10 @@ sw_result sw_sg_generate_vehicle(const sw_sg_vehicle_desc *desc, sw_sg_scene **o
     sw_result r = sw__gen_measure(&g.c, sw_sg_vehicle_model_files, status);
     if (r != SW_OK)
         return r;
-    g.c.face = malloc(sizeof *g.c.face);
+    g.c.face = sw__malloc(sizeof *g.c.face);
     g.c.b = g.c.face ? sw_sg_builder_create() : NULL;
     if (!g.c.b) {
-        free(g.c.face);
+        sw__free(g.c.face);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "vehicle: out of memory");
     }
     g.c.n_nodes = 1; /* the builder's root */
@@ -389,7 +390,7 @@ sw_result sw_sg_generate_vehicle(const sw_sg_vehicle_desc *desc, sw_sg_scene **o
             desc->progress(desc->user_data, 0.8 * (double)g.c.occ / (double)desc->surfaces, "cars");
     }
     bollards(&g, desc->surfaces - g.c.occ, k);
-    free(g.c.face);
+    sw__free(g.c.face);
     if (g.c.oom) {
         sw_sg_builder_free(g.c.b);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "vehicle: out of memory");

@@ -11,6 +11,7 @@
 #include "sw_sg_import_occt.hpp"
 #include "sw_sg_trim.h"
 #include "sw_status_util.h"
+#include "sw_hooks.h"
 
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
@@ -511,7 +512,8 @@ class importer
 /* OCCT's readers report through the process-wide default messenger, whose printer writes to
  * stdout ("Total number of loaded entities ..." in colour) — which would corrupt `info --json` and
  * any host's output. While a file is read, the default printers are set aside and replaced by one
- * that forwards warnings and failures to the import's warning callback and drops the chatter.
+ * that forwards warnings and failures to the import's warning callback, and everything (the
+ * chatter too) to the log hook's debug lines.
  * The messenger is global: concurrent imports share the swap (each restores what it saw). */
 class forward_printer : public Message_Printer
 {
@@ -519,7 +521,8 @@ class forward_printer : public Message_Printer
     forward_printer(sw_sg_warning_fn fn, void *user, std::string prefix)
         : fn_(fn), user_(user), prefix_(std::move(prefix))
     {
-        myTraceLevel = Message_Warning;
+        /* The chatter only when the host's logger wants debug lines (sw_setup.h). */
+        myTraceLevel = sw__log_enabled(SW_LOG_DEBUG) ? Message_Info : Message_Warning;
     }
 
   protected:
@@ -527,6 +530,7 @@ class forward_printer : public Message_Printer
     {
         if (fn_ && gravity >= Message_Warning)
             fn_(user_, (prefix_ + ": OCCT: " + text.ToCString()).c_str());
+        sw__log(SW_LOG_DEBUG, "%s: OCCT: %s", prefix_.c_str(), text.ToCString());
     }
 
   private:

@@ -1,6 +1,7 @@
 /* Picking by ray: BVH traversal nearest box first, then per face Bézier subdivision against the
  * ray's two planes and Newton on the exact surface (sw_sg_pick.h says why and how). */
 #include "sw_sg_pick.h"
+#include "sw_hooks.h"
 
 #include "sw_sg_geom.h"
 #include "sw_sg_trim.h"
@@ -163,7 +164,7 @@ static int subdivide(face_job *job, const double *net, int du, int dv, const dou
         newton(job, 0.5 * (rect[0] + rect[1]), 0.5 * (rect[2] + rect[3]));
         return 0;
     }
-    double *half = malloc(2 * (size_t)n_cp * 4 * sizeof *half);
+    double *half = sw__malloc(2 * (size_t)n_cp * 4 * sizeof *half);
     if (!half)
         return -1;
     int dir = depth % 2;
@@ -176,7 +177,7 @@ static int subdivide(face_job *job, const double *net, int du, int dv, const dou
     int rc = subdivide(job, half, du, dv, r_lo, depth + 1);
     if (rc == 0)
         rc = subdivide(job, half + 4 * n_cp, du, dv, r_hi, depth + 1);
-    free(half);
+    sw__free(half);
     return rc;
 }
 
@@ -197,7 +198,7 @@ static sw_result face_loops(face_job *job, sw_status *status)
     const sw_sg_face_rec *rec = job->rec;
     if (!(rec->flags & SW_SG_FACE_TRIMMED) || rec->n_loops == 0)
         return SW_OK;
-    job->loops = calloc(rec->n_loops, sizeof *job->loops);
+    job->loops = sw__calloc(rec->n_loops, sizeof *job->loops);
     if (!job->loops)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "pick: out of memory");
     double tol = 1e-6 * fmax(rec->uv_box[1] - rec->uv_box[0], rec->uv_box[3] - rec->uv_box[2]);
@@ -215,7 +216,7 @@ static void face_job_free(face_job *job)
 {
     for (uint32_t k = 0; k < job->n_loops; ++k)
         sw_sg_polyline_free(&job->loops[k]);
-    free(job->loops);
+    sw__free(job->loops);
 }
 
 /* Intersects one face with the local ray; updates *best_t and the hit when nearer. */
@@ -420,7 +421,7 @@ sw_result sw_sg_pick(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const doubl
     double best = t_max > 0.0 ? t_max : INFINITY, inv_d[3];
     for (int k = 0; k < 3; ++k)
         inv_d[k] = 1.0 / dir[k];
-    int32_t *stack = malloc(((size_t)bvh->n_nodes + 1) * sizeof *stack);
+    int32_t *stack = sw__malloc(((size_t)bvh->n_nodes + 1) * sizeof *stack);
     if (!stack)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "pick: out of memory");
     size_t top = 0;
@@ -455,7 +456,7 @@ sw_result sw_sg_pick(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const doubl
             }
         }
     }
-    free(stack);
+    sw__free(stack);
     if (r == SW_OK && sw_sg_scene_view_ptr(scene)->n_meshes)
         r = pick_meshes(scene, origin, dir, inv_d, &best, hit, status);
     if (r == SW_OK && (hit->face != SW_SG_NONE || hit->mesh != SW_SG_NONE))

@@ -4,6 +4,7 @@
  * mapped from a .sws file (sws_file.c). Guthe et al. 2005 §3 renders every face occurrence the
  * traversal yields as rational Bézier patches under its world transform. */
 #include "sw_sg_scene_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -79,7 +80,7 @@ static size_t vec_grow(sw__vec *v, size_t count)
             cap = v->max;
         if (cap > SIZE_MAX / v->elem)
             return SIZE_MAX;
-        unsigned char *d = realloc(v->data, cap * v->elem);
+        unsigned char *d = sw__realloc(v->data, cap * v->elem);
         if (!d)
             return SIZE_MAX;
         v->data = d;
@@ -101,7 +102,7 @@ static uint32_t vec_push(sw__vec *v, const void *elem)
 
 sw_sg_builder *sw_sg_builder_create(void)
 {
-    sw_sg_builder *b = calloc(1, sizeof *b);
+    sw_sg_builder *b = sw__calloc(1, sizeof *b);
     if (!b)
         return NULL;
     const size_t rec_max = (size_t)SW_SG_NONE - 1; /* SW_SG_NONE itself is never an index */
@@ -125,9 +126,9 @@ void sw_sg_builder_free(sw_sg_builder *b)
     if (!b)
         return;
     for (int s = 0; s < SW__SG_SEC_COUNT; s++)
-        free(b->vec[s].data);
-    free(b->last_child.data);
-    free(b);
+        sw__free(b->vec[s].data);
+    sw__free(b->last_child.data);
+    sw__free(b);
 }
 
 uint64_t sw_sg_builder_push_doubles(sw_sg_builder *b, const double *values, size_t count)
@@ -267,7 +268,7 @@ static void builder_move_arrays(sw_sg_builder *b, sw_sg_scene *scene)
             continue;
         sw__vec *v = &b->vec[s];
         if (v->n && v->n < v->cap) {
-            unsigned char *d = realloc(v->data, v->n * v->elem);
+            unsigned char *d = sw__realloc(v->data, v->n * v->elem);
             if (d)
                 v->data = d;
         }
@@ -300,11 +301,11 @@ static void builder_move_arrays(sw_sg_builder *b, sw_sg_scene *scene)
 sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *status)
 {
     *out = NULL;
-    sw_sg_scene *scene = calloc(1, sizeof *scene);
-    char *path = calloc(1, 1);
+    sw_sg_scene *scene = sw__calloc(1, sizeof *scene);
+    char *path = sw__calloc(1, 1);
     if (!scene || !path) {
-        free(scene);
-        free(path);
+        sw__free(scene);
+        sw__free(path);
         sw_sg_builder_free(b);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene: out of memory");
     }
@@ -435,11 +436,11 @@ void sw_sg_scene_free(sw_sg_scene *scene)
     if (!scene)
         return;
     for (int s = 0; s < SW__SG_SEC_COUNT; s++)
-        free(scene->owned[s]);
+        sw__free(scene->owned[s]);
     if (scene->map)
         munmap(scene->map, scene->map_size);
-    free(scene->path);
-    free(scene);
+    sw__free(scene->path);
+    sw__free(scene);
 }
 
 /* ---- traversal ------------------------------------------------------------------------------- */
@@ -476,7 +477,7 @@ static int trav_push(trav_stack *st, uint32_t node, uint32_t depth, int follow,
     if (st->n == st->cap) {
         size_t cap = st->cap * 2;
         trav_entry *e =
-            st->e == st->local ? malloc(cap * sizeof *e) : realloc(st->e, cap * sizeof *e);
+            st->e == st->local ? sw__malloc(cap * sizeof *e) : sw__realloc(st->e, cap * sizeof *e);
         if (!e)
             return 0;
         if (st->e == st->local)
@@ -529,7 +530,7 @@ static sw_result traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit,
             ok = trav_push(&st, nd->ref, e.depth + 1, 0, world, color);
     }
     if (st.e != st.local)
-        free(st.e);
+        sw__free(st.e);
     return ok ? SW_OK : SW_ERR_OUT_OF_MEMORY;
 }
 

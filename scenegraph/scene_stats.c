@@ -2,6 +2,7 @@
  * extraction (Guthe et al. 2005 §3 starts from those patches), degrees, instances, face
  * occurrences after instance expansion, and the world bounding box of the surfaces. */
 #include "sw_sg_scene_internal.h"
+#include "sw_hooks.h"
 
 #include <float.h>
 #include <stdlib.h>
@@ -147,13 +148,13 @@ sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats 
         out->bbox[r] = DBL_MAX;
         out->bbox[3 + r] = -DBL_MAX;
     }
-    stats_ctx c = {scene, out, malloc(((size_t)v->n_faces + 1) * 6 * sizeof(double))};
+    stats_ctx c = {scene, out, sw__malloc(((size_t)v->n_faces + 1) * 6 * sizeof(double))};
     if (!c.face_boxes)
         return SW_ERR_OUT_OF_MEMORY;
     for (uint32_t i = 0; i < v->n_faces; i++)
         face_sample_box(scene, i, c.face_boxes + (size_t)i * 6);
     sw_result r = sw_sg_scene_traverse(scene, stats_visit, &c);
-    free(c.face_boxes);
+    sw__free(c.face_boxes);
     out->meshes = v->n_meshes;
     for (uint32_t i = 0; i < v->n_meshes; i++)
         out->mesh_triangles += v->meshes[i].n_triangles;

@@ -4,6 +4,7 @@
  * through sw_sg_surface_validate / sw_sg_curve_validate. Mapped .sws files are hostile input
  * (CONVENTIONS.md, Errors): this is the "validate" step after sws_file.c's "parse". */
 #include "sw_sg_scene_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -286,19 +287,19 @@ static sw_result check_nodes(const vctx *c)
     sw_result r = check_node_records(c);
     if (r != SW_OK)
         return r;
-    unsigned char *marks = calloc(v->n_nodes, 1);
-    dfs_frame *stack = malloc((size_t)v->n_nodes * sizeof *stack);
+    unsigned char *marks = sw__calloc(v->n_nodes, 1);
+    dfs_frame *stack = sw__malloc((size_t)v->n_nodes * sizeof *stack);
     if (!marks || !stack) {
-        free(marks);
-        free(stack);
+        sw__free(marks);
+        sw__free(stack);
         return sw__fail(c->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory validating %u nodes",
                         c->what, v->n_nodes);
     }
     r = check_child_chains(c, marks);
     if (r == SW_OK)
         r = check_cycles(c, marks, stack);
-    free(marks);
-    free(stack);
+    sw__free(marks);
+    sw__free(stack);
     return r;
 }
 

@@ -1,5 +1,6 @@
 /* sw_result names and the sw_status helpers shared by every layer. */
 #include "sw_status_util.h"
+#include "sw_hooks.h"
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -28,14 +29,21 @@ const char *sw_result_id_str(sw_result result)
     return ids[result];
 }
 
+/* Every failure is also a debug line of the host's logger (sw_setup.h), when it asks for them. */
 sw_result sw__fail(sw_status *status, sw_result result, const char *fmt, ...)
 {
-    if (status) {
+    int logged = sw__log_enabled(SW_LOG_DEBUG);
+    if (status || logged) {
+        char local[sizeof status->message];
+        char *message = status ? status->message : local;
         va_list ap;
         va_start(ap, fmt);
-        status->result = result;
-        vsnprintf(status->message, sizeof status->message, fmt, ap);
+        vsnprintf(message, sizeof local, fmt, ap);
         va_end(ap);
+        if (status)
+            status->result = result;
+        if (logged)
+            sw__log(SW_LOG_DEBUG, "%s: %s", sw_result_id_str(result), message);
     }
     return result;
 }

@@ -40,6 +40,7 @@
  * are verified, validates the records (scene_validate.c). Save writes PATH.tmp-<pid>, fsyncs it
  * and renames it over PATH, so a reader sees either the old file or the new one. */
 #include "sw_crc32c.h"
+#include "sw_hooks.h"
 #include "sw_sg_scene_internal.h"
 #include "sw_status_util.h"
 
@@ -393,11 +394,11 @@ static sw_result map_file(sw_sg_scene *scene, sw_status *status)
 sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status)
 {
     *out = NULL;
-    sw_sg_scene *scene = calloc(1, sizeof *scene);
-    char *copy = malloc(strlen(path) + 1);
+    sw_sg_scene *scene = sw__calloc(1, sizeof *scene);
+    char *copy = sw__malloc(strlen(path) + 1);
     if (!scene || !copy) {
-        free(scene);
-        free(copy);
+        sw__free(scene);
+        sw__free(copy);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     scene->path = strcpy(copy, path);
@@ -572,7 +573,7 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
                  &file_size);
 
     size_t tlen = strlen(path) + 32;
-    char *tmp = malloc(tlen);
+    char *tmp = sw__malloc(tlen);
     if (!tmp)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
     snprintf(tmp, tlen, "%s.tmp-%ld", path, (long)getpid());
@@ -580,7 +581,7 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
     if (fd < 0) {
         r = sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO,
                      "%s: cannot create %s: %s", path, tmp, strerror(errno));
-        free(tmp);
+        sw__free(tmp);
         return r;
     }
     const char *step = NULL;
@@ -601,10 +602,10 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
         unlink(tmp);
         r = sw__fail(status, SW_ERR_IO, "%s: %s of %llu bytes through %s failed: %s", path, step,
                      (unsigned long long)file_size, tmp, strerror(err));
-        free(tmp);
+        sw__free(tmp);
         return r;
     }
-    free(tmp);
+    sw__free(tmp);
     sync_parent_dir(path);
     sw__status_ok(status);
     return SW_OK;

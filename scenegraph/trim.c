@@ -9,6 +9,7 @@
  * (convex hull property of rational curves with positive weights).
  */
 #include "sw_sg_trim.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -84,7 +85,7 @@ static void emit(vertex_buf *vb, const double *h)
         uint32_t cap = vb->cap ? vb->cap * 2 : 64;
         if (cap > vb->max)
             cap = vb->max;
-        double *uv = realloc(vb->uv, (size_t)cap * 2 * sizeof(double));
+        double *uv = sw__realloc(vb->uv, (size_t)cap * 2 * sizeof(double));
         if (!uv) {
             vb->oom = 1;
             return;
@@ -213,13 +214,13 @@ static sw_result flatten_curve(const sw_sg_curve *c, uint32_t index, double tol,
                         (int)c->degree, (int)c->n);
     const int32_t p = c->degree;
     const size_t seg = (size_t)(p + 1) * TRIM_DIM;
-    double *qw = malloc((size_t)(c->n - p) * seg * sizeof(double));
+    double *qw = sw__malloc((size_t)(c->n - p) * seg * sizeof(double));
     if (!qw)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim curve %u: out of memory", index);
     int32_t nb = decompose(c, qw);
     for (int32_t s = 0; s < nb; s++)
         flatten_bezier(qw + (size_t)s * seg, p, tol, 0, vb);
-    free(qw);
+    sw__free(qw);
     return SW_OK;
 }
 
@@ -237,12 +238,12 @@ sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, doubl
         sw_sg_scene_curve(scene, lp->first_curve + k, &c);
         sw_result r = flatten_curve(&c, lp->first_curve + k, tol, &vb, status);
         if (r != SW_OK) {
-            free(vb.uv);
+            sw__free(vb.uv);
             return r;
         }
     }
     if (vb.oom || vb.overflow) {
-        free(vb.uv);
+        sw__free(vb.uv);
         return vb.oom ? sw__fail(status, SW_ERR_OUT_OF_MEMORY, "loop %u: out of memory", loop)
                       : sw__fail(status, SW_ERR_LIMIT,
                                  "loop %u: more than %u vertices at tolerance %g", loop,
@@ -258,7 +259,7 @@ void sw_sg_polyline_free(sw_sg_polyline *p)
 {
     if (!p)
         return;
-    free(p->uv);
+    sw__free(p->uv);
     p->uv = NULL;
     p->count = 0;
 }

@@ -11,6 +11,7 @@
  * rational bicubic Bézier patch per region exact (tspline_bezier.c).
  */
 #include "sw_sg_tspline.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 #include "sw_sg_tspline_internal.h"
 
@@ -184,7 +185,7 @@ static int cmp_double(const void *a, const void *b)
 static double *boundaries(const double *knots, uint32_t n_points, double lo, double hi,
                           uint32_t *count)
 {
-    double *b = malloc(sizeof(double) * ((size_t)n_points * 5 + 2));
+    double *b = sw__malloc(sizeof(double) * ((size_t)n_points * 5 + 2));
     if (!b)
         return NULL;
     size_t m = 0;
@@ -237,7 +238,7 @@ static sw_result merge_cells(sw_sg_tspline *ts, const unsigned char *vcov,
 {
     const uint32_t nuc = ts->v.n_bu - 1, nvc = ts->v.n_bv - 1;
     uint32_t n = 0, cap = 64;
-    sw_sg_tspline_region *rg = malloc(sizeof *rg * cap);
+    sw_sg_tspline_region *rg = sw__malloc(sizeof *rg * cap);
     if (!rg)
         return SW_ERR_OUT_OF_MEMORY;
     for (uint32_t b = 0; b < nvc; b++) {
@@ -258,9 +259,9 @@ static sw_result merge_cells(sw_sg_tspline *ts, const unsigned char *vcov,
             if (r == UINT32_MAX) {
                 if (n == cap) {
                     cap *= 2;
-                    sw_sg_tspline_region *g = realloc(rg, sizeof *rg * cap);
+                    sw_sg_tspline_region *g = sw__realloc(rg, sizeof *rg * cap);
                     if (!g) {
-                        free(rg);
+                        sw__free(rg);
                         return SW_ERR_OUT_OF_MEMORY;
                     }
                     rg = g;
@@ -285,10 +286,10 @@ static sw_result list_region_points(sw_sg_tspline *ts, uint64_t total)
 {
     sw_sg_tspline_view *v = &ts->v;
     const uint32_t nuc = v->n_bu - 1;
-    uint32_t *stamp = malloc(sizeof(uint32_t) * v->n_regions);
-    ts->region_points = malloc(sizeof(uint32_t) * (total ? total : 1));
+    uint32_t *stamp = sw__malloc(sizeof(uint32_t) * v->n_regions);
+    ts->region_points = sw__malloc(sizeof(uint32_t) * (total ? total : 1));
     if (!stamp || !ts->region_points) {
-        free(stamp);
+        sw__free(stamp);
         return SW_ERR_OUT_OF_MEMORY;
     }
     for (int pass = 0; pass < 2; pass++) {
@@ -321,7 +322,7 @@ static sw_result list_region_points(sw_sg_tspline *ts, uint64_t total)
             }
         }
     }
-    free(stamp);
+    sw__free(stamp);
     v->region_points = ts->region_points;
     return SW_OK;
 }
@@ -378,9 +379,9 @@ static sw_result check_desc(const sw_sg_tspline_desc *d, const char *what, sw_st
 static sw_result copy_desc(sw_sg_tspline *ts, const sw_sg_tspline_desc *d)
 {
     const size_t n = d->n_points;
-    ts->cpw = malloc(sizeof(double) * n * 4);
-    ts->ku = malloc(sizeof(double) * n * 5);
-    ts->kv = malloc(sizeof(double) * n * 5);
+    ts->cpw = sw__malloc(sizeof(double) * n * 4);
+    ts->ku = sw__malloc(sizeof(double) * n * 5);
+    ts->kv = sw__malloc(sizeof(double) * n * 5);
     if (!ts->cpw || !ts->ku || !ts->kv)
         return SW_ERR_OUT_OF_MEMORY;
     memcpy(ts->cpw, d->cpw, sizeof(double) * n * 4);
@@ -424,17 +425,17 @@ static sw_result build_regions(sw_sg_tspline *ts, const char *what, sw_status *s
     if (total > SW_SG_TSPLINE_MAX_SUPPORT_CELLS)
         return sw__fail(status, SW_ERR_LIMIT, "%s: supports cover more than %u cells", what,
                         SW_SG_TSPLINE_MAX_SUPPORT_CELLS);
-    unsigned char *vcov = calloc((size_t)v->n_bu * (v->n_bv - 1), 1);
-    unsigned char *hcov = calloc((size_t)v->n_bv * (v->n_bu - 1), 1);
-    ts->cell_region = malloc(sizeof(uint32_t) * cells);
+    unsigned char *vcov = sw__calloc((size_t)v->n_bu * (v->n_bv - 1), 1);
+    unsigned char *hcov = sw__calloc((size_t)v->n_bv * (v->n_bu - 1), 1);
+    ts->cell_region = sw__malloc(sizeof(uint32_t) * cells);
     sw_result r = vcov && hcov && ts->cell_region ? SW_OK : SW_ERR_OUT_OF_MEMORY;
     if (r == SW_OK) {
         v->cell_region = ts->cell_region;
         mark_knot_lines(ts, vcov, hcov);
         r = merge_cells(ts, vcov, hcov);
     }
-    free(vcov);
-    free(hcov);
+    sw__free(vcov);
+    sw__free(hcov);
     if (r == SW_OK)
         r = list_region_points(ts, total);
     if (r != SW_OK)
@@ -452,7 +453,7 @@ sw_result sw_sg_tspline_create(const sw_sg_tspline_desc *desc, const char *what,
     sw_result r = check_desc(desc, what, status);
     if (r != SW_OK)
         return r;
-    sw_sg_tspline *ts = calloc(1, sizeof *ts);
+    sw_sg_tspline *ts = sw__calloc(1, sizeof *ts);
     if (!ts || copy_desc(ts, desc) != SW_OK) {
         sw_sg_tspline_free(ts);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
@@ -471,15 +472,15 @@ void sw_sg_tspline_free(sw_sg_tspline *ts)
 {
     if (!ts)
         return;
-    free(ts->cpw);
-    free(ts->ku);
-    free(ts->kv);
-    free(ts->bu);
-    free(ts->bv);
-    free(ts->cell_region);
-    free(ts->region_points);
-    free(ts->regions);
-    free(ts);
+    sw__free(ts->cpw);
+    sw__free(ts->ku);
+    sw__free(ts->kv);
+    sw__free(ts->bu);
+    sw__free(ts->bv);
+    sw__free(ts->cell_region);
+    sw__free(ts->region_points);
+    sw__free(ts->regions);
+    sw__free(ts);
 }
 
 const sw_sg_tspline_view *sw_sg_tspline_view_ptr(const sw_sg_tspline *ts)

@@ -8,6 +8,7 @@
  * w_i (P_i, 1), are summed into the patch's homogeneous control points.
  */
 #include "sw_sg_tspline.h"
+#include "sw_hooks.h"
 #include "sw_sg_tspline_internal.h"
 #include "sw_status_util.h"
 
@@ -50,11 +51,11 @@ sw_result sw_sg_tspline_extract_bezier(const sw_sg_tspline *ts, sw_sg_tspline_be
     assert(ts && out);
     memset(out, 0, sizeof *out);
     const sw_sg_tspline_view *v = sw_sg_tspline_view_ptr(ts);
-    sw_sg_bezier_patch *patches = malloc(sizeof *patches * v->n_regions);
-    double *storage = malloc(sizeof(double) * 64 * v->n_regions);
+    sw_sg_bezier_patch *patches = sw__malloc(sizeof *patches * v->n_regions);
+    double *storage = sw__malloc(sizeof(double) * 64 * v->n_regions);
     if (!patches || !storage) {
-        free(patches);
-        free(storage);
+        sw__free(patches);
+        sw__free(storage);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "T-spline Bézier extraction: out of memory");
     }
     for (uint32_t r = 0; r < v->n_regions; r++) {
@@ -69,8 +70,8 @@ sw_result sw_sg_tspline_extract_bezier(const sw_sg_tspline *ts, sw_sg_tspline_be
         for (int j = 0; j < 16; j++) {
             const double w = p->cpw[j * 4 + 3];
             if (!(w > 0.0)) {
-                free(patches);
-                free(storage);
+                sw__free(patches);
+                sw__free(storage);
                 return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
                                 "T-spline region %u: Bézier weight %d is %g, not positive", r, j,
                                 w);
@@ -88,8 +89,8 @@ void sw_sg_tspline_bezier_free(sw_sg_tspline_bezier *bz)
 {
     if (!bz)
         return;
-    free(bz->patches);
-    free(bz->storage);
+    sw__free(bz->patches);
+    sw__free(bz->storage);
     memset(bz, 0, sizeof *bz);
 }
 
@@ -125,7 +126,7 @@ static int cmp_u64(const void *a, const void *b)
 static sw_result add_adjacency(sw_sg_builder *b, const sw_sg_tspline_view *v, uint32_t face0)
 {
     const uint32_t nuc = v->n_bu - 1, nvc = v->n_bv - 1;
-    uint64_t *pairs = malloc(sizeof(uint64_t) * ((size_t)nuc * nvc * 2 + 1));
+    uint64_t *pairs = sw__malloc(sizeof(uint64_t) * ((size_t)nuc * nvc * 2 + 1));
     if (!pairs)
         return SW_ERR_OUT_OF_MEMORY;
     size_t n = 0;
@@ -148,7 +149,7 @@ static sw_result add_adjacency(sw_sg_builder *b, const sw_sg_tspline_view *v, ui
                                         face0 + (uint32_t)pairs[k]) == SW_SG_NONE)
             res = SW_ERR_OUT_OF_MEMORY;
     }
-    free(pairs);
+    sw__free(pairs);
     return res;
 }
 

@@ -9,6 +9,7 @@
  * (a point-based spline, §2). Every message names the file and line and what was expected.
  */
 #include "sw_sg_tspline.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -205,7 +206,7 @@ static sw_result parse_knots(lexer *lx, sw_sg_tsm_doc *d, int is_t)
         return sw__fail(lx->status, SW_ERR_FORMAT,
                         "%s:%u: index grid of %u x %u is larger than the limit %u", lx->name,
                         lx->line, d->n_sk, d->n_tk, MAX_GRID);
-    *k = malloc(sizeof(double) * *n);
+    *k = sw__malloc(sizeof(double) * *n);
     if (!*k)
         return sw__fail(lx->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", lx->name);
     *(is_t ? &d->tk_line : &d->sk_line) = lx->line;
@@ -280,7 +281,7 @@ static sw_result parse_block(lexer *lx, const char *kw, uint32_t max, void **arr
     if (r != SW_OK)
         return r;
     uint32_t cap = n < 64 ? n : 64;
-    *arr = calloc(cap ? cap : 1, size);
+    *arr = sw__calloc(cap ? cap : 1, size);
     if (!*arr)
         return sw__fail(lx->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", lx->name);
     for (uint32_t k = 0; k < n; k++) {
@@ -290,7 +291,7 @@ static sw_result parse_block(lexer *lx, const char *kw, uint32_t max, void **arr
                             lx->line, k, n, kw);
         if (k == cap) {
             cap = cap > n / 2 ? n : cap * 2; /* grows with what is really there */
-            void *g = realloc(*arr, size * cap);
+            void *g = sw__realloc(*arr, size * cap);
             if (!g)
                 return sw__fail(lx->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", lx->name);
             *arr = g;
@@ -381,7 +382,7 @@ sw_result sw_sg_tsm_parse(const char *text, size_t len, const char *name, sw_sg_
 {
     assert(out && (text || !len));
     *out = NULL;
-    sw_sg_tsm_doc *d = calloc(1, sizeof *d);
+    sw_sg_tsm_doc *d = sw__calloc(1, sizeof *d);
     if (!d)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
     snprintf(d->name, sizeof d->name, "%s", name ? name : "<memory>");
@@ -414,12 +415,12 @@ void sw_sg_tsm_doc_free(sw_sg_tsm_doc *doc)
 {
     if (!doc)
         return;
-    free(doc->sk);
-    free(doc->tk);
-    free(doc->edges);
-    free(doc->anchored);
-    free(doc->explicit_pts);
-    free(doc);
+    sw__free(doc->sk);
+    sw__free(doc->tk);
+    sw__free(doc->edges);
+    sw__free(doc->anchored);
+    sw__free(doc->explicit_pts);
+    sw__free(doc);
 }
 
 /* ---- validation: the T-mesh and ray casting ----------------------------------------------------
@@ -462,8 +463,8 @@ static sw_result check_knots(const sw_sg_tsm_doc *d, sw_status *status)
 static sw_result rasterize_edges(const sw_sg_tsm_doc *d, tmesh *t, sw_status *status)
 {
     t->m = d->n_sk, t->n = d->n_tk;
-    t->h = calloc((size_t)(t->m - 1) * t->n, 1);
-    t->v = calloc((size_t)t->m * (t->n - 1), 1);
+    t->h = sw__calloc((size_t)(t->m - 1) * t->n, 1);
+    t->v = sw__calloc((size_t)t->m * (t->n - 1), 1);
     if (!t->h || !t->v)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", d->name);
     for (uint32_t k = 0; k < d->n_edges; k++) {
@@ -600,12 +601,12 @@ typedef struct desc_arrays {
 
 static void free_arrays(desc_arrays *a)
 {
-    free(a->cpw);
-    free(a->ku);
-    free(a->kv);
-    free(a->used);
-    free(a->mesh.h);
-    free(a->mesh.v);
+    sw__free(a->cpw);
+    sw__free(a->ku);
+    sw__free(a->kv);
+    sw__free(a->used);
+    sw__free(a->mesh.h);
+    sw__free(a->mesh.v);
 }
 
 static sw_result fill_points(const sw_sg_tsm_doc *d, desc_arrays *a, sw_status *status)
@@ -643,11 +644,11 @@ sw_result sw_sg_tsm_validate(const sw_sg_tsm_doc *d, sw_sg_tspline **out, sw_sta
     desc_arrays a;
     memset(&a, 0, sizeof a);
     const size_t n = (size_t)d->n_anchored + d->n_explicit;
-    a.cpw = malloc(sizeof(double) * n * 4);
-    a.ku = malloc(sizeof(double) * n * 5);
-    a.kv = malloc(sizeof(double) * n * 5);
+    a.cpw = sw__malloc(sizeof(double) * n * 4);
+    a.ku = sw__malloc(sizeof(double) * n * 5);
+    a.kv = sw__malloc(sizeof(double) * n * 5);
     if (d->sk)
-        a.used = calloc((size_t)d->n_sk * d->n_tk, 1);
+        a.used = sw__calloc((size_t)d->n_sk * d->n_tk, 1);
     if (!a.cpw || !a.ku || !a.kv || (d->sk && !a.used))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", d->name);
     if (r == SW_OK && d->sk)
@@ -685,11 +686,11 @@ static sw_result read_file(const char *path, char **text, size_t *len, sw_status
         return sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO, "%s: %s", path,
                         strerror(errno));
     size_t cap = 1 << 16, n = 0;
-    char *buf = malloc(cap);
+    char *buf = sw__malloc(cap);
     sw_result r = buf ? SW_OK : SW_ERR_OUT_OF_MEMORY;
     while (r == SW_OK) {
         if (n + 1 >= cap) {
-            char *g = cap < MAX_FILE_BYTES ? realloc(buf, cap * 2) : NULL;
+            char *g = cap < MAX_FILE_BYTES ? sw__realloc(buf, cap * 2) : NULL;
             r = cap >= MAX_FILE_BYTES ? SW_ERR_LIMIT : g ? SW_OK : SW_ERR_OUT_OF_MEMORY;
             if (g)
                 buf = g, cap *= 2;
@@ -705,7 +706,7 @@ static sw_result read_file(const char *path, char **text, size_t *len, sw_status
     }
     fclose(f);
     if (r != SW_OK) {
-        free(buf);
+        sw__free(buf);
         return sw__fail(status, r, "%s: %s", path,
                         r == SW_ERR_LIMIT ? "larger than 1 GiB" : "could not be read");
     }
@@ -725,7 +726,7 @@ sw_result sw_sg_tspline_load(const char *path, sw_sg_tspline **out, sw_status *s
     if (r != SW_OK)
         return r;
     r = sw_sg_tspline_load_mem(text, len, path, out, status);
-    free(text);
+    sw__free(text);
     return r;
 }
 

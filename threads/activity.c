@@ -18,6 +18,7 @@
  * push takes one only when the consumer is asleep.
  */
 #include "sw_th_activity.h"
+#include "sw_hooks.h"
 
 #include <assert.h>
 #include <stdbool.h>
@@ -30,7 +31,7 @@ sw_result sw_th_spsc_init(sw_th_spsc *q, uint32_t capacity)
     uint64_t cap = 1;
     while (cap < (capacity ? capacity : 1024u))
         cap <<= 1;
-    q->slots = calloc(cap, sizeof *q->slots);
+    q->slots = sw__calloc(cap, sizeof *q->slots);
     if (!q->slots)
         return SW_ERR_OUT_OF_MEMORY;
     q->mask = cap - 1;
@@ -45,7 +46,7 @@ void sw_th_spsc_destroy(sw_th_spsc *q)
         return;
     pthread_mutex_destroy(&q->lock);
     pthread_cond_destroy(&q->cond);
-    free(q->slots);
+    sw__free(q->slots);
     q->slots = NULL;
 }
 
@@ -203,17 +204,17 @@ sw_result sw_th_activity_set_create(uint32_t n_producers, uint32_t n_consumers, 
     *out = NULL;
     if (n_producers < 1 || n_producers > 64 || n_consumers < 1 || n_consumers > 64)
         return SW_ERR_INVALID_ARGUMENT;
-    sw_th_activity_set *set = calloc(1, sizeof *set);
+    sw_th_activity_set *set = sw__calloc(1, sizeof *set);
     if (!set)
         return SW_ERR_OUT_OF_MEMORY;
     set->n_producers = n_producers;
     set->n_consumers = n_consumers;
     set->n_lists = n_producers > n_consumers ? n_producers : n_consumers;
-    set->lists = aligned_alloc(SW_TH_CACHE_LINE, set->n_lists * sizeof *set->lists);
-    set->producers = calloc(n_producers, sizeof *set->producers);
-    set->consumers = calloc(n_consumers, sizeof *set->consumers);
+    set->lists = sw__aligned_alloc(SW_TH_CACHE_LINE, set->n_lists * sizeof *set->lists);
+    set->producers = sw__calloc(n_producers, sizeof *set->producers);
+    set->consumers = sw__calloc(n_consumers, sizeof *set->consumers);
     if (!set->lists || !set->producers || !set->consumers) {
-        free(set->lists);
+        sw__aligned_free(set->lists);
         set->lists = NULL;
         sw_th_activity_set_destroy(set);
         return SW_ERR_OUT_OF_MEMORY;
@@ -235,10 +236,10 @@ void sw_th_activity_set_destroy(sw_th_activity_set *set)
         return;
     for (uint32_t i = 0; set->lists && i < set->n_lists; ++i)
         sw_th_spsc_destroy(&set->lists[i].q);
-    free(set->lists);
-    free(set->producers);
-    free(set->consumers);
-    free(set);
+    sw__aligned_free(set->lists);
+    sw__free(set->producers);
+    sw__free(set->consumers);
+    sw__free(set);
 }
 
 /* The lists producer p owns: p, p + N_p, p + 2 N_p, ... below n_lists (just p when N_p >= N_c). */

@@ -12,6 +12,7 @@
  * No lock anywhere (tests/threads checks this object file's symbols with nm).
  */
 #include "sw_th_deque.h"
+#include "sw_hooks.h"
 
 #include <assert.h>
 #include <stdlib.h>
@@ -19,7 +20,7 @@
 static sw_th__deque_ring *ring_alloc(int64_t capacity)
 {
     sw_th__deque_ring *r =
-        malloc(sizeof(sw_th__deque_ring) + (size_t)capacity * sizeof(_Atomic(void *)));
+        sw__malloc(sizeof(sw_th__deque_ring) + (size_t)capacity * sizeof(_Atomic(void *)));
     if (!r)
         return NULL;
     r->mask = capacity - 1;
@@ -48,11 +49,11 @@ sw_result sw_th_deque_init_owner(sw_th_deque *q, size_t capacity)
 
 void sw_th_deque_destroy_owner(sw_th_deque *q)
 {
-    free(atomic_load_explicit(&q->ring, memory_order_relaxed));
+    sw__free(atomic_load_explicit(&q->ring, memory_order_relaxed));
     atomic_store_explicit(&q->ring, NULL, memory_order_relaxed);
     while (q->retired) {
         sw_th__deque_ring *next = q->retired->retired_next;
-        free(q->retired);
+        sw__free(q->retired);
         q->retired = next;
     }
 }

@@ -22,6 +22,7 @@
  * steal never take it.
  */
 #include "sw_th_pool.h"
+#include "sw_hooks.h"
 #include "sw_th_deque.h"
 
 #include <assert.h>
@@ -163,7 +164,7 @@ static node *node_alloc(sw_th_pool *pool, worker *w)
         w->free_count--;
         return n;
     }
-    return malloc(sizeof(node));
+    return sw__malloc(sizeof(node));
 }
 
 /* Moves FREE_CHUNK nodes of a long free list to a spare slot (or back to malloc): a worker
@@ -184,7 +185,7 @@ static void node_spill(sw_th_pool *pool, worker *w)
     }
     while (chain) {
         node *next = chain->free_next;
-        free(chain);
+        sw__free(chain);
         chain = next;
     }
 }
@@ -192,7 +193,7 @@ static void node_spill(sw_th_pool *pool, worker *w)
 static void node_free(sw_th_pool *pool, worker *w, node *n)
 {
     if (!w) {
-        free(n);
+        sw__free(n);
         return;
     }
     n->free_next = w->free_list;
@@ -656,7 +657,7 @@ static void pool_free(sw_th_pool *pool)
             sw_th_deque_destroy_owner(&w->deques[p]);
         while (w->free_list) {
             node *next = w->free_list->free_next;
-            free(w->free_list);
+            sw__free(w->free_list);
             w->free_list = next;
         }
     }
@@ -664,14 +665,14 @@ static void pool_free(sw_th_pool *pool)
         node *chain = atomic_load_explicit(&pool->spare[i], memory_order_acquire);
         while (chain) {
             node *next = chain->free_next;
-            free(chain);
+            sw__free(chain);
             chain = next;
         }
     }
     pthread_mutex_destroy(&pool->lock);
     pthread_cond_destroy(&pool->wake_cond);
-    free(pool->workers);
-    free(pool);
+    sw__aligned_free(pool->workers);
+    sw__aligned_free(pool);
 }
 
 static void stop_and_join(sw_th_pool *pool)
@@ -708,11 +709,11 @@ sw_result sw_th_pool_create(const sw_th_pool_desc *desc, sw_th_pool **out)
     sw_th_pool_desc_defaults(&d, desc);
     if (d.worker_count > MAX_WORKERS || d.steal_mode > SW_TH_STEAL_MODE_HALF)
         return SW_ERR_INVALID_ARGUMENT;
-    sw_th_pool *pool = aligned_alloc(SW_TH_CACHE_LINE, round_up(sizeof *pool));
-    worker *workers = aligned_alloc(SW_TH_CACHE_LINE, round_up(d.worker_count * sizeof *workers));
+    sw_th_pool *pool = sw__aligned_alloc(SW_TH_CACHE_LINE, round_up(sizeof *pool));
+    worker *workers = sw__aligned_alloc(SW_TH_CACHE_LINE, round_up(d.worker_count * sizeof *workers));
     if (!pool || !workers) {
-        free(pool);
-        free(workers);
+        sw__aligned_free(pool);
+        sw__aligned_free(workers);
         return SW_ERR_OUT_OF_MEMORY;
     }
     /* Zero bytes are the initial state of every atomic counter and pointer here. */

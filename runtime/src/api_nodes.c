@@ -2,6 +2,7 @@
  * asks api_nodes_compile.c for a new version; geometry descs are checked and turned into small
  * private scenes here, outside the edit lock, so a slow import never holds the scene up. */
 #include "api_nodes_internal.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_face_cones.h"
 #include "sw_sg_tspline.h"
@@ -30,8 +31,8 @@ static void free_node(rt_node *n)
         free_node(c);
     }
     sw_sg_scene_free(n->geom);
-    free(n->name);
-    free(n);
+    sw__free(n->name);
+    sw__free(n);
 }
 
 static void free_children(rt_node *sentinel)
@@ -51,14 +52,14 @@ static void model_free(sw_rt_model *m)
         sw_rt_scene_release(v); /* frames still drawing it keep their references */
     free_children(&m->root);
     free_children(&m->detached);
-    free(m->name);
-    free(m->nodes.items);
-    free(m->nodes.generations);
+    sw__free(m->name);
+    sw__free(m->nodes.items);
+    sw__free(m->nodes.generations);
     pthread_mutex_destroy(&m->nodes.lock);
     pthread_mutex_destroy(&m->edit_lock);
     pthread_mutex_destroy(&m->pub_lock);
     pthread_cond_destroy(&m->pub_cond);
-    free(m);
+    sw__free(m);
 }
 
 void sw_rt_nodes_scene_free(sw_rt_scene *scene)
@@ -66,8 +67,8 @@ void sw_rt_nodes_scene_free(sw_rt_scene *scene)
     if (scene->model)
         model_free(scene->model);
     sw_lod_face_cones_free(scene->prebuilt_cones);
-    free(scene->face_nodes);
-    free(scene->mesh_nodes);
+    sw__free(scene->face_nodes);
+    sw__free(scene->mesh_nodes);
 }
 
 static void init_sentinel(rt_node *n, sw_node_kind kind)
@@ -82,9 +83,9 @@ static atomic_uint_fast64_t g_model_serial;
 
 static sw_rt_model *model_create(const sw_scene_desc *desc, sw_status *status)
 {
-    sw_rt_model *m = calloc(1, sizeof *m);
-    if (!m || (desc && desc->name && !(m->name = strdup(desc->name)))) {
-        free(m);
+    sw_rt_model *m = sw__calloc(1, sizeof *m);
+    if (!m || (desc && desc->name && !(m->name = sw__strdup(desc->name)))) {
+        sw__free(m);
         sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_scene_create: out of memory");
         return NULL;
     }
@@ -114,7 +115,7 @@ static sw_rt_model *model_create(const sw_scene_desc *desc, sw_status *status)
 sw_result sw_scene_create(const sw_scene_desc *desc, sw_scene *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_create: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_create: NULL out");
     out->id = 0;
     sw_rt_model *m = model_create(desc, status);
     if (!m)
@@ -170,7 +171,7 @@ static sw_result find_node(sw_rt_model *m, sw_node node, const char *fn, rt_node
 {
     void *item = NULL;
     if (sw_rt_pool_get_checked(&m->nodes, node.id, accept_node, NULL, &item) != SW_OK)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid", fn,
+        return SW__MISUSE(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid", fn,
                         node.id);
     *out = item;
     return SW_OK;
@@ -252,7 +253,7 @@ static sw_result check_camera(const sw_camera *c, const char *fn, sw_status *sta
 
 static double *homogeneous(const double *points, const double *weights, uint32_t n, int dim)
 {
-    double *cpw = malloc((size_t)n * (size_t)(dim + 1) * sizeof *cpw);
+    double *cpw = sw__malloc((size_t)n * (size_t)(dim + 1) * sizeof *cpw);
     if (!cpw)
         return NULL;
     for (uint32_t i = 0; i < n; i++) {
@@ -269,7 +270,7 @@ static uint64_t push_homogeneous(sw_sg_builder *b, const double *points, const d
 {
     double *cpw = homogeneous(points, weights, n, dim);
     uint64_t at = cpw ? sw_sg_builder_push_doubles(b, cpw, (size_t)n * (dim + 1)) : UINT64_MAX;
-    free(cpw);
+    sw__free(cpw);
     return at;
 }
 
@@ -288,9 +289,9 @@ static sw_result check_nurbs_desc(const sw_nurbs_desc *d, sw_status *status)
         return sw__fail(status, SW_ERR_LIMIT, "%s: %u x %u control points (at most %u)", fn,
                         d->count_u, d->count_v, SW__NODES_MAX_POINTS);
     if (!d->knots_u || !d->knots_v || !d->points)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL knots or points", fn);
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL knots or points", fn);
     if (d->loop_count && !d->loops)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn,
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn,
                         d->loop_count);
     if (d->loop_count > SW__NODES_MAX_LOOPS)
         return sw__fail(status, SW_ERR_LIMIT, "%s: %u trim loops (at most %u)", fn, d->loop_count,
@@ -321,9 +322,9 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
                           double box[4], uint32_t *loop_out, sw_status *status)
 {
     uint32_t nc = lp->curve_count;
-    uint64_t *kn = malloc(nc * sizeof *kn), *cp = malloc(nc * sizeof *cp);
-    double **ptrs = malloc(nc * sizeof *ptrs);
-    int32_t *counts = malloc(nc * sizeof *counts);
+    uint64_t *kn = sw__malloc(nc * sizeof *kn), *cp = sw__malloc(nc * sizeof *cp);
+    double **ptrs = sw__malloc(nc * sizeof *ptrs);
+    int32_t *counts = sw__malloc(nc * sizeof *counts);
     sw_result r = kn && cp && ptrs && counts ? SW_OK : SW_ERR_OUT_OF_MEMORY;
     for (uint32_t c = 0; r == SW_OK && c < nc; c++) {
         const sw_trim_curve *tc = &lp->curves[c];
@@ -374,10 +375,10 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
     }
     if (r == SW_OK && (*loop_out = sw_sg_builder_add_loop(b, &rec)) == SW_SG_NONE)
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "NURBS surface: out of memory");
-    free(kn);
-    free(cp);
-    free(ptrs);
-    free(counts);
+    sw__free(kn);
+    sw__free(cp);
+    sw__free(ptrs);
+    sw__free(counts);
     return r;
 }
 
@@ -465,7 +466,7 @@ static sw_result tspline_from_arrays(const sw_tspline_desc *d, sw_sg_tspline **t
         return sw__fail(status, SW_ERR_LIMIT, "T-spline: %u points (1..%u)", d->point_count,
                         SW__NODES_MAX_POINTS);
     if (!d->points || !d->knots_u || !d->knots_v)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "T-spline: NULL points or knots");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "T-spline: NULL points or knots");
     double *cpw = homogeneous(d->points, d->weights, d->point_count, 3);
     if (!cpw)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "T-spline: out of memory");
@@ -475,7 +476,7 @@ static sw_result tspline_from_arrays(const sw_tspline_desc *d, sw_sg_tspline **t
                              d->knots_v,
                              {d->domain[0], d->domain[1], d->domain[2], d->domain[3]}};
     sw_result r = sw_sg_tspline_create(&td, "T-spline", ts, status);
-    free(cpw);
+    sw__free(cpw);
     return r;
 }
 
@@ -521,7 +522,7 @@ static sw_result check_mesh_desc(const sw_mesh_desc *d, sw_status *status)
                         fn, d->vertex_count, d->triangle_count, SW__NODES_MAX_MESH,
                         SW__NODES_MAX_MESH);
     if (!d->positions || !d->indices)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL positions or indices", fn);
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL positions or indices", fn);
     for (uint32_t i = 0; i < d->vertex_count; i++) {
         const double *p = d->positions + 3 * (size_t)i;
         if (!all_finite(p, 3))
@@ -552,7 +553,7 @@ static int push_unit_normals(sw_sg_builder *b, const sw_mesh_desc *d, uint64_t *
     if (!d->normals)
         return 1;
     const size_t n = 3 * (size_t)d->vertex_count;
-    double *unit = malloc(n * sizeof *unit);
+    double *unit = sw__malloc(n * sizeof *unit);
     if (!unit)
         return 0;
     for (size_t i = 0; i < n; i += 3) {
@@ -562,7 +563,7 @@ static int push_unit_normals(sw_sg_builder *b, const sw_mesh_desc *d, uint64_t *
             unit[i + k] = v[k] / len;
     }
     *at = sw_sg_builder_push_doubles(b, unit, n);
-    free(unit);
+    sw__free(unit);
     return *at != UINT64_MAX;
 }
 
@@ -714,7 +715,7 @@ static sw_result new_node(const sw_node_desc *d, rt_node **out, sw_status *statu
                         (int)d->kind);
     if (d->kind == SW_NODE_CAMERA && !d->camera)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: CAMERA without camera", fn);
-    rt_node *n = calloc(1, sizeof *n);
+    rt_node *n = sw__calloc(1, sizeof *n);
     if (!n)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     n->kind = d->kind;
@@ -727,7 +728,7 @@ static sw_result new_node(const sw_node_desc *d, rt_node **out, sw_status *statu
     if (r == SW_OK && d->kind == SW_NODE_CAMERA &&
         (r = check_camera(d->camera, fn, status)) == SW_OK)
         n->camera = *d->camera;
-    if (r == SW_OK && d->name && !(n->name = strdup(d->name)))
+    if (r == SW_OK && d->name && !(n->name = sw__strdup(d->name)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     if (r == SW_OK)
         r = make_geom(d, &n->geom, status);
@@ -772,7 +773,7 @@ sw_result sw_node_add(sw_scene scene, const sw_node_desc *desc, sw_node *out, sw
     if (out)
         out->id = 0;
     if (!desc || !out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: NULL desc or out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: NULL desc or out");
     rt_node *n = NULL;
     sw_result r = new_node(desc, &n, status); /* a slow import runs here, unlocked */
     if (r != SW_OK)
@@ -798,7 +799,7 @@ sw_result sw_node_add_mesh(sw_scene scene, const sw_node_desc *node, const sw_me
     if (out)
         out->id = 0;
     if (!mesh)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add_mesh: NULL mesh");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add_mesh: NULL mesh");
     sw_node_desc d;
     if (node)
         d = *node;
@@ -957,7 +958,7 @@ sw_result sw_node_set_transform(sw_scene scene, sw_node node, const double trans
                                 sw_status *status)
 {
     if (!transform)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_transform: NULL transform");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_transform: NULL transform");
     return edit_node(scene, node, "sw_node_set_transform", edit_transform, transform, status);
 }
 
@@ -976,7 +977,7 @@ sw_result sw_node_set_nurbs(sw_scene scene, sw_node node, const sw_nurbs_desc *d
                             sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_nurbs: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_nurbs: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_NURBS, "sw_node_set_nurbs"};
     return set_geometry(scene, node, &swap, sw__rt_nurbs_geom(desc, &swap.geom, status), status);
 }
@@ -985,7 +986,7 @@ sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspline_des
                               sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_tspline: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_tspline: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_TSPLINE, "sw_node_set_tspline"};
     return set_geometry(scene, node, &swap, tspline_geom(desc, &swap.geom, status), status);
 }
@@ -994,7 +995,7 @@ sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *des
                            sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_mesh: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_mesh: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_MESH, "sw_node_set_mesh"};
     return set_geometry(scene, node, &swap, mesh_geom(desc, &swap.geom, status), status);
 }
@@ -1005,7 +1006,7 @@ sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *des
 sw_result sw_node_get_info(sw_scene scene, sw_node node, sw_node_info *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_info: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_info: NULL out");
     sw_rt_scene *c;
     sw_result r = begin_edit(scene, "sw_node_get_info", &c, status);
     if (r != SW_OK)
@@ -1053,7 +1054,7 @@ static void map_point(const double m[12], const double p[3], double w, double ou
 sw_result sw_node_get_camera(sw_scene scene, sw_node node, sw_camera *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_camera: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_get_camera: NULL out");
     sw_rt_scene *c;
     sw_result r = begin_edit(scene, "sw_node_get_camera", &c, status);
     if (r != SW_OK)
@@ -1083,7 +1084,7 @@ sw_result sw_node_get_camera(sw_scene scene, sw_node node, sw_camera *out, sw_st
 sw_result sw_scene_get_revisions(sw_scene scene, sw_scene_revisions *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_revisions: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_revisions: NULL out");
     sw_rt_scene *c;
     sw_result r = begin_edit(scene, "sw_scene_get_revisions", &c, status);
     if (r != SW_OK)

@@ -5,6 +5,7 @@
  * is reclaimed after a grace period"). The compile task runs in the model's one-worker pool, so
  * walkthrough frames, which only read the published pointer, never wait for it. */
 #include "api_nodes_internal.h"
+#include "sw_hooks.h"
 
 #include "sw_lod_face_cones.h"
 #include "sw_sg_bvh.h"
@@ -37,7 +38,7 @@ static int note_records(uint32_t **ids, uint32_t *count, uint32_t *cap, uint32_t
         uint32_t c = *cap ? *cap : 16;
         while (c < n)
             c *= 2;
-        uint32_t *grown = realloc(*ids, c * sizeof *grown);
+        uint32_t *grown = sw__realloc(*ids, c * sizeof *grown);
         if (!grown)
             return 0;
         *ids = grown;
@@ -128,7 +129,7 @@ static int pending_push(pending *p, rt_node *n)
 {
     if (p->count == p->cap) {
         uint32_t cap = p->cap ? p->cap * 2 : 16;
-        rt_node **grown = realloc(p->items, cap * sizeof *grown);
+        rt_node **grown = sw__realloc(p->items, cap * sizeof *grown);
         if (!grown)
             return 0;
         p->items = grown;
@@ -200,7 +201,7 @@ static sw_result copy_tree(sw_rt_model *m, compile_state *cs, sw_status *status)
         compile_instances(cs, &p);
     for (uint32_t i = 0; i < p.count; i++)
         p.items[i]->mark = 0;
-    free(p.items);
+    sw__free(p.items);
     if (r == SW_OK && cs->oom)
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "node scene: out of memory compiling");
     return r;
@@ -213,8 +214,8 @@ static sw_result finish_version(sw_sg_scene *sg, compile_state *cs, uint64_t lin
 {
     sw_rt_scene *v = sw_rt_scene_alloc(sg);
     if (!v) {
-        free(cs->face_nodes);
-        free(cs->mesh_nodes);
+        sw__free(cs->face_nodes);
+        sw__free(cs->mesh_nodes);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "node scene: out of memory");
     }
     v->face_nodes = cs->face_nodes;
@@ -249,15 +250,15 @@ sw_result sw__rt_model_compile(sw_rt_model *m, int unlock, sw_rt_scene **out, ui
         pthread_mutex_unlock(&m->edit_lock);
     if (r != SW_OK) {
         sw_sg_builder_free(cs.b);
-        free(cs.face_nodes);
-        free(cs.mesh_nodes);
+        sw__free(cs.face_nodes);
+        sw__free(cs.mesh_nodes);
         return r;
     }
     sw_sg_scene *sg = NULL;
     r = sw_sg_builder_finish(cs.b, &sg, status);
     if (r != SW_OK) {
-        free(cs.face_nodes);
-        free(cs.mesh_nodes);
+        sw__free(cs.face_nodes);
+        sw__free(cs.mesh_nodes);
         return r;
     }
     return finish_version(sg, &cs, m->serial, *revision, out, status);

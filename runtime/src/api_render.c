@@ -1,6 +1,7 @@
 /* Public rendering API: a headless renderer owns a GL context on its creating thread and draws
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
 #include "sw_rt.h"
+#include "sw_hooks.h"
 #include "sw_rt_pipeline.h"
 
 #include "sw_gpu_internal.h"
@@ -67,12 +68,12 @@ static double now_ms(void)
 sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_create: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_create: NULL out");
     out->id = 0;
     const uint32_t workers = desc ? desc->worker_threads : 0;
     if (workers > 1024)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "worker_threads %u above 1024", workers);
-    sw_rt_renderer *r = calloc(1, sizeof *r);
+    sw_rt_renderer *r = sw__calloc(1, sizeof *r);
     if (!r)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
     r->worker_threads = workers;
@@ -80,16 +81,18 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
                         ? sw_gpu_context_adopt_current(&r->gpu, status)
                         : sw_gpu_context_create_headless(&r->gpu, status);
     if (res != SW_OK) {
-        free(r);
+        sw__free(r);
         return res;
     }
     r->owner = pthread_self();
     out->id = sw_rt_pool_add(&g_renderers, r);
     if (!out->id) {
         sw_gpu_context_free(r->gpu);
-        free(r);
+        sw__free(r);
         return sw__fail(status, SW_ERR_LIMIT, "too many renderers");
     }
+    sw__log(SW_LOG_INFO, "renderer %#x: %s%s", out->id, sw_gpu_context_description_ptr(r->gpu),
+            desc && desc->use_current_context ? " (the host's context)" : "");
     return SW_OK;
 }
 
@@ -111,9 +114,9 @@ static sw_result owned_renderer(sw_renderer handle, const char *fn, sw_rt_render
     sw_result r = sw_rt_pool_get_checked(&g_renderers, handle.id, check_owner, NULL, &item);
     *out = item;
     if (r == SW_ERR_STALE_HANDLE)
-        return sw__fail(status, r, "%s: renderer handle %#x is stale or invalid", fn, handle.id);
+        return SW__MISUSE(status, r, "%s: renderer handle %#x is stale or invalid", fn, handle.id);
     if (r != SW_OK)
-        return sw__fail(status, r, "%s: called from a thread that does not own the renderer", fn);
+        return SW__MISUSE(status, r, "%s: called from a thread that does not own the renderer", fn);
     return SW_OK;
 }
 
@@ -127,7 +130,7 @@ static void retire_statics_task(void *ctx)
     retired_statics *rs = ctx;
     sw_lod_static_set_destroy(rs->set); /* waits for its running builds, runs pool tasks */
     sw_rt_scene_release(rs->scene);
-    free(rs);
+    sw__free(rs);
 }
 
 /* The scene's static LODs, given up (another scene, a new version of a node scene, the renderer
@@ -143,7 +146,7 @@ static void retire_statics(sw_rt_renderer *r)
     if (!set)
         return;
     sw_lod_static_set_cancel(set);
-    retired_statics *rs = malloc(sizeof *rs);
+    retired_statics *rs = sw__malloc(sizeof *rs);
     if (rs) {
         *rs = (retired_statics){set, r->cache_scene};
         sw_rt_scene_retain(r->cache_scene);
@@ -152,7 +155,7 @@ static void retire_statics(sw_rt_renderer *r)
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;
         sw_rt_scene_release(r->cache_scene);
-        free(rs);
+        sw__free(rs);
     }
     sw_lod_static_set_destroy(set); /* out of memory: here, waiting */
 }
@@ -207,8 +210,12 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
 {
     void *item;
     sw_result r = sw_rt_pool_remove_checked(&g_renderers, renderer.id, check_owner, NULL, &item);
-    if (r != SW_OK)
-        return r; /* stale, or another thread's context: left untouched */
+    if (r == SW_ERR_STALE_HANDLE) /* left untouched */
+        return SW__MISUSE(NULL, r, "sw_renderer_destroy: renderer handle %#x is stale or invalid",
+                          renderer.id);
+    if (r != SW_OK) /* another thread's context: left untouched */
+        return SW__MISUSE(NULL, r, "sw_renderer_destroy: called from a thread that does not own "
+                                   "the renderer");
     sw_rt_renderer *rr = item;
     while (rr->in_flight) { /* prepared, never submitted: V finishes them, nobody draws them */
         job_free((rt_job *)sw_rt_pipeline_pop(rr->pipeline));
@@ -219,7 +226,7 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
     drop_cache(rr);
     sw_th_pool_destroy(rr->pool);
     sw_gpu_context_free(rr->gpu);
-    free(rr);
+    sw__free(rr);
     return SW_OK;
 }
 
@@ -497,14 +504,14 @@ static void job_free(rt_job *j)
     sw_gpu_frame_plan_free(j->job.plan);
     if (j->scene)
         sw_rt_scene_release(j->scene);
-    free(j->output_path);
-    free(j);
+    sw__free(j->output_path);
+    sw__free(j);
 }
 
 /* A new job for a checked desc, its scene acquired; NULL with *status set on failure. */
 static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_status *status)
 {
-    rt_job *j = calloc(1, sizeof *j);
+    rt_job *j = sw__calloc(1, sizeof *j);
     if (!j) {
         sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
         return NULL;
@@ -523,7 +530,7 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
         res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                        "sw_renderer_prepare: frames of another scene are prepared; submit them "
                        "before preparing one of this scene");
-    if (res == SW_OK && desc->output_path && !(j->output_path = strdup(desc->output_path)))
+    if (res == SW_OK && desc->output_path && !(j->output_path = sw__strdup(desc->output_path)))
         res = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
     if (res == SW_OK)
         res = gpu_frame(r, j->scene, desc, &j->job.desc, status);
@@ -538,7 +545,7 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
 sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_prepare: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_prepare: NULL desc");
     sw_rt_renderer *r;
     sw_result res = owned_renderer(renderer, "sw_renderer_prepare", &r, status);
     if (res == SW_OK)
@@ -599,7 +606,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
                            sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
     sw_rt_renderer *r;
     sw_result res = owned_renderer(renderer, "sw_renderer_draw", &r, status);
     if (res != SW_OK)

@@ -1,5 +1,6 @@
 /* Public scene API: load (.sws mapped, or imported through OCCT), save, describe, fit cameras. */
 #include "sw_rt.h"
+#include "sw_hooks.h"
 
 #include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
@@ -32,7 +33,7 @@ static int is_cad_file(const char *path)
 
 sw_rt_scene *sw_rt_scene_alloc(sw_sg_scene *sg)
 {
-    sw_rt_scene *scene = calloc(1, sizeof *scene);
+    sw_rt_scene *scene = sw__calloc(1, sizeof *scene);
     if (!scene) {
         sw_sg_scene_free(sg);
         return NULL;
@@ -84,7 +85,7 @@ sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status
     if (out)
         out->id = 0;
     if (!desc || !desc->path || !out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load: NULL desc, path or out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load: NULL desc, path or out");
     sw_sg_scene *sg = NULL;
     sw_result r = sw_rt_scene_read(desc, &sg, status);
     if (r != SW_OK)
@@ -166,7 +167,7 @@ sw_result sw_scene_load_default(const char *data_dir, const sw_scene_load_desc *
                                 sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load_default: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load_default: NULL out");
     out->id = 0;
     if (!data_dir)
         data_dir = "/usr/share/opencascade/data";
@@ -210,7 +211,7 @@ void sw_rt_scene_release(sw_rt_scene *scene)
     sw_sg_bvh_free(scene->pick_bvh);
     sw_sg_scene_free(scene->sg);
     pthread_mutex_destroy(&scene->once_lock);
-    free(scene);
+    sw__free(scene);
 }
 
 /* Verifies every section and computes the stats, exactly once per scene. Locks once_lock, which
@@ -244,7 +245,7 @@ sw_result sw_rt_scene_lookup(sw_scene handle, sw_rt_scene **out, sw_status *stat
     void *item;
     *out = NULL;
     if (sw_rt_pool_get_checked(&g_scenes, handle.id, retain_scene, NULL, &item) != SW_OK)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
+        return SW__MISUSE(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
                         handle.id);
     *out = item;
     return SW_OK;
@@ -281,7 +282,7 @@ sw_result sw_rt_scene_acquire(sw_scene handle, sw_rt_scene **out, sw_status *sta
 sw_result sw_scene_save(sw_scene handle, const char *path, sw_status *status)
 {
     if (!path)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_save: NULL path");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_save: NULL path");
     sw_rt_scene *scene;
     sw_result r = sw_rt_scene_acquire(handle, &scene, status);
     if (r != SW_OK)
@@ -295,7 +296,8 @@ sw_result sw_scene_destroy(sw_scene handle)
 {
     sw_rt_scene *scene = sw_rt_pool_remove(&g_scenes, handle.id);
     if (!scene)
-        return SW_ERR_STALE_HANDLE;
+        return SW__MISUSE(NULL, SW_ERR_STALE_HANDLE,
+                          "sw_scene_destroy: scene handle %#x is stale or invalid", handle.id);
     sw_rt_scene_release(scene); /* freed now, or by the last call still using it */
     return SW_OK;
 }
@@ -303,7 +305,7 @@ sw_result sw_scene_destroy(sw_scene handle)
 sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *status)
 {
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_info: NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_get_info: NULL out");
     sw_rt_scene *scene;
     sw_result r = sw_rt_scene_acquire(handle, &scene, status);
     if (r != SW_OK)
@@ -344,7 +346,7 @@ const char *sw_surface_kind_name(uint32_t kind)
 sw_result sw_camera_fit(sw_scene handle, sw_view_preset view, sw_camera *out, sw_status *status)
 {
     if (!out || (unsigned)view > SW_VIEW_RIGHT)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_camera_fit: bad view or NULL out");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_camera_fit: bad view or NULL out");
     sw_rt_scene *scene;
     sw_result r = sw_rt_scene_acquire(handle, &scene, status);
     if (r != SW_OK)
@@ -368,7 +370,7 @@ sw_result sw_scene_pick(sw_scene handle, const double origin[3], const double di
                         sw_pick_hit *out, sw_status *status)
 {
     if (!origin || !direction || !out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_pick: NULL argument");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_pick: NULL argument");
     memset(out, 0, sizeof *out);
     sw_rt_scene *scene;
     sw_result r = sw_rt_scene_acquire(handle, &scene, status);

@@ -1,6 +1,7 @@
 /* Camera paths: the text format of docs/camera-path.md (parse, then validate), evaluation by a
  * Catmull-Rom-tangent Hermite spline over the key times, and the stock orbit and fly-through. */
 #include "sw_camera_path.h"
+#include "sw_hooks.h"
 
 #include "sw_rt.h"
 #include "sw_status_util.h"
@@ -224,7 +225,7 @@ static sw_result push_key(lexer *lx, sw_rt_camera_path *p, uint32_t *cap, const 
                         SW_RT_PATH_MAX_KEYS);
     if (p->n_keys == *cap) {
         const uint32_t ncap = *cap ? *cap * 2 : 64;
-        sw_rt_path_key *g = realloc(p->keys, (size_t)ncap * sizeof *g);
+        sw_rt_path_key *g = sw__realloc(p->keys, (size_t)ncap * sizeof *g);
         if (!g)
             return sw__fail(lx->status, SW_ERR_OUT_OF_MEMORY, "%s:%u: out of memory", lx->name,
                             lx->line);
@@ -409,11 +410,11 @@ sw_result sw_rt_path_load(const char *file, sw_rt_camera_path *out, sw_status *s
         return sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO, "%s: %s", file,
                         strerror(errno));
     size_t cap = 4096, n = 0;
-    char *buf = malloc(cap);
+    char *buf = sw__malloc(cap);
     sw_result r = buf ? SW_OK : SW_ERR_OUT_OF_MEMORY;
     while (r == SW_OK) {
         if (n == cap) {
-            char *g = cap < SW_RT_PATH_MAX_BYTES ? realloc(buf, cap * 2) : NULL;
+            char *g = cap < SW_RT_PATH_MAX_BYTES ? sw__realloc(buf, cap * 2) : NULL;
             r = cap >= SW_RT_PATH_MAX_BYTES ? SW_ERR_LIMIT : g ? SW_OK : SW_ERR_OUT_OF_MEMORY;
             if (!g)
                 break;
@@ -435,7 +436,7 @@ sw_result sw_rt_path_load(const char *file, sw_rt_camera_path *out, sw_status *s
                  r == SW_ERR_LIMIT ? "larger than 64 MiB: not a camera path"
                  : r == SW_ERR_IO  ? "could not be read"
                                    : "out of memory");
-    free(buf);
+    sw__free(buf);
     return r;
 }
 
@@ -485,7 +486,7 @@ void sw_rt_path_free(sw_rt_camera_path *path)
 {
     if (!path)
         return;
-    free(path->keys);
+    sw__free(path->keys);
     memset(path, 0, sizeof *path);
 }
 
@@ -581,7 +582,7 @@ void sw_rt_path_eval(const sw_rt_camera_path *path, double t, sw_camera *out)
 static sw_result alloc_keys(sw_rt_camera_path *out, uint32_t n, sw_status *status)
 {
     memset(out, 0, sizeof *out);
-    out->keys = calloc(n, sizeof *out->keys);
+    out->keys = sw__calloc(n, sizeof *out->keys);
     if (!out->keys)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "camera path: out of memory");
     out->n_keys = n;

@@ -1,5 +1,6 @@
 /* Generation-checked handle pools (CONVENTIONS.md: handles like sokol's sg_buffer). */
 #include "sw_rt.h"
+#include "sw_hooks.h"
 
 #include <stdlib.h>
 
@@ -10,11 +11,11 @@ static int grow(sw_rt_pool *pool)
         cap = SW_RT_POOL_MAX_SLOTS;
     if (cap <= pool->capacity)
         return 0;
-    void **items = realloc(pool->items, cap * sizeof *items);
+    void **items = sw__realloc(pool->items, cap * sizeof *items);
     if (!items)
         return 0;
     pool->items = items;
-    uint16_t *gens = realloc(pool->generations, cap * sizeof *gens);
+    uint16_t *gens = sw__realloc(pool->generations, cap * sizeof *gens);
     if (!gens)
         return 0;
     pool->generations = gens;

@@ -11,10 +11,13 @@
  * The pool T keeps working beside both (hierarchy builds and refinements).
  */
 #include "sw_rt_pipeline.h"
+#include "sw_hooks.h"
 
 #include "sw_status_util.h"
 
+#include <stdalign.h>
 #include <stdlib.h>
+#include <string.h>
 
 enum { QUEUE_SLOTS = 16 }; /* > 2 jobs + 2 markers each in flight: a push never waits */
 
@@ -53,9 +56,11 @@ static void *visibility_thread(void *arg)
 sw_result sw_rt_pipeline_start(sw_gpu_context *gpu, sw_rt_pipeline **out, sw_status *status)
 {
     *out = NULL;
-    sw_rt_pipeline *p = calloc(1, sizeof *p);
+    /* Over-aligned (its queues' indices have cache lines of their own): not malloc's alignment. */
+    sw_rt_pipeline *p = sw__aligned_alloc(alignof(sw_rt_pipeline), sizeof *p);
     if (!p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visibility thread: out of memory");
+    memset(p, 0, sizeof *p);
     p->gpu = gpu;
     if (sw_th_spsc_init(&p->jobs, QUEUE_SLOTS) != SW_OK ||
         sw_th_spsc_init(&p->done, QUEUE_SLOTS) != SW_OK) {
@@ -100,5 +105,5 @@ void sw_rt_pipeline_stop(sw_rt_pipeline *p)
     }
     sw_th_spsc_destroy(&p->jobs);
     sw_th_spsc_destroy(&p->done);
-    free(p);
+    sw__aligned_free(p);
 }

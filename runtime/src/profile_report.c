@@ -1,6 +1,7 @@
 /* Frame-time profiles: rows, summary statistics, and the CSV / JSON / SVG / HTML files of a
  * `splinewalk profile` run (docs/camera-path.md and the README describe what they hold). */
 #include "sw_profile_report.h"
+#include "sw_hooks.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -116,7 +117,7 @@ int sw_rt_profile_push(sw_rt_profile *p, const sw_rt_prof_row *row)
 {
     if (p->n_rows == p->cap_rows) {
         const uint32_t cap = p->cap_rows ? p->cap_rows * 2 : 256;
-        sw_rt_prof_row *g = cap > p->cap_rows ? realloc(p->rows, (size_t)cap * sizeof *g) : NULL;
+        sw_rt_prof_row *g = cap > p->cap_rows ? sw__realloc(p->rows, (size_t)cap * sizeof *g) : NULL;
         if (!g)
             return -1;
         p->rows = g;
@@ -128,7 +129,7 @@ int sw_rt_profile_push(sw_rt_profile *p, const sw_rt_prof_row *row)
 
 void sw_rt_profile_free(sw_rt_profile *p)
 {
-    free(p->rows);
+    sw__free(p->rows);
     p->rows = NULL;
     p->n_rows = p->cap_rows = 0;
 }
@@ -154,7 +155,7 @@ int sw_rt_profile_summarize(sw_rt_profile *p)
     memset(p->summary, 0, sizeof p->summary);
     if (p->n_rows == 0)
         return 0;
-    double *x = malloc((size_t)p->n_rows * sizeof *x);
+    double *x = sw__malloc((size_t)p->n_rows * sizeof *x);
     if (!x)
         return -1;
     for (int c = 0; c < SW_RT_COL_COUNT; c++) {
@@ -171,7 +172,7 @@ int sw_rt_profile_summarize(sw_rt_profile *p)
         s->max = x[p->n_rows - 1];
         s->mean = sum / p->n_rows;
     }
-    free(x);
+    sw__free(x);
     return 0;
 }
 

@@ -5,6 +5,7 @@
 #include <splinewalk/splinewalk.h>
 
 #include "sw_gpu.h"
+#include "sw_rt_misuse.h"
 #include "sw_sg_scene.h"
 
 #include <pthread.h>

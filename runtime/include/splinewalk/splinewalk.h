@@ -26,11 +26,18 @@
  * Results: every function returning sw_result may also be given status == NULL; on failure the
  * status (when given) holds the result and a message naming the file, position or argument.
  * Outputs (`out`) are zeroed on failure where the documentation says so, untouched otherwise.
+ *
+ * Misuse: a NULL desc or required pointer, a stale handle (also a second destroy), a call from a
+ * thread that does not own the renderer are programming mistakes. They return the documented
+ * result and change nothing, and their message goes to the log hook at SW_LOG_ERROR (sw_setup.h);
+ * a library built with SW_MISUSE_ASSERT (CMake option, on by default in Debug builds) aborts with
+ * that message on stderr instead.
  */
 #ifndef SPLINEWALK_H
 #define SPLINEWALK_H
 
 #include <splinewalk/sw_result.h>
+#include <splinewalk/sw_setup.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -177,8 +184,17 @@ typedef struct sw_renderer_desc {
                                 1: it draws with the OpenGL context current on the creating thread
                                 (the host's: 4.3+ core with glClipControl), which the host keeps
                                 current there for every call and destroys itself after
-                                sw_renderer_destroy. The renderer switches that context to
-                                zero-to-one clip depth (reversed-Z). */
+                                sw_renderer_destroy. Every call (create, draw, submit,
+                                destroy) leaves the context's GL state as it found it:
+                                bindings (program, vertex array, buffers and indexed
+                                uniform / storage ranges, framebuffers, renderbuffer,
+                                texture unit 0 and its sampler, the active unit),
+                                capabilities, viewport, scissor, blend, depth, stencil,
+                                colour masks and clear values, rasterisation, clip control
+                                and pixel store; the renderer draws as in a fresh context
+                                meanwhile (zero-to-one clip depth, reversed-Z). Not
+                                restored: texture units other than 0, image units,
+                                transform feedback, queries, GL errors. */
 } sw_renderer_desc;
 
 /* Creates a renderer owned by the calling thread: headless (EGL; llvmpipe when there is no GPU),
@@ -217,9 +233,9 @@ typedef struct sw_frame_desc {
                                 (Bézier patches, coarser nodes) and asked for, for later frames */
     int32_t present;         /* 1: the frame is also copied into the framebuffer bound to
                                 GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
-                                origin, width x height; the host's framebuffer bindings and
-                                viewport are restored (other GL state is the renderer's: set yours
-                                again after the call). Not read back unless output_path is set. */
+                                origin, width x height, whatever the host's GL state (scissor,
+                                masks, ...); that state is restored as use_current_context
+                                says. Not read back unless output_path is set. */
     int32_t wireframe;       /* 1: triangles drawn as lines (trimmed parts still cut away), to see
                                 the tessellation the error bound chose */
     int32_t static_lods;     /* 1: Kumar et al. 1997 static LODs: the scene's super-surfaces
