@@ -88,7 +88,8 @@ static void occurrence_box(const frame *f, const occurrence *o, double box[6])
 }
 
 /* An upper bound of the spectral norm of the occurrence's linear part, sqrt(|M|_1 |M|_inf): 1 for
- * a rigid transform (the Frobenius norm would give sqrt(3) and make every tolerance 1.7x tighter). */
+ * a rigid transform (the Frobenius norm would give sqrt(3) and make every tolerance 1.7x tighter).
+ */
 double sw__fr_stretch_bound(const double m[12])
 {
     double col = 0.0, row = 0.0;

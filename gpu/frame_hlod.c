@@ -32,7 +32,8 @@
 
 enum {
     MAX_ITEMS_PER_FACE = 16384, /* nodes (or parts) drawn for one face occurrence */
-    MAX_PART_DEPTH = 48,        /* halvings of a leaf's domain for its trim texture (2^-24 per direction) */
+    MAX_PART_DEPTH =
+        48, /* halvings of a leaf's domain for its trim texture (2^-24 per direction) */
     MAX_REFINE_ROUNDS = 8,
 };
 
@@ -44,11 +45,11 @@ typedef struct hl_item {
 
 typedef struct hl_choice {
     hl_item it;
-    double cpw[64];     /* the item's bicubic, eye-relative world, homogeneous */
-    double rect[4];     /* its rectangle in face parameters */
-    double err_w;       /* its error bound in world units */
-    double eps_obj;     /* ε_obj at its nearest depth */
-    trim_need need;     /* trim texels over rect */
+    double cpw[64]; /* the item's bicubic, eye-relative world, homogeneous */
+    double rect[4]; /* its rectangle in face parameters */
+    double err_w;   /* its error bound in world units */
+    double eps_obj; /* ε_obj at its nearest depth */
+    trim_need need; /* trim texels over rect */
 } hl_choice;
 
 typedef struct hl_face {
@@ -141,9 +142,8 @@ static void split_part(hl_face *hf, const hl_item *it, const trim_need *need)
 static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double err_w,
                    double eps_obj, const trim_need *need)
 {
-    if (hf->n_chosen >= MAX_ITEMS_PER_FACE ||
-        !sw__gpu_grow((void **)&hf->chosen, &hf->cap_chosen, hf->n_chosen + 1,
-                      sizeof *hf->chosen)) {
+    if (hf->n_chosen >= MAX_ITEMS_PER_FACE || !sw__gpu_grow((void **)&hf->chosen, &hf->cap_chosen,
+                                                            hf->n_chosen + 1, sizeof *hf->chosen)) {
         hf->oom = 1;
         return;
     }
@@ -221,8 +221,8 @@ static void visit(hl_face *hf, const hl_item *it)
         return;
     }
     double z = sw__gpu_view_box_depth(&f->view, box);
-    double eps_obj = sw_lod_object_tolerance(f->eps_px, z, f->view.focal_px, f->view.tan_x,
-                                             f->view.tan_y);
+    double eps_obj =
+        sw_lod_object_tolerance(f->eps_px, z, f->view.focal_px, f->view.tan_x, f->view.tan_y);
     trim_need need = {1.0, 1.0};
     if (hf->trimmed) {
         need.u = fmax(1.0, n->tex_c[0] * hf->scale * (it->range[1] - it->range[0]) / eps_obj);
@@ -284,7 +284,8 @@ static void hl_face_free(hl_face *hf)
     sw__free(hf->refine_tol);
 }
 
-/* ---- converged mode: build and refine before drawing ------------------------------------------ */
+/* ---- converged mode: build and refine before drawing ------------------------------------------
+ */
 static sw_result request_builds(frame *f, const double *boxes)
 {
     for (size_t i = 0; i < f->n_occ; ++i) {
@@ -436,7 +437,7 @@ static void lowest_degree(const double cpw[64], double low[64], int32_t *du, int
         else
             row_at_degree(cpw + 16 * j, 4, d, tol, tmp + 4 * (d + 1) * j);
     }
-    const size_t row = 4 * (size_t)(d + 1); /* doubles per row of tmp */
+    const size_t row = 4 * (size_t)(d + 1);             /* doubles per row of tmp */
     const int e = rows_degree(tmp, d + 1, 4, row, tol); /* v: the d + 1 columns */
     for (int i = 0; i <= d; ++i) {
         double col[16];
@@ -452,7 +453,8 @@ static void lowest_degree(const double cpw[64], double low[64], int32_t *du, int
     *dv = e;
 }
 
-/* ---- drawing the chosen items ------------------------------------------------------------------ */
+/* ---- drawing the chosen items ------------------------------------------------------------------
+ */
 /* The item as a patch of the direct path: clipped to the face's trim box, density for what its
  * approximation error leaves of ε_img. */
 static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
@@ -532,7 +534,8 @@ static sw_result item_border(hl_face *hf, const hl_choice *c, const double cell[
 }
 
 /* Per-item trim textures (a face whose one texture would be too large): the item's own draw,
- * trimmed over its rectangle when a loop crosses it, untrimmed when inside, nothing when outside. */
+ * trimmed over its rectangle when a loop crosses it, untrimmed when inside, nothing when outside.
+ */
 static sw_result draw_item_own(hl_face *hf, hl_choice *c, const sw__gpu_patch *pt, int64_t loops,
                                double sign, int on_gpu, sw_status *status)
 {
@@ -572,10 +575,10 @@ static double loop_tolerance(const hl_face *hf)
     double tol = INFINITY;
     for (size_t i = 0; i < hf->n_chosen; ++i) {
         const hl_choice *c = &hf->chosen[i];
-        tol = fmin(tol, 0.5 * (c->rect[1] - c->rect[0]) /
-                            sw__fr_class_texels(c->need.u, max_entry));
-        tol = fmin(tol, 0.5 * (c->rect[3] - c->rect[2]) /
-                            sw__fr_class_texels(c->need.v, max_entry));
+        tol =
+            fmin(tol, 0.5 * (c->rect[1] - c->rect[0]) / sw__fr_class_texels(c->need.u, max_entry));
+        tol =
+            fmin(tol, 0.5 * (c->rect[3] - c->rect[2]) / sw__fr_class_texels(c->need.v, max_entry));
     }
     return tol;
 }
@@ -605,14 +608,14 @@ static sw_result draw_one_texture(hl_face *hf, sw__gpu_patch *pts, double sign, 
     frame *f = hf->f;
     const double *ub = f->sv->faces[hf->o->face].uv_box;
     size_t draw = f->n_draws, first = f->mesh.n_idx;
-    sw_result r = on_gpu ? sw__fr_add_draw(f, hf->o, first, hf->trimmed, need, cell_min, status)
-                         : SW_OK;
+    sw_result r =
+        on_gpu ? sw__fr_add_draw(f, hf->o, first, hf->trimmed, need, cell_min, status) : SW_OK;
     for (size_t i = 0; i < hf->n_chosen && r == SW_OK; ++i) {
         if (!pts[i].visible)
             continue;
-        r = on_gpu ? sw__fr_gpu_patch(f, hf->o, &pts[i], ub, sign, (int32_t)draw, hf->trimmed,
-                                      status)
-                   : sw__gpu_tessellate_face(&pts[i], 1, 1, sign, ub, &f->mesh, status);
+        r = on_gpu
+                ? sw__fr_gpu_patch(f, hf->o, &pts[i], ub, sign, (int32_t)draw, hf->trimmed, status)
+                : sw__gpu_tessellate_face(&pts[i], 1, 1, sign, ub, &f->mesh, status);
         count_item(hf, &pts[i], on_gpu, hf->trimmed);
     }
     if (r == SW_OK && !on_gpu)

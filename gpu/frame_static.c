@@ -186,8 +186,8 @@ static sw_result face_borders(frame *f, const occurrence *o, double extent_px, s
         return SW_OK;
     const sw_sg_face_rec *rec = &f->sv->faces[o->face];
     const double *ub = rec->uv_box;
-    const double cells = fmin(fmax(ceil(extent_px / k_border_px), STATIC_BORDER_MIN_CELLS),
-                              STATIC_BORDER_MAX_CELLS);
+    const double cells =
+        fmin(fmax(ceil(extent_px / k_border_px), STATIC_BORDER_MIN_CELLS), STATIC_BORDER_MAX_CELLS);
     const double cell[2] = {(ub[1] - ub[0]) / cells, (ub[3] - ub[2]) / cells};
     if (!((rec->flags & SW_SG_FACE_TRIMMED) && rec->n_loops > 0)) {
         const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};

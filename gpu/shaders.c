@@ -48,17 +48,16 @@ static const char *const k_mesh_vs =
  * edge reads the edge texel and never the gutter (PLATFORM.md: trim parity exactness). The
  * library's shading is two-sided: the headlight lights whichever side faces the eye. Output is
  * gamma-encoded. */
-static const char *const k_surface_fs_interface =
-    "#version 430 core\n"
-    "in vec3 v_rel;\n"
-    "in vec3 v_nrm;\n"
-    "in vec2 v_st;\n"
-    "in vec2 v_uv;\n"
-    "flat in vec4 v_color;\n"
-    "flat in vec4 v_trim_rect;\n"
-    "flat in float v_trim_layer;\n"
-    "uniform sampler2DArray u_trim;\n"
-    "layout(location = 0) out vec4 o_color;\n";
+static const char *const k_surface_fs_interface = "#version 430 core\n"
+                                                  "in vec3 v_rel;\n"
+                                                  "in vec3 v_nrm;\n"
+                                                  "in vec2 v_st;\n"
+                                                  "in vec2 v_uv;\n"
+                                                  "flat in vec4 v_color;\n"
+                                                  "flat in vec4 v_trim_rect;\n"
+                                                  "flat in float v_trim_layer;\n"
+                                                  "uniform sampler2DArray u_trim;\n"
+                                                  "layout(location = 0) out vec4 o_color;\n";
 
 static const char *const k_surface_fs_trim =
     "bool sw_trim_inside(sampler2DArray atlas, vec2 st, vec4 rect, float layer) {\n"
@@ -105,8 +104,8 @@ static const char *const k_eval_vs =
     "layout(std430, binding = 0) readonly buffer Patches { PatchRec recs[]; };\n"
     "layout(std430, binding = 1) readonly buffer ControlPoints { vec4 cps[]; };\n"
     "uniform mat4 u_view_proj;\n"
-    "uniform ivec2 u_grid;\n" /* segments in u, v of this draw's class */
-    "uniform int u_base;\n"   /* first record of this draw */
+    "uniform ivec2 u_grid;\n"  /* segments in u, v of this draw's class */
+    "uniform int u_base;\n"    /* first record of this draw */
     "uniform int u_capture;\n" /* debug: > 0 writes every evaluated vertex to Capture */
     "layout(std430, binding = 5) buffer Capture { uint n_capture; uint pad[3]; vec4 cap[]; };\n"
     "out vec3 v_rel;\n"

@@ -85,11 +85,12 @@ typedef struct sw_gpu_frame_desc {
     int32_t no_readback; /* 1: nothing is read back (out stays empty; want_depth ignored) */
     int32_t wireframe;   /* 1: the surfaces' triangles drawn as lines, trimmed parts still cut
                             away (inspection: grid densities, hierarchy nodes, fat borders) */
-    const struct sw_lod_face_cones *face_cones; /* NULL: no back-patch culling; else the
-                              scene's per-face outward normal cones (sw_lod_face_cones.h, built once
-                              per scene): an occurrence of a SW_SG_FACE_CLOSED_SHELL face facing
-                              away from the eye over its whole box is culled (Kumar §4.4); with
-                              static_lods, whole super-surface instances by their units' cones too */
+    const struct sw_lod_face_cones
+        *face_cones;                       /* NULL: no back-patch culling; else the
+                         scene's per-face outward normal cones (sw_lod_face_cones.h, built once
+                         per scene): an occurrence of a SW_SG_FACE_CLOSED_SHELL face facing
+                         away from the eye over its whole box is culled (Kumar §4.4); with
+                         static_lods, whole super-surface instances by their units' cones too */
     struct sw_lod_static_set *static_lods; /* NULL: no static LODs; else the scene's set
                               (lod/sw_lod_static_set.h), whose BVH of unit instances then culls
                               instead of desc.bvh: a visible unit is drawn at the coarsest
@@ -121,7 +122,7 @@ typedef struct sw_gpu_frame_stats {
     double ms_trim;       /* trim-texture generation */
     double ms_draw;       /* draw submission until glFinish */
     double ms_readback;
-    double ms_gpu;        /* GPU time of trim textures + draw (two GL_TIMESTAMP queries) */
+    double ms_gpu; /* GPU time of trim textures + draw (two GL_TIMESTAMP queries) */
     /* trim-texture atlas (Guthe §4.4), kept in the context across frames */
     uint64_t atlas_pages;    /* pages (layers) after this frame */
     uint64_t atlas_texels;   /* texels of those pages */

@@ -383,8 +383,9 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
 #define SW__GPU_HOST_BUFFERS 11
 #define SW__GPU_HOST_TEXTURES 11
 #define SW__GPU_HOST_PIXEL_STORE 16
-#define SW__GPU_HOST_INDEXED 16 /* uniform and shader storage ranges saved (and fewer if the
-                                   context has fewer) */
+#define SW__GPU_HOST_INDEXED                                                                       \
+    16 /* uniform and shader storage ranges saved (and fewer if the                                \
+          context has fewer) */
 typedef struct sw__gpu_host_range {
     GLint buffer;
     GLint64 start, size;
@@ -393,7 +394,7 @@ typedef struct sw__gpu_host_state {
     GLint draw_fb, read_fb, viewport[4];
     GLint renderbuffer, program, vao, element_buffer, buffers[SW__GPU_HOST_BUFFERS];
     GLint n_indexed[2];
-    sw__gpu_host_range indexed[2][SW__GPU_HOST_INDEXED]; /* uniform, shader storage */
+    sw__gpu_host_range indexed[2][SW__GPU_HOST_INDEXED];            /* uniform, shader storage */
     GLint active_texture, textures[SW__GPU_HOST_TEXTURES], sampler; /* unit 0's */
     GLboolean caps[SW__GPU_HOST_CAPS];
     GLint scissor[4], blend[6];

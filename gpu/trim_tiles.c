@@ -60,8 +60,7 @@ int sw__gpu_trim_rect_class(const sw_sg_polyline *loops, uint32_t n_loops, const
     for (uint32_t k = 0; k < n_loops; ++k)
         if (loop_meets_rect(&loops[k], rect))
             return 0;
-    return sw_sg_trim_classify(loops, n_loops, 0.5 * (rect[0] + rect[1]),
-                               0.5 * (rect[2] + rect[3]))
+    return sw_sg_trim_classify(loops, n_loops, 0.5 * (rect[0] + rect[1]), 0.5 * (rect[2] + rect[3]))
                ? 1
                : -1;
 }

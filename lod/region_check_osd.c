@@ -152,7 +152,8 @@ static sw_result check_surface(const sw_sg_surface *s, int per_region, uint64_t 
     size_t count = rl.count * (size_t)per_region;
     double *verts = r == SW_OK ? sw__malloc(n * 3 * sizeof *verts) : NULL;
     double *pos = r == SW_OK ? sw__malloc((count ? count : 1) * 3 * sizeof *pos) : NULL;
-    sw_lod_osd_sample *samples = r == SW_OK ? sw__malloc((count ? count : 1) * sizeof *samples) : NULL;
+    sw_lod_osd_sample *samples =
+        r == SW_OK ? sw__malloc((count ? count : 1) * sizeof *samples) : NULL;
     if (r == SW_OK && (!verts || !pos || !samples))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory for %zu OSD samples", count);
     if (r == SW_OK && rl.count) {

@@ -578,7 +578,8 @@ typedef struct mesh_buf {
 
 static void mesh_buf_free(mesh_buf *m)
 {
-    sw__free(m->pos), sw__free(m->uv), sw__free(m->nrm), sw__free(m->face), sw__free(m->corner), sw__free(m->tri);
+    sw__free(m->pos), sw__free(m->uv), sw__free(m->nrm), sw__free(m->face), sw__free(m->corner),
+        sw__free(m->tri);
     memset(m, 0, sizeof *m);
 }
 
@@ -664,7 +665,8 @@ typedef struct grid {
 
 static void grid_free(grid *g)
 {
-    sw__free(g->n_col), sw__free(g->n_row), sw__free(g->gu), sw__free(g->gv), sw__free(g->first_u), sw__free(g->first_v);
+    sw__free(g->n_col), sw__free(g->n_row), sw__free(g->gu), sw__free(g->gv), sw__free(g->first_u),
+        sw__free(g->first_v);
     memset(g, 0, sizeof *g);
 }
 
@@ -1405,7 +1407,8 @@ sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_pa
 
 static void level_free(sw_lod_static_level *l)
 {
-    sw__free(l->positions), sw__free(l->normals), sw__free(l->uv), sw__free(l->face), sw__free(l->triangles);
+    sw__free(l->positions), sw__free(l->normals), sw__free(l->uv), sw__free(l->face),
+        sw__free(l->triangles);
     memset(l, 0, sizeof *l);
 }
 
@@ -1564,9 +1567,9 @@ static int on_level(void *ctx, int32_t level, const uint32_t *tri, uint32_t n_tr
 
 double sw_lod_static_default_delta(const double box[6])
 {
-    const double d = 1e-3 * sqrt((box[3] - box[0]) * (box[3] - box[0]) +
-                                 (box[4] - box[1]) * (box[4] - box[1]) +
-                                 (box[5] - box[2]) * (box[5] - box[2]));
+    const double d =
+        1e-3 * sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
+                    (box[5] - box[2]) * (box[5] - box[2]));
     return d > 0.0 ? d : 1e-12; /* a super-surface collapsed to a point */
 }
 

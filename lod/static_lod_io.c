@@ -15,7 +15,8 @@
 #define LODS_VERSION 1u
 #define LODS_MAX_LEVELS 9
 
-/* ---- the key ---------------------------------------------------------------------------------- */
+/* ---- the key ----------------------------------------------------------------------------------
+ */
 
 static uint64_t fnv(uint64_t h, const void *data, size_t n)
 {
@@ -49,7 +50,8 @@ static uint64_t set_key(const sw_lod_static_set *set, const sw_lod_static_desc *
     return fnv(h, i, sizeof i);
 }
 
-/* ---- writing ---------------------------------------------------------------------------------- */
+/* ---- writing ----------------------------------------------------------------------------------
+ */
 
 typedef struct writer {
     unsigned char *p;
@@ -127,7 +129,8 @@ sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, 
     return SW_OK;
 }
 
-/* ---- reading ---------------------------------------------------------------------------------- */
+/* ---- reading ----------------------------------------------------------------------------------
+ */
 
 typedef struct reader {
     const unsigned char *p;
@@ -266,11 +269,14 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
     if (!take(&r, magic, 8) || memcmp(magic, LODS_MAGIC, 8) != 0)
         return bad(&r, "not a static LOD cache (bad magic)", NULL);
     if (!take(&r, &version, 4) || version != LODS_VERSION)
-        return sw__fail(status, SW_ERR_VERSION, "%s: LODS offset 8: cache version %u, this program "
-                        "reads %u", what, version, LODS_VERSION);
+        return sw__fail(status, SW_ERR_VERSION,
+                        "%s: LODS offset 8: cache version %u, this program "
+                        "reads %u",
+                        what, version, LODS_VERSION);
     if (!take(&r, &n, 4) || !take(&r, &key, 8))
         return bad(&r, "truncated header", NULL);
-    if (n != sw_lod_static_set_unit_count(set) || key != set_key(set, sw__lod_static_set_levels(set)))
+    if (n != sw_lod_static_set_unit_count(set) ||
+        key != set_key(set, sw__lod_static_set_levels(set)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: the static LOD cache was made for other super-surfaces or settings "
                         "(%u units, this scene has %u): run `splinewalk build-lod` again",

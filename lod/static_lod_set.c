@@ -15,10 +15,10 @@
 #include <time.h>
 
 typedef struct slot {
-    _Atomic int state;                         /* sw_lod_static_state */
-    _Atomic(sw_lod_static_chain *) chain;      /* READY: the chain */
-    sw_th_group group;                         /* the slot's build task */
-    sw_status failure;                         /* FAILED: why (written before the state) */
+    _Atomic int state;                    /* sw_lod_static_state */
+    _Atomic(sw_lod_static_chain *) chain; /* READY: the chain */
+    sw_th_group group;                    /* the slot's build task */
+    sw_status failure;                    /* FAILED: why (written before the state) */
 } slot;
 
 struct sw_lod_static_set {
@@ -49,7 +49,8 @@ typedef struct build_job {
     uint32_t unit;
 } build_job;
 
-/* ---- units ------------------------------------------------------------------------------------ */
+/* ---- units ------------------------------------------------------------------------------------
+ */
 
 /* Home cluster of every face: the cluster holding most of its patches, ties to the lowest index
  * (patches are grouped by cluster and sorted by face inside, so a face's patches in one cluster
@@ -68,8 +69,7 @@ static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint3
             ++run;
             ++k;
         }
-        if (face < n_faces &&
-            (run > best[face] || (run == best[face] && c < home[face]))) {
+        if (face < n_faces && (run > best[face] || (run == best[face] && c < home[face]))) {
             best[face] = run;
             home[face] = c;
         }
@@ -93,7 +93,8 @@ static int patch_cmp(const void *a, const void *b)
 static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_status *status)
 {
     const sw_lod_supersurfaces *ss = s->ss;
-    uint32_t *unit_of_cluster = sw__malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
+    uint32_t *unit_of_cluster =
+        sw__malloc((ss->n_clusters ? ss->n_clusters : 1) * sizeof(uint32_t));
     uint32_t *count = sw__calloc(ss->n_clusters + 1, sizeof(uint32_t));
     if (!unit_of_cluster || !count) {
         sw__free(unit_of_cluster);
@@ -114,8 +115,8 @@ static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_statu
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     }
     for (uint32_t f = 0; f < s->n_faces; ++f) {
-        s->unit_of_face[f] = home[f] == SW_LOD_STATIC_NO_UNIT ? SW_LOD_STATIC_NO_UNIT
-                                                              : unit_of_cluster[home[f]];
+        s->unit_of_face[f] =
+            home[f] == SW_LOD_STATIC_NO_UNIT ? SW_LOD_STATIC_NO_UNIT : unit_of_cluster[home[f]];
         if (s->unit_of_face[f] != SW_LOD_STATIC_NO_UNIT)
             s->units[s->unit_of_face[f]].n_faces++;
     }
@@ -447,7 +448,8 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     if (desc)
         s->levels = desc->levels;
     s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    sw_result r = sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
+    sw_result r =
+        sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
     uint32_t *home = NULL;
     if (r == SW_OK) {
         home = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);
@@ -503,7 +505,8 @@ void sw_lod_static_set_destroy(sw_lod_static_set *s)
     sw__free(s);
 }
 
-/* ---- lookups ---------------------------------------------------------------------------------- */
+/* ---- lookups ----------------------------------------------------------------------------------
+ */
 
 uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *s)
 {
@@ -574,7 +577,8 @@ sw_result sw_lod_static_set_failure(const sw_lod_static_set *s, uint32_t unit, c
     return s->slots[unit].failure.result;
 }
 
-/* ---- builds ----------------------------------------------------------------------------------- */
+/* ---- builds -----------------------------------------------------------------------------------
+ */
 
 static uint64_t now_ns(void)
 {
@@ -627,8 +631,8 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
     if (job) {
         *job = (build_job){s, unit};
         /* in the slot's group: converged frames and destroy wait on it */
-        const sw_th_task task = {build_task, job, priority, NULL, 0, &sl->group,
-                                 SW_TH_TASK_STATIC_BUILD};
+        const sw_th_task task = {
+            build_task, job, priority, NULL, 0, &sl->group, SW_TH_TASK_STATIC_BUILD};
         if (sw_th_pool_submit(s->pool, &task) == SW_OK)
             return SW_OK;
         sw__free(job);
@@ -683,9 +687,14 @@ void sw_lod_static_set_get_stats(const sw_lod_static_set *s, sw_lod_static_set_s
             out->ready++;
             out->memory_bytes += sw_lod_static_memory(sw_lod_static_set_get(s, u));
             break;
-        case SW_LOD_STATIC_FAILED: out->failed++; break;
-        case SW_LOD_STATIC_QUEUED: out->queued++; break;
-        default: break;
+        case SW_LOD_STATIC_FAILED:
+            out->failed++;
+            break;
+        case SW_LOD_STATIC_QUEUED:
+            out->queued++;
+            break;
+        default:
+            break;
         }
     }
     out->builds = atomic_load(&s->n_builds);

@@ -280,8 +280,8 @@ static int sample_polyline(state *st, const sw_sg_surface *s, const sw_sg_bezier
                            uint32_t first_patch, const double *uv, uint32_t count, double h)
 {
     const size_t start = st->n_samples;
-    double *ts = sw__malloc(((size_t)SW__SAMPLES_PER_FACE + (size_t)set->n_u + (size_t)set->n_v + 1) *
-                        sizeof *ts);
+    double *ts = sw__malloc(
+        ((size_t)SW__SAMPLES_PER_FACE + (size_t)set->n_u + (size_t)set->n_v + 1) * sizeof *ts);
     if (!ts)
         return 0;
     for (uint32_t k = 0; k < count; ++k) {

@@ -51,10 +51,10 @@ typedef enum sw_lod_static_state {
 } sw_lod_static_state;
 
 typedef struct sw_lod_static_unit {
-    uint32_t first_face, n_faces;     /* into sw_lod_static_set_faces() */
-    uint32_t first_patch, n_patches;  /* into sw_lod_static_set_patches() */
-    double box[6];                    /* object-space box of its cut Bézier nets: lo xyz, hi xyz */
-    double delta;                     /* δ its level 0 is built with (known before the build) */
+    uint32_t first_face, n_faces;    /* into sw_lod_static_set_faces() */
+    uint32_t first_patch, n_patches; /* into sw_lod_static_set_patches() */
+    double box[6];                   /* object-space box of its cut Bézier nets: lo xyz, hi xyz */
+    double delta;                    /* δ its level 0 is built with (known before the build) */
     sw_lod_cone cone; /* outward normals of its patches (their pseudo-Gauss cones enclosed, Kumar
                          §4.4), object space; the full cone unless every face of the unit is in a
                          closed shell of consistent orientation (SW_SG_FACE_CLOSED_SHELL), as
@@ -99,10 +99,10 @@ typedef struct sw_lod_static_set_desc {
 
 typedef struct sw_lod_static_set_stats {
     uint32_t n_units, ready, failed, queued;
-    uint64_t builds;     /* chains built by the pool */
-    uint64_t adopted;    /* chains handed in (sw_lod_static_set_adopt: read from a cache) */
+    uint64_t builds;      /* chains built by the pool */
+    uint64_t adopted;     /* chains handed in (sw_lod_static_set_adopt: read from a cache) */
     double build_seconds; /* summed over builds (pool threads in parallel) */
-    size_t memory_bytes; /* the chains' memory */
+    size_t memory_bytes;  /* the chains' memory */
 } sw_lod_static_set_stats;
 
 /* Clusters the scene (§3), forms the units and their instances with the instances' BVH; builds no
@@ -138,8 +138,7 @@ sw_lod_static_state sw_lod_static_set_state(const sw_lod_static_set *set, uint32
 const sw_lod_static_chain *sw_lod_static_set_get(const sw_lod_static_set *set, uint32_t unit);
 /* Submits the unit's build unless it is QUEUED, READY or FAILED. SW_OK, SW_ERR_INVALID_ARGUMENT
  * (unit out of range), SW_ERR_OUT_OF_MEMORY (not submitted; the slot stays EMPTY). */
-sw_result sw_lod_static_set_request(sw_lod_static_set *set, uint32_t unit,
-                                    sw_th_priority priority);
+sw_result sw_lod_static_set_request(sw_lod_static_set *set, uint32_t unit, sw_th_priority priority);
 /* Converged frames: requests the unit and returns once it is READY or FAILED, running pool tasks
  * meanwhile. Returns its state then (EMPTY only when the request could not be submitted). */
 sw_lod_static_state sw_lod_static_set_wait(sw_lod_static_set *set, uint32_t unit);

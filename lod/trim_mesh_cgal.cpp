@@ -76,9 +76,11 @@ extern "C" sw_result sw_lod_cdt_insert_points(sw_lod_cdt *cdt, const double *uv,
         std::vector<std::size_t> order(n);
         for (uint32_t k = 0; k < n; ++k)
             order[k] = k;
-        using sort_traits = CGAL::Spatial_sort_traits_adapter_2<
-            kernel, CGAL::Pointer_property_map<kernel::Point_2>::type>;
-        CGAL::spatial_sort(order.begin(), order.end(), sort_traits(CGAL::make_property_map(points)));
+        using sort_traits =
+            CGAL::Spatial_sort_traits_adapter_2<kernel,
+                                                CGAL::Pointer_property_map<kernel::Point_2>::type>;
+        CGAL::spatial_sort(order.begin(), order.end(),
+                           sort_traits(CGAL::make_property_map(points)));
         const size_t first = cdt->handles.size();
         cdt->handles.resize(first + n);
         cdt_t::Face_handle hint;

@@ -55,7 +55,7 @@ typedef struct sw__vec {
 
 struct sw_sg_builder {
     sw__vec vec[SW__SG_SEC_COUNT]; /* indexed by SW__SG_SEC_* (META and LODS unused) */
-    sw__vec last_child;           /* uint32 per node: O(1) append of a child */
+    sw__vec last_child;            /* uint32 per node: O(1) append of a child */
     uint32_t root;
 };
 

@@ -28,13 +28,13 @@ extern "C" {
 #endif
 
 typedef struct sw_sg_pick_hit {
-    double t;        /* hit = origin + t * dir */
-    double point[3]; /* world */
-    double uv[2];    /* the face's parameters */
-    uint32_t face;   /* SW_SG_NONE: no face hit */
-    uint32_t item;   /* the BVH item (face occurrence); a mesh hit: its occurrence, in
-                        sw_sg_scene_traverse_meshes order */
-    uint32_t mesh;   /* SW_SG_NONE: no mesh hit (face and mesh are never both set) */
+    double t;                /* hit = origin + t * dir */
+    double point[3];         /* world */
+    double uv[2];            /* the face's parameters */
+    uint32_t face;           /* SW_SG_NONE: no face hit */
+    uint32_t item;           /* the BVH item (face occurrence); a mesh hit: its occurrence, in
+                                sw_sg_scene_traverse_meshes order */
+    uint32_t mesh;           /* SW_SG_NONE: no mesh hit (face and mesh are never both set) */
     uint32_t triangle, node; /* a mesh hit: the triangle in the mesh, the MESH node */
     double bary[3];          /* a mesh hit: the weights of the triangle's three vertices */
 } sw_sg_pick_hit;

@@ -115,8 +115,8 @@ typedef struct sw_sg_node_rec {
     uint32_t parent, first_child, next_sibling; /* SW_SG_NONE when absent */
     uint32_t ref;                               /* face (SURFACE) or prototype node (INSTANCE) */
     uint32_t name;                              /* byte offset into strings, SW_SG_NONE if none */
-    float color[4];                             /* linear RGBA; color[3] < 0 inherits the parent's */
-    double xform[12];                           /* row-major 3x4 local-to-parent */
+    float color[4];   /* linear RGBA; color[3] < 0 inherits the parent's */
+    double xform[12]; /* row-major 3x4 local-to-parent */
 } sw_sg_node_rec;
 
 /* Two faces sharing a B-rep edge (for super-surface clustering later). */
@@ -262,7 +262,7 @@ sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *statu
 typedef struct sw_sg_scene_stats {
     uint32_t faces, faces_by_kind[SW_SG_KIND_COUNT];
     uint32_t trimmed_faces, loops, curves;
-    uint64_t bezier_patches;  /* after extraction of every face */
+    uint64_t bezier_patches; /* after extraction of every face */
     uint32_t max_deg_u, max_deg_v, max_curve_degree;
     uint64_t control_points;
     uint32_t nodes, instances;

@@ -710,7 +710,8 @@ sw_result sw_th_pool_create(const sw_th_pool_desc *desc, sw_th_pool **out)
     if (d.worker_count > MAX_WORKERS || d.steal_mode > SW_TH_STEAL_MODE_HALF)
         return SW_ERR_INVALID_ARGUMENT;
     sw_th_pool *pool = sw__aligned_alloc(SW_TH_CACHE_LINE, round_up(sizeof *pool));
-    worker *workers = sw__aligned_alloc(SW_TH_CACHE_LINE, round_up(d.worker_count * sizeof *workers));
+    worker *workers =
+        sw__aligned_alloc(SW_TH_CACHE_LINE, round_up(d.worker_count * sizeof *workers));
     if (!pool || !workers) {
         sw__aligned_free(pool);
         sw__aligned_free(workers);

@@ -10,6 +10,8 @@
 #include "api_nodes_internal.h"
 
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
+#include "sw_rt_misuse.h"
 #include "sw_sg_generate.h"
 #include "sw_status_util.h"
 
@@ -45,20 +47,20 @@ sw_result sw_nurbs_create(const sw_nurbs_desc *desc, sw_nurbs *out, sw_status *s
     if (out)
         out->id = 0;
     if (!desc || !out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_nurbs_create: NULL desc or out");
-    rt_nurbs *n = calloc(1, sizeof *n);
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_nurbs_create: NULL desc or out");
+    rt_nurbs *n = sw__calloc(1, sizeof *n);
     if (!n)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_nurbs_create: out of memory");
     sw_result r = sw__rt_nurbs_geom(desc, &n->geom, status);
     if (r != SW_OK) {
-        free(n);
+        sw__free(n);
         return r;
     }
     n->serial = next_serial();
     out->id = sw_rt_pool_add(&g_nurbs, n);
     if (!out->id) {
         sw_sg_scene_free(n->geom);
-        free(n);
+        sw__free(n);
         return sw__fail(status, SW_ERR_LIMIT, "sw_nurbs_create: 65,535 objects alive already");
     }
     sw__status_ok(status);
@@ -77,8 +79,8 @@ static sw_result find_nurbs(sw_nurbs handle, const char *fn, rt_nurbs **out, sw_
 {
     void *item = NULL;
     if (sw_rt_pool_get_checked(&g_nurbs, handle.id, accept_any, NULL, &item) != SW_OK)
-        return sw__fail(status, SW_ERR_STALE_HANDLE, "%s: sw_nurbs handle %#x is stale or invalid",
-                        fn, handle.id);
+        return SW__MISUSE(status, SW_ERR_STALE_HANDLE,
+                          "%s: sw_nurbs handle %#x is stale or invalid", fn, handle.id);
     *out = item;
     return SW_OK;
 }
@@ -86,7 +88,7 @@ static sw_result find_nurbs(sw_nurbs handle, const char *fn, rt_nurbs **out, sw_
 sw_result sw_nurbs_update(sw_nurbs nurbs, const sw_nurbs_desc *desc, sw_status *status)
 {
     if (!desc)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_nurbs_update: NULL desc");
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_nurbs_update: NULL desc");
     sw_sg_scene *geom = NULL;
     sw_result r = sw__rt_nurbs_geom(desc, &geom, status); /* checked before anything changes */
     if (r != SW_OK)
@@ -113,9 +115,10 @@ sw_result sw_nurbs_destroy(sw_nurbs nurbs)
     rt_nurbs *n = sw_rt_pool_remove(&g_nurbs, nurbs.id);
     pthread_mutex_unlock(&g_nurbs_lock);
     if (!n)
-        return SW_ERR_STALE_HANDLE;
+        return SW__MISUSE(NULL, SW_ERR_STALE_HANDLE,
+                          "sw_nurbs_destroy: sw_nurbs handle %#x is stale or invalid", nurbs.id);
     sw_sg_scene_free(n->geom);
-    free(n);
+    sw__free(n);
     return SW_OK;
 }
 
@@ -144,11 +147,11 @@ void sw__rt_immediate_free(struct sw_rt_immediate *im, sw_gpu_context *gpu)
     }
     if (im->scene)
         sw_rt_scene_release(im->scene);
-    free(im->serials);
-    free(im->first_face);
-    free(im->slot_object);
-    free(im->occ);
-    free(im);
+    sw__free(im->serials);
+    sw__free(im->first_face);
+    sw__free(im->slot_object);
+    sw__free(im->occ);
+    sw__free(im);
 }
 
 static sw_result immediate_state(sw_renderer renderer, const char *fn, int drawing,
@@ -159,7 +162,7 @@ static sw_result immediate_state(sw_renderer renderer, const char *fn, int drawi
     sw_result r = sw__rt_renderer_immediate(renderer, fn, drawing, &slot, gpu, status);
     if (r != SW_OK)
         return r;
-    if (!*slot && !(*slot = calloc(1, sizeof **slot)))
+    if (!*slot && !(*slot = sw__calloc(1, sizeof **slot)))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     *out = *slot;
     return SW_OK;
@@ -179,9 +182,9 @@ typedef struct draw_set {
 
 static void draw_set_free(draw_set *s)
 {
-    free(s->object_of);
-    free(s->objects);
-    free(s->serials);
+    sw__free(s->object_of);
+    sw__free(s->objects);
+    sw__free(s->serials);
 }
 
 static uint32_t slot_of(uint32_t id)
@@ -193,11 +196,11 @@ static sw_result resolve_draws(struct sw_rt_immediate *im, const sw_immediate_de
                                sw_status *status)
 {
     const char *fn = "sw_renderer_draw_nurbs";
-    s->object_of = malloc(d->draw_count * sizeof *s->object_of);
-    s->objects = malloc(d->draw_count * sizeof *s->objects);
-    s->serials = malloc(d->draw_count * sizeof *s->serials);
+    s->object_of = sw__malloc(d->draw_count * sizeof *s->object_of);
+    s->objects = sw__malloc(d->draw_count * sizeof *s->objects);
+    s->serials = sw__malloc(d->draw_count * sizeof *s->serials);
     if (!im->slot_object)
-        im->slot_object = calloc(SW_RT_POOL_MAX_SLOTS + 1u, sizeof *im->slot_object);
+        im->slot_object = sw__calloc(SW_RT_POOL_MAX_SLOTS + 1u, sizeof *im->slot_object);
     if (!s->object_of || !s->objects || !s->serials || !im->slot_object)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     sw_result r = SW_OK;
@@ -266,22 +269,22 @@ static sw_result set_scene(struct sw_rt_immediate *im, sw_gpu_context *gpu, cons
     if (im->scene && im->n_objects == s->n_objects &&
         memcmp(im->serials, s->serials, s->n_objects * sizeof *s->serials) == 0)
         return SW_OK;
-    uint64_t *serials = malloc(s->n_objects * sizeof *serials);
-    uint32_t *first_face = malloc((s->n_objects + 1u) * sizeof *first_face);
+    uint64_t *serials = sw__malloc(s->n_objects * sizeof *serials);
+    uint32_t *first_face = sw__malloc((s->n_objects + 1u) * sizeof *first_face);
     sw_rt_scene *scene = NULL;
     sw_result r = serials && first_face
                       ? build_scene(s, &scene, first_face, status)
                       : sw__fail(status, SW_ERR_OUT_OF_MEMORY, "immediate scene: out of memory");
     if (r != SW_OK) {
-        free(serials);
-        free(first_face);
+        sw__free(serials);
+        sw__free(first_face);
         return r;
     }
     memcpy(serials, s->serials, s->n_objects * sizeof *serials);
     if (im->scene)
         sw_rt_scene_release(im->scene);
-    free(im->serials);
-    free(im->first_face);
+    sw__free(im->serials);
+    sw__free(im->first_face);
     im->scene = scene;
     im->serials = serials;
     im->first_face = first_face;
@@ -359,7 +362,7 @@ static sw_result check_immediate_desc(const sw_immediate_desc *d, sw_status *sta
 {
     const char *fn = "sw_renderer_draw_nurbs";
     if (!d)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL desc", fn);
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL desc", fn);
     if (d->draw_count < 1 || d->draw_count > SW__IMMEDIATE_MAX_DRAWS || !d->draws)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: %u draws (1..%u, non-NULL draws)", fn,
                         d->draw_count, SW__IMMEDIATE_MAX_DRAWS);
@@ -454,7 +457,7 @@ sw_result sw_renderer_shading_programs(sw_renderer renderer, uint32_t out[3], sw
 {
     const char *fn = "sw_renderer_shading_programs";
     if (!out)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL out", fn);
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL out", fn);
     struct sw_rt_immediate *im = NULL;
     sw_gpu_context *gpu = NULL;
     sw_result r = immediate_state(renderer, fn, 0, &im, &gpu, status);

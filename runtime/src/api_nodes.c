@@ -171,8 +171,8 @@ static sw_result find_node(sw_rt_model *m, sw_node node, const char *fn, rt_node
 {
     void *item = NULL;
     if (sw_rt_pool_get_checked(&m->nodes, node.id, accept_node, NULL, &item) != SW_OK)
-        return SW__MISUSE(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid", fn,
-                        node.id);
+        return SW__MISUSE(status, SW_ERR_STALE_HANDLE, "%s: node handle %#x is stale or invalid",
+                          fn, node.id);
     *out = item;
     return SW_OK;
 }
@@ -292,7 +292,7 @@ static sw_result check_nurbs_desc(const sw_nurbs_desc *d, sw_status *status)
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL knots or points", fn);
     if (d->loop_count && !d->loops)
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn,
-                        d->loop_count);
+                          d->loop_count);
     if (d->loop_count > SW__NODES_MAX_LOOPS)
         return sw__fail(status, SW_ERR_LIMIT, "%s: %u trim loops (at most %u)", fn, d->loop_count,
                         SW__NODES_MAX_LOOPS);

@@ -150,8 +150,9 @@ static void retire_statics(sw_rt_renderer *r)
     if (rs) {
         *rs = (retired_statics){set, r->cache_scene};
         sw_rt_scene_retain(r->cache_scene);
-        const sw_th_task task = {retire_statics_task, rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
-                                 NULL, SW_TH_TASK_STATIC_RETIRE};
+        const sw_th_task task = {
+            retire_statics_task,     rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL,
+            SW_TH_TASK_STATIC_RETIRE};
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;
         sw_rt_scene_release(r->cache_scene);
@@ -214,8 +215,9 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
         return SW__MISUSE(NULL, r, "sw_renderer_destroy: renderer handle %#x is stale or invalid",
                           renderer.id);
     if (r != SW_OK) /* another thread's context: left untouched */
-        return SW__MISUSE(NULL, r, "sw_renderer_destroy: called from a thread that does not own "
-                                   "the renderer");
+        return SW__MISUSE(NULL, r,
+                          "sw_renderer_destroy: called from a thread that does not own "
+                          "the renderer");
     sw_rt_renderer *rr = item;
     while (rr->in_flight) { /* prepared, never submitted: V finishes them, nobody draws them */
         job_free((rt_job *)sw_rt_pipeline_pop(rr->pipeline));
@@ -388,8 +390,7 @@ static void statics_task(void *ctx)
     sw_rt_renderer *r = ctx;
     sw_lod_static_set *set = NULL;
     sw_status st = {0};
-    sw_result res =
-        sw_lod_static_set_create(r->cache_scene->sg, r->pool, NULL, &set, &st);
+    sw_result res = sw_lod_static_set_create(r->cache_scene->sg, r->pool, NULL, &set, &st);
     if (res != SW_OK) {
         r->statics_failure = st;
         r->statics_failure.result = res;
@@ -402,8 +403,8 @@ static void statics_task(void *ctx)
     const void *cache = NULL;
     size_t cache_bytes = 0;
     if (sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st) == SW_OK)
-        (void)sw_lod_static_set_load(set, cache, cache_bytes, sw_sg_scene_path_ptr(r->cache_scene->sg),
-                                     NULL, &st);
+        (void)sw_lod_static_set_load(set, cache, cache_bytes,
+                                     sw_sg_scene_path_ptr(r->cache_scene->sg), NULL, &st);
     atomic_store(&r->statics, set);
     atomic_store(&r->statics_state, 2);
 }
@@ -415,8 +416,13 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
 {
     int expect = 0;
     if (atomic_compare_exchange_strong(&r->statics_state, &expect, 1)) {
-        const sw_th_task task = {statics_task, r, SW_TH_PRIORITY_BACKGROUND, NULL, 0,
-                                 &r->statics_group, SW_TH_TASK_STATIC_CLUSTER};
+        const sw_th_task task = {statics_task,
+                                 r,
+                                 SW_TH_PRIORITY_BACKGROUND,
+                                 NULL,
+                                 0,
+                                 &r->statics_group,
+                                 SW_TH_TASK_STATIC_CLUSTER};
         if (sw_th_pool_submit(r->pool, &task) != SW_OK) {
             atomic_store(&r->statics_state, 0);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: could not submit");

@@ -246,7 +246,7 @@ sw_result sw_rt_scene_lookup(sw_scene handle, sw_rt_scene **out, sw_status *stat
     *out = NULL;
     if (sw_rt_pool_get_checked(&g_scenes, handle.id, retain_scene, NULL, &item) != SW_OK)
         return SW__MISUSE(status, SW_ERR_STALE_HANDLE, "scene handle %#x is stale or invalid",
-                        handle.id);
+                          handle.id);
     *out = item;
     return SW_OK;
 }

@@ -50,9 +50,8 @@ static void print_json(const char *path, const sw_scene_info *in)
            (unsigned long long)in->control_points, in->nodes, in->instances,
            (unsigned long long)in->face_occurrences, in->adjacent_face_pairs, in->meshes,
            (unsigned long long)in->mesh_triangles, (unsigned long long)in->mesh_occurrences,
-           (unsigned long long)in->triangle_occurrences, in->bbox_min[0],
-           in->bbox_min[1], in->bbox_min[2], in->bbox_max[0], in->bbox_max[1], in->bbox_max[2],
-           in->memory_bytes);
+           (unsigned long long)in->triangle_occurrences, in->bbox_min[0], in->bbox_min[1],
+           in->bbox_min[2], in->bbox_max[0], in->bbox_max[1], in->bbox_max[2], in->memory_bytes);
 }
 
 static void print_text(const char *path, const sw_scene_info *in)

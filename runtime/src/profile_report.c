@@ -117,7 +117,8 @@ int sw_rt_profile_push(sw_rt_profile *p, const sw_rt_prof_row *row)
 {
     if (p->n_rows == p->cap_rows) {
         const uint32_t cap = p->cap_rows ? p->cap_rows * 2 : 256;
-        sw_rt_prof_row *g = cap > p->cap_rows ? sw__realloc(p->rows, (size_t)cap * sizeof *g) : NULL;
+        sw_rt_prof_row *g =
+            cap > p->cap_rows ? sw__realloc(p->rows, (size_t)cap * sizeof *g) : NULL;
         if (!g)
             return -1;
         p->rows = g;

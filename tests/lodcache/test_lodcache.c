@@ -308,8 +308,8 @@ static void hold_workers(sw_th_pool *pool, hold *h)
     atomic_store(&h->go, 0);
     sw_th_group_init(&h->group);
     for (uint32_t i = 0; i < n; ++i) {
-        const sw_th_task t = {hold_task, h, SW_TH_PRIORITY_FRAME, NULL, 0, &h->group,
-                              SW_TH_TASK_OTHER};
+        const sw_th_task t = {hold_task, h,         SW_TH_PRIORITY_FRAME, NULL,
+                              0,         &h->group, SW_TH_TASK_OTHER};
         sw_th_pool_submit(pool, &t);
     }
     while (atomic_load(&h->arrived) < (int)n)
@@ -681,8 +681,7 @@ static void refine_many(sw_lod_cache *c, sw_th_pool *pool, uint32_t face)
           (unsigned long long)(after.refinements - before.refinements));
     for (uint32_t k = 0; k < n; ++k) {
         const sw_lod_hnode *l = &h2->nodes[nodes[k]];
-        CHECK(l->child[0] >= 0 || l->error < err[k],
-              "leaf %d of the batch not refined", nodes[k]);
+        CHECK(l->child[0] >= 0 || l->error < err[k], "leaf %d of the batch not refined", nodes[k]);
     }
     printf("refine_leaves: %u leaves of face %u in one version (%d -> %d nodes)\n", n, face,
            n_before, h2->n_nodes);

@@ -501,7 +501,8 @@ static void test_stats(void **state)
             }
         for (int c = 0; c < 8; c++)
             for (int r = 0; r < 3; r++) {
-                double x = m[4 * r] * local[(c & 1) ? 3 : 0] + m[4 * r + 1] * local[(c & 2) ? 4 : 1] +
+                double x = m[4 * r] * local[(c & 1) ? 3 : 0] +
+                           m[4 * r + 1] * local[(c & 2) ? 4 : 1] +
                            m[4 * r + 2] * local[(c & 4) ? 5 : 2] + m[4 * r + 3];
                 outer[r] = fmin(outer[r], x);
                 outer[3 + r] = fmax(outer[3 + r], x);
@@ -512,7 +513,8 @@ static void test_stats(void **state)
                 sw_sg_surface_eval(&f, uv[0] + (uv[1] - uv[0]) * i / 16.0,
                                    uv[2] + (uv[3] - uv[2]) * j / 16.0, p);
                 for (int r = 0; r < 3; r++) {
-                    double x = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+                    double x =
+                        m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
                     inner[r] = fmin(inner[r], x);
                     inner[3 + r] = fmax(inner[3 + r], x);
                 }
