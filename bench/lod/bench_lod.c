@@ -104,8 +104,9 @@ static int build_static(const bench *b, sw_renderer r)
                     b->frames, 1e-3 * (bench_now_ms() - t0));
     }
     fprintf(stderr, "\n");
-    printf("static LOD preprocessing along the path (converged frames, builds in the pool): %.1f s\n",
-           1e-3 * (bench_now_ms() - t0));
+    printf(
+        "static LOD preprocessing along the path (converged frames, builds in the pool): %.1f s\n",
+        1e-3 * (bench_now_ms() - t0));
     return 0;
 }
 
@@ -115,8 +116,8 @@ static void report(const char *name, mode_result *res)
     printf("%-12s frames %d: median %.2f ms, p99 %.2f ms (visibility thread median %.2f ms); per "
            "frame %.0f triangles, %.1f super-surfaces static (%.1f of %.1f faces), fallback draws "
            "%.1f, pool waits %llu\n",
-           name, res->n, bench_quantile(res->ms, res->n, 0.5), bench_quantile(res->ms, res->n, 0.99),
-           bench_quantile(res->vis, res->n, 0.5),
+           name, res->n, bench_quantile(res->ms, res->n, 0.5),
+           bench_quantile(res->ms, res->n, 0.99), bench_quantile(res->vis, res->n, 0.5),
            res->triangles / n, res->static_drawn / n, res->static_faces / n, res->faces / n,
            res->fallbacks / n, (unsigned long long)res->waits);
 }
@@ -154,7 +155,8 @@ static int run(bench *b)
         free(res[m].vis);
     }
     printf("static on / off: median %.3f, p99 %.3f, triangles %.3f\n", median[0] / median[1],
-           p99[0] / p99[1], (double)res[0].triangles / (double)(res[1].triangles ? res[1].triangles : 1));
+           p99[0] / p99[1],
+           (double)res[0].triangles / (double)(res[1].triangles ? res[1].triangles : 1));
     return 0;
 }
 
