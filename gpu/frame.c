@@ -1192,6 +1192,16 @@ int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_
     return sw_sg_trim_classify(loops, n_loops, u, v);
 }
 
+static sw__gpu_trim_key trim_key(const frame *f, uint32_t face, const sw_sg_face_rec *rec,
+                                 const double rect[4])
+{
+    return (sw__gpu_trim_key){sw_sg_scene_serial(f->scene),
+                              face,
+                              rec->first_loop,
+                              rec->n_loops,
+                              {rect[0], rect[1], rect[2], rect[3]}};
+}
+
 /* A tile's trim texture: the face's loops clipped to the tile grown by one texel (the clipped
  * border then falls in the entry's gutter), keyed by the tile's rectangle. */
 static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, sw_status *status)
@@ -1201,8 +1211,7 @@ static sw_result make_tile_trim(frame *f, const pending_trim *t, double scale, s
     int32_t w = sw__fr_class_texels(t->width * scale, max_entry);
     int32_t h = sw__fr_class_texels(t->height * scale, max_entry);
     const double *r = t->rect;
-    sw__gpu_trim_key key = {
-        f->scene, t->face, rec->first_loop, rec->n_loops, {r[0], r[1], r[2], r[3]}};
+    const sw__gpu_trim_key key = trim_key(f, t->face, rec, r);
     int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
     f->draws[t->draw].trim_entry = id;
     if (id >= 0)
@@ -1233,8 +1242,7 @@ static sw_result make_trim(frame *f, const pending_trim *t, double scale, sw_sta
     int32_t w = sw__fr_class_texels(t->width * scale, max_entry);
     int32_t h = sw__fr_class_texels(t->height * scale, max_entry);
     const double *ub = rec->uv_box;
-    sw__gpu_trim_key key = {
-        f->scene, t->face, rec->first_loop, rec->n_loops, {ub[0], ub[1], ub[2], ub[3]}};
+    const sw__gpu_trim_key key = trim_key(f, t->face, rec, ub);
     int32_t id = sw__gpu_atlas_find(f->ctx, &key, w, h);
     f->draws[t->draw].trim_entry = id;
     int border = !f->ctx->crack_fill_off;

@@ -264,9 +264,11 @@ void sw__gpu_trim_page_draw(sw_gpu_context *ctx, GLuint tex, int32_t layer, int3
                             GLsizei n_loops);
 
 /* ---- trim-texture atlas (trim_atlas.c, §4.4) ------------------------------------------------- */
-/* Identity of a trim texture: the scene, the face and what its loops are (checked on reuse). */
+/* Identity of a trim texture: the scene (by serial: a freed scene's address goes to later ones,
+ * such as the next compiled version of a node scene with edited loops), the face and what its
+ * loops are (checked on reuse). */
 typedef struct sw__gpu_trim_key {
-    const void *scene;
+    uint64_t scene;
     uint32_t face, first_loop, n_loops;
     double uv_box[4];
 } sw__gpu_trim_key;

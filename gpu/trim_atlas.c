@@ -100,7 +100,7 @@ static int grow32(void **p, int32_t *cap, size_t need, size_t elem)
 
 static uint64_t key_hash(const sw__gpu_trim_key *k, int32_t w, int32_t h)
 {
-    uint64_t x = (uint64_t)(uintptr_t)k->scene * 0x9E3779B97F4A7C15ull;
+    uint64_t x = k->scene * 0x9E3779B97F4A7C15ull;
     x ^= ((uint64_t)k->face << 32 | (uint64_t)(uint32_t)w) * 0xC2B2AE3D27D4EB4Full;
     x ^= (uint64_t)(uint32_t)h * 0x165667B19E3779F9ull;
     return x ^ (x >> 29);

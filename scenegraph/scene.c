@@ -8,6 +8,7 @@
 #include "sw_status_util.h"
 
 #include <assert.h>
+#include <stdatomic.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -310,6 +311,7 @@ sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *s
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene: out of memory");
     }
     scene->path = path;
+    scene->serial = sw__sg_next_serial();
     builder_move_arrays(b, scene);
     sw_sg_builder_free(b);
     sw_result r = sw_sg_scene_validate(&scene->view, "scene", status);
@@ -334,6 +336,18 @@ const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene)
 const char *sw_sg_scene_path_ptr(const sw_sg_scene *scene)
 {
     return scene->path;
+}
+
+uint64_t sw_sg_scene_serial(const sw_sg_scene *scene)
+{
+    return scene->serial;
+}
+
+uint64_t sw__sg_next_serial(void)
+{
+    static _Atomic uint64_t next = 0;
+    /* relaxed: only uniqueness matters, and the scene is published to other threads later */
+    return atomic_fetch_add_explicit(&next, 1u, memory_order_relaxed) + 1u;
 }
 
 const void *sw__sg_view_section(const sw_sg_scene_view *view, int s, uint64_t *bytes,

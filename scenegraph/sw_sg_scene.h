@@ -162,6 +162,9 @@ typedef struct sw_sg_scene_view {
 const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene);
 /* Path of the file the scene was loaded from, or "" for one built in memory. */
 const char *sw_sg_scene_path_ptr(const sw_sg_scene *scene);
+/* A number no other scene of the process has had (1, 2, ...): what caches keyed by a scene hold
+ * instead of its address, which the allocator gives to a later scene once this one is freed. */
+uint64_t sw_sg_scene_serial(const sw_sg_scene *scene);
 
 /* Verifies (once) the checksums of the named sections of a mapped scene and, the first time all of
  * them have been verified, validates every index and offset (sw_sg_scene_validate). In-memory

@@ -53,7 +53,11 @@ struct sw_sg_scene {
     uint32_t verified;         /* sections whose checksum matched (sw_sg_section bits) */
     int validated;             /* 1 once sw_sg_scene_validate passed, -1 once it failed */
     sw_status validate_status; /* the failure, repeated to later callers */
+    uint64_t serial;           /* sw_sg_scene_serial */
 };
+
+/* The next scene serial (thread-safe). */
+uint64_t sw__sg_next_serial(void);
 
 /* sw_sg_scene_validate with byte offsets of each record in the messages: when `sec` is not NULL,
  * record i of section s is reported at sec[s].offset + i * record size. */

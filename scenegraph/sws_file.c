@@ -402,6 +402,7 @@ sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *statu
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
     }
     scene->path = strcpy(copy, path);
+    scene->serial = sw__sg_next_serial();
     sw_result r = map_file(scene, status);
     if (r == SW_OK)
         r = check_ident(path, scene->map, scene->map_size, status);

@@ -66,9 +66,7 @@ static void make_shape(shape *s, const double box[4], int w, int h, double phase
     s->all[3] = (sw_sg_polyline){s->island, 4};
     s->loops = leading_empty ? s->all : s->all + 1;
     s->n_loops = leading_empty ? 4 : 3;
-    static const int k_scene_tag = 0;
-    s->key = (sw__gpu_trim_key){
-        &k_scene_tag, face, 4 * face, s->n_loops, {box[0], box[1], box[2], box[3]}};
+    s->key = (sw__gpu_trim_key){1u, face, 4 * face, s->n_loops, {box[0], box[1], box[2], box[3]}};
     s->id = -1;
 }
 
