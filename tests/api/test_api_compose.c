@@ -1,7 +1,7 @@
 /* tests/api: depth compositing of the renderer's surfaces with a host's own 3D drawing (issue 7:
  * sw_frame_desc.present_depth, sw_camera_matrices, sw_frame_stats.view / proj / near_plane).
  *
- *   test_api_compose
+ *   test_api_compose [SCENE]
  *
  * The test is the host: its own EGL context (surfaceless, 4.5 core) and framebuffer (RGBA8 and a
  * 24-bit depth buffer, not the renderer's 32F format), and a renderer drawing in that context
@@ -20,7 +20,10 @@
  *  - the host's state the depth pass could touch beyond what host_state.c saves (unit 1's texture
  *    and sampler, the active unit) and its depth function and program are left as they were;
  *  - the matrices: proj's entries against the formula, stats equal to sw_camera_matrices, bad
- *    arguments refused. */
+ *    arguments refused;
+ *  - with SCENE, the scene paths (sw_renderer_draw, and prepare + submit): where the host's depth
+ *    buffer stayed 0 its clear colour stayed, elsewhere a surface was written; both paths give the
+ *    same host framebuffer, and stats matrices equal to sw_camera_matrices of their near plane. */
 #include <splinewalk/splinewalk.h>
 
 #include <EGL/egl.h>
@@ -337,7 +340,72 @@ static void check_matrices(void)
     EXPECT(sw_camera_matrices(&flat, W, H, 1.0, view, proj, &st) == SW_ERR_INVALID_ARGUMENT);
 }
 
-int main(void)
+/* A scene frame composited into the host's cleared framebuffer, drawn (split = 0) or prepared
+ * and submitted (1); returns the surface pixels, -1 on failure. */
+static long scene_composite(sw_renderer r, const sw_frame_desc *desc, int split, const host *h,
+                            uint8_t *rgba, float *depth)
+{
+    host_begin(h);
+    sw_frame_stats stats;
+    sw_status st = {0};
+    sw_result res =
+        split ? sw_renderer_prepare(r, desc, &st) : sw_renderer_draw(r, desc, &stats, &st);
+    if (res == SW_OK && split)
+        res = sw_renderer_submit(r, &stats, &st);
+    if (res != SW_OK) {
+        fprintf(stderr, "scene frame: %s\n", st.message);
+        return -1;
+    }
+    double view[16], proj[16];
+    EXPECT(sw_camera_matrices(&desc->camera, W, H, stats.near_plane, view, proj, &st) == SW_OK);
+    EXPECT(memcmp(stats.view, view, sizeof view) == 0 &&
+           memcmp(stats.proj, proj, sizeof proj) == 0);
+    read_host(rgba, depth);
+    long surface = 0, wrong = 0;
+    for (size_t i = 0; i < (size_t)W * H; i++) {
+        int clear = seen(rgba + 4 * i) == SEEN_CLEAR;
+        surface += depth[i] > 0.0f;
+        wrong += (depth[i] > 0.0f) == clear;
+    }
+    printf("scene %s: %ld surface pixels (near plane %g), %ld pixels whose colour disagrees with "
+           "the depth written\n",
+           split ? "prepare + submit" : "draw", surface, stats.near_plane, wrong);
+    EXPECT(surface > 100 && surface < (long)W * H - 100 && wrong == 0);
+    return surface;
+}
+
+static void check_scene(sw_renderer r, const char *path, const host *h)
+{
+    sw_scene scene;
+    sw_scene_load_desc load = {.path = path};
+    sw_status st = {0};
+    if (sw_scene_load(&load, &scene, &st) != SW_OK) {
+        fprintf(stderr, "%s: %s\n", path, st.message);
+        g_failures++;
+        return;
+    }
+    sw_frame_desc desc = {0};
+    desc.scene = scene;
+    EXPECT(sw_camera_fit(scene, SW_VIEW_ISO, &desc.camera, &st) == SW_OK);
+    desc.width = W;
+    desc.height = H;
+    desc.present = 1;
+    desc.present_depth = 1;
+    size_t n = (size_t)W * H;
+    uint8_t *rgba[2] = {malloc(n * 4), malloc(n * 4)};
+    float *depth[2] = {malloc(n * sizeof(float)), malloc(n * sizeof(float))};
+    long drawn = scene_composite(r, &desc, 0, h, rgba[0], depth[0]);
+    long split = scene_composite(r, &desc, 1, h, rgba[1], depth[1]);
+    EXPECT(drawn > 0 && split == drawn);
+    EXPECT(memcmp(rgba[0], rgba[1], n * 4) == 0 && memcmp(depth[0], depth[1], n * 4) == 0);
+    for (int k = 0; k < 2; k++) {
+        free(rgba[k]);
+        free(depth[k]);
+    }
+    EXPECT(sw_scene_destroy(scene) == SW_OK);
+}
+
+int main(int argc, char **argv)
 {
     if (make_context() != 0) {
         fprintf(stderr, "no EGL 4.5 core context\n");
@@ -421,6 +489,10 @@ int main(void)
         }
     printf("present without depth: %d pixels decided, %d not the renderer's\n", n, wrong);
     EXPECT(n > 3000 && wrong == 0);
+
+    if (argc > 1)
+        check_scene(r, argv[1], &h);
+    check_host_state(&h);
 
     sw_nurbs_destroy(plane);
     EXPECT(sw_renderer_destroy(r) == SW_OK);
