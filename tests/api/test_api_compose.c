@@ -394,6 +394,9 @@ static void check_scene(sw_renderer r, const char *path, const host *h)
     size_t n = (size_t)W * H;
     uint8_t *rgba[2] = {malloc(n * 4), malloc(n * 4)};
     float *depth[2] = {malloc(n * sizeof(float)), malloc(n * sizeof(float))};
+    desc.near_plane = -1.0;
+    EXPECT(sw_renderer_draw(r, &desc, NULL, &st) == SW_ERR_INVALID_ARGUMENT);
+    desc.near_plane = 0.0;
     long drawn = scene_composite(r, &desc, 0, h, rgba[0], depth[0]);
     long split = scene_composite(r, &desc, 1, h, rgba[1], depth[1]);
     EXPECT(drawn > 0 && split == drawn);
