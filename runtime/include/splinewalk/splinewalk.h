@@ -284,7 +284,9 @@ typedef struct sw_frame_desc {
                                 glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), glDepthRange(0, 1),
                                 depth cleared to 0, glDepthFunc(GL_GREATER). Geometry it draws
                                 before the call hides the surfaces behind it; geometry drawn after
-                                is hidden where a surface is nearer. 0: the colour copy above */
+                                is hidden where a surface is nearer. A framebuffer without a
+                                depth buffer gets the surfaces' colour, its background kept.
+                                0: the colour copy above */
     double near_plane;       /* > 0: the projection's near plane, in world units (what lies
                                 nearer is clipped); 0: chosen per frame from the scene's box
                                 (max(1e-4 x its diagonal, half the eye's distance to it)), given
