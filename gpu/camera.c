@@ -84,6 +84,25 @@ sw_result sw__gpu_view_init(sw__gpu_view *v, const sw_gpu_camera *cam, int32_t w
     return SW_OK;
 }
 
+void sw__gpu_view_matrices(const sw__gpu_view *v, double view[16], double proj[16])
+{
+    memset(view, 0, 16 * sizeof *view);
+    memset(proj, 0, 16 * sizeof *proj);
+    for (int c = 0; c < 3; ++c) {
+        view[c * 4 + 0] = v->right[c];
+        view[c * 4 + 1] = v->up[c];
+        view[c * 4 + 2] = -v->fwd[c];
+    }
+    view[12] = -dot3(v->right, v->eye);
+    view[13] = -dot3(v->up, v->eye);
+    view[14] = dot3(v->fwd, v->eye);
+    view[15] = 1.0;
+    proj[0] = 1.0 / v->tan_x;
+    proj[5] = 1.0 / v->tan_y;
+    proj[11] = -1.0;          /* clip w = -z_eye, the depth along the view axis */
+    proj[14] = v->near_plane; /* clip z = near: zero-to-one depth = near / w, as view_proj */
+}
+
 /* The same box-against-planes test as the BVH's culling (one classification for both). */
 #define N_PLANES(v) ((int32_t)(sizeof(v)->planes / sizeof(v)->planes[0]))
 

@@ -280,8 +280,8 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         glDeleteVertexArrays(1, &ctx->vao);
         glDeleteFramebuffers(1, &ctx->trim_fbo);
         glDeleteFramebuffers(1, &ctx->fbo);
-        glDeleteRenderbuffers(1, &ctx->rb_color);
-        glDeleteRenderbuffers(1, &ctx->rb_depth);
+        glDeleteTextures(1, &ctx->tex_color);
+        glDeleteTextures(1, &ctx->tex_depth);
     }
     if (adopted)
         sw__gpu_host_state_restore(&host);
@@ -307,16 +307,24 @@ sw_result sw__gpu_target_ensure(sw_gpu_context *ctx, int32_t w, int32_t h, sw_st
         return SW_OK;
     if (!ctx->fbo) {
         glGenFramebuffers(1, &ctx->fbo);
-        glGenRenderbuffers(1, &ctx->rb_color);
-        glGenRenderbuffers(1, &ctx->rb_depth);
+        glGenTextures(1, &ctx->tex_color);
+        glGenTextures(1, &ctx->tex_depth);
     }
-    glBindRenderbuffer(GL_RENDERBUFFER, ctx->rb_color);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, w, h);
-    glBindRenderbuffer(GL_RENDERBUFFER, ctx->rb_depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+    /* Textures, not renderbuffers: a depth-compositing present reads them (sw__gpu_present). */
+    const GLuint tex[2] = {ctx->tex_color, ctx->tex_depth};
+    const GLenum fmt[2][3] = {{GL_RGBA8, GL_RGBA, GL_UNSIGNED_BYTE},
+                              {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT, GL_FLOAT}};
+    for (int i = 0; i < 2; i++) {
+        glBindTexture(GL_TEXTURE_2D, tex[i]);
+        glTexImage2D(GL_TEXTURE_2D, 0, (GLint)fmt[i][0], w, h, 0, fmt[i][1], fmt[i][2], NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
     glBindFramebuffer(GL_FRAMEBUFFER, ctx->fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, ctx->rb_color);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, ctx->rb_depth);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, ctx->tex_color, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, ctx->tex_depth, 0);
     GLenum fs = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     if (fs != GL_FRAMEBUFFER_COMPLETE)
         return sw__fail(status, SW_ERR_GL, "render target %dx%d incomplete (0x%04x)", (int)w,

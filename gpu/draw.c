@@ -225,11 +225,49 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     return sw__gpu_check(status, "frame draw");
 }
 
-sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
+/* The fullscreen pass of a depth-compositing present, in the host's state as the host-state
+ * save left it (GL defaults: no blend, scissor or masks). It reads the render target on units 0
+ * (depth) and 1 (colour); unit 1 is not in the saved host state, so its 2D texture and sampler
+ * are put back here. */
+static void present_by_depth(sw_gpu_context *ctx, const sw__gpu_view *view)
+{
+    glViewport(0, 0, view->width, view->height);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER); /* reversed-Z: the host's nearer pixels stay */
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+    GLint unit1_texture = 0, unit1_sampler = 0;
+    glActiveTexture(GL_TEXTURE1);
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &unit1_texture);
+    glGetIntegerv(GL_SAMPLER_BINDING, &unit1_sampler);
+    glBindTexture(GL_TEXTURE_2D, ctx->tex_color);
+    glBindSampler(1, 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, ctx->tex_depth);
+    glBindSampler(0, 0);
+    glUseProgram(ctx->prog_present);
+    glBindVertexArray(ctx->vao);
+    for (GLuint a = 0; a < 3; ++a)
+        glDisableVertexAttribArray(a);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, (GLuint)unit1_texture);
+    glBindSampler(1, (GLuint)unit1_sampler);
+    glActiveTexture(GL_TEXTURE0);
+}
+
+sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view, int depth,
                           const sw__gpu_host_state *host, sw_status *status)
 {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, ctx->fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)host->draw_fb);
+    if (depth) {
+        present_by_depth(ctx, view);
+        return sw__gpu_check(status, "frame present (depth composite into the host's framebuffer)");
+    }
     glBlitFramebuffer(0, 0, view->width, view->height, 0, 0, view->width, view->height,
                       GL_COLOR_BUFFER_BIT, GL_NEAREST);
     return sw__gpu_check(status, "frame present (blit into the host's framebuffer)");

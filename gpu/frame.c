@@ -1126,8 +1126,9 @@ static sw_result tessellate(frame *f, const sw_gpu_frame_desc *desc, sw_status *
     else
         memset(&meshes, 0, sizeof meshes);
     static const double k_origin[3] = {0.0, 0.0, 0.0};
-    double near_plane =
-        scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box) : 1.0;
+    double near_plane = desc->near_plane > 0.0         ? desc->near_plane
+                        : scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box)
+                                                       : 1.0;
     if (r == SW_OK)
         r = sw__gpu_view_init(&f->view, &desc->camera, desc->width, desc->height, near_plane,
                               status);
@@ -1545,7 +1546,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
     f->st.ms_gpu = ns[1] > ns[0] ? 1e-6 * (double)(ns[1] - ns[0]) : 0.0;
     double t3 = sw__gpu_now_ms();
     if (r == SW_OK && desc->present)
-        r = sw__gpu_present(ctx, &f->view, &host, status);
+        r = sw__gpu_present(ctx, &f->view, desc->present_depth, &host, status);
     if (r == SW_OK && !desc->no_readback)
         r = sw__gpu_readback(ctx, &f->view, desc->want_depth, out, status);
     if (host_state)
@@ -1556,6 +1557,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
     f->st.ms_trim = t2 - t1;
     f->st.ms_draw = t3 - t2;
     f->st.ms_readback = t4 - t3;
+    f->st.near_plane = f->view.near_plane;
     if (stats)
         *stats = f->st;
     sw_lod_cache *cache = f->cache;

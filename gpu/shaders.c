@@ -3,7 +3,8 @@
  * the trim-texture lookup of Guthe et al. 2005 §4.3 that discards fragments outside the trim
  * region, read from the trim atlas of §4.4), and the trim program that draws fans and crack-filling
  * lines into a trim texture (§4), and the exact program that evaluates NURBS of any degree from
- * knot vectors in the vertex shader (eval_exact).
+ * knot vectors in the vertex shader (eval_exact), and the present program that composites the
+ * frame into a host's framebuffer by depth.
  */
 #include "sw_gpu_internal.h"
 #include "sw_status_util.h"
@@ -311,6 +312,28 @@ static const char *const k_trim_fs = "#version 430 core\n"
                                      "layout(location = 0) out vec4 o_color;\n"
                                      "void main() { o_color = vec4(1.0); }\n";
 
+/* Depth-compositing present (sw__gpu_present): one triangle covering the viewport, each pixel
+ * copying the render target's colour and depth; background pixels (depth 0: the reversed-Z
+ * clear) are discarded so that the host's framebuffer keeps its own there. */
+static const char *const k_present_vs =
+    "#version 430 core\n"
+    "void main() {\n"
+    "  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);\n"
+    "  gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);\n"
+    "}\n";
+
+static const char *const k_present_fs = "#version 430 core\n"
+                                        "layout(binding = 0) uniform sampler2D u_depth;\n"
+                                        "layout(binding = 1) uniform sampler2D u_color;\n"
+                                        "layout(location = 0) out vec4 o_color;\n"
+                                        "void main() {\n"
+                                        "  ivec2 p = ivec2(gl_FragCoord.xy);\n"
+                                        "  float d = texelFetch(u_depth, p, 0).r;\n"
+                                        "  if (!(d > 0.0)) discard;\n"
+                                        "  o_color = texelFetch(u_color, p, 0);\n"
+                                        "  gl_FragDepth = d;\n"
+                                        "}\n";
+
 static sw_result compile(GLenum type, const char *src, const char *what, GLuint *out,
                          sw_status *status)
 {
@@ -418,6 +441,9 @@ sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
     r = link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
     if (r != SW_OK)
         return r;
+    r = link(k_present_vs, k_present_fs, "present", &ctx->prog_present, status);
+    if (r != SW_OK)
+        return r;
     return sw__gpu_check(status, "program set-up");
 }
 
@@ -435,6 +461,8 @@ void sw__gpu_programs_free(sw_gpu_context *ctx)
     sw__gpu_shading_free(ctx, &ctx->surf);
     glDeleteProgram(ctx->prog_trim);
     ctx->prog_trim = 0;
+    glDeleteProgram(ctx->prog_present);
+    ctx->prog_present = 0;
 }
 
 sw_result sw__gpu_shading_create(sw_gpu_context *ctx, const char *shade_source,

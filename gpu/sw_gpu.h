@@ -107,6 +107,10 @@ typedef struct sw_gpu_frame_desc {
                               these occurrences of the scene's faces, culled one by one (bvh
                               ignored); read during prepare only */
     size_t n_occurrences;
+    int32_t present_depth; /* with present: the frame's depth written too, and only the surfaces'
+                              pixels that pass GL_GREATER against the host's depth buffer; the
+                              background leaves the host's pixels alone (sw__gpu_present) */
+    double near_plane;     /* > 0: the projection's near plane; 0: from the scene's box */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -157,6 +161,7 @@ typedef struct sw_gpu_frame_stats {
     /* triangle meshes (SW_SG_NODE_MESH occurrences; gpu/frame_mesh.c) */
     uint64_t meshes_drawn, meshes_culled; /* occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
+    double near_plane; /* the projection's (desc.near_plane or the scene box's) */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

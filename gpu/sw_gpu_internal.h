@@ -119,9 +119,11 @@ struct sw_gpu_context {
     sw__gpu_surface_programs surf; /* the surface programs frames draw with */
     /* trim-texture program: 2D positions in clip space, constant colour */
     GLuint prog_trim;
+    /* depth-compositing present: a fullscreen triangle reading the render target (shaders.c) */
+    GLuint prog_present;
     GLuint vao;
     /* main render target */
-    GLuint fbo, rb_color, rb_depth;
+    GLuint fbo, tex_color, tex_depth; /* textures: the depth-compositing present samples them */
     int32_t fbo_w, fbo_h;
     GLuint trim_fbo, trim_vbo;
     GLuint mesh_vbo, mesh_ibo;   /* per-frame streaming buffers */
@@ -168,7 +170,8 @@ void sw__gpu_shading_free(sw_gpu_context *ctx, sw__gpu_surface_programs *p);
 /* The library's GLSL by part (the values of sw_glsl_kind, sw_immediate.h); NULL out of range. */
 const char *sw__gpu_glsl_source(int kind);
 enum { SW__GPU_GLSL_KINDS = 6 };
-/* (Re)allocates the RGBA8 + 32F depth render target (context_egl.c). */
+/* (Re)allocates the RGBA8 + 32F depth render target, two textures (context_egl.c); leaves
+ * unit 0's GL_TEXTURE_2D binding at 0. */
 sw_result sw__gpu_target_ensure(sw_gpu_context *ctx, int32_t w, int32_t h, sw_status *status);
 double sw__gpu_now_ms(void);
 
@@ -186,6 +189,11 @@ typedef struct sw__gpu_view {
 
 /* Builds the camera basis and matrices; near_plane must be > 0. Returns SW_ERR_INVALID_ARGUMENT
  * for a degenerate camera (eye == target, up parallel to the view, fovy outside (0, 180)). */
+/* The view as world-to-eye `view` (GL's eye space: x right, y up, looking down -z) and
+ * `proj` (reversed-Z, infinite far plane: clip z = near, clip w = -z_eye, so zero-to-one depth
+ * = near / distance along the view axis), both column-major, m[col * 4 + row]; proj * view is
+ * view_proj with the eye translation put in. */
+void sw__gpu_view_matrices(const sw__gpu_view *v, double view[16], double proj[16]);
 sw_result sw__gpu_view_init(sw__gpu_view *v, const sw_gpu_camera *cam, int32_t w, int32_t h,
                             double near_plane, sw_status *status);
 /* 1 when the eye-relative box (min xyz, max xyz) may meet the frustum. */
@@ -417,8 +425,11 @@ void sw__gpu_host_state_save(sw__gpu_host_state *s);
 void sw__gpu_host_state_restore(const sw__gpu_host_state *s);
 /* 1 for a context adopted from the host (sw_gpu_context_adopt_current). */
 int sw__gpu_context_adopted(const sw_gpu_context *ctx);
-/* Copies the frame into the host's draw framebuffer (saved in `host`) at its origin. */
-sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view,
+/* Puts the frame into the host's draw framebuffer (saved in `host`) at its origin. depth 0: a
+ * blit of the colour, background included. depth 1: a fullscreen pass writes the colour and
+ * gl_FragDepth of the surfaces' pixels with GL_GREATER against the host's depth buffer (any
+ * format); background pixels (depth 0) are discarded, so the host's colour and depth stay. */
+sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view, int depth,
                           const sw__gpu_host_state *host, sw_status *status);
 /* Reads the frame back into `out` (rows top first; depth as eye-space depth, +INF background). */
 sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int want_depth,

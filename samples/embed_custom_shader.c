@@ -2,7 +2,9 @@
  * trimmed NURBS objects through the immediate API (sw_immediate.h, Guthe et al. 2005 §8) with
  * its own shading function: stripes along the surface parameter u, lit by the library's shading,
  * their count a uniform the host sets. The library evaluates the surfaces on the GPU and trims
- * them by trim textures; the host's sw_shade only colours what is left.
+ * them by trim textures; the host's sw_shade only colours what is left. The frame is composited
+ * by depth into the host's framebuffer (present_depth), and the host then draws a floor of its
+ * own through the surfaces with the matrices the frame used (sw_frame_stats.view / proj).
  *
  * usage: embed_custom_shader [OUT.png]   (default custom_shader.png; exit 0 on success)
  * build: cc embed_custom_shader.c $(pkg-config --cflags --libs splinewalk egl opengl) -lm
@@ -31,6 +33,28 @@ static const char *const k_shade =
     "  vec4 base = mix(color, vec4(1.0, 1.0, 1.0, 1.0), 0.6 * stripe);\n"
     "  return sw_shade_library(pos, normal, uv, base);\n"
     "}\n";
+
+/* The host's floor z = 0.6, a checkerboard of greys, cutting through the sheets and the cylinder;
+ * drawn with the renderer's depth convention (zero-to-one clip depth, GL_GREATER). */
+static GLuint floor_program(void)
+{
+    const char *vs = "#version 430 core\nlayout(location = 0) in vec2 xy;\nuniform mat4 mvp;\n"
+                     "out vec2 p;\nvoid main() { p = xy; gl_Position = mvp * vec4(xy, 0.6, 1); }\n";
+    const char *fs =
+        "#version 430 core\nin vec2 p;\nout vec4 c;\nvoid main() {\n"
+        "  c = vec4(vec3(0.5 + 0.15 * mod(floor(p.x / 2.0) + floor(p.y / 2.0), 2.0)), 1);\n}\n";
+    const char *src[2] = {vs, fs};
+    GLuint prog = glCreateProgram();
+    for (int k = 0; k < 2; k++) {
+        GLuint sh = glCreateShader(k ? GL_FRAGMENT_SHADER : GL_VERTEX_SHADER);
+        glShaderSource(sh, 1, &src[k], NULL);
+        glCompileShader(sh);
+        glAttachShader(prog, sh);
+        glDeleteShader(sh);
+    }
+    glLinkProgram(prog);
+    return prog;
+}
 
 /* A headless OpenGL 4.5 core context of the host's own, current on this thread. */
 static int host_context(void)
@@ -66,14 +90,24 @@ int main(int argc, char **argv)
     enum { W = 800, H = 600 };
     if (!host_context())
         return fail("no OpenGL 4.5 core context through EGL", NULL);
-    /* the host's framebuffer: the frame is presented into it */
-    GLuint fbo, color;
+    /* the host's framebuffer, colour and depth: the frame is composited into it */
+    GLuint fbo, rb[2];
     glGenFramebuffers(1, &fbo);
-    glGenRenderbuffers(1, &color);
-    glBindRenderbuffer(GL_RENDERBUFFER, color);
+    glGenRenderbuffers(2, rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
     glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, W, H);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, W, H);
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+    glViewport(0, 0, W, H);
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE); /* the renderer's depth convention */
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glClearDepth(0.0);
+    glClearColor(0.75f, 0.85f, 1.0f, 1.0f); /* the host's sky shows where no surface is */
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
     sw_status st = {0};
     sw_renderer renderer;
@@ -139,19 +173,43 @@ int main(int argc, char **argv)
     frame.width = W;
     frame.height = H;
     frame.error_px = 0.5;
-    frame.present = 1;       /* into the host's framebuffer, bound above */
-    frame.output_path = out; /* and the same frame as a PNG */
+    frame.present = 1;       /* into the host's framebuffer, bound above, */
+    frame.present_depth = 1; /* by depth: the sky stays, the floor below can cut through */
+    frame.output_path = out; /* and the renderer's own frame as a PNG */
     sw_frame_stats stats;
     if (sw_renderer_draw_nurbs(renderer, &frame, &stats, &st) != SW_OK)
         return fail("draw", &st);
 
-    /* the host's framebuffer holds the frame: count what is not background */
+    /* the floor, with the frame's matrices: mvp = proj x view (column-major) */
+    float mvp[16];
+    for (int k = 0; k < 16; k++) {
+        double sum = 0.0;
+        for (int m = 0; m < 4; m++)
+            sum += stats.proj[m * 4 + k % 4] * stats.view[k / 4 * 4 + m];
+        mvp[k] = (float)sum;
+    }
+    static const float quad[8] = {-10, -10, 30, -10, -10, 30, 30, 30};
+    GLuint vao, vbo, prog = floor_program();
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, sizeof quad, quad, GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, NULL);
+    glEnableVertexAttribArray(0);
+    glUseProgram(prog);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "mvp"), 1, GL_FALSE, mvp);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+
+    /* the host's framebuffer: count the surfaces' pixels (neither sky nor the floor's greys) */
     static unsigned char pixels[W * H * 4];
     glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
     glReadPixels(0, 0, W, H, GL_RGBA, GL_UNSIGNED_BYTE, pixels);
     long covered = 0;
-    for (long i = 0; i < (long)W * H; i++)
-        covered += pixels[4 * i] != 255 || pixels[4 * i + 1] != 255 || pixels[4 * i + 2] != 255;
+    for (long i = 0; i < (long)W * H; i++) {
+        const unsigned char *px = pixels + 4 * i;
+        covered += px[2] != 255 && (px[0] != px[1] || px[1] != px[2]);
+    }
     printf("%s: %llu triangles, %llu trim textures, %.1f ms; %.1f %% of the host's framebuffer "
            "covered\n",
            out, (unsigned long long)stats.triangles, (unsigned long long)stats.trim_textures,
@@ -160,7 +218,10 @@ int main(int argc, char **argv)
     sw_nurbs_destroy(sheet_obj);
     sw_nurbs_destroy(cyl_obj);
     sw_renderer_destroy(renderer);
-    glDeleteRenderbuffers(1, &color);
+    glDeleteProgram(prog);
+    glDeleteBuffers(1, &vbo);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteRenderbuffers(2, rb);
     glDeleteFramebuffers(1, &fbo);
     return covered > (long)W * H / 100 ? 0 : fail("nothing presented into the framebuffer", NULL);
 }

@@ -405,6 +405,8 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
     fd.output_path = desc->output_path;
     fd.walkthrough = desc->walkthrough;
     fd.present = desc->present;
+    fd.present_depth = desc->present_depth;
+    fd.near_plane = desc->near_plane;
     fd.eval_exact = desc->eval_exact;
     const sw_rt_frame_extra extra = {
         im->occ, n_occ, im->has_shading && !desc->library_shading ? &im->shading : NULL};

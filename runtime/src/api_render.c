@@ -288,6 +288,10 @@ static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
             !isfinite(desc->camera.up[k]))
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera has a non-finite coordinate");
     }
+    if (desc->near_plane != 0.0 && !(desc->near_plane > 0.0 && isfinite(desc->near_plane)))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "near plane %g must be positive and finite (0: from the scene's box)",
+                        desc->near_plane);
     return SW_OK;
 }
 
@@ -376,6 +380,8 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->eval_exact = desc->eval_exact != 0;
     frame->walkthrough = desc->walkthrough != 0;
     frame->present = desc->present != 0;
+    frame->present_depth = desc->present && desc->present_depth;
+    frame->near_plane = desc->near_plane;
     frame->wireframe = desc->wireframe != 0;
     frame->no_readback = desc->present && !desc->output_path;
     frame->want_depth = 0;
@@ -460,10 +466,53 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
     return res;
 }
 
-/* Writes a drawn frame's image when asked and fills the caller's stats (times from t0). */
+/* The matrices of a resolved camera (gpu_frame's), the one place they are made: sw__gpu_view_init
+ * builds the basis the frame draws with. */
+static sw_result frame_matrices(const sw_gpu_camera *camera, int32_t width, int32_t height,
+                                double near_plane, double view[16], double proj[16],
+                                sw_status *status)
+{
+    sw__gpu_view v;
+    sw_result res = sw__gpu_view_init(&v, camera, width, height, near_plane, status);
+    if (res == SW_OK)
+        sw__gpu_view_matrices(&v, view, proj);
+    return res;
+}
+
+sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t height,
+                             double near_plane, double view[16], double proj[16], sw_status *status)
+{
+    if (!camera || !view || !proj)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_camera_matrices: NULL pointer");
+    sw_frame_desc d = {0};
+    d.camera = *camera;
+    d.width = width;
+    d.height = height;
+    sw_result res = check_frame_desc(&d, status);
+    if (res != SW_OK)
+        return res;
+    if (camera_is_zero(camera))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "sw_camera_matrices: zero camera (fit one to a scene with sw_camera_fit)");
+    if (!(near_plane > 0.0 && isfinite(near_plane)))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "sw_camera_matrices: near plane %g must be positive and finite",
+                        near_plane);
+    sw_gpu_camera c;
+    res = resolve_camera(camera, NULL, &c, status); /* not zero: no scene to fit to */
+    if (res == SW_OK)
+        res = frame_matrices(&c, width ? width : 1280, height ? height : 720, near_plane, view,
+                             proj, status);
+    if (res == SW_OK)
+        sw__status_ok(status);
+    return res;
+}
+
+/* Writes a drawn frame's image when asked and fills the caller's stats (times from t0; the
+ * matrices of the frame's desc). */
 static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
-                              const sw_gpu_frame_stats *gstats, double t0, sw_frame_stats *stats,
-                              sw_status *status)
+                              const sw_gpu_frame_desc *frame, const sw_gpu_frame_stats *gstats,
+                              double t0, sw_frame_stats *stats, sw_status *status)
 {
     double t1 = now_ms();
     sw_result res = output_path ? sw_gpu_image_write(image, output_path, status) : SW_OK;
@@ -474,6 +523,10 @@ static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
         copy_stats(gstats, stats);
         stats->ms_write = t2 - t1;
         stats->ms_total = t2 - t0;
+        stats->near_plane = gstats->near_plane;
+        /* the camera drew this frame: it cannot fail here */
+        (void)frame_matrices(&frame->camera, frame->width, frame->height, gstats->near_plane,
+                             stats->view, stats->proj, NULL);
     }
     return res;
 }
@@ -502,7 +555,7 @@ static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_fram
     r->gpu->surf = library;
     if (res != SW_OK)
         return res;
-    return finish_frame(&image, desc->output_path, &gstats, t0, stats, status);
+    return finish_frame(&image, desc->output_path, &frame, &gstats, t0, stats, status);
 }
 
 static void job_free(rt_job *j)
@@ -599,7 +652,7 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     res = sw_gpu_frame_submit(r->gpu, j->job.plan, &image, &gstats, status);
     j->job.plan = NULL; /* consumed */
     if (res == SW_OK)
-        res = finish_frame(&image, j->output_path, &gstats, t0, stats, status);
+        res = finish_frame(&image, j->output_path, &j->job.desc, &gstats, t0, stats, status);
     if (res == SW_OK && stats) {
         stats->ms_visibility = j->job.ms_visibility;
         stats->ms_wait_visibility = t1 - t0;

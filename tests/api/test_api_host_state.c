@@ -9,11 +9,11 @@
  * textures on units 0 and 3, a sampler on unit 0, active unit 3) and sets every other piece of
  * state the renderer could touch to a value that is not GL's default. It snapshots all of it with
  * its own list of glGet queries (independent of the library's), then creates a renderer in that
- * context, draws (presenting into its framebuffer, plain, wireframe, static LODs, a split
- * frame) and destroys it, comparing the snapshot after each call: any one value not restored
- * fails, by name. The frame presented under the host's odd state (scissor, colour mask, pixel
- * store, depth range, polygon mode, clip control, sampler, ...) must equal, pixel for pixel, the
- * one presented under GL's defaults, and must not be empty. */
+ * context, draws (presenting into its framebuffer, also by depth, plain, wireframe, static
+ * LODs, a split frame) and destroys it, comparing the snapshot after each call: any one value not
+ * restored fails, by name. The frame presented under the host's odd state (scissor, colour mask,
+ * pixel store, depth range, polygon mode, clip control, sampler, ...) must equal, pixel for pixel,
+ * the one presented under GL's defaults, and must not be empty. */
 #include <splinewalk/splinewalk.h>
 
 #include <EGL/egl.h>
@@ -539,6 +539,10 @@ int main(int argc, char **argv)
         fprintf(stderr, "the frame presented under the host's state differs in %zu bytes\n",
                 differ);
     EXPECT(differ == 0);
+    frame.present_depth = 1; /* the depth-compositing pass (its own program, units 0 and 1) */
+    EXPECT_OK(sw_renderer_draw(renderer, &frame, NULL, NULL));
+    compare(&before, (take(&after), &after), "a frame presented by depth");
+    frame.present_depth = 0;
 
     frame.present = 0;
     EXPECT_OK(sw_renderer_draw(renderer, &frame, NULL, NULL));
@@ -569,7 +573,7 @@ int main(int argc, char **argv)
     EXPECT(sw_renderer_destroy(renderer) == SW_OK);
     EXPECT(sw_scene_destroy(scene) == SW_OK);
     EXPECT(glGetError() == GL_NO_ERROR);
-    printf("%zu GL state values compared after 8 calls; presented frame %dx%d equal to the one "
+    printf("%zu GL state values compared after 9 calls; presented frame %dx%d equal to the one "
            "under GL's defaults (%zu bytes differ)\n",
            N_QUERIES, W, H, differ);
     free(reference);

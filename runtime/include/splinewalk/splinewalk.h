@@ -175,6 +175,26 @@ typedef enum sw_view_preset {
 SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *out,
                                sw_status *status);
 
+/* The matrices a frame of this camera, size (0 x 0 = 1280 x 720) and near plane draws with,
+ * column-major as GL takes them (m[col * 4 + row]): view maps world to GL eye space (x right, y
+ * up, looking down -z; right = normalize((target - eye) x up)), proj is the renderer's reversed-Z
+ * perspective with an infinite far plane,
+ *     [fx 0  0     0   ]      fy = 1 / tan(fovy / 2), fx = fy x height / width,
+ *     [0  fy 0     0   ]      so that with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) window
+ *     [0  0  0   near  ]      depth = near / d for a point at distance d > near along the view
+ *     [0  0  -1    0   ]      axis: 1 at the near plane, towards 0 far away (clear to 0,
+ *                             GL_GREATER).
+ * Large world coordinates lose float precision in view: a host may subtract the eye from its
+ * positions and drop view's translation (view[12..14]) itself. Any thread. The renderer picks the
+ * near plane per frame unless sw_frame_desc.near_plane sets it; sw_frame_stats gives back the one
+ * used, and these matrices. Errors: SW_ERR_INVALID_ARGUMENT (NULL pointer; a zero camera: fit one
+ * with sw_camera_fit first; eye = target, up zero or parallel to the view, fovy outside (0, 180)
+ * (0 = 40); non-finite values; size outside 0..16384; near_plane not positive and finite). view
+ * and proj are written on success only. */
+SW_API sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t height,
+                                    double near_plane, double view[16], double proj[16],
+                                    sw_status *status);
+
 /* ---- rendering ------------------------------------------------------------------------------- */
 typedef struct sw_renderer_desc {
     uint32_t worker_threads;     /* threads of the worker pool that builds and refines hierarchies;
@@ -235,7 +255,8 @@ typedef struct sw_frame_desc {
                                 GL_DRAW_FRAMEBUFFER when the call began (a window's: 0), at its
                                 origin, width x height, whatever the host's GL state (scissor,
                                 masks, ...); that state is restored as use_current_context
-                                says. Not read back unless output_path is set. */
+                                says. Not read back unless output_path is set. With
+                                present_depth: composited by depth instead (below). */
     int32_t wireframe;       /* 1: triangles drawn as lines (trimmed parts still cut away), to see
                                 the tessellation the error bound chose */
     int32_t static_lods;     /* 1: Kumar et al. 1997 static LODs: the scene's super-surfaces
@@ -251,6 +272,25 @@ typedef struct sw_frame_desc {
                                 (i + k) mod (n + 1) among its n levels good enough for the view,
                                 the last choice meaning the per-frame path: neighbours at
                                 different levels. 0: the coarsest good level */
+    int32_t present_depth;   /* with present, 1: depth compositing (a host drawing its own 3D
+                                geometry around the surfaces). Instead of copying the whole
+                                image, a fullscreen pass writes, for each pixel a surface covers,
+                                its colour and its depth (gl_FragDepth, so any depth format of the
+                                host's) where that depth is GREATER than the host's depth buffer
+                                (GL_GREATER, depth writes on); background pixels are discarded:
+                                the host's colour and depth stay there. The host draws with the
+                                frame's matrices (sw_frame_stats.view / proj, or sw_camera_matrices
+                                with near_plane set) under the same depth convention:
+                                glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), glDepthRange(0, 1),
+                                depth cleared to 0, glDepthFunc(GL_GREATER). Geometry it draws
+                                before the call hides the surfaces behind it; geometry drawn after
+                                is hidden where a surface is nearer. A framebuffer without a
+                                depth buffer gets the surfaces' colour, its background kept.
+                                0: the colour copy above */
+    double near_plane;       /* > 0: the projection's near plane, in world units (what lies
+                                nearer is clipped); 0: chosen per frame from the scene's box
+                                (max(1e-4 x its diagonal, half the eye's distance to it)), given
+                                back in sw_frame_stats.near_plane */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -284,6 +324,11 @@ typedef struct sw_frame_stats {
     /* triangle meshes (sw_nodes.h MESH nodes) */
     uint64_t meshes_drawn, meshes_culled; /* mesh occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
+    /* the camera the frame drew with, for a host drawing beside it (present_depth):
+     * sw_camera_matrices of its camera (resolved: a zero camera's fitted one), size and
+     * near_plane */
+    double near_plane;
+    double view[16], proj[16];
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so

@@ -105,6 +105,10 @@ typedef struct sw_immediate_desc {
     int32_t library_shading;    /* 1: the library's shading even when the renderer has a host's */
     int32_t eval_exact;         /* 1: evaluated from knots and control points in the vertex shader
                                    (sw_frame_desc.eval_exact; degree <= 15); host shading too */
+    int32_t present_depth;      /* with present: composited by depth into the host's framebuffer
+                                   (sw_frame_desc.present_depth; the matrices in the stats) */
+    double near_plane;          /* > 0: the near plane; 0: from the objects' box
+                                   (sw_frame_desc.near_plane) */
 } sw_immediate_desc;
 
 /* Draws the objects through the renderer (owner thread; its context current — the host's with
