@@ -26,6 +26,9 @@
  *    same host framebuffer, and stats matrices equal to sw_camera_matrices of their near plane. */
 #include <splinewalk/splinewalk.h>
 
+#define SW_API_TEST_HOST_CONTEXT
+#include "api_test_expect.h"
+
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GL/glcorearb.h>
@@ -33,15 +36,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-static int g_failures;
-#define EXPECT(cond)                                                                               \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "line %d: expected %s\n", __LINE__, #cond);                            \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
 
 enum { W = 160, H = 120 };
 static const double k_eye_z = 5.0, k_fovy = 40.0;
@@ -100,25 +94,6 @@ typedef struct host {
     GLuint fbo, rb[2], program, vao, vbo, unit1_tex, unit1_sampler;
     GLint loc_mvp;
 } host;
-
-static int make_context(void)
-{
-    EGLDisplay dpy =
-        eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-    if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, NULL, NULL) || !eglBindAPI(EGL_OPENGL_API))
-        return -1;
-    const EGLint attrs[] = {EGL_CONTEXT_MAJOR_VERSION,
-                            4,
-                            EGL_CONTEXT_MINOR_VERSION,
-                            5,
-                            EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                            EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                            EGL_NONE};
-    EGLContext c = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attrs);
-    if (c == EGL_NO_CONTEXT || !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, c))
-        return -1;
-    return 0;
-}
 
 static GLuint compile(GLenum kind, const char *src)
 {
@@ -410,7 +385,7 @@ static void check_scene(sw_renderer r, const char *path, const host *h)
 
 int main(int argc, char **argv)
 {
-    if (make_context() != 0) {
+    if (sw_test_host_context() != 0) {
         fprintf(stderr, "no EGL 4.5 core context\n");
         return 1;
     }

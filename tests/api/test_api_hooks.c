@@ -18,6 +18,8 @@
  */
 #include <splinewalk/splinewalk.h>
 
+#include "api_test_expect.h"
+
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>
@@ -28,24 +30,6 @@
 #ifndef SW_TEST_MISUSE_ASSERTS
 #define SW_TEST_MISUSE_ASSERTS 0
 #endif
-
-static int g_failures;
-#define EXPECT(cond)                                                                               \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "line %d: expected %s\n", __LINE__, #cond);                            \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
-#define EXPECT_RESULT(call, want)                                                                  \
-    do {                                                                                           \
-        sw_result got_ = (call);                                                                   \
-        if (got_ != (want)) {                                                                      \
-            fprintf(stderr, "line %d: %s returned %s, expected %s\n", __LINE__, #call,             \
-                    sw_result_id_str(got_), sw_result_id_str(want));                               \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
 
 /* ---- a counting allocator with its own size header (the library's calls come from several
  * threads: the renderer's pool, its visibility thread) ------------------------------------------

@@ -16,6 +16,9 @@
  * the one presented under GL's defaults, and must not be empty. */
 #include <splinewalk/splinewalk.h>
 
+#define SW_API_TEST_HOST_CONTEXT
+#include "api_test_expect.h"
+
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GL/glcorearb.h>
@@ -23,14 +26,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int g_failures;
-#define EXPECT(cond)                                                                               \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "line %d: expected %s\n", __LINE__, #cond);                            \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
 #define EXPECT_OK(call)                                                                            \
     do {                                                                                           \
         sw_status st_ = {0};                                                                       \
@@ -46,24 +41,6 @@ enum { W = 200, H = 150 };
 
 /* ---- the host's context ------------------------------------------------------------------------
  */
-static int make_host_context(void)
-{
-    EGLDisplay dpy =
-        eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
-    if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, NULL, NULL) || !eglBindAPI(EGL_OPENGL_API))
-        return -1;
-    const EGLint attrs[] = {EGL_CONTEXT_MAJOR_VERSION,
-                            4,
-                            EGL_CONTEXT_MINOR_VERSION,
-                            5,
-                            EGL_CONTEXT_OPENGL_PROFILE_MASK,
-                            EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                            EGL_NONE};
-    EGLContext c = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attrs);
-    if (c == EGL_NO_CONTEXT || !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, c))
-        return -1;
-    return 0;
-}
 
 typedef struct host_objects {
     GLuint fbo_draw, fbo_read, rb[3], program, vao, buffers[12], tex[4], sampler;
@@ -480,7 +457,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s SCENE WORKDIR\n", argv[0]);
         return 2;
     }
-    if (make_host_context() != 0) {
+    if (sw_test_host_context() != 0) {
         fprintf(stderr, "no EGL surfaceless 4.5 core context for the host\n");
         return 1;
     }

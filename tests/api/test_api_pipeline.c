@@ -24,31 +24,15 @@
  */
 #include <splinewalk/splinewalk.h>
 
+#include "api_test_expect.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-static int g_failures;
 static const char *g_work;
-
-#define EXPECT(cond)                                                                               \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "line %d: expected %s\n", __LINE__, #cond);                            \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
-#define EXPECT_RESULT(call, want)                                                                  \
-    do {                                                                                           \
-        sw_result got_ = (call);                                                                   \
-        if (got_ != (want)) {                                                                      \
-            fprintf(stderr, "line %d: %s returned %s, expected %s\n", __LINE__, #call,             \
-                    sw_result_id_str(got_), sw_result_id_str(want));                               \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
 
 static sw_camera orbit(const sw_camera *home, int i)
 {
