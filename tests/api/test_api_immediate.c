@@ -39,7 +39,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-unsigned char *sw_test_read_rgba(const char *path, int *width, int *height);
+#include "api_test_image.h"
 
 static const char *g_work;
 

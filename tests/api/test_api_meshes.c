@@ -41,7 +41,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-unsigned char *sw_test_read_rgba(const char *path, int *width, int *height);
+#include "api_test_image.h"
 
 static const char *g_work;
 
@@ -686,22 +686,6 @@ static void draw(sw_renderer r, sw_scene s, const sw_camera *cam, int walkthroug
     CHECK(sw_renderer_draw(r, &f, fs, &st) == SW_OK, "draw %s: %s", name, st.message);
 }
 
-static double differing_percent(const char *a, const char *b)
-{
-    int wa = 0, ha = 0, wb = 0, hb = 0;
-    unsigned char *pa = sw_test_read_rgba(a, &wa, &ha), *pb = sw_test_read_rgba(b, &wb, &hb);
-    double percent = 100.0;
-    if (pa && pb && wa == wb && ha == hb && wa > 0) {
-        size_t n = (size_t)wa * (size_t)ha, differ = 0;
-        for (size_t i = 0; i < n; i++)
-            differ += memcmp(pa + 4 * i, pb + 4 * i, 4) != 0;
-        percent = 100.0 * (double)differ / (double)n;
-    }
-    free(pa);
-    free(pb);
-    return percent;
-}
-
 /* Pixels of one image with no pixel of the same colour (within 12 levels) within one pixel in
  * the other, the larger share of both ways (%). */
 static double one_pixel_percent(const char *a, const char *b)
@@ -794,7 +778,7 @@ static void test_occlusion(sw_renderer r, sphere_mesh *sm)
     sw_scene_load_desc ld = {.path = file};
     CHECK(sw_scene_load(&ld, &loaded, &st) == SW_OK, "load: %s", st.message);
     draw(r, loaded, &k_top, 0, "occlusion_reloaded", reload, NULL);
-    const double dr = differing_percent(conv, reload);
+    const double dr = sw_test_differing_percent(conv, reload);
     CHECK(dr == 0.0, "reloaded scene: %.4f %% of pixels differ", dr);
     printf("save / load: %.4f %% of pixels differ between the node scene and the reloaded file\n",
            dr);
@@ -819,8 +803,9 @@ static void test_occlusion(sw_renderer r, sphere_mesh *sm)
     sw_frame_desc fe = {.scene = s, .camera = k_top, .width = W, .height = H, .output_path = exact};
     fe.eval_exact = 1;
     CHECK(sw_renderer_draw(r, &fe, NULL, &st) == SW_OK, "exact: %s", st.message);
-    const double dw = differing_percent(conv, walk), ds = differing_percent(conv, split),
-                 de = differing_percent(conv, exact);
+    const double dw = sw_test_differing_percent(conv, walk),
+                 ds = sw_test_differing_percent(conv, split),
+                 de = sw_test_differing_percent(conv, exact);
     CHECK(dw == 0.0 && ds == 0.0 && de == 0.0,
           "walkthrough %.4f %%, split %.4f %%, eval_exact %.4f %% differ from converged", dw, ds,
           de);
@@ -866,7 +851,7 @@ static void test_mesh_vs_nurbs(sw_renderer r)
     char pa[1024], pb[1024];
     draw(r, a, &cam, 0, "plate_nurbs", pa, NULL);
     draw(r, b, &cam, 0, "plate_mesh", pb, NULL);
-    const double d = one_pixel_percent(pa, pb), exact = differing_percent(pa, pb);
+    const double d = one_pixel_percent(pa, pb), exact = sw_test_differing_percent(pa, pb);
     /* the control: the background differs from the plate everywhere it shows */
     CHECK(d <= 0.1, "plate as mesh vs as NURBS: %.4f %% unmatched within one pixel", d);
     printf("plate as a mesh vs as NURBS: %.4f %% of pixels unmatched within one pixel (limit "

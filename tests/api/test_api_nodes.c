@@ -39,7 +39,7 @@
 #include <string.h>
 #include <time.h>
 
-unsigned char *sw_test_read_rgba(const char *path, int *width, int *height);
+#include "api_test_image.h"
 
 static const char *g_tsm, *g_brep, *g_work;
 
@@ -364,22 +364,6 @@ static void test_misuse(built *b)
 }
 
 /* ---- rendering ------------------------------------------------------------------------------- */
-static double differing_percent(const char *a, const char *b)
-{
-    int wa = 0, ha = 0, wb = 0, hb = 0;
-    unsigned char *pa = sw_test_read_rgba(a, &wa, &ha), *pb = sw_test_read_rgba(b, &wb, &hb);
-    double percent = 100.0;
-    if (pa && pb && wa == wb && ha == hb && wa > 0) {
-        size_t n = (size_t)wa * (size_t)ha, differ = 0;
-        for (size_t i = 0; i < n; i++)
-            differ += memcmp(pa + 4 * i, pb + 4 * i, 4) != 0;
-        percent = 100.0 * (double)differ / (double)n;
-    }
-    free(pa);
-    free(pb);
-    return percent;
-}
-
 /* Pixels of A with no pixel of B within one pixel (8-neighbourhood) of the same colour within
  * `tol` levels per channel, and the other way round (the larger share, in %). An ε_img of 0.5 px
  * moves an edge or a shading gradient by at most one pixel between two tessellations of the same
@@ -453,7 +437,7 @@ static void compare_with_file(sw_renderer r, const char *file, sw_node_desc *nod
     const float green[4] = {0.1f, 0.8f, 0.2f, 1.0f};
     EXPECT_RESULT(sw_node_set_color(built_scene, n, green, NULL), SW_OK);
     draw(r, built_scene, &cam, cn, c);
-    double same = differing_percent(a, b), control = differing_percent(a, c);
+    double same = sw_test_differing_percent(a, b), control = sw_test_differing_percent(a, c);
     CHECK(same <= 0.1 && control > 1.0, "%s: %.4f %% differ (limit 0.1), recoloured %.2f %%", name,
           same, control);
     printf("%s: node scene vs file scene %.4f %% of pixels differ (limit 0.1 %%); after a "
@@ -707,7 +691,7 @@ static void test_live(void)
         snprintf(cn, sizeof cn, "ctl_%03d", k);
         reference_frame(ref, phase_of_edit((int)drawn), rn, ref_path);
         reference_frame(ref, phase_of_edit((int)drawn - 5), cn, ctl_path);
-        double exact = differing_percent(live_path, ref_path);
+        double exact = sw_test_differing_percent(live_path, ref_path);
         double same = image_distance(live_path, ref_path);
         double control = image_distance(live_path, ctl_path);
         worst_exact = fmax(worst_exact, exact);

@@ -5,10 +5,9 @@
 #include <cstdlib>
 #include <cstring>
 
-extern "C" unsigned char *sw_test_read_rgba(const char *path, int *width, int *height);
+#include "api_test_image.h"
 
-// RGBA8, top row first; NULL when the file cannot be read. The caller frees it with free().
-extern "C" unsigned char *sw_test_read_rgba(const char *path, int *width, int *height)
+unsigned char *sw_test_read_rgba(const char *path, int *width, int *height)
 {
     try {
         auto in = OIIO::ImageInput::open(path);
@@ -31,4 +30,20 @@ extern "C" unsigned char *sw_test_read_rgba(const char *path, int *width, int *h
     } catch (...) {
         return nullptr;
     }
+}
+
+double sw_test_differing_percent(const char *a, const char *b)
+{
+    int wa = 0, ha = 0, wb = 0, hb = 0;
+    unsigned char *pa = sw_test_read_rgba(a, &wa, &ha), *pb = sw_test_read_rgba(b, &wb, &hb);
+    double percent = 100.0;
+    if (pa && pb && wa == wb && ha == hb && wa > 0) {
+        size_t n = (size_t)wa * (size_t)ha, differ = 0;
+        for (size_t i = 0; i < n; i++)
+            differ += std::memcmp(pa + 4 * i, pb + 4 * i, 4) != 0;
+        percent = 100.0 * (double)differ / (double)n;
+    }
+    std::free(pa);
+    std::free(pb);
+    return percent;
 }
