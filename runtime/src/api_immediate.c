@@ -261,10 +261,9 @@ static sw_result build_scene(const draw_set *s, sw_rt_scene **out, uint32_t *fir
 }
 
 /* The renderer's scene for the set: the one drawn last when it holds the same geometry in the same
- * order, else a new one (the trim atlas then forgets its entries: they are keyed by the scene's
- * address, which a later scene may reuse). */
-static sw_result set_scene(struct sw_rt_immediate *im, sw_gpu_context *gpu, const draw_set *s,
-                           sw_status *status)
+ * order, else a new one (whose serial keeps the trim atlas from handing it the old one's
+ * textures; those age out of the atlas like any unused entry). */
+static sw_result set_scene(struct sw_rt_immediate *im, const draw_set *s, sw_status *status)
 {
     if (im->scene && im->n_objects == s->n_objects &&
         memcmp(im->serials, s->serials, s->n_objects * sizeof *s->serials) == 0)
@@ -289,7 +288,6 @@ static sw_result set_scene(struct sw_rt_immediate *im, sw_gpu_context *gpu, cons
     im->serials = serials;
     im->first_face = first_face;
     im->n_objects = s->n_objects;
-    sw__gpu_atlas_invalidate(gpu);
     return SW_OK;
 }
 
@@ -385,7 +383,7 @@ sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate_desc *
     pthread_mutex_lock(&g_nurbs_lock);
     r = resolve_draws(im, desc, &s, status);
     if (r == SW_OK)
-        r = set_scene(im, gpu, &s, status);
+        r = set_scene(im, &s, status);
     pthread_mutex_unlock(&g_nurbs_lock);
     if (r == SW_OK)
         r = make_occurrences(im, desc, &s, &n_occ, status);
