@@ -13,6 +13,7 @@
 #include "sw_hooks.h"
 #include "sw_status_util.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -123,14 +124,13 @@ static int collect_mesh(void *ctx, uint32_t mesh, uint32_t node, const double wo
     o->mesh = mesh;
     memcpy(o->world, world, sizeof o->world);
     memcpy(o->color, color, sizeof o->color);
-    const double *box = c->f->sv->meshes[mesh].box;
-    sw__fr_box_empty(o->box);
-    for (int k = 0; k < 8; ++k) {
-        const double h[4] = {box[(k & 1) ? 3 : 0], box[(k & 2) ? 4 : 1], box[(k & 4) ? 5 : 2], 1.0};
-        double w[4];
-        sw__fr_xform_h(world, c->f->view.eye, h, w);
-        sw__fr_box_add(o->box, w);
-        sw__fr_box_add(c->scene_box, w);
+    /* the world box as the BVH boxes occurrences, then eye-relative like the view's planes */
+    sw_sg_box_transform(world, c->f->sv->meshes[mesh].box, o->box);
+    for (int k = 0; k < 3; ++k) {
+        o->box[k] -= c->f->view.eye[k];
+        o->box[3 + k] -= c->f->view.eye[k];
+        c->scene_box[k] = fmin(c->scene_box[k], o->box[k]);
+        c->scene_box[3 + k] = fmax(c->scene_box[3 + k], o->box[3 + k]);
     }
     return 0;
 }

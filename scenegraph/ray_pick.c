@@ -356,17 +356,8 @@ static int mesh_visit(void *ctx, uint32_t mesh, uint32_t node, const double worl
     mesh_job *job = ctx;
     const uint32_t occ = job->occurrence++;
     const sw_sg_mesh_rec *m = &sw_sg_scene_view_ptr(job->scene)->meshes[mesh];
-    double box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
-    for (int c = 0; c < 8; ++c) {
-        const double q[3] = {m->box[(c & 1) ? 3 : 0], m->box[(c & 2) ? 4 : 1],
-                             m->box[(c & 4) ? 5 : 2]};
-        for (int k = 0; k < 3; ++k) {
-            const double *w = world + 4 * k;
-            const double x = w[0] * q[0] + w[1] * q[1] + w[2] * q[2] + w[3];
-            box[k] = fmin(box[k], x);
-            box[3 + k] = fmax(box[3 + k], x);
-        }
-    }
+    double box[6];
+    sw_sg_box_transform(world, m->box, box);
     local_ray lr;
     if (ray_box(job->origin, job->inv_d, box, job->best) == INFINITY ||
         !world_ray(world, job->origin, job->dir, &lr))
