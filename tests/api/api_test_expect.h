@@ -19,20 +19,22 @@ static int g_failures;
         }                                                                                          \
     } while (0)
 
-/* Counts and prints a call that returned another result than `want` (by id, not message). */
-#define EXPECT_RESULT(call, want)                                                                  \
-    do {                                                                                           \
-        sw_result got_ = (call);                                                                   \
-        if (got_ != (want)) {                                                                      \
-            fprintf(stderr, "line %d: %s returned %s, expected %s\n", __LINE__, #call,             \
-                    sw_result_id_str(got_), sw_result_id_str(want));                               \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
+/* Counts and prints a result other than `want` (by id, not message), naming the call and the line
+ * (a helper's caller's line where a helper checks on its behalf). */
+static inline void sw_test_expect_result(sw_result got, sw_result want, const char *call, int line)
+{
+    if (got != want) {
+        fprintf(stderr, "line %d: %s returned %s, expected %s\n", line, call, sw_result_id_str(got),
+                sw_result_id_str(want));
+        g_failures++;
+    }
+}
+#define EXPECT_RESULT(call, want) sw_test_expect_result((call), (want), #call, __LINE__)
 
 #ifdef SW_API_TEST_HOST_CONTEXT
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+#include <GL/glcorearb.h>
 
 /* Makes the host's context current on the calling thread: 0, or -1 when EGL cannot. */
 static inline int sw_test_host_context(void)
@@ -52,6 +54,15 @@ static inline int sw_test_host_context(void)
     if (c == EGL_NO_CONTEXT || !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, c))
         return -1;
     return 0;
+}
+
+/* A shader of the host's own programs, compiled (its status is the link's to report). */
+static inline GLuint sw_test_compile_shader(GLenum kind, const char *src)
+{
+    GLuint s = glCreateShader(kind);
+    glShaderSource(s, 1, &src, NULL);
+    glCompileShader(s);
+    return s;
 }
 #endif
 

@@ -12,6 +12,8 @@
  *                                         BIG_SCENE destroyed after a walkthrough frame (EGL) */
 #include <splinewalk/splinewalk.h>
 
+#include "api_test_expect.h"
+
 #include <math.h>
 #include <pthread.h>
 #include <sched.h>
@@ -20,25 +22,7 @@
 #include <string.h>
 #include <unistd.h>
 
-static int g_failures;
 static const char *g_scene_path, *g_work, *g_big_scene_path;
-
-static void expect_result(sw_result got, sw_result want, const char *call, int line)
-{
-    if (got != want) {
-        fprintf(stderr, "line %d: %s returned %s, expected %s\n", line, call, sw_result_id_str(got),
-                sw_result_id_str(want));
-        g_failures++;
-    }
-}
-#define EXPECT_RESULT(call, want) expect_result((call), (want), #call, __LINE__)
-#define EXPECT(cond)                                                                               \
-    do {                                                                                           \
-        if (!(cond)) {                                                                             \
-            fprintf(stderr, "line %d: expected %s\n", __LINE__, #cond);                            \
-            g_failures++;                                                                          \
-        }                                                                                          \
-    } while (0)
 
 static sw_scene load_scene(void)
 {
@@ -98,13 +82,14 @@ static void expect_stale_scene(sw_scene scene, int line)
     sw_camera camera;
     char path[4096];
     work_path(path, sizeof path, "stale.sws");
-    expect_result(sw_scene_get_info(scene, &info, &status), SW_ERR_STALE_HANDLE, "get_info", line);
+    sw_test_expect_result(sw_scene_get_info(scene, &info, &status), SW_ERR_STALE_HANDLE, "get_info",
+                          line);
     EXPECT(status.result == SW_ERR_STALE_HANDLE);
-    expect_result(sw_camera_fit(scene, SW_VIEW_ISO, &camera, NULL), SW_ERR_STALE_HANDLE,
-                  "camera_fit", line);
-    expect_result(sw_scene_save(scene, path, NULL), SW_ERR_STALE_HANDLE, "save", line);
+    sw_test_expect_result(sw_camera_fit(scene, SW_VIEW_ISO, &camera, NULL), SW_ERR_STALE_HANDLE,
+                          "camera_fit", line);
+    sw_test_expect_result(sw_scene_save(scene, path, NULL), SW_ERR_STALE_HANDLE, "save", line);
     EXPECT(!file_exists(path)); /* a failed call changes nothing */
-    expect_result(sw_scene_destroy(scene), SW_ERR_STALE_HANDLE, "destroy", line);
+    sw_test_expect_result(sw_scene_destroy(scene), SW_ERR_STALE_HANDLE, "destroy", line);
 }
 
 static void test_stale_and_double_destroy(void)
@@ -266,7 +251,8 @@ static void expect_bad_frame(sw_renderer r, sw_frame_desc frame, sw_result want,
     work_path(path, sizeof path, "bad_frame.png");
     frame.output_path = path;
     sw_status status = {0};
-    expect_result(sw_renderer_draw(r, &frame, NULL, &status), want, "draw (bad frame)", line);
+    sw_test_expect_result(sw_renderer_draw(r, &frame, NULL, &status), want, "draw (bad frame)",
+                          line);
     if (status.result != want || status.message[0] == '\0') {
         fprintf(stderr, "line %d: status holds %s '%s'\n", line, sw_result_id_str(status.result),
                 status.message);

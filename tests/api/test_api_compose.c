@@ -95,14 +95,6 @@ typedef struct host {
     GLint loc_mvp;
 } host;
 
-static GLuint compile(GLenum kind, const char *src)
-{
-    GLuint s = glCreateShader(kind);
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    return s;
-}
-
 static void make_host(host *h)
 {
     glGenRenderbuffers(2, h->rb);
@@ -116,11 +108,13 @@ static void make_host(host *h)
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, h->rb[1]);
     EXPECT(glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE);
 
-    GLuint vs = compile(GL_VERTEX_SHADER, "#version 450 core\nlayout(location=0) in vec3 p;\n"
-                                          "uniform mat4 u_mvp;\n"
-                                          "void main() { gl_Position = u_mvp * vec4(p, 1); }\n");
-    GLuint fs = compile(GL_FRAGMENT_SHADER, "#version 450 core\nout vec4 c;\n"
-                                            "void main() { c = vec4(1, 0, 0, 1); }\n");
+    GLuint vs = sw_test_compile_shader(GL_VERTEX_SHADER,
+                                       "#version 450 core\nlayout(location=0) in vec3 p;\n"
+                                       "uniform mat4 u_mvp;\n"
+                                       "void main() { gl_Position = u_mvp * vec4(p, 1); }\n");
+    GLuint fs =
+        sw_test_compile_shader(GL_FRAGMENT_SHADER, "#version 450 core\nout vec4 c;\n"
+                                                   "void main() { c = vec4(1, 0, 0, 1); }\n");
     h->program = glCreateProgram();
     glAttachShader(h->program, vs);
     glAttachShader(h->program, fs);

@@ -46,14 +46,6 @@ typedef struct host_objects {
     GLuint fbo_draw, fbo_read, rb[3], program, vao, buffers[12], tex[4], sampler;
 } host_objects;
 
-static GLuint compile(GLenum kind, const char *src)
-{
-    GLuint s = glCreateShader(kind);
-    glShaderSource(s, 1, &src, NULL);
-    glCompileShader(s);
-    return s;
-}
-
 static void make_host_objects(host_objects *o)
 {
     glGenRenderbuffers(3, o->rb);
@@ -73,10 +65,11 @@ static void make_host_objects(host_objects *o)
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, o->rb[2]);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 
-    GLuint vs = compile(GL_VERTEX_SHADER, "#version 450 core\nlayout(location=0) in vec4 p;\n"
-                                          "void main() { gl_Position = p; }\n");
-    GLuint fs = compile(GL_FRAGMENT_SHADER, "#version 450 core\nout vec4 c;\n"
-                                            "void main() { c = vec4(1); }\n");
+    GLuint vs = sw_test_compile_shader(GL_VERTEX_SHADER,
+                                       "#version 450 core\nlayout(location=0) in vec4 p;\n"
+                                       "void main() { gl_Position = p; }\n");
+    GLuint fs = sw_test_compile_shader(GL_FRAGMENT_SHADER, "#version 450 core\nout vec4 c;\n"
+                                                           "void main() { c = vec4(1); }\n");
     o->program = glCreateProgram();
     glAttachShader(o->program, vs);
     glAttachShader(o->program, fs);
