@@ -1343,10 +1343,11 @@ static void measure_mesh(const patch_set *ps, const mesh_ref *ref, const sw_lod_
     }
 }
 
-static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
-                             const sw_lod_static_level *level0, double delta, double eps_hint,
-                             const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
-                             sw_status *status)
+/* level0: the tree of level 0 for the mesh -> surface fallback, NULL when lv is level 0 */
+static sw_result measure_with(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
+                              const sw_lod_mesh_distance *level0, double delta, double eps_hint,
+                              const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
+                              sw_status *status)
 {
     sw_lod_static_measure_desc d;
     measure_desc_defaults(din, &d);
@@ -1375,15 +1376,26 @@ static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_l
         measure_face_surface(&ps->faces[f], md, &d, (m + sub - 1) / sub, &rg, out);
     }
     sw_lod_mesh_distance_free(md);
-    mesh_ref ref = {NULL, delta};
-    if (level0 && level0 != lv && level0->n_triangles > 0 &&
-        (r = sw_lod_mesh_distance_create(level0->positions, level0->triangles, level0->n_triangles,
-                                         (sw_lod_mesh_distance **)&ref.level0, status)) != SW_OK)
-        return r;
+    const mesh_ref ref = {level0, delta};
     measure_mesh(ps, &ref, lv, &d, &rg, out);
-    sw_lod_mesh_distance_free((sw_lod_mesh_distance *)ref.level0);
     sw__status_ok(status);
     return SW_OK;
+}
+
+static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
+                             const sw_lod_static_level *level0, double delta, double eps_hint,
+                             const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
+                             sw_status *status)
+{
+    sw_lod_mesh_distance *tree = NULL;
+    sw_result r = SW_OK;
+    if (level0 && level0 != lv && level0->n_triangles > 0)
+        r = sw_lod_mesh_distance_create(level0->positions, level0->triangles, level0->n_triangles,
+                                        &tree, status);
+    if (r == SW_OK)
+        r = measure_with(scene, ps, lv, tree, delta, eps_hint, din, out, status);
+    sw_lod_mesh_distance_free(tree);
+    return r;
 }
 
 sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
@@ -1524,6 +1536,7 @@ typedef struct build_ctx {
     sw_result r;
     sw_status *status;
     double t_measure;
+    sw_lod_mesh_distance *level0; /* built on the first level's measurement, shared by all */
 } build_ctx;
 
 static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
@@ -1535,9 +1548,16 @@ static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
     const sw_lod_static_measure_desc random = {1, 0, 0, 1};
     const sw_lod_static_level *l0 = &b->chain->levels[0];
     const double delta = b->chain->delta;
-    sw_result r = measure_set(b->scene, b->ps, l, l0, delta, l->eps_target, NULL, &dist, b->status);
+    sw_result r = SW_OK;
+    if (!b->level0) /* once per chain: level 0 is the largest mesh the measurement builds */
+        r = sw_lod_mesh_distance_create(l0->positions, l0->triangles, l0->n_triangles, &b->level0,
+                                        b->status);
     if (r == SW_OK)
-        r = measure_set(b->scene, b->ps, l, l0, delta, l->eps_target, &random, &dr, b->status);
+        r = measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, NULL, &dist,
+                         b->status);
+    if (r == SW_OK)
+        r = measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, &random, &dr,
+                         b->status);
     b->t_measure += now_seconds() - t0;
     if (r != SW_OK)
         return r;
@@ -1641,7 +1661,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         chain->delta = d.delta;
         chain->levels[0].eps = chain->levels[0].eps_target = d.delta;
         chain->seconds[0] = now_seconds() - t0;
-        build_ctx b = {scene, &ps, &m, chain, &d, SW_OK, status, 0.0};
+        build_ctx b = {scene, &ps, &m, chain, &d, SW_OK, status, 0.0, NULL};
         if (d.n_levels > 0) {
             double *tol = sw__malloc((size_t)d.n_levels * sizeof *tol);
             if (!tol)
@@ -1656,6 +1676,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
             if (r == SW_OK)
                 r = b.r;
             sw__free(tol);
+            sw_lod_mesh_distance_free(b.level0);
             chain->seconds[1] = now_seconds() - t0 - b.t_measure;
         }
         /* level 0's bound is rigorous; its measurement is a check, kept for the report */

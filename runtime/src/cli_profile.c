@@ -327,26 +327,38 @@ static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camer
     return r == SW_OK ? sw_renderer_submit(renderer, stats, status) : r;
 }
 
-/* The pool columns of frame `row`: what the renderer's pool did since the previous frame's end
- * (*prev, updated), its queue now and its injection queue's peak since then. No pool yet
- * (nothing asked for one): zeros. */
-static void sample_pool(sw_renderer renderer, sw_th_pool_stats *prev, sw_rt_prof_row *row)
+/* The pool's counters, queue and injection peak (since the previous read) at one moment; no pool
+ * yet (nothing asked for one): zeros. */
+typedef struct pool_sample {
+    sw_th_pool_stats stats;
+    int64_t queued, peak;
+} pool_sample;
+
+static void pool_read(sw_renderer renderer, int with_queues, pool_sample *out)
 {
     sw_th_pool *pool = sw_rt_renderer_pool_ptr(renderer);
-    sw_th_pool_stats now = {0};
-    int64_t queued = 0, peak = 0;
-    if (pool) {
-        sw_th_pool_stats_get(pool, &now);
-        queued = sw_th_pool_queued(pool, NULL);
-        peak = sw_th_pool_inject_peak_take(pool);
+    memset(out, 0, sizeof *out);
+    if (!pool)
+        return;
+    sw_th_pool_stats_get(pool, &out->stats);
+    if (with_queues) {
+        out->queued = sw_th_pool_queued(pool, NULL);
+        out->peak = sw_th_pool_inject_peak_take(pool);
     }
+}
+
+/* The pool columns of frame `row`: what the pool did between two reads inside the frame's window
+ * (just after its clock starts, just before it stops), so that in walkthrough mode the workers
+ * cannot show more than workers x frame_ms however the threads are scheduled between frames;
+ * its queue at the frame's end and its injection queue's peak since the previous frame. */
+static void pool_columns(const pool_sample *start, pool_sample *end, sw_rt_prof_row *row)
+{
     /* a running task's time may read a few ns ahead of what its end then records
      * (sw_th_pool_stats.ns_by_kind): the totals are kept from going back */
     for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
-        if (now.ns_by_kind[k] < prev->ns_by_kind[k])
-            now.ns_by_kind[k] = prev->ns_by_kind[k];
-    sw_rt_profile_row_pool(prev, &now, queued, peak, row);
-    *prev = now;
+        if (end->stats.ns_by_kind[k] < start->stats.ns_by_kind[k])
+            end->stats.ns_by_kind[k] = start->stats.ns_by_kind[k];
+    sw_rt_profile_row_pool(&start->stats, &end->stats, end->queued, end->peak, row);
 }
 
 /* Draws the n frames; each row's frame_ms is this thread's wall time for its frame. */
@@ -357,15 +369,17 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
     const int tty = isatty(STDERR_FILENO);
     char file[4200];
     sw_result r = SW_OK;
-    sw_th_pool_stats pool_prev = {0};
     if (threaded) {
         set_frame(path, 0, n, st, p, frame, file);
         r = sw_renderer_prepare(renderer, frame, status);
     }
     for (uint32_t i = 0; i < n && r == SW_OK; i++) {
         sw_frame_stats stats = {0};
+        pool_sample pool_start, pool_end;
         const double t0 = sw_cli_now_ms();
+        pool_read(renderer, 0, &pool_start);
         r = one_frame(renderer, threaded, path, i, n, frame, st, p, &stats, status);
+        pool_read(renderer, 1, &pool_end);
         const double ms = sw_cli_now_ms() - t0;
         const double t = sw_rt_path_frame_time(path, i, n);
         if (r != SW_OK) {
@@ -376,7 +390,7 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
         }
         sw_rt_prof_row row;
         sw_rt_profile_row(&stats, i, t, ms, resident_bytes(), is_capture(p, i), &row);
-        sample_pool(renderer, &pool_prev, &row);
+        pool_columns(&pool_start, &pool_end, &row);
         if (sw_rt_profile_push(p, &row) != 0)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
         if (tty)

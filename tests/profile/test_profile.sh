@@ -100,8 +100,8 @@ check_run() {
 # hierarchy is built once (builds <= surfaces); the pool's threads (the workers, plus the frame's
 # thread while a converged frame waits) cannot have spent more than (workers + 1) x the run's wall
 # time in tasks — in walkthrough mode, where only the workers run tasks and a running task's time
-# counts in the frames it spans, not even in any one frame (workers x frame_ms, plus 1 ms each for
-# the bookkeeping between frames); the visibility thread's requests went through the injection
+# counts in the frames it spans and the counters are read inside the frame's window, not even in
+# any one frame (workers x frame_ms, plus 1 ms for the clocks); the visibility thread's requests went through the injection
 # queue in the first frame (peak > 0).
 check_pool() {
   local dir=$1 workers wall
