@@ -86,8 +86,8 @@ static double unit_tolerance(const frame *f, const sw_lod_static_unit *un, const
 
 /* A static level is drawn only when it has at most this many triangles per Bézier patch: its
  * vertices are sent every frame, while the per-frame path evaluates each patch's grid in the
- * vertex shader from 16 control points, so a fine static level (level 0 within δ = 1e-3 of the
- * diagonal has ~160 per patch on CrankArm) costs more than the patches it replaces; the per-frame
+ * vertex shader from 16 control points, so a fine static level (a rigorous level 0 has 100-500
+ * per patch on the sample models) costs more than the patches it replaces; the per-frame
  * path drew ~40 per patch on the 64-CrankArm grid's orbit. Kumar §4 meant static LODs for the far
  * field, where few triangles do. */
 static const double k_static_max_tri_per_patch = 24.0;

@@ -1587,36 +1587,44 @@ static int on_level(void *ctx, int32_t level, const uint32_t *tri, uint32_t n_tr
 
 double sw_lod_static_default_delta(const double box[6])
 {
-    const double d =
-        1e-3 * sqrt((box[3] - box[0]) * (box[3] - box[0]) + (box[4] - box[1]) * (box[4] - box[1]) +
-                    (box[5] - box[2]) * (box[5] - box[2]));
+    const double d = SW_LOD_STATIC_DELTA_REL *
+                     sqrt((box[3] - box[0]) * (box[3] - box[0]) +
+                          (box[4] - box[1]) * (box[4] - box[1]) +
+                          (box[5] - box[2]) * (box[5] - box[2]));
     return d > 0.0 ? d : 1e-12; /* a super-surface collapsed to a point */
 }
 
-static sw_result desc_defaults(const sw_lod_static_desc *in, const patch_set *ps,
-                               sw_lod_static_desc *d, sw_status *status)
+sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static_desc *d,
+                                     sw_status *status)
 {
     *d = in ? *in : (sw_lod_static_desc){0};
-    if (d->delta == 0.0)
-        d->delta = sw_lod_static_default_delta(ps->box);
     if (d->n_levels == 0)
         d->n_levels = 4;
     else if (d->n_levels == -1)
         d->n_levels = 0;
     if (d->eps_first == 0.0)
-        d->eps_first = 4.0;
+        d->eps_first = 2.0;
     if (d->eps_growth == 0.0)
         d->eps_growth = 4.0;
     if (d->safety == 0.0)
         d->safety = 1.5;
     if (d->max_vertices == 0)
         d->max_vertices = 4000000;
-    if (!(d->delta > 0.0 && isfinite(d->delta)) || d->n_levels < 0 || d->n_levels > 8 ||
+    if (d->max_vertices_per_patch == 0)
+        d->max_vertices_per_patch = 4096;
+    if (!(d->delta >= 0.0 && isfinite(d->delta)) || d->n_levels < 0 || d->n_levels > 8 ||
         !(d->eps_first > 1.0) || !(d->eps_growth > 1.0) || !(d->safety >= 1.0))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "static lod: delta %g, %d levels, eps_first %g, growth %g, safety %g",
                         d->delta, (int)d->n_levels, d->eps_first, d->eps_growth, d->safety);
     return SW_OK;
+}
+
+/* The level-0 vertex limit of n patches: the smaller of the two limits. */
+static uint32_t vertex_limit(const sw_lod_static_desc *d, uint32_t n_patches)
+{
+    const double per = (double)d->max_vertices_per_patch * n_patches;
+    return per < (double)d->max_vertices ? (uint32_t)per : d->max_vertices;
 }
 
 sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
@@ -1631,7 +1639,10 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
     sw_lod_static_chain *chain = NULL;
     sw_result r = patch_set_init(scene, patches, n, &ps, status);
     if (r == SW_OK)
-        r = desc_defaults(desc, &ps, &d, status);
+        r = sw_lod_static_desc_resolve(desc, &d, status);
+    if (r == SW_OK && d.delta == 0.0)
+        d.delta = sw_lod_static_default_delta(ps.box);
+    const uint32_t max_vertices = r == SW_OK ? vertex_limit(&d, ps.n) : 0;
     for (uint32_t f = 0; r == SW_OK && f < ps.n_faces; ++f) {
         face_dom *fd = &ps.faces[f];
         if (!face_dom_refine(fd, sqrt(2.4 * 0.75 * d.delta))) {
@@ -1641,7 +1652,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         const double tol = 0.25 * d.delta / (fd->grad > 0.0 ? fd->grad : 1.0);
         r = face_dom_flatten(scene, fd, tol, status);
         if (r == SW_OK)
-            r = tessellate_face(scene, fd, 0.75 * d.delta, d.max_vertices, &m, status);
+            r = tessellate_face(scene, fd, 0.75 * d.delta, max_vertices, &m, status);
     }
     if (r == SW_OK && m.n_t == 0)
         r = sw__fail(status, SW_ERR_INVALID_GEOMETRY,

@@ -26,7 +26,8 @@ static uint64_t fnv(uint64_t h, const void *data, size_t n)
     return h;
 }
 
-/* The units' faces and patches, and the level settings the set builds with. */
+/* The units' faces and patches, and the level settings the set builds with (resolved: a change
+ * of a default, SW_LOD_STATIC_DELTA_REL included, makes older caches stale). */
 static uint64_t set_key(const sw_lod_static_set *set, const sw_lod_static_desc *levels)
 {
     uint64_t h = 1469598103934665603ull;
@@ -44,8 +45,10 @@ static uint64_t set_key(const sw_lod_static_set *set, const sw_lod_static_desc *
             h = fnv(h, rec, sizeof rec);
         }
     }
-    const double d[4] = {levels->delta, levels->eps_first, levels->eps_growth, levels->safety};
-    const int32_t i[2] = {levels->n_levels, (int32_t)levels->max_vertices};
+    const double d[5] = {levels->delta, levels->eps_first, levels->eps_growth, levels->safety,
+                         levels->delta > 0.0 ? 0.0 : SW_LOD_STATIC_DELTA_REL};
+    const int32_t i[3] = {levels->n_levels, (int32_t)levels->max_vertices,
+                          (int32_t)levels->max_vertices_per_patch};
     h = fnv(h, d, sizeof d);
     return fnv(h, i, sizeof i);
 }

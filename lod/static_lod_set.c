@@ -445,11 +445,11 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     s->scene = scene;
     s->pool = pool;
-    if (desc)
-        s->levels = desc->levels;
     s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    sw_result r =
-        sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
+    /* resolved now: the cache key (lod/static_lod_io.c) hashes the values the chains get */
+    sw_result r = sw_lod_static_desc_resolve(desc ? &desc->levels : NULL, &s->levels, status);
+    if (r == SW_OK)
+        r = sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);
     uint32_t *home = NULL;
     if (r == SW_OK) {
         home = sw__malloc((s->n_faces ? s->n_faces : 1) * sizeof *home);

@@ -41,13 +41,17 @@ typedef struct sw_lod_static_patch {
 
 /* Zero fields take the defaults. */
 typedef struct sw_lod_static_desc {
-    double delta;      /* δ of level 0, object space; 0 = 1e-3 x the diagonal of the patches'
-                          control-point box */
+    double delta;      /* δ of level 0, object space; 0 = SW_LOD_STATIC_DELTA_REL x the diagonal
+                          of the patches' control-point box */
     int32_t n_levels;  /* simplified levels after level 0 (1..8); 0 = 4; -1 = none */
-    double eps_first;  /* target ε of level 1 in units of δ (> 1); 0 = 4 */
+    double eps_first;  /* target ε of level 1 in units of δ (> 1); 0 = 2 */
     double eps_growth; /* ratio of consecutive target ε (> 1); 0 = 4 */
     double safety;     /* declared ε_k = safety x measured two-sided distance (>= 1); 0 = 1.5 */
     uint32_t max_vertices; /* level 0 limit (SW_ERR_LIMIT beyond it); 0 = 4,000,000 */
+    uint32_t max_vertices_per_patch; /* level 0 limit per patch, the same way; 0 = 4,096 (the
+                          sample models need 30-1,500; where a patch's rational derivative bounds
+                          are far too loose, tens of thousands: such a super-surface is refused in
+                          a moment rather than decimated for many minutes, and drawn per frame) */
 } sw_lod_static_desc;
 
 /* One level. Vertices are points of the exact surface (decimation only removes vertices), each
@@ -84,9 +88,23 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                               sw_status *status);
 void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
 
-/* The δ of level 0 when the desc leaves it 0: 1e-3 x the diagonal of `box` (the patches'
- * control-point box), 1e-12 for an empty one. */
+/* The default δ of level 0 relative to the super-surface's diagonal. Level 0 is never drawn
+ * (the frame draws a level only at <= 24 triangles per patch; a rigorous tessellation has
+ * hundreds): it is what the levels are decimated from, and the decimation's cost grows with its
+ * size times its reduction to level 1 (each collapse re-projects the points its faces carry).
+ * 2e-3 with level 1 at 2 δ keeps level 1's target (4e-3 x the diagonal) of the earlier 1e-3 / 4 δ
+ * at half the level-0 triangles. */
+#define SW_LOD_STATIC_DELTA_REL 2e-3
+
+/* The δ of level 0 when the desc leaves it 0: SW_LOD_STATIC_DELTA_REL x the diagonal of `box`
+ * (the patches' control-point box), 1e-12 for an empty one. */
 double sw_lod_static_default_delta(const double box[6]);
+
+/* *out = *in (NULL: all zero) with every zero field but delta replaced by its default, and the
+ * values checked: SW_ERR_INVALID_ARGUMENT for a negative or non-finite δ, n_levels outside
+ * -1..8, eps_first or eps_growth <= 1, safety < 1. delta stays 0 when left 0 (per patch set). */
+sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static_desc *out,
+                                     sw_status *status);
 
 /* Bytes the chain owns. */
 size_t sw_lod_static_memory(const sw_lod_static_chain *chain);

@@ -94,7 +94,8 @@ typedef struct sw_lod_static_instances {
 /* Zero fields take the defaults of each part. */
 typedef struct sw_lod_static_set_desc {
     sw_lod_ss_desc clustering; /* §3 */
-    sw_lod_static_desc levels; /* §4.1-§4.2, per unit; delta 0 = per unit, 1e-3 x its diagonal */
+    sw_lod_static_desc levels; /* §4.1-§4.2; delta 0 = per unit, SW_LOD_STATIC_DELTA_REL x its
+                                  diagonal */
 } sw_lod_static_set_desc;
 
 typedef struct sw_lod_static_set_stats {

@@ -15,7 +15,7 @@ static const char k_usage[] =
     "\n"
     "Builds the static LODs of every super-surface of SCENE (Kumar et al. 1997 §3-§4): the\n"
     "scene's Bézier patches clustered under a 45° normal-cone bound into super-surfaces of whole\n"
-    "faces, each tessellated within δ (1e-3 of its diagonal) and simplified into 4 more levels\n"
+    "faces, each tessellated within δ (2e-3 of its diagonal) and simplified into 4 more levels\n"
     "whose errors are measured both ways against the exact surface. The levels are written into\n"
     "the scene file's LODS section (a new file written aside, then renamed over OUT), so that\n"
     "`render`, `profile` and `view` with --static-lod start from them instead of building them.\n"

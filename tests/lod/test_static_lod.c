@@ -96,7 +96,7 @@ static int check_bad_input(const sw_sg_scene *scene)
     sw_lod_static_chain *c = NULL;
     sw_status st = {0};
     const sw_lod_static_patch bad_face = {v->n_faces, 0, 0}, bad_iu = {0, 60000, 0}, ok = {0, 0, 0};
-    const sw_lod_static_desc bad_desc = {-1.0, 0, 0.0, 0.0, 0.0, 0};
+    const sw_lod_static_desc bad_desc = {.delta = -1.0};
     int fail = 0;
     fail |= sw_lod_static_build(scene, &ok, 0, NULL, &c, &st) != SW_ERR_INVALID_ARGUMENT;
     fail |= sw_lod_static_build(scene, &bad_face, 1, NULL, &c, &st) != SW_ERR_INVALID_ARGUMENT;
@@ -135,7 +135,7 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
             t.skipped++;
             continue;
         }
-        const sw_lod_static_desc desc = {0.0, levels, 0.0, 0.0, 0.0, 0};
+        const sw_lod_static_desc desc = {.n_levels = levels};
         sw_lod_static_chain *c = NULL;
         sw_status st = {0};
         const sw_result r = sw_lod_static_build(scene, p, n, &desc, &c, &st);
