@@ -1,0 +1,364 @@
+/* SPDX-License-Identifier: MIT */
+/* gpu/ private: one frame as explicit stages, each with its own input and output item lists.
+ *
+ *   cull        (stage_cull.c)       scene, BVH or static unit instances, view
+ *                                    -> sw__fr_visible: face occurrences, unit instances, meshes
+ *   select      (stage_select.c,     visible items -> sw__fr_selection: per unit instance a static
+ *                stage_hierarchy.c)  level, per face occurrence its hierarchy cut (Guthe §7) or
+ *                                    its own Bézier patches
+ *   tessellate  (stage_tessellate*.c) selection -> sw__fr_geometry: CPU grids and triangles,
+ *                                    vertex-shader patch records, draws, fat borders (§7.1),
+ *                                    pending trim textures
+ *   trim        (stage_trim.c)       pending trims -> resolutions and flattened loops (plain
+ *                                    memory, with the trimmed faces' fat borders), then on the GL
+ *                                    thread the atlas entries of the draws (§4, §4.4)
+ *   submit      (stage_submit.c)     geometry -> batch, upload, draw, present, readback
+ *
+ * cull, select, tessellate and the trim plan are GL-free and run in sw_gpu_frame_prepare (the
+ * visibility thread); the trim atlas and submit run in sw_gpu_frame_submit (the GL thread).
+ * Every stage reads the frame's constants (sw__fr_env, resolved once from the desc by frame.c)
+ * and adds to the frame's stats. Never installed. */
+#ifndef SW_GPU_FRAME_STAGES_H
+#define SW_GPU_FRAME_STAGES_H
+
+#include "sw_gpu_internal.h"
+#include "sw_lod_cache.h"
+#include "sw_lod_face_cones.h"
+#include "sw_lod_sampling.h"
+#include "sw_lod_static_set.h"
+#include "sw_sg_bvh.h"
+#include "sw_sg_trim.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+enum {
+    MAX_SEGMENTS = 256, /* grid segments per patch and direction */
+    MAX_TRIM_LOOP_VERTICES = 1u << 22,
+    MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
+};
+static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
+static const double k_tile_texels = 1024.0; /* wanted trim texels per direction above which a
+                                               face's trim box is split into tiles, or a
+                                               hierarchy node into parts */
+
+/* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
+ * for predefined grids (§4.2) the counts a grid class, or pieces of one class, can draw. */
+typedef struct segment_set {
+    int32_t n[MAX_SEGMENTS];
+    int32_t count;
+} segment_set;
+
+/* ---- the frame's constants (frame.c resolves them once per frame) -------------------------- */
+typedef struct sw__fr_env {
+    sw_gpu_context *ctx; /* read only: its settings (eval mode, crack fill, patch hook, atlas) */
+    const sw_sg_scene *scene;
+    const sw_sg_scene_view *sv;
+    sw__gpu_view view;
+    sw_lod_screen_view screen; /* the view as the density bound needs it */
+    segment_set gpu_segments, cpu_segments;
+    double eps_px;        /* ε_img */
+    int exact;            /* desc.eval_exact */
+    int walkthrough;      /* desc.walkthrough: never wait for the pool */
+    int lod_colors;       /* desc.lod_colors */
+    int32_t static_force; /* desc.static_force */
+    sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
+} sw__fr_env;
+
+/* The constants of a frame of desc (its defaults resolved by sw__gpu_desc_defaults) but the view:
+ * its eye only. Errors: SW_ERR_INVALID_ARGUMENT (static LODs of another scene). */
+sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scene *scene,
+                          const sw_gpu_frame_desc *desc, sw_status *status);
+/* The view, its near plane from the eye-relative scene box (the cull stage's) unless the desc
+ * gives one; the density bound's view and the grid classes' segment counts. Errors: those of
+ * sw__gpu_view_init. */
+sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *desc,
+                          const double scene_box[6], sw_status *status);
+
+/* A face occurrence as the frame draws it. */
+typedef struct occurrence {
+    uint32_t face;
+    double world[12];
+    float color[4];
+} occurrence;
+
+/* An occurrence with the colour resolved (none or unset: the default grey). */
+void sw__fr_occurrence_init(occurrence *o, uint32_t face, const double world[12],
+                            const float color[4]);
+
+/* ---- cull: stage_cull.c ---------------------------------------------------------------------- */
+/* Face occurrences with their eye-relative boxes (6 per occurrence). */
+typedef struct sw__fr_faces {
+    occurrence *occ;
+    double *boxes;
+    size_t n, cap_occ, cap_boxes;
+} sw__fr_faces;
+/* Appends an occurrence; 0: out of memory. */
+int sw__fr_faces_push(sw__fr_faces *l, const occurrence *o, const double eye_box[6]);
+void sw__fr_faces_free(sw__fr_faces *l);
+
+/* A visible unit instance of the static set: its BVH item and, in the cull output's
+ * unit_faces, its face occurrences that are shown (inside the frustum, not back-facing). */
+typedef struct sw__fr_instance {
+    uint32_t item; /* of sw_lod_static_instances.bvh */
+    size_t first_face, n_faces;
+} sw__fr_instance;
+
+typedef struct sw__fr_mesh_occ {
+    uint32_t mesh;
+    double world[12];
+    float color[4];
+    double box[6]; /* eye-relative */
+} sw__fr_mesh_occ;
+
+typedef struct sw__fr_visible {
+    sw__fr_faces faces;      /* without static LODs: the visible face occurrences */
+    sw__fr_instance *instances; /* with static LODs: the visible unit instances, BVH order */
+    size_t n_instances, cap_instances;
+    sw__fr_faces unit_faces; /* their shown faces */
+    sw__fr_mesh_occ *meshes; /* mesh occurrences inside the frustum */
+    size_t n_meshes, cap_meshes;
+} sw__fr_visible;
+
+/* Before the view: the scene box the near plane is chosen from (eye-relative), and the mesh
+ * occurrences (their boxes join it). Needs env->view.eye only. */
+sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *desc,
+                                sw__fr_visible *vis, double scene_box[6], sw_status *status);
+/* After the view: the visible face occurrences (desc.occurrences, the BVH, or every occurrence
+ * of the scene), or with static LODs the visible unit instances (Kumar §4.4); back-patch culling
+ * by desc.face_cones; the meshes outside the frustum dropped. */
+sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__fr_visible *vis,
+                      sw_gpu_frame_stats *st, sw_status *status);
+void sw__fr_visible_free(sw__fr_visible *vis);
+/* Kumar §4.4's back-patch test of one face occurrence with its eye-relative box. */
+int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6]);
+
+/* ---- select: stage_select.c, stage_hierarchy.c ------------------------------------------- */
+/* Texels wanted per direction of a trim texture. */
+typedef struct trim_need {
+    double u, v;
+} trim_need;
+
+/* A chosen item of a face's hierarchy: a node, or a part [s0,s1] x [t0,t1] of its local domain
+ * (part_depth > 0). */
+typedef struct hl_item {
+    int32_t node, part_depth;
+    double range[4];
+} hl_item;
+typedef struct hl_choice {
+    hl_item it;
+    double cpw[64]; /* the item's bicubic, eye-relative world, homogeneous */
+    double rect[4]; /* its rectangle in face parameters */
+    double err_w;   /* its error bound in world units */
+    double eps_obj; /* ε_obj at its nearest depth */
+    trim_need need; /* trim texels over rect */
+} hl_choice;
+
+/* A unit instance drawn at a static level. */
+typedef struct sw__fr_static_pick {
+    uint32_t instance; /* of sw__fr_visible.instances */
+    const sw_lod_static_chain *chain;
+    int32_t level;
+    double extent_px; /* a bound of the unit's size on screen (its fat borders' sampling) */
+} sw__fr_static_pick;
+
+/* A face occurrence drawn by the per-frame path: its hierarchy cut, or (n_items 0 and
+ * !hierarchy) its own Bézier patches. */
+typedef struct sw__fr_face_pick {
+    occurrence occ;
+    int hierarchy;
+    size_t first_item, n_items; /* of sw__fr_selection.items */
+} sw__fr_face_pick;
+
+typedef struct sw__fr_selection {
+    sw__fr_static_pick *statics;
+    size_t n_statics, cap_statics;
+    sw__fr_face_pick *faces;
+    size_t n_faces, cap_faces;
+    hl_choice *items;
+    size_t n_items, cap_items;
+} sw__fr_selection;
+
+/* The hierarchy state of a frame (desc.hierarchies): the cache, the plan's reader slot, the group
+ * converged frames wait on, the walkthrough request. */
+typedef struct sw__fr_hierarchy {
+    sw_lod_cache *cache; /* NULL: every face drawn by its Bézier patches */
+    int32_t reader;      /* the plan's reader slot in the cache (epochs), -1 when none */
+    sw_th_group group;
+    sw_lod_cache_req req;
+    int planning;          /* 1: traversal only asks for refinements */
+    uint64_t refine_asked; /* refinements submitted (or in flight) in this planning round */
+} sw__fr_hierarchy;
+
+/* Kumar §4 and Guthe §7: per visible unit instance the coarsest static level within the view's
+ * tolerance (else its faces go to the per-frame path), per per-frame face occurrence its
+ * hierarchy cut (converged: after the builds and refinements it needs, waited for; walkthrough:
+ * requested). */
+sw_result sw__fr_select(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw__fr_visible *vis,
+                        sw__fr_selection *sel, sw_gpu_frame_stats *st, sw_status *status);
+void sw__fr_selection_free(sw__fr_selection *sel);
+/* LOD colouring: static level k (fine -> coarse), or -1 for the per-frame path. */
+void sw__fr_lod_color(int32_t level, float out[4]);
+/* The object-space tolerance of a unit under transform m at the view (frame-static's rule:
+ * ε_img at the nearest depth of its box, over the transform's stretch), and its screen extent. */
+double sw__fr_unit_tolerance(const sw__fr_env *env, const double obj_box[6], const double m[12],
+                             double *extent_px);
+
+/* stage_hierarchy.c. Walkthrough: requests the faces' hierarchies (never waits). Converged:
+ * builds them and refines until the cut needs no more, waiting for the pool. */
+sw_result sw__fr_hierarchy_prepare(const sw__fr_env *env, sw__fr_hierarchy *hy,
+                                   const sw__fr_faces *faces, sw_gpu_frame_stats *st,
+                                   sw_status *status);
+/* The cut of one occurrence's hierarchy h (§7), appended to sel->items. */
+sw_result sw__fr_hierarchy_cut(const sw__fr_env *env, sw__fr_hierarchy *hy, const occurrence *o,
+                               const sw_lod_hierarchy *h, sw__fr_selection *sel,
+                               sw_gpu_frame_stats *st, sw_status *status);
+
+/* ---- tessellate: stage_tessellate*.c -------------------------------------------------------- */
+typedef struct pending_trim {
+    size_t draw;
+    occurrence occ;       /* for its fat borders */
+    double width, height; /* wanted resolution before the frame budget */
+    double cell[2];       /* smallest grid cell of the face in u, v (fat-border sampling) */
+    int64_t loops;        /* its face's flattened loops in geometry.loops (-1 until the trim
+                             plan flattens a whole trim box's) */
+    int32_t clip;         /* 1: a tile or a node's part: the loops clipped to rect */
+    double rect[4];       /* with clip: the tile (face parameters) */
+    int32_t w, h;         /* texels of its class (the trim plan) */
+} pending_trim;
+
+/* A face occurrence's loops, flattened once. */
+typedef struct face_loops {
+    sw_sg_polyline *loops;
+    uint32_t n;
+} face_loops;
+
+typedef struct sw__fr_geometry {
+    sw__gpu_mesh mesh; /* CPU grids, fat borders, triangles */
+    sw__gpu_draw *draws;
+    size_t n_draws, cap_draws;
+    pending_trim *trims;
+    size_t n_trims, cap_trims;
+    size_t *shares; /* pairs (draw, source draw): draw uses the source's trim entry */
+    size_t n_shares, cap_shares;
+    face_loops *loops;
+    size_t n_loops, cap_loops;
+    sw__gpu_patch_rec *recs; /* GPU-evaluated patches (§4.2) */
+    float *cps;              /* their eye-relative homogeneous control points, 4 per point */
+    size_t n_recs, cap_recs, n_cps, cap_cps;
+    /* exact path (eval_exact): pieces, knots and eye-relative control points in double */
+    sw__gpu_exact_piece *pieces;
+    size_t n_pieces, cap_pieces;
+    double *knots, *dcps;
+    size_t n_knots, cap_knots, n_dcps, cap_dcps;
+    double gpu_vertices;       /* grid vertices the vertex shader will evaluate */
+    uint64_t border_triangles; /* fat-border triangles (in stats.triangles already) */
+} sw__fr_geometry;
+void sw__fr_geometry_free(sw__fr_geometry *g);
+
+/* The tessellation stage's working state. */
+typedef struct sw__fr_tess {
+    const sw__fr_env *env;
+    sw_gpu_frame_stats *st;
+    sw__fr_geometry *geo;
+    sw_sg_bezier_set **bez;     /* per face, extracted on first use in this frame */
+    const occurrence *ex_occ;   /* exact path: the occurrence whose net is at ex_base */
+    sw__gpu_exact_piece ex_base;
+    sw_sg_surface ex_srf;
+} sw__fr_tess;
+
+/* Everything selected, in order: static levels, per-frame faces, meshes. */
+sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
+                            const sw__fr_selection *sel, sw__fr_geometry *geo,
+                            sw_gpu_frame_stats *st, sw_status *status);
+
+/* stage_tessellate.c, for the paths below. */
+sw_result sw__fr_add_draw(sw__fr_tess *t, const occurrence *o, size_t first_idx, int trimmed,
+                          const trim_need *need, const double cell[2], sw_status *status);
+void sw__fr_report_patch(const sw__fr_tess *t, const occurrence *o, const sw__gpu_patch *pt,
+                         double s0, double s1, double t0, double t1, int32_t nu, int32_t nv,
+                         int gpu, int trimmed);
+/* Vertex-shader records of a visible patch; ub is the rectangle its draw's trim texture spans. */
+sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_patch *pt,
+                           const double ub[4], double sign, int32_t draw, int trimmed,
+                           sw_status *status);
+/* §7.1 fat border along a closed uv loop as its own draw. st_box NULL: untrimmed; else the draw
+ * uses the trim texture of draw `share` (whose texture spans st_box). */
+sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *uv, size_t n,
+                            int left_inside, const double cell[2], const double *st_box,
+                            size_t share, sw_status *status);
+/* The face's trim loops flattened at tolerance tol into a new geometry.loops entry, *index. */
+sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *index,
+                            sw_status *status);
+/* The fat borders along every loop of a flattened entry. */
+sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops,
+                              const double cell[2], sw_status *status);
+/* The normal sign of an occurrence: reversed face, mirroring transform. */
+double sw__fr_normal_sign(const sw__fr_env *env, const occurrence *o);
+/* 1 when the face's trim loops cut it (a trim texture is needed). */
+int sw__fr_face_trimmed(const sw__fr_env *env, uint32_t face);
+/* Effective segments of a direction of n segments drawn by predefined grid classes (pieces of
+ * the largest class when n exceeds it). */
+int32_t sw__fr_class_segments(int32_t n);
+/* The limit of grid vertices per frame (SW_ERR_LIMIT past it). */
+sw_result sw__fr_check_budget(const sw__fr_tess *t, sw_status *status);
+
+/* stage_tessellate_direct.c: a face by its Bézier patches (§4.2), tiled trim textures when
+ * large. */
+sw_result sw__fr_tess_direct(sw__fr_tess *t, const occurrence *o, sw_status *status);
+/* stage_tessellate_hierarchy.c: a face's hierarchy cut. */
+sw_result sw__fr_tess_hierarchy(sw__fr_tess *t, const occurrence *o, const hl_choice *items,
+                                size_t n, sw_status *status);
+/* stage_tessellate_static.c: a unit instance at its static level, with its faces' borders. */
+sw_result sw__fr_tess_static(sw__fr_tess *t, const sw__fr_visible *vis,
+                             const sw__fr_static_pick *pick, sw_status *status);
+/* stage_tessellate_mesh.c: triangles in object space for sw__fr_append_triangles. */
+typedef struct sw__fr_triangles {
+    const double *positions; /* 3 per vertex */
+    const float *normals_f;  /* 3 per vertex, or NULL */
+    const double *normals_d; /* 3 per vertex, or NULL; both NULL: flat, a normal per triangle */
+    double normal_matrix[9]; /* row-major 3x3 mapping normals to the world (with normals) */
+    uint32_t n_vertices, n_triangles;
+    const uint32_t *triangles; /* 3 per triangle */
+} sw__fr_triangles;
+/* Appends the triangles under the occurrence's transform (eye-relative, float) as one untrimmed
+ * draw of o->color: the one triangle path of static LODs and meshes. */
+sw_result sw__fr_append_triangles(sw__fr_tess *t, const occurrence *o, const sw__fr_triangles *tr,
+                                  sw_status *status);
+sw_result sw__fr_tess_meshes(sw__fr_tess *t, const sw__fr_visible *vis, sw_status *status);
+
+/* ---- trim: stage_trim.c --------------------------------------------------------------------- */
+/* Plain memory (prepare): every pending trim's texel class at the frame's common scale (within
+ * the atlas budget), the whole-box trims' loops flattened at their texel, and the trimmed faces'
+ * fat borders along them. */
+sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_frame_stats *st,
+                           sw_status *status);
+/* The GL thread: each trim's atlas entry (found, or added and rendered), set on its draw. */
+sw_result sw__fr_trim_atlas(sw_gpu_context *ctx, const sw_sg_scene *scene, sw__fr_geometry *geo,
+                            sw_gpu_frame_stats *st, sw_status *status);
+/* Texels of a resolution class (power-of-two footprints, gutters included). */
+int32_t sw__fr_class_texels(double want, int32_t max_entry);
+/* Whether the trimmed region lies to the left of loop k's direction. */
+int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k);
+
+/* ---- submit: stage_submit.c ------------------------------------------------------------------ */
+/* Batch, upload, draw. GL thread. */
+sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
+                        const sw_gpu_frame_desc *desc, sw__fr_geometry *geo,
+                        sw_status *status);
+
+/* ---- geometry helpers (frame_geom.c) -------------------------------------------------------- */
+/* Homogeneous control point mapped to eye-relative world space: w x' = R (w x) + w (t - eye). */
+void sw__fr_xform_h(const double m[12], const double eye[3], const double in[4], double out[4]);
+void sw__fr_box_empty(double box[6]);
+void sw__fr_box_add(double box[6], const double h[4]); /* adds the point h / h[3] */
+/* World box to eye-relative. */
+void sw__fr_eye_box(const double eye[3], const double world[6], double out[6]);
+/* Eye-relative box of an object box's corners under m. */
+void sw__fr_eye_box_of(const double eye[3], const double obj[6], const double m[12],
+                       double out[6]);
+double sw__fr_det3(const double m[12]);
+/* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm, 1 for a rigid one. */
+double sw__fr_stretch_bound(const double m[12]);
+
+#endif

@@ -1,0 +1,422 @@
+/* SPDX-License-Identifier: MIT */
+/* The cull stage: which face occurrences, unit instances and meshes may show in the view.
+ *
+ * Input: the scene (its traversal, or the caller's occurrences for immediate draws), its BVH
+ * (sw_sg_bvh_cull: a node outside the frustum is culled with its subtree, a node inside takes its
+ * subtree untested, Kumar §4.4), or with static LODs the set's BVH of unit instances; the view;
+ * the faces' normal cones. Output (sw__fr_visible): the visible face occurrences with their
+ * eye-relative boxes; with static LODs the visible unit instances with their shown faces; the
+ * mesh occurrences inside the frustum.
+ *
+ * Back-patch culling (Kumar §4.4): an occurrence of a closed-shell face whose outward cone, in the
+ * world, faces away from every view direction into its box is dropped before anything is asked
+ * of the pool, so culled faces cost nothing further. Sound only for an eye outside the solids:
+ * from inside a solid's material its back faces are what one sees.
+ *
+ * The unit-instance BVH. With static LODs the frame culls the set's BVH whose leaves are unit
+ * instances (lod/sw_lod_static_set.h: the face occurrences grouped by (unit, transform) once,
+ * when the set was made), not the faces' BVH: an instance is what gets a level, so its
+ * classification and back-patch test are decided once, at its leaf. Partly visible, each of its
+ * faces is classified against the frustum by its own box (the box and test of the faces' BVH, so
+ * the per-frame path gets the faces it got from that BVH and asks no hierarchy for the others).
+ * Wholly inside, none is tested: each face's drawn surface lies in the unit's box, so inside the
+ * frustum, and the face's control-net box holds that surface, so no plane can have the box wholly
+ * behind it — the test could only answer "not outside". An instance none of whose faces is shown
+ * is culled whole: no level is chosen, asked for or drawn. */
+#include "frame_stages.h"
+#include "sw_hooks.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int sw__fr_faces_push(sw__fr_faces *l, const occurrence *o, const double eye_box[6])
+{
+    if (!sw__gpu_grow((void **)&l->occ, &l->cap_occ, l->n + 1, sizeof *l->occ) ||
+        !sw__gpu_grow((void **)&l->boxes, &l->cap_boxes, 6 * (l->n + 1), sizeof *l->boxes))
+        return 0;
+    l->occ[l->n] = *o;
+    memcpy(l->boxes + 6 * l->n, eye_box, 6 * sizeof *l->boxes);
+    l->n++;
+    return 1;
+}
+
+void sw__fr_faces_free(sw__fr_faces *l)
+{
+    sw__free(l->occ);
+    sw__free(l->boxes);
+    memset(l, 0, sizeof *l);
+}
+
+void sw__fr_visible_free(sw__fr_visible *vis)
+{
+    sw__fr_faces_free(&vis->faces);
+    sw__fr_faces_free(&vis->unit_faces);
+    sw__free(vis->instances);
+    sw__free(vis->meshes);
+    memset(vis, 0, sizeof *vis);
+}
+
+/* The static set's instances when static LODs cull this frame (env resolves when they do). */
+static const sw_lod_static_instances *static_instances(const sw__fr_env *env)
+{
+    return env->statics ? sw_lod_static_set_instances(env->statics) : NULL;
+}
+
+static const sw_sg_bvh *face_bvh(const sw_gpu_frame_desc *desc)
+{
+    return desc->occurrences ? NULL : desc->bvh; /* immediate draws: no BVH culls them */
+}
+
+/* ---- every occurrence, boxed by its transformed control net (the path without a BVH) ------- */
+typedef struct all_taker {
+    const sw__fr_env *env;
+    sw__fr_faces *faces;
+    int oom;
+} all_taker;
+
+static void occurrence_box(const sw__fr_env *env, const occurrence *o, double box[6])
+{
+    sw_sg_surface s;
+    sw_sg_scene_face_surface(env->scene, o->face, &s);
+    sw__fr_box_empty(box);
+    size_t n = (size_t)s.n_u * (size_t)s.n_v;
+    for (size_t i = 0; i < n; ++i) {
+        double h[4];
+        sw__fr_xform_h(o->world, env->view.eye, s.cpw + 4 * i, h);
+        sw__fr_box_add(box, h);
+    }
+}
+
+static int take_any(void *user, uint32_t face, const double world[12], const float color[4])
+{
+    all_taker *t = user;
+    occurrence o;
+    double box[6];
+    sw__fr_occurrence_init(&o, face, world, color);
+    occurrence_box(t->env, &o, box);
+    if (!sw__fr_faces_push(t->faces, &o, box)) {
+        t->oom = 1;
+        return 1;
+    }
+    return 0;
+}
+
+static sw_result collect_all(const sw__fr_env *env, const sw_gpu_frame_desc *desc,
+                             sw__fr_faces *faces, double scene_box[6], sw_status *status)
+{
+    all_taker t = {env, faces, 0};
+    for (size_t i = 0; desc->occurrences && i < desc->n_occurrences && !t.oom; ++i) {
+        const sw_gpu_occurrence *o = &desc->occurrences[i];
+        if (o->face >= env->sv->n_faces)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                            "frame: occurrence %zu names face %u of %u", i, o->face,
+                            env->sv->n_faces);
+        take_any(&t, o->face, o->world, o->color);
+    }
+    if ((!desc->occurrences && sw_sg_scene_traverse(env->scene, take_any, &t) != SW_OK) || t.oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "scene traversal: out of memory");
+    sw__fr_box_empty(scene_box);
+    for (size_t i = 0; i < faces->n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            scene_box[k] = fmin(scene_box[k], faces->boxes[6 * i + k]);
+            scene_box[3 + k] = fmax(scene_box[3 + k], faces->boxes[6 * i + 3 + k]);
+        }
+    return SW_OK;
+}
+
+/* ---- meshes ------------------------------------------------------------------------------- */
+typedef struct mesh_taker {
+    const sw__fr_env *env;
+    sw__fr_visible *vis;
+    double *scene_box;
+    int oom;
+} mesh_taker;
+
+static int take_mesh(void *ctx, uint32_t mesh, uint32_t node, const double world[12],
+                     const float color[4])
+{
+    (void)node;
+    mesh_taker *c = ctx;
+    sw__fr_visible *vis = c->vis;
+    if (!sw__gpu_grow((void **)&vis->meshes, &vis->cap_meshes, vis->n_meshes + 1,
+                      sizeof *vis->meshes)) {
+        c->oom = 1;
+        return 1;
+    }
+    sw__fr_mesh_occ *o = &vis->meshes[vis->n_meshes++];
+    o->mesh = mesh;
+    memcpy(o->world, world, sizeof o->world);
+    memcpy(o->color, color, sizeof o->color);
+    /* the world box as the BVH boxes occurrences, then eye-relative like the view's planes */
+    double wb[6];
+    sw_sg_box_transform(world, c->env->sv->meshes[mesh].box, wb);
+    sw__fr_eye_box(c->env->view.eye, wb, o->box);
+    for (int k = 0; k < 3; ++k) {
+        c->scene_box[k] = fmin(c->scene_box[k], o->box[k]);
+        c->scene_box[3 + k] = fmax(c->scene_box[3 + k], o->box[3 + k]);
+    }
+    return 0;
+}
+
+/* Mesh occurrences join the scene box, so the near plane leaves a mesh close to the eye in
+ * front of it. */
+static sw_result collect_meshes(const sw__fr_env *env, sw__fr_visible *vis, double scene_box[6],
+                                sw_status *status)
+{
+    if (env->sv->n_meshes == 0)
+        return SW_OK;
+    mesh_taker c = {env, vis, scene_box, 0};
+    if (sw_sg_scene_traverse_meshes(env->scene, take_mesh, &c) != SW_OK || c.oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "mesh occurrences: out of memory");
+    return SW_OK;
+}
+
+static void cull_meshes(const sw__fr_env *env, sw__fr_visible *vis, sw_gpu_frame_stats *st)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < vis->n_meshes; ++i) {
+        if (!sw__gpu_view_box_visible(&env->view, vis->meshes[i].box)) {
+            st->meshes_culled++;
+            continue;
+        }
+        vis->meshes[k++] = vis->meshes[i];
+    }
+    vis->n_meshes = k;
+}
+
+sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *desc,
+                                sw__fr_visible *vis, double scene_box[6], sw_status *status)
+{
+    memset(vis, 0, sizeof *vis);
+    const sw_sg_bvh *bvh = face_bvh(desc);
+    const sw_lod_static_instances *units = static_instances(env);
+    sw_result r = SW_OK;
+    if (bvh || units) {
+        /* the unit-instance BVH's scene box is the face BVH's root box: the same near plane */
+        sw__fr_box_empty(scene_box);
+        if (bvh && bvh->n_nodes)
+            sw__fr_eye_box(env->view.eye, bvh->nodes[0].box, scene_box);
+        else if (!bvh && units->n_occs)
+            sw__fr_eye_box(env->view.eye, units->scene_box, scene_box);
+    } else {
+        r = collect_all(env, desc, &vis->faces, scene_box, status);
+    }
+    return r == SW_OK ? collect_meshes(env, vis, scene_box, status) : r;
+}
+
+/* ---- the faces' BVH ----------------------------------------------------------------------- */
+static void add_bvh_stats(sw_gpu_frame_stats *st, const sw_sg_bvh_cull_stats *cs)
+{
+    st->bvh_nodes_visited += cs->nodes_visited;
+    st->bvh_nodes_inside += cs->nodes_inside;
+    st->bvh_nodes_partly += cs->nodes_partly;
+    st->bvh_nodes_outside += cs->nodes_outside;
+    st->bvh_items_tested += cs->items_tested;
+    st->bvh_items_visible += cs->items_visible;
+    st->bvh_items_inside += cs->items_inside;
+}
+
+static void view_frustum(const sw__fr_env *env, sw_sg_frustum *fr)
+{
+    memcpy(fr->origin, env->view.eye, sizeof fr->origin);
+    memcpy(fr->planes, env->view.planes, sizeof env->view.planes);
+    fr->n_planes = (int32_t)(sizeof env->view.planes / sizeof env->view.planes[0]);
+}
+
+typedef struct bvh_taker {
+    const sw__fr_env *env;
+    const sw_sg_bvh *bvh;
+    sw__fr_faces *faces;
+} bvh_taker;
+
+static int take_bvh_item(void *ctx, uint32_t item, sw_sg_cull_class cls)
+{
+    (void)cls;
+    bvh_taker *t = ctx;
+    const sw_sg_bvh_item *it = &t->bvh->items[item];
+    occurrence o;
+    double box[6];
+    sw__fr_occurrence_init(&o, it->face, it->world, it->color);
+    sw__fr_eye_box(t->env->view.eye, it->box, box);
+    return !sw__fr_faces_push(t->faces, &o, box);
+}
+
+static sw_result collect_bvh(const sw__fr_env *env, const sw_sg_bvh *bvh, sw__fr_faces *faces,
+                             sw_gpu_frame_stats *st, sw_status *status)
+{
+    sw_sg_frustum fr;
+    view_frustum(env, &fr);
+    bvh_taker t = {env, bvh, faces};
+    sw_sg_bvh_cull_stats cs;
+    const int stopped = sw_sg_bvh_cull(bvh, &fr, take_bvh_item, &t, &cs);
+    st->faces_culled += bvh->n_items - cs.items_visible;
+    add_bvh_stats(st, &cs);
+    if (stopped)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    return SW_OK;
+}
+
+/* ---- back-patch culling ------------------------------------------------------------------ */
+int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6])
+{
+    sw_lod_cone w;
+    return sw_lod_cone_to_world(&fc->cones[o->face], o->world, &w) &&
+           sw_lod_cone_back_facing(&w, box);
+}
+
+static sw_result check_cones(const sw__fr_env *env, const sw_lod_face_cones *fc,
+                             sw_status *status)
+{
+    if (fc->n_faces != env->sv->n_faces)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "frame: face cones of %u faces for a scene of %u", fc->n_faces,
+                        env->sv->n_faces);
+    return SW_OK;
+}
+
+/* Drops (compacting) the back-facing occurrences. */
+static void cull_back_faces(const sw_lod_face_cones *fc, sw__fr_faces *faces,
+                            sw_gpu_frame_stats *st)
+{
+    size_t k = 0;
+    for (size_t i = 0; i < faces->n; ++i) {
+        if (sw__fr_face_back_facing(fc, &faces->occ[i], faces->boxes + 6 * i)) {
+            st->faces_backculled++;
+            st->faces_culled++;
+            continue;
+        }
+        if (k != i) {
+            faces->occ[k] = faces->occ[i];
+            memcpy(faces->boxes + 6 * k, faces->boxes + 6 * i, 6 * sizeof *faces->boxes);
+        }
+        k++;
+    }
+    faces->n = k;
+}
+
+/* ---- the unit-instance BVH (see the top of the file) --------------------------------------- */
+typedef struct instance_taker {
+    const sw__fr_env *env;
+    const sw_lod_static_instances *in;
+    const sw_lod_face_cones *fc; /* NULL: no back-patch culling */
+    sw_sg_frustum fr;
+    sw__fr_visible *vis;
+    sw_gpu_frame_stats *st;
+    uint64_t occs_seen; /* face occurrences of the instances reported */
+    int oom;
+} instance_taker;
+
+/* Back-patch culling of a whole instance: the unit's outward cone in the world faces away from
+ * every view direction into the instance's box (the cone is the full one unless the unit is part
+ * of a closed shell). */
+static int instance_back_facing(const instance_taker *t, const sw_lod_static_unit *un,
+                                const sw_sg_bvh_item *it)
+{
+    sw_lod_cone w;
+    if (!sw_lod_cone_to_world(&un->cone, it->world, &w))
+        return 0;
+    double eb[6];
+    sw__fr_eye_box(t->env->view.eye, it->box, eb);
+    return sw_lod_cone_back_facing(&w, eb);
+}
+
+enum { FACE_OUTSIDE = 0, FACE_BACK = 1, FACE_SHOWN = 2 };
+
+/* Face occurrence k of an instance: outside the frustum (tested only when the instance is partly
+ * visible), back-facing on its own (with cones), or shown; o and eb are set unless outside. */
+static int face_shown(const instance_taker *t, const sw_lod_static_instance *in,
+                      const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls, occurrence *o,
+                      double eb[6])
+{
+    const sw_lod_static_occ *oc = &t->in->occs[in->first_occ + k];
+    double wb[6];
+    sw_sg_box_transform(it->world, t->in->face_boxes + 6 * (size_t)oc->face, wb);
+    if (cls != SW_SG_CULL_INSIDE && sw_sg_frustum_classify(&t->fr, wb) == SW_SG_CULL_OUTSIDE)
+        return FACE_OUTSIDE;
+    sw__fr_occurrence_init(o, oc->face, it->world, oc->color);
+    sw__fr_eye_box(t->env->view.eye, wb, eb);
+    return t->fc && sw__fr_face_back_facing(t->fc, o, eb) ? FACE_BACK : FACE_SHOWN;
+}
+
+/* The instance's shown faces into vis->unit_faces; culled whole when none is. */
+static void take_shown_faces(instance_taker *t, const sw_lod_static_instance *in,
+                             const sw_sg_bvh_item *it, uint32_t item, sw_sg_cull_class cls)
+{
+    sw__fr_visible *vis = t->vis;
+    const size_t first = vis->unit_faces.n;
+    uint64_t back = 0;
+    for (uint32_t k = 0; k < in->n_occ && !t->oom; ++k) {
+        occurrence o;
+        double eb[6];
+        const int shown = face_shown(t, in, it, k, cls, &o, eb);
+        back += shown == FACE_BACK;
+        if (shown == FACE_SHOWN && !sw__fr_faces_push(&vis->unit_faces, &o, eb))
+            t->oom = 1;
+    }
+    const size_t n = vis->unit_faces.n - first;
+    t->st->faces_backculled += back;
+    t->st->faces_culled += in->n_occ - n;
+    if (n == 0 || t->oom)
+        return;
+    if (!sw__gpu_grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
+                      sizeof *vis->instances)) {
+        t->oom = 1;
+        return;
+    }
+    vis->instances[vis->n_instances++] = (sw__fr_instance){item, first, n};
+}
+
+static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
+{
+    instance_taker *t = ctx;
+    const sw_sg_bvh_item *it = &t->in->bvh->items[item];
+    const sw_lod_static_instance *in = &t->in->instances[it->face];
+    t->occs_seen += in->n_occ;
+    if (in->unit != SW_LOD_STATIC_NO_UNIT && t->fc &&
+        instance_back_facing(t, sw_lod_static_set_unit(t->env->statics, in->unit), it)) {
+        t->st->faces_backculled += in->n_occ;
+        t->st->faces_culled += in->n_occ;
+        return 0;
+    }
+    take_shown_faces(t, in, it, item, cls);
+    return t->oom;
+}
+
+static sw_result collect_instances(const sw__fr_env *env, const sw_lod_face_cones *fc,
+                                   sw__fr_visible *vis, sw_gpu_frame_stats *st,
+                                   sw_status *status)
+{
+    instance_taker t;
+    memset(&t, 0, sizeof t);
+    t.env = env;
+    t.in = sw_lod_static_set_instances(env->statics);
+    t.fc = fc;
+    t.vis = vis;
+    t.st = st;
+    view_frustum(env, &t.fr);
+    sw_sg_bvh_cull_stats cs;
+    sw_sg_bvh_cull(t.in->bvh, &t.fr, take_instance, &t, &cs);
+    add_bvh_stats(st, &cs);
+    if (t.oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    st->faces_culled += t.in->n_occs - t.occs_seen; /* in instances outside the frustum */
+    return SW_OK;
+}
+
+sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__fr_visible *vis,
+                      sw_gpu_frame_stats *st, sw_status *status)
+{
+    const sw_lod_face_cones *fc = desc->face_cones;
+    sw_result r = fc ? check_cones(env, fc, status) : SW_OK;
+    if (r == SW_OK && static_instances(env))
+        r = collect_instances(env, fc, vis, st, status);
+    else if (r == SW_OK && face_bvh(desc))
+        r = collect_bvh(env, face_bvh(desc), &vis->faces, st, status);
+    if (r == SW_OK && fc)
+        cull_back_faces(fc, &vis->faces, st);
+    if (r == SW_OK)
+        cull_meshes(env, vis, st);
+    return r;
+}

@@ -1,0 +1,78 @@
+/* SPDX-License-Identifier: MIT */
+/* The submit stage, on the GL thread: the vertex-shader records sorted by grid class into one
+ * batch (their colour and trim rectangle filled from their draws, whose atlas entries the trim
+ * stage set), and the frame drawn (draw.c: upload, one program per path, reversed-Z depth).
+ * Presenting and reading back follow it in sw_gpu_frame_submit. */
+#include "frame_stages.h"
+#include "sw_hooks.h"
+#include "sw_status_util.h"
+
+#include <string.h>
+
+/* Fills the records' colour and trim rectangle from their draws (trim entries are known after the
+ * atlas commit) and sorts them by grid class into ctx->recs_sorted (counting sort). */
+static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g,
+                             sw__gpu_patch_batch *b, sw_status *status)
+{
+    memset(b, 0, sizeof *b);
+    if (g->n_recs == 0)
+        return SW_OK;
+    if (!sw__gpu_grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, g->n_recs,
+                      sizeof *ctx->recs_sorted))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
+    for (size_t i = 0; i < g->n_recs; ++i) {
+        sw__gpu_patch_rec *rec = &g->recs[i];
+        const sw__gpu_draw *d = &g->draws[rec->draw];
+        memcpy(rec->color, d->color, sizeof rec->color);
+        if (d->trim_entry >= 0) {
+            sw__gpu_trim_rect tr;
+            sw__gpu_atlas_rect(ctx, d->trim_entry, &tr);
+            rec->trim_rect[0] = (float)tr.x0;
+            rec->trim_rect[1] = (float)tr.y0;
+            rec->trim_rect[2] = (float)tr.w;
+            rec->trim_rect[3] = (float)tr.h;
+            rec->layer = (float)tr.layer;
+        }
+        b->count[rec->level_v][rec->level_u]++;
+    }
+    uint32_t at = 0, next[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    for (int v = 0; v < SW__GPU_GRID_CLASSES; ++v)
+        for (int u = 0; u < SW__GPU_GRID_CLASSES; ++u) {
+            b->first[v][u] = next[v][u] = at;
+            at += b->count[v][u];
+        }
+    int keep = ctx->capture_max > 0;
+    if (keep && !sw__gpu_grow((void **)&ctx->rec_source, &ctx->cap_rec_source, g->n_recs,
+                              sizeof *ctx->rec_source))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
+    for (size_t i = 0; i < g->n_recs; ++i) {
+        const sw__gpu_patch_rec *rec = &g->recs[i];
+        uint32_t slot = next[rec->level_v][rec->level_u]++;
+        ctx->recs_sorted[slot] = *rec;
+        if (keep)
+            ctx->rec_source[slot] = (uint32_t)i;
+    }
+    b->recs = ctx->recs_sorted;
+    b->n_recs = g->n_recs;
+    b->cps = g->cps;
+    b->n_cps = g->n_cps;
+    b->exact = g->n_pieces > 0;
+    b->pieces = g->pieces;
+    b->n_pieces = g->n_pieces;
+    b->knots = g->knots;
+    b->n_knots = g->n_knots;
+    b->dcps = g->dcps;
+    b->n_dcps = g->n_dcps;
+    return SW_OK;
+}
+
+sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
+                        const sw_gpu_frame_desc *desc, sw__fr_geometry *geo,
+                        sw_status *status)
+{
+    sw__gpu_patch_batch batch;
+    sw_result r = build_batch(ctx, geo, &batch, status);
+    return r == SW_OK ? sw__gpu_draw_frame(ctx, view, desc, &geo->mesh, geo->draws, geo->n_draws,
+                                           &batch, status)
+                      : r;
+}

@@ -1,0 +1,91 @@
+/* SPDX-License-Identifier: MIT */
+/* The tessellate stage for unit instances drawn at a static level (Kumar et al. 1997 §4; the
+ * level is chosen by stage_select.c): the level's triangles under the instance's transform, and
+ * the fat borders of its shown faces.
+ *
+ * Cracks. A unit drawn at level k meets its neighbours — other units at other levels, faces of
+ * the per-frame path, and its own faces (level 0 triangulates face by face) — along borders that
+ * each side approximates within its own tolerance, all within ε_img on screen. Kumar §4.2-§4.3
+ * closes the static-static joins with boundary strips stepped between shared chains (Theorem 1);
+ * our chains are per face (each face's CDT places its own border vertices, and two faces of a
+ * B-rep edge meet only within the edge's tolerance), so no chain is shared to step along. We close
+ * every join the way the per-frame path closes its own (Guthe §7.1): each statically drawn face
+ * gets its fat border along its exact trim loops, the ribbon of width 2 ε_img that covers a crack
+ * between two sides each within ε_img (gpu/crack_fill.c argues the width). The overlap is sized
+ * from both sides' errors because both are bounded by the same ε_img. */
+#include "frame_stages.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Fat-border sampling of a statically drawn face: its uv box cut into cells of about
+ * k_border_px pixels of its unit's screen extent, between 2 and 32 per side. A chord over
+ * 4 px of a curve of radius r px strays 2 / r px from it: within the ribbon's quarter width at
+ * ε_img = 0.5 for r >= 8 px (tighter turns are features of a few pixels). Not rigorous between
+ * samples, as gpu/crack_fill.c says of its own sampling; cost now follows the screen size. */
+enum { STATIC_BORDER_MIN_CELLS = 2, STATIC_BORDER_MAX_CELLS = 32 };
+static const double k_border_px = 4.0;
+
+/* Appends the level's triangles, transformed to eye-relative world space, as one draw. */
+static sw_result append_level(sw__fr_tess *t, const occurrence *o, const sw_lod_static_level *lv,
+                              int32_t level, sw_status *status)
+{
+    const double *m = o->world;
+    /* rigid and similarity transforms keep normals along M n; shading is two-sided */
+    sw__fr_triangles tr = {.positions = lv->positions,
+                           .normals_f = lv->normals,
+                           .normal_matrix = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]},
+                           .n_vertices = lv->n_vertices,
+                           .n_triangles = lv->n_triangles,
+                           .triangles = lv->triangles};
+    occurrence shown = *o;
+    if (t->env->lod_colors)
+        sw__fr_lod_color(level, shown.color);
+    sw_result r = sw__fr_append_triangles(t, &shown, &tr, status);
+    t->st->static_triangles += lv->n_triangles;
+    return r;
+}
+
+/* The fat borders of one statically drawn face occurrence (see the top of the file). */
+static sw_result face_borders(sw__fr_tess *t, const occurrence *o, double extent_px,
+                              sw_status *status)
+{
+    if (t->env->ctx->crack_fill_off)
+        return SW_OK;
+    const sw_sg_face_rec *rec = &t->env->sv->faces[o->face];
+    const double *ub = rec->uv_box;
+    const double cells =
+        fmin(fmax(ceil(extent_px / k_border_px), STATIC_BORDER_MIN_CELLS), STATIC_BORDER_MAX_CELLS);
+    const double cell[2] = {(ub[1] - ub[0]) / cells, (ub[3] - ub[2]) / cells};
+    if (!sw__fr_face_trimmed(t->env, o->face)) {
+        const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
+        return sw__fr_fat_border(t, o, box_loop, 4, 1, cell, NULL, 0, status);
+    }
+    int64_t idx = -1;
+    sw_result r = sw__fr_face_loops(t, o->face, 0.25 * fmin(cell[0], cell[1]), &idx, status);
+    return r == SW_OK ? sw__fr_loop_borders(t, o, idx, cell, status) : r;
+}
+
+sw_result sw__fr_tess_static(sw__fr_tess *t, const sw__fr_visible *vis,
+                             const sw__fr_static_pick *pick, sw_status *status)
+{
+    const sw__fr_instance *vi = &vis->instances[pick->instance];
+    const sw_lod_static_instances *ins = sw_lod_static_set_instances(t->env->statics);
+    const sw_sg_bvh_item *it = &ins->bvh->items[vi->item];
+    const sw_lod_static_occ *oc0 = &ins->occs[ins->instances[it->face].first_occ];
+    occurrence first;
+    sw__fr_occurrence_init(&first, oc0->face, it->world, oc0->color);
+    sw_result r = append_level(t, &first, &pick->chain->levels[pick->level], pick->level, status);
+    t->st->static_units_drawn++;
+    t->st->static_levels_used |= 1u << (pick->level < 31 ? pick->level : 31);
+    for (size_t k = vi->first_face; k < vi->first_face + vi->n_faces && r == SW_OK; ++k) {
+        occurrence o = vis->unit_faces.occ[k];
+        if (t->env->lod_colors)
+            sw__fr_lod_color(-1, o.color); /* borders as the per-frame path colours its faces */
+        r = face_borders(t, &o, pick->extent_px, status);
+        t->st->static_faces++;
+        t->st->faces_drawn++;
+    }
+    return r;
+}

@@ -1,0 +1,195 @@
+/* SPDX-License-Identifier: MIT */
+/* The trim stage: trim textures for every trimmed draw (Guthe et al. 2005 §4, §5.3) through the
+ * context's atlas (§4.4).
+ *
+ * The plan (plain memory, on the visibility thread): each pending trim's resolution class — its
+ * wanted texels (§5.3, from the tessellate stage) rounded up to a power-of-two footprint, all
+ * scaled down together when the frame's footprints exceed the atlas budget — and, for a texture
+ * over a face's whole trim box, the face's loops flattened at half its texel, with the face's
+ * fat borders (§7.1) along those loops. The atlas (the GL thread): each texture found in the
+ * atlas (kept across frames) or added and rendered by fan parity; a tile's or a node part's
+ * texture from the face's loops clipped to its rectangle grown by one texel (the clipped border
+ * then falls in the entry's gutter), keyed by the rectangle. */
+#include "frame_stages.h"
+#include "sw_hooks.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const double k_max_frame_texels = 256e6; /* R8 trim texels per frame */
+
+/* Footprints (texture plus gutters) are powers of two, so that a class changes only when the
+ * wanted resolution doubles or halves, and pages pack them tightly. */
+int32_t sw__fr_class_texels(double want, int32_t max_entry)
+{
+    int32_t foot = 16;
+    while (foot - 2 * SW__GPU_ATLAS_GUTTER < want && foot - 2 * SW__GPU_ATLAS_GUTTER < max_entry)
+        foot *= 2;
+    int32_t n = foot - 2 * SW__GPU_ATLAS_GUTTER;
+    return n < max_entry ? n : max_entry;
+}
+
+/* Classified just left of the middle of the loop's longest edge (loops are simple, so one point
+ * decides for the whole loop). */
+int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k)
+{
+    const sw_sg_polyline *l = &loops[k];
+    uint32_t best = 0;
+    double best_len = -1.0;
+    for (uint32_t i = 0; i < l->count; ++i) {
+        const double *a = l->uv + 2 * i, *b = l->uv + 2 * ((i + 1) % l->count);
+        double len = hypot(b[0] - a[0], b[1] - a[1]);
+        if (len > best_len) {
+            best_len = len;
+            best = i;
+        }
+    }
+    if (l->count < 2 || !(best_len > 0.0))
+        return 1;
+    const double *a = l->uv + 2 * best, *b = l->uv + 2 * ((best + 1) % l->count);
+    double t[2] = {(b[0] - a[0]) / best_len, (b[1] - a[1]) / best_len}, step = 1e-3 * best_len;
+    double u = 0.5 * (a[0] + b[0]) - t[1] * step, v = 0.5 * (a[1] + b[1]) + t[0] * step;
+    return sw_sg_trim_classify(loops, n_loops, u, v);
+}
+
+/* ---- the plan ---------------------------------------------------------------------------------
+ */
+/* Atlas texels the frame's trims take at `scale`: their classes' footprints, gutters included. */
+static double trim_footprint(const sw__fr_geometry *g, int32_t max_entry, double scale)
+{
+    const int32_t g2 = 2 * SW__GPU_ATLAS_GUTTER;
+    double sum = 0.0;
+    for (size_t i = 0; i < g->n_trims; ++i)
+        sum += (double)(sw__fr_class_texels(g->trims[i].width * scale, max_entry) + g2) *
+               (double)(sw__fr_class_texels(g->trims[i].height * scale, max_entry) + g2);
+    return sum;
+}
+
+/* The common scale of the wanted trim resolutions that keeps the frame's atlas footprints within
+ * k_max_frame_texels. The wanted texels alone are no bound: rounding up to classes and the gutters
+ * make the footprints up to ~4x larger (a 10^6-surface building wanted 3.4e8 texels, scaled to the
+ * budget, and still needed 5.7e8, more than the atlas holds). Each step shrinks the scale by at
+ * least 10 %; when every trim is at the smallest class the footprints cannot shrink further and the
+ * atlas reports the overflow. */
+static double trim_scale(const sw__fr_geometry *g, int32_t max_entry)
+{
+    double total = 0.0;
+    for (size_t i = 0; i < g->n_trims; ++i)
+        total += g->trims[i].width * g->trims[i].height;
+    double scale = total > k_max_frame_texels ? sqrt(k_max_frame_texels / total) : 1.0;
+    for (int step = 0; step < 64; ++step) {
+        const double foot = trim_footprint(g, max_entry, scale);
+        if (foot <= k_max_frame_texels)
+            break;
+        scale *= fmin(0.9, sqrt(k_max_frame_texels / foot));
+    }
+    return scale;
+}
+
+/* A whole-box texture's loops, flattened at half its texel, and the face's fat borders. */
+static sw_result plan_whole_box(sw__fr_tess *t, size_t i, sw_status *status)
+{
+    pending_trim *p = &t->geo->trims[i];
+    const double *ub = t->env->sv->faces[p->occ.face].uv_box;
+    const double tol = 0.5 * fmin((ub[1] - ub[0]) / p->w, (ub[3] - ub[2]) / p->h);
+    int64_t loops = -1;
+    sw_result r = sw__fr_face_loops(t, p->occ.face, tol, &loops, status);
+    p->loops = loops;
+    if (r == SW_OK) /* the borders add untrimmed draws: p stays where it is */
+        r = sw__fr_loop_borders(t, &p->occ, loops, p->cell, status);
+    return r;
+}
+
+sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_frame_stats *st,
+                           sw_status *status)
+{
+    sw__fr_tess t;
+    memset(&t, 0, sizeof t);
+    t.env = env;
+    t.st = st;
+    t.geo = geo;
+    const int32_t max_entry = sw__gpu_atlas_max_entry(env->ctx);
+    const double scale = trim_scale(geo, max_entry);
+    sw_result r = SW_OK;
+    for (size_t i = 0; i < geo->n_trims && r == SW_OK; ++i) {
+        pending_trim *p = &geo->trims[i];
+        p->w = sw__fr_class_texels(p->width * scale, max_entry);
+        p->h = sw__fr_class_texels(p->height * scale, max_entry);
+        if (!p->clip)
+            r = plan_whole_box(&t, i, status);
+    }
+    return r;
+}
+
+/* ---- the atlas (GL thread) --------------------------------------------------------------------
+ */
+static sw__gpu_trim_key trim_key(const sw_sg_scene *scene, uint32_t face,
+                                 const sw_sg_face_rec *rec, const double rect[4])
+{
+    return (sw__gpu_trim_key){sw_sg_scene_serial(scene),
+                              face,
+                              rec->first_loop,
+                              rec->n_loops,
+                              {rect[0], rect[1], rect[2], rect[3]}};
+}
+
+/* A clipped texture's loops: the face's, clipped to the rectangle grown by one texel. */
+static sw_result add_clipped(sw_gpu_context *ctx, const sw__gpu_trim_key *key,
+                             const pending_trim *p, const face_loops *fl, int32_t *id,
+                             sw_status *status)
+{
+    const double *r = p->rect;
+    const double mu = (r[1] - r[0]) / p->w, mv = (r[3] - r[2]) / p->h;
+    const double g[4] = {r[0] - mu, r[1] + mu, r[2] - mv, r[3] + mv};
+    sw_sg_polyline *clipped = sw__calloc(fl->n ? fl->n : 1, sizeof *clipped);
+    if (!clipped)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", p->occ.face);
+    sw_result res = sw__gpu_trim_clip_loops(fl->loops, fl->n, g, clipped, status);
+    if (res == SW_OK) {
+        res = sw__gpu_atlas_add(ctx, key, p->w, p->h, clipped, fl->n, id, status);
+        for (uint32_t k = 0; k < fl->n; ++k)
+            sw_sg_polyline_free(&clipped[k]);
+    }
+    sw__free(clipped);
+    return res;
+}
+
+static sw_result atlas_entry(sw_gpu_context *ctx, const sw_sg_scene *scene, sw__fr_geometry *g,
+                             const pending_trim *p, sw_status *status)
+{
+    const sw_sg_face_rec *rec = &sw_sg_scene_view_ptr(scene)->faces[p->occ.face];
+    const sw__gpu_trim_key key = trim_key(scene, p->occ.face, rec, p->clip ? p->rect : rec->uv_box);
+    int32_t id = sw__gpu_atlas_find(ctx, &key, p->w, p->h);
+    sw_result r = SW_OK;
+    if (id < 0) {
+        const face_loops *fl = &g->loops[p->loops];
+        r = p->clip ? add_clipped(ctx, &key, p, fl, &id, status)
+                    : sw__gpu_atlas_add(ctx, &key, p->w, p->h, fl->loops, fl->n, &id, status);
+    }
+    g->draws[p->draw].trim_entry = id;
+    return r;
+}
+
+sw_result sw__fr_trim_atlas(sw_gpu_context *ctx, const sw_sg_scene *scene, sw__fr_geometry *geo,
+                            sw_gpu_frame_stats *st, sw_status *status)
+{
+    sw_result r = sw__gpu_atlas_begin(ctx, status);
+    for (size_t i = 0; i < geo->n_trims && r == SW_OK; ++i)
+        r = atlas_entry(ctx, scene, geo, &geo->trims[i], status);
+    sw__gpu_atlas_stats as;
+    memset(&as, 0, sizeof as);
+    if (r == SW_OK)
+        r = sw__gpu_atlas_commit(ctx, &as, status);
+    for (size_t i = 0; i < geo->n_shares; ++i)
+        geo->draws[geo->shares[2 * i]].trim_entry = geo->draws[geo->shares[2 * i + 1]].trim_entry;
+    st->trim_textures = as.entries;
+    st->trim_texels = as.entry_texels;
+    st->trim_reused = as.reused;
+    st->atlas_pages = as.pages;
+    st->atlas_texels = (uint64_t)as.pages * (uint64_t)as.side * (uint64_t)as.side;
+    st->atlas_switches = as.switches;
+    glFinish();
+    return r;
+}
