@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Draw submission and readback shared by the scene path and the plain-triangle path: one program,
  * reversed-Z depth (cleared to 0, GL_GREATER), trim-texture lookups for trimmed ranges (Guthe et
  * al. 2005 §4.3), glReadPixels with rows flipped to top-first and depth turned into eye-space

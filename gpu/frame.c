@@ -116,8 +116,7 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
     return SW_OK;
 }
 
-static sw_result hierarchy_init(sw_gpu_frame_plan *p, const sw_sg_scene *scene,
-                                sw_status *status)
+static sw_result hierarchy_init(sw_gpu_frame_plan *p, const sw_sg_scene *scene, sw_status *status)
 {
     sw__fr_hierarchy *hy = &p->hy;
     hy->reader = -1;
@@ -139,11 +138,12 @@ sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *d, const dou
                           sw_status *status)
 {
     static const double k_origin[3] = {0.0, 0.0, 0.0};
-    const double near_plane = d->near_plane > 0.0         ? d->near_plane
-                              : scene_box[0] <= scene_box[3] ? sw__gpu_near_plane(k_origin, scene_box)
-                                                             : 1.0;
-    sw_result r = sw__gpu_view_init(&env->view, &d->camera, d->width, d->height, near_plane,
-                                    status);
+    const double near_plane = d->near_plane > 0.0 ? d->near_plane
+                              : scene_box[0] <= scene_box[3]
+                                  ? sw__gpu_near_plane(k_origin, scene_box)
+                                  : 1.0;
+    sw_result r =
+        sw__gpu_view_init(&env->view, &d->camera, d->width, d->height, near_plane, status);
     screen_view_init(env);
     return r;
 }

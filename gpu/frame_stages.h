@@ -38,9 +38,9 @@ enum {
     MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
 };
 static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
-static const double k_tile_texels = 1024.0; /* wanted trim texels per direction above which a
-                                               face's trim box is split into tiles, or a
-                                               hierarchy node into parts */
+static const double k_tile_texels = 1024.0;      /* wanted trim texels per direction above which a
+                                                    face's trim box is split into tiles, or a
+                                                    hierarchy node into parts */
 
 /* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
  * for predefined grids (§4.2) the counts a grid class, or pieces of one class, can draw. */
@@ -57,11 +57,11 @@ typedef struct sw__fr_env {
     sw__gpu_view view;
     sw_lod_screen_view screen; /* the view as the density bound needs it */
     segment_set gpu_segments, cpu_segments;
-    double eps_px;        /* ε_img */
-    int exact;            /* desc.eval_exact */
-    int walkthrough;      /* desc.walkthrough: never wait for the pool */
-    int lod_colors;       /* desc.lod_colors */
-    int32_t static_force; /* desc.static_force */
+    double eps_px;              /* ε_img */
+    int exact;                  /* desc.eval_exact */
+    int walkthrough;            /* desc.walkthrough: never wait for the pool */
+    int lod_colors;             /* desc.lod_colors */
+    int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
 } sw__fr_env;
 
@@ -72,8 +72,8 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
 /* The view, its near plane from the eye-relative scene box (the cull stage's) unless the desc
  * gives one; the density bound's view and the grid classes' segment counts. Errors: those of
  * sw__gpu_view_init. */
-sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *desc,
-                          const double scene_box[6], sw_status *status);
+sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *desc, const double scene_box[6],
+                          sw_status *status);
 
 /* A face occurrence as the frame draws it. */
 typedef struct occurrence {
@@ -112,7 +112,7 @@ typedef struct sw__fr_mesh_occ {
 } sw__fr_mesh_occ;
 
 typedef struct sw__fr_visible {
-    sw__fr_faces faces;      /* without static LODs: the visible face occurrences */
+    sw__fr_faces faces;         /* without static LODs: the visible face occurrences */
     sw__fr_instance *instances; /* with static LODs: the visible unit instances, BVH order */
     size_t n_instances, cap_instances;
     sw__fr_faces unit_faces; /* their shown faces */
@@ -261,8 +261,8 @@ typedef struct sw__fr_tess {
     const sw__fr_env *env;
     sw_gpu_frame_stats *st;
     sw__fr_geometry *geo;
-    sw_sg_bezier_set **bez;     /* per face, extracted on first use in this frame */
-    const occurrence *ex_occ;   /* exact path: the occurrence whose net is at ex_base */
+    sw_sg_bezier_set **bez;   /* per face, extracted on first use in this frame */
+    const occurrence *ex_occ; /* exact path: the occurrence whose net is at ex_base */
     sw__gpu_exact_piece ex_base;
     sw_sg_surface ex_srf;
 } sw__fr_tess;
@@ -344,8 +344,7 @@ int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_
 /* ---- submit: stage_submit.c ------------------------------------------------------------------ */
 /* Batch, upload, draw. GL thread. */
 sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
-                        const sw_gpu_frame_desc *desc, sw__fr_geometry *geo,
-                        sw_status *status);
+                        const sw_gpu_frame_desc *desc, sw__fr_geometry *geo, sw_status *status);
 
 /* ---- geometry helpers (frame_geom.c) -------------------------------------------------------- */
 /* Homogeneous control point mapped to eye-relative world space: w x' = R (w x) + w (t - eye). */
@@ -355,8 +354,7 @@ void sw__fr_box_add(double box[6], const double h[4]); /* adds the point h / h[3
 /* World box to eye-relative. */
 void sw__fr_eye_box(const double eye[3], const double world[6], double out[6]);
 /* Eye-relative box of an object box's corners under m. */
-void sw__fr_eye_box_of(const double eye[3], const double obj[6], const double m[12],
-                       double out[6]);
+void sw__fr_eye_box_of(const double eye[3], const double obj[6], const double m[12], double out[6]);
 double sw__fr_det3(const double m[12]);
 /* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm, 1 for a rigid one. */
 double sw__fr_stretch_bound(const double m[12]);

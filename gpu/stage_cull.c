@@ -266,8 +266,7 @@ int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, co
            sw_lod_cone_back_facing(&w, box);
 }
 
-static sw_result check_cones(const sw__fr_env *env, const sw_lod_face_cones *fc,
-                             sw_status *status)
+static sw_result check_cones(const sw__fr_env *env, const sw_lod_face_cones *fc, sw_status *status)
 {
     if (fc->n_faces != env->sv->n_faces)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
@@ -385,8 +384,7 @@ static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
 }
 
 static sw_result collect_instances(const sw__fr_env *env, const sw_lod_face_cones *fc,
-                                   sw__fr_visible *vis, sw_gpu_frame_stats *st,
-                                   sw_status *status)
+                                   sw__fr_visible *vis, sw_gpu_frame_stats *st, sw_status *status)
 {
     instance_taker t;
     memset(&t, 0, sizeof t);

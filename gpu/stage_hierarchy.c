@@ -116,9 +116,8 @@ static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double 
     sw__fr_selection *sel = hf->sel;
     if (!sel)
         return;
-    if (hf->n_chosen >= MAX_ITEMS_PER_FACE ||
-        !sw__gpu_grow((void **)&sel->items, &sel->cap_items, sel->n_items + 1,
-                      sizeof *sel->items)) {
+    if (hf->n_chosen >= MAX_ITEMS_PER_FACE || !sw__gpu_grow((void **)&sel->items, &sel->cap_items,
+                                                            sel->n_items + 1, sizeof *sel->items)) {
         hf->oom = 1;
         return;
     }
@@ -195,8 +194,8 @@ static void visit(hl_face *hf, const hl_item *it)
         return;
     }
     double z = sw__gpu_view_box_depth(&env->view, box);
-    double eps_obj =
-        sw_lod_object_tolerance(env->eps_px, z, env->view.focal_px, env->view.tan_x, env->view.tan_y);
+    double eps_obj = sw_lod_object_tolerance(env->eps_px, z, env->view.focal_px, env->view.tan_x,
+                                             env->view.tan_y);
     trim_need need = {1.0, 1.0};
     if (hf->trimmed) {
         need.u = fmax(1.0, n->tex_c[0] * hf->scale * (it->range[1] - it->range[0]) / eps_obj);

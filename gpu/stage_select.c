@@ -56,7 +56,8 @@ double sw__fr_unit_tolerance(const sw__fr_env *env, const double obj_box[6], con
     const double z = sw__gpu_view_box_depth(v, eb);
     const double diag = sqrt((eb[3] - eb[0]) * (eb[3] - eb[0]) + (eb[4] - eb[1]) * (eb[4] - eb[1]) +
                              (eb[5] - eb[2]) * (eb[5] - eb[2]));
-    const double eps_world = sw_lod_object_tolerance(env->eps_px, z, v->focal_px, v->tan_x, v->tan_y);
+    const double eps_world =
+        sw_lod_object_tolerance(env->eps_px, z, v->focal_px, v->tan_x, v->tan_y);
     *extent_px = diag * env->eps_px / eps_world;
     return eps_world / sw__fr_stretch_bound(m);
 }
@@ -161,8 +162,7 @@ static sw_result select_instances(const sw__fr_env *env, const sw__fr_visible *v
         for (size_t k = vi->first_face; k < vi->first_face + vi->n_faces; ++k)
             if (!sw__fr_faces_push(perframe, &vis->unit_faces.occ[k],
                                    vis->unit_faces.boxes + 6 * k))
-                return sw__fail(status, SW_ERR_OUT_OF_MEMORY,
-                                "visible occurrences: out of memory");
+                return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
     }
     return SW_OK;
 }

@@ -11,8 +11,8 @@
 
 /* Fills the records' colour and trim rectangle from their draws (trim entries are known after the
  * atlas commit) and sorts them by grid class into ctx->recs_sorted (counting sort). */
-static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g,
-                             sw__gpu_patch_batch *b, sw_status *status)
+static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_patch_batch *b,
+                             sw_status *status)
 {
     memset(b, 0, sizeof *b);
     if (g->n_recs == 0)
@@ -67,8 +67,7 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g,
 }
 
 sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
-                        const sw_gpu_frame_desc *desc, sw__fr_geometry *geo,
-                        sw_status *status)
+                        const sw_gpu_frame_desc *desc, sw__fr_geometry *geo, sw_status *status)
 {
     sw__gpu_patch_batch batch;
     sw_result r = build_batch(ctx, geo, &batch, status);

@@ -101,10 +101,10 @@ void sw__fr_report_patch(const sw__fr_tess *t, const occurrence *o, const sw__gp
                          double s0, double s1, double t0, double t1, int32_t nu, int32_t nv,
                          int gpu, int trimmed)
 {
-    sw__gpu_drawn_patch d = {&t->env->view, o->face, o->world, pt->deg_u, pt->deg_v, pt->cpw,
-                             pt->u0,        pt->u1,  pt->v0,   pt->v1,    s0,        s1,
-                             t0,            t1,      nu,       nv,        gpu,       trimmed,
-                             pt->eps};
+    sw__gpu_drawn_patch d = {
+        &t->env->view, o->face, o->world, pt->deg_u, pt->deg_v, pt->cpw, pt->u0, pt->u1,
+        pt->v0,        pt->v1,  s0,       s1,        t0,        t1,      nu,     nv,
+        gpu,           trimmed, pt->eps};
     t->env->ctx->patch_hook(t->env->ctx->patch_hook_user, &d);
 }
 
@@ -306,8 +306,8 @@ sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *
     *index = (int64_t)g->n_loops++;
     sw_result r = SW_OK;
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k, ++fl->n)
-        r = sw_sg_trim_flatten_loop(t->env->scene, rec->first_loop + k, tol,
-                                    MAX_TRIM_LOOP_VERTICES, &fl->loops[k], status);
+        r = sw_sg_trim_flatten_loop(t->env->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
+                                    &fl->loops[k], status);
     return r;
 }
 
@@ -322,8 +322,8 @@ sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops
     return r;
 }
 
-static sw_result tess_face(sw__fr_tess *t, const sw__fr_selection *sel,
-                           const sw__fr_face_pick *p, sw_status *status)
+static sw_result tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,
+                           sw_status *status)
 {
     if (!p->hierarchy)
         return sw__fr_tess_direct(t, &p->occ, status);

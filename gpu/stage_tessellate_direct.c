@@ -549,7 +549,8 @@ sw_result sw__fr_tess_direct(sw__fr_tess *f, const occurrence *o, sw_status *sta
             r = gpu_face(f, o, pt, n, sign, trimmed, &need, cell, status);
             f->st->patches_gpu_evaluated += drawn;
         } else {
-            r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->geo->mesh, status);
+            r = sw__gpu_tessellate_face(pt, n_cols, n_rows, sign, rec->uv_box, &f->geo->mesh,
+                                        status);
             for (size_t p = 0; p < n && f->env->ctx->patch_hook; ++p)
                 if (pt[p].visible)
                     sw__fr_report_patch(f, o, &pt[p], pt[p].s0, pt[p].s1, pt[p].t0, pt[p].t1,
@@ -577,4 +578,3 @@ sw_result sw__fr_tess_direct(sw__fr_tess *f, const occurrence *o, sw_status *sta
     sw__free(cpw);
     return r;
 }
-

@@ -142,8 +142,8 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     int32_t deg_u, deg_v;
     lowest_degree(c->cpw, low, &deg_u, &deg_v);
     sw_lod_screen_density d;
-    sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->env->gpu_segments.n, f->env->gpu_segments.count,
-                           MAX_BOUND_SUBDIVISION, &d);
+    sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->env->gpu_segments.n,
+                           f->env->gpu_segments.count, MAX_BOUND_SUBDIVISION, &d);
     pt->eps = d.eps_obj;
     pt->nu = d.nu;
     pt->nv = d.nv;
@@ -336,7 +336,6 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
     sw__free(pts);
     return r;
 }
-
 
 sw_result sw__fr_tess_hierarchy(sw__fr_tess *f, const occurrence *o, const hl_choice *items,
                                 size_t n, sw_status *status)

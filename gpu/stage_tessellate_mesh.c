@@ -96,7 +96,6 @@ sw_result sw__fr_append_triangles(sw__fr_tess *f, const occurrence *o, const sw_
     return r;
 }
 
-
 sw_result sw__fr_tess_meshes(sw__fr_tess *f, const sw__fr_visible *vis, sw_status *status)
 {
     sw_result r = SW_OK;

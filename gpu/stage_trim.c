@@ -125,8 +125,8 @@ sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_f
 
 /* ---- the atlas (GL thread) --------------------------------------------------------------------
  */
-static sw__gpu_trim_key trim_key(const sw_sg_scene *scene, uint32_t face,
-                                 const sw_sg_face_rec *rec, const double rect[4])
+static sw__gpu_trim_key trim_key(const sw_sg_scene *scene, uint32_t face, const sw_sg_face_rec *rec,
+                                 const double rect[4])
 {
     return (sw__gpu_trim_key){sw_sg_scene_serial(scene),
                               face,

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Internal interfaces of gpu/ (never installed): the context's GL objects, the view set-up shared
  * by every draw path, CPU grid tessellation of Bézier patches (Guthe et al. 2005 §4.2, §5.2, on
  * the CPU in this slice) and trim-texture generation by fan parity (§4, §4.1, §7.1).
@@ -32,7 +33,8 @@ typedef enum sw__gpu_eval_mode {
 void sw__gpu_set_eval_mode(sw_gpu_context *ctx, sw__gpu_eval_mode mode);
 
 /* One instance of a predefined grid: a rational Bézier patch (or a piece of its domain) evaluated
- * by the vertex shader. std430 layout, mirrored by the GLSL struct in shaders.c (112 bytes). */
+ * by the vertex shader. std430 layout, mirrored by the GLSL struct in glsl/eval.vert.glsl
+ * (112 bytes). */
 typedef struct sw__gpu_patch_rec {
     float st[4];        /* s0, s1, t0, t1: the part of the local domain [0,1]^2 sampled */
     float trim_map[4];  /* trim lookup: (m0 + s m1, m2 + t m3) in the face's uv box's [0,1]^2 */
@@ -48,8 +50,8 @@ typedef struct sw__gpu_patch_rec {
 } sw__gpu_patch_rec;
 
 /* Exact evaluation (eval_exact): what a record's cp indexes instead of Bézier control points —
- * one B-spline span of a face occurrence. std430, mirrored by the GLSL struct in shaders.c
- * (64 bytes). The record's st maps to u = u0 + s (u1 - u0), v likewise. */
+ * one B-spline span of a face occurrence. std430, mirrored by the GLSL struct in
+ * glsl/exact.vert.glsl (64 bytes). The record's st maps to u = u0 + s (u1 - u0), v likewise. */
 typedef struct sw__gpu_exact_piece {
     double u0, u1, v0, v1; /* the Bézier patch's rectangle in the face's parameters */
     uint32_t ku, kv;       /* first knot of the face's u and v knot vectors (double index) */
@@ -119,7 +121,8 @@ struct sw_gpu_context {
     sw__gpu_surface_programs surf; /* the surface programs frames draw with */
     /* trim-texture program: 2D positions in clip space, constant colour */
     GLuint prog_trim;
-    /* depth-compositing present: a fullscreen triangle reading the render target (shaders.c) */
+    /* depth-compositing present: a fullscreen triangle reading the render target
+     * (glsl/present.vert.glsl, present.frag.glsl) */
     GLuint prog_present;
     GLuint vao;
     /* main render target */

@@ -24,7 +24,7 @@
  * Loops are stored in entry-local texel coordinates, clamped to the entry's rectangle grown by one
  * texel: a loop straying outside its uv box (flattening tolerance, a box from rounded data) can
  * then reach at most its own gutter, which lookups never read (they are clamped half a texel
- * inside the rectangle, shaders.c).
+ * inside the rectangle, glsl/surface_trim.frag.glsl).
  */
 #include "sw_gpu_internal.h"
 #include "sw_hooks.h"

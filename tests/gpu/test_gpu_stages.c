@@ -138,13 +138,13 @@ static int back_facing_everywhere(const sw_sg_scene *scene, const occurrence *o,
     sw_sg_surface srf;
     sw_sg_scene_face_surface(scene, o->face, &srf);
     const double *m = o->world, *ub = rec->uv_box;
-    const double cof[9] = {m[5] * m[10] - m[6] * m[9], m[6] * m[8] - m[4] * m[10],
-                           m[4] * m[9] - m[5] * m[8],  m[2] * m[9] - m[1] * m[10],
-                           m[0] * m[10] - m[2] * m[8], m[1] * m[8] - m[0] * m[9],
-                           m[1] * m[6] - m[2] * m[5],  m[2] * m[4] - m[0] * m[6],
-                           m[0] * m[5] - m[1] * m[4]};
+    const double cof[9] = {
+        m[5] * m[10] - m[6] * m[9], m[6] * m[8] - m[4] * m[10], m[4] * m[9] - m[5] * m[8],
+        m[2] * m[9] - m[1] * m[10], m[0] * m[10] - m[2] * m[8], m[1] * m[8] - m[0] * m[9],
+        m[1] * m[6] - m[2] * m[5],  m[2] * m[4] - m[0] * m[6],  m[0] * m[5] - m[1] * m[4]};
     const double det = m[0] * cof[0] + m[1] * cof[1] + m[2] * cof[2];
-    const double flip = ((rec->flags & SW_SG_FACE_REVERSED) ? -1.0 : 1.0) * (det < 0.0 ? -1.0 : 1.0);
+    const double flip =
+        ((rec->flags & SW_SG_FACE_REVERSED) ? -1.0 : 1.0) * (det < 0.0 ? -1.0 : 1.0);
     enum { N = 9 };
     for (int j = 0; j < N; ++j)
         for (int i = 0; i < N; ++i) {
@@ -242,8 +242,8 @@ static void check_select(const stages *s, const char *name)
                     found = in_rect(items[k].rect, ub, u, v);
                 holes += !found;
                 if (!found && holes <= 5 && getenv("SW_TEST_DEBUG")) {
-                    printf("  hole: face %u (%zu items) at (%g, %g), box %g %g %g %g\n", p->occ.face,
-                           p->n_items, u, v, ub[0], ub[1], ub[2], ub[3]);
+                    printf("  hole: face %u (%zu items) at (%g, %g), box %g %g %g %g\n",
+                           p->occ.face, p->n_items, u, v, ub[0], ub[1], ub[2], ub[3]);
                     for (size_t k = 0; k < p->n_items; ++k)
                         printf("    item %d/%d: %g %g %g %g\n", items[k].it.node,
                                items[k].it.part_depth, items[k].rect[0], items[k].rect[1],
@@ -292,7 +292,8 @@ static void check_tessellate(const stages *s, const char *name)
           (unsigned long long)s->st.triangles, (unsigned long long)(tri + g->border_triangles));
 }
 
-/* ---- trim -------------------------------------------------------------------------------------- */
+/* ---- trim --------------------------------------------------------------------------------------
+ */
 static void check_trim_plan(const stages *s, const char *name)
 {
     const sw__fr_geometry *g = &s->geo;
@@ -345,7 +346,8 @@ static void check_atlas(sw_gpu_context *ctx, const stages *s, const char *name)
     CHECK(bad == 0, "%s: %zu trimmed draws without an atlas entry of the planned size", name, bad);
 }
 
-/* ---- submit ------------------------------------------------------------------------------------ */
+/* ---- submit ------------------------------------------------------------------------------------
+ */
 static void check_chain(sw_gpu_context *ctx, const sw_sg_scene *scene,
                         const sw_gpu_frame_desc *desc, stages *s, const char *name)
 {
@@ -385,7 +387,8 @@ static void check_submit_analytic(sw_gpu_context *ctx)
     sw_status st = {0};
     sw__fr_geometry g;
     memset(&g, 0, sizeof g);
-    float cps[16] = {-0.5f, -0.5f, -1, 1, 0.5f, -0.5f, -1, 1, -0.5f, 0.5f, -1, 1, 0.5f, 0.5f, -1, 1};
+    float cps[16] = {-0.5f, -0.5f, -1, 1, 0.5f, -0.5f, -1, 1,
+                     -0.5f, 0.5f,  -1, 1, 0.5f, 0.5f,  -1, 1};
     sw__gpu_patch_rec rec;
     memset(&rec, 0, sizeof rec);
     rec.st[1] = rec.st[3] = 1.0f;
@@ -418,7 +421,8 @@ static void check_submit_analytic(sw_gpu_context *ctx)
             /* pixel centre to the plane z = -1 (top row first) */
             const double px = (x + 0.5 - 0.5 * W) / focal, py = (0.5 * H - (y + 0.5)) / focal;
             const int want = fabs(px) < 0.5 && fabs(py) < 0.5;
-            const int edge = fabs(fabs(px) - 0.5) < 1.0 / focal || fabs(fabs(py) - 0.5) < 1.0 / focal;
+            const int edge =
+                fabs(fabs(px) - 0.5) < 1.0 / focal || fabs(fabs(py) - 0.5) < 1.0 / focal;
             const int got = img.rgba[4 * ((size_t)y * W + (size_t)x) + 3] != 0;
             covered += got;
             wrong += got != want && !edge;
@@ -428,7 +432,8 @@ static void check_submit_analytic(sw_gpu_context *ctx)
     sw_gpu_image_free(&img);
 }
 
-/* ---- driver ------------------------------------------------------------------------------------ */
+/* ---- driver ------------------------------------------------------------------------------------
+ */
 static void run_model(sw_gpu_context *ctx, const char *path)
 {
     sw_sg_import_desc id = {path, NULL, NULL, NULL};
@@ -437,7 +442,8 @@ static void run_model(sw_gpu_context *ctx, const char *path)
     sw_lod_face_cones *fc = NULL;
     sw_lod_cache *cache = NULL;
     sw_status st = {0};
-    if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK || sw_sg_bvh_build(scene, &bvh, &st) != SW_OK ||
+    if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK ||
+        sw_sg_bvh_build(scene, &bvh, &st) != SW_OK ||
         sw_lod_face_cones_build(scene, &fc, &st) != SW_OK ||
         sw_lod_cache_create(scene, g_pool, NULL, &cache, &st) != SW_OK || bvh->n_nodes == 0) {
         CHECK(0, "%s: import, BVH, cones or cache: %s", path, st.message);
