@@ -150,7 +150,8 @@ void sw_gpu_camera_fit_box(const double box[6], const double from[3], const doub
     for (int k = 0; k < 3; k++)
         diag2 += (box[3 + k] - box[k]) * (box[3 + k] - box[k]);
     const double diag = diag2 > 0.0 ? sqrt(diag2) : 1.0;
-    const double fovy = 40.0, distance = diag / (2.0 * tan(fovy * M_PI / 360.0)) * 1.1;
+    const double fovy = SW_DEFAULT_FOVY_DEG,
+                 distance = diag / (2.0 * tan(fovy * M_PI / 360.0)) * 1.1;
     const double len = sqrt(dot3(from, from));
     memset(out, 0, sizeof *out);
     for (int k = 0; k < 3; k++) {

@@ -16,11 +16,11 @@ void sw__gpu_desc_defaults(const sw_gpu_frame_desc *in, sw_gpu_frame_desc *out)
 {
     *out = *in;
     if (out->width == 0 && out->height == 0) {
-        out->width = 1280;
-        out->height = 720;
+        out->width = SW_DEFAULT_WIDTH;
+        out->height = SW_DEFAULT_HEIGHT;
     }
     if (!(out->error_px > 0.0))
-        out->error_px = 0.5;
+        out->error_px = SW_DEFAULT_ERROR_PX;
 }
 
 double sw__gpu_near_plane(const double eye[3], const double world_box[6])

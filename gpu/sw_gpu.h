@@ -16,6 +16,7 @@
 #include "sw_sg_scene.h"
 
 #include <splinewalk/sw_result.h>
+#include <splinewalk/sw_defaults.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -59,8 +60,8 @@ void sw_gpu_camera_fit_box(const double box[6], const double from[3], const doub
                            sw_gpu_camera *out);
 
 typedef struct sw_gpu_frame_desc {
-    int32_t width, height; /* 0 = 1280 x 720 */
-    double error_px;       /* screen-space error bound ε_img in pixels; 0 = 0.5 */
+    int32_t width, height; /* 0 = SW_DEFAULT_WIDTH x SW_DEFAULT_HEIGHT */
+    double error_px;       /* screen-space error bound ε_img in pixels; 0 = SW_DEFAULT_ERROR_PX */
     sw_gpu_camera camera;
     float background[4]; /* RGBA */
     int32_t want_depth;  /* also read back depth */

@@ -588,7 +588,8 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
     bounds_masked(deg_u, deg_v, part, &all, 1, &rb);
     out->d1[0] = rb.d1[0] / (range[1] - range[0]);
     out->d1[1] = rb.d1[1] / (range[3] - range[2]);
-    out->eps_obj = v->eps_px * whole.zmin / (v->focal_px * sqrt(1.0 + whole.pmax * whole.pmax));
+    /* pmax bounds |tan| of every view direction into the part: the one tangent of the rule */
+    out->eps_obj = sw_lod_object_tolerance(v->eps_px, whole.zmin, v->focal_px, whole.pmax, 0.0);
     int32_t guess[2];
     int found = choose_segments(&whole, NULL, 1, v, allowed, n_allowed, guess);
     /* Sub-patch bounds pay for themselves only on grids of many cells: a bound costs ~10 us,

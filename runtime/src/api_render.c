@@ -366,15 +366,15 @@ static sw_result resolve_camera(const sw_camera *in, const sw_rt_scene *scene, s
         out->target[k] = c.target[k];
         out->up[k] = c.up[k];
     }
-    out->fovy_deg = c.fovy_deg > 0.0 ? c.fovy_deg : 40.0;
+    out->fovy_deg = c.fovy_deg > 0.0 ? c.fovy_deg : SW_DEFAULT_FOVY_DEG;
     return SW_OK;
 }
 
 static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
 {
-    frame->width = desc->width ? desc->width : 1280;
-    frame->height = desc->height ? desc->height : 720;
-    frame->error_px = desc->error_px > 0.0 ? desc->error_px : 0.5;
+    frame->width = desc->width ? desc->width : SW_DEFAULT_WIDTH;
+    frame->height = desc->height ? desc->height : SW_DEFAULT_HEIGHT;
+    frame->error_px = desc->error_px > 0.0 ? desc->error_px : SW_DEFAULT_ERROR_PX;
     frame->background[0] = frame->background[1] = frame->background[2] = 1.0f;
     frame->background[3] = 1.0f;
     frame->eval_exact = desc->eval_exact != 0;
@@ -501,8 +501,8 @@ sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t hei
     sw_gpu_camera c;
     res = resolve_camera(camera, NULL, &c, status); /* not zero: no scene to fit to */
     if (res == SW_OK)
-        res = frame_matrices(&c, width ? width : 1280, height ? height : 720, near_plane, view,
-                             proj, status);
+        res = frame_matrices(&c, width ? width : SW_DEFAULT_WIDTH,
+                             height ? height : SW_DEFAULT_HEIGHT, near_plane, view, proj, status);
     if (res == SW_OK)
         sw__status_ok(status);
     return res;

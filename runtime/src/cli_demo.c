@@ -113,7 +113,7 @@ int sw_cli_demo(int argc, char **argv)
 {
     if (sw_cli_print_help(argc, argv, k_usage))
         return 0;
-    demo_args a = {"demo-out", NULL, 1280, 720, 0.5};
+    demo_args a = {"demo-out", NULL, SW_DEFAULT_WIDTH, SW_DEFAULT_HEIGHT, SW_DEFAULT_ERROR_PX};
     int rc = parse_args(argc, argv, &a);
     if (rc || make_dir(a.dir))
         return rc ? rc : 1;

@@ -419,9 +419,9 @@ static void fill_meta(const profile_args *a, sw_renderer renderer, sw_rt_profile
     m->mode = a->converged ? "converged" : "walkthrough";
     m->eval = a->eval ? a->eval : "hierarchy";
     m->lp_num_threads = getenv("LP_NUM_THREADS");
-    m->width = a->frame.width ? a->frame.width : 1280;
-    m->height = a->frame.height ? a->frame.height : 720;
-    m->error_px = a->frame.error_px > 0.0 ? a->frame.error_px : 0.5;
+    m->width = a->frame.width ? a->frame.width : SW_DEFAULT_WIDTH;
+    m->height = a->frame.height ? a->frame.height : SW_DEFAULT_HEIGHT;
+    m->error_px = a->frame.error_px > 0.0 ? a->frame.error_px : SW_DEFAULT_ERROR_PX;
     m->worker_threads = pool.worker_count;
     m->sequential = a->sequential;
 }

@@ -131,8 +131,10 @@ int sw_cli_render(int argc, char **argv)
     sw_scene_destroy(scene);
     if (r != SW_OK)
         return sw_cli_report("render", &status);
-    printf("%s -> %s (%dx%d, error %.3g px)\n", a.scene, a.out, a.frame.width ? a.frame.width : 1280,
-           a.frame.height ? a.frame.height : 720, a.frame.error_px > 0 ? a.frame.error_px : 0.5);
+    printf("%s -> %s (%dx%d, error %.3g px)\n", a.scene, a.out,
+           a.frame.width ? a.frame.width : SW_DEFAULT_WIDTH,
+           a.frame.height ? a.frame.height : SW_DEFAULT_HEIGHT,
+           a.frame.error_px > 0 ? a.frame.error_px : SW_DEFAULT_ERROR_PX);
     printf("load %.0f ms, GL context %.0f ms\n", t1 - t0, t2 - t1);
     sw_cli_print_frame_stats("frame", &stats);
     return 0;

@@ -95,16 +95,19 @@ static int parse_value(view_args *a, const char *arg, const char *val)
 
 static int parse_args(int argc, char **argv, view_args *a)
 {
-    *a = (view_args){.w = 1280, .h = 720, .error_px = 0.5, .speed = 0.1};
+    *a = (view_args){.w = SW_DEFAULT_WIDTH,
+                     .h = SW_DEFAULT_HEIGHT,
+                     .error_px = SW_DEFAULT_ERROR_PX,
+                     .speed = 0.1};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        int *flag = !strcmp(arg, "--settle")      ? &a->settle
-                    : !strcmp(arg, "--overlay")   ? &a->overlay
-                    : !strcmp(arg, "--wireframe") ? &a->wireframe
-                    : !strcmp(arg, "--static-lod") ? &a->static_lods
-                    : !strcmp(arg, "--lod-colors") ? &a->lod_colors
+        int *flag = !strcmp(arg, "--settle")          ? &a->settle
+                    : !strcmp(arg, "--overlay")       ? &a->overlay
+                    : !strcmp(arg, "--wireframe")     ? &a->wireframe
+                    : !strcmp(arg, "--static-lod")    ? &a->static_lods
+                    : !strcmp(arg, "--lod-colors")    ? &a->lod_colors
                     : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
-                                                  : NULL;
+                                                      : NULL;
         if (flag) {
             *flag = 1;
             continue;
@@ -254,8 +257,7 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         int32_t pages, side;
         sw_rt_renderer_trim_atlas(v->renderer, &tex, &pages, &side);
         sw_cli_atlas_view_next(&v->atlas, pages);
-    }
-    else if (key == GLFW_KEY_R)
+    } else if (key == GLFW_KEY_R)
         walker_look_from(&v->wk, &v->home);
 }
 

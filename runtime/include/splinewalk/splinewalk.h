@@ -37,6 +37,7 @@
 #define SPLINEWALK_H
 
 #include <splinewalk/sw_result.h>
+#include <splinewalk/sw_defaults.h>
 #include <splinewalk/sw_setup.h>
 #include <stddef.h>
 #include <stdint.h>
