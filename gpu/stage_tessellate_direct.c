@@ -74,8 +74,9 @@ static void patch_setup(sw__fr_tess *f, const occurrence *o, const sw_sg_bezier_
     const double range[4] = {pt->s0, pt->s1, pt->t0, pt->t1};
     const segment_set *set = class_grids ? &f->env->gpu_segments : &f->env->cpu_segments;
     sw_lod_screen_density d;
-    sw_lod_screen_segments(bp->deg_u, bp->deg_v, cpw, range, &f->env->screen, set->n, set->count,
-                           MAX_BOUND_SUBDIVISION, &d);
+    if (!sw_lod_screen_segments(bp->deg_u, bp->deg_v, cpw, range, &f->env->screen, set->n,
+                                set->count, MAX_BOUND_SUBDIVISION, &d))
+        f->st->bound_exceeded++; /* capped at the largest grid: the bound is not kept */
     pt->eps = d.eps_obj;
     pt->nu = d.nu;
     pt->nv = d.nv;
@@ -309,8 +310,9 @@ static int tile_cells(tiling *t, tile *tl)
                 continue;
             const double range[4] = {c->s0, c->s1, c->t0, c->t1};
             sw_lod_screen_density d;
-            sw_lod_screen_segments(c->deg_u, c->deg_v, c->cpw, range, &f->env->screen, set->n,
-                                   set->count, MAX_BOUND_SUBDIVISION, &d);
+            if (!sw_lod_screen_segments(c->deg_u, c->deg_v, c->cpw, range, &f->env->screen, set->n,
+                                        set->count, MAX_BOUND_SUBDIVISION, &d))
+                f->st->bound_exceeded++; /* capped: the bound is not kept */
             c->eps = d.eps_obj;
             c->nu = d.nu;
             c->nv = d.nv;

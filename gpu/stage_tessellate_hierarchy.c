@@ -137,13 +137,21 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     sw_lod_screen_view scr = f->env->screen;
     double approx_px = f->env->eps_px * c->err_w / c->eps_obj;
     scr.eps_px = fmax(f->env->eps_px - approx_px, 0.25 * f->env->eps_px);
+    /* the sampling floor: a node whose approximation error leaves less than a quarter of ε_img
+     * is drawn at that quarter, over ε_img in all (counted: refinement stopped at its limit) */
+    const double excess_px = approx_px + scr.eps_px - f->env->eps_px;
+    if (excess_px > 0.0) {
+        f->st->bound_exceeded++;
+        f->st->bound_excess_px = fmax(f->st->bound_excess_px, excess_px);
+    }
     const double range[4] = {pt->s0, pt->s1, pt->t0, pt->t1};
     double low[64];
     int32_t deg_u, deg_v;
     lowest_degree(c->cpw, low, &deg_u, &deg_v);
     sw_lod_screen_density d;
-    sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->env->gpu_segments.n,
-                           f->env->gpu_segments.count, MAX_BOUND_SUBDIVISION, &d);
+    if (!sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->env->gpu_segments.n,
+                                f->env->gpu_segments.count, MAX_BOUND_SUBDIVISION, &d))
+        f->st->bound_exceeded++; /* capped at the largest grid: the bound is not kept */
     pt->eps = d.eps_obj;
     pt->nu = d.nu;
     pt->nv = d.nv;

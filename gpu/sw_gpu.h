@@ -137,9 +137,15 @@ typedef struct sw_gpu_frame_stats {
                                        others are CPU grids */
     uint64_t patches_exact; /* of those, evaluated from knots and control points (eval_exact) */
     /* hierarchy traversal (desc.hierarchies) */
-    uint64_t hlod_nodes;           /* hierarchy nodes (or parts of one) drawn */
-    uint64_t hlod_fallback_faces;  /* occurrences drawn by their Bézier patches: no hierarchy */
-    uint64_t hlod_refine_rounds;   /* rounds of refinement below the leaves the frame waited for */
+    uint64_t hlod_nodes;          /* hierarchy nodes (or parts of one) drawn */
+    uint64_t hlod_fallback_faces; /* occurrences drawn by their Bézier patches: no hierarchy */
+    uint64_t hlod_refine_rounds;  /* rounds of refinement below the leaves the frame waited for */
+    /* the guarantee: pieces drawn whose bound exceeds ε_img — a grid whose density the segment
+     * limit capped (the bound it needed is not known), or a hierarchy node whose approximation
+     * error left less than a quarter of ε_img to its sampling (the sampling floor); the worst
+     * known total bound over ε_img, in pixels (0 when none is known) */
+    uint64_t bound_exceeded;
+    double bound_excess_px;
     uint64_t hlod_over_budget;     /* nodes drawn although their error exceeds their share of
                                       ε_img (refinement stopped at its depth limit) */
     uint64_t hlod_waits;           /* times the frame waited for the pool (0 in walkthrough) */

@@ -327,6 +327,8 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->meshes_culled = g->meshes_culled;
     out->mesh_triangles = g->mesh_triangles;
     out->static_requests = g->static_requests;
+    out->bound_exceeded = g->bound_exceeded;
+    out->bound_excess_px = g->bound_excess_px;
 }
 
 static int camera_is_zero(const sw_camera *c)

@@ -183,6 +183,12 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
                (int)strlen(label), "", (unsigned long long)s->static_drawn,
                (unsigned long long)s->static_faces, (unsigned long long)s->static_triangles,
                (unsigned long long)s->static_requests);
+    if (s->bound_exceeded > 0 && s->bound_excess_px > 0.0)
+        printf("%*s  error bound: %llu pieces drawn over it (worst known excess %.3g px)\n",
+               (int)strlen(label), "", (unsigned long long)s->bound_exceeded, s->bound_excess_px);
+    else if (s->bound_exceeded > 0)
+        printf("%*s  error bound: %llu pieces drawn over it (grids capped at the segment limit)\n",
+               (int)strlen(label), "", (unsigned long long)s->bound_exceeded);
     printf("%*s  time: hierarchy builds %.1f ms, tessellate %.1f ms, trim textures %.1f ms, draw "
            "%.1f ms, readback %.1f ms, write %.1f ms, total %.1f ms\n",
            (int)strlen(label), "", s->ms_hierarchy, s->ms_tessellate, s->ms_trim, s->ms_draw,

@@ -96,6 +96,8 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_STATIC_FACES] = (double)st->static_faces;
     v[SW_RT_COL_STATIC_TRIANGLES] = (double)st->static_triangles;
     v[SW_RT_COL_STATIC_REQUESTS] = (double)st->static_requests;
+    v[SW_RT_COL_BOUND_EXCEEDED] = (double)st->bound_exceeded;
+    v[SW_RT_COL_BOUND_EXCESS_PX] = st->bound_excess_px;
     v[SW_RT_COL_RESIDENT_BYTES] = resident_bytes;
     v[SW_RT_COL_CAPTURED] = captured ? 1.0 : 0.0;
 }
@@ -249,7 +251,7 @@ static void json_string(FILE *f, const char *s)
 static const char *kind_name(sw_rt_prof_kind k)
 {
     static const char *const names[] = {"index", "seconds", "frame", "stage", "visibility stage",
-                                        "gpu",   "pool",    "count"};
+                                        "gpu",   "pool",    "pixels", "count"};
     _Static_assert(sizeof names / sizeof names[0] == SW_RT_KIND_COUNT + 1,
                    "a name per kind (SW_RT_KIND_COUNT, the count kind, is the last)");
     return names[k];

@@ -72,6 +72,10 @@
     X(STATIC_FACES, "static_faces", COUNT, "face instances they cover (of faces_drawn)")           \
     X(STATIC_TRIANGLES, "static_triangles", COUNT, "their triangles (of triangles)")               \
     X(STATIC_REQUESTS, "static_requests", COUNT, "walkthrough: static LOD builds queued")          \
+    X(BOUND_EXCEEDED, "bound_exceeded", COUNT,                                                     \
+      "pieces drawn whose error bound exceeds the screen-space error (capped grids, floors)")      \
+    X(BOUND_EXCESS_PX, "bound_excess_px", PIXELS,                                                  \
+      "the worst known bound over the screen-space error, in pixels")                              \
     SW_TH_TASK_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \
     SW_TH_TASK_KINDS(SW_RT__POOL_TASKS_COLUMN, X)                                                  \
     X(POOL_QUEUED, "pool_queued", COUNT,                                                           \
@@ -97,6 +101,7 @@ typedef enum sw_rt_prof_kind {
     SW_RT_KIND_VSTAGE, /* on the visibility thread (threaded runs): beside frame_ms, not in it */
     SW_RT_KIND_GPU,    /* ms on the GPU (timer queries): overlaps the submitting thread's stages */
     SW_RT_KIND_POOL,   /* ms in pool tasks, summed over the pool's threads: beside frame_ms */
+    SW_RT_KIND_PIXELS, /* a screen-space distance */
     SW_RT_KIND_COUNT
 } sw_rt_prof_kind;
 

@@ -35,6 +35,7 @@
 
 enum { W = 320, H = 240 };
 static sw_th_pool *g_pool;
+static int g_bound_counted; /* narrow views with pieces counted over the bound */
 static int g_partial_views; /* views that cut a model: the cull check is not vacuous */
 
 /* One frame's stage outputs, as sw_gpu_frame_prepare keeps them. */
@@ -432,6 +433,26 @@ static void check_submit_analytic(sw_gpu_context *ctx)
     sw_gpu_image_free(&img);
 }
 
+/* The counter of pieces over the bound counts: a 0.005° view of the model's middle, drawn by the
+ * faces' own Bézier patches, asks grids finer than the segment limit (a counter that never counts
+ * would pass the check above). */
+static void check_bound_counted(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                                const sw_gpu_frame_desc *base, const char *name)
+{
+    sw_gpu_frame_desc desc = *base;
+    desc.camera.fovy_deg = 0.005;
+    desc.hierarchies = NULL;
+    stages s;
+    sw_status st = {0};
+    if (run_prepare(&s, ctx, scene, &desc, &st) != SW_OK)
+        CHECK(0, "%s: narrow view: %s", name, st.message);
+    else
+        printf("%s: 0.005 deg view: %llu pieces over the bound\n", name,
+               (unsigned long long)s.st.bound_exceeded);
+    g_bound_counted += s.st.bound_exceeded > 0;
+    stages_free(&s);
+}
+
 /* ---- driver ------------------------------------------------------------------------------------
  */
 static void run_model(sw_gpu_context *ctx, const char *path)
@@ -477,7 +498,10 @@ static void run_model(sw_gpu_context *ctx, const char *path)
         check_tessellate(&coned, path);
         check_trim_plan(&coned, path);
         check_chain(ctx, scene, &desc, &coned, path);
+        CHECK(coned.st.bound_exceeded == 0, "%s: %llu pieces over the error bound", path,
+              (unsigned long long)coned.st.bound_exceeded);
     }
+    check_bound_counted(ctx, scene, &desc, path);
     stages_free(&plain);
     stages_free(&coned);
 done:
@@ -505,6 +529,7 @@ int main(int argc, char **argv)
     for (int a = 1; a < argc; ++a)
         run_model(ctx, argv[a]);
     CHECK(g_partial_views > 0, "no view left an occurrence outside: the cull check is vacuous");
+    CHECK(g_bound_counted > 0, "no narrow view counted a piece over the bound");
     sw_gpu_context_free(ctx);
     sw_th_pool_destroy(g_pool);
     puts(g_failures ? "FAIL" : "PASS");

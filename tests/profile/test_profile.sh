@@ -18,7 +18,7 @@ for tool in xmllint jq awk; do
   command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
 done
 
-columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
 
 # ---- help and usage ---------------------------------------------------------------------------
 "$sw" --help | grep -q '^  profile' || fail "splinewalk --help does not list profile"
@@ -57,7 +57,7 @@ check_run() {
   local dir=$1 n=$2
   [ "$(head -1 "$dir/profile.csv")" = "$columns" ] || fail "$dir: CSV header: $(head -1 "$dir/profile.csv")"
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
-  awk -F, -v n=53 'NR > 1 {
+  awk -F, -v n=55 'NR > 1 {
       if (NF != n) { print "row " NR ": " NF " fields"; bad = 1 }
       for (i = 1; i <= NF; i++) if ($i !~ /^-?[0-9]+(\.[0-9]+)?$/) { print "row " NR " field " i ": " $i; bad = 1 }
       if ($1 != NR - 2) { print "row " NR ": frame " $1; bad = 1 }

@@ -306,6 +306,9 @@ typedef struct sw_frame_stats {
     uint64_t fallback_draws; /* walkthrough: faces drawn without their hierarchy, plus leaves
                                 drawn coarser than the error asks, both requested from the pool */
     uint64_t pool_waits;     /* times the frame waited for the pool (0 in walkthrough) */
+    uint64_t bound_exceeded; /* pieces drawn whose error bound exceeds ε_img: grids capped at the
+                                segment limit, hierarchy nodes at the sampling floor */
+    double bound_excess_px;  /* the worst known bound over ε_img of those, in pixels */
     double ms_hierarchy;     /* waiting for hierarchy builds and refinements */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
     /* split frames (sw_renderer_prepare / submit): hierarchy and tessellate ran on the visibility
