@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — walk through huge trimmed-NURBS CAD models with a guaranteed screen-space error.
  *
  * The public C API, first slice: load a scene (.sws, or STEP / IGES / BREP imported through

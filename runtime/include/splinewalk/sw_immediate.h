@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — the immediate API: trimmed NURBS objects drawn by handle, without a scene, and
  * host shaders around the library's GPU evaluation and trimming (issue 7).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — scenes built from nodes: the scene-graph part of the embedding API (issue 7).
  *
  * A node scene is an sw_scene like a loaded one (sw_renderer_draw, sw_scene_save, sw_scene_pick,
