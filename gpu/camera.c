@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The view shared by every draw path: camera basis, reversed-Z perspective with an infinite far
  * plane (glClipControl zero-to-one, depth = near / z, cleared to 0, GL_GREATER), frustum planes in
  * eye-relative world coordinates for box culling (Guthe et al. 2005 §7: view-frustum culling of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // Frame images out through OpenImageIO: PNG (RGBA8) or OpenEXR (half RGBA plus a float Z channel
 // when the frame has depth). Written to a temporary name beside the target and renamed over it
 // (ARCHITECTURE.md: file safety). A thin C++ shim: no exception leaves it.

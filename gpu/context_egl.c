@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Headless OpenGL context through EGL (PLATFORM.md, "OpenGL without a GPU"): Mesa's surfaceless
  * platform first, then the EGL device platform (headless NVIDIA), then the default display; a
  * desktop GL 4.5 core context (4.3 accepted when glClipControl exists), no surface, rendering

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Crack filling between independently tessellated faces (Guthe et al. 2005 §7.1, after the fat
  * borders of Balázs et al. 2004). Core-profile GL has no wide lines, so each boundary loop of a
  * drawn face (its trim loops, or its parameter box when untrimmed) becomes a ribbon of triangles:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Predefined grids resident on the GPU (Guthe et al. 2005 §4.2): base grids of 1 and 3 segments
  * subdivided by powers of two in u and v independently (1, 2, 3, 4, 6, ..., 48, 64 segments per
  * direction: 12 x 12 classes, one index buffer). Rounding a Filip density up to the next class

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The host's GL state around the renderer's work in an adopted context (sw_renderer_desc.
  * use_current_context) and around a presenting frame (sw_frame_desc.present).
  *

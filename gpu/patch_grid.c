@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* CPU grid tessellation of a face occurrence's rational Bézier patches (Guthe et al. 2005 §4.2's
  * grids, evaluated on the CPU in double in this slice; densities from the Filip bound, §5.2,
  * chosen by the caller). Every patch column has one u-density and every row one v-density, so

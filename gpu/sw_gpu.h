@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk gpu/: an OpenGL 4.x core context (EGL; Mesa's surfaceless platform when there is no
  * display or GPU), and one converged frame of a scene: every face's Bézier patches drawn as grids
  * (evaluated on the CPU in this slice, at densities from the Filip bound, Guthe et al. 2005 §5.2),

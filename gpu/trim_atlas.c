@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The trim-texture atlas (Guthe et al. 2005 §4.4): every trim texture of a frame is a rectangle in
  * one layer ("page") of an R8 GL_TEXTURE_2D_ARRAY. New textures are sorted by height and packed
  * on shelves (placed side by side on the current row; a new row when the page's width is used

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim textures on the GPU (Guthe et al. 2005 §4), one atlas page at a time (§4.4): a triangle
  * fan from each trim loop's first vertex toggles the texels it covers (glLogicOp(GL_INVERT) on an
  * R8 target), so a texel centre covered an odd number of times is inside: even-odd parity without

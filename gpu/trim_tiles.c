@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim loops restricted to a tile of a face's trim box (Guthe et al. 2005 §5.3, §7: a close-up
  * needs trim textures finer than one texture over the whole face can hold, so frame.c splits the
  * face's trim box into tiles, each with its own texture). Two pieces of geometry:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Rational Bézier nets in homogeneous form: de Casteljau evaluation, subdivision and restriction
  * to a sub-rectangle, exact degree elevation, products of Bernstein polynomials (Farin, Curves and
  * Surfaces for CAGD, ch. 5-6; used by Guthe et al. 2005 §6.1-§6.2 and by error_bound.c).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* G1-constrained degree reduction of rational Bézier patches and curves to (bi)cubics, Guthe et
  * al. 2005 §6.1, and leaf subdivision until a rigorous error bound (error_bound.c) meets a
  * tolerance (§6, the blue subtrees of Fig. 7).

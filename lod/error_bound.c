@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A rigorous bound of |A/wA - B/wB| between two rational Bézier nets, for the approximation errors
  * of Guthe et al. 2005: degree reduction (§6.1), pairwise simplification (§6.2) and trim curves
  * approximated by rational cubics (§4.1).

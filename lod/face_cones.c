@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Per-face outward normal cones and the back-patch test (Kumar et al. 1997 §4.4); see
  * sw_lod_face_cones.h. */
 #include "sw_lod_face_cones.h"

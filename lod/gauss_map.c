@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The pseudo-Gauss map of a rational Bézier patch in Bézier form and the normal cone of its
  * control rays (Kumar et al. 1997 §3, eq. 1); the derivation of the degrees is in
  * sw_lod_supersurface.h.

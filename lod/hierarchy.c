@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The per-surface bicubic hierarchy of Guthe et al. 2005 §6 (Fig. 7): Bézier extraction (§6),
  * the box cut of §4.4, a subdivision tree per Bézier patch from degree_reduce.c (blue), a median
  * cut over the patch grid along the longer parameter direction whose pairs are simplified bottom-up

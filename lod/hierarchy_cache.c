@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The per-scene cache of face hierarchies (sw_lod_cache.h): builds in the worker pool on first
  * sight, at most once per face, lock-free publication and lookup, cancellation and priorities
  * through the pool's tokens, converged waits, copy-on-write refinement below the leaves (Guthe et

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // CGAL shim: distance from points to a triangle mesh by an AABB tree (exact closest point per
 // triangle in double precision). No exception escapes.
 #include "sw_lod_mesh_distance.h"

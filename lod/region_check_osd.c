@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The OpenSubdiv cross-check of uniform bicubic regions (sw_lod_osd_check.h). */
 #include "sw_lod_osd_check.h"
 #include "sw_hooks.h"

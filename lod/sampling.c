@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Sampling bounds for rational Bézier patches: the Filip et al. 1986 grid density (Guthe et al.
  * 2005 §5.2), the screen-to-object tolerance (§7) and the trim-texture resolution (§5.3).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Pairwise simplification of two adjacent rational bicubics into one, Guthe et al. 2005 §6.2: the
  * inverse of subdivision. The two children cover [0, s] and [s, 1] of the result along one
  * direction, s = Δt1 / (Δt1 + Δt2), so that subdividing the result at s keeps the children's knot

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Static LODs of a super-surface, Kumar et al. 1997 §4.1-§4.3: the adaptive trimmed tessellation
  * (level 0), the simplified levels (lod/static_lod_openmesh.cpp) and the two-sided measurement
  * that declares each level's ε_k.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // OpenMesh shim: a static LOD's simplified levels (Kumar et al. 1997 §4.2), borders first.
 //
 // Where the paper is loose: §4.2 simplifies with simplification envelopes (Cohen et al. 1996),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
  * units are formed and how slots are published). */
 #include "sw_lod_static_set.h"

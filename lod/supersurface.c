@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Super-surface clustering, Kumar et al. 1997 §3: greedy growth over patch adjacency under a
  * bound on the cluster's normal cone, then a second pass that merges small clusters (§7.1).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: rational Bézier patch utilities in homogeneous form — the building blocks of
  * degree reduction (Guthe et al. 2005 §6.1), pairwise simplification (§6.2) and the rigorous error
  * bounds (error_bound.c).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: the per-scene cache of face hierarchies (ARCHITECTURE.md: "once per surface,
  * on first sight, in the worker pool"; Guthe et al. 2005 §6 hierarchies, extended below their
  * leaves for close-ups as §7's traversal demands finer nodes).

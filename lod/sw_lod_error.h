@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: a rigorous bound of the distance between two rational Bézier nets over the
  * same parameter domain — an original patch P/w and its approximation P~/w~ (degree reduction,
  * Guthe et al. 2005 §6.1; pairwise simplification, §6.2; trim curves approximated by rational

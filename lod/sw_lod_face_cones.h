@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: per-face outward normal cones for back-patch culling (Kumar et al. 1997 §4.4).
  *
  * Where the cones live. A cone costs a Gauss-map pass over every patch of its face (gauss_map.c),

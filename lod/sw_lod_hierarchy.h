@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: the per-surface binary hierarchy of rational bicubic patches, Guthe et al. 2005
  * §6 (Fig. 7): the surface's Bézier patches (optionally cut to the trim region's box, §4.4), each
  * reduced to bicubics and subdivided until a leaf tolerance is met (§6.1, the blue subtrees),

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* OpenSubdiv limit-surface evaluation behind a C interface (lod/uniform_bicubic_osd.cpp).
  *
  * The independent reference for the project's uniform bicubic B-spline evaluator (the patch type

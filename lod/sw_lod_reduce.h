@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: G1-constrained degree reduction of rational Bézier patches of any degree to
  * rational bicubics (Guthe et al. 2005 §6.1), leaf subdivision until a rigorous error bound meets a
  * tolerance, the same for 2D trim curves to rational cubics (§4.1), and pairwise simplification of

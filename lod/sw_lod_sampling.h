@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/ sampling bounds: how densely a rational Bézier patch must be sampled so that its
  * piecewise-linear grid stays within an object-space tolerance (the Filip et al. 1986 bound as used
  * by Guthe et al. 2005 §5.2), the object-space tolerance that a screen-space error ε_img allows at

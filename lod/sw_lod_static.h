@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: static levels of detail of a super-surface, Kumar et al. 1997 §4.1-§4.3.
  *
  * Input: a set of trimmed rational Bézier patches (a super-surface, §3), each named by its face and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Simplification of a static LOD's level-0 mesh into coarser levels, behind a C interface
  * (lod/static_lod_openmesh.cpp: OpenMesh's Decimater, Kumar et al. 1997 §4.2).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: a scene's static LODs, built lazily in the worker pool and chosen per frame
  * (Kumar et al. 1997 §4, merged with the per-frame path as ARCHITECTURE.md says).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk lod/: super-surfaces, Kumar et al. 1997 §3 — a partition of a scene's rational Bézier
  * patches into connected clusters whose Gauss map fits a cone of half-angle alpha, for static LODs
  * (§4.1-§4.3) and back-patch culling (§4.4).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* 2D constrained Delaunay triangulation in a face's parameter domain, behind a C interface
  * (lod/trim_mesh_cgal.cpp, CGAL's Constrained_Delaunay_triangulation_2 with exact predicates).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim curves approximated by rational cubic Bézier pieces with a rigorous error bound, Guthe et
  * al. 2005 §4.1 ("similarly to the bi-cubic approximation of the surfaces we approximate the
  * trimming curves with rational cubic Bézier curves"): Bézier segments by knot insertion, each

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // CGAL shim: the constrained Delaunay triangulation of a face's parameter domain (Kumar et al.
 // 1997 §4.3: trimming curves are borders of the mesh). Exact predicates with inexact
 // constructions: crossing constraints are split at a computed intersection point. No exception

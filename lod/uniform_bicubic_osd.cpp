@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // OpenSubdiv shim: the limit surface of a regular control grid, evaluated by OpenSubdiv's Far
 // layer (TopologyRefiner -> adaptive refinement -> PatchTableFactory -> PatchMap + EvaluateBasis),
 // in double precision. It is the independent reference for sw_sg_uniform_bicubic_eval (Guthe et

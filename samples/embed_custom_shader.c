@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* embed_custom_shader: a host that owns its GL context (EGL, headless) and framebuffer, and draws
  * trimmed NURBS objects through the immediate API (sw_immediate.h, Guthe et al. 2005 §8) with
  * its own shading function: stripes along the surface parameter u, lit by the library's shading,

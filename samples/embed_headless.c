@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* embed_headless: the smallest program that embeds splinewalk without a window. It loads a scene
  * (a .sws file, anything `splinewalk import` reads, or the built-in default scene), fits the iso
  * camera preset to it, renders one converged frame headlessly (EGL; Mesa's llvmpipe when there

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* embed_minimal: a GLFW program that owns its window and GL context and lets splinewalk draw a
  * scene into it — the smallest host of the public API. The renderer runs on the window's context
  * (use_current_context); each frame is drawn in walkthrough mode (it never waits for the worker

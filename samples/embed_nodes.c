@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* embed_nodes: a scene built from nodes instead of a file, edited live. It makes a node scene
  * with a trimmed bicubic NURBS sheet (a round hole cut by four rational quarter circles), two
  * instances of it and a floor under them given as a triangle mesh, draws walkthrough frames

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Extraction of the rational Bézier patches of a NURBS surface (Guthe et al. 2005 §3: the GPU
  * pipeline starts from exactly these patches, each then trimmed by its own trim texture, §4).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The BVH over face occurrences or caller-made items (sw_sg_bvh.h). */
 #include "sw_sg_bvh.h"
 #include "sw_hooks.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* CRC-32C for .sws section checksums: slicing-by-8 in software, and the SSE4.2 crc32 instruction
  * on x86-64 CPUs that have it (chosen once at run time), so verifying a large mapped section costs
  * little next to reading it from disk. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The BREP exporter (sw_sg_export.h). A trimmed face becomes a face on its Geom_BSplineSurface
  * whose wires are its trim loops: one edge per trim curve (the pcurve, as a Geom2d_BSplineCurve),
  * consecutive edges sharing a vertex at the surface point of their join. The 3D curve of an edge

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The building generator (sw_sg_generate.h): storeys of nx x ny rooms of 4 m x 4 m, in
  * centimetres, z up. Every room has a floor and a ceiling (planar faces, the stair room's cut by
  * the stairwell), its south and west walls (and the east / north ones on the boundary) as two

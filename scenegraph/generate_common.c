@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared by the scene generators (generate_building.c, generate_vehicle.c): faces built in a
  * scratch record (a NURBS surface and trim loops drawn as pen paths) and stored in a builder, or
  * only counted (a dry run, builder NULL, to plan a scene of an exact size).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Internal to the scene generators (generate_*.c): see generate_common.c. */
 #ifndef SW_SG_GENERATE_COMMON_H
 #define SW_SG_GENERATE_COMMON_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The grid generator (sw_sg_generate.h). */
 #include "sw_sg_bvh.h"
 #include "sw_hooks.h"

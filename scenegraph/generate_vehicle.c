@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The vehicle generator (sw_sg_generate.h): a parking lot of cars, in millimetres, z up, each car
  * along +x from its rear. Every car is unique (its length, width, height and trims come from its
  * own random stream): per side a lower body surface, a bicubic B-spline lofted through four cubic

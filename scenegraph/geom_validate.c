@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Validation of NURBS curves and surfaces before anything evaluates them.
  *
  * Imported geometry is untrusted (CONVENTIONS.md, "files are hostile"): every later step

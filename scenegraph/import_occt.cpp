@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The OCCT importer: STEP (XCAF: assembly tree, instances, names, colours), IGES and BREP files
  * into an sw_sg_builder. Every face is converted to a NURBS surface (BRepBuilderAPI_NurbsConvert)
  * whose wires' pcurves become 2D rational B-spline trim loops, snapped closed (sw_sg_trim.h) as

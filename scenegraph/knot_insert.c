@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Boehm knot insertion into a rational B-spline curve in homogeneous form (The NURBS Book A5.1).
  *
  * Inserting a knot changes the basis, not the curve; it is the primitive behind Bézier extraction

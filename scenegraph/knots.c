@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Knot vectors: parameter domain, span search and B-spline basis functions with derivatives.
  *
  * Span search is The NURBS Book's A2.1 (binary search, last non-empty span closed); the basis

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Evaluation of rational B-spline curves and surfaces in homogeneous form (double precision).
  *
  * Derivatives are not taken from derivatives of the basis functions (The NURBS Book A2.3), whose

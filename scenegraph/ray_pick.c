@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Picking by ray: BVH traversal nearest box first, then per face Bézier subdivision against the
  * ray's two planes and Newton on the exact surface (sw_sg_pick.h says why and how). */
 #include "sw_sg_pick.h"

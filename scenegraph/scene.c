@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The scene container: the builder (growable record arrays and the double pool), the immutable
  * scene with its accessors, and the traversal that expands instances and composes transforms and
  * colours. Records and layout: sw_sg_scene.h; the arrays are the same whether built here or

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Scene statistics for `splinewalk info`: counts by surface kind, trims, Bézier patches after
  * extraction (Guthe et al. 2005 §3 starts from those patches), degrees, instances, face
  * occurrences after instance expansion, and the world bounding box of the surfaces. */

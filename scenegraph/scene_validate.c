@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Validation of a scene's arrays before anything dereferences them: every index, pool offset and
  * count against the array sizes (in 64-bit arithmetic that cannot overflow), the node graph for
  * cycles (child links and instance references together), and each face's and curve's geometry

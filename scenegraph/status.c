@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* sw_result names and the sw_status helpers shared by every layer. */
 #include "sw_status_util.h"
 #include "sw_hooks.h"

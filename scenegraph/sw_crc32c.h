@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* CRC-32C (Castagnoli, reflected polynomial 0x82F63B78): the per-section checksum of .sws files
  * (docs/sws-format.md). Internal to scenegraph/, never installed. */
 #ifndef SW_CRC32C_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk scenegraph/: a bounding-volume hierarchy (Kumar et al. 1997 §4.4). Its leaves are a
  * scene's face occurrences (sw_sg_bvh_build: frames without static LODs), or items a caller made
  * (sw_sg_bvh_build_items: lod/'s super-surface instances, the leaves §4.4 names, for frames with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Exporting a scene as an OCCT BREP compound (export_occt.cpp, a C++ shim that lets no exception
  * through), so that OCCT-based programs read the very geometry splinewalk draws: every face a
  * Geom_BSplineSurface bounded by wires of its trim loops' pcurves, every instance a located copy

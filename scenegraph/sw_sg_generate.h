@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk scenegraph/: test-scene generators (`splinewalk generate`). A grid: N instances of a
  * real model on a nearly cubic (or square) lattice, for the culling tests of Kumar et al. 1997
  * §4.4. The instances share the model's geometry: its faces, loops, curves and node tree are

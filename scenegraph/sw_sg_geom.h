@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk geometry kernel: knot vectors, rational B-spline (NURBS) curves and surfaces of any
  * degree and dimension, evaluated in homogeneous form in double precision; knot insertion and
  * extraction into rational Bézier patches.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Importing STEP / IGES / BREP through OpenCASCADE (import_occt.cpp, a C++ shim that lets no
  * exception through). Every face becomes a NURBS surface with its wires' pcurves as 2D rational
  * B-spline trim loops (snapped closed), its orientation, the assembly tree with instances and

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* C++-only entry points of the OCCT importer (import_occt.cpp) with a per-face observer, so tests
  * can compare each imported face with OCCT's own geometry of the same face. Never included from C.
  */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk scenegraph/: picking — the nearest point where a ray meets the scene's trimmed
  * surfaces (issue 7: "picking by ray through the BVH, returning node, surface and (u,v)").
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk scene: faces (trimmed NURBS surfaces), trim loops of 2D rational B-spline curves,
  * triangle meshes, a node tree (group, transform, instance, surface, mesh) with colours, and face
  * adjacency.

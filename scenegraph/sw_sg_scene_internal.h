@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The scene object shared by scene.c (builder, accessors, traversal), scene_validate.c and
  * sws_file.c (mapped scenes). Internal to scenegraph/, never installed. */
 #ifndef SW_SG_SCENE_INTERNAL_H

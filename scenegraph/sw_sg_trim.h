@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim loops: closing them bit-identically, flattening them into polylines, and classifying
  * parameter points by even-odd parity (the same rule the GPU's fan parity implements, Guthe et al.
  * 2005 §4).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk T-splines: bicubic rational T-spline surfaces (point-based splines whose blending
  * functions come from a T-mesh), their direct evaluation, Krishnamurthy & Yasui's region
  * decomposition with binary-search lookup, and extraction into rational bicubic Bézier patches

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Internal helpers shared by the T-spline files (tspline.c, tspline_bezier.c); never installed. */
 #ifndef SW_SG_TSPLINE_INTERNAL_H
 #define SW_SG_TSPLINE_INTERNAL_H

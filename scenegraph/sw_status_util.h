@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Internal helpers for filling an optional sw_status (never installed). */
 #ifndef SW_STATUS_UTIL_H
 #define SW_STATUS_UTIL_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The native scene file, .sws: the scene's record arrays written as they are in memory, so that
  * opening one is an mmap plus a check of the header and section table, and each section is
  * checksummed on first use (ARCHITECTURE.md, "Rules that keep the pipeline sane").

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim loops: snapping their joins closed, flattening them into closed polylines and classifying
  * parameter points by even-odd parity.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* T-spline surfaces: creation from point-based data, Krishnamurthy & Yasui's region
  * decomposition ("T-splines evaluation": the domain is cut wherever any blending function has a
  * knot line, each region keeps the list of control points that influence it, and a parameter finds

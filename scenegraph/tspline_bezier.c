@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Bézier extraction of T-splines and their hand-over to the scene as faces.
  *
  * Guthe et al. 2005 §3 converts T-splines to piecewise rational Bézier form with the local knot

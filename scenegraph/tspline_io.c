@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The .tsm text format for T-meshes (docs/tspline-format.md): parsing, then validation, as two
  * separate steps (CONVENTIONS.md, Errors: files are hostile).
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The uniform bicubic B-spline patch of a regular 4x4 control net: the patch OpenSubdiv evaluates
  * for regular Catmull-Clark faces, and the form Guthe et al. 2005 §6 approximates patches with
  * (bi-cubic hierarchy). Evaluated with the uniform cubic basis, converted to Bézier form with the

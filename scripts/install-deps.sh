@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # Installs the Debian 12 packages splinewalk builds, tests and demos with (PLATFORM.md).
 # As root: installs what is missing. Otherwise: prints the one apt-get line to run and fails.
 set -euo pipefail

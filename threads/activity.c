@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Activity lists (Kumar et al. 1997 §5.2, §5.3); the contract is in sw_th_activity.h.
  *
  * The ring is Lamport's SPSC queue in C11: the producer writes a slot, then publishes it by

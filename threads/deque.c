@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Chase-Lev work-stealing deque (Lê, Pop, Cohen, Zappa Nardelli, PPoPP 2013, Fig. 1).
  *
  * The paper's take() writes bottom, then a seq_cst fence, then reads top; its steal() reads top,

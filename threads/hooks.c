@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The allocator and log hooks behind sw_setup (sw_hooks.h). */
 #include "sw_hooks.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The work-stealing worker pool (sw_th_pool.h): per-worker Chase-Lev deques per priority,
  * lock-free MPSC injection queues for other threads, random-victim stealing of one task or of
  * half the victim's deque (Kumar et al. 1997, §5.1), and workers that sleep when idle.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The library's one way to allocate and to log (never installed): the host's hooks from
  * sw_setup (splinewalk/sw_setup.h), else malloc / free and stderr. Every C allocation of the
  * library goes through sw__malloc & co., so that a host allocator sees them all and a failing one

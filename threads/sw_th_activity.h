@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk threads — activity lists: the queues from the visibility thread V to the submission
  * thread P (Kumar et al. 1997 §5.2), and their N_p × N_c generalization (§5.3).
  *

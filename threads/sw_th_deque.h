@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk threads — Chase-Lev work-stealing deque of pointers.
  *
  * Algorithm: Chase & Lev, "Dynamic circular work-stealing deque" (SPAA 2005), in the C11 form of

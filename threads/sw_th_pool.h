@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk threads — the work-stealing worker pool (ARCHITECTURE.md: worker pool T).
  *
  * Kumar, Manocha, Zhang, Hoff 1997, §5.1: each processor runs from its own queue; an idle one

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/: what the frame benchmarks share besides timing (header only): the scene and its orbit,
  * and the options every one of them takes. */
 #ifndef SW_BENCH_SCENE_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/: the timing helpers every benchmark program shares (header only; not a library). */
 #ifndef SW_BENCH_STATS_H
 #define SW_BENCH_STATS_H

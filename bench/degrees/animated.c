@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/degrees: the animated trimmed surface, its camera and the screen tolerance. */
 #include "animated.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/degrees: the benchmark's input (Guthe et al. 2005 §9, Fig. 10) — a 10 x 10 rational
  * B-spline surface of degree d x d whose control points and weights move with a sine, trimmed by
  * one closed degree-d loop of 10 control points — its fixed camera, and the object-space

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/degrees — Guthe et al. 2005 §9, Fig. 10: approximation time and tessellation time of an
  * animated trimmed surface as its degree grows. A 10 x 10 rational B-spline surface (degrees
  * 3x3, 5x5, 7x7, uniform clamped knots) whose control points and weights move by a sine (one

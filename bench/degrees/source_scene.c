@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/degrees: the scene drawn for one frame — see source_scene.h. */
 #include "source_scene.h"
 #include "sw_lod_sampling.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/degrees: the scene the GPU frame path (sw_gpu_render_scene) draws for one frame of the
  * animated surface — the degree-d surface as one face, trimmed by the rational cubic
  * approximation of its trim loop (Guthe et al. 2005 §4.1), one clamped cubic Bézier curve per

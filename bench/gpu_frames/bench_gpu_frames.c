@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/gpu_frames: per-stage frame times of sw_gpu_render_scene (Guthe et al. 2005 §4.2, §4.4)
  * on imported models, iso view fitted to the scene box, medians over N frames:
  *   regen  every trim texture regenerated each frame in the same atlas pages (as the paper does)

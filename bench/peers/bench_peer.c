@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: the shared part of the side-by-side runs (see bench_peer.h). */
 #define _GNU_SOURCE
 #include "bench_peer.h"

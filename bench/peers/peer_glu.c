@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: the GLU peer (see peer_glu.h). */
 #include "peer_glu.h"
 

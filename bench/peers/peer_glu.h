@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: Mesa's GLU NURBS tessellator as a peer (bench/tessellation's bt_glu wrapper:
  * GLU_NURBS_TESSELLATOR mode, GLU_AUTO_LOAD_MATRIX off with each frame's matrices passed by
  * gluLoadSamplingMatrices, GLU_SAMPLING_METHOD = GLU_PARAMETRIC_ERROR at ε_img pixels,

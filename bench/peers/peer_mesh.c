@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: the OCCT peer's frames (see peer_mesh.h). */
 #include "peer_mesh.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: the OCCT peer's frames. The BREP of the scene is meshed once at the deflection
  * equal to ε_img at the path's nearest viewing distance — the object-space size of ε_img pixels
  * at the smallest eye-to-scene-box distance d along the path: ε_img · 2 d tan(fovy / 2) / height

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: the OCCT mesher shim (see peer_occt.h). Normals are averaged per vertex from the
  * triangles of the face (area-weighted), which is what the draw's Lambert shading needs. */
 #include "peer_occt.h"

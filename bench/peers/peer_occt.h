@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: OpenCASCADE's mesher as a peer, the C side of peer_occt.cpp (a thin C++ shim that
  * lets no exception through): reads a BREP (BRepTools::Read) and meshes it with
  * BRepMesh_IncrementalMesh at an absolute linear deflection (angular deflection 0.5 rad, OCCT's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: the splinewalk peer (see peer_splinewalk.h). */
 #include "peer_splinewalk.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/peers: splinewalk as a peer — the public API (runtime/include/splinewalk/splinewalk.h),
  * threaded (sw_renderer_prepare of frame i + 1 on the renderer's visibility thread while
  * sw_renderer_submit draws frame i, as bench/pipeline), walkthrough mode, default renderer (one

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/pipeline (issue 5; Kumar et al. 1997 Fig. 9): frame times along one camera path with the
  * renderer's visibility thread preparing frame i+1 while the submitting thread draws frame i
  * (sw_renderer_prepare / sw_renderer_submit, "threaded"), against every stage of a frame in one

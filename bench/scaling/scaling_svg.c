@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/scaling: the scaling plot (see scaling_svg.h). */
 #include "scaling_svg.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/steal: throughput of the worker pool (threads/sw_th_pool.h) when idle workers steal one
  * task versus half of the victim's deque (Kumar, Manocha, Zhang, Hoff 1997, §5.1: "partitions
  * Q(busy) into two"), for 1..N workers and two workloads:

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/supersurface: clustering time per model (lod/sw_lod_supersurface.h).
  *
  * Usage: bench_supersurface [--runs N] [--alpha DEG] MODEL...

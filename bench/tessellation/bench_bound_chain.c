@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: where splinewalk's grid densities lose against the screen-space error they
  * promise (Guthe et al. 2005 §5.2, §7). For every patch piece a frame draws (the frame's debug
  * hook), each link of the chain ε_img -> object tolerance -> Filip bound -> segments -> grid class

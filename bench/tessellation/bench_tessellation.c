@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation (Guthe et al. 2005 §9, Fig. 9): frame time of one rational bicubic patch,
  * untrimmed and trimmed (a star-shaped outer loop with a circular hole), at growing screen size,
  * rendered by splinewalk (sw_gpu_render_scene) and by Mesa's GLU NURBS tessellator (glu_nurbs.c)

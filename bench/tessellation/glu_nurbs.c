@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: the GLU NURBS tessellator baseline (Guthe et al. 2005 §9, Fig. 9) — see
  * glu_nurbs.h. The *_DATA callbacks receive the state through gluNurbsCallbackData (without it
  * GLU passes NULL and the callbacks would crash); registering a normal callback makes GLU evaluate

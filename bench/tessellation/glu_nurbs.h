@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: Mesa's GLU NURBS tessellator as the baseline of Guthe et al. 2005 §9
  * (Fig. 9). GLU is used in GLU_NURBS_TESSELLATOR mode (its renderer mode needs immediate-mode GL,
  * absent from a core context) with the frame's matrices loaded by gluLoadSamplingMatrices

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: the GLU baseline's draw path (see vbo_draw.h). The view-projection maps
  * eye-relative world positions to clip space with reversed-Z (gpu/camera.c), so depth is cleared
  * to 0 and tested with GL_GREATER under glClipControl zero-to-one, as in gpu/draw.c.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: the draw path of the GLU baseline (Guthe et al. 2005 §9, Fig. 9): triangles
  * GLU emitted, uploaded to a VBO and drawn with a small program that shades like gpu/'s surface
  * program (Lambert + headlight, two-sided, gamma-encoded) into an RGBA8 + 32F-depth target with

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: the benchmark's wavy rational bicubic patch and its fitted camera. */
 #include "wavy_patch.h"
 #include "sw_gpu_internal.h"

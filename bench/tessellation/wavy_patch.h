@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* bench/tessellation: the benchmark's patch (one wavy rational bicubic Bézier patch over
  * [-1,1]^2, weights 0.5-2) and its camera fitted to a screen width, shared by bench_tessellation
  * and bench_bound_chain. */

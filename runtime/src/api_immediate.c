@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Public immediate API (sw_immediate.h): Guthe et al. 2005 §8 in modern form — trimmed NURBS
  * objects by handle, drawn by list with model matrices through the renderer's scene frame path,
  * and host shading functions linked between the library's GPU evaluation and trimming.

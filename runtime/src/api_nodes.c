@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Public node-scene API (sw_nodes.h): the mutable node tree a host builds and edits. Each edit
  * asks api_nodes_compile.c for a new version; geometry descs are checked and turned into small
  * private scenes here, outside the edit lock, so a slow import never holds the scene up. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Node scenes: compiling the node tree into an immutable version (the scene graph's own scene,
  * built with sw_sg_builder, with its BVH and back-patch cones), publishing it by one atomic
  * pointer exchange, and reclaiming the version it replaces after a grace period

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Node scenes, inside the runtime (never installed): the mutable node tree (api_nodes.c) and its
  * compilation into published immutable versions (api_nodes_compile.c). sw_nodes.h says what the
  * host sees. */

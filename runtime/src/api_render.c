@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Public rendering API: a headless renderer owns a GL context on its creating thread and draws
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
 #include "sw_rt.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Public scene API: load (.sws mapped, or imported through OCCT), save, describe, fit cameras. */
 #include "sw_rt.h"
 #include "sw_hooks.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* sw_setup: the host's allocator and log hooks (splinewalk/sw_setup.h; the hooks themselves are
  * threads/hooks.c, below every library that allocates). */
 #include "sw_hooks.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Camera paths: the text format of docs/camera-path.md (parse, then validate), evaluation by a
  * Catmull-Rom-tangent Hermite spline over the key times, and the stock orbit and fly-through. */
 #include "sw_camera_path.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The splinewalk command-line tool's subcommands (runtime/src/cli_*.c). Each returns the process
  * exit status: 0 success, 1 a failure reported on stderr, 2 a usage error. */
 #ifndef SW_CLI_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk build-lod SCENE [-o OUT.sws] [--threads N] */
 #include "cli.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk check-osd [SCENE...] [--generated N] [--samples K] [--tolerance T] */
 #include "cli.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Helpers shared by the splinewalk subcommands: argument parsing, progress, error reports. */
 #include "cli.h"
 

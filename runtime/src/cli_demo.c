@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk demo: the built-in default scene, imported, saved, reloaded and rendered headlessly. */
 #include "cli.h"
 

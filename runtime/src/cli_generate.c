@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk generate grid|building: test scenes (culling tests, huge architectural scenes). */
 #include "cli.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk import IN -o OUT.sws */
 #include "cli.h"
 

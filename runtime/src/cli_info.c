@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk info SCENE [--json] */
 #include "cli.h"
 

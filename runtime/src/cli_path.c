@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk path orbit|fly SCENE -o PATH: writes a stock camera path fitted to a scene. */
 #include "cli.h"
 

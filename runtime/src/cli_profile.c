@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk profile SCENE --path PATH --out DIR [...]: frames along a camera path through the
  * public renderer API, timed stage by stage on the submitting thread and, threaded, on the
  * renderer's visibility thread (issue 5). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk render SCENE -o FRAME.png [...] */
 #include "cli.h"
 

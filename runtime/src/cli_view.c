@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk view SCENE: the interactive viewer (issue 5). A GLFW window is the host: its context
  * is current on this thread, a renderer is made on it (sw_renderer_desc.use_current_context), and
  * each frame is drawn in walkthrough mode — the same pipeline as `profile` and the embedding API —

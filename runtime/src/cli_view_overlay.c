@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The viewer's frame-time overlay: the last frames' times as bars in the window's lower left,
  * with marks at 16.7 and 33.3 ms, drawn by the viewer itself after the renderer presented its
  * frame — the host drawing around splinewalk, as an embedding program does. Bars of frames that

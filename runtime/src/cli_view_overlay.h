@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The viewer's overlays (cli_view_overlay.c): frame times, trim atlas. The window's GL thread
  * only. */
 #ifndef SW_CLI_VIEW_OVERLAY_H

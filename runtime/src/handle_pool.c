@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Generation-checked handle pools (CONVENTIONS.md: handles like sokol's sg_buffer). */
 #include "sw_rt.h"
 #include "sw_hooks.h"

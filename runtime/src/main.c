@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk: the command-line runtime. */
 #include "cli.h"
 

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The renderer's visibility thread V (Kumar et al. 1997 §5.2, ARCHITECTURE.md "runtime/"): it
  * prepares frames — culling, hierarchy selection, densities and grids, sw_gpu_frame_prepare —
  * while the renderer's owner thread, the submission thread P, draws the frame before. Two

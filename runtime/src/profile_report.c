@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Frame-time profiles: rows, summary statistics, and the CSV / JSON / SVG / HTML files of a
  * `splinewalk profile` run (docs/camera-path.md and the README describe what they hold). */
 #include "sw_profile_report.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Camera paths (never installed): keyframed cameras for profiling runs and, later, the viewer's
  * recordings. The text format is specified in docs/camera-path.md; this module parses it, then
  * validates it as a separate step (CONVENTIONS.md: files are hostile), evaluates it at any time,

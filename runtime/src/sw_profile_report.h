@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Frame-time profiles (never installed): one row of numbers per frame of a `splinewalk profile`
  * run, their summary (median, p90, p99, max, mean), and the files a run leaves: profile.csv,
  * profile.json, frametime.svg and report.html (hand-written SVG; the HTML is also well-formed XML).

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* runtime/ internals shared by the API implementation and the CLI (never installed). */
 #ifndef SW_RT_H
 #define SW_RT_H

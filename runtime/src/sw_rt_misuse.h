@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Misuse of the public API (never installed): a caller's programming mistake — a NULL desc or
  * out pointer, a stale handle (also a second destroy), a call from a thread that does not own the
  * renderer. CONVENTIONS.md (Errors) makes such a mistake an assert; issue 7 asks for the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* runtime/ internal: the visibility thread V of a renderer and its two activity lists
  * (pipeline.c says why frames, not nodes, go from V to the submission thread). Never installed.
  *

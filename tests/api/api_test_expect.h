@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/api: the failure counter, EXPECT and EXPECT_RESULT of the API test programs, and the
  * host's own EGL context (OpenGL 4.5 core, surfaceless) for the tests that play an embedding host.
  * Include once, in the program's main file; main returns g_failures != 0. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/api: frames read back for pixel comparisons (test_api_nodes_image_oiio.cpp, OpenImageIO).
  */
 #ifndef SW_API_TEST_IMAGE_H

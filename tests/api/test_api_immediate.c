@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/api: the immediate API (sw_immediate.h, Guthe et al. 2005 §8), against the shared library.
  *
  * usage: test_api_immediate WORKDIR   (EGL)

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/api: triangle-mesh nodes (sw_nodes.h MESH, issue 7), against the shared library.
  *
  * usage: test_api_meshes meshes WORKDIR   (no GL)

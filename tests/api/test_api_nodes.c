@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/api: scenes built from nodes (sw_nodes.h, issue 7), against the shared library.
  *
  * usage: test_api_nodes nodes TSM WORKDIR          (no GL)

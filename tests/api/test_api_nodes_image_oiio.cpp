@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // tests/api: reading a frame back for the node tests' pixel comparisons — a thin C++ shim over
 // OpenImageIO (the project's image library); no exception leaves it.
 #include <OpenImageIO/imageio.h>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/api: split frames — sw_renderer_prepare on the visibility thread, sw_renderer_submit on
  * the owner's (issue 5's frame overlap, issue 7's split calls), against the shared library.
  *

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # bench_peers and bench_scaling on tiny buildings, a few frames: exit status 0, truthful --help,
 # usage errors exit 2, and CSVs with every column, one field per column and finite positive
 # figures where a figure must be positive; GLU's and OCCT's last frames cover the same pixels

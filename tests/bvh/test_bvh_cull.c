@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/bvh: view-frustum culling by the BVH (scenegraph/sw_sg_bvh.h, sw_sg_bvh_cull; Kumar et al.
  * 1997 §4.4) against brute force, no GL. Hierarchies:
  *  - terrain.brep's face BVH: the file is one B-spline face (100,776 poles), so its BVH over faces

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Writes a corrupted copy of a valid .sws whose checksums are all correct again, so that only the
  * geometry check can catch it: `make_bad_sws IN OUT decreasing-knots|nan-weight`. The corruption
  * hits face 0: its first two u-knots are swapped with a larger value, or its first weight becomes

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # End-to-end tests of the splinewalk CLI: truthful --help, import/info/render on a real model, and
 # bad input (every case: a clear error naming the file and the problem, exit status 1, no crash).
 # usage: test_cli.sh SPLINEWALK MAKE_BAD_SWS DATA_DIR WORKDIR

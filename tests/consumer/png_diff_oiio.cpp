@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // sw_png_diff A.png B.png MAX_PERCENT: how many pixels of two frames differ (any channel by any
 // amount, or a different size), for the consumer test's "at most 0.1 % of pixels differ". A thin
 // C++ shim over OpenImageIO (the project's image library, CONVENTIONS.md); no exception leaves it.

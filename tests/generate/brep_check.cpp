@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* OCCT's own verdict on a BREP file: its faces, and how many BRepCheck_Analyzer finds invalid. */
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepTools.hxx>

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/generate: the building and vehicle generators (scenegraph/generate_building.c,
  * generate_vehicle.c: `splinewalk generate building|vehicle`), for each N given:
  *  - determinism: two runs with one seed save byte-identical .sws files, another seed differs;

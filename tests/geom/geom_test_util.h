@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared helpers of the geometry-kernel tests: a seeded generator and random rational B-spline
  * surfaces with clamped or unclamped knot vectors and repeated interior knots. */
 #ifndef GEOM_TEST_UTIL_H

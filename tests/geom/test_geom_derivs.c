@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Values, first and second derivatives of rational B-spline curves and surfaces against two
  * independent references:
  *  1. random rational surfaces (degrees 1..7 x 1..7) and curves, evaluated by a separate textbook

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The uniform bicubic B-spline evaluator against OpenSubdiv, linked for real through the
  * lod/uniform_bicubic_osd.cpp shim: random regular control grids (random heights and jittered
  * x, y), every interior face whose 4x4 neighbourhood lies in the grid, random (s, t) plus the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Knot insertion (Boehm) and Bézier extraction must not change a surface: random rational
  * surfaces of degrees 1..7 in u and v (random knot vectors with repeated knots, clamped and
  * unclamped ends, weights in [0.2, 5]) are evaluated at 10,000 random (u, v) each before and after,

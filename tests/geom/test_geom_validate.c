@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Validation rejects bad NURBS data with SW_ERR_INVALID_GEOMETRY (and accepts sound data):
  * decreasing, NaN and infinite knots, NaN / infinite / zero / negative weights, non-finite
  * coordinates, wrong counts and degrees, excessive knot multiplicity, an empty domain, missing

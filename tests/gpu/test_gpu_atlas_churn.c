@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The trim atlas (gpu/trim_atlas.c, Guthe et al. 2005 §4.4) when the trim textures a frame needs
  * change every frame: an animated scene (a new scene per frame, so no texture of an earlier frame
  * can be reused) seen by a moving camera (resolution classes change too). The atlas must reuse the

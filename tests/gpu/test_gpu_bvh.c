@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The BVH over face occurrences (scenegraph/sw_sg_bvh.h; Kumar et al. 1997 §4.4) and the frame's
  * culling by it (desc.bvh):
  *  - structure: every occurrence of the scene's traversal is an item exactly once; every item's

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Cracks between faces (Guthe et al. 2005 §7.1; gpu/crack_fill.c): faces are tessellated
  * independently, so along a shared edge each face's drawn border may miss the exact edge by up to
  * ε_img and sub-pixel cracks open between them. A crack pixel is a background pixel of our frame

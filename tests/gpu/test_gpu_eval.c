@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* GPU evaluation (Guthe et al. 2005 §4.2) against CPU grids: imported models rendered twice in the
  * same context, once with every patch tessellated on the CPU in double (patch_grid.c, the
  * reference) and once with patches of degree <= 3 x 3 evaluated in the vertex shader on the

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Exact evaluation (eval_exact: NURBS evaluated in the vertex shader from knot vectors and
  * control points, any degree up to 15) against the Bézier path (Guthe et al. 2005 §4.2: extracted
  * rational Bézier patches of degree <= 3 in the vertex shader, higher degrees as CPU grids in

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim-texture parity exactness through the trim atlas (Guthe et al. 2005 §4, §4.4; PLATFORM.md):
  * concave stars with a hole and an island inside the hole, each a different rotation and uv box,
  * are packed as entries into atlas pages (limited to 1024^2 so that pages hold several entries,

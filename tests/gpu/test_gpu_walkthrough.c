@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Walkthrough mode (ARCHITECTURE.md "two modes of the same pipeline"; issue 5's walkthrough
  * behaviour at the frame level): frames drawn through the hierarchy cache with desc.walkthrough
  * never wait for the worker pool, whatever is missing.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Edge pixels of depth images and their displacement through a Euclidean distance transform
  * (Felzenszwalb & Huttenlocher 2012); see edge_metric.hpp. */
 #include "edge_metric.hpp"

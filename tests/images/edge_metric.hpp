@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The image tests' edge metric: silhouette and depth-edge pixels of a depth image (coverage
  * boundary; depth discontinuities), an exact Euclidean distance transform (Felzenszwalb &
  * Huttenlocher 2012, "Distance transforms of sampled functions", lower envelope of parabolas),

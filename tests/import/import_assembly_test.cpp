@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Assemblies: a part used twice at different locations must become one prototype subtree drawn by
  * two INSTANCE nodes with the locations' transforms, converted once. Checked for a BREP compound
  * (TopoDS sharing) and for a STEP assembly written by OCCT's own XCAF writer (names, colours).

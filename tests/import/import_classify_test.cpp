@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Import + trim classification against OCCT (Foundation issue, "Import of Motor-c.brep ...").
  *
  * Each file is imported; for >= 2,000 random (u, v) per trimmed face, drawn inside the face's

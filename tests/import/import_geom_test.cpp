@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Imported surfaces against OCCT's evaluation of the same converted faces (Foundation issue).
  *
  * (1) sw_sg_surface_eval_d2 on every imported face vs Geom_BSplineSurface::D2 of OCCT's NURBS

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Shared helpers of the import tests: importing a file while keeping OCCT's converted face of
  * every scene face (the independent reference), a seeded generator, and pass/fail bookkeeping. */
 #ifndef OCCT_TEST_UTIL_HPP

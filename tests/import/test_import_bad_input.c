@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The importer's C interface on bad input: garbage STEP / IGES / BREP, an empty file, a missing
  * file, an unknown extension, a file with no faces — each the right sw_result with the file named
  * in the message and no crash. And the good path of sw_sg_import_into: a transform node named

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Trim loops (scenegraph/trim.c) against analytic shapes: a unit-square loop with a circular hole
  * made of exact rational quadratic arcs. Flattened vertices must lie on the circle, every chord
  * within the tolerance of it, join vertices bit-identical to the curves' first control points;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Unit properties of lod/'s Bézier utilities, degree reduction and error bound, each against an
  * independent reference (the scenegraph evaluators sw_sg_bezier_patch_eval, sw_sg_curve_eval,
  * sw_sg_surface_eval_d2, or a closed form):

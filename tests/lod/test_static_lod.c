@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Static LODs (issue 4, Kumar et al. 1997 §4.1-§4.3; lod/sw_lod_static.h): every face of every
  * model given on the command line becomes one super-surface (all its patches), is tessellated
  * within δ and simplified into levels; then an independent measurement — random surface points

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Super-surfaces (issue 4, Kumar et al. 1997 §3; lod/sw_lod_supersurface.h):
  *
  *  1. The Gauss-map cone bounds the true normals: S_u x S_v from the scenegraph's NURBS evaluator

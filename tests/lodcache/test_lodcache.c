@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/lodcache: the per-scene cache of face hierarchies (lod/sw_lod_cache.h) on a real model.
  *
  *   once      4 threads request every face of the model concurrently in random order (FRAME and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # `splinewalk check-osd` on the sample models with uniform bicubic regions and on generated nets:
 # every one reports regions > 0 and a difference to OpenSubdiv within 1e-10 (the command's exit
 # status), and a deliberately tiny tolerance makes it fail (the check can fail).

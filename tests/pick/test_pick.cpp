@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 // tests/pick: picking by ray (scenegraph/ray_pick.c) against OCCT's IntCurvesFace_ShapeIntersector
 // on the model's shape as OCCT reads the file itself (BRepTools::Read, STEPControl_Reader: the
 // world placement of every face, instances included), for random rays from a sphere around each

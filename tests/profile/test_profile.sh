@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # splinewalk path and profile, end to end on the default scene (issue 5, first slice):
 # - `path orbit|fly` write paths that `profile` reads back;
 # - `profile` writes profile.csv with the documented columns and one row per frame, all numbers;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* peak_rss: runs a command and prints its peak resident set (the kernel's ru_maxrss of the child,
  * what `/usr/bin/time -f %M` prints) so that a test can bound it without GNU time installed.
  *

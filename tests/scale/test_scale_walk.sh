@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # scale_walk_1e5 (issue 6, large-model readiness; label heavy): a generated 10^5-surface building
 # is loaded and walked by a walkthrough profile run along a fly-through, and
 # - generate, path and profile exit 0; the building has 10^5 surfaces drawn;

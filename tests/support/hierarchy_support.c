@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "hierarchy_support.h"
 
 #include "sw_lod_cache.h"

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/support: a worker pool and a bicubic-hierarchy cache for a scene behind one opaque handle,
  * so that C++ tests (which cannot include the C11-atomics headers of threads/) can render through
  * the hierarchy traversal (sw_gpu_frame_desc.hierarchies). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 #include "model_import.h"
 
 #include "sw_sg_import.h"

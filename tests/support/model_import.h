@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/support: importing a sample model for a test, the same way in every test program. */
 #ifndef SW_TEST_MODEL_IMPORT_H
 #define SW_TEST_MODEL_IMPORT_H

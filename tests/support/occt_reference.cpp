@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Test support: OCCT BRepMesh_IncrementalMesh of a model file as world-space triangles, the
  * independent reference the image tests draw through sw_gpu_render_triangles (see
  * occt_reference.hpp). Reading and meshing follow tests/gpu/test_gpu_models.cpp: absolute

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Test support: the independent reference of the image tests — OCCT's BRepMesh_IncrementalMesh of
  * a model file (BREP, STEP, IGES) at a given deflection, as world-space triangles (double xyz
  * positions + uint32 indices) ready for sw_gpu_render_triangles. The model is read once; each

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/support: the failure counter and CHECK of the plain-C test programs. Include once, in the
  * program's main file; main returns g_failures != 0. */
 #ifndef SW_TEST_CHECK_H

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer harness for .sws loading: every input is written to a temporary file, opened (mmap,
  * header and table checks) and, if that succeeds, fully required (checksums + validation), then
  * traversed. Each input is tried twice: as given, and with its checksums recomputed ("resealed")

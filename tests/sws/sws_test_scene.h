@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* A small scene shared by the .sws tests and the fuzz seed: three bicubic faces (one with two
  * knot spans in u, rational weights), trim loops of linear and rational quadratic curves, nested
  * transforms, two instances of a detached prototype, colours set and inherited, adjacency. */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Tests of the scene container and the .sws file (scene.c, scene_validate.c, sws_file.c,
  * scene_stats.c): a round trip that must be bit-identical, traversal against transforms composed
  * independently here, and hostile files (truncated, flipped bytes, huge offsets, bad indices,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: MIT
 # cmake -DNM=nm -DOBJECTS="deque.c.o;pool.c.o" -P check_no_lock.cmake
 # Fails if deque.c's object references a lock symbol, or if pool.c's (the control, which waits
 # on a condition variable) does not: a check that cannot see pool's mutex proves nothing.

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/threads: activity lists (threads/sw_th_activity.h; Kumar et al. 1997 §5.2, §5.3).
  *
  *  1. Markers, single-threaded: an empty list answers NOT_YET, items come out FIFO, a frame's

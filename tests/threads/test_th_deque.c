@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/threads: the Chase-Lev deque (threads/sw_th_deque.h) — LIFO for the owner, FIFO for
  * thieves, and exactly-once delivery while the ring grows under contention (each item counted in
  * a per-item atomic array, like GHC's testsuite/tests/rts/testwsdeque.c). */

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/threads: worker-pool behaviour (threads/sw_th_pool.h) — cancellation of stale requests,
  * priorities, group waiters that help, fork-join from tasks, shutdown that drains, idle
  * workers that sleep instead of spinning, and the accounting by task kind (counts, own time of

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/threads: exactly-once execution in the worker pool under random spawning.
  *
  * Every task has an id in [0, N) and an atomic run counter; a task spawns 0–3 children at random

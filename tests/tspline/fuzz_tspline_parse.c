@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* libFuzzer harness for .tsm loading (tspline_io.c, tspline.c, tspline_bezier.c): every input is
  * parsed and validated; a failure must come with no T-spline and a message naming the file. An
  * accepted T-spline is evaluated by all three paths (which must give finite points when its

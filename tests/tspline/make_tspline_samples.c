@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Writes the sample T-meshes of samples/tsplines/ (and, in the build, the copies the tests compare
  * with the checked-in files): make_tspline_samples OUTDIR.
  *

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* tests/tspline: T-splines (scenegraph/sw_sg_tspline.h) against independent references.
  *  - local_refinement.tsm equals its source NURBS (sw_sg_surface_eval, the NURBS kernel) to 1e-9
  *    relative at 20,000 random points, through all three evaluators;

@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The sources of the sample T-splines in samples/tsplines/ (written by make_tspline_samples.c),
  * shared with the tests that check the samples against them.
  *

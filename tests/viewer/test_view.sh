@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # tests/viewer: `splinewalk view` (issue 5) as a user meets it.
 #  1. No display: exit 1 with a message that points to `splinewalk profile` (before any import).
 #  2. Bad arguments: --screenshot without --script is a usage error (2); a missing script file

@@ -1,8 +1,10 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — walk through huge trimmed-NURBS CAD models with a guaranteed screen-space error.
  *
- * The public C API, first slice: load a scene (.sws, or STEP / IGES / BREP imported through
- * OpenCASCADE), describe it, save it, and render converged frames headlessly (EGL). Later issues
- * grow it into the embedding API (scene-graph nodes, a runtime on the host's GL context).
+ * The public C API: load a scene (.sws, or STEP / IGES / BREP imported through OpenCASCADE),
+ * describe it, save it, pick in it, and render frames headlessly (EGL) or with the host's GL
+ * context into its framebuffer. Scenes built from nodes: sw_nodes.h; objects drawn without a
+ * scene: sw_immediate.h; allocator and log hooks: sw_setup.h.
  *
  * Style (CONVENTIONS.md): objects are handles holding a pool index and a generation (0 invalid; a
  * stale handle yields SW_ERR_STALE_HANDLE, never a crash); create calls take a `const *_desc` in

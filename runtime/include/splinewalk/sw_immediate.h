@@ -1,5 +1,6 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — the immediate API: trimmed NURBS objects drawn by handle, without a scene, and
- * host shaders around the library's GPU evaluation and trimming (issue 7).
+ * host shaders around the library's GPU evaluation and trimming.
  *
  * The modern form of Guthe et al. 2005 §8 ("OpenGL API Integration", Figure 8): where the paper
  * proposes gluGenNurbsObjectsEXT / gluControlPoints4fvEXT / gluKnotVectorfvEXT /

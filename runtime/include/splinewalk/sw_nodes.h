@@ -1,4 +1,5 @@
-/* splinewalk — scenes built from nodes: the scene-graph part of the embedding API (issue 7).
+/* SPDX-License-Identifier: MIT */
+/* splinewalk — scenes built from nodes: the scene-graph part of the embedding API.
  *
  * A node scene is an sw_scene like a loaded one (sw_renderer_draw, sw_scene_save, sw_scene_pick,
  * sw_scene_get_info and sw_camera_fit take its handle), whose content the host builds and edits:

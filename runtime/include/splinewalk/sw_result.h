@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — result codes and the caller-owned status that carries their message.
  *
  * Every layer (scenegraph, lod, gpu, runtime) reports bad data, I/O and driver failures with an

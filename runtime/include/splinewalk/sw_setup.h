@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* splinewalk — process-wide setup: the host's allocator and log hooks (CONVENTIONS.md, API shape:
  * "Allocator and log hooks come in the setup desc with a user_data pointer"; like sokol's
  * sg_desc.allocator / sg_desc.logger).
