@@ -166,7 +166,7 @@ typedef struct sw_gpu_frame_stats {
     uint64_t static_requests;    /* walkthrough: unit builds queued, not waited for */
     uint64_t static_waits;       /* converged: units the frame waited for */
     uint32_t static_levels_used; /* bit k: some unit drawn at level k (31: 31 and beyond) */
-    /* triangle meshes (SW_SG_NODE_MESH occurrences; gpu/frame_mesh.c) */
+    /* triangle meshes (SW_SG_NODE_MESH occurrences; gpu/stage_tessellate_mesh.c) */
     uint64_t meshes_drawn, meshes_culled; /* occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
     double near_plane; /* the projection's (desc.near_plane or the scene box's) */

@@ -11,7 +11,7 @@
  *                  derivative constants), built in the worker pool by the frame itself from a
  *                  fresh sw_lod_cache of the frame's scene, with any refinement below its leaves
  *                  the view asks for: the frame stats' ms_hierarchy, which runs from the build
- *                  requests to the last refinement's end (gpu/frame_hlod.c);
+ *                  requests to the last refinement's end (gpu/stage_hierarchy.c);
  *   scene          the degree-d face trimmed by the cubic loop, and the empty cache (timed apart);
  *   tessellation   the rest of sw_gpu_render_scene (headless GL, llvmpipe on this machine): its
  *                  frame stats' tessellate (the traversal of the hierarchy, §7, bounds, grids),
@@ -54,8 +54,9 @@ enum { MAX_FRAMES = 1000 };
 
 /* ε_img's share of the trim loop's cubic approximation. */
 static const double k_trim_share = 0.1;
-/* The frame's bound of an occurrence transform's stretch is its Frobenius norm (gpu/frame_hlod.c),
- * sqrt(3) for the identity this scene's node has: the node errors it compares with ε_obj / 2. */
+/* The frame's bound of an occurrence transform's stretch is its Frobenius norm
+ * (gpu/stage_hierarchy.c), sqrt(3) for the identity this scene's node has: the node errors it
+ * compares with ε_obj / 2. */
 static const double k_frame_stretch = 1.7320508075688772;
 
 /* Per-frame figures, one array of `frames` values each. */
