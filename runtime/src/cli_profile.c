@@ -6,10 +6,12 @@
 #include "sw_camera_path.h"
 #include "sw_profile_report.h"
 #include "sw_rt.h"
+#include "sw_safe_write.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -190,6 +192,11 @@ static sw_result staging_commit(staging *st, const char *out, sw_status *status)
             return sw__fail(status, SW_ERR_IO, "%s: %s", to, strerror(errno));
     }
     rmdir(st->dir);
+    const int fd = open(out, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) { /* the renames made durable (the files were fsync'd when written) */
+        (void)fsync(fd);
+        close(fd);
+    }
     return SW_OK;
 }
 
@@ -218,18 +225,28 @@ static int html_fn(FILE *f, const sw_rt_profile *p, const char *svg)
     return sw_rt_profile_write_html(f, p, svg);
 }
 
+typedef struct report_job {
+    report_fn fn;
+    const sw_rt_profile *p;
+    const char *svg;
+} report_job;
+
+static int report_fill(FILE *f, const void *ctx)
+{
+    const report_job *job = ctx;
+    return job->fn(f, job->p, job->svg);
+}
+
+/* Each report through the project's one writer (sw_safe_write.h): built in memory, every write
+ * and the fsync checked, so a full disk fails the run instead of committing a short file. */
 static sw_result write_staged(staging *st, const char *name, report_fn fn, const sw_rt_profile *p,
                               const char *svg, sw_status *status)
 {
     char path[4200];
     staged_path(st, name, path, sizeof path);
     staging_remember(st, name);
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return sw__fail(status, SW_ERR_IO, "%s: %s", path, strerror(errno));
-    int bad = fn(f, p, svg);
-    bad |= fclose(f) != 0;
-    return bad ? sw__fail(status, SW_ERR_IO, "%s: write failed", path) : SW_OK;
+    const report_job job = {fn, p, svg};
+    return sw__write_file_printed(path, report_fill, &job, 0, status);
 }
 
 static sw_result write_reports(staging *st, const sw_rt_profile *p, sw_status *status)

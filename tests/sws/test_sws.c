@@ -820,7 +820,7 @@ static void test_missing_file(void **state)
     assert_non_null(strstr(st.message, p));
     snprintf(p, sizeof p, "%s/no-such-dir/x.sws", g_dir);
     assert_int_equal(sw_sg_scene_open(p, &s, &st), SW_ERR_NOT_FOUND);
-    assert_int_not_equal(sw_sg_scene_open(g_dir, &s, &st), SW_OK); /* a directory */
+    assert_int_equal(sw_sg_scene_open(g_dir, &s, &st), SW_ERR_NOT_REGULAR_FILE); /* a directory */
     assert_null(s);
 }
 
@@ -835,10 +835,10 @@ static void test_failed_saves(void **state)
     assert_int_not_equal(sw_sg_scene_save(s, p, &st), SW_OK);
     assert_non_null(strstr(st.message, p));
 
-    /* the target is a directory: the temporary file is written, the rename fails */
+    /* the target is a directory: refused before anything is written */
     snprintf(sub, sizeof sub, "%s/target", g_dir);
     assert_int_equal(mkdir(sub, 0700), 0);
-    assert_int_equal(sw_sg_scene_save(s, sub, &st), SW_ERR_IO);
+    assert_int_equal(sw_sg_scene_save(s, sub, &st), SW_ERR_NOT_REGULAR_FILE);
     assert_int_equal(count_temp_files(g_dir), 0);
     assert_int_equal(rmdir(sub), 0);
 
