@@ -17,6 +17,7 @@
 
 ssize_t (*sw__out_write_hook)(int fd, const void *data, size_t n);
 int (*sw__out_fsync_hook)(int fd);
+int sw__out_no_tmpfile;
 
 enum {
     KIND_TMPFILE = 1, /* unnamed O_TMPFILE in the target's directory, linked at commit */
@@ -215,7 +216,7 @@ static sw_result open_temp(sw__out *out, const struct stat *st, sw_status *statu
     remove_stale_temps(dir, base_of(out->target));
     const mode_t mode = st ? (st->st_mode & 07777) : 0666;
     out->fd = -1;
-    if (have_proc_fd()) {
+    if (!sw__out_no_tmpfile && have_proc_fd()) {
         out->fd = open(dir, O_TMPFILE | O_WRONLY | O_CLOEXEC, mode);
         if (out->fd >= 0)
             out->kind = KIND_TMPFILE;

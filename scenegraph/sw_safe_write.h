@@ -77,6 +77,8 @@ sw_result sw__write_file_printed(const char *path, sw__out_fill_fn fill, const v
  * goes through these; NULL (the default) means the system calls. A hook sets errno on failure. */
 extern ssize_t (*sw__out_write_hook)(int fd, const void *data, size_t n);
 extern int (*sw__out_fsync_hook)(int fd);
+/* Tests only: nonzero makes every temporary a named NAME.tmp-PID, as where O_TMPFILE is missing. */
+extern int sw__out_no_tmpfile;
 
 #ifdef __cplusplus
 }

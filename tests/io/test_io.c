@@ -223,9 +223,11 @@ static const format k_formats[] = {
     {"profile CSV", "prof", write_profile, 1},
 };
 
-/* Every write of a clean run failing in turn, then the fsync: error, old bytes, no temporary. */
-static void full_disk_simulated(const format *f)
+/* Every write of a clean run failing in turn, then the fsync: error, old bytes, no temporary.
+ * named: the temporaries are NAME.tmp-PID from the start (no O_TMPFILE). */
+static void full_disk_simulated(const format *f, int named)
 {
+    sw__out_no_tmpfile = named;
     const double t0 = now_s();
     char target[1200], file[1300], dir[1200];
     path_in(target, sizeof target, f->file);
@@ -275,9 +277,10 @@ static void full_disk_simulated(const format *f)
               "%s: the message does not say the disk is full: %s", f->name, st.message);
     }
     hooks_reset();
-    printf("%-12s %3ld writes, each failing in turn, then the fsync: %d lost or left behind "
-           "(%.2f s)\n",
-           f->name, writes, failures, now_s() - t0);
+    sw__out_no_tmpfile = 0;
+    printf("%-12s %3ld writes, each failing in turn, then the fsync (%s): %d lost or left "
+           "behind (%.2f s)\n",
+           f->name, writes, named ? "NAME.tmp-PID" : "O_TMPFILE", failures, now_s() - t0);
 }
 
 /* A real full file system: a 64 KiB tmpfs filled to ENOSPC (root with CAP_SYS_ADMIN only). */
@@ -519,8 +522,9 @@ int main(int argc, char **argv)
     setvbuf(stdout, NULL, _IOLBF, 0);
     if (setup(argv[1]) != 0)
         return 1;
-    for (size_t i = 0; i < sizeof k_formats / sizeof k_formats[0]; i++)
-        full_disk_simulated(&k_formats[i]);
+    for (int named = 0; named < 2; named++)
+        for (size_t i = 0; i < sizeof k_formats / sizeof k_formats[0]; i++)
+            full_disk_simulated(&k_formats[i], named);
     full_disk_real();
     targets();
     inputs();
