@@ -11,7 +11,9 @@
 # - a dead writer's NAME.tmp-PID is gone after the next write (temporaries that pile up);
 # - `info FIFO` returns at once with SW_ERR_NOT_REGULAR_FILE (an open() that blocks for ever),
 #   `import DIR.step` says "is a directory" (was "file not found"), `render -o frame` says the
-#   name has no extension (was "unsupported image type '.'").
+#   name has no extension (was "unsupported image type '.'");
+# - a writer killed (SIGKILL, SIGTERM; strace injects them at its fsync and its rename) leaves the
+#   old file as it was, and no temporary outlives the next run (skipped without strace/ptrace).
 # usage: test_io_cli.sh SPLINEWALK DATA_DIR WORKDIR
 set -u
 sw=$1 data=$2 work=$3
@@ -64,6 +66,28 @@ expect_error "import -o DIR" SW_ERR_NOT_REGULAR_FILE "out.sws: is a directory" -
 expect_error "import -o NODIR/x.sws" SW_ERR_NOT_FOUND "does not exist" -- \
   "$sw" import "$model" -o no-such-dir/x.sws
 pass "a symbolic link written through, a directory refused, a stale temporary removed"
+
+# ---- killed writers: strace delivers the signal at the writer's fsync or rename -----------------
+# (catches: a kill that leaves a partial target, or a temporary that no later run removes)
+if strace -f -o /dev/null true 2>/dev/null; then
+  cp m.sws keep.sws
+  cp stdout.path keep.path
+  (strace -f -o /dev/null -e trace=fsync -e inject=fsync:signal=KILL:when=1 \
+    "$sw" import "$model" -o keep.sws) >/dev/null 2>&1
+  cmp -s keep.sws m.sws || fail "kill -9 at the fsync of import: keep.sws changed"
+  (strace -f -o /dev/null -e trace=fsync -e inject=fsync:signal=TERM:when=1 \
+    "$sw" path fly m.sws -o keep.path) >/dev/null 2>&1
+  cmp -s keep.path stdout.path || fail "SIGTERM at the fsync of path: keep.path changed"
+  (strace -f -o /dev/null -e trace=rename -e inject=rename:signal=KILL \
+    "$sw" path fly m.sws -o keep.path) >/dev/null 2>&1
+  cmp -s keep.path stdout.path || fail "kill -9 at the rename of path: keep.path changed"
+  ls keep.path.tmp-* >/dev/null 2>&1 || echo "note: kill -9 at the rename left no temporary"
+  "$sw" path orbit m.sws -o keep.path >/dev/null 2>&1 || fail "path after a killed one"
+  ls ./*.tmp-* >/dev/null 2>&1 && fail "a killed writer's temporary outlived the next run: $(ls ./*.tmp-*)"
+  pass "killed writers (SIGKILL, SIGTERM at fsync and rename): old files kept, temporaries gone"
+else
+  echo "skip: killed writers (strace missing or ptrace not permitted)"
+fi
 
 # ---- inputs -----------------------------------------------------------------------------------
 mkfifo fifo.sws
