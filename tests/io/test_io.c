@@ -468,6 +468,9 @@ static void inputs(void)
 static int setup(const char *work)
 {
     char cmd[1200];
+    /* a run that died with the tmpfs mounted must not make the next one fail */
+    snprintf(cmd, sizeof cmd, "%s/tmpfs", work);
+    (void)umount2(cmd, MNT_DETACH);
     snprintf(cmd, sizeof cmd, "rm -rf '%s' && mkdir -p '%s'", work, work);
     if (system(cmd) != 0)
         return -1;
