@@ -301,6 +301,38 @@ static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec
     return SW_OK;
 }
 
+/* Every byte of the data area outside the sections is alignment padding: fewer than 16 bytes
+ * before each section and after the last one, all zero (issue 22: a byte flipped there was
+ * covered by no checksum). Sections do not overlap (check_overlaps ran). */
+static sw_result check_padding(const char *path, const unsigned char *p, uint64_t data_start,
+                               uint64_t file_size, const sw__sg_section_info *sec,
+                               sw_status *status)
+{
+    uint64_t pos = data_start;
+    for (;;) {
+        /* the next non-empty section at or after pos */
+        const sw__sg_section_info *next = NULL;
+        for (int s = 0; s < SWS_MAX_SECTIONS; s++)
+            if (sec[s].size && sec[s].offset >= pos && (!next || sec[s].offset < next->offset))
+                next = &sec[s];
+        const uint64_t end = next ? next->offset : file_size;
+        if (end - pos >= SWS_ALIGN)
+            return sw__fail(status, SW_ERR_FORMAT,
+                            "%s: offset %llu: %llu bytes belong to no section (padding is under "
+                            "%u bytes)",
+                            path, (unsigned long long)pos, (unsigned long long)(end - pos),
+                            SWS_ALIGN);
+        for (uint64_t i = pos; i < end; i++)
+            if (p[i])
+                return sw__fail(status, SW_ERR_FORMAT,
+                                "%s: offset %llu: padding byte 0x%02x, expected 0", path,
+                                (unsigned long long)i, p[i]);
+        if (!next)
+            return SW_OK;
+        pos = next->offset + next->size;
+    }
+}
+
 static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status *status)
 {
     const unsigned char *p = scene->map;
@@ -316,6 +348,8 @@ static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status 
             return r;
     }
     sw_result r = check_overlaps(scene->path, sec, status);
+    if (r == SW_OK)
+        r = check_padding(scene->path, p, data_start, h->file_size, sec, status);
     if (r != SW_OK)
         return r;
     memcpy(scene->sec, sec, sizeof scene->sec);
