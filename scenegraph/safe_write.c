@@ -38,18 +38,23 @@ static int do_fsync(int fd)
 
 static char *dup_str(const char *s)
 {
-    return sw__strdup(s);
+    char *d = sw__strdup(s);
+    if (!d)
+        errno = ENOMEM; /* the callers tell an allocation failure by errno */
+    return d;
 }
 
 static char *join(const char *dir, size_t dir_len, const char *name)
 {
     const size_t n = strlen(name);
     char *p = sw__malloc(dir_len + 1 + n + 1);
-    if (p) {
-        memcpy(p, dir, dir_len);
-        p[dir_len] = '/';
-        memcpy(p + dir_len + 1, name, n + 1);
+    if (!p) {
+        errno = ENOMEM;
+        return NULL;
     }
+    memcpy(p, dir, dir_len);
+    p[dir_len] = '/';
+    memcpy(p + dir_len + 1, name, n + 1);
     return p;
 }
 
