@@ -10,8 +10,10 @@
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -139,10 +141,41 @@ static int parse_args(int argc, char **argv, profile_args *a)
 
 /* ---- output directory: written aside, renamed in at the end ---------------------------------- */
 typedef struct staging {
-    char dir[4096]; /* DIR/.profile-XXXXXX */
+    char dir[4096]; /* DIR/.profile-PID-XXXXXX */
     char names[8][64];
     int n_names;
 } staging;
+
+/* Removes the staging folders DIR/.profile-PID-XXXXXX of runs that were killed (their PID no
+ * longer runs): they hold only the flat files a run stages. */
+static void remove_stale_staging(const char *out)
+{
+    DIR *d = opendir(out);
+    if (!d)
+        return;
+    const struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        char *end;
+        if (strncmp(e->d_name, ".profile-", 9) != 0)
+            continue;
+        const long pid = strtol(e->d_name + 9, &end, 10);
+        if (end == e->d_name + 9 || *end != '-' || pid <= 0 || pid == (long)getpid() ||
+            kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue;
+        char sub[4200];
+        snprintf(sub, sizeof sub, "%s/%s", out, e->d_name);
+        DIR *s = opendir(sub);
+        const struct dirent *f;
+        while (s && (f = readdir(s)) != NULL) {
+            if (strcmp(f->d_name, ".") != 0 && strcmp(f->d_name, "..") != 0)
+                unlinkat(dirfd(s), f->d_name, 0);
+        }
+        if (s)
+            closedir(s);
+        rmdir(sub);
+    }
+    closedir(d);
+}
 
 static sw_result make_staging(const char *out, staging *st, sw_status *status)
 {
@@ -153,7 +186,9 @@ static sw_result make_staging(const char *out, staging *st, sw_status *status)
     } else if (!S_ISDIR(sb.st_mode)) {
         return sw__fail(status, SW_ERR_IO, "%s: exists and is not a directory", out);
     }
-    if (snprintf(st->dir, sizeof st->dir, "%s/.profile-XXXXXX", out) >= (int)sizeof st->dir)
+    remove_stale_staging(out);
+    if (snprintf(st->dir, sizeof st->dir, "%s/.profile-%ld-XXXXXX", out, (long)getpid()) >=
+        (int)sizeof st->dir)
         return sw__fail(status, SW_ERR_IO, "%s: path too long", out);
     if (!mkdtemp(st->dir))
         return sw__fail(status, SW_ERR_IO, "%s: %s", st->dir, strerror(errno));

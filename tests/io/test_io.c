@@ -276,6 +276,22 @@ static void full_disk_simulated(const format *f, int named)
         CHECK(f->is_dir || r != SW_OK || strstr(st.message, "No space left"),
               "%s: the message does not say the disk is full: %s", f->name, st.message);
     }
+    if (f->is_dir) {
+        /* a killed run's staging folder is removed by the next run (catches: folders that pile
+         * up in DIR) */
+        const pid_t child = fork();
+        if (child == 0)
+            _exit(0);
+        waitpid(child, NULL, 0);
+        char stale[1400], staged[1500];
+        snprintf(stale, sizeof stale, "%s/.profile-%ld-AbCdEf", target, (long)child);
+        mkdir(stale, 0777);
+        snprintf(staged, sizeof staged, "%s/profile.csv", stale);
+        write_bytes(staged, "partial", 7);
+        hooks_reset();
+        CHECK(f->write(target, &st) == SW_OK, "%s: %s", f->name, st.message);
+        CHECK(access(stale, F_OK) != 0, "%s: a killed run's staging folder was left", f->name);
+    }
     hooks_reset();
     sw__out_no_tmpfile = 0;
     printf("%-12s %3ld writes, each failing in turn, then the fsync (%s): %d lost or left "
