@@ -1,16 +1,16 @@
 /* SPDX-License-Identifier: MIT */
 // Frame images out through OpenImageIO: PNG (RGBA8) or OpenEXR (half RGBA plus a float Z channel
-// when the frame has depth). Written to a temporary name beside the target and renamed over it
-// (ARCHITECTURE.md: file safety). A thin C++ shim: no exception leaves it.
+// when the frame has depth). Encoded to memory (an OIIO IOVecOutput proxy), then handed to the
+// project's one writer (sw_safe_write.h), which replaces the target whole or not at all: OIIO's
+// own file writes do not report a full disk. A thin C++ shim: no exception leaves it.
 #include "sw_gpu.h"
+#include "sw_safe_write.h"
 #include "sw_status_util.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
-#include <cstdio>
-#include <cstring>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 namespace
@@ -32,16 +32,23 @@ std::string lower_extension(const std::string &path)
     return e;
 }
 
-sw_result write_spec(const std::string &format, const std::string &tmp, const ImageSpec &spec,
-                     TypeDesc type, const void *data, const char *path, sw_status *status)
+// Encodes the image into `bytes` (nothing touches the disk here).
+sw_result write_spec(const std::string &format, std::vector<unsigned char> &bytes,
+                     const ImageSpec &spec, TypeDesc type, const void *data, const char *path,
+                     sw_status *status)
 {
     auto out = ImageOutput::create(format);
     if (!out)
         return sw__fail(status, SW_ERR_IO, "%s: OpenImageIO has no %s writer: %s", path,
                         format.c_str(), OIIO::geterror().c_str());
-    if (!out->open(tmp, spec))
-        return sw__fail(status, SW_ERR_IO, "%s: cannot create %s: %s", path, tmp.c_str(),
-                        out->geterror().c_str());
+    OIIO::Filesystem::IOVecOutput vec(bytes);
+    if (!out->supports("ioproxy") || !out->set_ioproxy(&vec))
+        return sw__fail(status, SW_ERR_INTERNAL,
+                        "%s: OpenImageIO's %s writer cannot encode to memory", path,
+                        format.c_str());
+    if (!out->open(path, spec))
+        return sw__fail(status, SW_ERR_IO, "%s: cannot start the %s encoder: %s", path,
+                        format.c_str(), out->geterror().c_str());
     bool ok = out->write_image(type, data);
     std::string err = ok ? std::string() : out->geterror();
     if (!out->close() && ok) {
@@ -49,19 +56,19 @@ sw_result write_spec(const std::string &format, const std::string &tmp, const Im
         err = out->geterror();
     }
     if (!ok)
-        return sw__fail(status, SW_ERR_IO, "%s: writing failed: %s", path, err.c_str());
+        return sw__fail(status, SW_ERR_IO, "%s: encoding failed: %s", path, err.c_str());
     return SW_OK;
 }
 
-sw_result write_png(const sw_gpu_image *img, const std::string &tmp, const char *path,
+sw_result write_png(const sw_gpu_image *img, std::vector<unsigned char> &bytes, const char *path,
                     sw_status *status)
 {
     ImageSpec spec(img->width, img->height, 4, TypeDesc::UINT8);
     spec.attribute("png:compressionLevel", 1);
-    return write_spec("png", tmp, spec, TypeDesc::UINT8, img->rgba, path, status);
+    return write_spec("png", bytes, spec, TypeDesc::UINT8, img->rgba, path, status);
 }
 
-sw_result write_exr(const sw_gpu_image *img, const std::string &tmp, const char *path,
+sw_result write_exr(const sw_gpu_image *img, std::vector<unsigned char> &bytes, const char *path,
                     sw_status *status)
 {
     int nc = img->depth ? 5 : 4;
@@ -81,7 +88,7 @@ sw_result write_exr(const sw_gpu_image *img, const std::string &tmp, const char 
         if (img->depth)
             px[i * (size_t)nc + 4] = img->depth[i];
     }
-    return write_spec("openexr", tmp, spec, TypeDesc::FLOAT, px.data(), path, status);
+    return write_spec("openexr", bytes, spec, TypeDesc::FLOAT, px.data(), path, status);
 }
 
 } // namespace
@@ -92,20 +99,22 @@ extern "C" sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *pat
     try {
         std::string p(path), ext = lower_extension(p);
         bool png = ext == "png", exr = ext == "exr";
+        if (ext.empty())
+            return sw__fail(status, SW_ERR_UNSUPPORTED,
+                            "%s: the image file name has no extension: end it in .png or .exr",
+                            path);
         if (!png && !exr)
             return sw__fail(status, SW_ERR_UNSUPPORTED,
                             "%s: unsupported image type '.%s' (use .png or .exr)", path,
                             ext.c_str());
         if (!img->rgba || img->width < 1 || img->height < 1)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: empty image", path);
-        std::string tmp = p + ".tmp-" + std::to_string((long)getpid());
-        sw_result r = png ? write_png(img, tmp, path, status) : write_exr(img, tmp, path, status);
-        if (r == SW_OK && std::rename(tmp.c_str(), p.c_str()) != 0)
-            r = sw__fail(status, SW_ERR_IO, "%s: cannot rename %s over it: %s", path, tmp.c_str(),
-                         std::strerror(errno));
-        if (r != SW_OK)
-            std::remove(tmp.c_str());
-        else
+        std::vector<unsigned char> bytes;
+        sw_result r =
+            png ? write_png(img, bytes, path, status) : write_exr(img, bytes, path, status);
+        if (r == SW_OK)
+            r = sw__write_file(path, bytes.data(), bytes.size(), 0, status);
+        if (r == SW_OK)
             sw__status_ok(status);
         return r;
     } catch (const std::exception &e) {

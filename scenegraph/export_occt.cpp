@@ -10,6 +10,8 @@
  * The importer reads OCCT's convention, which the loops already follow: outer loops counter-
  * clockwise, holes clockwise, in a FORWARD face; a SW_SG_FACE_REVERSED face is written REVERSED.
  */
+#include "sw_hooks.h"
+#include "sw_safe_write.h"
 #include "sw_sg_export.h"
 #include "sw_status_util.h"
 
@@ -37,7 +39,9 @@
 #include <gp_Trsf.hxx>
 
 #include <cmath>
+#include <cstring>
 #include <new>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -348,16 +352,30 @@ TopoDS_Shape exporter::node_shape(uint32_t n)
 
 } // namespace
 
-extern "C" sw_result sw_sg_export_brep(const sw_sg_scene *scene, const char *path,
-                                       sw_sg_export_report *report, sw_status *status)
+extern "C" sw_result sw_sg_export_brep_text(const sw_sg_scene *scene, char **text, size_t *len,
+                                            sw_sg_export_report *report, sw_status *status)
 {
-    if (!scene || !path)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "export: no scene or no path");
+    *text = NULL;
+    *len = 0;
+    if (!scene)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "export: no scene");
+    const char *path = "BREP export";
     try {
         exporter ex(scene);
         TopoDS_Shape all = ex.node_shape(sw_sg_scene_view_ptr(scene)->root);
-        if (!BRepTools::Write(all, path))
-            return sw__fail(status, SW_ERR_IO, "%s: could not be written", path);
+        std::ostringstream os;
+        BRepTools::Write(all, os);
+        if (!os.good())
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: the BREP text could not be built",
+                            path);
+        const std::string s = os.str();
+        char *t = static_cast<char *>(sw__malloc(s.size() + 1));
+        if (!t)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory for %zu bytes", path,
+                            s.size());
+        std::memcpy(t, s.data(), s.size() + 1);
+        *text = t;
+        *len = s.size();
         if (report)
             *report = {ex.faces_made, ex.occurrences};
         sw__status_ok(status);
@@ -372,4 +390,18 @@ extern "C" sw_result sw_sg_export_brep(const sw_sg_scene *scene, const char *pat
     } catch (...) {
         return sw__fail(status, SW_ERR_INTERNAL, "%s: unknown exception while exporting", path);
     }
+}
+
+extern "C" sw_result sw_sg_export_brep(const sw_sg_scene *scene, const char *path,
+                                       sw_sg_export_report *report, sw_status *status)
+{
+    if (!scene || !path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "export: no scene or no path");
+    char *text;
+    size_t len;
+    sw_result r = sw_sg_export_brep_text(scene, &text, &len, report, status);
+    if (r == SW_OK)
+        r = sw__write_file(path, text, len, 0, status);
+    sw__free(text);
+    return r;
 }

@@ -13,6 +13,7 @@
 #include "sw_sg_trim.h"
 #include "sw_status_util.h"
 #include "sw_hooks.h"
+#include "sw_safe_read.h"
 
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
@@ -974,9 +975,11 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
 {
     if (report)
         *report = rep_;
-    struct stat sb;
-    if (stat(path_.c_str(), &sb) != 0 || !S_ISREG(sb.st_mode))
-        return sw__fail(status, SW_ERR_NOT_FOUND, "%s: no such file", path_.c_str());
+    /* a regular file only, before OCCT opens it: a FIFO would block its reader, a directory or
+     * a device with a CAD name must say what it is (SW_ERR_NOT_REGULAR_FILE), not "not found" */
+    sw_result checked = sw__in_check(path_.c_str(), 0, "CAD file", status);
+    if (checked != SW_OK)
+        return checked;
     const std::string ext = lower_ext(path_);
     const bool step = ext == "step" || ext == "stp", iges = ext == "iges" || ext == "igs";
     if (!step && !iges && ext != "brep")

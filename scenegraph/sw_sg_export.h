@@ -18,10 +18,15 @@ typedef struct sw_sg_export_report {
     uint64_t occurrences; /* face occurrences of the compound, instances expanded */
 } sw_sg_export_report;
 
-/* Writes `scene` (SW_SG_SEC_ALL required) to `path` as it is: callers wanting an atomic file write
- * to a temporary name and rename it. Errors: SW_ERR_IO (the file could not be written),
- * SW_ERR_INVALID_GEOMETRY (OCCT refused a face's surface or curves; the face is named),
- * SW_ERR_OUT_OF_MEMORY, SW_ERR_INTERNAL (an OCCT exception). `report` may be NULL. */
+/* The BREP text of `scene` (SW_SG_SEC_ALL required) in memory: *text is sw__malloc'd, NUL after
+ * its *len bytes, the caller's to sw__free. Errors: SW_ERR_INVALID_GEOMETRY (OCCT refused a
+ * face's surface or curves; the face is named), SW_ERR_OUT_OF_MEMORY, SW_ERR_INTERNAL (an OCCT
+ * exception). `report` may be NULL. */
+sw_result sw_sg_export_brep_text(const sw_sg_scene *scene, char **text, size_t *len,
+                                 sw_sg_export_report *report, sw_status *status);
+/* sw_sg_export_brep_text written to `path` through the project's one writer (sw_safe_write.h:
+ * replaced whole or left as it was). Adds its errors: SW_ERR_IO (a full disk too),
+ * SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE. */
 sw_result sw_sg_export_brep(const sw_sg_scene *scene, const char *path, sw_sg_export_report *report,
                             sw_status *status);
 

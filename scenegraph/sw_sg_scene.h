@@ -243,7 +243,11 @@ void sw_sg_builder_set_root(sw_sg_builder *b, uint32_t node);
 sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *status);
 
 /* ---- .sws files (sws_file.c) ----------------------------------------------------------------- */
-/* Writes to PATH.tmp-<pid> and renames it over PATH; nothing is left behind on failure. */
+/* Writes PATH through the project's one writer (sw_safe_write.h): replaced whole or left as it
+ * was, nothing left behind on failure; a character device or FIFO is written directly, a
+ * symbolic link written through. Errors: those of sw_sg_scene_require, SW_ERR_IO (a full disk
+ * too), SW_ERR_NOT_FOUND (no such directory), SW_ERR_NOT_REGULAR_FILE (PATH is a directory),
+ * SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *status);
 /* As sw_sg_scene_save, with lods_size bytes at lods as the file's optional LODS section (the
  * static-LOD cache, lod/static_lod_io.c); lods NULL or lods_size 0 writes none. sw_sg_scene_save
@@ -257,7 +261,9 @@ sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *
                            sw_status *status);
 /* Maps a .sws file. Checks the header, version, the section table and that the file is as long as
  * the table says (a short mapping would raise SIGBUS); checksums are verified per section by
- * sw_sg_scene_require. Errors: SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_VERSION,
+ * sw_sg_scene_require. Opens without blocking and accepts a regular file only
+ * (sw_safe_read.h). Errors: SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE (a directory, FIFO or
+ * device), SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_VERSION,
  * SW_ERR_TRUNCATED, SW_ERR_CHECKSUM (the header's own CRC over itself and the section table, or the
  * 16-byte META section, both checked at open); the message names the file and the byte offset. */
 sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status);

@@ -38,10 +38,14 @@
  * Open checks everything up to the section table (and META, 16 bytes) and that the file is as
  * long as the header says, before any section body is read: a mapping shorter than that would
  * raise SIGBUS. sw_sg_scene_require() then verifies section checksums once each and, when all
- * are verified, validates the records (scene_validate.c). Save writes PATH.tmp-<pid>, fsyncs it
- * and renames it over PATH, so a reader sees either the old file or the new one. */
+ * are verified, validates the records (scene_validate.c). Open accepts a regular file only and
+ * cannot block (sw_safe_read.h). Save goes through the project's one writer (sw_safe_write.h: a
+ * temporary, fsync'd and renamed over PATH), so a reader sees either the old file or the new
+ * one, also on a full disk. */
 #include "sw_crc32c.h"
 #include "sw_hooks.h"
+#include "sw_safe_read.h"
+#include "sw_safe_write.h"
 #include "sw_sg_scene_internal.h"
 #include "sw_status_util.h"
 
@@ -298,6 +302,38 @@ static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec
     return SW_OK;
 }
 
+/* Every byte of the data area outside the sections is alignment padding: fewer than 16 bytes
+ * before each section and after the last one, all zero (issue 22: a byte flipped there was
+ * covered by no checksum). Sections do not overlap (check_overlaps ran). */
+static sw_result check_padding(const char *path, const unsigned char *p, uint64_t data_start,
+                               uint64_t file_size, const sw__sg_section_info *sec,
+                               sw_status *status)
+{
+    uint64_t pos = data_start;
+    for (;;) {
+        /* the next non-empty section at or after pos */
+        const sw__sg_section_info *next = NULL;
+        for (int s = 0; s < SWS_MAX_SECTIONS; s++)
+            if (sec[s].size && sec[s].offset >= pos && (!next || sec[s].offset < next->offset))
+                next = &sec[s];
+        const uint64_t end = next ? next->offset : file_size;
+        if (end - pos >= SWS_ALIGN)
+            return sw__fail(status, SW_ERR_FORMAT,
+                            "%s: offset %llu: %llu bytes belong to no section (padding is under "
+                            "%u bytes)",
+                            path, (unsigned long long)pos, (unsigned long long)(end - pos),
+                            SWS_ALIGN);
+        for (uint64_t i = pos; i < end; i++)
+            if (p[i])
+                return sw__fail(status, SW_ERR_FORMAT,
+                                "%s: offset %llu: padding byte 0x%02x, expected 0", path,
+                                (unsigned long long)i, p[i]);
+        if (!next)
+            return SW_OK;
+        pos = next->offset + next->size;
+    }
+}
+
 static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status *status)
 {
     const unsigned char *p = scene->map;
@@ -313,6 +349,8 @@ static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status 
             return r;
     }
     sw_result r = check_overlaps(scene->path, sec, status);
+    if (r == SW_OK)
+        r = check_padding(scene->path, p, data_start, h->file_size, sec, status);
     if (r != SW_OK)
         return r;
     memcpy(scene->sec, sec, sizeof scene->sec);
@@ -358,34 +396,30 @@ static void map_view(sw_sg_scene *scene)
     v->n_indices = s[SW__SG_SEC_INDICES].count;
 }
 
-/* open + fstat + mmap; the descriptor is closed before returning. */
+/* open (non-blocking: a FIFO must not hang) + fstat (regular files only) + mmap; the descriptor
+ * is closed before returning. */
 static sw_result map_file(sw_sg_scene *scene, sw_status *status)
 {
     const char *path = scene->path;
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return sw__fail(status, errno == ENOENT || errno == ENOTDIR ? SW_ERR_NOT_FOUND : SW_ERR_IO,
-                        "%s: cannot open: %s", path, strerror(errno));
-    struct stat st;
-    sw_result r = SW_OK;
-    if (fstat(fd, &st) != 0)
-        r = sw__fail(status, SW_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
-    else if (!S_ISREG(st.st_mode))
-        r = sw__fail(status, SW_ERR_IO, "%s: not a regular file", path);
-    else if (st.st_size == 0)
+    int fd;
+    uint64_t size;
+    sw_result r = sw__in_open(path, 0, "scene", &fd, &size, status);
+    if (r != SW_OK)
+        return r;
+    if (size == 0)
         r = sw__fail(status, SW_ERR_TRUNCATED, "%s: offset 0: empty file", path);
-    else if ((uint64_t)st.st_size > SIZE_MAX)
-        r = sw__fail(status, SW_ERR_LIMIT, "%s: %lld bytes do not fit in the address space", path,
-                     (long long)st.st_size);
+    else if (size > SIZE_MAX)
+        r = sw__fail(status, SW_ERR_LIMIT, "%s: %llu bytes do not fit in the address space", path,
+                     (unsigned long long)size);
     if (r == SW_OK) {
-        void *m = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
+        void *m = mmap(NULL, (size_t)size, PROT_READ, MAP_PRIVATE, fd, 0);
         if (m == MAP_FAILED)
             r = sw__fail(status, errno == ENOMEM ? SW_ERR_OUT_OF_MEMORY : SW_ERR_IO,
-                         "%s: cannot map %lld bytes: %s", path, (long long)st.st_size,
+                         "%s: cannot map %llu bytes: %s", path, (unsigned long long)size,
                          strerror(errno));
         else {
             scene->map = m;
-            scene->map_size = (size_t)st.st_size;
+            scene->map_size = (size_t)size;
         }
     }
     close(fd);
@@ -425,22 +459,6 @@ sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *statu
 }
 
 /* ---- save ------------------------------------------------------------------------------------ */
-
-static int write_all(int fd, const void *data, uint64_t n)
-{
-    const unsigned char *p = data;
-    while (n) {
-        size_t chunk = n > (1u << 30) ? (1u << 30) : (size_t)n;
-        ssize_t w = write(fd, p, chunk);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0)
-            return 0;
-        p += w;
-        n -= (uint64_t)w;
-    }
-    return 1;
-}
 
 /* Header, table and META for a scene's view and n_sec sections (the 9th: lods, lods_bytes, maybe
  * empty when there are 11);
@@ -487,39 +505,22 @@ static void build_header(const sw_sg_scene_view *v, uint32_t n_sec, const void *
 }
 
 /* Writes the sections in table order with zero padding up to each 16-byte boundary. */
-static int write_body(int fd, const unsigned char *head, uint64_t head_bytes, uint32_t n_sec,
-                      const void *const ptr[SWS_MAX_SECTIONS])
+static sw_result write_body(sw__out *out, const unsigned char *head, uint64_t head_bytes,
+                            uint32_t n_sec, const void *const ptr[SWS_MAX_SECTIONS],
+                            sw_status *status)
 {
     static const unsigned char zeros[SWS_ALIGN];
-    if (!write_all(fd, head, head_bytes))
-        return 0;
+    sw_result r = sw__out_write(out, head, (size_t)head_bytes, status);
     uint64_t pos = head_bytes;
-    for (int s = 0; s < (int)n_sec; s++) {
+    for (int s = 0; s < (int)n_sec && r == SW_OK; s++) {
         const unsigned char *e = head + SWS_HEADER_SIZE + (size_t)s * SWS_ENTRY_SIZE;
         uint64_t off = rd64(e + 8), bytes = rd64(e + 16);
-        if (!write_all(fd, zeros, off - pos) || !write_all(fd, ptr[s], bytes))
-            return 0;
+        r = sw__out_write(out, zeros, (size_t)(off - pos), status);
+        if (r == SW_OK)
+            r = sw__out_write(out, ptr[s], (size_t)bytes, status);
         pos = off + bytes;
     }
-    return 1;
-}
-
-/* Makes the rename durable; a failure here is not reported, the file itself is complete. */
-static void sync_parent_dir(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    char dir[4096];
-    if (!slash)
-        snprintf(dir, sizeof dir, ".");
-    else if ((size_t)(slash - path) < sizeof dir)
-        snprintf(dir, sizeof dir, "%.*s", slash == path ? 1 : (int)(slash - path), path);
-    else
-        return;
-    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd >= 0) {
-        fsync(fd);
-        close(fd);
-    }
+    return r;
 }
 
 sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *size,
@@ -574,41 +575,17 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
     build_header(&scene->view, n_sec, lods, lods ? lods_size : 0, ptr, meta, head, head_bytes,
                  &file_size);
 
-    size_t tlen = strlen(path) + 32;
-    char *tmp = sw__malloc(tlen);
-    if (!tmp)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-    snprintf(tmp, tlen, "%s.tmp-%ld", path, (long)getpid());
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0644);
-    if (fd < 0) {
-        r = sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO,
-                     "%s: cannot create %s: %s", path, tmp, strerror(errno));
-        sw__free(tmp);
+    sw__out out;
+    r = sw__out_open(&out, path, 0, status);
+    if (r != SW_OK)
+        return r;
+    r = write_body(&out, head, head_bytes, n_sec, ptr, status);
+    if (r != SW_OK) {
+        sw__out_abandon(&out);
         return r;
     }
-    const char *step = NULL;
-    if (!write_body(fd, head, head_bytes, n_sec, ptr))
-        step = "write";
-    else if (fsync(fd) != 0)
-        step = "fsync";
-    int err = errno;
-    if (close(fd) != 0 && !step) {
-        step = "close";
-        err = errno;
-    }
-    if (!step && rename(tmp, path) != 0) {
-        step = "rename";
-        err = errno;
-    }
-    if (step) {
-        unlink(tmp);
-        r = sw__fail(status, SW_ERR_IO, "%s: %s of %llu bytes through %s failed: %s", path, step,
-                     (unsigned long long)file_size, tmp, strerror(err));
-        sw__free(tmp);
-        return r;
-    }
-    sw__free(tmp);
-    sync_parent_dir(path);
-    sw__status_ok(status);
-    return SW_OK;
+    r = sw__out_commit(&out, status);
+    if (r == SW_OK)
+        sw__status_ok(status);
+    return r;
 }

@@ -11,6 +11,7 @@
  */
 #include "sw_sg_tspline.h"
 #include "sw_hooks.h"
+#include "sw_safe_read.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -679,42 +680,11 @@ sw_result sw_sg_tspline_load_mem(const char *text, size_t len, const char *name,
     return r;
 }
 
-/* Reads a whole file; *text is NUL-terminated. */
+/* Reads a whole file; *text is NUL-terminated. Non-blocking open, regular files only, and the
+ * size refused before a byte is read (a device or a sparse 2 GiB file is not read at all). */
 static sw_result read_file(const char *path, char **text, size_t *len, sw_status *status)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO, "%s: %s", path,
-                        strerror(errno));
-    size_t cap = 1 << 16, n = 0;
-    char *buf = sw__malloc(cap);
-    sw_result r = buf ? SW_OK : SW_ERR_OUT_OF_MEMORY;
-    while (r == SW_OK) {
-        if (n + 1 >= cap) {
-            char *g = cap < MAX_FILE_BYTES ? sw__realloc(buf, cap * 2) : NULL;
-            r = cap >= MAX_FILE_BYTES ? SW_ERR_LIMIT : g ? SW_OK : SW_ERR_OUT_OF_MEMORY;
-            if (g)
-                buf = g, cap *= 2;
-            if (r != SW_OK)
-                break;
-        }
-        const size_t got = fread(buf + n, 1, cap - 1 - n, f);
-        n += got;
-        if (got == 0) {
-            r = ferror(f) ? SW_ERR_IO : SW_OK;
-            break;
-        }
-    }
-    fclose(f);
-    if (r != SW_OK) {
-        sw__free(buf);
-        return sw__fail(status, r, "%s: %s", path,
-                        r == SW_ERR_LIMIT ? "larger than 1 GiB" : "could not be read");
-    }
-    buf[n] = '\0';
-    *text = buf;
-    *len = n;
-    return SW_OK;
+    return sw__in_read_all(path, MAX_FILE_BYTES, ".tsm file", text, len, status);
 }
 
 sw_result sw_sg_tspline_load(const char *path, sw_sg_tspline **out, sw_status *status)

@@ -5,6 +5,8 @@
 #include "sw_hooks.h"
 
 #include "sw_rt.h"
+#include "sw_safe_read.h"
+#include "sw_safe_write.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -406,43 +408,19 @@ sw_result sw_rt_path_load(const char *file, sw_rt_camera_path *out, sw_status *s
 {
     assert(file && out);
     memset(out, 0, sizeof *out);
-    FILE *f = fopen(file, "rb");
-    if (!f)
-        return sw__fail(status, errno == ENOENT ? SW_ERR_NOT_FOUND : SW_ERR_IO, "%s: %s", file,
-                        strerror(errno));
-    size_t cap = 4096, n = 0;
-    char *buf = sw__malloc(cap);
-    sw_result r = buf ? SW_OK : SW_ERR_OUT_OF_MEMORY;
-    while (r == SW_OK) {
-        if (n == cap) {
-            char *g = cap < SW_RT_PATH_MAX_BYTES ? sw__realloc(buf, cap * 2) : NULL;
-            r = cap >= SW_RT_PATH_MAX_BYTES ? SW_ERR_LIMIT : g ? SW_OK : SW_ERR_OUT_OF_MEMORY;
-            if (!g)
-                break;
-            buf = g;
-            cap *= 2;
-        }
-        const size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) {
-            r = ferror(f) ? SW_ERR_IO : SW_OK;
-            break;
-        }
-    }
-    fclose(f);
+    char *buf = NULL;
+    size_t n = 0;
+    /* non-blocking, regular files only, the size refused before a byte is read */
+    sw_result r = sw__in_read_all(file, SW_RT_PATH_MAX_BYTES, "camera path", &buf, &n, status);
     if (r == SW_OK)
         r = sw_rt_path_parse(buf, n, file, out, status);
-    else
-        sw__fail(status, r, "%s: %s", file,
-                 r == SW_ERR_LIMIT ? "larger than 64 MiB: not a camera path"
-                 : r == SW_ERR_IO  ? "could not be read"
-                                   : "out of memory");
     sw__free(buf);
     return r;
 }
 
-static int write_path(FILE *f, const sw_rt_camera_path *p)
+static int write_path(FILE *f, const void *ctx)
 {
+    const sw_rt_camera_path *p = ctx;
     fprintf(f,
             "splinewalk-path %d\n"
             "# camera path (docs/camera-path.md): eye and target on a Catmull-Rom spline over "
@@ -463,24 +441,14 @@ static int write_path(FILE *f, const sw_rt_camera_path *p)
     return ferror(f) ? -1 : 0;
 }
 
-sw_result sw_rt_path_save(const sw_rt_camera_path *path, const char *file, sw_status *status)
+sw_result sw_rt_path_save(const sw_rt_camera_path *path, const char *file, unsigned flags,
+                          sw_status *status)
 {
     assert(path && file);
-    char tmp[4096];
-    if (snprintf(tmp, sizeof tmp, "%s.tmp-%ld", file, (long)getpid()) >= (int)sizeof tmp)
-        return sw__fail(status, SW_ERR_IO, "%s: path too long", file);
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
-        return sw__fail(status, SW_ERR_IO, "%s: %s", tmp, strerror(errno));
-    int bad = write_path(f, path);
-    bad |= fclose(f) != 0;
-    if (bad || rename(tmp, file) != 0) {
-        const int e = errno;
-        remove(tmp);
-        return sw__fail(status, SW_ERR_IO, "%s: could not be written: %s", file, strerror(e));
-    }
-    sw__status_ok(status);
-    return SW_OK;
+    sw_result r = sw__write_file_printed(file, write_path, path, flags, status);
+    if (r == SW_OK)
+        sw__status_ok(status);
+    return r;
 }
 
 void sw_rt_path_free(sw_rt_camera_path *path)

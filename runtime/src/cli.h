@@ -23,6 +23,10 @@ int sw_cli_is_help(const char *arg);
 int sw_cli_print_help(int argc, char **argv, const char *usage);
 /* Prints "splinewalk <cmd>: <result>: <message>" to stderr; returns 1. */
 int sw_cli_report(const char *cmd, const sw_status *status);
+/* Refuses an output path before the command's work (sw__out_check: a directory, a missing
+ * directory): 0 when it can be written, else reports it like sw_cli_report and returns 1.
+ * flags: SW__OUT_DASH_STDOUT where the command writes "-" to standard output. */
+int sw_cli_check_output(const char *cmd, const char *path, unsigned flags);
 /* A progress bar on stderr: redrawn in place on a terminal, else a line per quarter and stage. */
 void sw_cli_progress(void *user_data, double fraction, const char *stage);
 void sw_cli_progress_end(void);

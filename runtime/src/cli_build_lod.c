@@ -141,6 +141,8 @@ int sw_cli_build_lod(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;
+    if (sw_cli_check_output("build-lod", a.out, 0))
+        return 1;
     sw_status status = {0};
     sw_scene handle;
     const double t0 = sw_cli_now_ms();

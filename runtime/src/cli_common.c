@@ -2,6 +2,8 @@
 /* Helpers shared by the splinewalk subcommands: argument parsing, progress, error reports. */
 #include "cli.h"
 
+#include "sw_safe_write.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -31,6 +33,12 @@ int sw_cli_report(const char *cmd, const sw_status *status)
     fprintf(stderr, "splinewalk %s: %s (%s): %s\n", cmd, sw_result_str(status->result),
             sw_result_id_str(status->result), status->message[0] ? status->message : "(no details)");
     return 1;
+}
+
+int sw_cli_check_output(const char *cmd, const char *path, unsigned flags)
+{
+    sw_status status = {0};
+    return sw__out_check(path, flags, &status) == SW_OK ? 0 : sw_cli_report(cmd, &status);
 }
 
 static struct {

@@ -2,7 +2,9 @@
 /* splinewalk generate grid|building: test scenes (culling tests, huge architectural scenes). */
 #include "cli.h"
 
+#include "sw_hooks.h"
 #include "sw_rt.h"
+#include "sw_safe_write.h"
 #include "sw_sg_export.h"
 #include "sw_sg_generate.h"
 #include "sw_status_util.h"
@@ -250,35 +252,20 @@ static sw_result load_models(const char *data, const char *const *files, int n,
     return SW_OK;
 }
 
-/* The BREP to a temporary name (renamed once the .sws is written too). */
-static sw_result write_brep(const gen_args *a, sw_sg_scene *scene, char *tmp, size_t tmp_size,
-                            sw_sg_export_report *er, sw_status *status)
-{
-    snprintf(tmp, tmp_size, "%s.tmp-%ld", a->brep, (long)getpid());
-    sw_result r = sw_sg_export_brep(scene, tmp, er, status);
-    if (r != SW_OK) {
-        unlink(tmp);
-        if (r == SW_ERR_IO) /* name the file asked for, not the temporary one */
-            r = sw__fail(status, SW_ERR_IO, "%s: could not be written (%s)", a->brep,
-                         strerror(errno ? errno : EIO));
-    }
-    return r;
-}
-
+/* The BREP is built in memory first (an OCCT refusal leaves both outputs untouched) and written
+ * once the .sws is, both through the project's one writer (sw_safe_write.h). */
 static sw_result write_building(const gen_args *a, sw_sg_scene *scene, double *ms_write,
                                 sw_sg_export_report *er, sw_status *status)
 {
     const double t0 = sw_cli_now_ms();
-    char tmp[4200] = "";
-    sw_result r = a->brep ? write_brep(a, scene, tmp, sizeof tmp, er, status) : SW_OK;
+    char *brep = NULL;
+    size_t brep_len = 0;
+    sw_result r = a->brep ? sw_sg_export_brep_text(scene, &brep, &brep_len, er, status) : SW_OK;
     if (r == SW_OK)
         r = sw_sg_scene_save(scene, a->out, status);
-    if (r != SW_OK && tmp[0])
-        unlink(tmp);
-    else if (tmp[0] && rename(tmp, a->brep) != 0) {
-        r = sw__fail(status, SW_ERR_IO, "%s: could not be written (%s)", a->brep, strerror(errno));
-        unlink(tmp);
-    }
+    if (r == SW_OK && a->brep)
+        r = sw__write_file(a->brep, brep, brep_len, 0, status);
+    sw__free(brep);
     *ms_write = sw_cli_now_ms() - t0;
     return r;
 }
@@ -369,6 +356,9 @@ int sw_cli_generate(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;
+    if (sw_cli_check_output("generate", a.out, 0) ||
+        (a.brep && sw_cli_check_output("generate", a.brep, 0)))
+        return 1;
     if (strcmp(a.kind, "grid") != 0)
         return generate_scene(&a);
 

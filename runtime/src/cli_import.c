@@ -39,6 +39,8 @@ int sw_cli_import(int argc, char **argv)
         fprintf(stderr, "splinewalk import: need IN and -o OUT.sws\n%s", k_usage);
         return 2;
     }
+    if (sw_cli_check_output("import", out, 0))
+        return 1;
     sw_status status = {0};
     sw_scene scene;
     double t0 = sw_cli_now_ms();

@@ -3,6 +3,7 @@
 #include "cli.h"
 
 #include "sw_camera_path.h"
+#include "sw_safe_write.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -18,7 +19,8 @@ static const char k_usage[] =
     "         of the box height, weaving sideways, looking a quarter of the run ahead (fovy 60)\n"
     "\n"
     "options:\n"
-    "  -o, --output PATH   the path file to write (temporary name, then renamed)\n"
+    "  -o, --output PATH   the path file to write (replaced whole or not at all; - is standard\n"
+    "                      output)\n"
     "  --frames N          frames a profiling run takes along the path by default (default 120)\n"
     "  --seconds S         duration of the path in seconds (default 10)\n"
     "  -h, --help          this text\n";
@@ -79,6 +81,8 @@ int sw_cli_path(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;
+    if (sw_cli_check_output("path", a.out, SW__OUT_DASH_STDOUT))
+        return 1;
 
     sw_status status = {0};
     sw_scene scene;
@@ -97,12 +101,13 @@ int sw_cli_path(int argc, char **argv)
     else
         r = sw_rt_path_fly(box, a.seconds, (uint32_t)a.frames, &path, &status);
     if (r == SW_OK)
-        r = sw_rt_path_save(&path, a.out, &status);
+        r = sw_rt_path_save(&path, a.out, SW__OUT_DASH_STDOUT, &status);
     const uint32_t keys = path.n_keys;
     sw_rt_path_free(&path);
     if (r != SW_OK)
         return sw_cli_report("path", &status);
-    printf("%s: %s of %s, %u keys over %g s, %d frames\n", a.out, a.kind, a.scene, keys, a.seconds,
-           a.frames);
+    /* with -o - the path itself is on standard output */
+    fprintf(strcmp(a.out, "-") ? stdout : stderr, "%s: %s of %s, %u keys over %g s, %d frames\n",
+            a.out, a.kind, a.scene, keys, a.seconds, a.frames);
     return 0;
 }

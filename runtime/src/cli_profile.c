@@ -7,10 +7,14 @@
 #include "sw_camera_path.h"
 #include "sw_profile_report.h"
 #include "sw_rt.h"
+#include "sw_safe_write.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -138,10 +142,41 @@ static int parse_args(int argc, char **argv, profile_args *a)
 
 /* ---- output directory: written aside, renamed in at the end ---------------------------------- */
 typedef struct staging {
-    char dir[4096]; /* DIR/.profile-XXXXXX */
+    char dir[4096]; /* DIR/.profile-PID-XXXXXX */
     char names[8][64];
     int n_names;
 } staging;
+
+/* Removes the staging folders DIR/.profile-PID-XXXXXX of runs that were killed (their PID no
+ * longer runs): they hold only the flat files a run stages. */
+static void remove_stale_staging(const char *out)
+{
+    DIR *d = opendir(out);
+    if (!d)
+        return;
+    const struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        char *end;
+        if (strncmp(e->d_name, ".profile-", 9) != 0)
+            continue;
+        const long pid = strtol(e->d_name + 9, &end, 10);
+        if (end == e->d_name + 9 || *end != '-' || pid <= 0 || pid == (long)getpid() ||
+            kill((pid_t)pid, 0) == 0 || errno != ESRCH)
+            continue;
+        char sub[4200];
+        snprintf(sub, sizeof sub, "%s/%s", out, e->d_name);
+        DIR *s = opendir(sub);
+        const struct dirent *f;
+        while (s && (f = readdir(s)) != NULL) {
+            if (strcmp(f->d_name, ".") != 0 && strcmp(f->d_name, "..") != 0)
+                unlinkat(dirfd(s), f->d_name, 0);
+        }
+        if (s)
+            closedir(s);
+        rmdir(sub);
+    }
+    closedir(d);
+}
 
 static sw_result make_staging(const char *out, staging *st, sw_status *status)
 {
@@ -152,7 +187,9 @@ static sw_result make_staging(const char *out, staging *st, sw_status *status)
     } else if (!S_ISDIR(sb.st_mode)) {
         return sw__fail(status, SW_ERR_IO, "%s: exists and is not a directory", out);
     }
-    if (snprintf(st->dir, sizeof st->dir, "%s/.profile-XXXXXX", out) >= (int)sizeof st->dir)
+    remove_stale_staging(out);
+    if (snprintf(st->dir, sizeof st->dir, "%s/.profile-%ld-XXXXXX", out, (long)getpid()) >=
+        (int)sizeof st->dir)
         return sw__fail(status, SW_ERR_IO, "%s: path too long", out);
     if (!mkdtemp(st->dir))
         return sw__fail(status, SW_ERR_IO, "%s: %s", st->dir, strerror(errno));
@@ -191,6 +228,11 @@ static sw_result staging_commit(staging *st, const char *out, sw_status *status)
             return sw__fail(status, SW_ERR_IO, "%s: %s", to, strerror(errno));
     }
     rmdir(st->dir);
+    const int fd = open(out, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd >= 0) { /* the renames made durable (the files were fsync'd when written) */
+        (void)fsync(fd);
+        close(fd);
+    }
     return SW_OK;
 }
 
@@ -219,18 +261,28 @@ static int html_fn(FILE *f, const sw_rt_profile *p, const char *svg)
     return sw_rt_profile_write_html(f, p, svg);
 }
 
+typedef struct report_job {
+    report_fn fn;
+    const sw_rt_profile *p;
+    const char *svg;
+} report_job;
+
+static int report_fill(FILE *f, const void *ctx)
+{
+    const report_job *job = ctx;
+    return job->fn(f, job->p, job->svg);
+}
+
+/* Each report through the project's one writer (sw_safe_write.h): built in memory, every write
+ * and the fsync checked, so a full disk fails the run instead of committing a short file. */
 static sw_result write_staged(staging *st, const char *name, report_fn fn, const sw_rt_profile *p,
                               const char *svg, sw_status *status)
 {
     char path[4200];
     staged_path(st, name, path, sizeof path);
     staging_remember(st, name);
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return sw__fail(status, SW_ERR_IO, "%s: %s", path, strerror(errno));
-    int bad = fn(f, p, svg);
-    bad |= fclose(f) != 0;
-    return bad ? sw__fail(status, SW_ERR_IO, "%s: write failed", path) : SW_OK;
+    const report_job job = {fn, p, svg};
+    return sw__write_file_printed(path, report_fill, &job, 0, status);
 }
 
 static sw_result write_reports(staging *st, const sw_rt_profile *p, sw_status *status)

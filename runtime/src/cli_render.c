@@ -109,6 +109,8 @@ int sw_cli_render(int argc, char **argv)
     if (rc)
         return rc;
 
+    if (sw_cli_check_output("render", a.out, 0))
+        return 1;
     sw_status status = {0};
     double t0 = sw_cli_now_ms();
     sw_scene scene;

@@ -433,7 +433,7 @@ static int run_interactive(GLFWwindow *win, sw_renderer r, sw_scene scene, viewe
         glfwSwapBuffers(win);
     }
     if (v->args->record && v->recording.n_keys > 0) {
-        if (sw_rt_path_save(&v->recording, v->args->record, &st) != SW_OK)
+        if (sw_rt_path_save(&v->recording, v->args->record, 0, &st) != SW_OK)
             return sw_cli_report("view", &st);
         printf("recorded %u keys to %s\n", v->recording.n_keys, v->args->record);
     }

@@ -43,11 +43,16 @@ typedef struct sw_rt_camera_path {
  * SW_ERR_TRUNCATED (the text ends inside a record), SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_rt_path_parse(const char *text, size_t len, const char *name, sw_rt_camera_path *out,
                            sw_status *status);
-/* Reads a file (at most SW_RT_PATH_MAX_BYTES) and parses it. Adds SW_ERR_NOT_FOUND, SW_ERR_IO. */
+/* Reads a regular file of at most SW_RT_PATH_MAX_BYTES, refused by its size before it is read
+ * (sw_safe_read.h: a FIFO or device cannot block it), and parses it. Adds SW_ERR_NOT_FOUND,
+ * SW_ERR_NOT_REGULAR_FILE, SW_ERR_IO. */
 sw_result sw_rt_path_load(const char *file, sw_rt_camera_path *out, sw_status *status);
-/* Writes the path (17 significant digits: it reads back bit-identical) to file.tmp-<pid>, then
- * renames it over `file`. Errors: SW_ERR_IO (nothing is left behind). */
-sw_result sw_rt_path_save(const sw_rt_camera_path *path, const char *file, sw_status *status);
+/* Writes the path (17 significant digits: it reads back bit-identical) to `file` through the
+ * project's one writer (sw_safe_write.h: replaced whole or left as it was); flags
+ * SW__OUT_DASH_STDOUT makes "-" standard output. Errors: SW_ERR_IO (a full disk too; nothing is
+ * left behind), SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE, SW_ERR_OUT_OF_MEMORY. */
+sw_result sw_rt_path_save(const sw_rt_camera_path *path, const char *file, unsigned flags,
+                          sw_status *status);
 void sw_rt_path_free(sw_rt_camera_path *path);
 
 /* Start and end time of the path (equal for a single key). */

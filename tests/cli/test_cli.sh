@@ -184,7 +184,7 @@ expect_error "generate building: missing sample data" SW_ERR_NOT_FOUND no-such-d
   "$sw" generate building --surfaces 1000 --data no-such-dir -o bad.sws --brep bad.brep
 expect_error "generate building: output in a missing directory" SW_ERR_NOT_FOUND nodir/b.sws -- \
   "$sw" generate building --surfaces 1000 -o nodir/b.sws --brep b-nodir.brep
-expect_error "generate building: BREP in a missing directory" SW_ERR_IO nodir/b.brep -- \
+expect_error "generate building: BREP in a missing directory" SW_ERR_NOT_FOUND nodir/b.brep -- \
   "$sw" generate building --surfaces 1000 -o b-nodir.sws --brep nodir/b.brep
 if [ "$(id -u)" -ne 0 ]; then
   expect_error "generate building: unwritable output" SW_ERR_IO ro/b.sws -- \

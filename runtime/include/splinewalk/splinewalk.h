@@ -78,7 +78,9 @@ typedef struct sw_scene_load_desc {
  * call only; callbacks run on the calling thread before it returns, never after a failure is
  * returned. *out = {0} on failure.
  * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc, path or out), SW_ERR_UNSUPPORTED (unknown
- * extension or input), SW_ERR_NOT_FOUND, SW_ERR_IO, SW_ERR_FORMAT, SW_ERR_TRUNCATED,
+ * extension or input), SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE (a directory, FIFO or device:
+ * inputs are opened without blocking and must be regular files), SW_ERR_IO, SW_ERR_FORMAT,
+ * SW_ERR_TRUNCATED,
  * SW_ERR_CHECKSUM, SW_ERR_VERSION, SW_ERR_INVALID_GEOMETRY, SW_ERR_OUT_OF_MEMORY,
  * SW_ERR_LIMIT (65,535 scenes alive), SW_ERR_INTERNAL. */
 SW_API sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status);
@@ -242,7 +244,9 @@ typedef struct sw_frame_desc {
     sw_camera camera;
     int32_t width, height;   /* 0 = 1280 x 720 */
     double error_px;         /* screen-space error ε_img in pixels; 0 = 0.5 */
-    const char *output_path; /* .png or .exr (with depth); NULL = render only */
+    const char *output_path; /* .png or .exr (with depth); NULL = render only. Replaced whole or
+                                left as it was (a full disk is SW_ERR_IO); a device or FIFO is
+                                written in place, a symbolic link written through */
     int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
                                 vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
                                 Bézier patches (degree <= 3 in the shader, higher on the CPU) */

@@ -20,7 +20,8 @@ extern "C" {
 #define SW_API __attribute__((visibility("default")))
 #endif
 
-/* One table generates the enum and its names (like sokol's _SG_LOGITEM_XMACRO). */
+/* One table generates the enum and its names (like sokol's _SG_LOGITEM_XMACRO). New ids go at
+ * the end: the numbers of the others stay stable for a program built against an older library. */
 #define SW_RESULT_XMACRO(X)                                                                        \
     X(SW_OK, "ok")                                                                                 \
     X(SW_ERR_IO, "input/output error")                                                             \
@@ -37,7 +38,8 @@ extern "C" {
     X(SW_ERR_NO_CONTEXT, "no OpenGL context could be created")                                     \
     X(SW_ERR_INVALID_ARGUMENT, "invalid argument")                                                 \
     X(SW_ERR_STALE_HANDLE, "stale or invalid handle")                                              \
-    X(SW_ERR_INTERNAL, "internal error")
+    X(SW_ERR_INTERNAL, "internal error")                                                           \
+    X(SW_ERR_NOT_REGULAR_FILE, "not a regular file")
 
 typedef enum sw_result {
 #define SW__RESULT_ENUM(id, text) id,
