@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Input files that cannot block or flood (sw_safe_read.h). */
 #include "sw_safe_read.h"
 

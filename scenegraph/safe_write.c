@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Output files that are replaced whole or not at all (sw_safe_write.h). */
 #define _GNU_SOURCE /* O_TMPFILE, linkat's AT_SYMLINK_FOLLOW */
 #include "sw_safe_write.h"

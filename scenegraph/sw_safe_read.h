@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* Opening input files so that no input can block or flood the program (never installed; issue
  * 22 item 2): opened with O_NONBLOCK (a FIFO without a writer does not hang open()), O_CLOEXEC
  * and O_NOCTTY, then fstat'ed: only a regular file is accepted — a directory, FIFO, device or

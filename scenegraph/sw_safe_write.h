@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The one way the project writes an output file (never installed; issue 22 item 1).
  *
  * A write either replaces the target completely or leaves it byte-identical: the bytes go to a

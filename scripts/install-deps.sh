@@ -13,6 +13,7 @@ packages=(
   libocct-foundation-dev libtbb-dev occt-misc libcgal-dev
   xvfb xauth libcmocka-dev
   libxml2-utils jq  # tests/profile: xmllint checks the SVG and HTML, jq the JSON
+  strace  # tests/io: kills a writer at its fsync and rename (signal injection)
 )
 if [ "${SW_WITH_CLANG:-0}" = 1 ]; then
   packages+=(clang libclang-rt-14-dev)

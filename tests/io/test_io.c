@@ -1,3 +1,4 @@
+/* SPDX-License-Identifier: MIT */
 /* The project's one writer and its guarded inputs (issue 22 items 1 and 2; scenegraph/
  * sw_safe_write.h, sw_safe_read.h), format by format.
  *

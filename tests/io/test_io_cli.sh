@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
 # The project's one writer and its guarded inputs through the CLI (issue 22 items 1 and 2). Each
 # check names the fault it catches:
 # - `import -o /dev/null` succeeds and /dev/null stays a character device (a writer that renames
