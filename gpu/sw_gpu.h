@@ -40,8 +40,17 @@ const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
 
 typedef struct sw_gpu_camera {
     double eye[3], target[3], up[3];
-    double fovy_deg; /* vertical field of view */
+    double fovy_deg; /* vertical field of view, in [SW_GPU_FOVY_MIN_DEG, 180) */
 } sw_gpu_camera;
+
+/* The floors of the view (issue 19), the public SW_FOVY_MIN_DEG and SW_ERROR_MIN_PX: below them
+ * the refinement a frame asks for outgrows what the arithmetic resolves. At fovy 0.01 deg a pixel
+ * of a 720-row frame spans 2.4e-7 rad, 4 float ulps (2^-24 x 4) of a camera-relative position:
+ * the GPU's float evaluation alone then costs a quarter of a pixel. ε_img 0.01 px asks for 50 x
+ * the triangles of the default 0.5 px. fovy >= 0.5 deg and ε_img >= 0.05 px render within the
+ * bounds of every refinement loop (README: issue 19). */
+#define SW_GPU_FOVY_MIN_DEG 0.01
+#define SW_GPU_ERROR_MIN_PX 0.01
 
 /* A face occurrence given by the caller (immediate draws): face record, world transform (3 x 4
  * row-major), linear RGBA colour (color[3] < 0: the default grey). */

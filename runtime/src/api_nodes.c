@@ -245,11 +245,11 @@ static sw_result check_camera(const sw_camera *c, const char *fn, sw_status *sta
     }
     int finite = all_finite(c->eye, 3) && all_finite(c->target, 3) && all_finite(c->up, 3);
     if (!finite || !(dd > 0.0) || !(xx > 0.0) ||
-        (c->fovy_deg != 0.0 && !(c->fovy_deg > 0.0 && c->fovy_deg < 180.0)))
+        (c->fovy_deg != 0.0 && !(c->fovy_deg >= SW_FOVY_MIN_DEG && c->fovy_deg < 180.0)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: camera not finite, eye = target, up parallel to the view, or fovy "
-                        "out of (0, 180)",
-                        fn);
+                        "out of [%g, 180)",
+                        fn, SW_FOVY_MIN_DEG);
     return SW_OK;
 }
 

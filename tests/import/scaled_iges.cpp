@@ -1,10 +1,11 @@
-/* scaled_iges IN.brep|IN.step|IN.iges OUT.iges DIAGONAL
+/* scaled_iges IN.brep|IN.step|IN.iges OUT.iges DIAGONAL [brep]
  *
  * Writes a copy of a part as IGES, uniformly scaled about its bounding-box centre so that the box
  * diagonal becomes DIAGONAL, the way a unit conversion does it (BRepBuilderAPI_Transform with a
  * gp_Trsf scale, copy = true; IGESControl_Writer turns the trims into B-spline pcurves). Issue 19:
  * such copies of real parts made the first frame's trim flattening recurse at a tolerance of
- * 1e-17; tests/cli/test_scaled_iges.sh renders them. Exit status 0 on success. */
+ * 1e-17; tests/cli/test_scaled_iges.sh renders them. A fifth argument `brep` writes the faces as
+ * an IGES B-rep (write.iges.brep.mode 1) instead of trimmed surfaces. Exit status 0 on success. */
 #include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepTools.hxx>
@@ -51,8 +52,8 @@ static bool read_shape(const std::string &path, TopoDS_Shape &shape)
 
 int main(int argc, char **argv)
 {
-    if (argc != 4) {
-        std::fprintf(stderr, "usage: %s IN OUT.iges DIAGONAL\n", argv[0]);
+    if (argc != 4 && !(argc == 5 && std::string(argv[4]) == "brep")) {
+        std::fprintf(stderr, "usage: %s IN OUT.iges DIAGONAL [brep]\n", argv[0]);
         return 2;
     }
     const double target = std::strtod(argv[3], nullptr);
@@ -70,8 +71,8 @@ int main(int argc, char **argv)
         BRepBndLib::Add(shape, box);
         double x0, y0, z0, x1, y1, z1;
         box.Get(x0, y0, z0, x1, y1, z1);
-        const double diag = std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) +
-                                      (z1 - z0) * (z1 - z0));
+        const double diag =
+            std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
         gp_Trsf t;
         t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), target / diag);
         BRepBuilderAPI_Transform xf(shape, t, Standard_True);
@@ -80,7 +81,8 @@ int main(int argc, char **argv)
             return 1;
         }
         IGESControl_Controller::Init();
-        IGESControl_Writer w; /* the defaults a user gets: trimmed surfaces (type 144) */
+        /* the defaults a user gets: trimmed surfaces (type 144); or B-rep faces (MSBO) */
+        IGESControl_Writer w("MM", argc == 5 ? 1 : 0);
         if (!w.AddShape(xf.Shape()) || (w.ComputeModel(), !w.Write(argv[2]))) {
             std::fprintf(stderr, "scaled_iges: cannot write %s\n", argv[2]);
             return 1;

@@ -158,8 +158,16 @@ SW_API sw_result sw_scene_pick(sw_scene scene, const double origin[3], const dou
  * target must differ and up must not be parallel to target - eye. */
 typedef struct sw_camera {
     double eye[3], target[3], up[3];
-    double fovy_deg; /* vertical field of view in degrees; 0 = 40 */
+    double fovy_deg; /* vertical field of view in degrees; 0 = 40; else in [SW_FOVY_MIN_DEG, 180) */
 } sw_camera;
+
+/* The floors of the view every front end is held to (sw_renderer_draw, sw_renderer_prepare,
+ * sw_camera_matrices, node cameras, camera paths): a field of view below SW_FOVY_MIN_DEG degrees
+ * or a screen-space error below SW_ERROR_MIN_PX pixels is refused with SW_ERR_INVALID_ARGUMENT
+ * (below them the refinement outgrows what the float and double arithmetic resolve). fovy >= 0.5
+ * degrees and error_px >= 0.05 render within the bounds of every refinement loop. */
+#define SW_FOVY_MIN_DEG 0.01
+#define SW_ERROR_MIN_PX 0.01
 
 typedef enum sw_view_preset {
     SW_VIEW_ISO = 0,   /* from (+1,+1,+1), up +Z */
@@ -188,7 +196,8 @@ SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *o
  * positions and drop view's translation (view[12..14]) itself. Any thread. The renderer picks the
  * near plane per frame unless sw_frame_desc.near_plane sets it; sw_frame_stats gives back the one
  * used, and these matrices. Errors: SW_ERR_INVALID_ARGUMENT (NULL pointer; a zero camera: fit one
- * with sw_camera_fit first; eye = target, up zero or parallel to the view, fovy outside (0, 180)
+ * with sw_camera_fit first; eye = target, up zero or parallel to the view, fovy outside
+ * [SW_FOVY_MIN_DEG, 180)
  * (0 = 40); non-finite values; size outside 0..16384; near_plane not positive and finite). view
  * and proj are written on success only. */
 SW_API sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t height,
@@ -237,8 +246,8 @@ SW_API const char *sw_renderer_description_ptr(sw_renderer renderer);
 typedef struct sw_frame_desc {
     sw_scene scene;
     sw_camera camera;
-    int32_t width, height;   /* 0 = 1280 x 720 */
-    double error_px;         /* screen-space error ε_img in pixels; 0 = 0.5 */
+    int32_t width, height; /* 0 = 1280 x 720 */
+    double error_px; /* screen-space error ε_img in pixels; 0 = 0.5; else >= SW_ERROR_MIN_PX */
     const char *output_path; /* .png or .exr (with depth); NULL = render only */
     int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
                                 vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
@@ -338,7 +347,8 @@ typedef struct sw_frame_stats {
  * thread only; the scene may be used by other threads meanwhile. desc is read during the call
  * only. stats may be NULL; it is written on success only.
  * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc; a thread other than the renderer's owner; size out
- * of 0..16384; error_px negative or not finite; fovy out of (0, 180); a non-finite or degenerate
+ * of 0..16384; error_px below SW_ERROR_MIN_PX or not finite; fovy out of [SW_FOVY_MIN_DEG, 180);
+ * a non-finite or degenerate
  * camera), SW_ERR_STALE_HANDLE (renderer or desc->scene), SW_ERR_UNSUPPORTED (output extension
  * not .png or .exr), SW_ERR_IO, SW_ERR_GL, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY,
  * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */
