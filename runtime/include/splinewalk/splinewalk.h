@@ -246,8 +246,9 @@ SW_API const char *sw_renderer_description_ptr(sw_renderer renderer);
 typedef struct sw_frame_desc {
     sw_scene scene;
     sw_camera camera;
-    int32_t width, height; /* 0 = 1280 x 720 */
-    double error_px; /* screen-space error ε_img in pixels; 0 = 0.5; else >= SW_ERROR_MIN_PX */
+    int32_t width, height;   /* 0 = 1280 x 720 */
+    double error_px;         /* screen-space error ε_img in pixels; 0 = 0.5; else at least
+                                SW_ERROR_MIN_PX */
     const char *output_path; /* .png or .exr (with depth); NULL = render only */
     int32_t eval_exact;      /* 1: every patch evaluated from knots and control points in the
                                 vertex shader (Krishnamurthy & Yasui; degree <= 15); 0: rational
