@@ -171,6 +171,12 @@ typedef struct sw_gpu_frame_stats {
     uint64_t meshes_drawn, meshes_culled; /* occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
     double near_plane; /* the projection's (desc.near_plane or the scene box's) */
+    /* counted fallbacks of the loops bounded at their root (issue 19), 0 in an ordinary frame */
+    uint64_t trim_loops_floored; /* loops flattened at the rounding floor or the depth cap
+                                    (sw_sg_polyline.below_floor / depth_capped): chords may lie
+                                    farther than the trim tolerance from the curve */
+    uint64_t borders_capped;     /* fat borders sampled coarser than their cells: the view's
+                                    sample budget (sw__gpu_mesh.border_capped) */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

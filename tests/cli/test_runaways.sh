@@ -12,7 +12,7 @@
 #     floor removed from the frame desc's validation (runtime/src/api_render.c check_frame_desc):
 #     the render then runs into this script's 20 s limit.
 #  heavy: the floors that must render, on Motor-c at 640x480: ε_img 0.05 px and fovy 0.5 degrees
-#   (a camera looking at the part's centre from the iso direction): each within 300 s, an image
+#   (the iso camera at the distance that fits the part at that fovy): each within 300 s, an image
 #   that is not empty; their time and peak RSS are printed (/usr/bin/time when present).
 # usage: test_runaways.sh SPLINEWALK SCALED_IGES SW_PNG_DIFF DATA_DIR WORKDIR quick|heavy
 set -u
@@ -78,12 +78,13 @@ else
   rc=$?
   if [ $rc -eq 0 ] && not_empty e005.png; then pass "Motor-c at ε_img 0.05 px"
   else fail "Motor-c at ε_img 0.05 px: exit status $rc"; tail -3 e005.log; fi
-  # fovy 0.5°, from the iso direction at the fitted distance: the centre of the part, magnified
+  # fovy 0.5°, from the iso direction at the distance that fits the part (sw_camera_fit's rule,
+  # diagonal / (2 tan(fovy / 2)) x 1.1: 126 diagonals away, a telephoto view)
   c=$("$sw" info motor.sws --json | python3 -c '
-import json, sys
+import json, math, sys
 b = json.load(sys.stdin)["bbox"]
 c = [(b[i] + b[i + 3]) / 2 for i in range(3)]
-d = sum((b[i + 3] - b[i]) ** 2 for i in range(3)) ** 0.5 * 1.6
+d = sum((b[i + 3] - b[i]) ** 2 for i in range(3)) ** 0.5 / (2 * math.tan(math.radians(0.25))) * 1.1
 e = [c[i] + d / 3 ** 0.5 for i in range(3)]
 print(",".join("%.9g" % v for v in e + c + [0, 0, 1, 0.5]))')
   timed 300 f05.log -- "$sw" render motor.sws -o f05.png --size 640x480 --camera "$c"
