@@ -11,10 +11,10 @@
 #     SW_ERR_INVALID_ARGUMENT naming the floor (they spun, or grew memory at ~600 MB/s). Catches a
 #     floor removed from the frame desc's validation (runtime/src/api_render.c check_frame_desc):
 #     the render then runs into this script's 20 s limit.
-#  heavy: the floors that must render, on Motor-c at 640x480: ε_img 0.05 px and fovy 0.5 degrees
+#  floors (make test, ~10 s): the floors that must render, on Motor-c at 640x480: ε_img 0.05 px and fovy 0.5 degrees
 #   (the iso camera at the distance that fits the part at that fovy): each within 300 s, an image
 #   that is not empty; their time and peak RSS are printed (/usr/bin/time when present).
-# usage: test_runaways.sh SPLINEWALK SCALED_IGES SW_PNG_DIFF DATA_DIR WORKDIR quick|heavy
+# usage: test_runaways.sh SPLINEWALK SCALED_IGES SW_PNG_DIFF DATA_DIR WORKDIR quick|floors
 set -u
 sw=$1 scaled=$2 pngdiff=$3 data=$4 work=$5 mode=$6
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
