@@ -48,7 +48,7 @@ typedef struct sw_gpu_camera {
  * of a 720-row frame spans 2.4e-7 rad, 4 float ulps (2^-24 x 4) of a camera-relative position:
  * the GPU's float evaluation alone then costs a quarter of a pixel. ε_img 0.01 px asks for 50 x
  * the triangles of the default 0.5 px. fovy >= 0.5 deg and ε_img >= 0.05 px render within the
- * bounds of every refinement loop (README: issue 19). */
+ * bounds of every refinement loop (issue 19; tests/cli/test_runaways.sh). */
 #define SW_GPU_FOVY_MIN_DEG 0.01
 #define SW_GPU_ERROR_MIN_PX 0.01
 
