@@ -52,12 +52,12 @@ sw_result sw__gpu_view_init(sw__gpu_view *v, const sw_gpu_camera *cam, int32_t w
         v->up[k] = cam->up[k];
     }
     cross3(v->fwd, v->up, v->right);
-    if (!normalize3(v->fwd) || !normalize3(v->right) || !(cam->fovy_deg > 0.0) ||
+    if (!normalize3(v->fwd) || !normalize3(v->right) || !(cam->fovy_deg >= SW_FOVY_MIN_DEG) ||
         !(cam->fovy_deg < 180.0) || !(near_plane > 0.0))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "degenerate camera (eye = target, up parallel to the view, fovy %g "
-                        "outside (0, 180) or near plane %g)",
-                        cam->fovy_deg, near_plane);
+                        "outside [%g, 180) or near plane %g)",
+                        cam->fovy_deg, SW_FOVY_MIN_DEG, near_plane);
     cross3(v->right, v->fwd, v->up);
     v->width = w;
     v->height = h;

@@ -118,6 +118,15 @@ static size_t count_samples(const double *uv, size_t n, double du, double dv)
     return total;
 }
 
+/* The most samples one ribbon may take: 64 per pixel of the frame's perimeter (a loop 32 times
+ * around the frame at one sample per pixel), and never fewer than two per loop vertex. */
+static size_t border_budget(const sw__gpu_view *v, size_t n)
+{
+    const size_t view =
+        64u * ((size_t)(v->width > 0 ? v->width : 1) + (size_t)(v->height > 0 ? v->height : 1));
+    return view > 2 * n ? view : 2 * n;
+}
+
 /* Screen position (pixels from the centre) of an eye-relative point; 0 if not in front. */
 static int screen_of(const sw__gpu_view *v, const double p[3], double out[2])
 {
@@ -458,6 +467,17 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
     if (n < 2 || !(du > 0.0) || !(dv > 0.0))
         return SW_OK;
     size_t m = count_samples(uv, n, du, dv);
+    /* The cap from the request: the view's pixels bound the samples a ribbon can use;
+     * cells shrunk by a deep refinement (fovy 1e-9 grew memory at ~600 MB/s here) are widened
+     * until the loop fits. Each segment keeps one sample, so m <= n + budget after one pass. */
+    const size_t budget = border_budget(v, n);
+    if (m > budget) {
+        const double widen = (double)m / (double)budget;
+        du *= widen;
+        dv *= widen;
+        m = count_samples(uv, n, du, dv);
+        mesh->border_capped++;
+    }
     sw_result r = sw__gpu_mesh_reserve(mesh, 4 * m, 6 * m, status);
     if (r != SW_OK)
         return r;

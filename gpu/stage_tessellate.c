@@ -261,12 +261,16 @@ sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *u
     sw__fr_geometry *g = t->geo;
     sw_sg_surface srf;
     sw_sg_scene_face_surface(t->env->scene, o->face, &srf);
-    size_t first = g->mesh.n_idx;
+    const size_t first = g->mesh.n_idx;
+    const uint64_t capped = g->mesh.border_capped;
     /* st over the face's uv box when the ribbon is drawn untrimmed: no lookup reads it, but the
      * shading's uv (u_uv_map) does */
     const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
     sw_result r = sw__gpu_fat_border(&t->env->view, &srf, o->world, uv, n, left_inside, cell[0],
                                      cell[1], 2.0 * t->env->eps_px, st_rect, &g->mesh, status);
+    /* sampled coarser than its cells (the view's sample budget): it may leave a crack open */
+    t->st->borders_capped += g->mesh.border_capped - capped;
+    t->st->bound_exceeded += g->mesh.border_capped - capped;
     if (r != SW_OK || g->mesh.n_idx == first)
         return r;
     trim_need none = {0.0, 0.0};
@@ -305,9 +309,14 @@ sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     *index = (int64_t)g->n_loops++;
     sw_result r = SW_OK;
-    for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k, ++fl->n)
+    for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k, ++fl->n) {
         r = sw_sg_trim_flatten_loop(t->env->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
                                     &fl->loops[k], status);
+        if (r == SW_OK && (fl->loops[k].below_floor || fl->loops[k].depth_capped)) {
+            t->st->trim_loops_floored++; /* farther than tol from the exact loop somewhere */
+            t->st->bound_exceeded++;
+        }
+    }
     return r;
 }
 

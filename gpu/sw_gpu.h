@@ -42,8 +42,10 @@ const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
 
 typedef struct sw_gpu_camera {
     double eye[3], target[3], up[3];
-    double fovy_deg; /* vertical field of view */
+    double fovy_deg; /* vertical field of view, in [SW_FOVY_MIN_DEG, 180) */
 } sw_gpu_camera;
+
+/* The view's floors are splinewalk/sw_defaults.h's SW_FOVY_MIN_DEG and SW_ERROR_MIN_PX. */
 
 /* A face occurrence given by the caller (immediate draws): face record, world transform (3 x 4
  * row-major), linear RGBA colour (color[3] < 0: the default grey). */
@@ -142,9 +144,11 @@ typedef struct sw_gpu_frame_stats {
     uint64_t hlod_fallback_faces; /* occurrences drawn by their Bézier patches: no hierarchy */
     uint64_t hlod_refine_rounds;  /* rounds of refinement below the leaves the frame waited for */
     /* the guarantee: pieces drawn whose bound exceeds ε_img — a grid whose density the segment
-     * limit capped (the bound it needed is not known), or a hierarchy node whose approximation
-     * error left less than a quarter of ε_img to its sampling (the sampling floor); the worst
-     * known total bound over ε_img, in pixels (0 when none is known) */
+     * limit capped (the bound it needed is not known), a hierarchy node whose approximation
+     * error left less than a quarter of ε_img to its sampling (the sampling floor), a trim loop
+     * flattened at the rounding floor or depth cap (trim_loops_floored), a fat border sampled
+     * coarser than its cells (borders_capped); the worst known total bound over ε_img, in pixels
+     * (0 when none is known) */
     uint64_t bound_exceeded;
     double bound_excess_px;
     uint64_t hlod_over_budget;     /* nodes drawn although their error exceeds their share of
@@ -170,6 +174,12 @@ typedef struct sw_gpu_frame_stats {
     uint64_t meshes_drawn, meshes_culled; /* occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */
     double near_plane; /* the projection's (desc.near_plane or the scene box's) */
+    /* counted fallbacks of the loops bounded at their root, 0 in an ordinary frame */
+    uint64_t trim_loops_floored; /* loops flattened at the rounding floor or the depth cap
+                                    (sw_sg_polyline.below_floor / depth_capped): chords may lie
+                                    farther than the trim tolerance from the curve */
+    uint64_t borders_capped;     /* fat borders sampled coarser than their cells: the view's
+                                    sample budget (sw__gpu_mesh.border_capped) */
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -221,6 +221,8 @@ typedef struct sw__gpu_mesh {
     sw__gpu_vertex *v;
     uint32_t *idx;
     size_t n_v, cap_v, n_idx, cap_idx;
+    uint64_t border_capped; /* fat borders sampled coarser than their cells: the sample budget
+                               of sw__gpu_fat_border was hit (counted, never reset here) */
 } sw__gpu_mesh;
 
 /* Grows *p (capacity *cap elements of elem bytes) to hold `need`, doubling; 0 when out of memory
@@ -255,6 +257,10 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
  * the exact surface with steps no longer than (du, dv). left_inside: the face lies to the left of
  * the polyline's direction in (u, v). st_box (u0, u1, v0, v1) or NULL: the rectangle the trim
  * lookup of the ribbon's draw spans (vertices then carry st over it), else st = 0 (untrimmed).
+ * Bounded by the view: at most max(2 n, 64 (width + height)) samples (a loop 32 times around the
+ * frame at one sample per pixel); a loop whose cells ask for more is sampled with (du, dv) scaled
+ * up to fit, and mesh->border_capped counts it (the ribbon then follows the loop's chords at
+ * coarser steps: within the budget, not the grid's cells).
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,

@@ -24,6 +24,7 @@
 #include "sw_status_util.h"
 
 #include <assert.h>
+#include <float.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdalign.h>
@@ -71,7 +72,7 @@ struct sw_lod_cache {
     alignas(64) _Atomic uint64_t epoch;
     _Atomic size_t bytes;
     _Atomic uint64_t submitted, builds, failed, cancelled, superseded, refinements,
-        refine_cancelled, retired_count, freed_count;
+        refine_cancelled, retired_count, freed_count, refine_capped;
     pthread_mutex_t retire_lock; /* protects `retired`; publishers and collectors only */
     retired *retired;
 };
@@ -544,6 +545,35 @@ static sw_lod_hierarchy *replace_leaf(const sw_lod_hierarchy *old, int32_t leaf,
     return h;
 }
 
+/* Refinement bounded at its root: a tolerance the bounds cannot meet (their rounding
+ * noise, data at the edge of the validated range) asked for ever deeper leaves, frame after
+ * frame, memory growing 8-20 MB/s. A leaf is not refined further, and the fallback counted, when
+ *  - it lies REFINE_MAX_DEPTH levels below the root (each level halves one direction: 2^-32 of
+ *    the face's domain both ways, far below any pixel of a view above the fovy floor);
+ *  - its rectangle is at the rounding floor in u or v: no wider than REFINE_FLOOR_ULPS ulps of
+ *    its coordinates, where a split no longer yields distinct parameters;
+ *  - the hierarchy holds REFINE_MAX_NODES nodes (~90 MB for one face): more than the pixels of a
+ *    frame can use.
+ * Such a leaf is drawn over budget (the frame counts it, hlod_over_budget). */
+enum { REFINE_MAX_DEPTH = 64, REFINE_FLOOR_ULPS = 64, REFINE_MAX_NODES = 1 << 17 };
+
+static int refine_capped(const sw_lod_hierarchy *h, int32_t node)
+{
+    if (h->n_nodes >= REFINE_MAX_NODES)
+        return 1;
+    const double *r = h->nodes[node].rect;
+    for (int k = 0; k < 2; ++k) {
+        const double mag = fmax(fabs(r[2 * k]), fabs(r[2 * k + 1]));
+        if (!(r[2 * k + 1] - r[2 * k] > REFINE_FLOOR_ULPS * DBL_EPSILON * mag))
+            return 1;
+    }
+    int32_t depth = 0;
+    for (int32_t i = h->nodes[node].parent; i >= 0 && depth < REFINE_MAX_DEPTH;
+         i = h->nodes[i].parent)
+        ++depth;
+    return depth >= REFINE_MAX_DEPTH;
+}
+
 /* The leaf's own finer hierarchy merged into a new version of cur, or NULL (nothing to publish). */
 static sw_lod_hierarchy *refine_leaf(sw_lod_cache *c, uint32_t face, const sw_lod_hierarchy *cur,
                                      int32_t node, double tolerance)
@@ -551,6 +581,10 @@ static sw_lod_hierarchy *refine_leaf(sw_lod_cache *c, uint32_t face, const sw_lo
     const sw_lod_hnode *leaf = &cur->nodes[node];
     if (leaf->child[0] >= 0 || leaf->error <= tolerance)
         return NULL;
+    if (refine_capped(cur, node)) {
+        count(&c->refine_capped);
+        return NULL;
+    }
     sw_sg_surface surf;
     sw_sg_scene_face_surface(c->scene, face, &surf);
     sw_lod_hierarchy_desc d = c->desc.hierarchy;
@@ -613,9 +647,9 @@ static void refine_task(void *ctx)
 }
 
 /* With the refining flag held: whether any of the nodes of the face's current version is a leaf
- * above its tolerance. */
+ * above its tolerance that may still be refined (capped ones are counted in *capped). */
 static sw_result refine_check(slot *s, const int32_t *nodes, const double *tolerance, uint32_t n,
-                              sw_lod_refine_outcome *oc)
+                              sw_lod_refine_outcome *oc, _Atomic uint64_t *capped)
 {
     const sw_lod_hierarchy *h = atomic_load_explicit(&s->current, memory_order_acquire);
     *oc = SW_LOD_REFINE_DONE;
@@ -623,7 +657,12 @@ static sw_result refine_check(slot *s, const int32_t *nodes, const double *toler
         if (nodes[k] < 0 || nodes[k] >= h->n_nodes || !(tolerance[k] > 0.0))
             return SW_ERR_INVALID_ARGUMENT;
         const sw_lod_hnode *l = &h->nodes[nodes[k]];
-        if (l->child[0] < 0 && l->error > tolerance[k])
+        if (!(l->child[0] < 0 && l->error > tolerance[k]))
+            continue;
+        /* a capped leaf stays as it is: asking again each frame would refine nothing */
+        if (refine_capped(h, nodes[k]))
+            count(capped);
+        else
             *oc = SW_LOD_REFINE_SUBMITTED;
     }
     return SW_OK;
@@ -670,7 +709,7 @@ sw_result sw_lod_cache_refine_leaves(sw_lod_cache *c, uint32_t face, const int32
         *oc = SW_LOD_REFINE_BUSY;
         return SW_OK;
     }
-    sw_result res = refine_check(s, nodes, tolerance, n, oc);
+    sw_result res = refine_check(s, nodes, tolerance, n, oc, &c->refine_capped);
     refine_job *j = NULL;
     if (res == SW_OK && *oc == SW_LOD_REFINE_SUBMITTED) {
         j = refine_job_new(c, face, nodes, tolerance, n, r);
@@ -795,5 +834,6 @@ void sw_lod_cache_stats_get(const sw_lod_cache *c, sw_lod_cache_stats *out)
         atomic_load_explicit(&m->failed, o),           atomic_load_explicit(&m->cancelled, o),
         atomic_load_explicit(&m->superseded, o),       atomic_load_explicit(&m->refinements, o),
         atomic_load_explicit(&m->refine_cancelled, o), atomic_load_explicit(&m->retired_count, o),
-        atomic_load_explicit(&m->freed_count, o),      sw_lod_cache_memory(c)};
+        atomic_load_explicit(&m->freed_count, o),      sw_lod_cache_memory(c),
+        atomic_load_explicit(&m->refine_capped, o)};
 }

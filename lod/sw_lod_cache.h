@@ -99,7 +99,10 @@ typedef struct sw_lod_cache_stats {
     uint64_t refinements; /* versions published by refinement */
     uint64_t refine_cancelled;
     uint64_t versions_retired, versions_freed;
-    size_t memory_bytes; /* sw_lod_cache_memory */
+    size_t memory_bytes;    /* sw_lod_cache_memory */
+    uint64_t refine_capped; /* refinements of leaves above their tolerance refused (issue 19): at
+                               the depth cap, a parameter rectangle at the rounding floor, or a
+                               hierarchy at its node cap (hierarchy_cache.c, refine_leaf) */
 } sw_lod_cache_stats;
 
 /* scene: its FACES and POOL sections required and validated (sw_sg_scene_require), and it must

@@ -199,6 +199,12 @@ static sw_result check_node_records(const vctx *c)
                             "%s: node %u%s: non-finite colour or "
                             "transform",
                             c->what, i, at);
+        for (int k = 0; k < 12; k++)
+            if (!(fabs(nd->xform[k]) <= SW_SG_XFORM_MAX)) /* the rule: sw_sg_geom.h */
+                return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
+                                "%s: node %u%s: transform entry %d is %g, beyond %g (products "
+                                "would overflow)",
+                                c->what, i, at, k, nd->xform[k], SW_SG_XFORM_MAX);
     }
     return SW_OK;
 }
@@ -335,7 +341,7 @@ static sw_result check_mesh(const vctx *c, uint32_t i, const sw_sg_mesh_rec *m)
                             idx[k], m->n_vertices);
     const double *p = v->pool + m->positions;
     for (uint64_t k = 0; k < nv3; k++)
-        if (!isfinite(p[k]) ||
+        if (!(fabs(p[k]) <= SW_SG_COORD_MAX) || /* finite, and the rule of sw_sg_geom.h */
             (m->normals != SW_SG_NO_NORMALS && !isfinite(v->pool[m->normals + k])))
             return sw__fail(c->status, SW_ERR_INVALID_GEOMETRY,
                             "%s: mesh %u%s: vertex %llu: non-finite position or normal", c->what, i,

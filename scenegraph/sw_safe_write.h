@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The one way the project writes an output file (never installed; issue 22 item 1).
+/* The one way the project writes an output file (never installed).
  *
  * A write either replaces the target completely or leaves it byte-identical: the bytes go to a
  * temporary in the target's directory — an unnamed O_TMPFILE file where the file system offers

@@ -32,11 +32,26 @@ extern "C" {
 
 #define SW_SG_MAX_DEGREE 31 /* larger degrees are rejected as invalid geometry */
 
+/* The range validation admits, so that no product the evaluation and the bounds form
+ * overflows or underflows. The largest of them is a coordinate times the square of the net's
+ * weight ratio (the rational second-derivative bounds of lod/sampling.c, error_bound.c's wratio),
+ * times a transform's scale and a focal length in pixels (< 1e6), and then squared (distances,
+ * segment counts): with every factor within these limits that is at most
+ * (1e30 x 1e30 x 1e30 x 1e6)^2 = 1e192, finite; homogeneous products w x and 1 / w stay normal
+ * doubles (1e130, 1e100). Each is far beyond real data (the universe is ~1e30 mm across; OCCT's
+ * weights lie within a factor 10 of each other); a weight of 1e-300 or a coordinate or transform
+ * entry of 1e308, which passed before and then refined forever, is rejected with its position. */
+#define SW_SG_COORD_MAX 1e30    /* |Euclidean coordinate| and |knot| of curves and surfaces */
+#define SW_SG_WEIGHT_MIN 1e-100 /* each weight in [SW_SG_WEIGHT_MIN, SW_SG_WEIGHT_MAX] */
+#define SW_SG_WEIGHT_MAX 1e100
+#define SW_SG_WEIGHT_RATIO_MAX 1e15 /* largest / smallest weight of one curve or surface */
+#define SW_SG_XFORM_MAX 1e30        /* |entry| of a node's 3 x 4 transform */
+
 /* A rational B-spline curve in homogeneous form; pointers are borrowed. */
 typedef struct sw_sg_curve {
     int32_t degree;
-    int32_t n;          /* number of control points, >= degree + 1 */
-    int32_t dim;        /* homogeneous dimension (3 for trim curves: w*u, w*v, w) */
+    int32_t n;           /* number of control points, >= degree + 1 */
+    int32_t dim;         /* homogeneous dimension (3 for trim curves: w*u, w*v, w) */
     const double *knots; /* n + degree + 1, non-decreasing */
     const double *cpw;   /* n * dim */
 } sw_sg_curve;
@@ -44,7 +59,7 @@ typedef struct sw_sg_curve {
 /* A rational B-spline (tensor-product) surface in homogeneous form; pointers are borrowed. */
 typedef struct sw_sg_surface {
     int32_t deg_u, deg_v;
-    int32_t n_u, n_v;     /* control points in u and in v */
+    int32_t n_u, n_v;      /* control points in u and in v */
     const double *knots_u; /* n_u + deg_u + 1 */
     const double *knots_v; /* n_v + deg_v + 1 */
     const double *cpw;     /* n_u * n_v * 4, u fastest */

@@ -24,15 +24,25 @@ sw_result sw_sg_trim_snap_loop(int32_t n_curves, double *const *cpw, const int32
  * closing vertex is not repeated. Every join point is the Euclidean image of the curve's first
  * control point, so adjacent curves share bit-identical vertices. */
 typedef struct sw_sg_polyline {
-    double *uv;     /* 2 * count */
+    double *uv; /* 2 * count */
     uint32_t count;
+    /* Counted fallbacks of sw_sg_trim_flatten_loop (0 elsewhere), where a chord may be farther
+     * than the requested tol from its curve: */
+    uint32_t below_floor;  /* curves whose tol was raised to the rounding floor of their data */
+    uint32_t depth_capped; /* pieces emitted unflat at the depth cap */
 } sw_sg_polyline;
 
 /* Flattens loop `loop` so that every chord is within `tol` (parameter units) of the curve, using a
  * bound from the control polygon (a subdivided segment is emitted when its control points lie
  * within tol of its chord). Allocates out->uv (free with sw_sg_polyline_free).
+ * Bounded whatever tol and the data (trim.c's header): tol is raised to a floor of 64 ulps of each
+ * curve's largest coordinate (64 DBL_EPSILON max |u|, |v| of its control points) and subdivision
+ * stops at the depth its control polygon's length needs (at most 40); out->below_floor and
+ * out->depth_capped count where that happened (0: every chord within tol). The work is at most
+ * about max_vertices x 40 subdivisions.
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than `max_vertices`), SW_ERR_INVALID_GEOMETRY
- * (a curve that is not a clamped 2D curve: its first vertex would not be its first control point). */
+ * (a curve that is not a clamped 2D curve: its first vertex would not be its first control point).
+ */
 sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, double tol,
                                   uint32_t max_vertices, sw_sg_polyline *out, sw_status *status);
 void sw_sg_polyline_free(sw_sg_polyline *p);

@@ -303,7 +303,7 @@ static sw_result check_overlaps(const char *path, const sw__sg_section_info *sec
 }
 
 /* Every byte of the data area outside the sections is alignment padding: fewer than 16 bytes
- * before each section and after the last one, all zero (issue 22: a byte flipped there was
+ * before each section and after the last one, all zero (else a byte flipped there would be
  * covered by no checksum). Sections do not overlap (check_overlaps ran). */
 static sw_result check_padding(const char *path, const unsigned char *p, uint64_t data_start,
                                uint64_t file_size, const sw__sg_section_info *sec,

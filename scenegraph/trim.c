@@ -8,17 +8,32 @@
  * point. Flattening decomposes each curve into rational Bézier segments (The NURBS Book, A5.6) and
  * subdivides them by de Casteljau until the control polygon lies within the tolerance of its chord
  * (convex hull property of rational curves with positive weights).
+ *
+ * Bounded at the root: a tolerance below what double arithmetic on the curve's own
+ * coordinates can resolve is never met, and every piece then split down to the depth cap, 2^depth
+ * pieces per segment (a scaled IGES part asked for 1.85e-17 and spun for minutes). So
+ *  - the tolerance is raised to a floor of TRIM_FLOOR_ULPS ulps of the curve's largest
+ *    coordinate (de Casteljau's midpoints, the division by the weight and the distance test each
+ *    round relative to it, a few ulps per level, TRIM_MAX_DEPTH levels at most); curves flattened
+ *    at the floor are counted in the polyline (below_floor);
+ *  - the depth is capped by what the request needs: a piece of parameter length 2^-d of a
+ *    Bézier segment has a control polygon no longer than 2^-d p max|P_i+1 - P_i| (W^2 for the
+ *    weight ratio W of a rational one), which is within the tolerance once that is; pieces emitted
+ *    at the cap (rounding, or a loose rational bound) are counted (depth_capped);
+ *  - the walk stops as soon as the vertex budget is spent (SW_ERR_LIMIT), so the work is at most
+ *    max_vertices x depth splits, whatever the data.
  */
 #include "sw_sg_trim.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-enum { TRIM_DIM = 3, TRIM_MAX_DEPTH = 40 };
+enum { TRIM_DIM = 3, TRIM_MAX_DEPTH = 40, TRIM_FLOOR_ULPS = 64 };
 
 /* ---- snapping ------------------------------------------------------------------------------ */
 
@@ -72,6 +87,7 @@ typedef struct vertex_buf {
     double *uv;
     uint32_t count, cap, max;
     int overflow, oom;
+    uint32_t below_floor, depth_capped; /* the counted fallbacks (sw_sg_polyline) */
 } vertex_buf;
 
 static void emit(vertex_buf *vb, const double *h)
@@ -124,10 +140,19 @@ static int bezier_flat(const double *q, int32_t p, double tol)
 }
 
 /* Emits the start vertex of every flat piece of the Bézier segment q (degree p, homogeneous),
- * splitting at t = 1/2; q is overwritten by its left half. */
-static void flatten_bezier(double *q, int32_t p, double tol, int depth, vertex_buf *vb)
+ * splitting at t = 1/2 down to depth max_depth; q is overwritten by its left half. Stops at once
+ * when the buffer is full or out of memory (the caller fails then). */
+static void flatten_bezier(double *q, int32_t p, double tol, int depth, int max_depth,
+                           vertex_buf *vb)
 {
-    if (depth >= TRIM_MAX_DEPTH || bezier_flat(q, p, tol)) {
+    if (vb->overflow || vb->oom)
+        return;
+    if (bezier_flat(q, p, tol)) {
+        emit(vb, q);
+        return;
+    }
+    if (depth >= max_depth) {
+        vb->depth_capped++;
         emit(vb, q);
         return;
     }
@@ -143,8 +168,30 @@ static void flatten_bezier(double *q, int32_t p, double tol, int depth, vertex_b
                TRIM_DIM * sizeof(double));
     }
     /* q now holds, at index i, the left half's point i (the diagonal of the scheme). */
-    flatten_bezier(q, p, tol, depth + 1, vb);
-    flatten_bezier(right, p, tol, depth + 1, vb);
+    flatten_bezier(q, p, tol, depth + 1, max_depth, vb);
+    flatten_bezier(right, p, tol, depth + 1, max_depth, vb);
+}
+
+/* The depth at which every piece of Bézier segment q (degree p, homogeneous, positive weights)
+ * is flat within tol by the length bound of the header, plus two levels of margin; at most
+ * TRIM_MAX_DEPTH (also for tol = 0, the floor of a curve at the origin). */
+static int depth_needed(const double *q, int32_t p, double tol)
+{
+    double wmin = INFINITY, wmax = 0.0, step = 0.0, a[2], b[2];
+    for (int32_t i = 0; i <= p; i++) {
+        wmin = fmin(wmin, q[i * TRIM_DIM + 2]);
+        wmax = fmax(wmax, q[i * TRIM_DIM + 2]);
+    }
+    for (int32_t i = 0; i < p; i++) {
+        euclid(q + (size_t)i * TRIM_DIM, a);
+        euclid(q + (size_t)(i + 1) * TRIM_DIM, b);
+        step = fmax(step, hypot(b[0] - a[0], b[1] - a[1]));
+    }
+    const double ratio = wmax / wmin, len = p * step * ratio * ratio;
+    if (!(len > tol))
+        return 2;
+    const double d = ceil(log2(len / tol)) + 2.0;
+    return d < TRIM_MAX_DEPTH ? (int)d : TRIM_MAX_DEPTH;
 }
 
 static int is_clamped(const sw_sg_curve *c)
@@ -219,8 +266,21 @@ static sw_result flatten_curve(const sw_sg_curve *c, uint32_t index, double tol,
     if (!qw)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim curve %u: out of memory", index);
     int32_t nb = decompose(c, qw);
-    for (int32_t s = 0; s < nb; s++)
-        flatten_bezier(qw + (size_t)s * seg, p, tol, 0, vb);
+    /* The floor: TRIM_FLOOR_ULPS ulps of the largest Euclidean coordinate of the curve. */
+    double mag = 0.0;
+    for (int32_t i = 0; i < c->n; i++)
+        for (int k = 0; k < 2; k++)
+            mag = fmax(mag,
+                       fabs(c->cpw[(size_t)i * TRIM_DIM + k] / c->cpw[(size_t)i * TRIM_DIM + 2]));
+    const double floor_tol = TRIM_FLOOR_ULPS * DBL_EPSILON * mag;
+    if (!(tol >= floor_tol)) {
+        tol = floor_tol;
+        vb->below_floor++;
+    }
+    for (int32_t s = 0; s < nb && !vb->overflow && !vb->oom; s++) {
+        double *q = qw + (size_t)s * seg;
+        flatten_bezier(q, p, tol, 0, depth_needed(q, p, tol), vb);
+    }
     sw__free(qw);
     return SW_OK;
 }
@@ -230,10 +290,9 @@ sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, doubl
 {
     const sw_sg_scene_view *view = sw_sg_scene_view_ptr(scene);
     assert(out && loop < view->n_loops);
-    out->uv = NULL;
-    out->count = 0;
+    memset(out, 0, sizeof *out);
     const sw_sg_loop_rec *lp = &view->loops[loop];
-    vertex_buf vb = {NULL, 0, 0, max_vertices, 0, 0};
+    vertex_buf vb = {NULL, 0, 0, max_vertices, 0, 0, 0, 0};
     for (uint32_t k = 0; k < lp->n_curves; k++) {
         sw_sg_curve c;
         sw_sg_scene_curve(scene, lp->first_curve + k, &c);
@@ -252,6 +311,8 @@ sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, doubl
     }
     out->uv = vb.uv;
     out->count = vb.count;
+    out->below_floor = vb.below_floor;
+    out->depth_capped = vb.depth_capped;
     sw__status_ok(status);
     return SW_OK;
 }
@@ -261,8 +322,7 @@ void sw_sg_polyline_free(sw_sg_polyline *p)
     if (!p)
         return;
     sw__free(p->uv);
-    p->uv = NULL;
-    p->count = 0;
+    memset(p, 0, sizeof *p);
 }
 
 /* ---- classification ------------------------------------------------------------------------ */

@@ -212,6 +212,11 @@ static sw_result read_transform(const double in[12], const char *fn, double out[
     if (!all_finite(in, 12) || !(fabs(det) > 1e-300))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: transform is not finite or its 3x3 part is singular", fn);
+    for (int k = 0; k < 12; k++)
+        if (!(fabs(in[k]) <= SW_SG_XFORM_MAX)) /* the rule: scenegraph/sw_sg_geom.h */
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                            "%s: transform entry %d is %g, beyond %g (products would overflow)", fn,
+                            k, in[k], SW_SG_XFORM_MAX);
     memcpy(out, in, 12 * sizeof *out);
     return SW_OK;
 }
@@ -241,11 +246,11 @@ static sw_result check_camera(const sw_camera *c, const char *fn, sw_status *sta
     }
     int finite = all_finite(c->eye, 3) && all_finite(c->target, 3) && all_finite(c->up, 3);
     if (!finite || !(dd > 0.0) || !(xx > 0.0) ||
-        (c->fovy_deg != 0.0 && !(c->fovy_deg > 0.0 && c->fovy_deg < 180.0)))
+        (c->fovy_deg != 0.0 && !(c->fovy_deg >= SW_FOVY_MIN_DEG && c->fovy_deg < 180.0)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: camera not finite, eye = target, up parallel to the view, or fovy "
-                        "out of (0, 180)",
-                        fn);
+                        "out of [%g, 180)",
+                        fn, SW_FOVY_MIN_DEG);
     return SW_OK;
 }
 
@@ -526,10 +531,11 @@ static sw_result check_mesh_desc(const sw_mesh_desc *d, sw_status *status)
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL positions or indices", fn);
     for (uint32_t i = 0; i < d->vertex_count; i++) {
         const double *p = d->positions + 3 * (size_t)i;
-        if (!all_finite(p, 3))
+        if (!all_finite(p, 3) || !(fmax(fmax(fabs(p[0]), fabs(p[1])), fabs(p[2])) <=
+                                   SW_SG_COORD_MAX)) /* the rule: scenegraph/sw_sg_geom.h */
             return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
-                            "%s: vertex %u: position (%g, %g, %g) is not finite", fn, i, p[0], p[1],
-                            p[2]);
+                            "%s: vertex %u: position (%g, %g, %g) is not finite or beyond %g", fn,
+                            i, p[0], p[1], p[2], SW_SG_COORD_MAX);
         const double *n = d->normals ? d->normals + 3 * (size_t)i : NULL;
         if (n && (!all_finite(n, 3) || !(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] > 0.0)))
             return sw__fail(status, SW_ERR_INVALID_GEOMETRY,

@@ -277,13 +277,17 @@ static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
     if (desc->width < 0 || desc->height < 0 || desc->width > 16384 || desc->height > 16384)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "frame size %dx%d out of 1..16384",
                         desc->width, desc->height);
-    if (desc->error_px != 0.0 && !(desc->error_px > 0.0 && isfinite(desc->error_px)))
+    if (desc->error_px != 0.0 && !(desc->error_px >= SW_ERROR_MIN_PX && isfinite(desc->error_px)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "screen-space error %g px must be positive and finite", desc->error_px);
+                        "screen-space error %g px must be finite and at least %g px (the floor "
+                        "below which refinement outgrows the arithmetic)",
+                        desc->error_px, SW_ERROR_MIN_PX);
     if (desc->camera.fovy_deg != 0.0 &&
-        !(desc->camera.fovy_deg > 0.0 && desc->camera.fovy_deg < 180.0))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "field of view %g° out of (0, 180)",
-                        desc->camera.fovy_deg);
+        !(desc->camera.fovy_deg >= SW_FOVY_MIN_DEG && desc->camera.fovy_deg < 180.0))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "field of view %g° out of [%g, 180) (the floor below which refinement "
+                        "outgrows the arithmetic)",
+                        desc->camera.fovy_deg, SW_FOVY_MIN_DEG);
     for (int k = 0; k < 3; k++) {
         if (!isfinite(desc->camera.eye[k]) || !isfinite(desc->camera.target[k]) ||
             !isfinite(desc->camera.up[k]))

@@ -36,8 +36,8 @@ static double norm3(const double a[3])
 }
 
 /* A camera the renderer accepts: eye away from target relative to the coordinates' size, up
- * neither zero nor along the view (gpu/camera.c rejects both), fovy in (0°, 180°). Returns NULL
- * or what is wrong. */
+ * neither zero nor along the view (gpu/camera.c rejects both), fovy in [SW_FOVY_MIN_DEG, 180°).
+ * Returns NULL or what is wrong. */
 static const char *camera_problem(const sw_camera *c)
 {
     double d[3], scale = 1.0;
@@ -46,8 +46,8 @@ static const char *camera_problem(const sw_camera *c)
         scale = fmax(scale, fmax(fabs(c->eye[k]), fabs(c->target[k])));
     }
     const double dn = norm3(d), un = norm3(c->up);
-    if (!(c->fovy_deg > 0.0 && c->fovy_deg < 180.0))
-        return "the field of view is outside (0, 180) degrees";
+    if (!(c->fovy_deg >= SW_FOVY_MIN_DEG && c->fovy_deg < 180.0))
+        return "the field of view is outside [0.01, 180) degrees (SW_FOVY_MIN_DEG)";
     if (!(dn > 1e-9 * scale))
         return "the eye coincides with the target";
     if (!(un > 0.0))

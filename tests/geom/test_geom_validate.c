@@ -4,6 +4,7 @@
  * coordinates, wrong counts and degrees, excessive knot multiplicity, an empty domain, missing
  * arrays. The result id is asserted; the message must name the object (`what`). */
 #include "geom_test_util.h"
+#include "sw_sg_scene.h"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -183,6 +184,75 @@ static void test_validate_curves(void **state)
            "dim 1 rejected\n");
 }
 
+/* Issue 19: finite values whose products overflow the evaluation's range (the rule of
+ * sw_sg_geom.h). A weight of 1e-300 or a coordinate of 1e308 passed validation and then refined
+ * forever; each is now refused with SW_ERR_INVALID_GEOMETRY, the object and the control point.
+ * Planted fault (the range checks dropped from bad_point): every case here passes validation. */
+static void test_validate_rejects_overflowing_values(void **state)
+{
+    (void)state;
+    fixture f;
+    const struct {
+        int index, coord;
+        double value; /* Euclidean for coordinates */
+        const char *name, *where;
+    } cases[] = {
+        {7, 3, 1e-300, "weight 1e-300", "control point (2, 1)"},
+        {7, 3, 1e300, "weight 1e300", "control point (2, 1)"},
+        {11, 0, 1e308, "coordinate 1e308", "control point (1, 2)"},
+        {12, 2, -2e30, "coordinate -2e30", "control point (2, 2)"},
+        {19, 3, 1e-16, "weight ratio 1e16", "factor"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        fixture_init(&f);
+        double *pw = f.cpw + cases[k].index * 4;
+        if (cases[k].coord == 3) { /* keep the Euclidean point */
+            for (int c = 0; c < 3; c++)
+                pw[c] *= cases[k].value / pw[3];
+            pw[3] = cases[k].value;
+        } else {
+            pw[cases[k].coord] = cases[k].value * pw[3];
+        }
+        expect_invalid(&f, cases[k].name);
+        sw_status st = {0};
+        sw_sg_surface_validate(&f.s, "face 12", &st);
+        assert_non_null(strstr(st.message, cases[k].where));
+    }
+    /* just inside the limits passes: weights 1e14 x apart, near 1e-100, coordinates of 9e29 */
+    fixture_init(&f);
+    for (int i = 0; i < 20; i++) {
+        double *pw = f.cpw + i * 4;
+        const double w = i % 2 ? 1e-100 : 1e-86;
+        for (int c = 0; c < 3; c++)
+            pw[c] = pw[c] / pw[3] * w;
+        pw[3] = w;
+    }
+    f.cpw[5 * 4] = 9e29 * f.cpw[5 * 4 + 3];
+    f.ku[0] = -1e30;
+    assert_int_equal(sw_sg_surface_validate(&f.s, "face 12", NULL), SW_OK);
+    f.ku[0] = -1.5e30;
+    expect_invalid(&f, "knot -1.5e30");
+    /* trim curves: the same rule */
+    double knots[4] = {0, 0, 1, 1}, cpw[6] = {0, 0, 1, 1e-301, 1e-301, 1e-301};
+    sw_sg_curve c = {.degree = 1, .n = 2, .dim = 3, .knots = knots, .cpw = cpw};
+    sw_status st = {0};
+    assert_int_equal(sw_sg_curve_validate(&c, "trim curve 3", &st), SW_ERR_INVALID_GEOMETRY);
+    assert_non_null(strstr(st.message, "control point 1"));
+    cpw[3] = cpw[4] = 1e35;
+    cpw[5] = 1.0;
+    assert_int_equal(sw_sg_curve_validate(&c, "trim curve 3", &st), SW_ERR_INVALID_GEOMETRY);
+    /* a node transform of 1e308: the scene is refused at its validation, naming the node */
+    sw_sg_builder *b = sw_sg_builder_create();
+    assert_non_null(b);
+    const double xf[12] = {1e308, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    sw_sg_builder_add_node(b, SW_SG_NODE_TRANSFORM, 0, 0, xf, NULL, NULL);
+    sw_sg_scene *scene = NULL;
+    assert_int_equal(sw_sg_builder_finish(b, &scene, &st), SW_ERR_INVALID_GEOMETRY);
+    printf("  %-28s -> %s\n", "node transform 1e308", st.message);
+    assert_non_null(strstr(st.message, "node 1"));
+    assert_null(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -191,6 +261,7 @@ int main(void)
         cmocka_unit_test(test_validate_rejects_bad_weights_and_points),
         cmocka_unit_test(test_validate_rejects_bad_counts),
         cmocka_unit_test(test_validate_curves),
+        cmocka_unit_test(test_validate_rejects_overflowing_values),
     };
     return cmocka_run_group_tests_name("geom_validate", tests, NULL, NULL);
 }

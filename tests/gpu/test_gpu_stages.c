@@ -433,21 +433,21 @@ static void check_submit_analytic(sw_gpu_context *ctx)
     sw_gpu_image_free(&img);
 }
 
-/* The counter of pieces over the bound counts: a 0.005° view of the model's middle, drawn by the
- * faces' own Bézier patches, asks grids finer than the segment limit (a counter that never counts
- * would pass the check above). */
+/* The counter of pieces over the bound counts: a view of the model at the floor of the field of
+ * view (0.01°)'s middle, drawn by the faces' own Bézier patches, asks grids finer than the segment
+ * limit (a counter that never counts would pass the check above). */
 static void check_bound_counted(sw_gpu_context *ctx, const sw_sg_scene *scene,
                                 const sw_gpu_frame_desc *base, const char *name)
 {
     sw_gpu_frame_desc desc = *base;
-    desc.camera.fovy_deg = 0.005;
+    desc.camera.fovy_deg = SW_FOVY_MIN_DEG;
     desc.hierarchies = NULL;
     stages s;
     sw_status st = {0};
     if (run_prepare(&s, ctx, scene, &desc, &st) != SW_OK)
         CHECK(0, "%s: narrow view: %s", name, st.message);
     else
-        printf("%s: 0.005 deg view: %llu pieces over the bound\n", name,
+        printf("%s: 0.01 deg view: %llu pieces over the bound\n", name,
                (unsigned long long)s.st.bound_exceeded);
     g_bound_counted += s.st.bound_exceeded > 0;
     stages_free(&s);

@@ -61,10 +61,10 @@ static void make_shape(shape *s, const double box[4], int w, int h, double phase
         s->island[2 * k] = cu + su * isl[2 * k];
         s->island[2 * k + 1] = cv + sv * isl[2 * k + 1];
     }
-    s->all[0] = (sw_sg_polyline){s->star, 0};
-    s->all[1] = (sw_sg_polyline){s->star, 2 * STAR_POINTS};
-    s->all[2] = (sw_sg_polyline){s->hole, HOLE_N};
-    s->all[3] = (sw_sg_polyline){s->island, 4};
+    s->all[0] = (sw_sg_polyline){.uv = s->star, .count = 0};
+    s->all[1] = (sw_sg_polyline){.uv = s->star, .count = 2 * STAR_POINTS};
+    s->all[2] = (sw_sg_polyline){.uv = s->hole, .count = HOLE_N};
+    s->all[3] = (sw_sg_polyline){.uv = s->island, .count = 4};
     s->loops = leading_empty ? s->all : s->all + 1;
     s->n_loops = leading_empty ? 4 : 3;
     s->key = (sw__gpu_trim_key){1u, face, 4 * face, s->n_loops, {box[0], box[1], box[2], box[3]}};

@@ -228,6 +228,112 @@ static void test_snap(void **state)
     assert_true(fabs(rat[0][3] / rat[0][5] - rat[1][0] / rat[1][2]) < 1e-15);
 }
 
+/* Loop 0 of a planar face: a quadratic arc from A to B whose middle control point lies `bulge`
+ * off the chord AB, closed by a line back, every coordinate times `scale` (a part scaled down as a
+ * unit conversion does it). A and B are not dyadic, so subdivision rounds. */
+static const double ARC_A[2] = {0.1, 0.2}, ARC_B[2] = {0.7, 0.55};
+
+static void arc_normal(double n[2])
+{
+    const double dx = ARC_B[0] - ARC_A[0], dy = ARC_B[1] - ARC_A[1], l = hypot(dx, dy);
+    n[0] = -dy / l;
+    n[1] = dx / l;
+}
+
+static sw_sg_scene *make_bulge_scene(double bulge, double scale)
+{
+    sw_sg_builder *b = sw_sg_builder_create();
+    assert_non_null(b);
+    const double lk[4] = {0, 0, 1, 1}, qk[6] = {0, 0, 0, 1, 1, 1};
+    double n[2];
+    arc_normal(n);
+    const double mid[2] = {0.5 * (ARC_A[0] + ARC_B[0]) + bulge * n[0],
+                           0.5 * (ARC_A[1] + ARC_B[1]) + bulge * n[1]};
+    const double arc[9] = {ARC_A[0] * scale, ARC_A[1] * scale, 1, mid[0] * scale, mid[1] * scale, 1,
+                           ARC_B[0] * scale, ARC_B[1] * scale, 1};
+    const double back[6] = {ARC_B[0] * scale, ARC_B[1] * scale, 1,
+                            ARC_A[0] * scale, ARC_A[1] * scale, 1};
+    uint32_t first = add_curve(b, 2, 3, qk, arc);
+    add_curve(b, 1, 2, lk, back);
+    sw_sg_loop_rec outer = {first, 2, SW_SG_LOOP_OUTER, 0};
+    uint32_t l0 = sw_sg_builder_add_loop(b, &outer);
+    const double net[16] = {0, 0, 0, 1, scale, 0, 0, 1, 0, scale, 0, 1, scale, scale, 0, 1};
+    const double fk[4] = {0, 0, scale, scale};
+    sw_sg_face_rec f;
+    memset(&f, 0, sizeof f);
+    f.deg_u = f.deg_v = 1;
+    f.n_u = f.n_v = 2;
+    f.knots_u = sw_sg_builder_push_doubles(b, fk, 4);
+    f.knots_v = sw_sg_builder_push_doubles(b, fk, 4);
+    f.cpw = sw_sg_builder_push_doubles(b, net, 16);
+    f.first_loop = l0;
+    f.n_loops = 1;
+    f.flags = SW_SG_FACE_TRIMMED;
+    f.uv_box[1] = f.uv_box[3] = scale;
+    uint32_t fi = sw_sg_builder_add_face(b, &f);
+    sw_sg_builder_add_node(b, SW_SG_NODE_SURFACE, 0, fi, NULL, NULL, NULL);
+    sw_sg_scene *scene = NULL;
+    assert_int_equal(sw_sg_builder_finish(b, &scene, NULL), SW_OK);
+    return scene;
+}
+
+/* Issue 19, the scaled-IGES hang: a tolerance below the rounding of the loop's own coordinates
+ * (1e-20 of a loop at 0.7, or 1e-26 of the same loop scaled by 1e-6) is met only where rounding
+ * happens to cancel, so the walk splits rounding noise down to the depth cap. With the floor the
+ * arc is flattened at 64 ulps of its largest coordinate in a few vertices and the fallback is
+ * counted. Planted fault (the floor removed in flatten_curve; the code before issue 19 too): 295
+ * vertices instead of 17, and this fails. */
+static void test_flatten_below_rounding(void **state)
+{
+    (void)state;
+    const double scales[2] = {1.0, 1e-6}, bulge = 1e-12;
+    double n[2];
+    arc_normal(n);
+    for (int k = 0; k < 2; k++) {
+        const double scale = scales[k];
+        sw_sg_scene *scene = make_bulge_scene(bulge, scale);
+        sw_sg_polyline pl;
+        sw_status st = {0};
+        assert_int_equal(sw_sg_trim_flatten_loop(scene, 0, 1e-20 * scale, 1u << 16, &pl, &st),
+                         SW_OK);
+        /* the arc's sagitta bulge / 2 at tolerance 64 eps * 0.7: a handful of pieces */
+        printf("scale %g: %u vertices, %u curves below the floor, %u pieces depth-capped\n", scale,
+               pl.count, pl.below_floor, pl.depth_capped);
+        assert_true(pl.count >= 3 && pl.count <= 65);
+        assert_int_equal(pl.below_floor, 2); /* both curves were asked below their floor */
+        assert_int_equal(pl.depth_capped, 0);
+        /* every vertex between the chord and the arc's apex, within rounding */
+        for (uint32_t i = 0; i < pl.count; i++) {
+            const double d = (pl.uv[2 * i] / scale - ARC_A[0]) * n[0] +
+                             (pl.uv[2 * i + 1] / scale - ARC_A[1]) * n[1];
+            assert_true(d >= -1e-15 && d <= 0.5 * bulge + 1e-15);
+        }
+        sw_sg_polyline_free(&pl);
+        /* a requested tolerance above the floor is kept: no fallback counted */
+        assert_int_equal(sw_sg_trim_flatten_loop(scene, 0, 1e-13 * scale, 1u << 16, &pl, &st),
+                         SW_OK);
+        assert_int_equal(pl.below_floor + pl.depth_capped, 0);
+        sw_sg_polyline_free(&pl);
+        sw_sg_scene_free(scene);
+    }
+}
+
+/* A loop the vertex budget cannot hold at such a tolerance (the circle: ~1e7 vertices even at the
+ * floor) ends with SW_ERR_LIMIT as soon as the budget is spent. Planted fault (the code before
+ * issue 19: no floor, and the walk going on after the budget was spent): 2^40 pieces per arc, and
+ * this test runs into its timeout. */
+static void test_flatten_budget_stops(void **state)
+{
+    (void)state;
+    sw_sg_scene *scene = make_scene();
+    sw_sg_polyline pl;
+    sw_status st = {0};
+    assert_int_equal(sw_sg_trim_flatten_loop(scene, 1, 1e-20, 1u << 12, &pl, &st), SW_ERR_LIMIT);
+    assert_null(pl.uv);
+    assert_int_equal(pl.count, 0);
+    sw_sg_scene_free(scene);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -235,6 +341,8 @@ int main(void)
         cmocka_unit_test(test_flatten_joins),
         cmocka_unit_test(test_classify),
         cmocka_unit_test(test_snap),
+        cmocka_unit_test(test_flatten_below_rounding),
+        cmocka_unit_test(test_flatten_budget_stops),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -853,10 +853,59 @@ static void test_failure(void)
     sw_sg_scene_free(m.scene);
 }
 
+/* Issue 19: refinement bounded at its root. Asking again and again for a tolerance the bounds
+ * cannot meet (1e-300: what a weight of 1e-300 or a coordinate of 1e308 asked for, memory growing
+ * 8-20 MB/s in refine_leaf / merge_subtree) ends: every round refines the deepest worst leaf, until
+ * the depth cap, the parameter floor or the node cap refuses it, and the refusal is counted in
+ * refine_capped. Planted fault (refine_capped() returning 0): all 400 rounds refine, the hierarchy
+ * grows past the node cap, and the checks fail. */
+static void test_runaway(const model *m)
+{
+    enum { ROUNDS = 400, MAX_NODES = 1 << 17 };
+    uint32_t face;
+    if (pick_faces(m, &face, 1) < 1) {
+        ++failures;
+        return;
+    }
+    sw_th_pool *pool = make_pool(1);
+    sw_lod_cache *c = make_cache(m, pool);
+    sw_th_group g;
+    sw_th_group_init(&g);
+    sw_lod_cache_request_group(c, face, NULL, &g);
+    sw_th_group_wait(pool, &g);
+    int32_t leaf = worst_leaf(sw_lod_cache_get(c, face));
+    int rounds = 0, done = 0;
+    for (; rounds < ROUNDS && !done && leaf >= 0; ++rounds) {
+        sw_th_group_init(&g);
+        sw_lod_refine_outcome oc;
+        CHECK(sw_lod_cache_refine(c, face, leaf, 1e-300, NULL, &g, &oc) == SW_OK, "refine");
+        sw_th_group_wait(pool, &g);
+        done = oc == SW_LOD_REFINE_DONE;
+        /* the deepest leaf below the one refined: follow the worse child down */
+        const sw_lod_hierarchy *h = sw_lod_cache_get(c, face);
+        while (h->nodes[leaf].child[0] >= 0) {
+            const int32_t *ch = h->nodes[leaf].child;
+            leaf = h->nodes[ch[0]].error >= h->nodes[ch[1]].error ? ch[0] : ch[1];
+        }
+    }
+    sw_lod_cache_stats st;
+    sw_lod_cache_stats_get(c, &st);
+    const sw_lod_hierarchy *h = sw_lod_cache_get(c, face);
+    printf("runaway: face %u, %d rounds, %d nodes, %llu refinements, %llu refused (capped), %zu "
+           "bytes\n",
+           face, rounds, h->n_nodes, (unsigned long long)st.refinements,
+           (unsigned long long)st.refine_capped, sw_lod_cache_memory(c));
+    CHECK(done, "refinement at 1e-300 still going after %d rounds", rounds);
+    CHECK(st.refine_capped >= 1, "no refusal counted");
+    CHECK(h->n_nodes <= MAX_NODES + 4096, "%d nodes", h->n_nodes);
+    sw_lod_cache_destroy(c);
+    sw_th_pool_destroy(pool);
+}
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
-        fprintf(stderr, "usage: %s once|cancel|converged|refine|failure [MODEL] [rounds]\n",
+        fprintf(stderr, "usage: %s once|cancel|converged|refine|runaway|failure [MODEL] [rounds]\n",
                 argv[0]);
         return 2;
     }
@@ -879,6 +928,8 @@ int main(int argc, char **argv)
         test_converged(&m);
     else if (!strcmp(mode, "refine"))
         test_refine(&m, rounds);
+    else if (!strcmp(mode, "runaway"))
+        test_runaway(&m);
     else {
         fprintf(stderr, "unknown mode %s\n", mode);
         failures = 1;

@@ -163,8 +163,11 @@ SW_API sw_result sw_scene_pick(sw_scene scene, const double origin[3], const dou
  * target must differ and up must not be parallel to target - eye. */
 typedef struct sw_camera {
     double eye[3], target[3], up[3];
-    double fovy_deg; /* vertical field of view in degrees; 0 = 40 */
+    double fovy_deg; /* vertical field of view in degrees; 0 = SW_DEFAULT_FOVY_DEG; else in
+                        [SW_FOVY_MIN_DEG, 180) */
 } sw_camera;
+
+/* The view's floors, SW_FOVY_MIN_DEG and SW_ERROR_MIN_PX, are in sw_defaults.h. */
 
 typedef enum sw_view_preset {
     SW_VIEW_ISO = 0,   /* from (+1,+1,+1), up +Z */
@@ -193,7 +196,8 @@ SW_API sw_result sw_camera_fit(sw_scene scene, sw_view_preset view, sw_camera *o
  * positions and drop view's translation (view[12..14]) itself. Any thread. The renderer picks the
  * near plane per frame unless sw_frame_desc.near_plane sets it; sw_frame_stats gives back the one
  * used, and these matrices. Errors: SW_ERR_INVALID_ARGUMENT (NULL pointer; a zero camera: fit one
- * with sw_camera_fit first; eye = target, up zero or parallel to the view, fovy outside (0, 180)
+ * with sw_camera_fit first; eye = target, up zero or parallel to the view, fovy outside
+ * [SW_FOVY_MIN_DEG, 180)
  * (0 = 40); non-finite values; size outside 0..16384; near_plane not positive and finite). view
  * and proj are written on success only. */
 SW_API sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t height,
@@ -243,7 +247,8 @@ typedef struct sw_frame_desc {
     sw_scene scene;
     sw_camera camera;
     int32_t width, height;   /* 0 = 1280 x 720 */
-    double error_px;         /* screen-space error ε_img in pixels; 0 = 0.5 */
+    double error_px;         /* screen-space error ε_img in pixels; 0 = SW_DEFAULT_ERROR_PX;
+                                else at least SW_ERROR_MIN_PX */
     const char *output_path; /* .png or .exr (with depth); NULL = render only. Replaced whole or
                                 left as it was (a full disk is SW_ERR_IO); a device or FIFO is
                                 written in place, a symbolic link written through */
@@ -348,7 +353,8 @@ typedef struct sw_frame_stats {
  * thread only; the scene may be used by other threads meanwhile. desc is read during the call
  * only. stats may be NULL; it is written on success only.
  * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc; a thread other than the renderer's owner; size out
- * of 0..16384; error_px negative or not finite; fovy out of (0, 180); a non-finite or degenerate
+ * of 0..16384; error_px below SW_ERROR_MIN_PX or not finite; fovy out of [SW_FOVY_MIN_DEG, 180);
+ * a non-finite or degenerate
  * camera), SW_ERR_STALE_HANDLE (renderer or desc->scene), SW_ERR_UNSUPPORTED (output extension
  * not .png or .exr), SW_ERR_IO, SW_ERR_GL, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY,
  * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */

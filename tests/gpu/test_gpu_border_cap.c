@@ -1,0 +1,59 @@
+/* The fat border's sampling is bounded by the view (issue 19 item 1): a loop whose grid cells are
+ * tiny (a face refined deep under a narrow field of view: fovy 1e-9 grew memory at ~600 MB/s in
+ * sw__gpu_fat_border) takes at most max(2 n, 64 (width + height)) samples, the fallback counted
+ * in mesh.border_capped; a loop at ordinary cells is sampled as before, uncounted.
+ * Scene: the unit square z = 0 (bilinear), a circular loop of 10,000 vertices in it, seen from
+ * above at 160 x 120. With cells of 1e-9 the loop asked for 10,000 x 4,096 = 4.1e7 samples
+ * (~7 GB of samples and ribbon vertices). Planted fault (the budget check in
+ * sw__gpu_fat_border removed): 1.6e8 ribbon vertices, and the vertex check fails (or the
+ * allocation does). No GL needed. */
+#include "sw_gpu_internal.h"
+#include "test_check.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+enum { N_LOOP = 10000, W = 160, H = 120 };
+
+int main(void)
+{
+    const double knots[4] = {0, 0, 1, 1};
+    const double cpw[16] = {0, 0, 0, 1, 1, 0, 0, 1, 0, 1, 0, 1, 1, 1, 0, 1};
+    const sw_sg_surface srf = {1, 1, 2, 2, knots, knots, cpw};
+    const double world[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    const sw_gpu_camera cam = {{0.5, 0.5, 2.0}, {0.5, 0.5, 0.0}, {0, 1, 0}, 40.0};
+    sw__gpu_view v;
+    sw_status st = {0};
+    if (sw__gpu_view_init(&v, &cam, W, H, 0.01, &st) != SW_OK) {
+        printf("view: %s\n", st.message);
+        return 1;
+    }
+    double *uv = malloc(2 * N_LOOP * sizeof *uv);
+    if (!uv)
+        return 1;
+    for (int i = 0; i < N_LOOP; ++i) {
+        const double a = 2.0 * M_PI * i / N_LOOP;
+        uv[2 * i] = 0.5 + 0.3 * cos(a);
+        uv[2 * i + 1] = 0.5 + 0.3 * sin(a);
+    }
+    const size_t budget = 64u * (W + H) > 2u * N_LOOP ? 64u * (W + H) : 2u * N_LOOP;
+    const double cells[2] = {0.01, 1e-9};
+    for (int k = 0; k < 2; ++k) {
+        sw__gpu_mesh mesh = {0};
+        sw_result r = sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, cells[k], cells[k], 1.0,
+                                         NULL, &mesh, &st);
+        printf("cells %g: %s, %zu ribbon vertices, border_capped %llu\n", cells[k],
+               sw_result_str(r), mesh.n_v, (unsigned long long)mesh.border_capped);
+        CHECK(r == SW_OK, "cells %g: %s", cells[k], st.message);
+        /* each kept sample makes one quad (4 vertices); at most n + budget samples */
+        CHECK(mesh.n_v <= 4 * (N_LOOP + budget), "cells %g: %zu vertices over the budget", cells[k],
+              mesh.n_v);
+        CHECK(mesh.n_v > 0, "cells %g: no ribbon", cells[k]);
+        CHECK(mesh.border_capped == (k == 1), "cells %g: border_capped %llu", cells[k],
+              (unsigned long long)mesh.border_capped);
+        sw__gpu_mesh_free(&mesh);
+    }
+    free(uv);
+    printf("%s\n", g_failures ? "FAILED" : "passed");
+    return g_failures != 0;
+}

@@ -1,0 +1,97 @@
+/* scaled_iges IN.brep|IN.step|IN.iges OUT.iges DIAGONAL [brep]
+ *
+ * Writes a copy of a part as IGES, uniformly scaled about its bounding-box centre so that the box
+ * diagonal becomes DIAGONAL, the way a unit conversion does it (BRepBuilderAPI_Transform with a
+ * gp_Trsf scale, copy = true; IGESControl_Writer turns the trims into B-spline pcurves). Issue 19:
+ * such copies of real parts made the first frame's trim flattening recurse at a tolerance of
+ * 1e-17; tests/cli/test_scaled_iges.sh renders them. A fifth argument `brep` writes the faces as
+ * an IGES B-rep (write.iges.brep.mode 1) instead of trimmed surfaces. Exit status 0 on success. */
+#include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
+#include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <Bnd_Box.hxx>
+#include <IGESControl_Controller.hxx>
+#include <IGESControl_Reader.hxx>
+#include <IGESControl_Writer.hxx>
+#include <STEPControl_Reader.hxx>
+#include <Standard_Failure.hxx>
+#include <TopoDS_Shape.hxx>
+#include <gp_Trsf.hxx>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+static bool ends_with(const std::string &s, const char *suffix)
+{
+    std::string x(suffix);
+    return s.size() >= x.size() && s.compare(s.size() - x.size(), x.size(), x) == 0;
+}
+
+static bool read_shape(const std::string &path, TopoDS_Shape &shape)
+{
+    if (ends_with(path, ".brep")) {
+        BRep_Builder b;
+        return BRepTools::Read(shape, path.c_str(), b);
+    }
+    if (ends_with(path, ".step") || ends_with(path, ".stp")) {
+        STEPControl_Reader r;
+        if (r.ReadFile(path.c_str()) != IFSelect_RetDone || r.TransferRoots() == 0)
+            return false;
+        shape = r.OneShape();
+        return !shape.IsNull();
+    }
+    IGESControl_Reader r;
+    if (r.ReadFile(path.c_str()) != IFSelect_RetDone || r.TransferRoots() == 0)
+        return false;
+    shape = r.OneShape();
+    return !shape.IsNull();
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 4 && !(argc == 5 && std::string(argv[4]) == "brep")) {
+        std::fprintf(stderr, "usage: %s IN OUT.iges DIAGONAL [brep]\n", argv[0]);
+        return 2;
+    }
+    const double target = std::strtod(argv[3], nullptr);
+    if (!(target > 0.0) || !std::isfinite(target)) {
+        std::fprintf(stderr, "scaled_iges: bad diagonal %s\n", argv[3]);
+        return 2;
+    }
+    try {
+        TopoDS_Shape shape;
+        if (!read_shape(argv[1], shape)) {
+            std::fprintf(stderr, "scaled_iges: cannot read %s\n", argv[1]);
+            return 1;
+        }
+        Bnd_Box box;
+        BRepBndLib::Add(shape, box);
+        double x0, y0, z0, x1, y1, z1;
+        box.Get(x0, y0, z0, x1, y1, z1);
+        const double diag =
+            std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
+        gp_Trsf t;
+        t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), target / diag);
+        BRepBuilderAPI_Transform xf(shape, t, Standard_True);
+        if (!xf.IsDone()) {
+            std::fprintf(stderr, "scaled_iges: transform failed\n");
+            return 1;
+        }
+        IGESControl_Controller::Init();
+        /* the defaults a user gets: trimmed surfaces (type 144); or B-rep faces (MSBO) */
+        IGESControl_Writer w("MM", argc == 5 ? 1 : 0);
+        if (!w.AddShape(xf.Shape()) || (w.ComputeModel(), !w.Write(argv[2]))) {
+            std::fprintf(stderr, "scaled_iges: cannot write %s\n", argv[2]);
+            return 1;
+        }
+        std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target,
+                    target / diag);
+    } catch (const Standard_Failure &e) {
+        std::fprintf(stderr, "scaled_iges: OCCT: %s\n", e.GetMessageString());
+        return 1;
+    }
+    return 0;
+}
