@@ -36,6 +36,11 @@
  *  - evaluated on the surface, and halved while the surface bulges more than width_px / 4 on
  *    screen from the chord to it: a face seen edge-on needs a long step (capped at 4 x width_px
  *    in object size), which on a curved face leaves the surface (fins of a motor: 1 px and more).
+ * An affine face (sw_sg_surface_affine: a plane, the most common face of a CAD model) is exact
+ * along any straight (u, v) segment and any grid, so its ribbon takes the loop's vertices only and
+ * its inner points by the straight step, with no evaluation in between; the cut at the loop and
+ * the near plane are as above (tests/gpu/test_gpu_border_affine.c: the same inner vertices as the
+ * sampled path within 1e-5 px).
  * Only the sample's own loop cuts the step: where another loop of the face comes closer than the
  * step (a thin bridge between a hole and the outer boundary), the ribbon may still reach up to
  * width_px beyond the face.
@@ -79,9 +84,11 @@ static void eval_point(const sw_sg_surface *srf, const double world[12], const d
     n[0] = du[1] * dv[2] - du[2] * dv[1];
     n[1] = du[2] * dv[0] - du[0] * dv[2];
     n[2] = du[0] * dv[1] - du[1] * dv[0];
-    double in[3];
+    /* du, dv are w^2 S_u, w^2 S_v; `in` is the true derivative along in_uv, so that a length h
+     * along `in` (inward_length) is the step h along in_uv in (u, v) that inner_point takes */
+    double in[3], w2 = h[3] * h[3];
     for (int k = 0; k < 3; ++k)
-        in[k] = du[k] * in_uv[0] + dv[k] * in_uv[1];
+        in[k] = (du[k] * in_uv[0] + dv[k] * in_uv[1]) / w2;
     out->uv[0] = u;
     out->uv[1] = v;
     out->in_uv[0] = in_uv[0];
@@ -342,7 +349,44 @@ typedef struct ribbon_ctx {
     const loop_grid *grid;
     double side, width_px;
     const double *st_box; /* trim lookup's rectangle, or NULL (st = 0) */
+    int affine;           /* the surface is affine in (u, v): su, sv its world derivatives */
+    double su[3], sv[3];
 } ribbon_ctx;
+
+/* An affine surface (a plane, as CAD files store most faces) needs no evaluation along the step:
+ * its world derivatives once per ribbon. */
+static void ribbon_affine(ribbon_ctx *c)
+{
+    double o[3], du[3], dv[3];
+    c->affine = sw_sg_surface_affine(c->srf, o, du, dv);
+    if (!c->affine)
+        return;
+    for (int r = 0; r < 3; ++r) {
+        const double *m = c->world + 4 * r;
+        c->su[r] = m[0] * du[0] + m[1] * du[1] + m[2] * du[2];
+        c->sv[r] = m[0] * dv[0] + m[1] * dv[1] + m[2] * dv[2];
+    }
+}
+
+/* The inner point on an affine surface: exact along the step, so no bulge to halve for; halved
+ * only while it or the chord's middle is behind the near plane, as for curved ones. */
+static double inner_point_affine(const ribbon_ctx *c, const border_point *e, const double r_uv[2],
+                                 double s, double out[3])
+{
+    enum { MAX_HALVINGS = 12 };
+    for (int k = 0; k < MAX_HALVINGS; ++k, s *= 0.5) {
+        double q[3], m[3], sq[2], sm[2];
+        for (int i = 0; i < 3; ++i) {
+            q[i] = e->p[i] + s * (c->su[i] * r_uv[0] + c->sv[i] * r_uv[1]);
+            m[i] = 0.5 * (e->p[i] + q[i]);
+        }
+        if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm)) {
+            memcpy(out, q, sizeof q);
+            return s;
+        }
+    }
+    return 0.0;
+}
 
 /* The inner point of sample e for the step direction r_uv (first-order length h along r_uv):
  * cut at the loop, on the surface, halved while the surface bulges from the chord to it.
@@ -355,6 +399,8 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const doub
     if (!(h > 0.0) || !starts_inside(e, r_uv, c->side))
         return 0.0;
     double s = ray_exit(c->grid, e->uv, r_uv, h), tol = 0.25 * c->width_px;
+    if (c->affine)
+        return inner_point_affine(c, e, r_uv, s, out);
     for (int k = 0; k < MAX_HALVINGS; ++k, s *= 0.5) {
         double uq[2] = {e->uv[0] + s * r_uv[0], e->uv[1] + s * r_uv[1]};
         double um[2] = {e->uv[0] + 0.5 * s * r_uv[0], e->uv[1] + 0.5 * s * r_uv[1]};
@@ -462,10 +508,17 @@ static void prev_direction(const double *uv, size_t n, size_t i, double out[2])
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
                              double du, double dv, double width_px, const double *st_box,
-                             sw__gpu_mesh *mesh, sw_status *status)
+                             int affine, sw__gpu_mesh *mesh, sw_status *status)
 {
     if (n < 2 || !(du > 0.0) || !(dv > 0.0))
         return SW_OK;
+    ribbon_ctx c = {v, srf, world, NULL, left_inside ? 1.0 : -1.0, width_px, st_box, 0, {0}, {0}};
+    if (affine)
+        ribbon_affine(&c);
+    /* On an affine surface a straight uv segment is a straight line on screen, drawn exactly by
+     * any grid: its ribbon needs its ends only (thinning would drop every sample between). */
+    if (c.affine)
+        du = dv = INFINITY;
     size_t m = count_samples(uv, n, du, dv);
     /* The cap from the request: the view's pixels bound the samples a ribbon can use;
      * cells shrunk by a deep refinement (fovy 1e-9 grew memory at ~600 MB/s here) are widened
@@ -503,7 +556,7 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
             memcpy(bp[at].d_next, t, sizeof t);
         }
     }
-    ribbon_ctx c = {v, srf, world, &grid, left_inside ? 1.0 : -1.0, width_px, st_box};
+    c.grid = &grid;
     emit_ribbon(&c, bp, thin_samples(v, bp, m, 0.25 * width_px), mesh);
     loop_grid_free(&grid);
     sw__free(bp);

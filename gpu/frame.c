@@ -29,6 +29,11 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on)
     ctx->crack_fill_off = !on;
 }
 
+void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on)
+{
+    ctx->border_affine_off = !on;
+}
+
 void sw__gpu_set_eval_mode(sw_gpu_context *ctx, sw__gpu_eval_mode mode)
 {
     ctx->eval_mode = (int32_t)mode;

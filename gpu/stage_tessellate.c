@@ -267,7 +267,8 @@ sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *u
      * shading's uv (u_uv_map) does */
     const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
     sw_result r = sw__gpu_fat_border(&t->env->view, &srf, o->world, uv, n, left_inside, cell[0],
-                                     cell[1], 2.0 * t->env->eps_px, st_rect, &g->mesh, status);
+                                     cell[1], 2.0 * t->env->eps_px, st_rect,
+                                     !t->env->ctx->border_affine_off, &g->mesh, status);
     /* sampled coarser than its cells (the view's sample budget): it may leave a crack open */
     t->st->borders_capped += g->mesh.border_capped - capped;
     t->st->bound_exceeded += g->mesh.border_capped - capped;

@@ -142,6 +142,7 @@ struct sw_gpu_context {
     struct sw__gpu_patch_rec *recs_sorted;
     size_t cap_recs_sorted;
     int32_t crack_fill_off;        /* 1: no fat borders (§7.1) */
+    int32_t border_affine_off;     /* 1: affine faces' borders sampled as curved ones */
     sw__gpu_patch_hook patch_hook; /* debug hook, NULL = none */
     void *patch_hook_user;
     /* exact evaluation from knots and control points (eval_exact) */
@@ -260,14 +261,19 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
  * Bounded by the view: at most max(2 n, 64 (width + height)) samples (a loop 32 times around the
  * frame at one sample per pixel); a loop whose cells ask for more is sampled with (du, dv) scaled
  * up to fit, and mesh->border_capped counts it (the ribbon then follows the loop's chords at
- * coarser steps: within the budget, not the grid's cells).
+ * coarser steps: within the budget, not the grid's cells). affine: 1 lets an affine surface
+ * (sw_sg_surface_affine, a plane) take the ribbon from its loop's vertices and straight inner
+ * steps, with no evaluation between (exact there); 0 samples it as any other.
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
                              double du, double dv, double width_px, const double *st_box,
-                             sw__gpu_mesh *mesh, sw_status *status);
+                             int affine, sw__gpu_mesh *mesh, sw_status *status);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
+/* Fat borders of affine faces by their loop's vertices (default) or sampled as curved ones: the
+ * A/B of bench_prepare and the test that both cover alike. */
+void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on);
 
 /* ---- trim textures (trim_texture.c) --------------------------------------------------------- */
 /* Renders loops already in the clip space of one atlas page into layer `layer` of the R8 array

@@ -24,6 +24,7 @@
 #include "sw_sg_geom.h"
 
 #include <assert.h>
+#include <math.h>
 #include <string.h>
 
 #define SW__P1 (SW_SG_MAX_DEGREE + 1)
@@ -214,6 +215,52 @@ void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[
         h[4 + d] = a[1][0][d];
         h[8 + d] = a[0][1][d];
     }
+}
+
+/* The Greville abscissa of pole i: the mean of its degree interior knots. */
+static double greville(const double *knots, int32_t degree, int32_t i)
+{
+    double sum = 0.0;
+    for (int32_t k = 1; k <= degree; ++k)
+        sum += knots[i + k];
+    return sum / degree;
+}
+
+int sw_sg_surface_affine(const sw_sg_surface *s, double origin[3], double du[3], double dv[3])
+{
+    const int32_t nu = s->n_u, nv = s->n_v;
+    const double *q = s->cpw, w = q[3];
+    if (nu < 2 || nv < 2 || !(w > 0.0))
+        return 0;
+    const double gu0 = greville(s->knots_u, s->deg_u, 0), gv0 = greville(s->knots_v, s->deg_v, 0);
+    const double su = greville(s->knots_u, s->deg_u, nu - 1) - gu0;
+    const double sv = greville(s->knots_v, s->deg_v, nv - 1) - gv0;
+    if (!(su > 0.0) || !(sv > 0.0))
+        return 0;
+    double scale = 0.0;
+    for (int32_t i = 0; i < nu * nv; ++i) {
+        if (fabs(q[4 * i + 3] - w) > 1e-14 * w)
+            return 0;
+        for (int d = 0; d < 3; ++d)
+            scale = fmax(scale, fabs(q[4 * i + d] / q[4 * i + 3]));
+    }
+    const double *p00 = q, *pu = q + 4 * (nu - 1), *pv = q + 4 * (size_t)(nv - 1) * (size_t)nu;
+    for (int d = 0; d < 3; ++d) {
+        du[d] = (pu[d] - p00[d]) / (w * su);
+        dv[d] = (pv[d] - p00[d]) / (w * sv);
+        origin[d] = p00[d] / w - gu0 * du[d] - gv0 * dv[d];
+    }
+    const double tol = 1e-12 * scale;
+    for (int32_t j = 0; j < nv; ++j) {
+        const double gv = greville(s->knots_v, s->deg_v, j);
+        for (int32_t i = 0; i < nu; ++i) {
+            const double gu = greville(s->knots_u, s->deg_u, i), *p = q + 4 * ((size_t)j * nu + i);
+            for (int d = 0; d < 3; ++d)
+                if (fabs(p[d] / p[3] - (origin[d] + gu * du[d] + gv * dv[d])) > tol)
+                    return 0;
+        }
+    }
+    return 1;
 }
 
 void sw_sg_surface_eval_d2(const sw_sg_surface *s, double u, double v, sw_sg_surface_d2 *out)

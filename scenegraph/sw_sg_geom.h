@@ -102,6 +102,11 @@ void sw_sg_surface_eval(const sw_sg_surface *s, double u, double v, double p[3])
 void sw_sg_surface_eval_d2(const sw_sg_surface *s, double u, double v, sw_sg_surface_d2 *out);
 /* Homogeneous point and first derivatives: h[0..3] = S^w, h[4..7] = dS^w/du, h[8..11] = dS^w/dv. */
 void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[12]);
+/* 1 when the surface is an affine map of its parameters, S(u, v) = origin + u du + v dv, to
+ * within 1e-12 of its control net's magnitude (planes, as CAD files store them, at any degree):
+ * equal weights and every pole on the affine function at its Greville abscissae, which a B-spline
+ * reproduces exactly (linear precision). Then fills origin, du, dv; else returns 0. */
+int sw_sg_surface_affine(const sw_sg_surface *s, double origin[3], double du[3], double dv[3]);
 
 /* ---- knot insertion and Bézier extraction ---------------------------------------------------- */
 /* Number of distinct interior knots of a knot vector's domain + 1 = number of Bézier segments. */

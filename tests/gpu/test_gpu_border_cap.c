@@ -38,10 +38,12 @@ int main(void)
     }
     const size_t budget = 64u * (W + H) > 2u * N_LOOP ? 64u * (W + H) : 2u * N_LOOP;
     const double cells[2] = {0.01, 1e-9};
+    /* affine 0: the plane sampled at its cells as a curved face is (its affine path would take
+     * the loop's vertices only, and never reach the cap) */
     for (int k = 0; k < 2; ++k) {
         sw__gpu_mesh mesh = {0};
         sw_result r = sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, cells[k], cells[k], 1.0,
-                                         NULL, &mesh, &st);
+                                         NULL, 0, &mesh, &st);
         printf("cells %g: %s, %zu ribbon vertices, border_capped %llu\n", cells[k],
                sw_result_str(r), mesh.n_v, (unsigned long long)mesh.border_capped);
         CHECK(r == SW_OK, "cells %g: %s", cells[k], st.message);
