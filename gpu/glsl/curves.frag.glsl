@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+// Curved triangles and their anti-aliasing (Santana §3.2, §4; Loop & Blinn 2005 for cubics),
+// drawn into a float coverage target in three modes:
+//  0 stencil parity: fan triangles pass, curved triangles pass only between chord and curve
+//    (s_chord F < 0), each toggling the stencil (GL_INVERT): odd = inside at the pixel centre;
+//  1 cover: +1 where the stencil is odd;
+//  2 edge correction, drawn once over stencil-odd pixels (u_h = 1) and once over the others
+//    (u_h = 0): adds (coverage of the pixel square by the piece's inside half-plane) - u_h, so a
+//    pixel near one edge ends with exactly that coverage and one far from every edge keeps 0 or 1.
+// The coverage (§4 eq. 3-6) uses the signed distance d = F / |grad F| with grad F from the chain
+// rule over dFdx / dFdy of k, l, m (exact: they are affine), as eq. 3 does for its conic. Where
+// §4 maps d linearly to coverage (eq. 4, e = 1/2 - d), which is exact only for axis-aligned
+// edges (up to 0.043 = 11/255 off at 45 degrees), we take the exact area of the pixel square on
+// the inside of the line through the linearization.
+#version 450 core
+in vec3 v_klm;
+in vec2 v_cut;
+flat in vec3 v_flags;
+uniform int u_mode;
+uniform float u_h;
+uniform int u_fault; // tests: 1 plants a sign error in the implicit form (k^n + l m)
+layout(location = 0) out vec4 o_cov;
+
+// Area of the unit pixel square centred at the origin where dot(n, q) <= t, n a unit vector.
+float halfplane_coverage(vec2 n, float t)
+{
+    float a = max(abs(n.x), abs(n.y)), b = min(abs(n.x), abs(n.y));
+    float lo = 0.5 * (a - b), hi = 0.5 * (a + b), at = abs(t), c;
+    if (at >= hi)
+        c = 1.0;
+    else if (at <= lo)
+        c = 0.5 + at / a;
+    else
+        c = 1.0 - (hi - at) * (hi - at) / (2.0 * a * b);
+    return t >= 0.0 ? c : 1.0 - c;
+}
+
+void main()
+{
+    vec3 f = v_klm, fx = dFdx(f), fy = dFdy(f);
+    int kind = int(round(v_flags.x));
+    float lm = u_fault == 1 ? -f.y * f.z : f.y * f.z;
+    float F;
+    vec2 g, gk = vec2(fx.x, fy.x), gl = vec2(fx.y, fy.y), gm = vec2(fx.z, fy.z);
+    float sg = u_fault == 1 ? -1.0 : 1.0;
+    if (kind <= 0) {
+        F = f.x;
+        g = gk;
+    } else if (kind == 1) {
+        F = f.x * f.x - lm;
+        g = 2.0 * f.x * gk - sg * (f.z * gl + f.y * gm);
+    } else {
+        F = f.x * f.x * f.x - lm;
+        g = 3.0 * f.x * f.x * gk - sg * (f.z * gl + f.y * gm);
+    }
+    if (u_mode == 0) {
+        if (kind >= 1 && v_flags.y * F >= 0.0)
+            discard;
+        o_cov = vec4(0.0);
+        return;
+    }
+    if (u_mode == 1) {
+        o_cov = vec4(1.0);
+        return;
+    }
+    // the piece's own slab: the cut lines at its ends are normal to its end tangents, so smooth
+    // joins split the plane between neighbours without overlap or gap
+    if (v_cut.x < 0.0 || v_cut.y <= 0.0)
+        discard;
+    float Fi = v_flags.z * F;
+    vec2 gi = v_flags.z * g;
+    float len = length(gi);
+    if (!(len > 0.0))
+        discard;
+    float d = Fi / len; // pixels, > 0 outside
+    if (abs(d) >= 0.75)  // beyond the square's half diagonal: full or empty, as the stencil says
+        discard;
+    o_cov = vec4(halfplane_coverage(gi / len, -d) - u_h);
+}
