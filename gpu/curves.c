@@ -4,7 +4,8 @@
  * Per draw, on the CPU in double: the view's pixel positions of three triangle sets — the stencil
  * fan over the pieces' end points plus each curved piece's control hull (Santana §3's curved
  * triangles), a cover rectangle, and each piece's band (its control hull grown by 1.5 px, which
- * holds every pixel whose square the piece touches) — with k, l, m evaluated at each vertex. Then
+ * holds every pixel whose square the piece touches) — with the piece's local coordinates at each
+ * vertex and its implicit form expanded in them (local_form). Then
  * four passes: stencil parity, cover, edge corrections (glsl/curves.frag.glsl) into a float
  * coverage target, and the composite over the caller's framebuffer
  * (glsl/curves_composite.frag.glsl). The geometry depends on the view (the band's width is in
@@ -25,19 +26,89 @@
 
 typedef struct vtx {
     float pos[2];
-    float klm[3];
+    float uv[2]; /* the piece's local coordinates: (model - centre) / size */
     float cut[2];
     float flags[3];
+    float coef[12]; /* F(u, v): 1, u, v, u^2, u v, v^2, u^3, u^2 v, u v^2, v^3 (two unused) */
 } vtx;
+
+/* A piece's implicit form expanded into a bivariate polynomial in local coordinates, in double
+ * precision, then scaled so that |grad F| = 1 at the local origin. Why: evaluated in float as
+ * k^3 - l m, F loses everything when k, l and m are nearly constant over the piece (a short,
+ * nearly straight piece of a cubic whose inflections or double point lie far away: then k^3 and
+ * l m agree in their leading digits): we measured distance errors of 3 px at zoom 1 that way.
+ * Expanded around the piece, the terms are of the size of F's variation across the piece. */
+typedef struct local_form {
+    double centre[2], size;
+    double c[10];
+} local_form;
+
+typedef struct bipoly {
+    double a[4][4]; /* a[i][j] u^i v^j, i + j <= 3 */
+} bipoly;
+
+static bipoly bp_mul(const bipoly *x, const bipoly *y)
+{
+    bipoly r;
+    memset(&r, 0, sizeof r);
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; i + j < 4; ++j)
+            for (int k = 0; i + k < 4; ++k)
+                for (int l = 0; j + l < 4 && i + k + j + l < 4; ++l)
+                    r.a[i + k][j + l] += x->a[i][j] * y->a[k][l];
+    return r;
+}
+
+static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
+{
+    double lo[2] = {p->cp[0][0], p->cp[0][1]}, hi[2] = {lo[0], lo[1]};
+    for (int i = 1; i < p->n_cp; ++i)
+        for (int k = 0; k < 2; ++k) {
+            lo[k] = fmin(lo[k], p->cp[i][k]);
+            hi[k] = fmax(hi[k], p->cp[i][k]);
+        }
+    f->centre[0] = 0.5 * (lo[0] + hi[0]);
+    f->centre[1] = 0.5 * (lo[1] + hi[1]);
+    f->size = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), 1e-300);
+    bipoly k[3];
+    for (int j = 0; j < 3; ++j) {
+        memset(&k[j], 0, sizeof k[j]);
+        k[j].a[0][0] = p->klm[j][0] * f->centre[0] + p->klm[j][1] * f->centre[1] + p->klm[j][2];
+        k[j].a[1][0] = p->klm[j][0] * f->size;
+        k[j].a[0][1] = p->klm[j][1] * f->size;
+    }
+    bipoly F;
+    if (p->kind == SW__CURVES_LINE) {
+        F = k[0];
+    } else {
+        F = bp_mul(&k[0], &k[0]);
+        if (p->kind == SW__CURVES_CUBIC)
+            F = bp_mul(&F, &k[0]);
+        bipoly lm = bp_mul(&k[1], &k[2]);
+        /* the planted fault of the tests: a sign error in the implicit form, k^n + l m */
+        double sg = fault == 1 ? 1.0 : -1.0;
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; i + j < 4; ++j)
+                F.a[i][j] += sg * lm.a[i][j];
+    }
+    double g = hypot(F.a[1][0], F.a[0][1]);
+    if (!(g > 0.0))
+        g = 1.0;
+    static const int idx[10][2] = {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1, 1},
+                                   {0, 2}, {3, 0}, {2, 1}, {1, 2}, {0, 3}};
+    for (int t = 0; t < 10; ++t)
+        f->c[t] = F.a[idx[t][0]][idx[t][1]] / g;
+}
 
 struct sw__curves_renderer {
     GLuint prog, prog_comp, vao, vbo, fbo, tex, rb;
     int32_t fbo_w, fbo_h;
-    GLint loc_size, loc_mode, loc_h, loc_fault;
+    GLint loc_size, loc_mode, loc_h;
     GLint loc_c_size, loc_c_cov, loc_c_color, loc_c_origin, loc_c_ss;
     int fault, vbaa;
     vtx *v;
     size_t n, cap;
+    double clip[4]; /* x0, y0, x1, y1 (Sutherland-Hodgman order: min x, min y, max x, max y) */
 };
 
 static sw_result compile(GLenum type, const char *src, GLuint *out, sw_status *status)
@@ -111,7 +182,6 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
     r->loc_size = glGetUniformLocation(r->prog, "u_size");
     r->loc_mode = glGetUniformLocation(r->prog, "u_mode");
     r->loc_h = glGetUniformLocation(r->prog, "u_h");
-    r->loc_fault = glGetUniformLocation(r->prog, "u_fault");
     r->loc_c_size = glGetUniformLocation(r->prog_comp, "u_size");
     r->loc_c_cov = glGetUniformLocation(r->prog_comp, "u_cov");
     r->loc_c_color = glGetUniformLocation(r->prog_comp, "u_color");
@@ -121,14 +191,15 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
     glGenBuffers(1, &r->vbo);
     glBindVertexArray(r->vao);
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo);
-    glEnableVertexAttribArray(0);
-    glEnableVertexAttribArray(1);
-    glEnableVertexAttribArray(2);
-    glEnableVertexAttribArray(3);
+    for (GLuint a = 0; a < 7; ++a)
+        glEnableVertexAttribArray(a);
     glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, pos));
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, klm));
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, uv));
     glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, cut));
     glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, flags));
+    for (GLuint a = 0; a < 3; ++a)
+        glVertexAttribPointer(4 + a, 4, GL_FLOAT, GL_FALSE, sizeof(vtx),
+                              (void *)(offsetof(vtx, coef) + 16 * a));
     glBindVertexArray(0);
     res = gl_check(status, "renderer set-up");
     if (res != SW_OK) {
@@ -220,22 +291,34 @@ static void apply(const double m[6], const double p[2], double out[2])
     out[1] = m[3] * p[0] + m[4] * p[1] + m[5];
 }
 
-/* A vertex at pixel position q for piece p (NULL: a fan / cover vertex). */
-static void set_vtx(vtx *v, const xform *x, const sw__curves_piece *p, const double q[2],
-                    float kind)
+void sw__curves_piece_local_form(const sw__curves_piece *p, double centre[2], double *size,
+                                 double c[10])
 {
+    local_form f;
+    local_form_make(p, 0, &f);
+    centre[0] = f.centre[0];
+    centre[1] = f.centre[1];
+    *size = f.size;
+    memcpy(c, f.c, sizeof f.c);
+}
+
+/* A vertex at pixel position q for piece p with local form f (NULL: a fan / cover vertex). */
+static void set_vtx(vtx *v, const xform *x, const sw__curves_piece *p, const local_form *f,
+                    const double q[2], float kind)
+{
+    memset(v, 0, sizeof *v);
     v->pos[0] = (float)q[0];
     v->pos[1] = (float)q[1];
-    memset(v->klm, 0, sizeof v->klm);
-    memset(v->cut, 0, sizeof v->cut);
     v->flags[0] = kind;
     v->flags[1] = v->flags[2] = 1.0f;
     if (!p)
         return;
     double m[2];
     apply(x->inv, q, m);
-    for (int j = 0; j < 3; ++j)
-        v->klm[j] = (float)(p->klm[j][0] * m[0] + p->klm[j][1] * m[1] + p->klm[j][2]);
+    v->uv[0] = (float)((m[0] - f->centre[0]) / f->size);
+    v->uv[1] = (float)((m[1] - f->centre[1]) / f->size);
+    for (int t = 0; t < 10; ++t)
+        v->coef[t] = (float)f->c[t];
     /* cut lines in pixel space: the end tangents mapped by the view's linear part */
     double a[2], b[2];
     apply(x->m, p->cp[0], a);
@@ -282,19 +365,51 @@ static int hull(double (*pts)[2], int n, double (*out)[2])
     return k > 1 ? k - 1 : k;
 }
 
-/* Fan triangles over a convex polygon, carrying piece p's functionals. */
-static int emit_polygon(sw__curves_renderer *r, const xform *x, const sw__curves_piece *p,
-                        const double (*poly)[2], int n, float kind)
+/* Clips a convex polygon (n <= 24) to the rectangle [x0, x1] x [y0, y1] (Sutherland-Hodgman);
+ * returns the new size (<= n + 4). Far zooms make pieces 1e5 px wide: clipped here, in double,
+ * the rasterizer gets triangles of the target's size and interpolates over a short range. */
+static int clip_rect(const double (*in)[2], int n, const double rect[4], double (*out)[2])
 {
+    double a[32][2], b[32][2];
+    memcpy(a, in, sizeof(double) * 2 * (size_t)n);
+    for (int side = 0; side < 4 && n > 0; ++side) {
+        int axis = side & 1, upper = side >> 1, m = 0;
+        double lim = rect[side];
+        for (int i = 0; i < n; ++i) {
+            const double *p = a[i], *q = a[(i + 1) % n];
+            int pin = upper ? p[axis] <= lim : p[axis] >= lim;
+            int qin = upper ? q[axis] <= lim : q[axis] >= lim;
+            if (pin)
+                memcpy(b[m++], p, sizeof b[0]);
+            if (pin != qin) {
+                double t = (lim - p[axis]) / (q[axis] - p[axis]);
+                b[m][axis] = lim;
+                b[m][1 - axis] = p[1 - axis] + t * (q[1 - axis] - p[1 - axis]);
+                m++;
+            }
+        }
+        memcpy(a, b, sizeof(double) * 2 * (size_t)m);
+        n = m;
+    }
+    memcpy(out, a, sizeof(double) * 2 * (size_t)n);
+    return n;
+}
+
+/* Fan triangles over a convex polygon clipped to r->clip, carrying piece p's local form. */
+static int emit_polygon(sw__curves_renderer *r, const xform *x, const sw__curves_piece *p,
+                        const local_form *f, const double (*poly_in)[2], int n_in, float kind)
+{
+    double poly[32][2];
+    int n = clip_rect(poly_in, n_in, r->clip, poly);
     if (n < 3)
         return 1;
     vtx *v = push(r, 3 * (size_t)(n - 2));
     if (!v)
         return 0;
     for (int i = 1; i + 1 < n; ++i) {
-        set_vtx(v++, x, p, poly[0], kind);
-        set_vtx(v++, x, p, poly[i], kind);
-        set_vtx(v++, x, p, poly[i + 1], kind);
+        set_vtx(v++, x, p, f, poly[0], kind);
+        set_vtx(v++, x, p, f, poly[i], kind);
+        set_vtx(v++, x, p, f, poly[i + 1], kind);
     }
     return 1;
 }
@@ -357,6 +472,10 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
 
     /* geometry: [0, n_stencil) fan + hulls, then the cover quad, then the bands */
     r->n = 0;
+    r->clip[0] = -2.0;
+    r->clip[1] = -2.0;
+    r->clip[2] = tw + 2.0;
+    r->clip[3] = th + 2.0;
     double anchor[2];
     apply(x.m, shape->pieces[0].cp[0], anchor);
     for (size_t i = 0; i < shape->n_pieces; ++i) {
@@ -365,18 +484,18 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
         memcpy(tri[0], anchor, sizeof tri[0]);
         apply(x.m, p->cp[0], tri[1]);
         apply(x.m, p->cp[p->n_cp - 1], tri[2]);
-        vtx *v = push(r, 3);
-        if (!v)
+        /* a clockwise triangle is still convex: the clipper keeps either orientation */
+        if (!emit_polygon(r, &x, NULL, NULL, (const double(*)[2])tri, 3, -1.0f))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
-        for (int k = 0; k < 3; ++k)
-            set_vtx(v + k, &x, NULL, tri[k], -1.0f);
         if (p->kind == SW__CURVES_LINE)
             continue;
+        local_form lf;
+        local_form_make(p, r->fault, &lf);
         double pts[4][2], h[8][2];
         for (int k = 0; k < p->n_cp; ++k)
             apply(x.m, p->cp[k], pts[k]);
         int nh = hull(pts, p->n_cp, h);
-        if (!emit_polygon(r, &x, p, (const double(*)[2])h, nh, (float)p->kind))
+        if (!emit_polygon(r, &x, p, &lf, (const double(*)[2])h, nh, (float)p->kind))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     }
     size_t n_stencil = r->n;
@@ -385,7 +504,7 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
                           {(x1 - ox) * ss, (y0 - oy) * ss},
                           {(x1 - ox) * ss, (y1 - oy) * ss},
                           {(x0 - ox) * ss, (y1 - oy) * ss}};
-        if (!emit_polygon(r, &x, NULL, (const double(*)[2])q, 4, -1.0f))
+        if (!emit_polygon(r, &x, NULL, NULL, (const double(*)[2])q, 4, -1.0f))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     }
     size_t n_cover_end = r->n;
@@ -403,7 +522,9 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
             }
         }
         int nh = hull(pts, n, h);
-        if (!emit_polygon(r, &x, p, (const double(*)[2])h, nh, (float)p->kind))
+        local_form lf;
+        local_form_make(p, r->fault, &lf);
+        if (!emit_polygon(r, &x, p, &lf, (const double(*)[2])h, nh, (float)p->kind))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     }
     size_t n_all = r->n;
@@ -428,8 +549,7 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     glClear(GL_COLOR_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     glUseProgram(r->prog);
     glUniform2f(r->loc_size, (float)tw, (float)th);
-    glUniform1i(r->loc_fault, r->fault);
-
+    
     /* 1: parity into the stencil's low bit */
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glEnable(GL_STENCIL_TEST);
@@ -476,8 +596,11 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
         /* the box in target pixels, drawn with the same vertex layout */
         r->n = 0;
         xform id = {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}};
+        r->clip[0] = r->clip[1] = -2.0;
+        r->clip[2] = view->width + 2.0;
+        r->clip[3] = view->height + 2.0;
         double q[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-        if (!emit_polygon(r, &id, NULL, (const double(*)[2])q, 4, -1.0f))
+        if (!emit_polygon(r, &id, NULL, NULL, (const double(*)[2])q, 4, -1.0f))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
         glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(r->n * sizeof(vtx)), r->v, GL_STREAM_DRAW);
         glDrawArrays(GL_TRIANGLES, 0, (GLsizei)r->n);

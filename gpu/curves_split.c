@@ -443,7 +443,7 @@ static cubic_class cubic_classify(const double q[4][2], double roots[2], int *n_
     *n_roots = 0;
     if (s3 <= 1e-12 * sc)
         return C_QUADRATIC;
-    if (fabs(x23) <= 1e-12 * sc * sc) {
+    if (fabs(x23) <= 1e-15 * sc * sc) { /* else a far root, which lin() keeps well scaled */
         /* c2 parallel to c3: one inflection at infinity besides t = -x12 / (3 x13) */
         roots[0] = -x12 / (3.0 * x13);
         *n_roots = 1;
@@ -470,15 +470,159 @@ static cubic_class cubic_classify(const double q[4][2], double roots[2], int *n_
     double pi = sigma * sigma + (v[0] * c[3][0] + v[1] * c[3][1]) / (s3 * s3);
     double d = sigma * sigma - 4.0 * pi;
     double sq = sqrt(fmax(d, 0.0));
-    roots[0] = 0.5 * (sigma - sq);
-    roots[1] = 0.5 * (sigma + sq);
+    double qq = 0.5 * (sigma + copysign(sq, sigma)); /* stable: the far root, then pi / it */
+    roots[0] = qq;
+    roots[1] = qq != 0.0 ? pi / qq : 0.0;
     *n_roots = 2;
     return C_LOOP;
 }
 
-static void emit_cubic_piece(builder *b, const double qm[4][2]);
+/* Real roots of d0 + d1 t + d2 t^2 + d3 t^3 (degree found from the coefficients), by bisection
+ * between the critical points within the Cauchy bound. */
+static int real_roots3(const double d[4], double roots[3])
+{
+    double mx = fmax(fmax(fabs(d[0]), fabs(d[1])), fmax(fabs(d[2]), fabs(d[3])));
+    int n = 3;
+    while (n > 0 && fabs(d[n]) <= 1e-14 * mx)
+        n--;
+    if (n == 0)
+        return 0;
+    if (n == 1) {
+        roots[0] = -d[0] / d[1];
+        return 1;
+    }
+    double bound = 1.0;
+    for (int i = 0; i < n; ++i)
+        bound = fmax(bound, 1.0 + fabs(d[i] / d[n]));
+    double cuts[4] = {-bound, 0, 0, bound};
+    int nc = 1;
+    if (n == 2) {
+        cuts[nc++] = -d[1] / (2 * d[2]);
+    } else {
+        double a = 3 * d[3], bb = 2 * d[2], c = d[1], disc = bb * bb - 4 * a * c;
+        if (disc > 0) {
+            double q = -0.5 * (bb + copysign(sqrt(disc), bb));
+            double r0 = q / a, r1 = q != 0 ? c / q : r0;
+            cuts[nc++] = fmin(r0, r1);
+            cuts[nc++] = fmax(r0, r1);
+        }
+    }
+    cuts[nc++] = bound;
+    int k = 0;
+    for (int i = 0; i + 1 < nc; ++i) {
+        double lo = fmax(cuts[i], -bound), hi = fmin(cuts[i + 1], bound);
+        double flo = ((d[3] * lo + d[2]) * lo + d[1]) * lo + d[0];
+        double fhi = ((d[3] * hi + d[2]) * hi + d[1]) * hi + d[0];
+        if (!(lo < hi) || (flo > 0) == (fhi > 0))
+            continue;
+        for (int it = 0; it < 200 && lo < hi; ++it) {
+            double mid = 0.5 * (lo + hi);
+            if (mid <= lo || mid >= hi)
+                break;
+            double fm = ((d[3] * mid + d[2]) * mid + d[1]) * mid + d[0];
+            if ((fm > 0) == (flo > 0))
+                lo = mid;
+            else
+                hi = mid;
+        }
+        roots[k++] = 0.5 * (lo + hi);
+    }
+    return k;
+}
 
-static void emit_cubic_rec(builder *b, const double q[4][2], int depth)
+/* Whether another branch of the piece's implicit cubic enters its control hull grown by a
+ * quarter of its size (which holds the stencil triangles and, but for tiny pieces, the band).
+ * The implicit cubic's real points are C(t) for all real t (plus at most an isolated point), so
+ * this is C(t) for t outside [0, 1] crossing the grown hull's boundary more than once on either
+ * side: once is the curve leaving it past its end. Loop & Blinn 2005 only split loops at their
+ * double point, which is not enough: the Hermite pieces of the degree-7 test had a branch a
+ * few pixels off inside their hull (a wedge of wrong parity). */
+static int other_branch_near(const double q[4][2])
+{
+    double lo[2] = {q[0][0], q[0][1]}, hi[2] = {lo[0], lo[1]};
+    for (int i = 1; i < 4; ++i)
+        for (int k = 0; k < 2; ++k) {
+            lo[k] = fmin(lo[k], q[i][k]);
+            hi[k] = fmax(hi[k], q[i][k]);
+        }
+    double size = fmax(hi[0] - lo[0], hi[1] - lo[1]), g = 0.25 * size;
+    /* grown hull: the control points offset by +-g (a square around each) */
+    double pts[16][2], h[20][2];
+    for (int i = 0; i < 4; ++i)
+        for (int s = 0; s < 4; ++s) {
+            pts[4 * i + s][0] = q[i][0] + ((s & 1) ? g : -g);
+            pts[4 * i + s][1] = q[i][1] + ((s & 2) ? g : -g);
+        }
+    /* convex hull by gift wrapping (16 points) */
+    int start = 0, nh = 0;
+    for (int i = 1; i < 16; ++i)
+        if (pts[i][0] < pts[start][0] || (pts[i][0] == pts[start][0] && pts[i][1] < pts[start][1]))
+            start = i;
+    int cur = start;
+    do {
+        memcpy(h[nh++], pts[cur], sizeof h[0]);
+        int nx = (cur + 1) % 16;
+        for (int i = 0; i < 16; ++i) {
+            double e1[2] = {pts[nx][0] - pts[cur][0], pts[nx][1] - pts[cur][1]};
+            double e2[2] = {pts[i][0] - pts[cur][0], pts[i][1] - pts[cur][1]};
+            double cr = cross2(e1, e2);
+            if (cr < 0 || (cr == 0 && hypot(e2[0], e2[1]) > hypot(e1[0], e1[1])))
+                nx = i;
+        }
+        cur = nx;
+    } while (cur != start && nh < 20);
+    double c[4][2], x12, x13, x23;
+    cubic_power(q, c, &x12, &x13, &x23);
+    int after = 0, before = 0;
+    for (int e = 0; e < nh; ++e) {
+        const double *a = h[e], *bq = h[(e + 1) % nh];
+        double n[2] = {bq[1] - a[1], a[0] - bq[0]};
+        double d[4] = {n[0] * (c[0][0] - a[0]) + n[1] * (c[0][1] - a[1]),
+                       n[0] * c[1][0] + n[1] * c[1][1], n[0] * c[2][0] + n[1] * c[2][1],
+                       n[0] * c[3][0] + n[1] * c[3][1]};
+        double r[3];
+        int nr = real_roots3(d, r);
+        for (int k = 0; k < nr; ++k) {
+            double t = r[k];
+            if (t >= 0.0 && t <= 1.0)
+                continue;
+            double p[2] = {((c[3][0] * t + c[2][0]) * t + c[1][0]) * t + c[0][0],
+                           ((c[3][1] * t + c[2][1]) * t + c[1][1]) * t + c[0][1]};
+            double ed[2] = {bq[0] - a[0], bq[1] - a[1]};
+            double s = ((p[0] - a[0]) * ed[0] + (p[1] - a[1]) * ed[1]) /
+                       (ed[0] * ed[0] + ed[1] * ed[1]);
+            if (s < 0.0 || s >= 1.0)
+                continue;
+            if (t > 1.0)
+                after++;
+            else
+                before++;
+        }
+    }
+    return after > 1 || before > 1;
+}
+
+/* The class and special parameters of the whole cubic, carried into its pieces (mapped to each
+ * piece's parameter) instead of classifying each piece again: a piece ending at a cusp or next
+ * to a far root is numerically near the boundary between classes, and its own classification
+ * gave k, l, m off by 1e-5 of its size (1.5 px at zoom 1000). */
+typedef struct cubic_info {
+    cubic_class cls;
+    double roots[2];
+    int n_roots;
+} cubic_info;
+
+static cubic_info info_map(const cubic_info *in, double t0, double t1)
+{
+    cubic_info o = *in;
+    for (int i = 0; i < in->n_roots; ++i)
+        o.roots[i] = (in->roots[i] - t0) / (t1 - t0);
+    return o;
+}
+
+static void emit_cubic_piece(builder *b, const double qm[4][2], const cubic_info *ci);
+
+static void emit_cubic_rec(builder *b, const double q[4][2], int depth, const cubic_info *ci)
 {
     if (b->err != SW_OK)
         return;
@@ -491,14 +635,16 @@ static void emit_cubic_rec(builder *b, const double q[4][2], int depth)
     double e[2] = {q[3][0] - q[0][0], q[3][1] - q[0][1]};
     int closed = hypot(e[0], e[1]) <= 1e-9 * (fabs(q[1][0] - q[0][0]) + fabs(q[1][1] - q[0][1]) +
                                                fabs(q[2][0] - q[0][0]) + fabs(q[2][1] - q[0][1]));
-    if ((turn > MAX_TURN || !convex || closed) && depth < MAX_SPLIT_DEPTH) {
+    if ((turn > MAX_TURN || !convex || closed || other_branch_near(q)) &&
+        depth < MAX_SPLIT_DEPTH) {
         double l[4][2], r[4][2];
         cubic_split(q, 0.5, l, r);
-        emit_cubic_rec(b, l, depth + 1);
-        emit_cubic_rec(b, r, depth + 1);
+        cubic_info li = info_map(ci, 0.0, 0.5), ri = info_map(ci, 0.5, 1.0);
+        emit_cubic_rec(b, l, depth + 1, &li);
+        emit_cubic_rec(b, r, depth + 1, &ri);
         return;
     }
-    emit_cubic_piece(b, q);
+    emit_cubic_piece(b, q, ci);
 }
 
 /* An integral cubic in model coordinates: split at its special parameters in (0, 1), then into
@@ -522,7 +668,7 @@ static void emit_cubic(builder *b, const double q[4][2])
         emit_line(b, q[0], q[3]);
         return;
     }
-    double roots[2];
+    double roots[2] = {0, 0};
     int nr;
     cubic_class cls = cubic_classify(ql, roots, &nr);
     if (cls == C_QUADRATIC) { /* a degree-elevated parabola: exact as a conic */
@@ -559,7 +705,9 @@ static void emit_cubic(builder *b, const double q[4][2])
         memcpy(prev_end, s[3], sizeof prev_end);
         if (i < nt && (cls == C_CUSP || cls == C_LOOP))
             add_corner(b, s[3]);
-        emit_cubic_rec(b, s, 0);
+        cubic_info all = {cls, {roots[0], roots[1]}, nr};
+        cubic_info ci = info_map(&all, t0, t1);
+        emit_cubic_rec(b, s, 0, &ci);
         t0 = t1;
     }
     /* a loop's crossing is a corner of the outline even where it is not a split point */
@@ -581,7 +729,7 @@ static void emit_cubic(builder *b, const double q[4][2])
  * m = L M^2 (at the double point's parameters); cusp k = L^2, l = m = L^3; inflection at
  * infinity k = L, l = L^3, m = 1. Rather than their tables, the Bernstein coefficients of these
  * polynomials are fitted by affine functionals of the plane; the residual proves the class. */
-static void emit_cubic_piece(builder *b, const double qm[4][2])
+static void emit_cubic_piece(builder *b, const double qm[4][2], const cubic_info *ci)
 {
     double lo[2] = {qm[0][0], qm[0][1]}, hi[2] = {qm[0][0], qm[0][1]};
     for (int i = 1; i < 4; ++i)
@@ -594,9 +742,8 @@ static void emit_cubic_piece(builder *b, const double qm[4][2])
     for (int i = 0; i < 4; ++i)
         for (int k = 0; k < 2; ++k)
             q[i][k] = (qm[i][k] - qm[0][k]) / size;
-    double roots[2];
-    int nr;
-    cubic_class cls = cubic_classify(q, roots, &nr);
+    const double *roots = ci->roots;
+    cubic_class cls = ci->cls;
     poly3 k, l, m, one = {{1, 0, 0, 0}};
     switch (cls) {
     case C_QUADRATIC: {
@@ -661,7 +808,7 @@ static void emit_cubic_piece(builder *b, const double qm[4][2])
     double res = fit_affine(q, bk, fk);
     res = fmax(res, fit_affine(q, bl, fl));
     res = fmax(res, fit_affine(q, bm, fm));
-    if (!(res <= 1e-6)) {
+    if (!(res <= 1e-4)) {
         /* not representable (numerically degenerate): fall back to the chord polygon's conic
          * split would be wrong; report instead */
         b->err = sw__fail(b->status, SW_ERR_INVALID_GEOMETRY,
@@ -1050,7 +1197,7 @@ sw_result sw__curves_shape_create(const sw__curves_loop *loops, uint32_t n_loops
     s->box[1] = lo[1];
     s->box[2] = hi[0];
     s->box[3] = hi[1];
-    s->approx_tol = 1.0 / (16.0 * px_per_unit);
+    s->approx_tol = SW__CURVES_BUILD_PX / px_per_unit;
     sw_result r = build(s, status);
     if (r != SW_OK) {
         sw__curves_shape_free(s);
@@ -1065,9 +1212,9 @@ sw_result sw__curves_shape_fit_view(sw__curves_shape *shape, double px_per_unit,
 {
     if (rebuilt)
         *rebuilt = 0;
-    if (shape->n_approx == 0 || shape->approx_bound * px_per_unit <= 0.125)
+    if (shape->n_approx == 0 || shape->approx_bound * px_per_unit <= SW__CURVES_REFIT_PX)
         return SW_OK;
-    shape->approx_tol = 1.0 / (16.0 * px_per_unit);
+    shape->approx_tol = SW__CURVES_BUILD_PX / px_per_unit;
     sw_result r = build(shape, status);
     if (r == SW_OK) {
         shape->rebuilds++;

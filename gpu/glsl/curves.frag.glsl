@@ -8,17 +8,20 @@
 //    (u_h = 0): adds (coverage of the pixel square by the piece's inside half-plane) - u_h, so a
 //    pixel near one edge ends with exactly that coverage and one far from every edge keeps 0 or 1.
 // The coverage (§4 eq. 3-6) uses the signed distance d = F / |grad F| with grad F from the chain
-// rule over dFdx / dFdy of k, l, m (exact: they are affine), as eq. 3 does for its conic. Where
+// rule over dFdx / dFdy of the local coordinates (exact: they are affine), as eq. 3 does for its
+// conic; a finite difference of F itself would be off by F'' times a pixel. Where
 // §4 maps d linearly to coverage (eq. 4, e = 1/2 - d), which is exact only for axis-aligned
 // edges (up to 0.043 = 11/255 off at 45 degrees), we take the exact area of the pixel square on
 // the inside of the line through the linearization.
 #version 450 core
-in vec3 v_klm;
+in vec2 v_uv;
 in vec2 v_cut;
 flat in vec3 v_flags;
+flat in vec4 v_c0;
+flat in vec4 v_c1;
+flat in vec2 v_c2;
 uniform int u_mode;
 uniform float u_h;
-uniform int u_fault; // tests: 1 plants a sign error in the implicit form (k^n + l m)
 layout(location = 0) out vec4 o_cov;
 
 // Area of the unit pixel square centred at the origin where dot(n, q) <= t, n a unit vector.
@@ -37,22 +40,18 @@ float halfplane_coverage(vec2 n, float t)
 
 void main()
 {
-    vec3 f = v_klm, fx = dFdx(f), fy = dFdy(f);
+    vec2 uvx = dFdx(v_uv), uvy = dFdy(v_uv);
+    float u = v_uv.x, v = v_uv.y;
+    // F = c00 + c10 u + c01 v + c20 u^2 + c11 u v + c02 v^2 + c30 u^3 + c21 u^2 v + c12 u v^2
+    //   + c03 v^3
+    float F = v_c0.x + u * (v_c0.y + u * (v_c0.w + u * v_c1.z)) +
+              v * (v_c0.z + v * (v_c1.y + v * v_c2.y)) + u * v * (v_c1.x + u * v_c1.w + v * v_c2.x);
+    float Fu = v_c0.y + u * (2.0 * v_c0.w + 3.0 * u * v_c1.z) +
+               v * (v_c1.x + 2.0 * u * v_c1.w + v * v_c2.x);
+    float Fv = v_c0.z + v * (2.0 * v_c1.y + 3.0 * v * v_c2.y) +
+               u * (v_c1.x + u * v_c1.w + 2.0 * v * v_c2.x);
+    vec2 g = vec2(Fu * uvx.x + Fv * uvx.y, Fu * uvy.x + Fv * uvy.y); // d/dx, d/dy in pixels
     int kind = int(round(v_flags.x));
-    float lm = u_fault == 1 ? -f.y * f.z : f.y * f.z;
-    float F;
-    vec2 g, gk = vec2(fx.x, fy.x), gl = vec2(fx.y, fy.y), gm = vec2(fx.z, fy.z);
-    float sg = u_fault == 1 ? -1.0 : 1.0;
-    if (kind <= 0) {
-        F = f.x;
-        g = gk;
-    } else if (kind == 1) {
-        F = f.x * f.x - lm;
-        g = 2.0 * f.x * gk - sg * (f.z * gl + f.y * gm);
-    } else {
-        F = f.x * f.x * f.x - lm;
-        g = 3.0 * f.x * f.x * gk - sg * (f.z * gl + f.y * gm);
-    }
     if (u_mode == 0) {
         if (kind >= 1 && v_flags.y * F >= 0.0)
             discard;

@@ -471,6 +471,59 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
             }
         }
     free(cn);
+    if (getenv("SW_CURVES_PROBE") && zoom == atof(getenv("SW_CURVES_PROBE"))) {
+        double det = v[0] * v[4] - v[1] * v[3], X = mxi + 0.5 - v[2], Y = mxj + 0.5 - v[5];
+        double mx_ = (v[4] * X - v[1] * Y) / det, my_ = (-v[3] * X + v[0] * Y) / det;
+        for (size_t k = 0; k < shape->n_pieces; ++k) {
+            const sw__curves_piece *p = &shape->pieces[k];
+            double lo0 = 1e9, lo1 = 1e9, hi0 = -1e9, hi1 = -1e9;
+            for (int q = 0; q < p->n_cp; ++q) {
+                lo0 = fmin(lo0, p->cp[q][0]); hi0 = fmax(hi0, p->cp[q][0]);
+                lo1 = fmin(lo1, p->cp[q][1]); hi1 = fmax(hi1, p->cp[q][1]);
+            }
+            double m = 3 / s;
+            if (mx_ > lo0 - m && mx_ < hi0 + m && my_ > lo1 - m && my_ < hi1 + m) {
+                printf("piece %zu kind %d s_chord %g s_in %g F %g:", k, p->kind, p->s_chord, p->s_in,
+                       sw__curves_piece_eval(p, mx_, my_));
+                for (int q = 0; q < p->n_cp; ++q)
+                    printf(" (%.6f,%.6f)", p->cp[q][0], p->cp[q][1]);
+                double ce[2], sz, cf[10];
+                sw__curves_piece_local_form(p, ce, &sz, cf);
+                float u = (float)((mx_ - ce[0]) / sz), vv = (float)((my_ - ce[1]) / sz);
+                float uu[10] = {1, u, vv, u * u, u * vv, vv * vv, u * u * u, u * u * vv, u * vv * vv, vv * vv * vv};
+                float Ff = 0;
+                for (int q = 0; q < 10; ++q)
+                    Ff += (float)cf[q] * uu[q];
+                printf("\n   local u %g v %g Ffloat %g coefs", u, vv, Ff);
+                for (int q = 0; q < 10; ++q)
+                    printf(" %.3g", cf[q]);
+                printf("\n");
+            }
+        }
+        for (int j = mxj + 3; j >= mxj - 3; --j) {
+            for (int i = mxi - 4; i <= mxi + 4; ++i)
+                if (i >= 0 && j >= 0 && i < W && j < H)
+                    printf(" %3d/%5.1f", px[4 * (j * W + i)], 255 * fmin(fabs(ref[j * W + i]), 1));
+            printf("\n");
+        }
+    }
+    if (getenv("SW_CURVES_DUMP")) { /* error image: red = rendered too high, green = too low */
+        char path[256];
+        snprintf(path, sizeof path, "%s/curves_err_x%g.ppm", getenv("SW_CURVES_DUMP"), zoom);
+        FILE *f = fopen(path, "wb");
+        if (f) {
+            fprintf(f, "P6 %d %d 255\n", W, H);
+            for (int j = H - 1; j >= 0; --j)
+                for (int i = 0; i < W; ++i) {
+                    double e = px[4 * (j * W + i)] / 255.0 - fmin(fabs(ref[j * W + i]), 1.0);
+                    unsigned char o[3] = {(unsigned char)fmin(255, fmax(0, e * 2550)),
+                                          (unsigned char)fmin(255, fmax(0, -e * 2550)),
+                                          (unsigned char)(px[4 * (j * W + i)] / 4)};
+                    fwrite(o, 1, 3, f);
+                }
+            fclose(f);
+        }
+    }
     double mean = n_edge ? sum / n_edge : 0;
     printf("  zoom x%-6g pieces %4zu (approx %3u, bound %.4f px, rebuilds %u)  edge px %5zu  "
            "mean %5.2f/255  max %5.2f/255 at (%d,%d)  | near corners: %3zu px, mean %6.2f/255, "
@@ -481,7 +534,7 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
     *worst_mean = fmax(*worst_mean, mean);
     *worst_max = fmax(*worst_max, mx);
     int ok = mean <= 2.0 / 255 && mx <= 12.0 / 255 && bad_comp == 0 && n_edge > 0 &&
-             shape->approx_bound * s <= 0.125;
+             shape->approx_bound * s <= SW__CURVES_REFIT_PX;
     return ok;
 }
 
