@@ -103,7 +103,7 @@ static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
 struct sw__curves_renderer {
     GLuint prog, prog_comp, vao, vbo, fbo, tex, rb;
     int32_t fbo_w, fbo_h;
-    GLint loc_size, loc_mode, loc_h;
+    GLint loc_size, loc_mode;
     GLint loc_c_size, loc_c_cov, loc_c_color, loc_c_origin, loc_c_ss;
     int fault, vbaa;
     vtx *v;
@@ -181,7 +181,6 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
     }
     r->loc_size = glGetUniformLocation(r->prog, "u_size");
     r->loc_mode = glGetUniformLocation(r->prog, "u_mode");
-    r->loc_h = glGetUniformLocation(r->prog, "u_h");
     r->loc_c_size = glGetUniformLocation(r->prog_comp, "u_size");
     r->loc_c_cov = glGetUniformLocation(r->prog_comp, "u_cov");
     r->loc_c_color = glGetUniformLocation(r->prog_comp, "u_color");
@@ -570,14 +569,11 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     glUniform1i(r->loc_mode, 1);
     glDrawArrays(GL_TRIANGLES, (GLint)n_stencil, (GLsizei)(n_cover_end - n_stencil));
 
-    /* 3: edge corrections relative to the stencil's centre classification */
-    glUniform1i(r->loc_mode, 2);
-    for (int h = 1; h >= 0; --h) {
-        glStencilFunc(GL_EQUAL, h, 1);
-        glUniform1f(r->loc_h, (float)h);
-        glDrawArrays(GL_TRIANGLES, (GLint)n_cover_end, (GLsizei)(n_all - n_cover_end));
-    }
+    /* 3: edge corrections, each relative to its own half-plane's value at the pixel centre
+     * (glsl/curves.frag.glsl says why), so no stencil test */
     glDisable(GL_STENCIL_TEST);
+    glUniform1i(r->loc_mode, 2);
+    glDrawArrays(GL_TRIANGLES, (GLint)n_cover_end, (GLsizei)(n_all - n_cover_end));
     glStencilMask(0xff);
 
     /* 4: composite over the target */

@@ -4,9 +4,14 @@
 //  0 stencil parity: fan triangles pass, curved triangles pass only between chord and curve
 //    (s_chord F < 0), each toggling the stencil (GL_INVERT): odd = inside at the pixel centre;
 //  1 cover: +1 where the stencil is odd;
-//  2 edge correction, drawn once over stencil-odd pixels (u_h = 1) and once over the others
-//    (u_h = 0): adds (coverage of the pixel square by the piece's inside half-plane) - u_h, so a
-//    pixel near one edge ends with exactly that coverage and one far from every edge keeps 0 or 1.
+//  2 edge correction: adds (coverage of the pixel square by the piece's inside half-plane) minus
+//    (1 if the pixel centre is in that half-plane), whatever the stencil says. A pixel far from
+//    every edge keeps the stencil's 0 or 1; one near a single edge ends with its coverage; and one
+//    crossed by several edges that do not cross inside it (an acute corner seen from more than a
+//    pixel away, the thin spike of a cusp, two close parts of an outline) ends with the exact area
+//    too: crossing each edge flips the parity, so the area is the centre's value plus each edge's
+//    (area - centre value) of its own half-plane. Subtracting the stencil's centre value instead
+//    (as a first version did) is only right where the centre is inside every nearby half-plane.
 // The coverage (§4 eq. 3-6) uses the signed distance d = F / |grad F| with grad F from the chain
 // rule over dFdx / dFdy of the local coordinates (exact: they are affine), as eq. 3 does for its
 // conic; a finite difference of F itself would be off by F'' times a pixel. Where
@@ -21,7 +26,6 @@ flat in vec4 v_c0;
 flat in vec4 v_c1;
 flat in vec2 v_c2;
 uniform int u_mode;
-uniform float u_h;
 layout(location = 0) out vec4 o_cov;
 
 // Area of the unit pixel square centred at the origin where dot(n, q) <= t, n a unit vector.
@@ -72,7 +76,7 @@ void main()
     if (!(len > 0.0))
         discard;
     float d = Fi / len; // pixels, > 0 outside
-    if (abs(d) >= 0.75)  // beyond the square's half diagonal: full or empty, as the stencil says
+    if (abs(d) >= 0.75)  // beyond the square's half diagonal: the correction below is 0
         discard;
-    o_cov = vec4(halfplane_coverage(gi / len, -d) - u_h);
+    o_cov = vec4(halfplane_coverage(gi / len, -d) - (d < 0.0 ? 1.0 : 0.0));
 }
