@@ -3,8 +3,8 @@
  *
  * Per draw, on the CPU in double: the view's pixel positions of three triangle sets — the stencil
  * fan over the pieces' end points plus each curved piece's control hull (Santana §3's curved
- * triangles), a cover rectangle, and each piece's band (its control hull grown by 1.5 px, which
- * holds every pixel whose square the piece touches) — with the piece's local coordinates at each
+ * triangles), a cover rectangle, and each piece's band (its control hull grown by the pixel square: every pixel whose
+ * square the piece can touch) — with the piece's local coordinates at each
  * vertex and its implicit form expanded in them (local_form). Then
  * four passes: stencil parity, cover, edge corrections (glsl/curves.frag.glsl) into a float
  * coverage target, and the composite over the caller's framebuffer
@@ -20,7 +20,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define BAND_MARGIN 1.5 /* px: a pixel square within 0.75 px of a piece lies in its band */
+/* px: a pixel's square meets a piece's control hull exactly when the pixel's centre lies in the
+ * hull grown by the square, the hull of the control points offset by +-1/2 px in x and y: only
+ * those pixels can need the piece's correction (the curve lies in its hull). The 1/64 px covers
+ * float rounding of the vertices. A wider band (this was 1.5 px) only adds pixels where the
+ * correction must be 0 but where another branch of the piece's implicit curve, or the straight
+ * extension of an edge beyond its end, can make it non-zero. */
+#define BAND_MARGIN (0.5 + 1.0 / 64.0)
 #define VBAA_SIZE 24.0  /* px: shapes smaller than this on screen go through the 8x path */
 #define VBAA_SCALE 8
 
