@@ -3,8 +3,8 @@
  *
  * Per draw, on the CPU in double: the view's pixel positions of three triangle sets — the stencil
  * fan over the pieces' end points plus each curved piece's control hull (Santana §3's curved
- * triangles), a cover rectangle, and each piece's band (its control hull grown by the pixel square: every pixel whose
- * square the piece can touch) — with the piece's local coordinates at each
+ * triangles), a cover rectangle, and each piece's band (its control hull grown by 0.75 px: every pixel of its slab whose square
+ * meets the curve) — with the piece's local coordinates at each
  * vertex and its implicit form expanded in them (local_form). Then
  * four passes: stencil parity, cover, edge corrections (glsl/curves.frag.glsl) into a float
  * coverage target, and the composite over the caller's framebuffer
@@ -20,13 +20,16 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* px: a pixel's square meets a piece's control hull exactly when the pixel's centre lies in the
- * hull grown by the square, the hull of the control points offset by +-1/2 px in x and y: only
- * those pixels can need the piece's correction (the curve lies in its hull). The 1/64 px covers
- * float rounding of the vertices. A wider band (this was 1.5 px) only adds pixels where the
- * correction must be 0 but where another branch of the piece's implicit curve, or the straight
- * extension of an edge beyond its end, can make it non-zero. */
-#define BAND_MARGIN (0.5 + 1.0 / 64.0)
+/* px: the band must hold every pixel centre in the piece's slab (between its cut lines) whose
+ * square meets the curve. That curve point lies within the square's half diagonal (0.7071 px)
+ * of the centre; it is on this piece, or, near a cut line, on the neighbour just past it, hence
+ * within about that distance of this piece's end point: so the control hull grown by 0.75 px (the
+ * hull of the control points offset by +-0.75 px in x and y) holds them all. A wider band (this
+ * was 1.5 px) only adds pixels whose correction must be 0 but where another branch of the
+ * piece's implicit curve, or an edge's straight extension past a corner, can make it non-zero;
+ * the hull grown by only the pixel square (0.5 px) misses pixels at joins whose square meets the
+ * curve just past the cut line (nurbs7 x1: 36/255). */
+#define BAND_MARGIN 0.75
 #define VBAA_SIZE 24.0  /* px: shapes smaller than this on screen go through the 8x path */
 #define VBAA_SCALE 8
 
@@ -109,7 +112,7 @@ static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
 struct sw__curves_renderer {
     GLuint prog, prog_comp, vao, vbo, fbo, tex, rb;
     int32_t fbo_w, fbo_h;
-    GLint loc_size, loc_mode;
+    GLint loc_size, loc_mode, loc_h;
     GLint loc_c_size, loc_c_cov, loc_c_color, loc_c_origin, loc_c_ss;
     int fault, vbaa;
     vtx *v;
@@ -187,6 +190,7 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
     }
     r->loc_size = glGetUniformLocation(r->prog, "u_size");
     r->loc_mode = glGetUniformLocation(r->prog, "u_mode");
+    r->loc_h = glGetUniformLocation(r->prog, "u_h");
     r->loc_c_size = glGetUniformLocation(r->prog_comp, "u_size");
     r->loc_c_cov = glGetUniformLocation(r->prog_comp, "u_cov");
     r->loc_c_color = glGetUniformLocation(r->prog_comp, "u_color");
@@ -575,11 +579,16 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     glUniform1i(r->loc_mode, 1);
     glDrawArrays(GL_TRIANGLES, (GLint)n_stencil, (GLsizei)(n_cover_end - n_stencil));
 
-    /* 3: edge corrections, each relative to its own half-plane's value at the pixel centre
-     * (glsl/curves.frag.glsl says why), so no stencil test */
-    glDisable(GL_STENCIL_TEST);
+    /* 3: edge corrections, each relative to its own half-plane's value at the pixel centre but
+     * for centres on the curve, where the stencil's value stands for it (glsl/curves.frag.glsl
+     * says why): once over stencil-odd pixels and once over the others */
     glUniform1i(r->loc_mode, 2);
-    glDrawArrays(GL_TRIANGLES, (GLint)n_cover_end, (GLsizei)(n_all - n_cover_end));
+    for (int h = 1; h >= 0; --h) {
+        glStencilFunc(GL_EQUAL, h, 1);
+        glUniform1f(r->loc_h, (float)h);
+        glDrawArrays(GL_TRIANGLES, (GLint)n_cover_end, (GLsizei)(n_all - n_cover_end));
+    }
+    glDisable(GL_STENCIL_TEST);
     glStencilMask(0xff);
 
     /* 4: composite over the target */

@@ -12,6 +12,12 @@
 //    too: crossing each edge flips the parity, so the area is the centre's value plus each edge's
 //    (area - centre value) of its own half-plane. Subtracting the stencil's centre value instead
 //    (as a first version did) is only right where the centre is inside every nearby half-plane.
+//    But the stencil decides a centre within a rounding error of the curve by the rasterizer's
+//    snapped hull edges (1/256 px on llvmpipe, 1/16 px allowed by GL) where the curve hugs them
+//    near a piece's ends, and a centre there that the stencil and sign(d) put on opposite sides
+//    would end half a pixel off (nurbs7 x1: 127/255). So within EPS of the curve the centre's
+//    side is taken from the stencil (u_h: drawn once over stencil-odd pixels, once over the
+//    others), which is exact for one edge, and for several unless another one also passes nearby.
 // The coverage (§4 eq. 3-6) uses the signed distance d = F / |grad F| with grad F from the chain
 // rule over dFdx / dFdy of the local coordinates (exact: they are affine), as eq. 3 does for its
 // conic; a finite difference of F itself would be off by F'' times a pixel. Where
@@ -26,6 +32,8 @@ flat in vec4 v_c0;
 flat in vec4 v_c1;
 flat in vec2 v_c2;
 uniform int u_mode;
+uniform float u_h;
+const float EPS = 1.0 / 16.0; // px
 layout(location = 0) out vec4 o_cov;
 
 // Area of the unit pixel square centred at the origin where dot(n, q) <= t, n a unit vector.
@@ -78,5 +86,7 @@ void main()
     float d = Fi / len; // pixels, > 0 outside
     if (abs(d) >= 0.75)  // beyond the square's half diagonal: the correction below is 0
         discard;
-    o_cov = vec4(halfplane_coverage(gi / len, -d) - (d < 0.0 ? 1.0 : 0.0));
+    // the centre's side: where it is within EPS of the curve, the stencil's (u_h) stands for it
+    float side = abs(d) <= EPS ? u_h : (d < 0.0 ? 1.0 : 0.0);
+    o_cov = vec4(halfplane_coverage(gi / len, -d) - side);
 }
