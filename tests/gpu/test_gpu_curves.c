@@ -494,6 +494,26 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
                 float Ff = 0;
                 for (int q = 0; q < 10; ++q)
                     Ff += (float)cf[q] * uu[q];
+                double U = (mx_ - ce[0]) / sz, V = (my_ - ce[1]) / sz;
+                double Fd = cf[0] + cf[1] * U + cf[2] * V + cf[3] * U * U + cf[4] * U * V + cf[5] * V * V +
+                            cf[6] * U * U * U + cf[7] * U * U * V + cf[8] * U * V * V + cf[9] * V * V * V;
+                double Fu = cf[1] + 2 * cf[3] * U + cf[4] * V + 3 * cf[6] * U * U + 2 * cf[7] * U * V + cf[8] * V * V;
+                double Fv = cf[2] + cf[4] * U + 2 * cf[5] * V + cf[7] * U * U + 2 * cf[8] * U * V + 3 * cf[9] * V * V;
+                double cut0 = (mx_ - p->cp[0][0]) * p->tan0[0] + (my_ - p->cp[0][1]) * p->tan0[1];
+                double cut1 = (p->cp[p->n_cp - 1][0] - mx_) * p->tan1[0] + (p->cp[p->n_cp - 1][1] - my_) * p->tan1[1];
+                {
+                    double gx = Fu / sz, gy = Fv / sz; /* model gradient */
+                    /* pixel gradient: grad_px = M^-T grad_model */
+                    double ipx = (v[4] * gx - v[3] * gy) / det, ipy = (-v[1] * gx + v[0] * gy) / det;
+                    double dd = p->s_in * Fd / hypot(ipx, ipy);
+                    double nx = p->s_in * ipx / hypot(ipx, ipy), ny = p->s_in * ipy / hypot(ipx, ipy);
+                    double a = fmax(fabs(nx), fabs(ny)), bq = fmin(fabs(nx), fabs(ny));
+                    double lo = 0.5 * (a - bq), hi = 0.5 * (a + bq), t = -dd, at = fabs(t), cv;
+                    if (at >= hi) cv = 1; else if (at <= lo) cv = 0.5 + at / a; else cv = 1 - (hi - at) * (hi - at) / (2 * a * bq);
+                    if (t < 0) cv = 1 - cv;
+                    printf("\n   pixel d %g cov %g correction %g", dd, cv, cv - (dd < 0));
+                }
+                printf("\n   d_px %g (s_in d %g) cut0 %g cut1 %g px", Fd / hypot(Fu, Fv) * sz * s, p->s_in * Fd / hypot(Fu, Fv) * sz * s, cut0 * s, cut1 * s);
                 printf("\n   local u %g v %g Ffloat %g coefs", u, vv, Ff);
                 for (int q = 0; q < 10; ++q)
                     printf(" %.3g", cf[q]);
