@@ -68,7 +68,10 @@ static bipoly bp_mul(const bipoly *x, const bipoly *y)
     return r;
 }
 
-static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
+/* The local form of piece p around the box `box` (model x0, y0, x1, y1; NULL: the piece's
+ * control points' box). */
+static void local_form_make(const sw__curves_piece *p, int fault, const double *box,
+                            local_form *f)
 {
     double lo[2] = {p->cp[0][0], p->cp[0][1]}, hi[2] = {lo[0], lo[1]};
     for (int i = 1; i < p->n_cp; ++i)
@@ -76,6 +79,12 @@ static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
             lo[k] = fmin(lo[k], p->cp[i][k]);
             hi[k] = fmax(hi[k], p->cp[i][k]);
         }
+    if (box) {
+        lo[0] = box[0];
+        lo[1] = box[1];
+        hi[0] = box[2];
+        hi[1] = box[3];
+    }
     f->centre[0] = 0.5 * (lo[0] + hi[0]);
     f->centre[1] = 0.5 * (lo[1] + hi[1]);
     f->size = fmax(fmax(hi[0] - lo[0], hi[1] - lo[1]), 1e-300);
@@ -85,6 +94,17 @@ static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
         k[j].a[0][0] = p->klm[j][0] * f->centre[0] + p->klm[j][1] * f->centre[1] + p->klm[j][2];
         k[j].a[1][0] = p->klm[j][0] * f->size;
         k[j].a[0][1] = p->klm[j][1] * f->size;
+    }
+    if (p->kind == SW__CURVES_CUSP) {
+        /* not a polynomial: k and l as affine forms, then the branch (the fault: the other one) */
+        memset(f->c, 0, sizeof f->c);
+        for (int j = 0; j < 2; ++j) {
+            f->c[3 * j] = k[j].a[0][0];
+            f->c[3 * j + 1] = k[j].a[1][0];
+            f->c[3 * j + 2] = k[j].a[0][1];
+        }
+        f->c[6] = fault == 1 ? -p->branch : p->branch;
+        return;
     }
     bipoly F;
     if (p->kind == SW__CURVES_LINE) {
@@ -100,7 +120,11 @@ static void local_form_make(const sw__curves_piece *p, int fault, local_form *f)
             for (int j = 0; i + j < 4; ++j)
                 F.a[i][j] += sg * lm.a[i][j];
     }
-    double g = hypot(F.a[1][0], F.a[0][1]);
+    /* scaled to a largest coefficient of 1: float's range then holds any zoom */
+    double g = 0.0;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; i + j < 4; ++j)
+            g = fmax(g, fabs(F.a[i][j]));
     if (!(g > 0.0))
         g = 1.0;
     static const int idx[10][2] = {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1, 1},
@@ -304,7 +328,7 @@ void sw__curves_piece_local_form(const sw__curves_piece *p, double centre[2], do
                                  double c[10])
 {
     local_form f;
-    local_form_make(p, 0, &f);
+    local_form_make(p, 0, NULL, &f);
     centre[0] = f.centre[0];
     centre[1] = f.centre[1];
     *size = f.size;
@@ -404,14 +428,34 @@ static int clip_rect(const double (*in)[2], int n, const double rect[4], double 
     return n;
 }
 
-/* Fan triangles over a convex polygon clipped to r->clip, carrying piece p's local form. */
+/* Fan triangles over a convex polygon clipped to r->clip, carrying piece p's local form expanded
+ * around the clipped polygon. Why there: F is evaluated in float, and its error is float's
+ * epsilon times the size of F's terms over the region it is expanded for, divided by |grad F|
+ * where the fragment is. Expanded around the whole piece, at x1000 the region is 1e5 px across
+ * and a pixel of the cusp test, where |grad F| is 1/40 of its value at the piece's centre, was
+ * off by 2 px (cusp x1000: mean 46/255). Around the clipped polygon the region is at most the
+ * target's size (and the band's width), whatever the zoom. */
 static int emit_polygon(sw__curves_renderer *r, const xform *x, const sw__curves_piece *p,
-                        const local_form *f, const double (*poly_in)[2], int n_in, float kind)
+                        int fault, const double (*poly_in)[2], int n_in, float kind)
 {
     double poly[32][2];
     int n = clip_rect(poly_in, n_in, r->clip, poly);
     if (n < 3)
         return 1;
+    local_form lf, *f = NULL;
+    if (p) {
+        double box[4] = {INFINITY, INFINITY, -INFINITY, -INFINITY};
+        for (int i = 0; i < n; ++i) {
+            double q[2];
+            apply(x->inv, poly[i], q);
+            for (int k = 0; k < 2; ++k) {
+                box[k] = fmin(box[k], q[k]);
+                box[2 + k] = fmax(box[2 + k], q[k]);
+            }
+        }
+        local_form_make(p, fault, box, &lf);
+        f = &lf;
+    }
     vtx *v = push(r, 3 * (size_t)(n - 2));
     if (!v)
         return 0;
@@ -494,17 +538,15 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
         apply(x.m, p->cp[0], tri[1]);
         apply(x.m, p->cp[p->n_cp - 1], tri[2]);
         /* a clockwise triangle is still convex: the clipper keeps either orientation */
-        if (!emit_polygon(r, &x, NULL, NULL, (const double(*)[2])tri, 3, -1.0f))
+        if (!emit_polygon(r, &x, NULL, 0, (const double(*)[2])tri, 3, -1.0f))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
         if (p->kind == SW__CURVES_LINE)
             continue;
-        local_form lf;
-        local_form_make(p, r->fault, &lf);
         double pts[4][2], h[8][2];
         for (int k = 0; k < p->n_cp; ++k)
             apply(x.m, p->cp[k], pts[k]);
         int nh = hull(pts, p->n_cp, h);
-        if (!emit_polygon(r, &x, p, &lf, (const double(*)[2])h, nh, (float)p->kind))
+        if (!emit_polygon(r, &x, p, r->fault, (const double(*)[2])h, nh, (float)p->kind))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     }
     size_t n_stencil = r->n;
@@ -513,7 +555,7 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
                           {(x1 - ox) * ss, (y0 - oy) * ss},
                           {(x1 - ox) * ss, (y1 - oy) * ss},
                           {(x0 - ox) * ss, (y1 - oy) * ss}};
-        if (!emit_polygon(r, &x, NULL, NULL, (const double(*)[2])q, 4, -1.0f))
+        if (!emit_polygon(r, &x, NULL, 0, (const double(*)[2])q, 4, -1.0f))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     }
     size_t n_cover_end = r->n;
@@ -531,9 +573,7 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
             }
         }
         int nh = hull(pts, n, h);
-        local_form lf;
-        local_form_make(p, r->fault, &lf);
-        if (!emit_polygon(r, &x, p, &lf, (const double(*)[2])h, nh, (float)p->kind))
+        if (!emit_polygon(r, &x, p, r->fault, (const double(*)[2])h, nh, (float)p->kind))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     }
     size_t n_all = r->n;
@@ -611,7 +651,7 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
         r->clip[2] = view->width + 2.0;
         r->clip[3] = view->height + 2.0;
         double q[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-        if (!emit_polygon(r, &id, NULL, NULL, (const double(*)[2])q, 4, -1.0f))
+        if (!emit_polygon(r, &id, NULL, 0, (const double(*)[2])q, 4, -1.0f))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
         glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(r->n * sizeof(vtx)), r->v, GL_STREAM_DRAW);
         glDrawArrays(GL_TRIANGLES, 0, (GLsizei)r->n);

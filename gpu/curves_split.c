@@ -124,6 +124,10 @@ double sw__curves_piece_eval(const sw__curves_piece *p, double x, double y)
         return v[0];
     case SW__CURVES_CONIC:
         return v[0] * v[0] - v[1] * v[2];
+    case SW__CURVES_CUSP: {
+        double k = fmax(v[0], 0.0);
+        return v[1] + p->branch * k * sqrt(k);
+    }
     default:
         return v[0] * v[0] * v[0] - v[1] * v[2];
     }
@@ -134,6 +138,12 @@ static void piece_grad(const sw__curves_piece *p, double x, double y, double g[2
     double v[3];
     for (int j = 0; j < 3; ++j)
         v[j] = p->klm[j][0] * x + p->klm[j][1] * y + p->klm[j][2];
+    if (p->kind == SW__CURVES_CUSP) {
+        double rk = 1.5 * p->branch * sqrt(fmax(v[0], 0.0));
+        for (int c = 0; c < 2; ++c)
+            g[c] = p->klm[1][c] + rk * p->klm[0][c];
+        return;
+    }
     double ck = p->kind == SW__CURVES_LINE ? 1.0
                 : p->kind == SW__CURVES_CONIC ? 2.0 * v[0]
                                               : 3.0 * v[0] * v[0];
@@ -798,7 +808,7 @@ static void emit_cubic_piece(builder *b, const double qm[4][2], const cubic_info
     double a = mk > 0 ? 1.0 / mk : 1.0;
     double a32 = a * sqrt(a);
     /* l m = a^3 k^3 needs l scaled by x and m by a^3 / x: balance their sizes */
-    double xl = ml > 0 && mm > 0 ? sqrt(a * a * a * mm / ml) : a32;
+    double xl = ml > 0 && mm > 0 && cls != C_CUSP ? sqrt(a * a * a * mm / ml) : a32;
     double xm = a * a * a / xl;
     for (int i = 0; i < 4; ++i) {
         bk[i] *= a;
@@ -819,6 +829,17 @@ static void emit_cubic_piece(builder *b, const double qm[4][2], const cubic_info
     if (!p)
         return;
     p->kind = SW__CURVES_CUBIC;
+    if (cls == C_CUSP) {
+        /* k = L^2, l = m = L^3: F = k^3 - l^2 vanishes on both branches, L < 0 and L > 0, which
+         * leave the cusp tangent to each other. A piece ending at the cusp then has the other
+         * branch within a pixel all along the thin spike, where F / |grad F| measures the
+         * distance to the wrong branch or to neither (cusp x1, x10: up to 170/255 off).
+         * F = l + branch k^(3/2) with branch = -sign(L) on the piece vanishes on this branch
+         * only (k >= 0 on the curve; beyond k = 0, past the cusp, it is l, the cusp tangent). */
+        double Lmid = 0.5 - roots[0];
+        p->kind = SW__CURVES_CUSP;
+        p->branch = Lmid < 0.0 ? 1.0 : -1.0;
+    }
     p->n_cp = 4;
     memcpy(p->cp, qm, sizeof p->cp);
     const double *f[3] = {fk, fl, fm};
@@ -1027,7 +1048,7 @@ static void piece_point(const sw__curves_piece *p, double t, double out[2])
             out[c] = (mt * mt * p->cp[0][c] + 2 * p->w * mt * t * p->cp[1][c] +
                       t * t * p->cp[2][c]) /
                      W;
-        } else if (p->kind == SW__CURVES_CUBIC) {
+        } else if (p->kind == SW__CURVES_CUBIC || p->kind == SW__CURVES_CUSP) {
             out[c] = mt * mt * mt * p->cp[0][c] + 3 * mt * mt * t * p->cp[1][c] +
                      3 * mt * t * t * p->cp[2][c] + t * t * t * p->cp[3][c];
         } else {

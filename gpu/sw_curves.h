@@ -49,7 +49,10 @@ typedef struct sw__curves_loop {
 typedef enum sw__curves_kind {
     SW__CURVES_LINE = 0,  /* F = k (k: signed distance to the line) */
     SW__CURVES_CONIC = 1, /* F = k^2 - l m (rational quadratic, exact) */
-    SW__CURVES_CUBIC = 2  /* F = k^3 - l m (integral cubic, Loop-Blinn) */
+    SW__CURVES_CUBIC = 2, /* F = k^3 - l m (integral cubic, Loop-Blinn) */
+    /* a piece of an integral cubic with a cusp: F = l + branch max(k, 0)^(3/2), the one branch
+     * of k^3 = l^2 that the piece lies on (curves_split.c, emit_cubic_piece, says why) */
+    SW__CURVES_CUSP = 3
 } sw__curves_kind;
 
 /* One drawable piece, in the shape's (model) coordinates. */
@@ -58,6 +61,7 @@ typedef struct sw__curves_piece {
     int32_t n_cp;        /* 2, 3 or 4 Euclidean control points */
     double cp[4][2];     /* for a conic, cp[1] is the off-curve point and w its normalized weight */
     double w;            /* conic only: middle weight with end weights 1 */
+    double branch;       /* cusp only: +1 or -1, which branch of k^3 = l^2 */
     double klm[3][3];    /* affine functionals: value = a x + b y + c with klm[j] = {a, b, c} */
     double s_chord;      /* sign: s_chord F < 0 between the chord and the curve (near the curve) */
     double s_in;         /* sign: s_in F < 0 on the inside (fill) side of the piece */
