@@ -376,6 +376,15 @@ static void area_accumulate(const poly *pl, double sign, double *cov)
     }
 }
 
+/* A local form's value and gradient (polynomial kinds only), for the probe. */
+static double probe_form(const double *cf, double U, double V, double g[2])
+{
+    g[0] = cf[1] + 2 * cf[3] * U + cf[4] * V + 3 * cf[6] * U * U + 2 * cf[7] * U * V + cf[8] * V * V;
+    g[1] = cf[2] + cf[4] * U + 2 * cf[5] * V + cf[7] * U * U + 2 * cf[8] * U * V + 3 * cf[9] * V * V;
+    return cf[0] + cf[1] * U + cf[2] * V + cf[3] * U * U + cf[4] * U * V + cf[5] * V * V +
+           cf[6] * U * U * U + cf[7] * U * U * V + cf[8] * U * V * V + cf[9] * V * V * V;
+}
+
 /* ---- the run ---------------------------------------------------------------------------------- */
 
 static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshape *ts,
@@ -481,7 +490,7 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
                 lo0 = fmin(lo0, p->cp[q][0]); hi0 = fmax(hi0, p->cp[q][0]);
                 lo1 = fmin(lo1, p->cp[q][1]); hi1 = fmax(hi1, p->cp[q][1]);
             }
-            double m = 3 / s;
+            double m = (getenv("SW_CURVES_PROBE_ALL") ? 1e9 : 3) / s;
             if (mx_ > lo0 - m && mx_ < hi0 + m && my_ > lo1 - m && my_ < hi1 + m) {
                 printf("piece %zu kind %d s_chord %g s_in %g F %g:", k, p->kind, p->s_chord, p->s_in,
                        sw__curves_piece_eval(p, mx_, my_));
@@ -512,6 +521,16 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
                     if (at >= hi) cv = 1; else if (at <= lo) cv = 0.5 + at / a; else cv = 1 - (hi - at) * (hi - at) / (2 * a * bq);
                     if (t < 0) cv = 1 - cv;
                     printf("\n   pixel d %g cov %g correction %g", dd, cv, cv - (dd < 0));
+                    /* two Newton steps as the shader takes them, in model units */
+                    double P[2] = {U, V}, gg[2];
+                    for (int it = 0; it < 3; ++it) {
+                        double F0 = probe_form(cf, P[0], P[1], gg), g2 = gg[0] * gg[0] + gg[1] * gg[1];
+                        printf("\n   newton %d: F %g at offset (%g, %g) px", it, F0, (P[0] - U) * sz * s, (P[1] - V) * sz * s);
+                        P[0] -= F0 / g2 * gg[0];
+                        P[1] -= F0 / g2 * gg[1];
+                    }
+                    double cx_ = P[0] * sz + ce[0], cy_ = P[1] * sz + ce[1], cd = hypot(cx_ - mx_, cy_ - my_) * s;
+                    printf("\n   foot at %g px", cd);
                 }
                 printf("\n   d_px %g (s_in d %g) cut0 %g cut1 %g px", Fd / hypot(Fu, Fv) * sz * s, p->s_in * Fd / hypot(Fu, Fv) * sz * s, cut0 * s, cut1 * s);
                 printf("\n   local u %g v %g Ffloat %g coefs", u, vv, Ff);
