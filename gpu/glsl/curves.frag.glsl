@@ -18,7 +18,7 @@
 //    would end half a pixel off (nurbs7 x1: 127/255). So within EPS of the curve the centre's
 //    side is taken from the stencil (u_h: drawn once over stencil-odd pixels, once over the
 //    others), which is exact for one edge, and for several unless another one also passes nearby.
-// The coverage (§4 eq. 3-6) uses the signed distance d = F / |grad F| with grad F from the chain
+// The coverage (§4 eq. 3-6) starts from the signed distance d = F / |grad F| (refined below by Newton steps to the nearest curve point) with grad F from the chain
 // rule over dFdx / dFdy of the local coordinates (exact: they are affine), as eq. 3 does for its
 // conic; a finite difference of F itself would be off by F'' times a pixel. Where
 // §4 maps d linearly to coverage (eq. 4, e = 1/2 - d), which is exact only for axis-aligned
