@@ -36,9 +36,11 @@
 typedef struct vtx {
     float pos[2];
     float uv[2]; /* the piece's local coordinates: (model - centre) / size */
-    float cut[2];
+    float cut[3];   /* px past the start cut line, before the end cut line, left of the chord */
     float flags[3];
-    float coef[12]; /* F(u, v): 1, u, v, u^2, u v, v^2, u^3, u^2 v, u v^2, v^3 (two unused) */
+    /* F(u, v): 1, u, v, u^2, u v, v^2, u^3, u^2 v, u v^2, v^3; then the least and the largest
+     * signed distance (px) of the control points from the chord: the strip holding the piece */
+    float coef[12];
 } vtx;
 
 /* A piece's implicit form expanded into a bivariate polynomial in local coordinates, in double
@@ -228,7 +230,7 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
         glEnableVertexAttribArray(a);
     glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, pos));
     glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, uv));
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, cut));
+    glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, cut));
     glVertexAttribPointer(3, 3, GL_FLOAT, GL_FALSE, sizeof(vtx), (void *)offsetof(vtx, flags));
     for (GLuint a = 0; a < 3; ++a)
         glVertexAttribPointer(4 + a, 4, GL_FLOAT, GL_FALSE, sizeof(vtx),
@@ -363,6 +365,25 @@ static void set_vtx(vtx *v, const xform *x, const sw__curves_piece *p, const loc
     double l0 = hypot(t0[0], t0[1]), l1 = hypot(t1[0], t1[1]);
     v->cut[0] = (float)(((q[0] - a[0]) * t0[0] + (q[1] - a[1]) * t0[1]) / l0);
     v->cut[1] = (float)(((b[0] - q[0]) * t1[0] + (b[1] - q[1]) * t1[1]) / l1);
+    /* the chord strip: with the slab, a box around the piece in which a foot point found by the
+     * shader's Newton steps must lie to be on this piece (glsl/curves.frag.glsl) */
+    double e[2] = {b[0] - a[0], b[1] - a[1]}, le = hypot(e[0], e[1]);
+    double nl[2] = {le > 0.0 ? -e[1] / le : 0.0, le > 0.0 ? e[0] / le : 0.0};
+    double hmin = 0.0, hmax = 0.0;
+    for (int k = 1; k + 1 < p->n_cp; ++k) {
+        double c[2];
+        apply(x->m, p->cp[k], c);
+        double h = (c[0] - a[0]) * nl[0] + (c[1] - a[1]) * nl[1];
+        hmin = fmin(hmin, h);
+        hmax = fmax(hmax, h);
+    }
+    if (!(le > 0.0)) { /* no chord: no strip to check against */
+        hmin = -1e30;
+        hmax = 1e30;
+    }
+    v->cut[2] = (float)((q[0] - a[0]) * nl[0] + (q[1] - a[1]) * nl[1]);
+    v->coef[10] = (float)hmin;
+    v->coef[11] = (float)hmax;
     v->flags[1] = (float)p->s_chord;
     v->flags[2] = (float)p->s_in;
 }

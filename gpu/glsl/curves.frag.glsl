@@ -26,14 +26,16 @@
 // the inside of the line through the linearization.
 #version 450 core
 in vec2 v_uv;
-in vec2 v_cut;
+in vec3 v_cut; // px past the start cut line, before the end cut line, left of the chord
 flat in vec3 v_flags;
 flat in vec4 v_c0;
 flat in vec4 v_c1;
-flat in vec2 v_c2;
+flat in vec4 v_c2; // the last two coefficients, the chord strip (least, largest)
 uniform int u_mode;
 uniform float u_h;
 const float EPS = 1.0 / 16.0; // px
+// px: how far past the piece's slab and chord strip a foot point may lie and still be on it
+const float FOOT_TOL_CUT = 0.75, FOOT_TOL_STRIP = 0.25;
 layout(location = 0) out vec4 o_cov;
 
 // The piece's implicit form and its gradient in local coordinates. Kinds 0-2: the polynomial
@@ -56,6 +58,27 @@ float implicit_form(int kind, vec2 p, out vec2 grad)
            v * (v_c0.z + v * (v_c1.y + v * v_c2.y)) + u * v * (v_c1.x + u * v_c1.w + v * v_c2.x);
 }
 
+// One Newton step towards F = 0 along the gradient, from the point at offset s (px) from the
+// pixel centre; g: the gradient there, in pixels.
+vec2 newton_step(int kind, vec2 s, vec2 uvx, vec2 uvy, out vec2 g)
+{
+    vec2 G;
+    float F = implicit_form(kind, v_uv + uvx * s.x + uvy * s.y, G);
+    g = vec2(dot(G, uvx), dot(G, uvy));
+    float g2 = dot(g, g);
+    return g2 > 0.0 ? s - F / g2 * g : s;
+}
+
+// Whether the point at offset s from the centre lies in the piece's box (its slab, between the
+// cut lines, and its chord strip, which holds the control points, so the curve) grown by the
+// tolerances: a foot point outside lies on another branch of the implicit curve.
+bool on_piece(vec2 s, vec3 cutx, vec3 cuty)
+{
+    vec3 c = v_cut + cutx * s.x + cuty * s.y;
+    return c.x >= -FOOT_TOL_CUT && c.y >= -FOOT_TOL_CUT && c.z >= v_c2.z - FOOT_TOL_STRIP &&
+           c.z <= v_c2.w + FOOT_TOL_STRIP;
+}
+
 // Area of the unit pixel square centred at the origin where dot(n, q) <= t, n a unit vector.
 float halfplane_coverage(vec2 n, float t)
 {
@@ -73,6 +96,7 @@ float halfplane_coverage(vec2 n, float t)
 void main()
 {
     vec2 uvx = dFdx(v_uv), uvy = dFdy(v_uv);
+    vec3 cutx = dFdx(v_cut), cuty = dFdy(v_cut);
     int kind = int(round(v_flags.x));
     vec2 G;
     float F = implicit_form(kind, v_uv, G);
@@ -94,21 +118,37 @@ void main()
     float g2 = dot(g, g);
     if (!(g2 > 0.0))
         discard;
-    // The edge is the tangent line at the curve point nearest the centre, found by two Newton
+    // The edge is the tangent line at the curve point nearest the centre, found by three Newton
     // steps along the gradient: F / |grad F| alone is the distance to the curve only to first
     // order, and where |grad F| changes over a pixel (small pieces whose implicit cubic has its
     // double point or inflections a few pixels away, the cusp's neighbourhood) it was off by
-    // 0.15 px at 0.5 px from the curve (nurbs7 x1: 35/255).
+    // 0.15 px at 0.5 px from the curve (nurbs7 x1: 35/255); where another branch passes a pixel
+    // away, the first step overshoots twofold and two steps left the foot 0.15 px off (7/255).
     vec2 s = -F / g2 * g; // pixels
     if (dot(s, s) >= 2.25)
         discard; // beyond 1.5 px: no part of the curve in this pixel's square
-    vec2 G1;
-    float F1 = implicit_form(kind, v_uv + uvx * s.x + uvy * s.y, G1);
-    vec2 g1 = vec2(dot(G1, uvx), dot(G1, uvy));
+    vec2 g1;
+    s = newton_step(kind, s, uvx, uvy, g1);
+    s = newton_step(kind, s, uvx, uvy, g1);
+    // The other branches of a piece's implicit cubic (its C(t) for t far outside [0, 1]) are
+    // kept out of its grown control hull (curves_split.c, other_branch_near), but not out of the
+    // band around a piece a few pixels long: there the gradient at the centre can point to such a
+    // branch, and the steps land on it (nurbs7 x1: a branch at t = -36, 0.3 px from a centre
+    // 0.8 px from the curve, 41/255; the first-order distance is that branch's too). Such a foot
+    // lies outside the piece's box; then the steps start again from the centre's projection
+    // into the chord strip, a point next to the piece, from which they reach its own branch.
+    // (Not the first choice: outside a strongly curved piece the strip's edge can be pixels off
+    // the curve, and the tangent there is not the one at the nearest point.)
+    if (!on_piece(s, cutx, cuty)) {
+        vec2 gc = vec2(cutx.z, cuty.z); // the chord's unit normal in pixels
+        float gc2 = dot(gc, gc);
+        s = gc2 > 0.0 ? gc * ((clamp(v_cut.z, v_c2.z, v_c2.w) - v_cut.z) / gc2) : vec2(0.0);
+        s = newton_step(kind, s, uvx, uvy, g1);
+        s = newton_step(kind, s, uvx, uvy, g1);
+    }
     float g12 = dot(g1, g1);
     if (!(g12 > 0.0))
         discard;
-    s -= F1 / g12 * g1;
     vec2 n = v_flags.z * g1 * inversesqrt(g12); // unit normal, towards the outside
     float d = -dot(n, s);                          // the centre's signed distance, > 0 outside
     if (abs(d) >= 0.75) // beyond the square's half diagonal: the correction below is 0

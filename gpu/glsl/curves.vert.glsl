@@ -7,18 +7,18 @@
 #version 450 core
 layout(location = 0) in vec2 a_pos;
 layout(location = 1) in vec2 a_uv;
-layout(location = 2) in vec2 a_cut;   // distances past the start and before the end cut lines
+layout(location = 2) in vec3 a_cut;   // px past the start / before the end cut line, off the chord
 layout(location = 3) in vec3 a_flags; // kind (-1 fan, 0 line, 1 conic, 2 cubic), s_chord, s_in
 layout(location = 4) in vec4 a_c0;    // 1, u, v, u^2
 layout(location = 5) in vec4 a_c1;    // u v, v^2, u^3, u^2 v
-layout(location = 6) in vec4 a_c2;    // u v^2, v^3, -, -
+layout(location = 6) in vec4 a_c2;    // u v^2, v^3, chord strip: least, largest
 uniform vec2 u_size;
 out vec2 v_uv;
-out vec2 v_cut;
+out vec3 v_cut;
 flat out vec3 v_flags;
 flat out vec4 v_c0;
 flat out vec4 v_c1;
-flat out vec2 v_c2;
+flat out vec4 v_c2;
 void main()
 {
     v_uv = a_uv;
@@ -26,6 +26,6 @@ void main()
     v_flags = a_flags;
     v_c0 = a_c0;
     v_c1 = a_c1;
-    v_c2 = a_c2.xy;
+    v_c2 = a_c2;
     gl_Position = vec4(a_pos / u_size * 2.0 - 1.0, 0.0, 1.0);
 }
