@@ -6,7 +6,8 @@
  * corner), conic (an annulus of two rational-quadratic circles, even-odd), loop (a cubic whose
  * loop lies inside its parameter range, closed by a line), cusp (a cubic with a cusp, closed by a
  * line), nurbs7 (a rational degree-7 NURBS with interior knots, closed by a line: drawn through
- * the Hermite approximation, whose bound must stay <= 1/8 px at every zoom).
+ * the Hermite approximation, whose bound must stay <= SW__CURVES_REFIT_PX = 1/32 px at every
+ * zoom).
  *
  * Each is drawn at zooms x1, x10, x100, x1000 (and x0.08, where the shape is ~15 px wide and
  * takes the 8x view-based path of §5), rotated, with a sub-pixel offset, into a 256x256 RGBA8
