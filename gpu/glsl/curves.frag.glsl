@@ -18,12 +18,12 @@
 //    would end half a pixel off (nurbs7 x1: 127/255). So within EPS of the curve the centre's
 //    side is taken from the stencil (u_h: drawn once over stencil-odd pixels, once over the
 //    others), which is exact for one edge, and for several unless another one also passes nearby.
-// The coverage (§4 eq. 3-6) starts from the signed distance d = F / |grad F| (refined below by Newton steps to the nearest curve point) with grad F from the chain
-// rule over dFdx / dFdy of the local coordinates (exact: they are affine), as eq. 3 does for its
-// conic; a finite difference of F itself would be off by F'' times a pixel. Where
-// §4 maps d linearly to coverage (eq. 4, e = 1/2 - d), which is exact only for axis-aligned
-// edges (up to 0.043 = 11/255 off at 45 degrees), we take the exact area of the pixel square on
-// the inside of the line through the linearization.
+// The coverage (§4 eq. 3-6) starts from the signed distance d = F / |grad F| (refined below by
+// Newton steps to the nearest curve point) with grad F from the chain rule over dFdx / dFdy of
+// the local coordinates (exact: they are affine), as eq. 3 does for its conic; a finite
+// difference of F itself would be off by F'' times a pixel. Where §4 maps d linearly to coverage
+// (eq. 4, e = 1/2 - d), which is exact only for axis-aligned edges (up to 0.043 = 11/255 off at
+// 45 degrees), we take the exact area of the pixel square on the inside of the tangent line.
 #version 450 core
 in vec2 v_uv;
 in vec3 v_cut; // px past the start cut line, before the end cut line, left of the chord
