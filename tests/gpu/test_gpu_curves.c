@@ -42,6 +42,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define W 256
 #define H 256
@@ -386,6 +387,75 @@ static double probe_form(const double *cf, double U, double V, double g[2])
            cf[6] * U * U * U + cf[7] * U * U * V + cf[8] * U * V * V + cf[9] * V * V * V;
 }
 
+/* ---- timing (argv[3] "time"; figures for docs/curves.md, not a pass/fail test) ---------------- */
+
+static double now_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Median wall time of shape creation, and of a draw (until glFinish) at zoom x1 and x1000 with
+ * the view held still and with the view moving by a sub-pixel offset every draw. */
+static void time_draws(sw__curves_renderer *r, const sw__curves_loop *loops, uint32_t n_loops,
+                       const tshape *ts, GLuint fbo)
+{
+    enum { N = 41 };
+    double t[N];
+    sw_status st = {0};
+    for (int i = 0; i < N; ++i) {
+        sw__curves_shape *sh = NULL;
+        double t0 = now_ms();
+        if (sw__curves_shape_create(loops, n_loops, S0, &sh, &st) != SW_OK)
+            return;
+        t[i] = now_ms() - t0;
+        sw__curves_shape_free(sh);
+    }
+    qsort(t, N, sizeof t[0], cmp_double);
+    printf("  shape create (x1 tolerance): median %.3f ms\n", t[N / 2]);
+    sw__curves_shape *shape = NULL;
+    if (sw__curves_shape_create(loops, n_loops, S0, &shape, &st) != SW_OK)
+        return;
+    static const double zooms[2] = {1, 1000};
+    for (int z = 0; z < 2; ++z)
+        for (int moving = 0; moving < 2; ++moving) {
+            double s = S0 * zooms[z], c = cos(ROT), sn = sin(ROT), centre[2];
+            if (zooms[z] <= 1.0) {
+                centre[0] = 0.5 * (shape->box[0] + shape->box[2]);
+                centre[1] = 0.5 * (shape->box[1] + shape->box[3]);
+            } else {
+                memcpy(centre, ts->focus, sizeof centre);
+            }
+            sw__curves_view view = {{s * c, -s * sn, 0, s * sn, s * c, 0}, W, H};
+            const float red[4] = {1, 0, 0, 1};
+            for (int i = -1; i < N; ++i) { /* i = -1: warm-up (re-approximation, first upload) */
+                double off = moving ? 0.01 * i : 0.0;
+                view.m[2] = W / 2 + 0.37 + off - (view.m[0] * centre[0] + view.m[1] * centre[1]);
+                view.m[5] = H / 2 + 0.21 - (view.m[3] * centre[0] + view.m[4] * centre[1]);
+                glFinish();
+                double t0 = now_ms();
+                if (sw__curves_draw(r, shape, &view, red, fbo, &st) != SW_OK) {
+                    fprintf(stderr, "FAIL: draw: %s\n", st.message);
+                    return;
+                }
+                glFinish();
+                if (i >= 0)
+                    t[i] = now_ms() - t0;
+            }
+            qsort(t, N, sizeof t[0], cmp_double);
+            printf("  draw x%g, view %s: median %.3f ms (%zu pieces)\n", zooms[z],
+                   moving ? "moving" : "still ", t[N / 2], shape->n_pieces);
+        }
+    sw__curves_shape_free(shape);
+}
+
 /* ---- the run ---------------------------------------------------------------------------------- */
 
 static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshape *ts,
@@ -581,7 +651,7 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
 int main(int argc, char **argv)
 {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s DIR quadratic|conic|loop|cusp|nurbs7 [plant]\n", argv[0]);
+        fprintf(stderr, "usage: %s DIR quadratic|conic|loop|cusp|nurbs7 [plant|time]\n", argv[0]);
         return 2;
     }
     tshape ts;
@@ -590,6 +660,7 @@ int main(int argc, char **argv)
         return 2;
     }
     int plant = argc > 3 && !strcmp(argv[3], "plant");
+    int timing = argc > 3 && !strcmp(argv[3], "time");
     sw_status st = {0};
     sw_gpu_context *ctx = NULL;
     if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK) {
@@ -632,6 +703,13 @@ int main(int argc, char **argv)
     }
     printf("%s%s: %zu pieces, %zu corners\n", argv[2], plant ? " (planted sign error)" : "",
            shape->n_pieces, shape->n_corners);
+    if (timing) {
+        time_draws(r, loops, (uint32_t)ts.n_loops, &ts, fbo);
+        sw__curves_shape_free(shape);
+        sw__curves_renderer_free(r);
+        sw_gpu_context_free(ctx);
+        return 0;
+    }
     static const double zooms[5] = {1, 10, 100, 1000, 0.08};
     int ok = 1;
     double wm = 0, wx = 0;
