@@ -410,16 +410,20 @@ static void time_draws(sw__curves_renderer *r, const sw__curves_loop *loops, uin
     enum { N = 41 };
     double t[N];
     sw_status st = {0};
-    for (int i = 0; i < N; ++i) {
-        sw__curves_shape *sh = NULL;
-        double t0 = now_ms();
-        if (sw__curves_shape_create(loops, n_loops, S0, &sh, &st) != SW_OK)
-            return;
-        t[i] = now_ms() - t0;
-        sw__curves_shape_free(sh);
+    for (double zc = 1; zc <= 1000; zc *= 1000) {
+        size_t np = 0;
+        for (int i = 0; i < N; ++i) {
+            sw__curves_shape *sh = NULL;
+            double t0 = now_ms();
+            if (sw__curves_shape_create(loops, n_loops, S0 * zc, &sh, &st) != SW_OK)
+                return;
+            t[i] = now_ms() - t0;
+            np = sh->n_pieces;
+            sw__curves_shape_free(sh);
+        }
+        qsort(t, N, sizeof t[0], cmp_double);
+        printf("  shape create (x%g tolerance): median %.3f ms (%zu pieces)\n", zc, t[N / 2], np);
     }
-    qsort(t, N, sizeof t[0], cmp_double);
-    printf("  shape create (x1 tolerance): median %.3f ms\n", t[N / 2]);
     sw__curves_shape *shape = NULL;
     if (sw__curves_shape_create(loops, n_loops, S0, &shape, &st) != SW_OK)
         return;
