@@ -1057,24 +1057,99 @@ static void piece_point(const sw__curves_piece *p, double t, double out[2])
     }
 }
 
-/* Even-odd parity of a point against every piece, each as a 32-chord polyline through its
- * points at t = j / 32 (exact at t = 1/2, where create() asks). */
-static int parity(const sw__curves_piece *ps, size_t n, const double pt[2])
+/* Even-odd parity of points against the outline, each piece as a 32-chord polyline through its
+ * points at t = j / 32 (exact at t = 1/2, where build() asks). The chords are bucketed once into
+ * horizontal rows by their y range, so a point tests only the chords of its row: a chord crossing
+ * the point's horizontal line has that line's y in its range, so it is in that row. */
+#define PARITY_CHORDS 32
+
+typedef struct parity_grid {
+    double (*seg)[4]; /* x0, y0, x1, y1 */
+    size_t n_seg;
+    size_t *start; /* row r's chords: idx[start[r] .. start[r + 1]) */
+    size_t *idx;
+    size_t rows;
+    double y0, h;
+} parity_grid;
+
+static size_t grid_row(const parity_grid *g, double y)
 {
-    int in = 0;
+    double r = floor((y - g->y0) / g->h);
+    return r < 0.0 ? 0 : r >= (double)g->rows ? g->rows - 1 : (size_t)r;
+}
+
+static int parity_grid_make(parity_grid *g, const sw__curves_piece *ps, size_t n)
+{
+    memset(g, 0, sizeof *g);
+    g->n_seg = n * PARITY_CHORDS;
+    g->seg = malloc(sizeof *g->seg * (g->n_seg ? g->n_seg : 1));
+    if (!g->seg)
+        return 0;
+    double lo = INFINITY, hi = -INFINITY;
     for (size_t i = 0; i < n; ++i) {
-        const int m = 32;
         double prev[2] = {ps[i].cp[0][0], ps[i].cp[0][1]};
-        for (int j = 1; j <= m; ++j) {
-            double cur[2];
-            piece_point(&ps[i], (double)j / m, cur);
-            if ((prev[1] > pt[1]) != (cur[1] > pt[1])) {
-                double x = prev[0] + (pt[1] - prev[1]) * (cur[0] - prev[0]) / (cur[1] - prev[1]);
-                if (x > pt[0])
-                    in ^= 1;
-            }
+        for (int j = 1; j <= PARITY_CHORDS; ++j) {
+            double cur[2], *sg = g->seg[i * PARITY_CHORDS + (size_t)(j - 1)];
+            piece_point(&ps[i], (double)j / PARITY_CHORDS, cur);
+            sg[0] = prev[0];
+            sg[1] = prev[1];
+            sg[2] = cur[0];
+            sg[3] = cur[1];
+            lo = fmin(lo, fmin(prev[1], cur[1]));
+            hi = fmax(hi, fmax(prev[1], cur[1]));
             prev[0] = cur[0];
             prev[1] = cur[1];
+        }
+    }
+    g->rows = (size_t)sqrt((double)g->n_seg) + 1;
+    g->y0 = lo;
+    g->h = hi > lo ? (hi - lo) / (double)g->rows : 1.0;
+    g->start = calloc(g->rows + 1, sizeof *g->start);
+    if (!g->start)
+        return 0;
+    for (int pass = 0; pass < 2; ++pass) { /* count, then fill */
+        for (size_t k = 0; k < g->n_seg; ++k) {
+            const double *sg = g->seg[k];
+            size_t r0 = grid_row(g, fmin(sg[1], sg[3])), r1 = grid_row(g, fmax(sg[1], sg[3]));
+            for (size_t r = r0; r <= r1; ++r) {
+                if (pass == 0)
+                    g->start[r + 1]++;
+                else
+                    g->idx[g->start[r]++] = k;
+            }
+        }
+        if (pass == 0) {
+            for (size_t r = 0; r < g->rows; ++r)
+                g->start[r + 1] += g->start[r];
+            g->idx = malloc(sizeof *g->idx * (g->start[g->rows] ? g->start[g->rows] : 1));
+            if (!g->idx)
+                return 0;
+        } else { /* the fill advanced each start to the next row's: shift back */
+            for (size_t r = g->rows; r > 0; --r)
+                g->start[r] = g->start[r - 1];
+            g->start[0] = 0;
+        }
+    }
+    return 1;
+}
+
+static void parity_grid_free(parity_grid *g)
+{
+    free(g->seg);
+    free(g->start);
+    free(g->idx);
+}
+
+static int parity(const parity_grid *g, const double pt[2])
+{
+    int in = 0;
+    size_t r = grid_row(g, pt[1]);
+    for (size_t k = g->start[r]; k < g->start[r + 1]; ++k) {
+        const double *sg = g->seg[g->idx[k]];
+        if ((sg[1] > pt[1]) != (sg[3] > pt[1])) {
+            double x = sg[0] + (pt[1] - sg[1]) * (sg[2] - sg[0]) / (sg[3] - sg[1]);
+            if (x > pt[0])
+                in ^= 1;
         }
     }
     return in;
@@ -1105,8 +1180,11 @@ static sw_result build(sw__curves_shape *s, sw_status *status)
         /* Which side is inside, by parity just left of each piece's mid point: orient() took
          * the left. Loop orientation alone cannot say it: a self-crossing loop (a loop cubic
          * closed by a line) has its inside on the left in one lobe and on the right in the
-         * other. Quadratic in the pieces; fine for outlines of a few thousand pieces. */
-        for (size_t i = 0; i < b.n; ++i) {
+         * other. */
+        parity_grid grid;
+        if (!parity_grid_make(&grid, b.p, b.n))
+            b.err = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
+        for (size_t i = 0; i < b.n && b.err == SW_OK; ++i) {
             sw__curves_piece *p = &b.p[i];
             double m[2], a[2], e[2];
             piece_point(p, 0.5, m);
@@ -1117,9 +1195,10 @@ static sw_result build(sw__curves_shape *s, sw_status *status)
                                  p->cp[p->n_cp - 1][1] - p->cp[0][1]);
             double eps = 1e-3 * chord / len;
             double q[2] = {m[0] - eps * d[1], m[1] + eps * d[0]};
-            if (!parity(b.p, b.n, q))
+            if (!parity(&grid, q))
                 p->s_in = -p->s_in;
         }
+        parity_grid_free(&grid);
     }
     if (b.err != SW_OK) {
         free(b.p);
