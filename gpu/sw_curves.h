@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Resolution-independent filled 2D outlines (issue 21 items 1 and 2): closed loops of lines and
+/* Resolution-independent filled 2D outlines (Santana §3-§5): closed loops of lines and
  * rational NURBS curves of any degree, filled by even-odd parity, with edges that stay exact and
  * anti-aliased at any zoom. Never installed.
  *
@@ -11,8 +11,8 @@
  *    implicit cubic k^3 - l m for integral cubics, classified serpentine / loop / cusp and split
  *    at inflections, double points and cusps). Higher degrees and rational cubics are replaced by
  *    C1 cubic Hermite pieces with a rigorous distance bound, built to 1/256 px and re-done when
- *    the view's zoom pushes that bound above 1/32 px (sw__curves_shape_fit_view). The issue asks
- *    for 1/8 px; that is too late: shifting an edge by 1/8 px can change a pixel's coverage by
+ *    the view's zoom pushes that bound above 1/32 px (sw__curves_shape_fit_view). Not at 1/8 px:
+ *    that is too late: shifting an edge by 1/8 px can change a pixel's coverage by
  *    32/255, beyond the 12/255 budget (SW__CURVES_REFIT_PX below).
  *  - The interior: instead of §3.1's constrained Delaunay triangulation, a stencil fan over the
  *    pieces' end points toggled with GL_INVERT (as the trim atlas does, Guthe et al. 2005 §4), the
@@ -94,8 +94,8 @@ typedef struct sw__curves_shape {
 } sw__curves_shape;
 
 /* The approximations' bound in pixels: built to SW__CURVES_BUILD_PX at the zoom asked for, redone
- * when a zoom pushes it above SW__CURVES_REFIT_PX. The issue asks for a redo above 1/8 px; we redo
- * earlier because a displacement of e px moves a pixel's coverage by up to e: 1/8 px is 32/255,
+ * when a zoom pushes it above SW__CURVES_REFIT_PX, not as late as 1/8 px,
+ * because a displacement of e px moves a pixel's coverage by up to e: 1/8 px is 32/255,
  * beyond the 12/255 coverage budget. 1/256 px costs about 2x the pieces of 1/16 px (the Hermite
  * error falls as h^4) and is redone every 8x of zoom. */
 #define SW__CURVES_BUILD_PX (1.0 / 256.0)

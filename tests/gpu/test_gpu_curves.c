@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Exact anti-aliased outlines (gpu/curves.c, issue 21 items 1-2; Santana §3-§5) against exact
+/* Exact anti-aliased outlines (gpu/curves.c; Santana §3-§5) against exact
  * area coverage computed here in double precision.
  *
  * One curve class per run (argv[2]): quadratic (a closed quadratic B-spline, TrueType-like, no
