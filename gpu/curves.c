@@ -3,8 +3,8 @@
  *
  * Per draw, on the CPU in double: the view's pixel positions of three triangle sets — the stencil
  * fan over the pieces' end points plus each curved piece's control hull (Santana §3's curved
- * triangles), a cover rectangle, and each piece's band (its control hull grown by 0.75 px: every pixel of its slab whose square
- * meets the curve) — with the piece's local coordinates at each
+ * triangles), a cover rectangle, and each piece's band (its control hull grown by 0.75 px: every
+ * pixel of its slab whose square meets the curve) — with the piece's local coordinates at each
  * vertex and its implicit form expanded in them (local_form). Then
  * four passes: stencil parity, cover, edge corrections (glsl/curves.frag.glsl) into a float
  * coverage target, and the composite over the caller's framebuffer
@@ -30,13 +30,13 @@
  * the hull grown by only the pixel square (0.5 px) misses pixels at joins whose square meets the
  * curve just past the cut line (nurbs7 x1: 36/255). */
 #define BAND_MARGIN 0.75
-#define VBAA_SIZE 24.0  /* px: shapes smaller than this on screen go through the 8x path */
+#define VBAA_SIZE 24.0 /* px: shapes smaller than this on screen go through the 8x path */
 #define VBAA_SCALE 8
 
 typedef struct vtx {
     float pos[2];
-    float uv[2]; /* the piece's local coordinates: (model - centre) / size */
-    float cut[3];   /* px past the start cut line, before the end cut line, left of the chord */
+    float uv[2];  /* the piece's local coordinates: (model - centre) / size */
+    float cut[3]; /* px past the start cut line, before the end cut line, left of the chord */
     float flags[3];
     /* F(u, v): 1, u, v, u^2, u v, v^2, u^3, u^2 v, u v^2, v^3; then the least and the largest
      * signed distance (px) of the control points from the chord: the strip holding the piece */
@@ -72,8 +72,7 @@ static bipoly bp_mul(const bipoly *x, const bipoly *y)
 
 /* The local form of piece p around the box `box` (model x0, y0, x1, y1; NULL: the piece's
  * control points' box). */
-static void local_form_make(const sw__curves_piece *p, int fault, const double *box,
-                            local_form *f)
+static void local_form_make(const sw__curves_piece *p, int fault, const double *box, local_form *f)
 {
     double lo[2] = {p->cp[0][0], p->cp[0][1]}, hi[2] = {lo[0], lo[1]};
     for (int i = 1; i < p->n_cp; ++i)
@@ -515,7 +514,8 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
         }
     }
     int ss = r->vbaa && (hi[0] - lo[0] < VBAA_SIZE || hi[1] - lo[1] < VBAA_SIZE) ? VBAA_SCALE : 1;
-    int32_t x0 = (int32_t)floor(fmax(lo[0] - 2.0, 0.0)), y0 = (int32_t)floor(fmax(lo[1] - 2.0, 0.0));
+    int32_t x0 = (int32_t)floor(fmax(lo[0] - 2.0, 0.0)),
+            y0 = (int32_t)floor(fmax(lo[1] - 2.0, 0.0));
     int32_t x1 = (int32_t)ceil(fmin(hi[0] + 2.0, view->width)),
             y1 = (int32_t)ceil(fmin(hi[1] + 2.0, view->height));
     if (x1 <= x0 || y1 <= y0)
@@ -619,7 +619,7 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     glClear(GL_COLOR_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     glUseProgram(r->prog);
     glUniform2f(r->loc_size, (float)tw, (float)th);
-    
+
     /* 1: parity into the stencil's low bit */
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glEnable(GL_STENCIL_TEST);

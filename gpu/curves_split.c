@@ -144,10 +144,11 @@ static void piece_grad(const sw__curves_piece *p, double x, double y, double g[2
             g[c] = p->klm[1][c] + rk * p->klm[0][c];
         return;
     }
-    double ck = p->kind == SW__CURVES_LINE ? 1.0
+    double ck = p->kind == SW__CURVES_LINE    ? 1.0
                 : p->kind == SW__CURVES_CONIC ? 2.0 * v[0]
                                               : 3.0 * v[0] * v[0];
-    double cl = p->kind == SW__CURVES_LINE ? 0.0 : -v[2], cm = p->kind == SW__CURVES_LINE ? 0.0 : -v[1];
+    double cl = p->kind == SW__CURVES_LINE ? 0.0 : -v[2],
+           cm = p->kind == SW__CURVES_LINE ? 0.0 : -v[1];
     for (int c = 0; c < 2; ++c)
         g[c] = ck * p->klm[0][c] + cl * p->klm[1][c] + cm * p->klm[2][c];
 }
@@ -161,7 +162,8 @@ static void orient(sw__curves_piece *p, const double mid[2], const double dmid[2
     if (p->kind == SW__CURVES_LINE) {
         p->s_chord = 1.0;
     } else {
-        double cx = 0.5 * (p->cp[0][0] + p->cp[n - 1][0]), cy = 0.5 * (p->cp[0][1] + p->cp[n - 1][1]);
+        double cx = 0.5 * (p->cp[0][0] + p->cp[n - 1][0]),
+               cy = 0.5 * (p->cp[0][1] + p->cp[n - 1][1]);
         p->s_chord = sw__curves_piece_eval(p, cx, cy) < 0.0 ? 1.0 : -1.0;
     }
     double g[2];
@@ -319,7 +321,8 @@ static void emit_conic(builder *b, const double q[3][2], const double w[3], int 
     orient(p, mid, dmid);
 }
 
-/* ---- integral cubics (Loop & Blinn 2005 §4) --------------------------------------------------- */
+/* ---- integral cubics (Loop & Blinn 2005 §4) ---------------------------------------------------
+ */
 
 static void cubic_split(const double q[4][2], double t, double l[4][2], double r[4][2])
 {
@@ -423,8 +426,7 @@ static double fit_affine(const double q[4][2], const double v[4], double phi[3])
 }
 
 /* Power-basis coefficients of the cubic and the crosses x12, x13, x23 of c1, c2, c3. */
-static void cubic_power(const double q[4][2], double c[4][2], double *x12, double *x13,
-                        double *x23)
+static void cubic_power(const double q[4][2], double c[4][2], double *x12, double *x13, double *x23)
 {
     for (int k = 0; k < 2; ++k) {
         c[0][k] = q[0][k];
@@ -447,8 +449,7 @@ static cubic_class cubic_classify(const double q[4][2], double roots[2], int *n_
 {
     double c[4][2], x12, x13, x23;
     cubic_power(q, c, &x12, &x13, &x23);
-    double s1 = hypot(c[1][0], c[1][1]), s2 = hypot(c[2][0], c[2][1]),
-           s3 = hypot(c[3][0], c[3][1]);
+    double s1 = hypot(c[1][0], c[1][1]), s2 = hypot(c[2][0], c[2][1]), s3 = hypot(c[3][0], c[3][1]);
     double sc = fmax(s1, fmax(s2, s3));
     *n_roots = 0;
     if (s3 <= 1e-12 * sc)
@@ -599,8 +600,8 @@ static int other_branch_near(const double q[4][2])
             double p[2] = {((c[3][0] * t + c[2][0]) * t + c[1][0]) * t + c[0][0],
                            ((c[3][1] * t + c[2][1]) * t + c[1][1]) * t + c[0][1]};
             double ed[2] = {bq[0] - a[0], bq[1] - a[1]};
-            double s = ((p[0] - a[0]) * ed[0] + (p[1] - a[1]) * ed[1]) /
-                       (ed[0] * ed[0] + ed[1] * ed[1]);
+            double s =
+                ((p[0] - a[0]) * ed[0] + (p[1] - a[1]) * ed[1]) / (ed[0] * ed[0] + ed[1] * ed[1]);
             if (s < 0.0 || s >= 1.0)
                 continue;
             if (t > 1.0)
@@ -644,9 +645,8 @@ static void emit_cubic_rec(builder *b, const double q[4][2], int depth, const cu
     double turn = polygon_turn(q, 4, &convex);
     double e[2] = {q[3][0] - q[0][0], q[3][1] - q[0][1]};
     int closed = hypot(e[0], e[1]) <= 1e-9 * (fabs(q[1][0] - q[0][0]) + fabs(q[1][1] - q[0][1]) +
-                                               fabs(q[2][0] - q[0][0]) + fabs(q[2][1] - q[0][1]));
-    if ((turn > MAX_TURN || !convex || closed || other_branch_near(q)) &&
-        depth < MAX_SPLIT_DEPTH) {
+                                              fabs(q[2][0] - q[0][0]) + fabs(q[2][1] - q[0][1]));
+    if ((turn > MAX_TURN || !convex || closed || other_branch_near(q)) && depth < MAX_SPLIT_DEPTH) {
         double l[4][2], r[4][2];
         cubic_split(q, 0.5, l, r);
         cubic_info li = info_map(ci, 0.0, 0.5), ri = info_map(ci, 0.5, 1.0);
@@ -1045,9 +1045,8 @@ static void piece_point(const sw__curves_piece *p, double t, double out[2])
     for (int c = 0; c < 2; ++c) {
         if (p->kind == SW__CURVES_CONIC) {
             double W = mt * mt + 2 * p->w * mt * t + t * t;
-            out[c] = (mt * mt * p->cp[0][c] + 2 * p->w * mt * t * p->cp[1][c] +
-                      t * t * p->cp[2][c]) /
-                     W;
+            out[c] =
+                (mt * mt * p->cp[0][c] + 2 * p->w * mt * t * p->cp[1][c] + t * t * p->cp[2][c]) / W;
         } else if (p->kind == SW__CURVES_CUBIC || p->kind == SW__CURVES_CUSP) {
             out[c] = mt * mt * mt * p->cp[0][c] + 3 * mt * mt * t * p->cp[1][c] +
                      3 * mt * t * t * p->cp[2][c] + t * t * t * p->cp[3][c];
@@ -1191,8 +1190,8 @@ static sw_result build(sw__curves_shape *s, sw_status *status)
             piece_point(p, 0.5 - 1e-4, a);
             piece_point(p, 0.5 + 1e-4, e);
             double d[2] = {e[0] - a[0], e[1] - a[1]}, len = hypot(d[0], d[1]);
-            double chord = hypot(p->cp[p->n_cp - 1][0] - p->cp[0][0],
-                                 p->cp[p->n_cp - 1][1] - p->cp[0][1]);
+            double chord =
+                hypot(p->cp[p->n_cp - 1][0] - p->cp[0][0], p->cp[p->n_cp - 1][1] - p->cp[0][1]);
             double eps = 1e-3 * chord / len;
             double q[2] = {m[0] - eps * d[1], m[1] + eps * d[0]};
             if (!parity(&grid, q))

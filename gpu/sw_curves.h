@@ -60,14 +60,14 @@ typedef enum sw__curves_kind {
 /* One drawable piece, in the shape's (model) coordinates. */
 typedef struct sw__curves_piece {
     int32_t kind;
-    int32_t n_cp;        /* 2, 3 or 4 Euclidean control points */
-    double cp[4][2];     /* for a conic, cp[1] is the off-curve point and w its normalized weight */
-    double w;            /* conic only: middle weight with end weights 1 */
-    double branch;       /* cusp only: +1 or -1, which branch of k^3 = l^2 */
-    double klm[3][3];    /* affine functionals: value = a x + b y + c with klm[j] = {a, b, c} */
-    double s_chord;      /* sign: s_chord F < 0 between the chord and the curve (near the curve) */
-    double s_in;         /* sign: s_in F < 0 on the inside (fill) side of the piece */
-    double tan0[2];      /* unit tangents at the start and the end (direction of travel) */
+    int32_t n_cp;     /* 2, 3 or 4 Euclidean control points */
+    double cp[4][2];  /* for a conic, cp[1] is the off-curve point and w its normalized weight */
+    double w;         /* conic only: middle weight with end weights 1 */
+    double branch;    /* cusp only: +1 or -1, which branch of k^3 = l^2 */
+    double klm[3][3]; /* affine functionals: value = a x + b y + c with klm[j] = {a, b, c} */
+    double s_chord;   /* sign: s_chord F < 0 between the chord and the curve (near the curve) */
+    double s_in;      /* sign: s_in F < 0 on the inside (fill) side of the piece */
+    double tan0[2];   /* unit tangents at the start and the end (direction of travel) */
     double tan1[2];
     uint32_t loop;
     uint32_t approx; /* 1: part of a Hermite approximation of a higher-degree / rational cubic */
@@ -81,11 +81,11 @@ typedef struct sw__curves_shape {
     uint32_t n_loops;
     double (*corners)[2];
     size_t n_corners;
-    double box[4];         /* x0, y0, x1, y1 of the control points */
-    double approx_bound;   /* largest distance bound of an approximated piece (model units) */
-    double approx_tol;     /* the tolerance the approximations were built for */
-    uint32_t rebuilds;     /* how many times sw__curves_shape_fit_view re-approximated */
-    uint32_t n_approx;     /* pieces from approximations */
+    double box[4];       /* x0, y0, x1, y1 of the control points */
+    double approx_bound; /* largest distance bound of an approximated piece (model units) */
+    double approx_tol;   /* the tolerance the approximations were built for */
+    uint32_t rebuilds;   /* how many times sw__curves_shape_fit_view re-approximated */
+    uint32_t n_approx;   /* pieces from approximations */
     /* the input, copied, for rebuilds */
     uint32_t n_src_loops;
     uint32_t *src_loop_n; /* curves per loop */

@@ -60,12 +60,12 @@ typedef struct tcurve {
 typedef struct tshape {
     tcurve c[4];
     int n_curves;
-    int loop_of[4];    /* loop index of each curve (curves of one loop are consecutive) */
-    double sign[4];    /* the reference's winding weight per loop */
+    int loop_of[4]; /* loop index of each curve (curves of one loop are consecutive) */
+    double sign[4]; /* the reference's winding weight per loop */
     int n_loops;
     double corners[8][2];
     int n_corners;
-    double focus[2];   /* an on-curve point the zooms centre on */
+    double focus[2]; /* an on-curve point the zooms centre on */
 } tshape;
 
 static void line_curve(tcurve *c, const double a[2], const double b[2])
@@ -85,7 +85,8 @@ static void circle(tcurve *c, double cx, double cy, double r, double phase)
     double k[12] = {0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4};
     memcpy(c->knots, k, sizeof k);
     for (int i = 0; i < 9; ++i) {
-        double a = phase + M_PI / 4 * i, w = (i % 2) ? sqrt(0.5) : 1.0, rr = (i % 2) ? r * sqrt(2) : r;
+        double a = phase + M_PI / 4 * i, w = (i % 2) ? sqrt(0.5) : 1.0,
+               rr = (i % 2) ? r * sqrt(2) : r;
         c->cpw[3 * i] = w * (cx + rr * cos(a));
         c->cpw[3 * i + 1] = w * (cy + rr * sin(a));
         c->cpw[3 * i + 2] = w;
@@ -207,7 +208,8 @@ static int make_shape(const char *cls, tshape *s)
     return 1;
 }
 
-/* ---- reference: flattening and exact clipped area ---------------------------------------------- */
+/* ---- reference: flattening and exact clipped area ----------------------------------------------
+ */
 
 typedef struct poly {
     double (*p)[2];
@@ -230,7 +232,8 @@ static void poly_add(poly *pl, const double q[2])
 /* h: homogeneous Bézier (degree p) already in pixel space. Emits the end point of each chord. */
 static void flatten_bez(const double *h, int p, poly *pl, int depth)
 {
-    double a[2] = {h[0] / h[2], h[1] / h[2]}, e[2] = {h[3 * p] / h[3 * p + 2], h[3 * p + 1] / h[3 * p + 2]};
+    double a[2] = {h[0] / h[2], h[1] / h[2]},
+           e[2] = {h[3 * p] / h[3 * p + 2], h[3 * p + 1] / h[3 * p + 2]};
     double d[2] = {e[0] - a[0], e[1] - a[1]}, len2 = d[0] * d[0] + d[1] * d[1], worst = 0;
     for (int i = 1; i < p; ++i) {
         double q[2] = {h[3 * i] / h[3 * i + 2] - a[0], h[3 * i + 1] / h[3 * i + 2] - a[1]};
@@ -293,7 +296,9 @@ static void flatten_curve(const tcurve *c, const double v[6], poly *pl)
     for (int s = 0; s + p < n; s += p) {
         double h[3 * 32];
         for (int i = 0; i <= p; ++i) {
-            double e[2] = {cpw[3 * (s + i)] / cpw[3 * (s + i) + 2], cpw[3 * (s + i) + 1] / cpw[3 * (s + i) + 2]}, q[2];
+            double e[2] = {cpw[3 * (s + i)] / cpw[3 * (s + i) + 2],
+                           cpw[3 * (s + i) + 1] / cpw[3 * (s + i) + 2]},
+                   q[2];
             to_px(v, e, q);
             double w = cpw[3 * (s + i) + 2];
             h[3 * i] = w * q[0];
@@ -381,13 +386,16 @@ static void area_accumulate(const poly *pl, double sign, double *cov)
 /* A local form's value and gradient (polynomial kinds only), for the probe. */
 static double probe_form(const double *cf, double U, double V, double g[2])
 {
-    g[0] = cf[1] + 2 * cf[3] * U + cf[4] * V + 3 * cf[6] * U * U + 2 * cf[7] * U * V + cf[8] * V * V;
-    g[1] = cf[2] + cf[4] * U + 2 * cf[5] * V + cf[7] * U * U + 2 * cf[8] * U * V + 3 * cf[9] * V * V;
+    g[0] =
+        cf[1] + 2 * cf[3] * U + cf[4] * V + 3 * cf[6] * U * U + 2 * cf[7] * U * V + cf[8] * V * V;
+    g[1] =
+        cf[2] + cf[4] * U + 2 * cf[5] * V + cf[7] * U * U + 2 * cf[8] * U * V + 3 * cf[9] * V * V;
     return cf[0] + cf[1] * U + cf[2] * V + cf[3] * U * U + cf[4] * U * V + cf[5] * V * V +
            cf[6] * U * U * U + cf[7] * U * U * V + cf[8] * U * V * V + cf[9] * V * V * V;
 }
 
-/* ---- timing (argv[3] "time"; figures for docs/curves.md, not a pass/fail test) ---------------- */
+/* ---- timing (argv[3] "time"; figures for docs/curves.md, not a pass/fail test) ----------------
+ */
 
 static double now_ms(void)
 {
@@ -460,11 +468,11 @@ static void time_draws(sw__curves_renderer *r, const sw__curves_loop *loops, uin
     sw__curves_shape_free(shape);
 }
 
-/* ---- the run ---------------------------------------------------------------------------------- */
+/* ---- the run ----------------------------------------------------------------------------------
+ */
 
-static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshape *ts,
-                    double zoom, GLuint fbo, int print_only_fail, double *worst_mean,
-                    double *worst_max)
+static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshape *ts, double zoom,
+                    GLuint fbo, int print_only_fail, double *worst_mean, double *worst_max)
 {
     (void)print_only_fail;
     double centre[2];
@@ -513,7 +521,7 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
         free(pl.p);
     }
     /* corners: the shape's own list (cusps, crossings, joins) and the test's */
-    double (*cn)[2] = malloc(sizeof *cn * (shape->n_corners + ts->n_corners + 1));
+    double(*cn)[2] = malloc(sizeof *cn * (shape->n_corners + ts->n_corners + 1));
     size_t ncn = 0;
     for (size_t k = 0; k < shape->n_corners; ++k)
         to_px(v, shape->corners[k], cn[ncn++]);
@@ -562,52 +570,71 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
             const sw__curves_piece *p = &shape->pieces[k];
             double lo0 = 1e9, lo1 = 1e9, hi0 = -1e9, hi1 = -1e9;
             for (int q = 0; q < p->n_cp; ++q) {
-                lo0 = fmin(lo0, p->cp[q][0]); hi0 = fmax(hi0, p->cp[q][0]);
-                lo1 = fmin(lo1, p->cp[q][1]); hi1 = fmax(hi1, p->cp[q][1]);
+                lo0 = fmin(lo0, p->cp[q][0]);
+                hi0 = fmax(hi0, p->cp[q][0]);
+                lo1 = fmin(lo1, p->cp[q][1]);
+                hi1 = fmax(hi1, p->cp[q][1]);
             }
             double m = (getenv("SW_CURVES_PROBE_ALL") ? 1e9 : 3) / s;
             if (mx_ > lo0 - m && mx_ < hi0 + m && my_ > lo1 - m && my_ < hi1 + m) {
-                printf("piece %zu kind %d s_chord %g s_in %g F %g:", k, p->kind, p->s_chord, p->s_in,
-                       sw__curves_piece_eval(p, mx_, my_));
+                printf("piece %zu kind %d s_chord %g s_in %g F %g:", k, p->kind, p->s_chord,
+                       p->s_in, sw__curves_piece_eval(p, mx_, my_));
                 for (int q = 0; q < p->n_cp; ++q)
                     printf(" (%.6f,%.6f)", p->cp[q][0], p->cp[q][1]);
                 double ce[2], sz, cf[10];
                 sw__curves_piece_local_form(p, ce, &sz, cf);
                 float u = (float)((mx_ - ce[0]) / sz), vv = (float)((my_ - ce[1]) / sz);
-                float uu[10] = {1, u, vv, u * u, u * vv, vv * vv, u * u * u, u * u * vv, u * vv * vv, vv * vv * vv};
+                float uu[10] = {1,       u,         vv,         u * u,       u * vv,
+                                vv * vv, u * u * u, u * u * vv, u * vv * vv, vv * vv * vv};
                 float Ff = 0;
                 for (int q = 0; q < 10; ++q)
                     Ff += (float)cf[q] * uu[q];
                 double U = (mx_ - ce[0]) / sz, V = (my_ - ce[1]) / sz;
-                double Fd = cf[0] + cf[1] * U + cf[2] * V + cf[3] * U * U + cf[4] * U * V + cf[5] * V * V +
-                            cf[6] * U * U * U + cf[7] * U * U * V + cf[8] * U * V * V + cf[9] * V * V * V;
-                double Fu = cf[1] + 2 * cf[3] * U + cf[4] * V + 3 * cf[6] * U * U + 2 * cf[7] * U * V + cf[8] * V * V;
-                double Fv = cf[2] + cf[4] * U + 2 * cf[5] * V + cf[7] * U * U + 2 * cf[8] * U * V + 3 * cf[9] * V * V;
+                double Fd = cf[0] + cf[1] * U + cf[2] * V + cf[3] * U * U + cf[4] * U * V +
+                            cf[5] * V * V + cf[6] * U * U * U + cf[7] * U * U * V +
+                            cf[8] * U * V * V + cf[9] * V * V * V;
+                double Fu = cf[1] + 2 * cf[3] * U + cf[4] * V + 3 * cf[6] * U * U +
+                            2 * cf[7] * U * V + cf[8] * V * V;
+                double Fv = cf[2] + cf[4] * U + 2 * cf[5] * V + cf[7] * U * U + 2 * cf[8] * U * V +
+                            3 * cf[9] * V * V;
                 double cut0 = (mx_ - p->cp[0][0]) * p->tan0[0] + (my_ - p->cp[0][1]) * p->tan0[1];
-                double cut1 = (p->cp[p->n_cp - 1][0] - mx_) * p->tan1[0] + (p->cp[p->n_cp - 1][1] - my_) * p->tan1[1];
+                double cut1 = (p->cp[p->n_cp - 1][0] - mx_) * p->tan1[0] +
+                              (p->cp[p->n_cp - 1][1] - my_) * p->tan1[1];
                 {
                     double gx = Fu / sz, gy = Fv / sz; /* model gradient */
                     /* pixel gradient: grad_px = M^-T grad_model */
-                    double ipx = (v[4] * gx - v[3] * gy) / det, ipy = (-v[1] * gx + v[0] * gy) / det;
+                    double ipx = (v[4] * gx - v[3] * gy) / det,
+                           ipy = (-v[1] * gx + v[0] * gy) / det;
                     double dd = p->s_in * Fd / hypot(ipx, ipy);
-                    double nx = p->s_in * ipx / hypot(ipx, ipy), ny = p->s_in * ipy / hypot(ipx, ipy);
+                    double nx = p->s_in * ipx / hypot(ipx, ipy),
+                           ny = p->s_in * ipy / hypot(ipx, ipy);
                     double a = fmax(fabs(nx), fabs(ny)), bq = fmin(fabs(nx), fabs(ny));
                     double lo = 0.5 * (a - bq), hi = 0.5 * (a + bq), t = -dd, at = fabs(t), cv;
-                    if (at >= hi) cv = 1; else if (at <= lo) cv = 0.5 + at / a; else cv = 1 - (hi - at) * (hi - at) / (2 * a * bq);
-                    if (t < 0) cv = 1 - cv;
+                    if (at >= hi)
+                        cv = 1;
+                    else if (at <= lo)
+                        cv = 0.5 + at / a;
+                    else
+                        cv = 1 - (hi - at) * (hi - at) / (2 * a * bq);
+                    if (t < 0)
+                        cv = 1 - cv;
                     printf("\n   pixel d %g cov %g correction %g", dd, cv, cv - (dd < 0));
                     /* two Newton steps as the shader takes them, in model units */
                     double P[2] = {U, V}, gg[2];
                     for (int it = 0; it < 3; ++it) {
-                        double F0 = probe_form(cf, P[0], P[1], gg), g2 = gg[0] * gg[0] + gg[1] * gg[1];
-                        printf("\n   newton %d: F %g at offset (%g, %g) px", it, F0, (P[0] - U) * sz * s, (P[1] - V) * sz * s);
+                        double F0 = probe_form(cf, P[0], P[1], gg),
+                               g2 = gg[0] * gg[0] + gg[1] * gg[1];
+                        printf("\n   newton %d: F %g at offset (%g, %g) px", it, F0,
+                               (P[0] - U) * sz * s, (P[1] - V) * sz * s);
                         P[0] -= F0 / g2 * gg[0];
                         P[1] -= F0 / g2 * gg[1];
                     }
-                    double cx_ = P[0] * sz + ce[0], cy_ = P[1] * sz + ce[1], cd = hypot(cx_ - mx_, cy_ - my_) * s;
+                    double cx_ = P[0] * sz + ce[0], cy_ = P[1] * sz + ce[1],
+                           cd = hypot(cx_ - mx_, cy_ - my_) * s;
                     printf("\n   foot at %g px", cd);
                 }
-                printf("\n   d_px %g (s_in d %g) cut0 %g cut1 %g px", Fd / hypot(Fu, Fv) * sz * s, p->s_in * Fd / hypot(Fu, Fv) * sz * s, cut0 * s, cut1 * s);
+                printf("\n   d_px %g (s_in d %g) cut0 %g cut1 %g px", Fd / hypot(Fu, Fv) * sz * s,
+                       p->s_in * Fd / hypot(Fu, Fv) * sz * s, cut0 * s, cut1 * s);
                 printf("\n   local u %g v %g Ffloat %g coefs", u, vv, Ff);
                 for (int q = 0; q < 10; ++q)
                     printf(" %.3g", cf[q]);
@@ -642,9 +669,9 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
     printf("  zoom x%-6g pieces %4zu (approx %3u, bound %.4f px, rebuilds %u)  edge px %5zu  "
            "mean %5.2f/255  max %5.2f/255 at (%d,%d)  | near corners: %3zu px, mean %6.2f/255, "
            "max %6.2f/255  | composite mismatches %zu\n",
-           zoom, shape->n_pieces, shape->n_approx, shape->approx_bound * s, shape->rebuilds,
-           n_edge, mean * 255, mx * 255, mxi, mxj, n_corner,
-           n_corner ? csum / n_corner * 255 : 0.0, cmx * 255, bad_comp);
+           zoom, shape->n_pieces, shape->n_approx, shape->approx_bound * s, shape->rebuilds, n_edge,
+           mean * 255, mx * 255, mxi, mxj, n_corner, n_corner ? csum / n_corner * 255 : 0.0,
+           cmx * 255, bad_comp);
     *worst_mean = fmax(*worst_mean, mean);
     *worst_max = fmax(*worst_max, mx);
     int ok = mean <= 2.0 / 255 && mx <= 12.0 / 255 && bad_comp == 0 && n_edge > 0 &&
