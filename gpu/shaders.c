@@ -9,6 +9,7 @@
  * crack-filling lines into a trim texture (§4); and the present program that composites the frame
  * into a host's framebuffer by depth. Each file says what its stage does. */
 #include "sw_glsl_sources.h"
+#include "sw_curves.h"
 #include "sw_gpu_internal.h"
 #include "sw_status_util.h"
 
@@ -180,4 +181,12 @@ const char *sw__gpu_glsl_source(int kind)
         &k_surface_fs_main,      &k_eval_vs,         &k_exact_vs,
     };
     return kind >= 0 && kind < SW__GPU_GLSL_KINDS ? *k_parts[kind] : NULL;
+}
+
+/* The curve programs' sources (gpu/curves.c links them itself; sw_curves.h). */
+const char *sw__gpu_curves_glsl(int which)
+{
+    static const char *const k_curves[3] = {sw_glsl_curves_vert, sw_glsl_curves_frag,
+                                            sw_glsl_curves_composite_frag};
+    return which >= 0 && which < 3 ? k_curves[which] : NULL;
 }
