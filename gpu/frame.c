@@ -117,6 +117,7 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
                         "frame: the static LODs belong to another scene");
     /* static LODs cull and draw only the scene's own occurrences, and not on the exact path */
     env->statics = env->exact || d->occurrences ? NULL : d->static_lods;
+    env->pool = d->pool;
     memcpy(env->view.eye, d->camera.eye, sizeof env->view.eye);
     return SW_OK;
 }

@@ -29,6 +29,7 @@
 #include "sw_sg_bvh.h"
 #include "sw_sg_trim.h"
 
+#include <stdatomic.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -63,6 +64,7 @@ typedef struct sw__fr_env {
     int lod_colors;             /* desc.lod_colors */
     int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
+    sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
 } sw__fr_env;
 
 /* The constants of a frame of desc (its defaults resolved by sw__gpu_desc_defaults) but the view:
@@ -261,16 +263,27 @@ typedef struct sw__fr_tess {
     const sw__fr_env *env;
     sw_gpu_frame_stats *st;
     sw__fr_geometry *geo;
-    sw_sg_bezier_set **bez;   /* per face, extracted on first use in this frame */
+    _Atomic(sw_sg_bezier_set *) *bez; /* per face, extracted on first use in this frame (by
+                                         whichever chunk needs it first: compare-and-swap) */
     const occurrence *ex_occ; /* exact path: the occurrence whose net is at ex_base */
     sw__gpu_exact_piece ex_base;
     sw_sg_surface ex_srf;
 } sw__fr_tess;
 
-/* Everything selected, in order: static levels, per-frame faces, meshes. */
+/* Everything selected, in order: static levels, per-frame faces, meshes. The per-frame faces
+ * in chunks shared with env->pool's workers when there are enough of them
+ * (stage_tessellate_parallel.c). */
 sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
                             const sw__fr_selection *sel, sw__fr_geometry *geo,
                             sw_gpu_frame_stats *st, sw_status *status);
+
+/* stage_tessellate_parallel.c: faces [first, end) of sel->faces into t->geo and t->st, split in
+ * chunks run by the calling thread and the pool's workers, appended in order. */
+sw_result sw__fr_tess_faces(sw__fr_tess *t, const sw__fr_selection *sel, size_t first, size_t end,
+                            sw_status *status);
+/* One face pick into t (the chunk body; stage_tessellate.c). */
+sw_result sw__fr_tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,
+                           sw_status *status);
 
 /* stage_tessellate.c, for the paths below. */
 sw_result sw__fr_add_draw(sw__fr_tess *t, const occurrence *o, size_t first_idx, int trimmed,

@@ -332,7 +332,7 @@ sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops
     return r;
 }
 
-static sw_result tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,
+sw_result sw__fr_tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,
                            sw_status *status)
 {
     if (!p->hierarchy)
@@ -356,18 +356,17 @@ sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
     sw_result r = SW_OK;
     for (size_t i = 0; i < sel->n_statics && r == SW_OK; ++i)
         r = sw__fr_tess_static(&t, vis, &sel->statics[i], status);
-    for (size_t i = 0; i < sel->n_faces && r == SW_OK; ++i) {
-        r = tess_face(&t, sel, &sel->faces[i], status);
-        if (r == SW_OK)
-            r = sw__fr_check_budget(&t, status);
-    }
+    if (r == SW_OK)
+        r = sw__fr_tess_faces(&t, sel, 0, sel->n_faces, status);
     if (r == SW_OK)
         r = sw__fr_tess_meshes(&t, vis, status);
-    for (uint32_t i = 0; i < env->sv->n_faces; ++i)
-        if (t.bez[i]) {
-            sw_sg_bezier_set_free(t.bez[i]);
-            sw__free(t.bez[i]);
+    for (uint32_t i = 0; i < env->sv->n_faces; ++i) {
+        sw_sg_bezier_set *set = atomic_load_explicit(&t.bez[i], memory_order_relaxed);
+        if (set) {
+            sw_sg_bezier_set_free(set);
+            sw__free(set);
         }
+    }
     sw__free(t.bez);
     return r;
 }

@@ -24,7 +24,8 @@ enum {
 static sw_result face_bezier(sw__fr_tess *f, uint32_t face, const sw_sg_bezier_set **out,
                              sw_status *status)
 {
-    if (!f->bez[face]) {
+    sw_sg_bezier_set *have = atomic_load_explicit(&f->bez[face], memory_order_acquire);
+    if (!have) {
         sw_sg_bezier_set *set = sw__calloc(1, sizeof *set);
         if (!set)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", face);
@@ -36,9 +37,16 @@ static sw_result face_bezier(sw__fr_tess *f, uint32_t face, const sw_sg_bezier_s
             sw__free(set);
             return r;
         }
-        f->bez[face] = set;
+        /* another chunk may have extracted the same face meanwhile: the first one stays */
+        if (atomic_compare_exchange_strong_explicit(&f->bez[face], &have, set,
+                                                    memory_order_acq_rel, memory_order_acquire)) {
+            have = set;
+        } else {
+            sw_sg_bezier_set_free(set);
+            sw__free(set);
+        }
     }
-    *out = f->bez[face];
+    *out = have;
     return SW_OK;
 }
 

@@ -115,6 +115,10 @@ typedef struct sw_gpu_frame_desc {
                               pixels that pass GL_GREATER against the host's depth buffer; the
                               background leaves the host's pixels alone (sw__gpu_present) */
     double near_plane;     /* > 0: the projection's near plane; 0: from the scene's box */
+    struct sw_th_pool *pool; /* NULL: prepare runs on the calling thread alone; else the
+                              per-frame faces are tessellated in chunks by the caller and this
+                              pool's workers together (the output in the same order as on one
+                              thread); the caller never runs another task while it joins them */
 } sw_gpu_frame_desc;
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
@@ -180,6 +184,10 @@ typedef struct sw_gpu_frame_stats {
                                     farther than the trim tolerance from the curve */
     uint64_t borders_capped;     /* fat borders sampled coarser than their cells: the view's
                                     sample budget (sw__gpu_mesh.border_capped) */
+    /* the tessellation in chunks (desc.pool): chunks, those the pool's workers took, and the
+     * time the preparing thread waited at the join for chunks a worker was still running */
+    uint64_t tess_chunks, tess_chunks_by_pool;
+    double ms_join;
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -74,7 +74,8 @@ typedef void (*sw_th_task_fn)(void *ctx);
     X(A, STATIC_CLUSTER, "static_cluster", "super-surface clustering of a scene (static LODs)")    \
     X(A, STATIC_BUILD, "static_build", "static LOD builds of one super-surface")                   \
     X(A, STATIC_RETIRE, "static_retire", "freeing a retired set of static LODs")                   \
-    X(A, COMPILE, "compile", "node scenes' compile tasks")
+    X(A, COMPILE, "compile", "node scenes' compile tasks")                                        \
+    X(A, FRAME_STAGE, "frame_stage", "chunks of a frame's tessellation taken by workers")
 
 typedef enum sw_th_task_kind {
 #define SW_TH__KIND_ENUM(a, id, name, what) SW_TH_TASK_##id,

@@ -7,10 +7,17 @@
  *              hierarchies are still being built)
  *   hierarchy  the bicubic hierarchies (Guthe §6–7), converged: a first unmeasured pass builds
  *              and refines them, so the measured passes only traverse
- * and, in alternating passes, A/B of the fat borders of affine faces (planes): by their loop's
- * vertices (on, the default) or sampled at the grid's cells as curved faces are (off). One
- * submitted frame per variant gives the triangles and the pixels the two variants differ in.
- * Usage: bench_prepare [--views N] [--passes P] [--size WxH] FILE...   (.brep/.step/.igs, .sws)
+ * and, in alternating passes, two A/B pairs:
+ *   affine     fat borders of affine faces (planes) by their loop's vertices (on, the default)
+ *              or sampled at the grid's cells as curved faces are (off), on one thread; one
+ *              submitted frame per variant gives the triangles and the pixels they differ in;
+ *   chunks     the faces tessellated by the preparing thread alone, or in chunks shared with a
+ *              pool of --workers workers (desc.pool).
+ * Each variant prints the median of the prepare's wall time, of the preparing thread's CPU time
+ * and of the process's CPU time (every thread: the pool's share of the work included, so the
+ * split's extra work shows).
+ * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--workers W] FILE...
+ *        (.brep/.step/.igs imported, .sws opened)
  */
 #include "sw_gpu_internal.h"
 #include "sw_lod_cache.h"
@@ -25,12 +32,16 @@
 
 enum { MAX_VIEWS = 256, MAX_PASSES = 16 };
 
-static double thread_cpu_ms(void)
+static double clock_ms(clockid_t id)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    clock_gettime(id, &ts);
     return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
 }
+
+enum { WALL, THREAD, PROCESS, N_CLOCKS };
+static const clockid_t k_clocks[N_CLOCKS] = {CLOCK_MONOTONIC, CLOCK_THREAD_CPUTIME_ID,
+                                             CLOCK_PROCESS_CPUTIME_ID};
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -55,30 +66,76 @@ static sw_gpu_camera orbit_camera(const double box[6], int i, int n)
 
 typedef struct bench {
     sw_gpu_context *ctx;
+    sw_th_pool *pool;
     const sw_sg_scene *scene;
     sw_gpu_frame_desc desc;
     double box[6];
     int views;
 } bench;
 
-/* One pass over the orbit; adds each prepare's thread CPU time to ms (NULL: unmeasured). */
-static int pass(bench *b, double *ms)
+/* Times of one variant, per clock, over its passes. */
+typedef struct series {
+    double ms[N_CLOCKS][MAX_PASSES * MAX_VIEWS];
+    int n;
+} series;
+
+/* One pass over the orbit, each prepare's times added to s (NULL: unmeasured). */
+static int pass(bench *b, series *s)
 {
     for (int i = 0; i < b->views; ++i) {
         b->desc.camera = orbit_camera(b->box, i, b->views);
         sw_status st = {0};
         sw_gpu_frame_plan *plan = NULL;
-        double t0 = thread_cpu_ms();
+        double t0[N_CLOCKS], t1[N_CLOCKS];
+        for (int k = 0; k < N_CLOCKS; ++k)
+            t0[k] = clock_ms(k_clocks[k]);
         if (sw_gpu_frame_prepare(b->ctx, b->scene, &b->desc, &plan, &st) != SW_OK) {
             fprintf(stderr, "prepare: %s\n", st.message);
             return 0;
         }
-        double t1 = thread_cpu_ms();
+        for (int k = 0; k < N_CLOCKS; ++k)
+            t1[k] = clock_ms(k_clocks[k]);
         sw_gpu_frame_plan_free(plan);
-        if (ms)
-            ms[i] = t1 - t0;
+        if (!s)
+            continue;
+        for (int k = 0; k < N_CLOCKS; ++k)
+            s->ms[k][s->n] = t1[k] - t0[k];
+        s->n++;
     }
     return 1;
+}
+
+static void print_series(const char *name, series *s)
+{
+    printf("    %-24s wall %8.2f  thread CPU %8.2f  process CPU %8.2f ms\n", name,
+           median(s->ms[WALL], s->n), median(s->ms[THREAD], s->n), median(s->ms[PROCESS], s->n));
+}
+
+/* Alternating passes of two variants set by set(b, 0 or 1), side by side; prints both. */
+static int ab(bench *b, int passes, void (*set)(bench *, int), const char *names[2])
+{
+    static series s[2];
+    s[0].n = s[1].n = 0;
+    for (int p = 0; p < passes; ++p)
+        for (int k = 0; k < 2; ++k) {
+            set(b, k);
+            if (!pass(b, &s[k]))
+                return 0;
+        }
+    set(b, 0);
+    for (int k = 0; k < 2; ++k)
+        print_series(names[k], &s[k]);
+    return 1;
+}
+
+static void set_affine(bench *b, int k)
+{
+    sw__gpu_set_border_affine(b->ctx, k == 0);
+}
+
+static void set_chunks(bench *b, int k)
+{
+    b->desc.pool = k ? b->pool : NULL;
 }
 
 /* View 0 submitted with the affine path on and off: triangles of each, differing pixels. */
@@ -112,28 +169,20 @@ static int compare_images(bench *b)
 
 static int run_mode(bench *b, const char *mode, int passes)
 {
-    static double ms[2][MAX_PASSES * MAX_VIEWS];
-    int n[2] = {0, 0};
+    static const char *affine[2] = {"affine borders on", "affine borders off"};
+    static const char *chunks[2] = {"one thread", "chunks with the pool"};
+    printf("  %s, medians of %d prepares per variant:\n", mode, passes * b->views);
     if (!pass(b, NULL)) /* warm-up: hierarchies built and refined, buffers grown */
         return 0;
-    for (int p = 0; p < passes; ++p)
-        for (int k = 0; k < 2; ++k) { /* on, off: alternating, side by side */
-            sw__gpu_set_border_affine(b->ctx, k == 0);
-            if (!pass(b, ms[k] + n[k]))
-                return 0;
-            n[k] += b->views;
-        }
-    sw__gpu_set_border_affine(b->ctx, 1);
-    double on = median(ms[0], n[0]), off = median(ms[1], n[1]);
-    printf("  %-9s prepare, thread CPU ms, median of %d: affine borders on %.2f, off %.2f "
-           "(on/off %.3f)\n",
-           mode, n[0], on, off, off > 0.0 ? on / off : 0.0);
-    return compare_images(b);
+    if (!ab(b, passes, set_affine, affine) || !compare_images(b))
+        return 0;
+    return ab(b, passes, set_chunks, chunks);
 }
 
 static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, int w, int h,
                        int views, int passes)
 {
+    /* the hierarchies' builds use a pool of their own, so that the chunks' pool is idle */
     sw_status st = {0};
     sw_sg_import_desc id = {path, NULL, NULL, NULL};
     sw_sg_scene *scene = NULL;
@@ -150,7 +199,7 @@ static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, 
     }
     sw_sg_scene_stats ss;
     sw_sg_scene_compute_stats(scene, &ss);
-    bench b = {ctx, scene, {0}, {0}, views};
+    bench b = {ctx, pool, scene, {0}, {0}, views};
     memcpy(b.box, ss.bbox, sizeof b.box);
     b.desc.width = w;
     b.desc.height = h;
@@ -158,7 +207,14 @@ static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, 
     printf("%s (%u faces):\n", path, ss.faces);
     int ok = run_mode(&b, "direct", passes);
     sw_lod_cache *cache = NULL;
-    if (ok && sw_lod_cache_create(scene, pool, NULL, &cache, &st) != SW_OK) {
+    sw_th_pool *builds = NULL;
+    sw_th_pool_desc pd = {0};
+    pd.worker_count = 1;
+    if (ok && sw_th_pool_create(&pd, &builds) != SW_OK) {
+        fprintf(stderr, "pool: cannot start\n");
+        ok = 0;
+    }
+    if (ok && sw_lod_cache_create(scene, builds, NULL, &cache, &st) != SW_OK) {
         fprintf(stderr, "%s: %s\n", path, st.message);
         ok = 0;
     }
@@ -167,18 +223,21 @@ static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, 
         ok = run_mode(&b, "hierarchy", passes);
     }
     sw_lod_cache_destroy(cache);
+    sw_th_pool_destroy(builds);
     sw_sg_scene_free(scene);
     return ok;
 }
 
 int main(int argc, char **argv)
 {
-    int views = 24, passes = 2, w = 1280, h = 720, first = 1;
+    int views = 24, passes = 2, w = 1280, h = 720, workers = 1, first = 1;
     for (; first < argc && strncmp(argv[first], "--", 2) == 0; first += 2) {
         if (first + 1 >= argc)
             break;
         if (strcmp(argv[first], "--views") == 0)
             views = atoi(argv[first + 1]);
+        else if (strcmp(argv[first], "--workers") == 0)
+            workers = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--passes") == 0)
             passes = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--size") == 0 &&
@@ -188,8 +247,9 @@ int main(int argc, char **argv)
             break;
     }
     if (first >= argc || views < 1 || views > MAX_VIEWS || passes < 1 || passes > MAX_PASSES ||
-        w < 1 || h < 1) {
-        fprintf(stderr, "usage: %s [--views N<=%d] [--passes P<=%d] [--size WxH] FILE...\n",
+        w < 1 || h < 1 || workers < 1 || workers > 64) {
+        fprintf(stderr,
+                "usage: %s [--views N<=%d] [--passes P<=%d] [--size WxH] [--workers W] FILE...\n",
                 argv[0], MAX_VIEWS, MAX_PASSES);
         return 2;
     }
@@ -200,15 +260,15 @@ int main(int argc, char **argv)
         return 1;
     }
     sw_th_pool_desc pd = {0};
-    pd.worker_count = 1;
+    pd.worker_count = (uint32_t)workers;
     sw_th_pool *pool = NULL;
     if (sw_th_pool_create(&pd, &pool) != SW_OK) {
         fprintf(stderr, "pool: cannot start\n");
         sw_gpu_context_free(ctx);
         return 1;
     }
-    printf("%s, %dx%d, ε_img default, %d views, %d passes per variant\n",
-           sw_gpu_context_description_ptr(ctx), w, h, views, passes);
+    printf("%s, %dx%d, ε_img default, %d views, %d passes per variant, %d pool workers\n",
+           sw_gpu_context_description_ptr(ctx), w, h, views, passes, workers);
     int ok = 1;
     for (int a = first; a < argc && ok; ++a)
         ok = bench_scene(ctx, pool, argv[a], w, h, views, passes);

@@ -334,6 +334,9 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->static_requests = g->static_requests;
     out->bound_exceeded = g->bound_exceeded;
     out->bound_excess_px = g->bound_excess_px;
+    out->tess_chunks = g->tess_chunks;
+    out->tess_chunks_by_pool = g->tess_chunks_by_pool;
+    out->ms_join = g->ms_join;
 }
 
 static int camera_is_zero(const sw_camera *c)
@@ -466,6 +469,7 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
     frame->face_cones = r->cones ? r->cones : scene->prebuilt_cones;
     if (!frame->eval_exact && !desc->no_hierarchy)
         frame->hierarchies = r->cache;
+    frame->pool = r->pool;
     frame->lod_colors = desc->lod_colors != 0;
     frame->static_force = desc->static_force > 0 ? desc->static_force : 0;
     if (desc->static_lods && !frame->eval_exact)

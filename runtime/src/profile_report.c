@@ -34,7 +34,8 @@ _Static_assert(SW_RT_COL_POOL_FIRST_TASKS - SW_RT_COL_POOL_FIRST_MS == SW_TH_TAS
                "one ms and one tasks column per pool task kind, in order");
 /* Pool kinds' colours (same order as the kinds). */
 static const char *const k_pool_colour[] = {"#a0a0a0", "#4c8bd6", "#9ecae9", "#8e6bbf",
-                                            "#59a14f", "#edc948", "#f28e2b", "#e15759"};
+                                            "#59a14f", "#edc948", "#f28e2b", "#e15759",
+                                            "#76b7b2"};
 _Static_assert(sizeof k_pool_colour / sizeof k_pool_colour[0] == SW_TH_TASK_KIND_COUNT,
                "one colour per pool task kind");
 
@@ -69,6 +70,7 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[split ? SW_RT_COL_VIS_HIERARCHY_MS : SW_RT_COL_HIERARCHY_MS] = st->ms_hierarchy;
     v[split ? SW_RT_COL_VIS_TESSELLATE_MS : SW_RT_COL_TESSELLATE_MS] = st->ms_tessellate;
     v[SW_RT_COL_VIS_MS] = st->ms_visibility;
+    v[SW_RT_COL_VIS_JOIN_MS] = st->ms_join;
     v[SW_RT_COL_WAIT_VISIBILITY_MS] = st->ms_wait_visibility;
     v[SW_RT_COL_TRIM_MS] = st->ms_trim;
     v[SW_RT_COL_DRAW_MS] = st->ms_draw;
@@ -727,7 +729,7 @@ static void print_pool_summary(FILE *f, const sw_rt_profile *p)
 void sw_rt_profile_print_summary(FILE *f, const sw_rt_profile *p)
 {
     fprintf(f, "%-16s %9s %9s %9s %9s %9s\n", "ms", "median", "p90", "p99", "max", "mean");
-    for (int c = SW_RT_COL_FRAME_MS; c <= SW_RT_COL_VIS_TESSELLATE_MS; c++) {
+    for (int c = SW_RT_COL_FRAME_MS; c <= SW_RT_COL_VIS_JOIN_MS; c++) {
         const sw_rt_prof_stat *s = &p->summary[c];
         const char *name = k_cols[c].name;
         fprintf(f, "%s%-*.*s %9.2f %9.2f %9.2f %9.2f %9.2f\n", c == SW_RT_COL_FRAME_MS ? "" : "  ",

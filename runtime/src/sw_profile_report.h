@@ -54,6 +54,8 @@
       "threaded: of vis_ms, waiting for hierarchy builds and refinements")                         \
     X(VIS_TESSELLATE_MS, "vis_tessellate_ms", VSTAGE,                                              \
       "threaded: of vis_ms, culling, traversal, bounds, CPU grids, requests")                      \
+    X(VIS_JOIN_MS, "vis_join_ms", VSTAGE,                                                          \
+      "of the tessellation, waiting at its join for chunks the pool's workers still ran")          \
     X(PATCHES, "patches", COUNT, "patches drawn (trimmed + untrimmed)")                            \
     X(PATCHES_TRIMMED, "patches_trimmed", COUNT, "patches drawn with a trim texture")              \
     X(PATCHES_CULLED, "patches_culled", COUNT, "patches culled")                                   \

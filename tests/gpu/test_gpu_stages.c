@@ -35,8 +35,9 @@
 
 enum { W = 320, H = 240 };
 static sw_th_pool *g_pool;
-static int g_bound_counted; /* narrow views with pieces counted over the bound */
-static int g_partial_views; /* views that cut a model: the cull check is not vacuous */
+static int g_bound_counted;  /* narrow views with pieces counted over the bound */
+static int g_partial_views;  /* views that cut a model: the cull check is not vacuous */
+static int g_parallel_split; /* frames tessellated in chunks: the parallel check is not vacuous */
 
 /* One frame's stage outputs, as sw_gpu_frame_prepare keeps them. */
 typedef struct stages {
@@ -349,6 +350,101 @@ static void check_atlas(sw_gpu_context *ctx, const stages *s, const char *name)
 
 /* ---- submit ------------------------------------------------------------------------------------
  */
+/* The same frame tessellated in chunks with the pool's workers (desc.pool) must be the one
+ * thread's geometry item for item: every chunk appended in order with its vertex, index, draw,
+ * loop and control-point numbers rebased. Planted fault seen failing: the records' draw index not
+ * rebased in append_geometry (stage_tessellate_parallel.c). */
+static int same_draw(const sw__gpu_draw *a, const sw__gpu_draw *b)
+{
+    return a->first_idx == b->first_idx && a->n_idx == b->n_idx &&
+           memcmp(a->color, b->color, sizeof a->color) == 0 && a->trim_entry == b->trim_entry &&
+           memcmp(a->uv_map, b->uv_map, sizeof a->uv_map) == 0;
+}
+
+static int same_trim(const pending_trim *a, const pending_trim *b)
+{
+    return a->draw == b->draw && same_occurrence(&a->occ, b->occ.face, b->occ.world) &&
+           a->width == b->width && a->height == b->height && a->cell[0] == b->cell[0] &&
+           a->cell[1] == b->cell[1] && a->loops == b->loops && a->clip == b->clip &&
+           memcmp(a->rect, b->rect, sizeof a->rect) == 0 && a->w == b->w && a->h == b->h;
+}
+
+static int same_loops(const face_loops *a, const face_loops *b)
+{
+    if (a->n != b->n)
+        return 0;
+    for (uint32_t k = 0; k < a->n; ++k)
+        if (a->loops[k].count != b->loops[k].count ||
+            memcmp(a->loops[k].uv, b->loops[k].uv, 2 * a->loops[k].count * sizeof(double)) != 0)
+            return 0;
+    return 1;
+}
+
+static size_t first_mismatch(const sw__fr_geometry *a, const sw__fr_geometry *b)
+{
+    const sw__gpu_mesh *m = &a->mesh, *n = &b->mesh;
+    if (m->n_v != n->n_v || memcmp(m->v, n->v, m->n_v * sizeof *m->v) != 0)
+        return 1;
+    if (m->n_idx != n->n_idx || memcmp(m->idx, n->idx, m->n_idx * sizeof *m->idx) != 0)
+        return 2;
+    if (a->n_draws != b->n_draws)
+        return 3;
+    for (size_t i = 0; i < a->n_draws; ++i)
+        if (!same_draw(&a->draws[i], &b->draws[i]))
+            return 3;
+    if (a->n_trims != b->n_trims)
+        return 4;
+    for (size_t i = 0; i < a->n_trims; ++i)
+        if (!same_trim(&a->trims[i], &b->trims[i]))
+            return 4;
+    if (a->n_shares != b->n_shares ||
+        memcmp(a->shares, b->shares, 2 * a->n_shares * sizeof *a->shares) != 0)
+        return 5;
+    if (a->n_loops != b->n_loops)
+        return 6;
+    for (size_t i = 0; i < a->n_loops; ++i)
+        if (!same_loops(&a->loops[i], &b->loops[i]))
+            return 6;
+    if (a->n_recs != b->n_recs || memcmp(a->recs, b->recs, a->n_recs * sizeof *a->recs) != 0)
+        return 7;
+    if (a->n_cps != b->n_cps || memcmp(a->cps, b->cps, 4 * a->n_cps * sizeof *a->cps) != 0)
+        return 8;
+    return a->gpu_vertices != b->gpu_vertices || a->border_triangles != b->border_triangles ? 9 : 0;
+}
+
+static void check_parallel(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                           const sw_gpu_frame_desc *desc, const stages *one, const char *name)
+{
+    static const char *const what[] = {
+        "",       "vertices", "indices", "draws",          "trims",
+        "shares", "loops",    "records", "control points", "vertex counts"};
+    sw_gpu_frame_desc d = *desc;
+    d.pool = g_pool;
+    stages par;
+    sw_status st = {0};
+    if (run_prepare(&par, ctx, scene, &d, &st) != SW_OK) {
+        CHECK(0, "%s: stages with the pool: %s", name, st.message);
+        stages_free(&par);
+        return;
+    }
+    size_t bad = first_mismatch(&par.geo, &one->geo);
+    printf("%s: tessellation in %llu chunks (%llu by workers, join %.2f ms): %s\n", name,
+           (unsigned long long)par.st.tess_chunks, (unsigned long long)par.st.tess_chunks_by_pool,
+           par.st.ms_join, bad ? what[bad] : "the one thread's geometry");
+    /* below 32 faces a split is not worth it (MIN_FACES_PER_CHUNK) */
+    CHECK(par.st.tess_chunks > 1 || one->sel.n_faces < 32, "%s: %zu faces not split (%llu chunks)",
+          name, one->sel.n_faces, (unsigned long long)par.st.tess_chunks);
+    g_parallel_split += par.st.tess_chunks > 1;
+    CHECK(bad == 0, "%s: chunked tessellation differs from one thread's in its %s", name,
+          what[bad]);
+    CHECK(par.st.triangles == one->st.triangles && par.st.faces_drawn == one->st.faces_drawn &&
+              par.st.patches_culled == one->st.patches_culled &&
+              par.st.bound_exceeded == one->st.bound_exceeded,
+          "%s: chunked stats differ (triangles %llu vs %llu)", name,
+          (unsigned long long)par.st.triangles, (unsigned long long)one->st.triangles);
+    stages_free(&par);
+}
+
 static void check_chain(sw_gpu_context *ctx, const sw_sg_scene *scene,
                         const sw_gpu_frame_desc *desc, stages *s, const char *name)
 {
@@ -497,6 +593,7 @@ static void run_model(sw_gpu_context *ctx, const char *path)
         check_select(&coned, path);
         check_tessellate(&coned, path);
         check_trim_plan(&coned, path);
+        check_parallel(ctx, scene, &desc, &coned, path);
         check_chain(ctx, scene, &desc, &coned, path);
         CHECK(coned.st.bound_exceeded == 0, "%s: %llu pieces over the error bound", path,
               (unsigned long long)coned.st.bound_exceeded);
@@ -530,6 +627,8 @@ int main(int argc, char **argv)
         run_model(ctx, argv[a]);
     CHECK(g_partial_views > 0, "no view left an occurrence outside: the cull check is vacuous");
     CHECK(g_bound_counted > 0, "no narrow view counted a piece over the bound");
+    CHECK(g_parallel_split > 0,
+          "no frame was tessellated in chunks: the parallel check is vacuous");
     sw_gpu_context_free(ctx);
     sw_th_pool_destroy(g_pool);
     puts(g_failures ? "FAIL" : "PASS");

@@ -344,6 +344,11 @@ typedef struct sw_frame_stats {
      * near_plane */
     double near_plane;
     double view[16], proj[16];
+    /* the tessellation split in chunks with the renderer's pool: chunks, those its workers ran,
+     * and the time the frame's preparing thread waited at the join for a worker's chunk (it runs
+     * no other task meanwhile) */
+    uint64_t tess_chunks, tess_chunks_by_pool;
+    double ms_join;
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so
