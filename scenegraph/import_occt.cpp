@@ -398,14 +398,29 @@ double max_tolerance(const TopoDS_Face &f, TopAbs_ShapeEnum type)
     return t;
 }
 
-/* A B-spline surface whose weights no exact repair can bring into the scene's range
- * (sw_sg_geom.h: a weight <= 0 or not finite, or two weights more than SW_SG_WEIGHT_RATIO_MAX
- * apart) is refused before BRepBuilderAPI_NurbsConvert sees it: OCCT re-projects the face's
- * pcurves onto such a surface for minutes (Ball.brep with one weight 1e-20: 5 minutes, then the
- * face is refused anyway). */
-void check_weights(const Handle(Geom_BSplineSurface) & s, const std::string &what)
+/* A B-spline surface whose poles or weights no exact repair can bring into the scene's range
+ * (sw_sg_geom.h: a coordinate beyond SW_SG_COORD_MAX, a weight <= 0 or not finite, or two weights
+ * more than SW_SG_WEIGHT_RATIO_MAX apart) is refused before BRepBuilderAPI_NurbsConvert sees it:
+ * OCCT re-projects the face's pcurves onto such a surface for seconds to minutes (Ball.brep with
+ * one weight 1e-20: 5 minutes; with one coordinate 1e31: 11 s), then the face is refused anyway. */
+void check_poles(const Handle(Geom_BSplineSurface) & s, const std::string &what)
 {
-    if (s.IsNull() || (!s->IsURational() && !s->IsVRational()))
+    if (s.IsNull())
+        return;
+    for (int j = 1; j <= s->NbVPoles(); j++)
+        for (int i = 1; i <= s->NbUPoles(); i++) {
+            const gp_Pnt &p = s->Pole(i, j);
+            const double c[3] = {p.X(), p.Y(), p.Z()};
+            for (int k = 0; k < 3; k++)
+                if (!(std::fabs(c[k]) <= SW_SG_COORD_MAX)) {
+                    char buf[160];
+                    std::snprintf(buf, sizeof buf,
+                                  ": control point (%d, %d) coordinate %d is %g, beyond %g", i - 1,
+                                  j - 1, k, c[k], SW_SG_COORD_MAX);
+                    throw face_error{what + buf};
+                }
+        }
+    if (!s->IsURational() && !s->IsVRational())
         return;
     double lo = HUGE_VAL, hi = 0.0;
     int lo_at[2] = {0, 0}, hi_at[2] = {0, 0};
@@ -449,7 +464,7 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     if (raw.IsNull())
         throw face_error{"the file's surface of this face could not be built by OCCT (invalid "
                          "surface data)"};
-    check_weights(Handle(Geom_BSplineSurface)::DownCast(raw), what);
+    check_poles(Handle(Geom_BSplineSurface)::DownCast(raw), what);
 
     BRepBuilderAPI_NurbsConvert nc(f);
     if (!nc.IsDone())
