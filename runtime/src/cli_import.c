@@ -21,8 +21,9 @@ static const char k_usage[] =
     "\n"
     "options:\n"
     "  -o, --output FILE   the .sws file to write (required)\n"
-    "  --partial           import what is whole of a truncated file: the entities whose data,\n"
-    "                      and the data of every entity they point at, is present (IGES)\n"
+    "  --partial           import what is whole of a truncated IGES file: the shapes whose\n"
+    "                      data, and the data of every entity they point at, is present (a\n"
+    "                      truncated STEP or BREP file cannot be read in part: refused still)\n"
     "  -h, --help          this text\n";
 
 int sw_cli_import(int argc, char **argv)

@@ -101,6 +101,13 @@ for w in 0 1e-20; do
         fail "$step: weight $w: no warning naming file and face"
 done
 grep -q "differ by a factor" ball_1e-20.log || fail "5: the reason (weights apart) is not given"
+# render reports it too, and draws the rest (EGL; llvmpipe without a GPU)
+run 30 ball_render.log render ball_w0.brep -o ball_w0.png --size 160x120
+rc=$?
+[ $rc -eq 0 ] || fail "4: render of Ball.brep with weight 0: exit $rc"
+grep -q "^warning: ball_w0.brep: face 10 skipped: " ball_render.log || fail "4: render does not name the face"
+grep -q "^render: 1 faces skipped" ball_render.log || fail "4: render does not count the face"
+grep -q "faces drawn 1[0-9]," ball_render.log || fail "4: render drew no faces"
 
 fi
 
