@@ -119,7 +119,7 @@ int main(int argc, char **argv)
     if (rc >= 0)
         return rc;
     sw_status status = {0};
-    sw_scene_load_desc load = {a.scene, progress, warning, NULL};
+    sw_scene_load_desc load = {a.scene, progress, warning, NULL, NULL, 0};
     sw_scene scene;
     sw_result r = a.scene ? sw_scene_load(&load, &scene, &status)
                           : sw_scene_load_default(NULL, &load, &scene, &status);

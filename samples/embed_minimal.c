@@ -37,7 +37,7 @@ int main(int argc, char **argv)
     long frames = argc == 3 ? strtol(argv[2], NULL, 10) : -1;
     sw_status st = {0};
     sw_scene scene = {0};
-    sw_scene_load_desc ld = {argv[1], NULL, NULL, NULL};
+    sw_scene_load_desc ld = {argv[1], NULL, NULL, NULL, NULL, 0};
     if (sw_scene_load(&ld, &scene, &st) != SW_OK)
         return fail(argv[1], &st);
     sw_camera home;

@@ -14,6 +14,7 @@
 #include "sw_status_util.h"
 #include "sw_hooks.h"
 #include "sw_safe_read.h"
+#include "sw_sg_iges.h"
 
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
@@ -33,6 +34,16 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Reader.hxx>
+#include <IGESData_IGESEntity.hxx>
+#include <IGESData_IGESModel.hxx>
+#include <IGESGeom_BoundedSurface.hxx>
+#include <IGESGeom_TrimmedSurface.hxx>
+#include <IGESSolid_Face.hxx>
+#include <Interface_Check.hxx>
+#include <Interface_CheckIterator.hxx>
+#include <Interface_EntityIterator.hxx>
+#include <Interface_Graph.hxx>
+#include <Interface_InterfaceModel.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_Printer.hxx>
@@ -40,6 +51,13 @@
 #include <Quantity_ColorRGBA.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <STEPControl_Reader.hxx>
+#include <StepGeom_Surface.hxx>
+#include <StepShape_Face.hxx>
+#include <StepShape_FaceSurface.hxx>
+#include <TCollection_HAsciiString.hxx>
+#include <Transfer_TransientProcess.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 #include <Standard_Failure.hxx>
 #include <TDF_LabelMapHasher.hxx>
 #include <TDF_LabelSequence.hxx>
@@ -61,8 +79,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <new>
@@ -94,9 +114,10 @@ struct face_data {
     std::vector<loop_data> loops;
 };
 
-/* A face that cannot be converted; the message says why. */
+/* A face that cannot be converted; the message says why, the code what kind of reason it is. */
 struct face_error {
     std::string why;
+    sw_result code = SW_ERR_INVALID_GEOMETRY;
 };
 
 double now_ms()
@@ -190,7 +211,8 @@ void surface_arrays(const Handle(Geom_BSplineSurface) & s, face_data &fd)
 {
     const int nu = s->NbUPoles(), nv = s->NbVPoles(), du = s->UDegree(), dv = s->VDegree();
     if (du > SW_SG_MAX_DEGREE || dv > SW_SG_MAX_DEGREE)
-        throw face_error{"surface degree above " + std::to_string(SW_SG_MAX_DEGREE)};
+        throw face_error{"surface degree above " + std::to_string(SW_SG_MAX_DEGREE),
+                         SW_ERR_UNSUPPORTED};
     TColStd_Array1OfReal ku(1, nu + du + 1), kv(1, nv + dv + 1);
     s->UKnotSequence(ku);
     s->VKnotSequence(kv);
@@ -224,7 +246,8 @@ curve_data pcurve(const TopoDS_Edge &e, const TopoDS_Face &cf)
     if (e.Orientation() == TopAbs_REVERSED)
         bs->Reverse();
     if (bs->Degree() > SW_SG_MAX_DEGREE)
-        throw face_error{"pcurve degree above " + std::to_string(SW_SG_MAX_DEGREE)};
+        throw face_error{"pcurve degree above " + std::to_string(SW_SG_MAX_DEGREE),
+                         SW_ERR_UNSUPPORTED};
     curve_data cd;
     cd.degree = bs->Degree();
     const int n = bs->NbPoles();
@@ -375,6 +398,57 @@ double max_tolerance(const TopoDS_Face &f, TopAbs_ShapeEnum type)
     return t;
 }
 
+/* A B-spline surface whose poles or weights no exact repair can bring into the scene's range
+ * (sw_sg_geom.h: a coordinate beyond SW_SG_COORD_MAX, a weight <= 0 or not finite, or two weights
+ * more than SW_SG_WEIGHT_RATIO_MAX apart) is refused before BRepBuilderAPI_NurbsConvert sees it:
+ * OCCT re-projects the face's pcurves onto such a surface for seconds to minutes (Ball.brep with
+ * one weight 1e-20: 5 minutes; with one coordinate 1e31: 11 s), then the face is refused anyway. */
+void check_poles(const Handle(Geom_BSplineSurface) & s, const std::string &what)
+{
+    if (s.IsNull())
+        return;
+    for (int j = 1; j <= s->NbVPoles(); j++)
+        for (int i = 1; i <= s->NbUPoles(); i++) {
+            const gp_Pnt &p = s->Pole(i, j);
+            const double c[3] = {p.X(), p.Y(), p.Z()};
+            for (int k = 0; k < 3; k++)
+                if (!(std::fabs(c[k]) <= SW_SG_COORD_MAX)) {
+                    char buf[160];
+                    std::snprintf(buf, sizeof buf,
+                                  ": control point (%d, %d) coordinate %d is %g, beyond %g", i - 1,
+                                  j - 1, k, c[k], SW_SG_COORD_MAX);
+                    throw face_error{what + buf};
+                }
+        }
+    if (!s->IsURational() && !s->IsVRational())
+        return;
+    double lo = HUGE_VAL, hi = 0.0;
+    int lo_at[2] = {0, 0}, hi_at[2] = {0, 0};
+    for (int j = 1; j <= s->NbVPoles(); j++)
+        for (int i = 1; i <= s->NbUPoles(); i++) {
+            const double w = s->Weight(i, j);
+            char buf[160];
+            if (!(w > 0.0) || !std::isfinite(w)) {
+                std::snprintf(buf, sizeof buf, ": weight of control point (%d, %d) is %g", i - 1,
+                              j - 1, w);
+                throw face_error{what + buf};
+            }
+            if (w < lo)
+                lo = w, lo_at[0] = i - 1, lo_at[1] = j - 1;
+            if (w > hi)
+                hi = w, hi_at[0] = i - 1, hi_at[1] = j - 1;
+        }
+    if (hi > lo * SW_SG_WEIGHT_RATIO_MAX) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf,
+                      ": weights %g (control point (%d, %d)) and %g (control point (%d, %d)) "
+                      "differ by a factor %g > %g",
+                      lo, lo_at[0], lo_at[1], hi, hi_at[0], hi_at[1], hi / lo,
+                      SW_SG_WEIGHT_RATIO_MAX);
+        throw face_error{what + buf};
+    }
+}
+
 /* Converts one face; throws face_error or Standard_Failure when it cannot. */
 face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what)
 {
@@ -382,6 +456,15 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     fd.rec.kind = kind_of(BRepAdaptor_Surface(f, Standard_False).GetType());
     fd.rec.flags = f.Orientation() == TopAbs_REVERSED ? (uint32_t)SW_SG_FACE_REVERSED : 0u;
     fd.rec.tolerance = max_tolerance(f, TopAbs_EDGE);
+
+    /* OCCT's readers leave a face without its surface when the file's surface could not be
+     * built (a BREP weight of 0: Standard_ConstructionError, caught by the reader); the NURBS
+     * conversion would dereference it. */
+    const Handle(Geom_Surface) raw = BRep_Tool::Surface(f);
+    if (raw.IsNull())
+        throw face_error{"the file's surface of this face could not be built by OCCT (invalid "
+                         "surface data)"};
+    check_poles(Handle(Geom_BSplineSurface)::DownCast(raw), what);
 
     BRepBuilderAPI_NurbsConvert nc(f);
     if (!nc.IsDone())
@@ -428,6 +511,88 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     return fd;
 }
 
+/* ---- the scene's checks, face by face ---------------------------------------------------------
+ * The scene refuses invalid geometry as a whole (sw_sg_scene_validate, at sw_sg_builder_finish).
+ * The same checks are made here on each converted face before it enters the builder, so that one
+ * bad face is repaired or skipped, with its file, index and reason, instead of refusing the file
+ * with a message about "scene: face N". */
+
+sw_result validate_face(const face_data &fd, const std::string &what, sw_status *st)
+{
+    const sw_sg_surface s{(int32_t)fd.rec.deg_u, (int32_t)fd.rec.deg_v, (int32_t)fd.rec.n_u,
+                          (int32_t)fd.rec.n_v,   fd.knots_u.data(),      fd.knots_v.data(),
+                          fd.cpw.data()};
+    sw_result r = sw_sg_surface_validate(&s, what.c_str(), st);
+    for (size_t l = 0; r == SW_OK && l < fd.loops.size(); l++)
+        for (size_t k = 0; r == SW_OK && k < fd.loops[l].curves.size(); k++) {
+            const curve_data &cd = fd.loops[l].curves[k];
+            const sw_sg_curve c{cd.degree, (int32_t)(cd.cpw.size() / 3), 3, cd.knots.data(),
+                                cd.cpw.data()};
+            const std::string cw =
+                what + ": loop " + std::to_string(l) + " curve " + std::to_string(k);
+            r = sw_sg_curve_validate(&c, cw.c_str(), st);
+        }
+    if (r == SW_OK && !(std::isfinite(fd.rec.tolerance) && fd.rec.tolerance >= 0.0 &&
+                        std::isfinite(fd.rec.uv_box[0]) && std::isfinite(fd.rec.uv_box[1]) &&
+                        std::isfinite(fd.rec.uv_box[2]) && std::isfinite(fd.rec.uv_box[3])))
+        r = sw__fail(st, SW_ERR_INVALID_GEOMETRY, "%s: tolerance or parameter box not finite",
+                     what.c_str());
+    return r;
+}
+
+/* The exact repair there is for weights: when all of a net's weights are positive and finite and
+ * within SW_SG_WEIGHT_RATIO_MAX of each other, but lie as a whole outside [SW_SG_WEIGHT_MIN,
+ * SW_SG_WEIGHT_MAX], every homogeneous coordinate is multiplied by one power of two that brings
+ * the largest weight into [0.5, 1): each point of the curve or surface stays where it was, bit
+ * for bit (unless a value would underflow: then nothing is changed). A zero or negative weight has
+ * no exact repair — a zero weight makes its point's term vanish from numerator and denominator
+ * alike, so at a clamped corner the surface is 0/0 and its limit depends on the direction it is
+ * approached from (along a collapsed edge and across it); any positive weight put there moves the
+ * surface wherever that control point has influence — so such a face is skipped. Returns the
+ * factor's exponent, or 0 when no repair was made. */
+int rescale_weights(std::vector<double> &cpw, size_t dim)
+{
+    double lo = HUGE_VAL, hi = 0.0;
+    for (size_t i = dim - 1; i < cpw.size(); i += dim) {
+        const double w = cpw[i];
+        if (!(w > 0.0) || !std::isfinite(w))
+            return 0;
+        lo = std::min(lo, w), hi = std::max(hi, w);
+    }
+    if (cpw.empty() || (lo >= SW_SG_WEIGHT_MIN && hi <= SW_SG_WEIGHT_MAX) ||
+        hi > lo * SW_SG_WEIGHT_RATIO_MAX)
+        return 0;
+    int e = 0;
+    std::frexp(hi, &e);
+    for (double v : cpw) {
+        const double x = std::ldexp(v, -e);
+        if (v != 0.0 && (!std::isfinite(x) || std::fabs(x) < DBL_MIN))
+            return 0;
+    }
+    for (double &v : cpw)
+        v = std::ldexp(v, -e);
+    return -e != 0 ? -e : 0;
+}
+
+/* Repairs what rescale_weights can in the face's surface and curves; says what it did in `done`.
+ */
+bool repair_face(face_data &fd, std::string &done)
+{
+    bool any = false;
+    if (int e = rescale_weights(fd.cpw, 4)) {
+        done += "surface weights scaled by 2^" + std::to_string(e);
+        any = true;
+    }
+    for (size_t l = 0; l < fd.loops.size(); l++)
+        for (size_t k = 0; k < fd.loops[l].curves.size(); k++)
+            if (int e = rescale_weights(fd.loops[l].curves[k].cpw, 3)) {
+                done += std::string(any ? "; " : "") + "loop " + std::to_string(l) + " curve " +
+                        std::to_string(k) + " weights scaled by 2^" + std::to_string(e);
+                any = true;
+            }
+    return any;
+}
+
 /* ---- the importer --------------------------------------------------------------------------- */
 
 struct rgba {
@@ -450,6 +615,7 @@ class importer
     const sw_sg_import_desc *desc_;
     sw__occt_face_observer *obs_;
     std::string path_, name_;
+    std::string part_name_; /* the XCAF name of the part whose faces are being converted */
     sw_sg_import_report rep_{};
     uint32_t faces_estimate_ = 1;
 
@@ -479,6 +645,22 @@ class importer
         if (desc_->warning)
             desc_->warning(desc_->user_data, m.c_str());
     }
+    std::string part_note() const
+    {
+        return part_name_.empty() ? std::string() : " (part '" + part_name_ + "')";
+    }
+    /* A skipped or repaired face: to the warning callback in words, to face_problem as a record.
+     * `face` is SW_SG_NONE for a face the reader dropped before conversion (`entity` names it). */
+    void problem(uint32_t face, sw_sg_face_action action, sw_result reason,
+                 const std::string &message, uint32_t entity = 0)
+    {
+        warn(message);
+        if (desc_->face_problem) {
+            const sw_sg_face_problem p{path_.c_str(), face,   entity,         part_name_.c_str(),
+                                       action,        reason, message.c_str()};
+            desc_->face_problem(desc_->user_data, &p);
+        }
+    }
     uint32_t node(sw_sg_node_kind kind, uint32_t parent, uint32_t ref, const double *xf,
                   const float *color, const char *name)
     {
@@ -489,6 +671,10 @@ class importer
     }
 
     sw_result read_brep(TopoDS_Shape &shape, sw_status *status);
+    sw_result check_iges(sw_sg_iges_scan &scan, sw_status *status);
+    sw_result read_iges_partial(const sw_sg_iges_scan &scan, TopoDS_Shape &shape,
+                                sw_status *status);
+    void report_dropped_faces(const Handle(XSControl_WorkSession) & ws, bool step);
     sw_result read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape, bool step,
                        sw_status *status);
     void estimate_faces(const TopoDS_Shape &shape);
@@ -570,6 +756,147 @@ sw_result importer::read_brep(TopoDS_Shape &shape, sw_status *status)
     return SW_OK;
 }
 
+/* An IGES file's structure, before OCCT reads it (sw_sg_iges.h): a truncated file is refused,
+ * or with SW_SG_IMPORT_PARTIAL read in part. A file not in fixed format is left to OCCT. */
+sw_result importer::check_iges(sw_sg_iges_scan &scan, sw_status *status)
+{
+    char *text = nullptr;
+    size_t len = 0;
+    sw_result r =
+        sw__in_read_all(path_.c_str(), (uint64_t)1 << 36, "IGES file", &text, &len, status);
+    if (r != SW_OK)
+        return r;
+    sw_status st{};
+    r = sw_sg_iges_scan_text(text, len, &scan, &st);
+    sw__free(text);
+    if (r == SW_ERR_UNSUPPORTED)
+        return SW_OK;
+    if (r != SW_OK)
+        return sw__fail(status, r, "%s: %s", path_.c_str(), st.message);
+    if (!scan.truncated)
+        return SW_OK;
+    const uint32_t whole = scan.entities - scan.incomplete;
+    if (!(desc_->flags & SW_SG_IMPORT_PARTIAL))
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: truncated IGES file: %s; the data of %u of its %u entities is whole "
+                        "(a partial import keeps the shapes made of those only)",
+                        path_.c_str(), scan.why, whole, scan.entities);
+    rep_.truncated = 1;
+    warn(path_ + ": truncated IGES file: " + scan.why + "; importing in part: the data of " +
+         std::to_string(whole) + " of its " + std::to_string(scan.entities) +
+         " entities is whole");
+    return SW_OK;
+}
+
+/* What is whole of a truncated IGES file: only the roots that reach no incomplete entity
+ * (sw_sg_iges.h) through OCCT's graph of the file (Interface_Graph::Shareds: parameter data and
+ * directory entry pointers) are transferred — OCCT neither marks nor guards an entity whose data
+ * is missing (its transfer of a cut IGES B-rep face dereferenced the face's missing loop list).
+ * The plain reader: XCAF transfers every root. */
+sw_result importer::read_iges_partial(const sw_sg_iges_scan &scan, TopoDS_Shape &shape,
+                                      sw_status *status)
+{
+    IGESControl_Reader r;
+    if (r.ReadFile(path_.c_str()) != IFSelect_RetDone)
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: truncated IGES file: OCCT cannot read what is left", path_.c_str());
+    Handle(IGESData_IGESModel) model = Handle(IGESData_IGESModel)::DownCast(r.Model());
+    /* OCCT also makes an entity of a directory entry cut after its first record: it is not
+     * among the scan's entities, so it counts as unsafe below */
+    if (model.IsNull() || (uint32_t)model->NbEntities() < scan.entities ||
+        (uint32_t)model->NbEntities() > scan.entities + 1)
+        return sw__fail(status, SW_ERR_TRUNCATED,
+                        "%s: truncated IGES file: OCCT read %d entities where %u directory "
+                        "entries are present, so none can be kept safely",
+                        path_.c_str(), model.IsNull() ? 0 : model->NbEntities(), scan.entities);
+    auto incomplete = [&](const Handle(Standard_Transient) & t) {
+        Handle(IGESData_IGESEntity) e = Handle(IGESData_IGESEntity)::DownCast(t);
+        const int dn = e.IsNull() ? 0 : model->DNum(e);
+        return dn < 1 || (uint32_t)(dn - 1) / 2 >= scan.entities ||
+               scan.entity_incomplete[(dn - 1) / 2];
+    };
+    const int roots = r.NbRootsForTransfer();
+    const Interface_Graph &graph = r.WS()->Graph();
+    /* 0 unknown, 1 whole with all it reaches, 2 not: memoized over the shared sub-graphs */
+    std::vector<uint8_t> state((size_t)model->NbEntities() + 1, 0);
+    std::vector<std::pair<int, bool>> stack; /* (entity number, children pushed) */
+    auto reaches_only_whole = [&](const Handle(Standard_Transient) & root) {
+        stack.assign(1, {model->Number(root), false});
+        while (!stack.empty()) {
+            auto [n, pushed] = stack.back();
+            if (n < 1 || n > model->NbEntities()) {
+                stack.pop_back();
+                continue;
+            }
+            if (state[n] != 0 && state[n] != 3) {
+                stack.pop_back();
+                continue;
+            }
+            if (!pushed) {
+                stack.back().second = true;
+                if (incomplete(model->Value(n))) {
+                    state[n] = 2;
+                    stack.pop_back();
+                    continue;
+                }
+                state[n] = 3; /* on the stack: a cycle back to it is not a defect */
+                for (Interface_EntityIterator it = graph.Shareds(model->Value(n)); it.More();
+                     it.Next())
+                    stack.push_back({model->Number(it.Value()), false});
+                continue;
+            }
+            uint8_t s = 1;
+            for (Interface_EntityIterator it = graph.Shareds(model->Value(n)); it.More(); it.Next()) {
+                const int c = model->Number(it.Value());
+                if (c >= 1 && c <= model->NbEntities() && state[c] == 2)
+                    s = 2;
+            }
+            state[n] = s;
+            stack.pop_back();
+        }
+        const int n = model->Number(root);
+        return n >= 1 && n <= model->NbEntities() && state[n] == 1;
+    };
+    /* A root that reaches an incomplete entity is opened where it is a container of shapes
+     * (group 402, solid 186, shell 514, subfigure 308/408): its whole parts are kept. */
+    uint32_t kept = 0, left = 0;
+    std::vector<uint8_t> visited(state.size(), 0);
+    std::vector<Handle(Standard_Transient)> todo;
+    for (int i = 1; i <= roots; i++)
+        if (!r.RootForTransfer(i).IsNull())
+            todo.push_back(r.RootForTransfer(i));
+    while (!todo.empty()) {
+        const Handle(Standard_Transient) e = todo.back();
+        todo.pop_back();
+        const int n = model->Number(e);
+        if (n < 1 || n > model->NbEntities() || visited[n])
+            continue;
+        visited[n] = 1;
+        if (reaches_only_whole(e)) {
+            kept += r.TransferEntity(e) ? 1u : 0u;
+            continue;
+        }
+        Handle(IGESData_IGESEntity) ie = Handle(IGESData_IGESEntity)::DownCast(e);
+        const int type = ie.IsNull() ? 0 : ie->TypeNumber();
+        if (incomplete(e) ||
+            !(type == 402 || type == 186 || type == 514 || type == 308 || type == 408)) {
+            left++;
+            continue;
+        }
+        for (Interface_EntityIterator it = graph.Shareds(e); it.More(); it.Next())
+            todo.push_back(it.Value());
+    }
+    warn(path_ + ": partial import: " + std::to_string(kept) + " entities transferred whole; " +
+         std::to_string(left) + " left out (their data, or data they point at, is missing)");
+    if (r.NbShapes() > 0)
+        shape = r.OneShape();
+    if (shape.IsNull())
+        return sw__fail(status, SW_ERR_TRUNCATED, "%s: truncated IGES file: nothing whole is left",
+                        path_.c_str());
+    report_dropped_faces(r.WS(), false);
+    return SW_OK;
+}
+
 /* STEP and IGES through XCAF (assemblies, names, colours); plain readers as the fall-back. */
 sw_result importer::read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape, bool step,
                              sw_status *status)
@@ -582,11 +909,15 @@ sw_result importer::read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape
         r.SetColorMode(true), r.SetNameMode(true), r.SetLayerMode(false);
         rs = r.ReadFile(path_.c_str());
         ok = rs == IFSelect_RetDone && r.Transfer(doc);
+        if (rs == IFSelect_RetDone)
+            report_dropped_faces(r.ChangeReader().WS(), true);
     } else {
         IGESCAFControl_Reader r;
         r.SetColorMode(true), r.SetNameMode(true), r.SetLayerMode(false);
         rs = r.ReadFile(path_.c_str());
         ok = rs == IFSelect_RetDone && r.Transfer(doc);
+        if (rs == IFSelect_RetDone)
+            report_dropped_faces(r.WS(), false);
     }
     if (rs != IFSelect_RetDone)
         return sw__fail(status, SW_ERR_FORMAT, "%s: not a readable %s file (reader status %d)",
@@ -614,6 +945,69 @@ sw_result importer::read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape
         return sw__fail(status, SW_ERR_FORMAT, "%s: the %s file holds no shape", path_.c_str(),
                         fmt);
     return SW_OK;
+}
+
+/* Faces OCCT's transfer dropped before they became TopoDS faces — it reports them only in its
+ * transfer process's checks (a STEP face: "a Face from Shell not mapped to TopoDS", its surface
+ * "Surface has not been created", e.g. for a weight of 0) — reported as skipped faces with the
+ * file's entity number. The plain-reader fall-back transfers again and is not looked at. */
+void importer::report_dropped_faces(const Handle(XSControl_WorkSession) & ws, bool step)
+{
+    if (ws.IsNull() || ws->TransferReader().IsNull() ||
+        ws->TransferReader()->TransientProcess().IsNull() || ws->Model().IsNull())
+        return;
+    const Handle(Transfer_TransientProcess) tp = ws->TransferReader()->TransientProcess();
+    const Handle(Interface_InterfaceModel) model = ws->Model();
+    const Interface_CheckIterator checks = tp->CheckList(Standard_False);
+    auto first_message = [](const Handle(Interface_Check) & c) -> std::string {
+        std::string m = c->NbFails() > 0      ? c->CFail(1)
+                        : c->NbWarnings() > 0 ? c->CWarning(1)
+                                              : "";
+        const size_t a = m.find_first_not_of(' '), b = m.find_last_not_of(' ');
+        return a == std::string::npos ? "" : m.substr(a, b - a + 1);
+    };
+    auto label = [&model](const Handle(Standard_Transient) & e) -> std::string {
+        Handle(TCollection_HAsciiString) l = model->StringLabel(e);
+        return l.IsNull() ? std::string("?") : std::string(l->ToCString());
+    };
+    std::unordered_map<const Standard_Transient *, std::string> failed;
+    /* the iterator's position is shared by its copies: each loop starts it */
+    Interface_CheckIterator it = checks;
+    for (it.Start(); it.More(); it.Next())
+        if (!it.Value()->Entity().IsNull() && it.Value()->HasFailed())
+            failed[it.Value()->Entity().get()] = first_message(it.Value());
+    for (it.Start(); it.More(); it.Next()) {
+        const Handle(Interface_Check) &c = it.Value();
+        const Handle(Standard_Transient) ent = c->Entity();
+        if (ent.IsNull())
+            continue;
+        std::string why = first_message(c);
+        if (step) {
+            if (!ent->IsKind(STANDARD_TYPE(StepShape_Face)) ||
+                !(c->HasFailed() || why.find("not mapped") != std::string::npos))
+                continue;
+            Handle(StepShape_FaceSurface) fs = Handle(StepShape_FaceSurface)::DownCast(ent);
+            if (!fs.IsNull() && !fs->FaceGeometry().IsNull()) {
+                auto g = failed.find(fs->FaceGeometry().get());
+                if (g != failed.end())
+                    why += "; its surface " + label(fs->FaceGeometry()) + ": " + g->second;
+            }
+        } else if (!c->HasFailed() ||
+                   !(ent->IsKind(STANDARD_TYPE(IGESSolid_Face)) ||
+                     ent->IsKind(STANDARD_TYPE(IGESGeom_TrimmedSurface)) ||
+                     ent->IsKind(STANDARD_TYPE(IGESGeom_BoundedSurface)))) {
+            continue;
+        }
+        const std::string id = label(ent);
+        const size_t digit = id.find_first_of("0123456789");
+        const uint32_t number =
+            digit == std::string::npos ? 0u : (uint32_t)std::strtoul(id.c_str() + digit, nullptr, 10);
+        rep_.faces_failed++, rep_.faces_dropped++;
+        problem(SW_SG_NONE, SW_SG_FACE_SKIPPED, SW_ERR_INVALID_GEOMETRY,
+                path_ + ": face " + id + " (" + (step ? "STEP entity" : "IGES entity") +
+                    ") skipped: OCCT did not transfer it: " + why,
+                number);
+    }
 }
 
 void importer::estimate_faces(const TopoDS_Shape &shape)
@@ -804,22 +1198,45 @@ uint32_t importer::face_index(const TopoDS_Face &f)
     const uint32_t ordinal = rep_.faces_read++;
     const std::string what = name_ + ": face " + std::to_string(ordinal);
     uint32_t idx = SW_SG_NONE;
-    std::string why;
+    std::string why, repaired;
+    sw_result code = SW_OK;
     TopoDS_Face converted;
     try {
         face_data fd = convert_face(f, converted, what);
+        sw_status st{};
+        if (validate_face(fd, what, &st) != SW_OK) {
+            /* the message names the face already ("FILE: face N: ...") */
+            if (!repair_face(fd, repaired) || validate_face(fd, what, nullptr) != SW_OK) {
+                repaired.clear();
+                throw face_error{st.message, st.result};
+            }
+            std::string found = st.message;
+            if (found.compare(0, what.size() + 2, what + ": ") == 0)
+                found.erase(0, what.size() + 2);
+            repaired = path_ + ": face " + std::to_string(ordinal) + part_note() +
+                       " repaired: " + found +
+                       "; exact repair: " + repaired;
+        }
         idx = push_face(fd);
         face_orient_[idx] = f.Orientation();
     } catch (const face_error &e) {
-        why = e.why;
+        why = e.why, code = e.code;
+        if (why.compare(0, what.size() + 2, what + ": ") == 0) /* the message names the face */
+            why.erase(0, what.size() + 2);
     } catch (const Standard_Failure &e) {
         why = std::string(e.DynamicType()->Name()) + ": " + e.GetMessageString();
+        code = SW_ERR_INTERNAL;
     }
     if (idx == SW_SG_NONE) {
         rep_.faces_failed++;
-        warn(path_ + ": face " + std::to_string(ordinal) + " could not be converted: " + why);
+        problem(ordinal, SW_SG_FACE_SKIPPED, code,
+                path_ + ": face " + std::to_string(ordinal) + part_note() + " skipped: " + why);
     } else {
         rep_.faces_converted++;
+        if (!repaired.empty()) {
+            rep_.faces_repaired++;
+            problem(ordinal, SW_SG_FACE_REPAIRED, SW_ERR_INVALID_GEOMETRY, repaired);
+        }
         if (obs_)
             obs_->on_face(idx, f, converted);
     }
@@ -967,7 +1384,10 @@ void importer::fill_label(const TDF_Label &l, uint32_t n)
         for (TopExp_Explorer ex(st_->GetShape(sub), TopAbs_FACE); ex.More(); ex.Next())
             face_colors_[ex.Current().TShape().get()] = col;
     }
+    const std::string outer = part_name_;
+    part_name_ = label_name(l);
     add_shape(st_->GetShape(l), n);
+    part_name_ = outer;
 }
 
 sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_report *report,
@@ -986,6 +1406,18 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
         return sw__fail(status, SW_ERR_UNSUPPORTED,
                         "%s: unknown extension (expected .step, .stp, .iges, .igs or .brep)",
                         path_.c_str());
+    struct scan_guard { /* freed on every way out */
+        sw_sg_iges_scan s{};
+        ~scan_guard()
+        {
+            sw_sg_iges_scan_free(&s);
+        }
+    } scan;
+    if (iges) {
+        checked = check_iges(scan.s, status);
+        if (checked != SW_OK)
+            return checked;
+    }
 
     progress(0.0, "read");
     double t0 = now_ms();
@@ -1002,7 +1434,9 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
     sw_result r;
     try {
         quiet_messenger quiet(desc_->warning, desc_->user_data, path_);
-        if (step || iges) {
+        if (rep_.truncated) {
+            r = read_iges_partial(scan.s, shape, status);
+        } else if (step || iges) {
             XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", doc);
             r = read_cad(doc, shape, step, status);
         } else {
@@ -1099,7 +1533,12 @@ sw_result sw__occt_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
         sw_sg_builder_free(b);
         return r;
     }
-    return sw_sg_builder_finish(b, out, status);
+    r = sw_sg_builder_finish(b, out, status);
+    if (r != SW_OK && status) { /* the scene's checks name "scene": say which file it came from */
+        const std::string m = status->message;
+        sw__fail(status, r, "%s: %s", desc->path, m.c_str());
+    }
+    return r;
 }
 
 extern "C" sw_result sw_sg_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,

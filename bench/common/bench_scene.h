@@ -18,7 +18,7 @@ static inline sw_result bench_scene_orbit(const char *path, double distance, int
                                           sw_scene *scene, sw_rt_camera_path *orbit,
                                           sw_status *st)
 {
-    sw_scene_load_desc ld = {path, NULL, NULL, NULL};
+    sw_scene_load_desc ld = {path, NULL, NULL, NULL, NULL, 0};
     sw_result r = path ? sw_scene_load(&ld, scene, st) : sw_scene_load_default(NULL, NULL, scene, st);
     sw_scene_info info;
     if (r == SW_OK)

@@ -110,7 +110,7 @@ int main(int argc, char **argv)
            sw_gpu_context_description_ptr(ctx), lp ? lp : "(unset)", w, h, frames);
     int ok = 1;
     for (int a = first; a < argc && ok; ++a) {
-        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL};
+        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL, NULL, 0};
         sw_sg_scene *scene = NULL;
         if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {
             fprintf(stderr, "%s: %s\n", argv[a], st.message);

@@ -163,7 +163,7 @@ int bp_probe_scene(const bp_job *job, bp_result *out)
 {
     sw_status st;
     memset(&st, 0, sizeof st);
-    sw_scene_load_desc ld = {job->scene, NULL, NULL, NULL};
+    sw_scene_load_desc ld = {job->scene, NULL, NULL, NULL, NULL, 0};
     sw_scene s = {0};
     sw_scene_info info;
     sw_result r = sw_scene_load(&ld, &s, &st);

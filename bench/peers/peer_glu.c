@@ -536,7 +536,7 @@ int bp_peer_glu(const bp_job *job, bp_result *out)
     double t_start = bench_now_ms();
     sw_status st;
     memset(&st, 0, sizeof st);
-    sw_scene_load_desc ld = {job->scene, NULL, NULL, NULL};
+    sw_scene_load_desc ld = {job->scene, NULL, NULL, NULL, NULL, 0};
     sw_scene scene = {0};
     sw_rt_scene *rs = NULL;
     if (sw_scene_load(&ld, &scene, &st) != SW_OK || sw_rt_scene_acquire(scene, &rs, &st) != SW_OK) {

@@ -57,7 +57,7 @@ static int pass(sw_run *r, double *ms, double *tri, double *t_first)
 
 static int load(sw_run *r, sw_rt_camera_path *own_path, bp_result *out)
 {
-    sw_scene_load_desc ld = {r->job.scene, NULL, NULL, NULL};
+    sw_scene_load_desc ld = {r->job.scene, NULL, NULL, NULL, NULL, 0};
     sw_scene_info info;
     if (sw_scene_load(&ld, &r->scene, &r->st) != SW_OK ||
         sw_scene_get_info(r->scene, &info, &r->st) != SW_OK)

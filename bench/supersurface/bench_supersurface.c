@@ -28,7 +28,7 @@ static int cmp_double(const void *a, const void *b)
 
 static int bench_model(const char *path, int runs, const sw_lod_ss_desc *desc)
 {
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
+    sw_sg_import_desc d = {path, NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL;
     sw_status st = {0};
     if (sw_sg_import_file(&d, &scene, NULL, &st) != SW_OK) {

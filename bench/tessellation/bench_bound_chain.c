@@ -349,7 +349,7 @@ int main(int argc, char **argv)
     }
 #ifdef BT_WITH_IMPORT
     for (int a = first_file; a < argc && ok; ++a) {
-        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL};
+        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL, NULL, 0};
         sw_sg_scene *scene = NULL;
         if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {
             fprintf(stderr, "import %s: %s\n", argv[a], st.message);

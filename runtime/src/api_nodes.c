@@ -506,8 +506,8 @@ static sw_result tspline_geom(const sw_tspline_desc *d, sw_sg_scene **out, sw_st
 
 static sw_result import_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *status)
 {
-    sw_scene_load_desc ld = {d->import_path, NULL, d->import_warning, d->user_data};
-    sw_result r = sw_rt_scene_read(&ld, out, status);
+    sw_scene_load_desc ld = {d->import_path, NULL, d->import_warning, d->user_data, NULL, 0};
+    sw_result r = sw_rt_scene_read(&ld, out, NULL, status);
     if (r == SW_OK)
         r = sw_sg_scene_require(*out, SW_SG_SEC_ALL, status); /* a mapped .sws: verify it now */
     if (r != SW_OK) {

@@ -66,8 +66,39 @@ static sw_result wrap_scene(sw_sg_scene *sg, sw_scene *out, sw_status *status)
     return sw_rt_scene_add_handle(scene, out, status);
 }
 
-sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out, sw_status *status)
+/* The importer's callbacks handed on to the host's: the context is the load desc, whose
+ * user_data goes to each; the face records become the public ones (the same fields). */
+static void relay_progress(void *ctx, double fraction, const char *stage)
 {
+    const sw_scene_load_desc *desc = ctx;
+    desc->progress(desc->user_data, fraction, stage);
+}
+
+static void relay_warning(void *ctx, const char *message)
+{
+    const sw_scene_load_desc *desc = ctx;
+    desc->warning(desc->user_data, message);
+}
+
+static void relay_face_problem(void *ctx, const sw_sg_face_problem *p)
+{
+    const sw_scene_load_desc *desc = ctx;
+    const sw_face_problem q = {p->path,
+                               p->face,
+                               p->entity,
+                               p->name,
+                               p->action == SW_SG_FACE_REPAIRED ? SW_FACE_REPAIRED
+                                                                : SW_FACE_SKIPPED,
+                               p->reason,
+                               p->message};
+    desc->face_problem(desc->user_data, &q);
+}
+
+sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out,
+                           sw_sg_import_report *report, sw_status *status)
+{
+    if (report)
+        memset(report, 0, sizeof *report);
     if (has_extension(desc->path, ".sws"))
         return sw_sg_scene_open(desc->path, out, status);
     if (has_extension(desc->path, ".tsm"))
@@ -77,8 +108,13 @@ sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out, sw
                         "%s: unknown extension (expected .sws, .step, .stp, .iges, .igs, .brep "
                         "or .tsm)",
                         desc->path);
-    sw_sg_import_desc import = {desc->path, desc->progress, desc->warning, desc->user_data};
-    return sw_sg_import_file(&import, out, NULL, status);
+    sw_sg_import_desc import = {desc->path,
+                                desc->progress ? relay_progress : NULL,
+                                desc->warning ? relay_warning : NULL,
+                                (void *)desc,
+                                desc->face_problem ? relay_face_problem : NULL,
+                                (desc->flags & SW_LOAD_PARTIAL) ? SW_SG_IMPORT_PARTIAL : 0u};
+    return sw_sg_import_file(&import, out, report, status);
 }
 
 sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status)
@@ -88,10 +124,17 @@ sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status
     if (!desc || !desc->path || !out)
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_scene_load: NULL desc, path or out");
     sw_sg_scene *sg = NULL;
-    sw_result r = sw_rt_scene_read(desc, &sg, status);
+    sw_sg_import_report report;
+    sw_result r = sw_rt_scene_read(desc, &sg, &report, status);
     if (r != SW_OK)
         return r;
-    return wrap_scene(sg, out, status);
+    sw_rt_scene *scene = sw_rt_scene_alloc(sg);
+    if (!scene)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "out of memory");
+    scene->faces_skipped = report.faces_failed;
+    scene->faces_repaired = report.faces_repaired;
+    scene->partial = report.truncated;
+    return sw_rt_scene_add_handle(scene, out, status);
 }
 
 /* The default scene: OCCT's "modern kitchen" sample models are already placed in Room.brep's
@@ -129,8 +172,12 @@ static sw_result import_part(sw_sg_builder *b, uint32_t parent, const double *xf
     int n = snprintf(path, sizeof path, "%s/%s", data_dir, file);
     if (n < 0 || (size_t)n >= sizeof path)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "data directory path too long");
-    sw_sg_import_desc import = {path, NULL, desc ? desc->warning : NULL,
-                                desc ? desc->user_data : NULL};
+    sw_sg_import_desc import = {path,
+                                NULL,
+                                desc && desc->warning ? relay_warning : NULL,
+                                (void *)desc,
+                                desc && desc->face_problem ? relay_face_problem : NULL,
+                                0};
     return sw_sg_import_into(b, parent, xform, &import, NULL, status);
 }
 
@@ -335,6 +382,9 @@ sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *stat
     out->mesh_triangles = s->mesh_triangles;
     out->mesh_occurrences = s->mesh_occurrences;
     out->triangle_occurrences = s->triangle_occurrences;
+    out->faces_skipped = scene->faces_skipped;
+    out->faces_repaired = scene->faces_repaired;
+    out->partial = scene->partial;
     sw_rt_scene_release(scene);
     return SW_OK;
 }

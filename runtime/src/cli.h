@@ -6,6 +6,8 @@
 
 #include <splinewalk/splinewalk.h>
 
+#include <stdio.h>
+
 int sw_cli_import(int argc, char **argv);
 int sw_cli_info(int argc, char **argv);
 int sw_cli_render(int argc, char **argv);
@@ -31,8 +33,23 @@ int sw_cli_check_output(const char *cmd, const char *path, unsigned flags);
 void sw_cli_progress(void *user_data, double fraction, const char *stage);
 void sw_cli_progress_end(void);
 void sw_cli_warning(void *user_data, const char *message);
-/* Loads a scene with the progress bar and warnings on stderr. */
-sw_result sw_cli_load_scene(const char *path, sw_scene *out, sw_status *status);
+/* Loads a scene with the progress bar and warnings on stderr (each skipped or repaired face of a
+ * CAD import among them); flags: sw_scene_load_desc.flags (SW_LOAD_PARTIAL for --partial). */
+sw_result sw_cli_load_scene(const char *path, uint32_t flags, sw_scene *out, sw_status *status);
+/* The faces the last sw_cli_load_scene skipped or repaired, as its face_problem records gave them
+ * (strings copied; valid until the next load). */
+typedef struct sw_cli_face_note {
+    uint32_t face, entity;
+    sw_face_action action;
+    sw_result reason;
+    char name[128];
+} sw_cli_face_note;
+size_t sw_cli_face_notes(const sw_cli_face_note **out);
+/* After a load that imported a CAD file: "N faces skipped, M repaired, ..." on `f` when any
+ * face was skipped or repaired or the file was imported in part; nothing otherwise. */
+void sw_cli_print_import_notes(FILE *f, const char *cmd, const sw_scene_info *info);
+/* sw_cli_report, with a hint at --partial for a truncated file (commands that take it). */
+int sw_cli_report_load(const char *cmd, const sw_status *status);
 /* "1280x720" → width, height (1..16384). Returns 0 on success. */
 int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h);
 /* "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy" → camera. Returns 0 on success. */

@@ -146,7 +146,7 @@ int sw_cli_build_lod(int argc, char **argv)
     sw_status status = {0};
     sw_scene handle;
     const double t0 = sw_cli_now_ms();
-    if (sw_cli_load_scene(a.scene, &handle, &status) != SW_OK)
+    if (sw_cli_load_scene(a.scene, 0, &handle, &status) != SW_OK)
         return sw_cli_report("build-lod", &status);
     sw_rt_scene *scene = NULL;
     sw_th_pool *pool = NULL;

@@ -46,7 +46,7 @@ static int check_scene(const char *path, const osd_args *a)
     sw_status status = {0};
     sw_scene handle;
     sw_rt_scene *scene;
-    if (sw_cli_load_scene(path, &handle, &status) != SW_OK)
+    if (sw_cli_load_scene(path, 0, &handle, &status) != SW_OK)
         return sw_cli_report("check-osd", &status);
     sw_result r = sw_rt_scene_acquire(handle, &scene, &status);
     sw_lod_osd_report rep = {0};

@@ -86,12 +86,57 @@ void sw_cli_warning(void *user_data, const char *message)
     fprintf(stderr, "warning: %s\n", message);
 }
 
-sw_result sw_cli_load_scene(const char *path, sw_scene *out, sw_status *status)
+static struct {
+    sw_cli_face_note *notes;
+    size_t n, cap;
+} g_faces;
+
+static void collect_face(void *user_data, const sw_face_problem *p)
 {
-    sw_scene_load_desc desc = {path, sw_cli_progress, sw_cli_warning, NULL};
+    (void)user_data;
+    if (g_faces.n == g_faces.cap) {
+        size_t cap = g_faces.cap ? 2 * g_faces.cap : 16;
+        sw_cli_face_note *grown = realloc(g_faces.notes, cap * sizeof *grown);
+        if (!grown)
+            return; /* the warning line still names it */
+        g_faces.notes = grown, g_faces.cap = cap;
+    }
+    sw_cli_face_note *n = &g_faces.notes[g_faces.n++];
+    n->face = p->face, n->entity = p->entity, n->action = p->action, n->reason = p->reason;
+    snprintf(n->name, sizeof n->name, "%s", p->name ? p->name : "");
+}
+
+size_t sw_cli_face_notes(const sw_cli_face_note **out)
+{
+    *out = g_faces.notes;
+    return g_faces.n;
+}
+
+sw_result sw_cli_load_scene(const char *path, uint32_t flags, sw_scene *out, sw_status *status)
+{
+    g_faces.n = 0;
+    sw_scene_load_desc desc = {path, sw_cli_progress, sw_cli_warning, NULL, collect_face, flags};
     sw_result r = sw_scene_load(&desc, out, status);
     sw_cli_progress_end();
     return r;
+}
+
+void sw_cli_print_import_notes(FILE *f, const char *cmd, const sw_scene_info *info)
+{
+    if (!info->faces_skipped && !info->faces_repaired && !info->partial)
+        return;
+    fprintf(f, "%s: %u faces skipped, %u repaired (each named in a warning above)%s\n",
+            cmd, info->faces_skipped, info->faces_repaired,
+            info->partial ? "; the file is truncated and was imported in part (--partial)" : "");
+}
+
+int sw_cli_report_load(const char *cmd, const sw_status *status)
+{
+    int rc = sw_cli_report(cmd, status);
+    if (status->result == SW_ERR_TRUNCATED)
+        fprintf(stderr, "splinewalk %s: --partial imports what is whole of a truncated file\n",
+                cmd);
+    return rc;
 }
 
 int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h)

@@ -124,7 +124,7 @@ int sw_cli_demo(int argc, char **argv)
     double t0 = sw_cli_now_ms();
     printf("building the default scene from %s\n",
            a.data ? a.data : "/usr/share/opencascade/data");
-    sw_scene_load_desc desc = {NULL, sw_cli_progress, sw_cli_warning, NULL};
+    sw_scene_load_desc desc = {NULL, sw_cli_progress, sw_cli_warning, NULL, NULL, 0};
     sw_result r = sw_scene_load_default(a.data, &desc, &built, &status);
     sw_cli_progress_end();
     if (r != SW_OK)
@@ -140,7 +140,7 @@ int sw_cli_demo(int argc, char **argv)
 
     sw_scene scene;
     sw_scene_info info;
-    if (sw_cli_load_scene(sws, &scene, &status) != SW_OK ||
+    if (sw_cli_load_scene(sws, 0, &scene, &status) != SW_OK ||
         sw_scene_get_info(scene, &info, &status) != SW_OK)
         return sw_cli_report("demo", &status);
     double t3 = sw_cli_now_ms();

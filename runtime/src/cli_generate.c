@@ -244,7 +244,7 @@ static sw_result load_models(const char *data, const char *const *files, int n,
                             "%s: no such file: the models come from the OCCT sample "
                             "data (Debian's occt-misc); give its folder with --data DIR",
                             path);
-        sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL};
+        sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL, NULL, 0};
         sw_result r = sw_sg_import_file(&d, &models[m], NULL, status);
         if (r != SW_OK)
             return r;
@@ -364,7 +364,7 @@ int sw_cli_generate(int argc, char **argv)
 
     sw_status status = {0};
     sw_scene scene;
-    if (sw_cli_load_scene(a.model, &scene, &status) != SW_OK)
+    if (sw_cli_load_scene(a.model, 0, &scene, &status) != SW_OK)
         return sw_cli_report("generate", &status);
     sw_rt_scene *model = NULL;
     sw_sg_grid_report rep;

@@ -86,7 +86,7 @@ int sw_cli_path(int argc, char **argv)
 
     sw_status status = {0};
     sw_scene scene;
-    if (sw_cli_load_scene(a.scene, &scene, &status) != SW_OK)
+    if (sw_cli_load_scene(a.scene, 0, &scene, &status) != SW_OK)
         return sw_cli_report("path", &status);
     sw_scene_info info;
     sw_result r = sw_scene_get_info(scene, &info, &status);

@@ -529,7 +529,7 @@ int sw_cli_profile(int argc, char **argv)
         return sw_cli_report("profile", &status);
     const uint32_t n = a.frames ? (uint32_t)a.frames : path.frames ? path.frames : 100;
     sw_scene scene;
-    if (sw_cli_load_scene(a.scene, &scene, &status) != SW_OK) {
+    if (sw_cli_load_scene(a.scene, 0, &scene, &status) != SW_OK) {
         sw_rt_path_free(&path);
         return sw_cli_report("profile", &status);
     }

@@ -11,12 +11,14 @@ static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
-    "                         [--static-force K]\n"
+    "                         [--static-force K] [--partial]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as EXR\n"
     "with a depth channel when FRAME ends in .exr. Prints how many patches were drawn trimmed by\n"
-    "trim textures, untrimmed, and culled, and how long each step took.\n"
+    "trim textures, untrimmed, and culled, and how long each step took. A CAD file's faces skipped\n"
+    "or repaired by the import are each named in a warning on stderr and counted (as `import`\n"
+    "does); a truncated IGES file is refused unless --partial.\n"
     "\n"
     "options:\n"
     "  -o, --output FILE   image to write (.png or .exr; required)\n"
@@ -42,6 +44,7 @@ static const char k_usage[] =
     "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
     "                      (i + K) mod (n + 1) of its n levels good enough for the view, the last\n"
     "                      choice meaning per-frame: neighbours at different levels\n"
+    "  --partial           import what is whole of a truncated file (see `import --help`)\n"
     "  -h, --help          this text\n";
 
 typedef struct render_args {
@@ -49,6 +52,7 @@ typedef struct render_args {
     sw_frame_desc frame;
     sw_view_preset view;
     int has_camera;
+    uint32_t load_flags;
 } render_args;
 
 static int parse_args(int argc, char **argv, render_args *a)
@@ -57,6 +61,10 @@ static int parse_args(int argc, char **argv, render_args *a)
         const char *arg = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
         int bad = 0;
+        if (!strcmp(arg, "--partial")) {
+            a->load_flags |= SW_LOAD_PARTIAL;
+            continue;
+        }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
             *(!strcmp(arg, "--static-lod") ? &a->frame.static_lods : &a->frame.lod_colors) = 1;
             continue;
@@ -114,9 +122,12 @@ int sw_cli_render(int argc, char **argv)
     sw_status status = {0};
     double t0 = sw_cli_now_ms();
     sw_scene scene;
-    if (sw_cli_load_scene(a.scene, &scene, &status) != SW_OK)
-        return sw_cli_report("render", &status);
+    if (sw_cli_load_scene(a.scene, a.load_flags, &scene, &status) != SW_OK)
+        return sw_cli_report_load("render", &status);
     double t1 = sw_cli_now_ms();
+    sw_scene_info load_info;
+    if (sw_scene_get_info(scene, &load_info, NULL) == SW_OK)
+        sw_cli_print_import_notes(stdout, "render", &load_info);
     sw_renderer renderer = {0};
     sw_frame_stats stats = {0};
     a.frame.scene = scene;

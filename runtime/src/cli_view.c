@@ -501,7 +501,7 @@ int sw_cli_view(int argc, char **argv)
     sw_scene scene = {0};
     if (!win)
         rc = 1;
-    else if (sw_cli_load_scene(a.scene, &scene, &st) != SW_OK)
+    else if (sw_cli_load_scene(a.scene, 0, &scene, &st) != SW_OK)
         rc = sw_cli_report("view", &st);
     else
         rc = view_scene(&a, win, scene, a.script ? &script : NULL);

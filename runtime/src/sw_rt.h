@@ -55,6 +55,9 @@ typedef struct sw_rt_scene {
     int ready;
     sw_result ready_result;
     sw_sg_scene_stats stats;
+    uint32_t faces_skipped, faces_repaired; /* of the CAD import that made it; set before the
+                                               handle is published, then immutable */
+    int32_t partial;
     struct sw_sg_bvh *pick_bvh; /* immutable once built; freed with the scene */
     /* Node scenes (api_nodes*.c). The handle's scene is a container: sg NULL, `model` the node
      * tree, and acquiring it yields the model's published version instead. A version is an
@@ -75,8 +78,11 @@ sw_rt_scene *sw_rt_scene_alloc(sw_sg_scene *sg);
 /* Gives the scene a handle (the pool takes the caller's reference). On failure frees the scene
  * and returns SW_ERR_LIMIT. */
 sw_result sw_rt_scene_add_handle(sw_rt_scene *scene, sw_scene *out, sw_status *status);
-/* Reads a scene file as sw_scene_load does (.sws mapped, .tsm, or CAD through OCCT). */
-sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out, sw_status *status);
+struct sw_sg_import_report;
+/* Reads a scene file as sw_scene_load does (.sws mapped, .tsm, or CAD through OCCT); `report`
+ * (may be NULL) gets a CAD import's counts, zero otherwise. */
+sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out,
+                           struct sw_sg_import_report *report, sw_status *status);
 /* Node scenes: frees the model of a container and what a version owns (api_nodes.c); called by
  * the last release. */
 void sw_rt_nodes_scene_free(sw_rt_scene *scene);

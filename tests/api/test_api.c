@@ -27,7 +27,7 @@ static const char *g_scene_path, *g_work, *g_big_scene_path;
 
 static sw_scene load_scene(void)
 {
-    sw_scene_load_desc desc = {g_scene_path, NULL, NULL, NULL};
+    sw_scene_load_desc desc = {g_scene_path, NULL, NULL, NULL, NULL, 0};
     sw_scene scene = {0};
     sw_status status = {0};
     EXPECT_RESULT(sw_scene_load(&desc, &scene, &status), SW_OK);
@@ -56,14 +56,14 @@ static void test_null_arguments(void)
     EXPECT(scene.id == 0); /* *out = {0} on failure */
     sw_scene_load_desc no_path = {0};
     EXPECT_RESULT(sw_scene_load(&no_path, &scene, NULL), SW_ERR_INVALID_ARGUMENT);
-    sw_scene_load_desc desc = {g_scene_path, NULL, NULL, NULL};
+    sw_scene_load_desc desc = {g_scene_path, NULL, NULL, NULL, NULL, 0};
     EXPECT_RESULT(sw_scene_load(&desc, NULL, NULL), SW_ERR_INVALID_ARGUMENT);
     EXPECT_RESULT(sw_scene_load_default(NULL, NULL, NULL, NULL), SW_ERR_INVALID_ARGUMENT);
-    sw_scene_load_desc wrong_ext = {"scene.txt", NULL, NULL, NULL};
+    sw_scene_load_desc wrong_ext = {"scene.txt", NULL, NULL, NULL, NULL, 0};
     EXPECT_RESULT(sw_scene_load(&wrong_ext, &scene, NULL), SW_ERR_UNSUPPORTED);
     char missing[4096];
     work_path(missing, sizeof missing, "missing.sws");
-    sw_scene_load_desc absent = {missing, NULL, NULL, NULL};
+    sw_scene_load_desc absent = {missing, NULL, NULL, NULL, NULL, 0};
     EXPECT_RESULT(sw_scene_load(&absent, &scene, NULL), SW_ERR_NOT_FOUND);
 
     scene = load_scene();
@@ -208,7 +208,7 @@ static int destroy_while_saving_once(void)
     pthread_join(thread, NULL);
     EXPECT(s.other_result == 0);
     if (s.saves_ok > 0) {
-        sw_scene_load_desc desc = {s.path, NULL, NULL, NULL};
+        sw_scene_load_desc desc = {s.path, NULL, NULL, NULL, NULL, 0};
         sw_scene copy;
         sw_scene_info after;
         EXPECT_RESULT(sw_scene_load(&desc, &copy, NULL), SW_OK);
@@ -430,7 +430,7 @@ static void test_destroy_while_drawing(sw_renderer r)
  * lets it go. */
 static void test_destroy_after_walkthrough(sw_renderer r)
 {
-    sw_scene_load_desc desc = {g_big_scene_path, NULL, NULL, NULL};
+    sw_scene_load_desc desc = {g_big_scene_path, NULL, NULL, NULL, NULL, 0};
     sw_scene big;
     sw_status status = {0};
     EXPECT_RESULT(sw_scene_load(&desc, &big, &status), SW_OK);

@@ -221,7 +221,7 @@ static sw_camera far_out(const sw_camera *home, int i)
 
 static void test_static_walkthrough(const char *scene_path, int frames)
 {
-    sw_scene_load_desc ld = {scene_path, NULL, NULL, NULL};
+    sw_scene_load_desc ld = {scene_path, NULL, NULL, NULL, NULL, 0};
     sw_scene scene = {0};
     sw_renderer r = {0};
     sw_renderer_desc rd = {.worker_threads = 2};
@@ -285,7 +285,7 @@ int main(int argc, char **argv)
     }
     g_work = argv[2];
     int frames = argc == 4 ? atoi(argv[3]) : 30;
-    sw_scene_load_desc ld = {argv[1], NULL, NULL, NULL};
+    sw_scene_load_desc ld = {argv[1], NULL, NULL, NULL, NULL, 0};
     sw_scene scene = {0};
     sw_status st = {0};
     if (sw_scene_load(&ld, &scene, &st) != SW_OK || frames < 2) {

@@ -669,7 +669,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: %s TERRAIN.brep CRANKARM.brep\n", argv[0]);
         return 2;
     }
-    sw_sg_import_desc id = {argv[1], NULL, NULL, NULL};
+    sw_sg_import_desc id = {argv[1], NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *terrain = NULL;
     sw_status st = {0};
     if (sw_sg_import_file(&id, &terrain, NULL, &st) != SW_OK) {
@@ -685,7 +685,7 @@ int main(int argc, char **argv)
     if (g)
         unit_instances(g, "grid of 10000 terrain instances", 10000);
     sw_sg_scene_free(g);
-    sw_sg_import_desc cd = {argv[2], NULL, NULL, NULL};
+    sw_sg_import_desc cd = {argv[2], NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *crank = NULL;
     if (sw_sg_import_file(&cd, &crank, NULL, &st) != SW_OK) {
         CHECK(0, "import %s: %s", argv[2], st.message);

@@ -574,7 +574,7 @@ static void test_brep(const sw_sg_scene *s, const char *work)
         CHECK(0, "export: %s", st.message);
         return;
     }
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
+    sw_sg_import_desc d = {path, NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *back = NULL;
     if (sw_sg_import_file(&d, &back, NULL, &st) != SW_OK) {
         CHECK(0, "import of the export: %s", st.message);
@@ -612,7 +612,7 @@ int main(int argc, char **argv)
     for (int m = 0; m < n_models; ++m) {
         char path[1024];
         snprintf(path, sizeof path, "%s/%s", argv[1], files[m]);
-        sw_sg_import_desc d = {path, NULL, NULL, NULL};
+        sw_sg_import_desc d = {path, NULL, NULL, NULL, NULL, 0};
         sw_status st = {0};
         if (sw_sg_import_file(&d, &g_models[m], NULL, &st) != SW_OK) {
             fprintf(stderr, "%s\n", st.message);

@@ -205,7 +205,7 @@ static void check_sws(sw_sg_scene *scene, const char *name)
 
 static sw_sg_scene *load(const char *path)
 {
-    sw_sg_import_desc id = {path, NULL, NULL, NULL};
+    sw_sg_import_desc id = {path, NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL;
     sw_status st = {0};
     if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK)
@@ -239,7 +239,7 @@ static sw_sg_scene *mirrored(const char *path, int both)
     uint32_t proto =
         b ? sw_sg_builder_add_node(b, SW_SG_NODE_GROUP, SW_SG_NONE, 0, NULL, NULL, "prototype")
           : SW_SG_NONE;
-    sw_sg_import_desc id = {path, NULL, NULL, NULL};
+    sw_sg_import_desc id = {path, NULL, NULL, NULL, NULL, 0};
     if (proto == SW_SG_NONE || sw_sg_import_into(b, proto, NULL, &id, NULL, &st) != SW_OK) {
         CHECK(0, "mirror %s: %s", path, st.message);
         sw_sg_builder_free(b);

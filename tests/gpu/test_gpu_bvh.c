@@ -167,7 +167,7 @@ int main(int argc, char **argv)
         return 1;
     }
     for (int a = 1; a < argc; ++a) {
-        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL};
+        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL, NULL, 0};
         sw_sg_scene *scene = NULL;
         if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {
             CHECK(0, "import %s: %s", argv[a], st.message);

@@ -92,7 +92,7 @@ int main(int argc, char **argv)
     int ok = 1;
     totals tot = {0, 0};
     for (int a = 3; a < argc; ++a) {
-        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL};
+        sw_sg_import_desc id = {argv[a], NULL, NULL, NULL, NULL, 0};
         sw_sg_scene *scene = NULL;
         if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {
             fprintf(stderr, "import %s: %s\n", argv[a], st.message);

@@ -345,7 +345,7 @@ static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache 
 
 static int run_file(sw_gpu_context *ctx, const char *outdir, const char *path, collector *c)
 {
-    sw_sg_import_desc id = {path, NULL, NULL, NULL};
+    sw_sg_import_desc id = {path, NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL;
     sw_status st = {0};
     if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {

@@ -553,7 +553,7 @@ static void check_bound_counted(sw_gpu_context *ctx, const sw_sg_scene *scene,
  */
 static void run_model(sw_gpu_context *ctx, const char *path)
 {
-    sw_sg_import_desc id = {path, NULL, NULL, NULL};
+    sw_sg_import_desc id = {path, NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL;
     sw_sg_bvh *bvh = NULL;
     sw_lod_face_cones *fc = NULL;

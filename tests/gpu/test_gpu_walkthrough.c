@@ -136,7 +136,7 @@ int main(int argc, char **argv)
         return 2;
     }
     sw_status st = {0};
-    sw_sg_import_desc id = {argv[2], NULL, NULL, NULL};
+    sw_sg_import_desc id = {argv[2], NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL;
     if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {
         fprintf(stderr, "FAIL: import %s: %s\n", argv[2], st.message);

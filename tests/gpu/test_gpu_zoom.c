@@ -430,7 +430,7 @@ int main(int argc, char **argv)
     if (argc == 4)
         g_shift_px = strtod(argv[3], NULL);
     sw_status st = {0};
-    sw_sg_import_desc id = {argv[2], NULL, NULL, NULL};
+    sw_sg_import_desc id = {argv[2], NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL, *one = NULL;
     if (sw_sg_import_file(&id, &scene, NULL, &st) != SW_OK) {
         fprintf(stderr, "FAIL: import %s: %s\n", argv[2], st.message);

@@ -440,7 +440,7 @@ static void inputs(void)
                    SW_ERR_NOT_REGULAR_FILE, "character device");
     expect_refusal(".tsm directory", sw_sg_tspline_load(g_dir, &ts, &st), &st,
                    SW_ERR_NOT_REGULAR_FILE, "is a directory");
-    sw_sg_import_desc d = {dir, NULL, NULL, NULL};
+    sw_sg_import_desc d = {dir, NULL, NULL, NULL, NULL, 0};
     expect_refusal("CAD directory", sw_sg_import_file(&d, &s, NULL, &st), &st,
                    SW_ERR_NOT_REGULAR_FILE, "is a directory");
     d.path = fifo;

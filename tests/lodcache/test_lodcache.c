@@ -88,7 +88,7 @@ static sw_lod_hierarchy_desc face_desc(const sw_sg_scene *scene, uint32_t face)
 static bool load_model(const char *path, model *m)
 {
     memset(m, 0, sizeof *m);
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
+    sw_sg_import_desc d = {path, NULL, NULL, NULL, NULL, 0};
     sw_status st = {0};
     if (sw_sg_import_file(&d, &m->scene, NULL, &st) != SW_OK) {
         fprintf(stderr, "%s: import failed: %s\n", path, st.message);

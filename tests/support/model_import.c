@@ -7,7 +7,7 @@
 
 int sw_test_import_model(const char *path, sw_sg_scene **out)
 {
-    sw_sg_import_desc d = {path, NULL, NULL, NULL};
+    sw_sg_import_desc d = {path, NULL, NULL, NULL, NULL, 0};
     sw_status st = {0};
     *out = NULL;
     sw_result r = sw_sg_import_file(&d, out, NULL, &st);

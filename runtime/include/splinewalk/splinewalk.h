@@ -65,11 +65,38 @@ typedef struct sw_node {
 typedef void (*sw_progress_fn)(void *user_data, double fraction, const char *stage);
 typedef void (*sw_warning_fn)(void *user_data, const char *message);
 
+/* A face of an imported CAD file that could not be drawn exactly as it was: repaired where an
+ * exact repair exists (the surface unchanged, e.g. all weights scaled by one power of two), else
+ * skipped while the rest of the file is imported. Strings are borrowed for the call only. */
+typedef enum sw_face_action { SW_FACE_SKIPPED = 1, SW_FACE_REPAIRED = 2 } sw_face_action;
+typedef struct sw_face_problem {
+    const char *path;      /* the file */
+    uint32_t face;         /* the face's index in the file: 0-based, in the order OCCT reads the
+                              faces; UINT32_MAX for a face OCCT's reader dropped before it became a
+                              face (then `entity` names it) */
+    uint32_t entity;       /* the file's own number of such a dropped face (STEP #N, IGES
+                              directory entry); 0 otherwise */
+    const char *name;      /* the name of the part holding the face (STEP); "" when none */
+    sw_face_action action; /* SW_FACE_SKIPPED or SW_FACE_REPAIRED */
+    sw_result reason;      /* SW_ERR_INVALID_GEOMETRY (its data: a weight of 0, weights too far
+                              apart, a trim loop that does not close, ...), SW_ERR_UNSUPPORTED (a
+                              degree above 31), SW_ERR_INTERNAL (OCCT failed on it) */
+    const char *message;   /* file, face and reason in words, as given to `warning` */
+} sw_face_problem;
+typedef void (*sw_face_problem_fn)(void *user_data, const sw_face_problem *problem);
+
+/* sw_scene_load_desc.flags */
+#define SW_LOAD_PARTIAL 1u /* a truncated file is imported in part instead of refused (below) */
+
 typedef struct sw_scene_load_desc {
     const char *path;        /* required: .sws, .step/.stp, .iges/.igs, .brep, .tsm (T-spline) */
     sw_progress_fn progress; /* NULL: none; called on the loading thread */
-    sw_warning_fn warning;   /* NULL: none; a face that cannot be converted is reported here */
+    sw_warning_fn warning;   /* NULL: none; each skipped or repaired face is reported here in
+                                words, and OCCT's own warnings */
     void *user_data;
+    sw_face_problem_fn face_problem; /* NULL: none; each skipped or repaired face as a record,
+                                        on the loading thread, before the load returns */
+    uint32_t flags;                  /* 0 or SW_LOAD_PARTIAL */
 } sw_scene_load_desc;
 
 /* Loads or imports a scene. A .sws file is mapped and checked (header, section table, size;
@@ -77,6 +104,13 @@ typedef struct sw_scene_load_desc {
  * scene is the caller's: free it with sw_scene_destroy. desc and desc->path are read during the
  * call only; callbacks run on the calling thread before it returns, never after a failure is
  * returned. *out = {0} on failure.
+ * A CAD file's faces that cannot be drawn exactly are repaired or skipped, each reported to
+ * face_problem and warning, and counted in sw_scene_info; the rest is imported. A structurally
+ * truncated file — an IGES file whose Terminate record is missing or disagrees with the records
+ * present — is SW_ERR_TRUNCATED, unless flags has SW_LOAD_PARTIAL: then only the entities whose
+ * data is whole, and whose referenced entities' data is whole, are imported, and
+ * sw_scene_info.partial is 1. (Truncated STEP and BREP files cannot be read at all: SW_ERR_FORMAT
+ * with or without the flag.)
  * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc, path or out), SW_ERR_UNSUPPORTED (unknown
  * extension or input), SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE (a directory, FIFO or device:
  * inputs are opened without blocking and must be regular files), SW_ERR_IO, SW_ERR_FORMAT,
@@ -121,6 +155,11 @@ typedef struct sw_scene_info {
     uint64_t mesh_triangles;       /* their triangles, each mesh once */
     uint64_t mesh_occurrences;     /* meshes drawn, instances expanded */
     uint64_t triangle_occurrences; /* their triangles, instances expanded */
+    /* Of the CAD import that made the scene (sw_scene_load of a .step/.iges/.brep); 0 otherwise,
+     * also for a .sws written from such an import. */
+    uint32_t faces_skipped;  /* not in the scene, each reported to face_problem */
+    uint32_t faces_repaired; /* in the scene after an exact repair */
+    int32_t partial;         /* 1: a truncated file imported in part (SW_LOAD_PARTIAL) */
 } sw_scene_info;
 
 /* Describes the scene (the first call on a scene verifies it and walks it once). Any thread.
