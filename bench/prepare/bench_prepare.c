@@ -184,7 +184,7 @@ static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, 
 {
     /* the hierarchies' builds use a pool of their own, so that the chunks' pool is idle */
     sw_status st = {0};
-    sw_sg_import_desc id = {path, NULL, NULL, NULL};
+    sw_sg_import_desc id = {.path = path};
     sw_sg_scene *scene = NULL;
     size_t len = strlen(path);
     sw_result r = len > 4 && strcmp(path + len - 4, ".sws") == 0
