@@ -13,6 +13,8 @@
  * scale would be the next step for large ones.
  */
 #include "sw_curves.h"
+#include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -145,70 +147,19 @@ struct sw__curves_renderer {
     double clip[4]; /* x0, y0, x1, y1 (Sutherland-Hodgman order: min x, min y, max x, max y) */
 };
 
-static sw_result compile(GLenum type, const char *src, GLuint *out, sw_status *status)
-{
-    GLuint sh = glCreateShader(type);
-    glShaderSource(sh, 1, &src, NULL);
-    glCompileShader(sh);
-    GLint ok = 0;
-    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[600];
-        glGetShaderInfoLog(sh, sizeof log, NULL, log);
-        glDeleteShader(sh);
-        return sw__fail(status, SW_ERR_GL, "curves: shader does not compile: %s", log);
-    }
-    *out = sh;
-    return SW_OK;
-}
-
-static sw_result link(const char *vs, const char *fs, GLuint *out, sw_status *status)
-{
-    GLuint v = 0, f = 0;
-    sw_result r = compile(GL_VERTEX_SHADER, vs, &v, status);
-    if (r == SW_OK)
-        r = compile(GL_FRAGMENT_SHADER, fs, &f, status);
-    if (r != SW_OK) {
-        glDeleteShader(v);
-        return r;
-    }
-    GLuint p = glCreateProgram();
-    glAttachShader(p, v);
-    glAttachShader(p, f);
-    glLinkProgram(p);
-    glDeleteShader(v);
-    glDeleteShader(f);
-    GLint ok = 0;
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[600];
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        glDeleteProgram(p);
-        return sw__fail(status, SW_ERR_GL, "curves: program does not link: %s", log);
-    }
-    *out = p;
-    return SW_OK;
-}
-
-static sw_result gl_check(sw_status *status, const char *what)
-{
-    GLenum e = glGetError();
-    if (e != GL_NO_ERROR)
-        return sw__fail(status, SW_ERR_GL, "curves: GL error 0x%x in %s", e, what);
-    return SW_OK;
-}
-
 sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *status)
 {
     assert(out);
     *out = NULL;
-    sw__curves_renderer *r = calloc(1, sizeof *r);
+    sw__curves_renderer *r = sw__calloc(1, sizeof *r);
     if (!r)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
     r->vbaa = 1;
-    sw_result res = link(sw__gpu_curves_glsl(0), sw__gpu_curves_glsl(1), &r->prog, status);
+    sw_result res = sw__gpu_program_link(sw__gpu_curves_glsl(0), sw__gpu_curves_glsl(1), "curves",
+                                         &r->prog, status);
     if (res == SW_OK)
-        res = link(sw__gpu_curves_glsl(0), sw__gpu_curves_glsl(2), &r->prog_comp, status);
+        res = sw__gpu_program_link(sw__gpu_curves_glsl(0), sw__gpu_curves_glsl(2),
+                                   "curves composite", &r->prog_comp, status);
     if (res != SW_OK) {
         sw__curves_renderer_free(r);
         return res;
@@ -235,7 +186,7 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
         glVertexAttribPointer(4 + a, 4, GL_FLOAT, GL_FALSE, sizeof(vtx),
                               (void *)(offsetof(vtx, coef) + 16 * a));
     glBindVertexArray(0);
-    res = gl_check(status, "renderer set-up");
+    res = sw__gpu_check(status, "curves renderer set-up");
     if (res != SW_OK) {
         sw__curves_renderer_free(r);
         return res;
@@ -255,8 +206,8 @@ void sw__curves_renderer_free(sw__curves_renderer *r)
     glDeleteFramebuffers(1, &r->fbo);
     glDeleteTextures(1, &r->tex);
     glDeleteRenderbuffers(1, &r->rb);
-    free(r->v);
-    free(r);
+    sw__free(r->v);
+    sw__free(r);
 }
 
 void sw__curves_renderer_set_fault(sw__curves_renderer *r, int fault)
@@ -294,7 +245,7 @@ static sw_result ensure_target(sw__curves_renderer *r, int32_t w, int32_t h, sw_
         return sw__fail(status, SW_ERR_GL, "curves: coverage target %dx%d incomplete", w, h);
     r->fbo_w = w;
     r->fbo_h = h;
-    return gl_check(status, "coverage target");
+    return sw__gpu_check(status, "curves coverage target");
 }
 
 static vtx *push(sw__curves_renderer *r, size_t k)
@@ -303,7 +254,7 @@ static vtx *push(sw__curves_renderer *r, size_t k)
         size_t cap = r->cap ? 2 * r->cap : 1024;
         while (cap < r->n + k)
             cap *= 2;
-        vtx *q = realloc(r->v, cap * sizeof *q);
+        vtx *q = sw__realloc(r->v, cap * sizeof *q);
         if (!q)
             return NULL;
         r->v = q;
@@ -680,5 +631,5 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     glDisable(GL_BLEND);
     glBindVertexArray(0);
     glUseProgram(0);
-    return gl_check(status, "draw");
+    return sw__gpu_check(status, "curves draw");
 }

@@ -22,6 +22,7 @@
  * F = k^2 - l m with k = b1, l = 2 w b0, m = 2 w b2 (negative between chord and curve).
  */
 #include "sw_curves.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <assert.h>
@@ -58,7 +59,7 @@ static void add_corner(builder *b, const double pt[2])
         return;
     if (b->n_corners == b->cap_corners) {
         size_t cap = b->cap_corners ? 2 * b->cap_corners : 16;
-        void *q = realloc(b->corners, cap * sizeof *b->corners);
+        void *q = sw__realloc(b->corners, cap * sizeof *b->corners);
         if (!q) {
             b->err = sw__fail(b->status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
             return;
@@ -77,7 +78,7 @@ static sw__curves_piece *new_piece(builder *b)
         return NULL;
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 64;
-        void *q = realloc(b->p, cap * sizeof *b->p);
+        void *q = sw__realloc(b->p, cap * sizeof *b->p);
         if (!q) {
             b->err = sw__fail(b->status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
             return NULL;
@@ -987,10 +988,10 @@ static void emit_curve(builder *b, const sw_sg_curve *c)
     const int p = c->degree;
     int32_t n = c->n;
     size_t cap_n = (size_t)n + (size_t)(n + p) * (size_t)p;
-    double *knots = malloc(sizeof(double) * (cap_n + (size_t)p + 1));
-    double *cpw = malloc(sizeof(double) * 3 * cap_n);
-    double *k2 = malloc(sizeof(double) * (cap_n + (size_t)p + 1));
-    double *c2 = malloc(sizeof(double) * 3 * cap_n);
+    double *knots = sw__malloc(sizeof(double) * (cap_n + (size_t)p + 1));
+    double *cpw = sw__malloc(sizeof(double) * 3 * cap_n);
+    double *k2 = sw__malloc(sizeof(double) * (cap_n + (size_t)p + 1));
+    double *c2 = sw__malloc(sizeof(double) * 3 * cap_n);
     if (!knots || !cpw || !k2 || !c2) {
         b->err = sw__fail(b->status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
         goto done;
@@ -1016,10 +1017,10 @@ static void emit_curve(builder *b, const sw_sg_curve *c)
     for (int32_t s = 0; s + p < n; s += p)
         emit_bezier(b, cpw + 3 * (size_t)s, p);
 done:
-    free(knots);
-    free(cpw);
-    free(k2);
-    free(c2);
+    sw__free(knots);
+    sw__free(cpw);
+    sw__free(k2);
+    sw__free(c2);
 }
 
 static int is_clamped(const sw_sg_curve *c)
@@ -1081,7 +1082,7 @@ static int parity_grid_make(parity_grid *g, const sw__curves_piece *ps, size_t n
 {
     memset(g, 0, sizeof *g);
     g->n_seg = n * PARITY_CHORDS;
-    g->seg = malloc(sizeof *g->seg * (g->n_seg ? g->n_seg : 1));
+    g->seg = sw__malloc(sizeof *g->seg * (g->n_seg ? g->n_seg : 1));
     if (!g->seg)
         return 0;
     double lo = INFINITY, hi = -INFINITY;
@@ -1103,7 +1104,7 @@ static int parity_grid_make(parity_grid *g, const sw__curves_piece *ps, size_t n
     g->rows = (size_t)sqrt((double)g->n_seg) + 1;
     g->y0 = lo;
     g->h = hi > lo ? (hi - lo) / (double)g->rows : 1.0;
-    g->start = calloc(g->rows + 1, sizeof *g->start);
+    g->start = sw__calloc(g->rows + 1, sizeof *g->start);
     if (!g->start)
         return 0;
     for (int pass = 0; pass < 2; ++pass) { /* count, then fill */
@@ -1120,7 +1121,7 @@ static int parity_grid_make(parity_grid *g, const sw__curves_piece *ps, size_t n
         if (pass == 0) {
             for (size_t r = 0; r < g->rows; ++r)
                 g->start[r + 1] += g->start[r];
-            g->idx = malloc(sizeof *g->idx * (g->start[g->rows] ? g->start[g->rows] : 1));
+            g->idx = sw__malloc(sizeof *g->idx * (g->start[g->rows] ? g->start[g->rows] : 1));
             if (!g->idx)
                 return 0;
         } else { /* the fill advanced each start to the next row's: shift back */
@@ -1134,9 +1135,9 @@ static int parity_grid_make(parity_grid *g, const sw__curves_piece *ps, size_t n
 
 static void parity_grid_free(parity_grid *g)
 {
-    free(g->seg);
-    free(g->start);
-    free(g->idx);
+    sw__free(g->seg);
+    sw__free(g->start);
+    sw__free(g->idx);
 }
 
 static int parity(const parity_grid *g, const double pt[2])
@@ -1200,12 +1201,12 @@ static sw_result build(sw__curves_shape *s, sw_status *status)
         parity_grid_free(&grid);
     }
     if (b.err != SW_OK) {
-        free(b.p);
-        free(b.corners);
+        sw__free(b.p);
+        sw__free(b.corners);
         return b.err;
     }
-    free(s->pieces);
-    free(s->corners);
+    sw__free(s->pieces);
+    sw__free(s->corners);
     s->pieces = b.p;
     s->n_pieces = b.n;
     s->corners = b.corners;
@@ -1253,12 +1254,12 @@ sw_result sw__curves_shape_create(const sw__curves_loop *loops, uint32_t n_loops
                 return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
                                 "curves: loop %u is open after curve %u", L, k);
         }
-    sw__curves_shape *s = calloc(1, sizeof *s);
+    sw__curves_shape *s = sw__calloc(1, sizeof *s);
     if (!s)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
-    s->src_loop_n = calloc(n_loops ? n_loops : 1, sizeof *s->src_loop_n);
-    s->src = calloc(n_curves ? n_curves : 1, sizeof *s->src);
-    s->src_data = calloc(n_doubles ? n_doubles : 1, sizeof *s->src_data);
+    s->src_loop_n = sw__calloc(n_loops ? n_loops : 1, sizeof *s->src_loop_n);
+    s->src = sw__calloc(n_curves ? n_curves : 1, sizeof *s->src);
+    s->src_data = sw__calloc(n_doubles ? n_doubles : 1, sizeof *s->src_data);
     if (!s->src_loop_n || !s->src || !s->src_data) {
         sw__curves_shape_free(s);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
@@ -1327,10 +1328,10 @@ void sw__curves_shape_free(sw__curves_shape *s)
 {
     if (!s)
         return;
-    free(s->pieces);
-    free(s->corners);
-    free(s->src_loop_n);
-    free(s->src);
-    free(s->src_data);
-    free(s);
+    sw__free(s->pieces);
+    sw__free(s->corners);
+    sw__free(s->src_loop_n);
+    sw__free(s->src);
+    sw__free(s->src_data);
+    sw__free(s);
 }

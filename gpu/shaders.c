@@ -86,8 +86,8 @@ static sw_result link_parts(const char *vs, const char *const *fs, GLsizei n_fs,
     return SW_OK;
 }
 
-static sw_result link(const char *vs, const char *fs, const char *what, GLuint *out,
-                      sw_status *status)
+sw_result sw__gpu_program_link(const char *vs, const char *fs, const char *what, GLuint *out,
+                               sw_status *status)
 {
     return link_parts(vs, &fs, 1, what, SW_ERR_GL, out, status);
 }
@@ -133,10 +133,10 @@ sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
     sw_result r = link_surfaces(k_surface_fs_default_shade, SW_ERR_GL, &ctx->surf, status);
     if (r != SW_OK)
         return r;
-    r = link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
+    r = sw__gpu_program_link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
     if (r != SW_OK)
         return r;
-    r = link(k_present_vs, k_present_fs, "present", &ctx->prog_present, status);
+    r = sw__gpu_program_link(k_present_vs, k_present_fs, "present", &ctx->prog_present, status);
     if (r != SW_OK)
         return r;
     return sw__gpu_check(status, "program set-up");

@@ -159,6 +159,10 @@ sw_result sw__gpu_check(sw_status *status, const char *what);
 /* Makes an owned (headless) context current on the calling thread if another one is; an adopted
  * context is left alone. Every entry point that issues GL calls starts with it. */
 void sw__gpu_make_current(sw_gpu_context *ctx);
+/* A program of one vertex and one fragment stage; `what` names it in the error (SW_ERR_GL with
+ * the GLSL log). shaders.c. */
+sw_result sw__gpu_program_link(const char *vs, const char *fs, const char *what, GLuint *out,
+                               sw_status *status);
 /* Compiles the programs (shaders.c). */
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status);
 void sw__gpu_programs_free(sw_gpu_context *ctx);
