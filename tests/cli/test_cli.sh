@@ -60,6 +60,62 @@ exact=$(sed -n 's/.*, \([0-9]*\) by the exact path.*/\1/p' exact.txt)
 [ -s motor.exr ] || fail "no EXR written"
 pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 
+# The EXR's content (issue 19: a non-empty file passed before, a blank or wrong image too): its
+# RGB must be the PNG render of the same view to within one level (the EXR holds RGBA8 / 255 in
+# half); its Z must cover exactly the pixels the PNG shows the part on (finite there, +inf on the
+# white background; <= 0.5 % of them may disagree, at antialiased edges), at least 5 % of the
+# image; and every finite Z must lie within the depth range of the part's bounding box seen by
+# the iso preset (centre at diag / (2 tan 20 deg) x 1.1, +- diag / 2), as info --json gives it.
+# Caught when planted: rows written bottom-up (gpu/capture_oiio.cpp write_exr), a Z channel of 0.
+"$sw" render "$model" -o motor_exr_ref.png --size 160x120 >/dev/null 2>&1 || fail "render PNG beside the EXR"
+if oiiotool motor.exr --ch R,G,B -d uint8 -o exr_rgb.ppm && oiiotool motor.exr --ch Z -o exr_z.pfm &&
+   oiiotool motor_exr_ref.png --ch R,G,B -o png_rgb.ppm; then
+  exr_check=$(python3 - info_brep.json exr_rgb.ppm png_rgb.ppm exr_z.pfm <<'PY'
+import json, math, struct, sys
+def pnm(path):
+    data = open(path, "rb").read()
+    fields, pos = [], 0
+    while len(fields) < 4:
+        while data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b"#":
+            pos = data.index(b"\n", pos)
+            continue
+        end = pos
+        while not data[end:end + 1].isspace():
+            end += 1
+        fields.append(data[pos:end])
+        pos = end
+    return fields, data[pos + 1:]
+(m1, w1, h1, _), rgb_exr = pnm(sys.argv[2])
+(m2, w2, h2, _), rgb_png = pnm(sys.argv[3])
+(m3, w3, h3, scale), zraw = pnm(sys.argv[4])
+w, h = int(w1), int(h1)
+if (m1, m2, m3) != (b"P6", b"P6", b"Pf") or (int(w2), int(h2), int(w3), int(h3)) != (w, h, w, h):
+    print("bad conversions", m1, m2, m3, w1, h1, w2, h2, w3, h3); sys.exit(1)
+z = struct.unpack(("<" if float(scale) < 0 else ">") + "%df" % (w * h), zraw[:4 * w * h])
+z = [z[(h - 1 - y) * w + x] for y in range(h) for x in range(w)]  # PFM rows are bottom-up
+color = max(abs(a - b) for a, b in zip(rgb_exr, rgb_png))
+covered = [math.isfinite(v) for v in z]
+white = [rgb_png[3 * i:3 * i + 3] == b"\xff\xff\xff" for i in range(w * h)]
+disagree = sum(c == wh for c, wh in zip(covered, white))
+n_cov = sum(covered)
+b = json.load(open(sys.argv[1]))["bbox"]
+diag = math.dist(b[:3], b[3:])
+d = diag / (2 * math.tan(math.radians(20))) * 1.1
+zs = [v for v in z if math.isfinite(v)]
+out = [v for v in zs if not d - diag / 2 <= v <= d + diag / 2]
+ok = color <= 1 and n_cov >= 0.05 * w * h and disagree <= 0.005 * w * h and not out
+print("RGB max difference %d level(s); Z covers %d of %d pixels, %d disagree with the PNG's "
+      "part; Z in [%.4g, %.4g], box range [%.4g, %.4g]%s" % (color, n_cov, w * h, disagree,
+      min(zs) if zs else 0, max(zs) if zs else 0, d - diag / 2, d + diag / 2, "" if ok else " BAD"))
+sys.exit(0 if ok else 1)
+PY
+  ) && pass "EXR content: $exr_check" || fail "EXR content: $exr_check"
+else
+  fail "EXR content: oiiotool could not convert the EXR or the PNG"
+fi
+
 # OCCT's IGES reader prints to stdout by default: `info --json` must still print one JSON line.
 "$sw" info --json "$data/iges/bearing.iges" >iges.json 2>/dev/null || fail "info bearing.iges"
 [ "$(head -c 1 iges.json)" = "{" ] && [ "$(wc -l <iges.json)" -eq 1 ] ||
