@@ -8,9 +8,10 @@
  * Bézier extraction), over a uniform grid of its trim box whose cells project to at most
  * k_ref_cell_px pixels (measured on a 33 x 33 sampling of the face in the frame's view, not by
  * lod/sampling.c's bounds), each cell's two triangles kept when their centroid is inside the
- * face's trim loops by exact even-odd classification (sw_sg_trim_classify on loops flattened to
- * 1e-7 of the trim box; no trim texture). It is drawn by sw_gpu_render_triangles (the same camera,
- * projection and depth convention, nothing else of the frame's pipeline).
+ * face's trim loops by exact even-odd classification (sw_sg_trim_classify's rule, by scanlines, on
+ * loops flattened to 1e-7 of the trim box; no trim texture). It is drawn by
+ * sw_gpu_render_triangles (the same camera, projection and depth convention, nothing else of the
+ * frame's pipeline).
  *
  * The comparison (sw_test_ref_compare), per pixel, coverage from depth (finite = covered):
  *  - a coverage error is a pixel whose coverage in the test frame is found nowhere within one
@@ -50,6 +51,9 @@ typedef struct sw_test_ref_mesh {
     sw__gpu_view view;
     sw_sg_polyline **loops; /* per face, flattened on first use (NULL: not yet) */
     uint32_t *n_loops;
+    double *xs; /* a row's crossings (sw__ref_row) */
+    unsigned char *keep;
+    size_t cap_xs, cap_keep;
     int failed;
 } sw_test_ref_mesh;
 
@@ -150,9 +154,45 @@ static inline void sw__ref_cells(const sw_test_ref_mesh *m, const sw_sg_surface 
         lu = fmax(lu, a);
         lv = fmax(lv, c);
     }
-    /* the probe's chords are shorter than the curve: 2 cells per probe interval at least */
-    *nu = (int32_t)fmin(K_REF_MAX_CELLS, fmax(2.0 * (P - 1), ceil(lu / k_ref_cell_px)));
-    *nv = (int32_t)fmin(K_REF_MAX_CELLS, fmax(2.0 * (P - 1), ceil(lv / k_ref_cell_px)));
+    /* at least the probe's intervals: a face smaller than a pixel still follows its curvature */
+    *nu = (int32_t)fmin(K_REF_MAX_CELLS, fmax(P - 1, ceil(lu / k_ref_cell_px)));
+    *nv = (int32_t)fmin(K_REF_MAX_CELLS, fmax(P - 1, ceil(lv / k_ref_cell_px)));
+}
+
+static inline int sw__ref_cmp(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Even-odd classification of the points (u0 + k du, v), k = 0..n-1, into keep[k], by one scanline:
+ * the rule of sw_sg_trim_classify (a crossing where the edge's ends lie on either side of v, taken
+ * when u lies left of it), the crossings of the row computed once and sorted. */
+static inline int sw__ref_row(sw_test_ref_mesh *m, const sw_sg_polyline *loops, uint32_t n_loops,
+                              double v, double u0, double du, int32_t n, unsigned char *keep)
+{
+    size_t nx = 0;
+    for (uint32_t l = 0; l < n_loops; ++l) {
+        const double *p = loops[l].uv;
+        const uint32_t c = loops[l].count;
+        for (uint32_t i = 0, j = c ? c - 1 : 0; i < c; j = i++) {
+            const double ui = p[2 * i], vi = p[2 * i + 1], uj = p[2 * j], vj = p[2 * j + 1];
+            if ((vi > v) == (vj > v))
+                continue;
+            if (!sw__ref_grow((void **)&m->xs, &m->cap_xs, nx + 1, sizeof *m->xs))
+                return 0;
+            m->xs[nx++] = ui + (v - vi) * (uj - ui) / (vj - vi);
+        }
+    }
+    qsort(m->xs, nx, sizeof *m->xs, sw__ref_cmp);
+    size_t left = 0; /* crossings at or left of u: the point is inside when those right are odd */
+    for (int32_t k = 0; k < n; ++k) {
+        const double u = u0 + du * k;
+        while (left < nx && !(u < m->xs[left]))
+            ++left;
+        keep[k] = (unsigned char)((nx - left) & 1u);
+    }
+    return 1;
 }
 
 static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12],
@@ -186,25 +226,36 @@ static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12]
             m->n_pos += 3;
         }
     const double du = (b[1] - b[0]) / nu, dv = (b[3] - b[2]) / nv;
-    for (int32_t j = 0; j < nv; ++j)
+    if (!sw__ref_grow((void **)&m->keep, &m->cap_keep, 2 * (size_t)nu, 1)) {
+        m->failed = 1;
+        return 1;
+    }
+    memset(m->keep, 1, 2 * (size_t)nu);
+    for (int32_t j = 0; j < nv; ++j) {
+        /* centroids of (a, c, e) at (i + 2/3, j + 1/3) and of (a, e, d) at (i + 1/3, j + 2/3) */
+        const double v0 = b[2] + dv * j;
+        if (loops && (!sw__ref_row(m, loops, n_loops, v0 + dv / 3.0, b[0] + du * 2.0 / 3.0, du,
+                                   nu, m->keep) ||
+                      !sw__ref_row(m, loops, n_loops, v0 + dv * 2.0 / 3.0, b[0] + du / 3.0, du,
+                                   nu, m->keep + nu))) {
+            m->failed = 1;
+            return 1;
+        }
         for (int32_t i = 0; i < nu; ++i) {
             const uint32_t a = (uint32_t)(base + (size_t)j * (nu + 1) + i), c = a + 1,
                            d = a + (uint32_t)nu + 1, e = d + 1;
-            const double u0 = b[0] + du * i, v0 = b[2] + dv * j;
-            /* centroids of (a, c, e) and (a, e, d) */
-            if (!loops || sw_sg_trim_classify(loops, n_loops, u0 + du * 2.0 / 3.0,
-                                              v0 + dv / 3.0)) {
+            if (m->keep[i]) {
                 m->idx[m->n_idx++] = a;
                 m->idx[m->n_idx++] = c;
                 m->idx[m->n_idx++] = e;
             }
-            if (!loops || sw_sg_trim_classify(loops, n_loops, u0 + du / 3.0,
-                                              v0 + dv * 2.0 / 3.0)) {
+            if (m->keep[nu + i]) {
                 m->idx[m->n_idx++] = a;
                 m->idx[m->n_idx++] = e;
                 m->idx[m->n_idx++] = d;
             }
         }
+    }
     return 0;
 }
 
@@ -243,6 +294,8 @@ static inline int sw_test_ref_render(sw_gpu_context *ctx, const sw_sg_scene *sce
     free(m.n_loops);
     free(m.pos);
     free(m.idx);
+    free(m.xs);
+    free(m.keep);
     return ok;
 }
 

@@ -9,14 +9,14 @@
  * normals); at most 0.1 % of the pixels covered by either may differ, per view.
  *
  * Since the two paths share densities, atlas and extraction, each view is also drawn at a quarter
- * of the size by both paths (fat borders off) and compared with an independent reference (gpu_test_reference.h: a
- * dense mesh of the exact NURBS with exact trims, drawn as plain triangles): at most 4 + 0.1 % of the
- * covered pixels may have a coverage found nowhere within 1 px in the reference, or a depth off
- * the reference's on its smooth interiors. What it catches (issue 19, each planted and seen
- * failing): densities a quarter of what the bound asks (lod/sampling.c: sw_lod_screen_segments'
- * counts divided by 4) — the two paths still agreed, the reference shows coverage errors; the
- * trim atlas looking up a texel row off (gpu/trim_atlas.c) — both paths trim the same wrong
- * texels, the reference's exact classification does not.
+ * of the size by both paths (fat borders off) and compared with an independent reference
+ * (gpu_test_reference.h: a dense mesh of the exact NURBS with exact trims, drawn as plain
+ * triangles): at most 4 + 0.1 % of the covered pixels may have a coverage found nowhere within
+ * 1 px in the reference, or a depth off the reference's on its smooth interiors. What it catches
+ * (issue 19, each planted and seen failing while the two paths still agreed, 0.0000 % differ):
+ * densities a quarter of what the bound asks (lod/sampling.c sw_lod_screen_segments) — all 6
+ * views fail, 169-1696 depth errors and up to 98 coverage errors (limits 8-11); the trim atlas
+ * read 2 texel rows off (gpu/glsl/surface_trim.frag.glsl) — 4 of 6 views fail, 13-38 depth errors.
  *
  * Usage: test_gpu_eval OUTDIR WIDTHxHEIGHT FILE...
  */

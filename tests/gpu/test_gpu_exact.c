@@ -9,13 +9,14 @@
  * some face of degree > 3 (which the Bézier path draws on the CPU) must be drawn exactly.
  *
  * Since the two paths share densities and atlas, each view is also drawn at a quarter of the size
- * by both paths (fat borders off) and compared with an independent reference (gpu_test_reference.h: a dense mesh of
- * the exact NURBS with exact trims, drawn as plain triangles): at most 4 + 0.1 % of the covered
- * pixels may have a coverage found nowhere within 1 px in the reference, or a depth off the
- * reference's on its smooth interiors. What it catches (issue 19, each planted and seen failing):
- * densities a quarter of what the bound asks (lod/sampling.c: sw_lod_screen_segments' counts
- * divided by 4) and the trim atlas looking up a texel row off (gpu/trim_atlas.c) — both paths
- * agreed with each other under either fault, the reference did not.
+ * by both paths (fat borders off) and compared with an independent reference
+ * (gpu_test_reference.h: a dense mesh of the exact NURBS with exact trims, drawn as plain
+ * triangles): at most 4 + 0.1 % of the covered pixels may have a coverage found nowhere within
+ * 1 px in the reference, or a depth off the reference's on its smooth interiors. What it catches
+ * (issue 19, each planted and seen failing): densities a quarter of what the bound asks
+ * (lod/sampling.c sw_lod_screen_segments) — all 6 views fail against the reference, while the
+ * two paths disagreed on 2 of them only; the trim atlas read 2 texel rows off
+ * (gpu/glsl/surface_trim.frag.glsl) — 4 of 6 views fail, while the two paths agreed on all.
  *
  * Usage: test_gpu_exact OUTDIR WIDTHxHEIGHT FILE...
  */
