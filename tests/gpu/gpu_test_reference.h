@@ -35,7 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const double k_ref_cell_px = 0.5;    /* largest projected cell of the reference grid */
+static const double k_ref_cell_px = 0.5; /* largest projected cell of the reference grid */
 /* relative depth tolerance on smooth interiors: ε_img bounds the projected distance only, so a
  * face seen head-on may deviate along the view ray without a pixel's error (linkrods' face 23,
  * front view: 0.29 % with densities and grids right); a density or evaluation fault that moves
@@ -234,10 +234,10 @@ static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12]
     for (int32_t j = 0; j < nv; ++j) {
         /* centroids of (a, c, e) at (i + 2/3, j + 1/3) and of (a, e, d) at (i + 1/3, j + 2/3) */
         const double v0 = b[2] + dv * j;
-        if (loops && (!sw__ref_row(m, loops, n_loops, v0 + dv / 3.0, b[0] + du * 2.0 / 3.0, du,
-                                   nu, m->keep) ||
-                      !sw__ref_row(m, loops, n_loops, v0 + dv * 2.0 / 3.0, b[0] + du / 3.0, du,
-                                   nu, m->keep + nu))) {
+        if (loops && (!sw__ref_row(m, loops, n_loops, v0 + dv / 3.0, b[0] + du * 2.0 / 3.0, du, nu,
+                                   m->keep) ||
+                      !sw__ref_row(m, loops, n_loops, v0 + dv * 2.0 / 3.0, b[0] + du / 3.0, du, nu,
+                                   m->keep + nu))) {
             m->failed = 1;
             return 1;
         }
@@ -272,15 +272,15 @@ static inline int sw_test_ref_render(sw_gpu_context *ctx, const sw_sg_scene *sce
     const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     m.loops = calloc(n_faces ? n_faces : 1, sizeof *m.loops);
     m.n_loops = calloc(n_faces ? n_faces : 1, sizeof *m.n_loops);
-    int ok = m.loops && m.n_loops &&
-             sw__gpu_view_init(&m.view, &desc->camera, desc->width, desc->height, 1e-6, &st) ==
-                 SW_OK &&
-             sw_sg_scene_traverse(scene, sw__ref_visit, &m) == SW_OK && !m.failed &&
-             m.n_pos / 3 <= UINT32_MAX && m.n_idx <= UINT32_MAX;
+    int ok =
+        m.loops && m.n_loops &&
+        sw__gpu_view_init(&m.view, &desc->camera, desc->width, desc->height, 1e-6, &st) == SW_OK &&
+        sw_sg_scene_traverse(scene, sw__ref_visit, &m) == SW_OK && !m.failed &&
+        m.n_pos / 3 <= UINT32_MAX && m.n_idx <= UINT32_MAX;
     sw_gpu_frame_desc d = *desc;
     d.want_depth = 1;
-    if (ok && sw_gpu_render_triangles(ctx, m.pos, (uint32_t)(m.n_pos / 3), m.idx,
-                                      (uint32_t)m.n_idx, &d, out, &st) != SW_OK) {
+    if (ok && sw_gpu_render_triangles(ctx, m.pos, (uint32_t)(m.n_pos / 3), m.idx, (uint32_t)m.n_idx,
+                                      &d, out, &st) != SW_OK) {
         fprintf(stderr, "reference: %s\n", st.message);
         ok = 0;
     }
@@ -300,9 +300,9 @@ static inline int sw_test_ref_render(sw_gpu_context *ctx, const sw_sg_scene *sce
 }
 
 typedef struct sw_test_ref_diff {
-    long covered;        /* pixels covered in the reference or the test frame */
-    long coverage_errors; /* test coverage found nowhere within 1 px in the reference */
-    long depth_errors;    /* smooth interiors whose depths differ beyond k_ref_depth_rel */
+    long covered;           /* pixels covered in the reference or the test frame */
+    long coverage_errors;   /* test coverage found nowhere within 1 px in the reference */
+    long depth_errors;      /* smooth interiors whose depths differ beyond k_ref_depth_rel */
     double worst_depth_rel; /* the largest relative depth difference on smooth interiors */
 } sw_test_ref_diff;
 

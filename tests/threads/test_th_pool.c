@@ -329,7 +329,8 @@ static void test_fork_join(void **state)
     }
 }
 
-/* ---- the calling thread's waits (issue 19: what a frame's "pool waits" are made of) ----------- */
+/* ---- the calling thread's waits (issue 19: what a frame's "pool waits" are made of) -----------
+ */
 
 static void sleep_20_fn(void *ctx)
 {
