@@ -180,6 +180,11 @@ check_run conv 40
 [ "$(column conv fallback_draws | sort -u)" = 0 ] || fail "converged: fallback draws"
 column conv pool_hierarchy_wait_tasks | awk '{ n += $1 } END { exit !(n > 0) }' ||
   fail "converged: no pool task waited for a hierarchy build"
+# the wait counters are alive where waits happen (the walkthrough's 0 above means something)
+column conv pool_waits | awk '{ n += $1 } END { exit !(n > 0) }' ||
+  fail "converged: no frame counted a pool wait"
+paste -d, <(column conv hierarchy_ms) <(column conv vis_hierarchy_ms) |
+  awk -F, '{ t += $1 + $2 } END { exit !(t > 0) }' || fail "converged: no hierarchy wait timed"
 settled conv
 pass "converged pool: $(cat pool.txt)"
 stages_add_up conv 20 >median.txt || fail "converged: stages do not add up on the median frame: $(cat median.txt)"
