@@ -32,6 +32,13 @@ double sw__gpu_now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
+void sw__gpu_waits_since(const sw_th_wait_count *since, sw_gpu_frame_stats *st)
+{
+    const sw_th_wait_count now = sw_th_thread_waits();
+    st->pool_waits += now.waits - since->waits;
+    st->ms_pool_wait += 1e-6 * (double)(now.ns - since->ns);
+}
+
 sw_result sw__gpu_check(sw_status *status, const char *what)
 {
     GLenum e = glGetError();

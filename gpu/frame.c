@@ -178,6 +178,7 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
 {
     *out = NULL;
     double t0 = sw__gpu_now_ms();
+    const sw_th_wait_count w0 = sw_th_thread_waits(); /* issue 19: every wait of the frame */
     sw_gpu_frame_plan *p = sw__calloc(1, sizeof *p);
     if (!p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
@@ -196,6 +197,7 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
     sw__fr_selection_free(&p->sel);
     p->ms_prepare = sw__gpu_now_ms() - t0;
     p->st.ms_tessellate = p->ms_prepare - p->st.ms_hierarchy; /* the waits are counted apart */
+    sw__gpu_waits_since(&w0, &p->st);
     *out = p;
     return SW_OK;
 }
@@ -204,6 +206,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
                               sw_gpu_frame_stats *stats, sw_status *status)
 {
     memset(out, 0, sizeof *out);
+    const sw_th_wait_count w0 = sw_th_thread_waits();
     sw__gpu_make_current(ctx);
     const sw_gpu_frame_desc *desc = &plan->desc;
     sw__fr_geometry *geo = &plan->geo;
@@ -248,6 +251,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
     st->ms_draw = t3 - t2;
     st->ms_readback = t4 - t3;
     st->near_plane = plan->env.view.near_plane;
+    sw__gpu_waits_since(&w0, st);
     if (stats)
         *stats = *st;
     sw_lod_cache *cache = plan->hy.cache;

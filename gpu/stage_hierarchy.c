@@ -323,13 +323,9 @@ static void wait_group(sw__fr_hierarchy *hy, sw_th_pool *pool, sw_gpu_frame_stat
     st->hlod_waits++;
 }
 
-sw_result sw__fr_hierarchy_prepare(const sw__fr_env *env, sw__fr_hierarchy *hy,
-                                   const sw__fr_faces *faces, sw_gpu_frame_stats *st,
-                                   sw_status *status)
+static sw_result converge(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw__fr_faces *faces,
+                          sw_gpu_frame_stats *st, sw_status *status)
 {
-    if (env->walkthrough)
-        return request_walkthrough(env, hy, faces, status);
-    double t0 = sw__gpu_now_ms();
     sw_th_pool *pool = sw_lod_cache_pool(hy->cache);
     sw_th_group_init(&hy->group);
     if (request_builds(hy, faces) != SW_OK) {
@@ -357,6 +353,19 @@ sw_result sw__fr_hierarchy_prepare(const sw__fr_env *env, sw__fr_hierarchy *hy,
             break; /* nothing could be refined further (depth limits): drawn over budget */
     }
     hy->planning = 0;
-    st->ms_hierarchy = sw__gpu_now_ms() - t0;
+    return r;
+}
+
+/* ms_hierarchy: the time this stage's thread blocked on the pool, in both modes (issue 19: it
+ * was the converged stage's wall time, planning traversals included, and 0 by construction in
+ * walkthrough mode). */
+sw_result sw__fr_hierarchy_prepare(const sw__fr_env *env, sw__fr_hierarchy *hy,
+                                   const sw__fr_faces *faces, sw_gpu_frame_stats *st,
+                                   sw_status *status)
+{
+    const sw_th_wait_count w0 = sw_th_thread_waits();
+    sw_result r = env->walkthrough ? request_walkthrough(env, hy, faces, status)
+                                   : converge(env, hy, faces, st, status);
+    st->ms_hierarchy += 1e-6 * (double)(sw_th_thread_waits().ns - w0.ns);
     return r;
 }

@@ -157,9 +157,16 @@ typedef struct sw_gpu_frame_stats {
     double bound_excess_px;
     uint64_t hlod_over_budget;     /* nodes drawn although their error exceeds their share of
                                       ε_img (refinement stopped at its depth limit) */
-    uint64_t hlod_waits;           /* times the frame waited for the pool (0 in walkthrough) */
+    uint64_t hlod_waits;           /* converged: the hierarchy stage's group waits */
     uint64_t hlod_refine_requests; /* walkthrough: refinements asked for, not waited for */
-    double ms_hierarchy;           /* waiting for hierarchy builds and refinements */
+    double ms_hierarchy; /* the hierarchy stage's time blocked waiting for the pool (its builds
+                            and refinements), in both modes (sw_th_thread_waits) */
+    /* every wait of the frame for the pool, wherever it happens (prepare and submit, on the
+     * threads that ran them: sw_th_thread_waits): group waits that found tasks pending (hierarchy
+     * and static-LOD builds, refinements, a cache given up), bracketed waits on tasks' results.
+     * 0 in walkthrough mode unless the frame blocked (the walkthrough tests assert it) */
+    uint64_t pool_waits;
+    double ms_pool_wait; /* the time in those waits */
     /* BVH culling (sw_sg_bvh_cull_stats) by desc.bvh, or with desc.static_lods by the static set's
      * BVH of super-surface instances (items = unit instances): nodes classified against the
      * frustum, of them wholly inside, partly inside and outside; items classified one by one;

@@ -649,12 +649,18 @@ sw_lod_static_state sw_lod_static_set_wait(sw_lod_static_set *s, uint32_t unit)
     if (sw_lod_static_set_request(s, unit, SW_TH_PRIORITY_FRAME) != SW_OK)
         return SW_LOD_STATIC_EMPTY;
     slot *sl = &s->slots[unit];
+    int waiting = 0; /* one wait of the caller's (sw_th_thread_waits), spins included */
     for (;;) {
         const int st = atomic_load_explicit(&sl->state, memory_order_acquire);
-        if (st == SW_LOD_STATIC_READY || st == SW_LOD_STATIC_FAILED)
+        if (st == SW_LOD_STATIC_READY || st == SW_LOD_STATIC_FAILED || st == SW_LOD_STATIC_EMPTY) {
+            if (waiting)
+                sw_th_wait_end();
             return (sw_lod_static_state)st;
-        if (st == SW_LOD_STATIC_EMPTY)
-            return SW_LOD_STATIC_EMPTY;
+        }
+        if (!waiting) {
+            waiting = 1;
+            sw_th_wait_begin();
+        }
         sw_th_group_wait(s->pool, &sl->group); /* runs pool tasks meanwhile */
         if (sw_th_group_pending(&sl->group) == 0)
             sched_yield(); /* a requester is between its claim and its submission */

@@ -113,6 +113,9 @@ static _Thread_local uint64_t tls_rng;
  * (SW_TH_TASK_KIND_COUNT: none) and since when it runs uninterrupted by a nested task. */
 static _Thread_local uint32_t tls_seg_kind = SW_TH_TASK_KIND_COUNT;
 static _Thread_local uint64_t tls_seg_start;
+/* The calling thread's waits (sw_th_thread_waits): outermost waits counted, their time summed. */
+static _Thread_local uint32_t tls_wait_depth;
+static _Thread_local uint64_t tls_wait_start, tls_waits, tls_wait_ns;
 
 static void cpu_relax(void)
 {
@@ -791,9 +794,34 @@ sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task)
 /* The group waiter idles like a worker (same counters, same Dekker pair, same condition
  * variable): it must stay wakeable by new work, or a pool whose workers all wait on groups
  * would deadlock on a task submitted after they blocked. */
+void sw_th_wait_begin(void)
+{
+    if (tls_wait_depth++ == 0) {
+        tls_waits++;
+        tls_wait_start = now_ns();
+    }
+}
+
+void sw_th_wait_end(void)
+{
+    assert(tls_wait_depth > 0);
+    if (--tls_wait_depth == 0)
+        tls_wait_ns += now_ns() - tls_wait_start;
+}
+
+sw_th_wait_count sw_th_thread_waits(void)
+{
+    const sw_th_wait_count c = {tls_waits, tls_wait_ns};
+    return c;
+}
+
 void sw_th_group_wait(sw_th_pool *pool, sw_th_group *group)
 {
     assert(pool && group);
+    /* acquire: as the loop's test below */
+    if (atomic_load_explicit(&group->pending, memory_order_acquire) <= 0)
+        return;
+    sw_th_wait_begin();
     worker *w = own_worker(pool);
     bool searching = false;
     uint32_t fails = 0;
@@ -835,6 +863,7 @@ void sw_th_group_wait(sw_th_pool *pool, sw_th_group *group)
         atomic_fetch_sub_explicit(&pool->sleepers, 1, memory_order_seq_cst);
     }
     stop_searching(pool, &searching);
+    sw_th_wait_end();
 }
 
 uint32_t sw_th_pool_worker_count(const sw_th_pool *pool)

@@ -145,8 +145,25 @@ SW_API void sw_th_pool_destroy(sw_th_pool *pool);
 SW_API sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task);
 
 /* Returns when the group has no pending task. The caller runs pool tasks meanwhile (any task,
- * not only the group's) and blocks only when it finds none. Callable from a task (fork-join). */
+ * not only the group's) and blocks only when it finds none. Callable from a task (fork-join).
+ * A call that finds tasks pending is one wait of the calling thread (sw_th_thread_waits). */
 SW_API void sw_th_group_wait(sw_th_pool *pool, sw_th_group *group);
+
+/* The calling thread's waits for pool work (issue 19: a walkthrough frame must never wait, and
+ * its stats must be able to say so when it does). A wait is an outermost sw_th_group_wait that
+ * found tasks pending, or an outermost sw_th_wait_begin / sw_th_wait_end bracket; waits nested
+ * inside a wait (a task run meanwhile that waits itself) are part of it. ns: the wall time inside
+ * them. Counters of the calling thread only, since it started: a frame takes the difference of
+ * two readings on each thread it runs on. Lock-free, wait-free. */
+typedef struct sw_th_wait_count {
+    uint64_t waits;
+    uint64_t ns;
+} sw_th_wait_count;
+SW_API sw_th_wait_count sw_th_thread_waits(void);
+/* Brackets a wait of the calling thread for pool work that is not a group wait: a condition
+ * variable a task signals, a spin on a result a task publishes. Pairs nest. */
+SW_API void sw_th_wait_begin(void);
+SW_API void sw_th_wait_end(void);
 
 SW_API uint32_t sw_th_pool_worker_count(const sw_th_pool *pool);
 /* Index of the calling thread among the pool's workers, or -1 for any other thread. */

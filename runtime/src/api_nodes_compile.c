@@ -377,8 +377,13 @@ sw_result sw_rt_model_acquire_version(sw_rt_model *m, int latest, sw_rt_scene **
             schedule_compile(m);
         pthread_mutex_unlock(&m->edit_lock);
         pthread_mutex_lock(&m->pub_lock);
+        const int waits = m->compiled_revision < target; /* for the compile task: a pool wait */
+        if (waits)
+            sw_th_wait_begin();
         while (m->compiled_revision < target)
             pthread_cond_wait(&m->pub_cond, &m->pub_lock);
+        if (waits)
+            sw_th_wait_end();
         sw_result r = atomic_load_explicit(&m->published_revision, memory_order_acquire) >= target
                           ? SW_OK
                           : m->compile_result;

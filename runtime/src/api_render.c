@@ -162,12 +162,51 @@ static void retire_statics(sw_rt_renderer *r)
     sw_lod_static_set_destroy(set); /* out of memory: here, waiting */
 }
 
-/* Drops the hierarchy cache (waiting for its tasks), the static LODs (freed in the pool) and the
- * BVH, then the scene reference they needed. */
+typedef struct retired_cache {
+    sw_lod_cache *cache;
+    sw_rt_scene *scene; /* a reference the cache's tasks need until they are done */
+} retired_cache;
+
+static void retire_cache_task(void *ctx)
+{
+    retired_cache *rc = ctx;
+    sw_lod_cache_destroy(rc->cache); /* waits for its builds, runs pool tasks */
+    sw_rt_scene_release(rc->scene);
+    sw__free(rc);
+}
+
+/* The hierarchy cache, given up: destroyed by a pool task once its builds and refinements end,
+ * so the frame thread never waits for them (issue 19: a walkthrough frame drawing a node scene's
+ * new version waited here for the old version's builds, 25-98 times in api_nodes_live's 300
+ * frames, uncounted until the waits were counted where they happen). */
+static void retire_cache(sw_rt_renderer *r)
+{
+    if (!r->cache)
+        return;
+    /* no scene yet: a cache that failed to set up, no build asked for */
+    retired_cache *rc = r->cache_scene && r->pool ? sw__malloc(sizeof *rc) : NULL;
+    if (rc) {
+        *rc = (retired_cache){r->cache, r->cache_scene};
+        sw_rt_scene_retain(r->cache_scene);
+        const sw_th_task task = {retire_cache_task, rc, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL,
+                                 SW_TH_TASK_OTHER};
+        if (sw_th_pool_submit(r->pool, &task) == SW_OK) {
+            r->cache = NULL;
+            return;
+        }
+        sw_rt_scene_release(r->cache_scene);
+        sw__free(rc);
+    }
+    sw_lod_cache_destroy(r->cache); /* out of memory: here, waiting */
+    r->cache = NULL;
+}
+
+/* Drops the hierarchy cache and the static LODs (both freed in the pool) and the BVH, then the
+ * scene reference they needed. */
 static void drop_cache(sw_rt_renderer *r)
 {
     retire_statics(r);
-    sw_lod_cache_destroy(r->cache);
+    retire_cache(r);
     r->cache = NULL;
     sw_sg_bvh_free(r->bvh);
     r->bvh = NULL;
@@ -317,7 +356,6 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->hierarchy_nodes = g->hlod_nodes;
     out->refine_rounds = g->hlod_refine_rounds;
     out->fallback_draws = g->hlod_fallback_faces + g->hlod_refine_requests;
-    out->pool_waits = g->hlod_waits;
     out->ms_hierarchy = g->ms_hierarchy;
     out->ms_tessellate = g->ms_tessellate;
     out->ms_trim = g->ms_trim;
@@ -520,10 +558,14 @@ sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t hei
 }
 
 /* Writes a drawn frame's image when asked and fills the caller's stats (times from t0; the
- * matrices of the frame's desc). */
+ * matrices of the frame's desc). pool_waits: the calling thread's waits for the pool since w0
+ * (the whole call: scene, caches, prepare, submit) plus other_waits (other threads' and earlier
+ * calls' for this frame: the visibility thread's prepare, sw_renderer_prepare's), so every place
+ * where the frame can block on the pool is counted, in both modes (issue 19). */
 static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
                               const sw_gpu_frame_desc *frame, const sw_gpu_frame_stats *gstats,
-                              double t0, sw_frame_stats *stats, sw_status *status)
+                              double t0, const sw_th_wait_count *w0, uint64_t other_waits,
+                              sw_frame_stats *stats, sw_status *status)
 {
     double t1 = now_ms();
     sw_result res = output_path ? sw_gpu_image_write(image, output_path, status) : SW_OK;
@@ -532,6 +574,7 @@ static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
     if (res == SW_OK && stats) {
         memset(stats, 0, sizeof *stats);
         copy_stats(gstats, stats);
+        stats->pool_waits = sw_th_thread_waits().waits - w0->waits + other_waits;
         stats->ms_write = t2 - t1;
         stats->ms_total = t2 - t0;
         stats->near_plane = gstats->near_plane;
@@ -545,8 +588,8 @@ static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
 /* Renders and writes the frame of a checked desc on the renderer's thread; extra (NULL: none)
  * gives an immediate frame's occurrences and surface programs. */
 static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
-                            const sw_rt_frame_extra *extra, sw_frame_stats *stats,
-                            sw_status *status)
+                            const sw_rt_frame_extra *extra, const sw_th_wait_count *w0,
+                            sw_frame_stats *stats, sw_status *status)
 {
     double t0 = now_ms();
     sw_gpu_frame_desc frame = {0};
@@ -566,7 +609,7 @@ static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_fram
     r->gpu->surf = library;
     if (res != SW_OK)
         return res;
-    return finish_frame(&image, desc->output_path, &frame, &gstats, t0, stats, status);
+    return finish_frame(&image, desc->output_path, &frame, &gstats, t0, w0, 0, stats, status);
 }
 
 static void job_free(rt_job *j)
@@ -628,9 +671,11 @@ sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, s
         res = sw_rt_pipeline_start(r->gpu, &r->pipeline, status);
     if (res != SW_OK)
         return res;
+    const uint64_t w0 = sw_th_thread_waits().waits;
     rt_job *j = job_create(r, desc, status);
     if (!j)
         return status ? status->result : SW_ERR_INVALID_ARGUMENT;
+    j->job.pool_waits_before = sw_th_thread_waits().waits - w0;
     j->job.frame = ++r->frames_prepared;
     r->in_flight++;
     sw_rt_pipeline_push(r->pipeline, &j->job);
@@ -648,6 +693,7 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "sw_renderer_submit: no prepared frame (call sw_renderer_prepare first)");
     double t0 = now_ms();
+    const sw_th_wait_count w0 = sw_th_thread_waits();
     rt_job *j = (rt_job *)sw_rt_pipeline_pop(r->pipeline);
     r->in_flight--;
     double t1 = now_ms();
@@ -663,7 +709,8 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     res = sw_gpu_frame_submit(r->gpu, j->job.plan, &image, &gstats, status);
     j->job.plan = NULL; /* consumed */
     if (res == SW_OK)
-        res = finish_frame(&image, j->output_path, &j->job.desc, &gstats, t0, stats, status);
+        res = finish_frame(&image, j->output_path, &j->job.desc, &gstats, t0, &w0,
+                           j->job.pool_waits + j->job.pool_waits_before, stats, status);
     if (res == SW_OK && stats) {
         stats->ms_visibility = j->job.ms_visibility;
         stats->ms_wait_visibility = t1 - t0;
@@ -688,11 +735,12 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     res = check_frame_desc(desc, status);
     if (res != SW_OK)
         return res;
+    const sw_th_wait_count w0 = sw_th_thread_waits();
     sw_rt_scene *scene;
     res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &scene, status);
     if (res != SW_OK)
         return res;
-    res = draw_frame(r, scene, desc, NULL, stats, status);
+    res = draw_frame(r, scene, desc, NULL, &w0, stats, status);
     sw_rt_scene_release(scene);
     return res;
 }
@@ -724,8 +772,9 @@ sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_s
     if (r->in_flight)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: %u prepared frames wait; submit them first", fn, r->in_flight);
+    const sw_th_wait_count w0 = sw_th_thread_waits();
     res = check_frame_desc(desc, status);
     if (res == SW_OK)
-        res = draw_frame(r, scene, desc, extra, stats, status);
+        res = draw_frame(r, scene, desc, extra, &w0, stats, status);
     return res;
 }

@@ -31,8 +31,10 @@ struct sw_rt_pipeline {
 
 static void prepare_job(sw_rt_pipeline *p, sw_rt_frame_job *job)
 {
+    const uint64_t w0 = sw_th_thread_waits().waits; /* V's blocking on the pool: the frame's */
     job->result = sw_gpu_frame_prepare(p->gpu, job->sg, &job->desc, &job->plan, &job->status);
     job->ms_visibility = job->plan ? sw_gpu_frame_plan_ms(job->plan) : 0.0;
+    job->pool_waits = sw_th_thread_waits().waits - w0;
 }
 
 /* V's loop: a job, then its frame's marker; the marker of frame 0 means stop. */

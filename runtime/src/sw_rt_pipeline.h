@@ -10,6 +10,7 @@
 
 #include "sw_gpu.h"
 #include "sw_th_activity.h"
+#include "sw_th_pool.h"
 
 #include <splinewalk/sw_result.h>
 
@@ -24,6 +25,9 @@ typedef struct sw_rt_frame_job {
     sw_result result;
     sw_status status;
     double ms_visibility; /* V's time for the job */
+    uint64_t pool_waits;  /* V's waits for the pool while preparing it (sw_th_thread_waits) */
+    /* P's own: its waits for the pool while making the job (scene, caches) */
+    uint64_t pool_waits_before;
 } sw_rt_frame_job;
 
 typedef struct sw_rt_pipeline sw_rt_pipeline;

@@ -28,6 +28,13 @@
  *   between each, all submitted without pool waits; another thread adding, hiding, removing
  *   nodes and editing the surface while this one draws walkthrough frames and picks (run under
  *   TSan too); a draw with the destroyed scene's handle is SW_ERR_STALE_HANDLE.
+ *   Pool waits are counted wherever the frame's threads block on the pool (issue 19; before,
+ *   only the converged hierarchy stage counted them, so 0 held by construction). Counted
+ *   honestly they showed a real wait: a frame drawing a new version destroyed the old version's
+ *   hierarchy cache in place, waiting for its builds (25-98 of 300 frames); the cache is now
+ *   retired in the pool (runtime/src/api_render.c retire_cache). Seen failing with a planted
+ *   walkthrough wait for one face's build (gpu/stage_hierarchy.c request_walkthrough): "pool
+ *   waits 285" of 300 frames, 7 with another thread editing.
  */
 #include <splinewalk/splinewalk.h>
 

@@ -12,6 +12,11 @@
  *     no frame waits for the pool, every prepared frame is submitted once, and the visibility
  *     thread's work is reported (ms_visibility) apart from the submitting thread's (its stages,
  *     ms_wait_visibility included, are parts of ms_total; how large a part is for profiles).
+ *     Pool waits are counted wherever the frame's threads block on the pool (issue 19: group
+ *     waits that find tasks pending and bracketed waits on tasks' results, on the visibility
+ *     thread and on the submitting one; before, only the converged hierarchy stage counted, so
+ *     0 held by construction). Seen failing with a planted walkthrough wait for one face's build
+ *     (gpu/stage_hierarchy.c request_walkthrough): "pool waits 1" here, "pool waits 5" in 4.
  *
  *  4. With STATIC_SCENE: static LODs (Kumar §4) in walkthrough split frames, the camera far out
  *     (8x the fitted distance) and turning: no frame waits for the pool while the super-surfaces

@@ -60,6 +60,45 @@ exact=$(sed -n 's/.*, \([0-9]*\) by the exact path.*/\1/p' exact.txt)
 [ -s motor.exr ] || fail "no EXR written"
 pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 
+# The EXR's content (issue 19: a non-empty file passed before, a blank or wrong image too): its
+# RGB must be the PNG render of the same view to within one level (the EXR holds RGBA8 / 255 in
+# half); its Z must cover exactly the pixels the PNG shows the part on (finite there, +inf on the
+# white background; <= 0.5 % of them may disagree, at antialiased edges), at least 5 % of the
+# image; and every finite Z must lie within the depth range of the part's bounding box seen by
+# the iso preset (centre at diag / (2 tan 20 deg) x 1.1, +- diag / 2), as info --json gives it.
+# Caught when planted: rows written bottom-up (gpu/capture_oiio.cpp write_exr), a Z channel of 0.
+"$sw" render "$model" -o motor_exr_ref.png --size 160x120 >/dev/null 2>&1 || fail "render PNG beside the EXR"
+if oiiotool --dumpdata motor.exr >exr.txt && oiiotool --dumpdata motor_exr_ref.png >png.txt; then
+  exr_check=$(python3 - info_brep.json exr.txt png.txt <<'PY'
+import json, math, sys
+def pixels(path):  # oiiotool --dumpdata: "Pixel (x, y): v0 v1 ..." per pixel, row by row (8-bit
+    # files add "(f0 f1 ...)", the values / 255)
+    return [[float(v) for v in line.split(":")[1].split("(")[0].split()]
+            for line in open(path) if line.lstrip().startswith("Pixel (")]
+exr, png = pixels(sys.argv[2]), pixels(sys.argv[3])
+n = len(png)
+if n == 0 or len(exr) != n or any(len(p) != 5 for p in exr):
+    print("%d EXR pixels (RGBA + Z each expected), %d PNG pixels" % (len(exr), n)); sys.exit(1)
+color = max(abs(round(255 * e[k]) - p[k]) for e, p in zip(exr, png) for k in range(3))
+covered = [math.isfinite(e[4]) for e in exr]
+white = [p[:3] == [255, 255, 255] for p in png]
+disagree = sum(c == w for c, w in zip(covered, white))
+b = json.load(open(sys.argv[1]))["bbox"]
+diag = math.dist(b[:3], b[3:])
+d = diag / (2 * math.tan(math.radians(20))) * 1.1
+zs = [e[4] for e in exr if math.isfinite(e[4])]
+out = [z for z in zs if not d - diag / 2 <= z <= d + diag / 2]
+ok = color <= 1 and len(zs) >= 0.05 * n and disagree <= 0.005 * n and not out
+print("RGB max difference %d level(s); Z covers %d of %d pixels, %d disagree with the PNG's part; "
+      "Z in [%.4g, %.4g], the box's range [%.4g, %.4g]%s" % (color, len(zs), n, disagree,
+      min(zs) if zs else 0, max(zs) if zs else 0, d - diag / 2, d + diag / 2, "" if ok else " BAD"))
+sys.exit(0 if ok else 1)
+PY
+  ) && pass "EXR content: $exr_check" || fail "EXR content: $exr_check"
+else
+  fail "EXR content: oiiotool could not read the EXR or the PNG"
+fi
+
 # OCCT's IGES reader prints to stdout by default: `info --json` must still print one JSON line.
 "$sw" info --json "$data/iges/bearing.iges" >iges.json 2>/dev/null || fail "info bearing.iges"
 [ "$(head -c 1 iges.json)" = "{" ] && [ "$(wc -l <iges.json)" -eq 1 ] ||

@@ -3,14 +3,21 @@
  * behaviour at the frame level): frames drawn through the hierarchy cache with desc.walkthrough
  * never wait for the worker pool, whatever is missing.
  *  1. A fast orbit (FRAMES_MOVING frames, 11° apart, distance swinging between 0.35 and 1.1 of
- *     the fitted distance) starting with an empty cache: every frame must report 0 waits, and the
+ *     the fitted distance) starting with an empty cache: every frame must report 0 pool waits and
+ *     0 ms blocked (sw_gpu_frame_stats.pool_waits / ms_pool_wait / ms_hierarchy, counted wherever
+ *     the frame's threads block on the pool: group waits that find tasks pending, bracketed waits
+ *     on tasks' results — issue 19; the old hlod_waits was counted on the converged branch only,
+ *     so this test passed by construction). It catches a walkthrough frame that waits for a
+ *     build: planted as a converged-style wait for one face's hierarchy in the walkthrough
+ *     requests (stage_hierarchy.c request_walkthrough), it fails with "waits 1". And the
  *     first frames must really have drawn fallbacks (faces without a hierarchy yet, drawn by their
  *     Bézier patches; leaves too coarse, drawn as they are and queued for refinement) — else the
  *     test would not test anything.
  *  2. The camera stops: within FRAMES_SETTLE frames the fallbacks must fall to 0 (the pool
  *     finished what the view needs while frames went on), and that frame must match a converged
  *     frame of the same view drawn with a fresh cache: at most 0.1 % of the covered pixels differ
- *     (coverage, or a channel by more than 8 levels).
+ *     (coverage, or a channel by more than 8 levels). That converged frame must itself count its
+ *     waits for the fresh cache's builds (pool_waits > 0, ms_hierarchy > 0): the counter is alive.
  *
  * Usage: test_gpu_walkthrough OUTDIR MODEL [FRAMES_MOVING [WxH]]
  * (default 40 frames at 480x270; .ci/run's ThreadSanitizer build runs 2,000 at 320x240, issue 5's
@@ -69,21 +76,25 @@ static int moving(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache *c
                   const double box[6])
 {
     uint64_t waits = 0, first_fallbacks = 0, total_fallbacks = 0;
+    double blocked_ms = 0.0;
     for (int i = 0; i < frames_moving; ++i) {
         sw_gpu_image img;
         sw_gpu_frame_stats fs;
         if (!frame(ctx, scene, cache, orbit_camera(box, i), 1, &img, &fs))
             return 0;
         sw_gpu_image_free(&img);
-        waits += fs.hlod_waits;
+        waits += fs.pool_waits;
+        blocked_ms += fs.ms_pool_wait + fs.ms_hierarchy;
         total_fallbacks += fallbacks(&fs);
         if (i == 0)
             first_fallbacks = fallbacks(&fs);
     }
-    int ok = waits == 0 && first_fallbacks > 0;
-    printf("moving: %d frames, waits %llu, fallbacks in the first frame %llu, in all %llu%s\n",
-           frames_moving, (unsigned long long)waits, (unsigned long long)first_fallbacks,
-           (unsigned long long)total_fallbacks, ok ? "" : "  <-- FAIL");
+    int ok = waits == 0 && blocked_ms == 0.0 && first_fallbacks > 0;
+    printf("moving: %d frames, waits %llu (%.1f ms blocked), fallbacks in the first frame %llu, "
+           "in all %llu%s\n",
+           frames_moving, (unsigned long long)waits, blocked_ms,
+           (unsigned long long)first_fallbacks, (unsigned long long)total_fallbacks,
+           ok ? "" : "  <-- FAIL");
     return ok;
 }
 
@@ -98,8 +109,9 @@ static int settling(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache 
         sw_gpu_image_free(&walk);
         if (!frame(ctx, scene, cache, cam, 1, &walk, &fs))
             return 0;
-        if (fs.hlod_waits != 0) {
-            printf("settling frame %d waited  <-- FAIL\n", i);
+        if (fs.pool_waits != 0 || fs.ms_pool_wait != 0.0) {
+            printf("settling frame %d waited %llu times  <-- FAIL\n", i,
+                   (unsigned long long)fs.pool_waits);
             return 0;
         }
         if (fallbacks(&fs) == 0)
@@ -113,7 +125,10 @@ static int settling(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_lod_cache 
     if (ok)
         df = sw_test_compare_images(&walk, &conv, 8);
     double frac = (double)df.differ / (double)(df.covered ? df.covered : 1);
-    ok = ok && df.covered > 1000 && frac <= 1e-3;
+    const int counted = ok && fs.pool_waits > 0 && fs.ms_hierarchy > 0.0;
+    printf("converged frame with a fresh cache: %llu pool waits, %.1f ms in hierarchy waits%s\n",
+           (unsigned long long)fs.pool_waits, fs.ms_hierarchy, counted ? "" : "  <-- FAIL");
+    ok = ok && counted && df.covered > 1000 && frac <= 1e-3;
     printf("stopped: fallbacks 0 after %d frames (limit %d); vs converged: %ld of %ld covered "
            "pixels differ (%.4f %%, limit 0.1 %%)%s\n",
            settled + 1, FRAMES_SETTLE, df.differ, df.covered, 100.0 * frac, ok ? "" : "  <-- FAIL");

@@ -5,7 +5,11 @@
 # - `profile` writes profile.csv with the documented columns and one row per frame, all numbers;
 #   profile.json agrees with the CSV (its median recomputed here); other_ms = frame_ms - stages;
 # - converged: on the median frame the stages add up to frame_ms within 5 % (other <= 5 %);
-#   walkthrough: no frame waits for the pool; converged: no fallback draws;
+#   walkthrough: no frame waits for the pool (pool_waits 0, hierarchy_ms and vis_hierarchy_ms
+#   0.0000: both count where a frame's threads block on the pool, in both modes, issue 19; before,
+#   only the converged branch counted them, so these checks held by construction; seen failing
+#   with a planted walkthrough wait for one face's build in gpu/stage_hierarchy.c
+#   request_walkthrough: pool_waits and vis_hierarchy_ms both fail); converged: no fallback draws;
 # - frametime.svg and report.html are well-formed XML; 3 frames captured, nothing left staged;
 # - bad path files: exit 1, file:line and the result id on stderr, no output written.
 # usage: test_profile.sh SPLINEWALK DATA_DIR WORKDIR SOURCE_DIR
@@ -181,6 +185,11 @@ check_run conv 40
 [ "$(column conv fallback_draws | sort -u)" = 0 ] || fail "converged: fallback draws"
 column conv pool_hierarchy_wait_tasks | awk '{ n += $1 } END { exit !(n > 0) }' ||
   fail "converged: no pool task waited for a hierarchy build"
+# the wait counters are alive where waits happen (the walkthrough's 0 above means something)
+column conv pool_waits | awk '{ n += $1 } END { exit !(n > 0) }' ||
+  fail "converged: no frame counted a pool wait"
+paste -d, <(column conv hierarchy_ms) <(column conv vis_hierarchy_ms) |
+  awk -F, '{ t += $1 + $2 } END { exit !(t > 0) }' || fail "converged: no hierarchy wait timed"
 settled conv
 pass "converged pool: $(cat pool.txt)"
 stages_add_up conv 20 >median.txt || fail "converged: stages do not add up on the median frame: $(cat median.txt)"

@@ -6,7 +6,10 @@
 # - profile.csv has the documented header and one numeric row per frame, frame indices in order;
 #   profile.json holds the same number of frames;
 # - every frame draws faces and triangles (a walk that loads nothing or draws nothing fails);
-# - no frame waits for the worker pool (walkthrough mode, issue 5);
+# - no frame waits for the worker pool (walkthrough mode, issue 5). pool_waits counts wherever
+#   the frame's threads block on the pool (issue 19; before, only the converged branch counted,
+#   so 0 held by construction); seen failing with a planted walkthrough wait for one face's
+#   build (gpu/stage_hierarchy.c request_walkthrough): frames 9, 11, 12, 14, 16 "1 pool waits";
 # - the peak resident set of the profile process stays under MAX_RSS_MIB (from the measured peak,
 #   with margin: see tests/scale/CMakeLists.txt).
 # usage: test_scale_walk.sh SPLINEWALK PEAK_RSS DATA_DIR WORKDIR SOURCE_DIR FRAMES MAX_RSS_MIB

@@ -329,6 +329,50 @@ static void test_fork_join(void **state)
     }
 }
 
+/* ---- the calling thread's waits (issue 19: what a frame's "pool waits" are made of) -----------
+ */
+
+static void sleep_20_fn(void *ctx)
+{
+    (void)ctx;
+    sleep_ms(20);
+}
+
+/* A group wait that finds nothing pending is no wait; one that finds a task pending is one, its
+ * time at least the task's (whoever runs it); a fork-join wait whose nested tasks wait too (run
+ * by this thread while it helps) is still one; bracketed waits nest. */
+static void test_thread_waits(void **state)
+{
+    (void)state;
+    sw_th_pool *pool = pool_with(2);
+    sw_th_group grp;
+    sw_th_group_init(&grp);
+    sw_th_wait_count a = sw_th_thread_waits();
+    sw_th_group_wait(pool, &grp);
+    sw_th_wait_count b = sw_th_thread_waits();
+    assert_int_equal(b.waits, a.waits);
+    assert_int_equal(b.ns, a.ns);
+    sw_th_task t = {.fn = sleep_20_fn, .group = &grp};
+    assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
+    sw_th_group_wait(pool, &grp);
+    sw_th_wait_count c = sw_th_thread_waits();
+    assert_int_equal(c.waits, b.waits + 1);
+    assert_true(c.ns - b.ns >= 15000000u);
+    fib_ctx f = {pool, 14, -1};
+    sw_th_task ft = {.fn = fib_fn, .ctx = &f, .group = &grp};
+    assert_int_equal(sw_th_pool_submit(pool, &ft), SW_OK);
+    sw_th_group_wait(pool, &grp);
+    assert_int_equal(f.result, fib_serial(14));
+    sw_th_wait_count d = sw_th_thread_waits();
+    assert_int_equal(d.waits, c.waits + 1);
+    sw_th_wait_begin();
+    sw_th_wait_begin();
+    sw_th_wait_end();
+    sw_th_wait_end();
+    assert_int_equal(sw_th_thread_waits().waits, d.waits + 1);
+    sw_th_pool_destroy(pool);
+}
+
 /* ---- shutdown and sleeping ------------------------------------------------------------------- */
 
 typedef struct tree_ctx {
@@ -697,6 +741,7 @@ int main(void)
         cmocka_unit_test(test_priority_local),
         cmocka_unit_test(test_group_wait_helps),
         cmocka_unit_test(test_fork_join),
+        cmocka_unit_test(test_thread_waits),
         cmocka_unit_test(test_shutdown_drains),
         cmocka_unit_test(test_no_lost_wakeup),
         cmocka_unit_test(test_idle_workers_sleep),

@@ -5,10 +5,13 @@
 #  2. Bad arguments: --screenshot without --script is a usage error (2); a missing script file
 #     is named in the error (1).
 #  3. Under xvfb-run: the window opens, 60 frames of a scripted orbit are drawn in walkthrough mode
-#     (0 pool waits), the last view is drawn converged (--settle), the window's back buffer is
-#     saved through OpenImageIO, and the viewer closes cleanly (exit 0). The screenshot must match
-#     `splinewalk render --camera` of the camera it printed (<= 0.1 % of pixels differ): what the
-#     window shows is the renderer's frame, presented into the window's framebuffer.
+#     (0 pool waits: counted wherever the frame blocks on the pool, issue 19 — before, only on
+#     the converged branch, so 0 held by construction; seen failing with a planted walkthrough
+#     wait for one face's build, "pool waits 1"), the last view is drawn converged (--settle),
+#     the window's back buffer is saved through OpenImageIO, and the viewer closes cleanly
+#     (exit 0). The screenshot must match `splinewalk render --camera` of the camera it printed
+#     (<= 0.1 % of pixels differ): what the window shows is the renderer's frame, presented into
+#     the window's framebuffer.
 #     The frame-time, wireframe and trim-atlas overlays change the frame, each only as it should.
 #  4. samples/embed_minimal (a GLFW host of the public API) draws 30 frames into its window and
 #     exits 0.

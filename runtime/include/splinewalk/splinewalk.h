@@ -355,11 +355,16 @@ typedef struct sw_frame_stats {
     uint64_t refine_rounds;  /* rounds of refinement below the hierarchies' leaves waited for */
     uint64_t fallback_draws; /* walkthrough: faces drawn without their hierarchy, plus leaves
                                 drawn coarser than the error asks, both requested from the pool */
-    uint64_t pool_waits;     /* times the frame waited for the pool (0 in walkthrough) */
+    uint64_t pool_waits;     /* times the frame blocked on the worker pool, wherever it can
+                                (hierarchy and static-LOD builds and refinements waited for, a
+                                cache given up with builds in flight, a node scene's compile),
+                                on every thread that worked on it; 0 in walkthrough mode unless
+                                a walkthrough frame blocked */
     uint64_t bound_exceeded; /* pieces drawn whose error bound exceeds ε_img: grids capped at the
                                 segment limit, hierarchy nodes at the sampling floor */
     double bound_excess_px;  /* the worst known bound over ε_img of those, in pixels */
-    double ms_hierarchy;     /* waiting for hierarchy builds and refinements */
+    double ms_hierarchy;     /* blocked waiting for hierarchy builds and refinements (both
+                                modes; 0 when none was waited for) */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
     /* split frames (sw_renderer_prepare / submit): hierarchy and tessellate ran on the visibility
      * thread, in ms_visibility there (its whole time for the frame); the rest on the caller's, in
