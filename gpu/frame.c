@@ -178,7 +178,7 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
 {
     *out = NULL;
     double t0 = sw__gpu_now_ms();
-    const sw_th_wait_count w0 = sw_th_thread_waits(); /* issue 19: every wait of the frame */
+    const sw_th_wait_count w0 = sw_th_thread_waits(); /* every wait of the frame */
     sw_gpu_frame_plan *p = sw__calloc(1, sizeof *p);
     if (!p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");

@@ -356,9 +356,8 @@ static sw_result converge(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw_
     return r;
 }
 
-/* ms_hierarchy: the time this stage's thread blocked on the pool, in both modes (issue 19: it
- * was the converged stage's wall time, planning traversals included, and 0 by construction in
- * walkthrough mode). */
+/* ms_hierarchy: the time this stage's thread blocked on the pool, in both modes (not the stage's
+ * wall time: its planning traversals are work, not waiting). */
 sw_result sw__fr_hierarchy_prepare(const sw__fr_env *env, sw__fr_hierarchy *hy,
                                    const sw__fr_faces *faces, sw_gpu_frame_stats *st,
                                    sw_status *status)

@@ -159,11 +159,13 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 }
 
 /* The counters a tessellation adds to (every counter of the struct but the ones set by other
- * stages, so that one added later is not lost silently: the size check below). */
+ * stages, so that one added later is not lost silently: the size check below). pool_waits and
+ * ms_pool_wait are not among them: they are the preparing thread's own (sw_th_thread_waits), and
+ * a chunk never waits for the pool. */
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 408,
+        sizeof(sw_gpu_frame_stats) == 424,
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;

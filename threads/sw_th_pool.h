@@ -15,7 +15,7 @@
  * it belongs to; sw_th_token_cancel bumps the generation, and a task whose generation went stale
  * is skipped (not run), counted, and still completes its group.
  *
- * Accounting (issue 5's profile): every task names a kind (what the renderer submits: hierarchy
+ * Accounting (for the profile): every task names a kind (what the renderer submits: hierarchy
  * builds, refinements, static-LOD clustering, builds and retirement, scene compiles). Each worker
  * counts the tasks of each kind it ran and, when timing is on (the desc's time_tasks or
  * sw_th_pool_set_task_timing: two CLOCK_MONOTONIC reads per task, measurable on tasks of ~0.1 us,
@@ -74,7 +74,7 @@ typedef void (*sw_th_task_fn)(void *ctx);
     X(A, STATIC_CLUSTER, "static_cluster", "super-surface clustering of a scene (static LODs)")    \
     X(A, STATIC_BUILD, "static_build", "static LOD builds of one super-surface")                   \
     X(A, STATIC_RETIRE, "static_retire", "freeing a retired set of static LODs")                   \
-    X(A, COMPILE, "compile", "node scenes' compile tasks")                                        \
+    X(A, COMPILE, "compile", "node scenes' compile tasks")                                         \
     X(A, FRAME_STAGE, "frame_stage", "chunks of a frame's tessellation taken by workers")
 
 typedef enum sw_th_task_kind {
@@ -149,8 +149,8 @@ SW_API sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task);
  * A call that finds tasks pending is one wait of the calling thread (sw_th_thread_waits). */
 SW_API void sw_th_group_wait(sw_th_pool *pool, sw_th_group *group);
 
-/* The calling thread's waits for pool work (issue 19: a walkthrough frame must never wait, and
- * its stats must be able to say so when it does). A wait is an outermost sw_th_group_wait that
+/* The calling thread's waits for pool work (a walkthrough frame must never wait, and its stats
+ * must be able to say so when it does). A wait is an outermost sw_th_group_wait that
  * found tasks pending, or an outermost sw_th_wait_begin / sw_th_wait_end bracket; waits nested
  * inside a wait (a task run meanwhile that waits itself) are part of it. ns: the wall time inside
  * them. Counters of the calling thread only, since it started: a frame takes the difference of

@@ -176,9 +176,8 @@ static void retire_cache_task(void *ctx)
 }
 
 /* The hierarchy cache, given up: destroyed by a pool task once its builds and refinements end,
- * so the frame thread never waits for them (issue 19: a walkthrough frame drawing a node scene's
- * new version waited here for the old version's builds, 25-98 times in api_nodes_live's 300
- * frames, uncounted until the waits were counted where they happen). */
+ * so the frame thread never waits for them (a walkthrough frame drawing a node scene's new
+ * version would otherwise wait here for the old version's builds). */
 static void retire_cache(sw_rt_renderer *r)
 {
     if (!r->cache)
@@ -561,7 +560,7 @@ sw_result sw_camera_matrices(const sw_camera *camera, int32_t width, int32_t hei
  * matrices of the frame's desc). pool_waits: the calling thread's waits for the pool since w0
  * (the whole call: scene, caches, prepare, submit) plus other_waits (other threads' and earlier
  * calls' for this frame: the visibility thread's prepare, sw_renderer_prepare's), so every place
- * where the frame can block on the pool is counted, in both modes (issue 19). */
+ * where the frame can block on the pool is counted, in both modes. */
 static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
                               const sw_gpu_frame_desc *frame, const sw_gpu_frame_stats *gstats,
                               double t0, const sw_th_wait_count *w0, uint64_t other_waits,
