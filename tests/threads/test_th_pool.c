@@ -329,13 +329,20 @@ static void test_fork_join(void **state)
     }
 }
 
-/* ---- the calling thread's waits (issue 19: what a frame's "pool waits" are made of) -----------
- */
+/* ---- the calling thread's waits (what a frame's "pool waits" are made of) ------------------ */
 
 static void sleep_20_fn(void *ctx)
 {
     (void)ctx;
     sleep_ms(20);
+}
+
+/* fib_fn after 20 ms: the group is still pending when the submitting thread reaches its wait
+ * (fib(14) alone could end before it does on a loaded machine, and then no wait is counted). */
+static void sleep_then_fib_fn(void *ctx)
+{
+    sleep_ms(20);
+    fib_fn(ctx);
 }
 
 /* A group wait that finds nothing pending is no wait; one that finds a task pending is one, its
@@ -359,7 +366,7 @@ static void test_thread_waits(void **state)
     assert_int_equal(c.waits, b.waits + 1);
     assert_true(c.ns - b.ns >= 15000000u);
     fib_ctx f = {pool, 14, -1};
-    sw_th_task ft = {.fn = fib_fn, .ctx = &f, .group = &grp};
+    sw_th_task ft = {.fn = sleep_then_fib_fn, .ctx = &f, .group = &grp};
     assert_int_equal(sw_th_pool_submit(pool, &ft), SW_OK);
     sw_th_group_wait(pool, &grp);
     assert_int_equal(f.result, fib_serial(14));
