@@ -101,7 +101,8 @@ static sw_result append_mesh(sw__gpu_mesh *dst, const sw__gpu_mesh *src, sw_stat
     sw_result r = sw__gpu_mesh_reserve(dst, src->n_v, src->n_idx, status);
     if (r != SW_OK)
         return r;
-    memcpy(dst->v + dst->n_v, src->v, src->n_v * sizeof *src->v);
+    if (src->n_v > 0) /* memcpy wants real pointers even for 0 bytes */
+        memcpy(dst->v + dst->n_v, src->v, src->n_v * sizeof *src->v);
     for (size_t i = 0; i < src->n_idx; ++i)
         dst->idx[dst->n_idx + i] = src->idx[i] + (uint32_t)v0;
     dst->n_v += src->n_v;
@@ -142,7 +143,8 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
     for (size_t i = 0; i < 2 * src->n_shares; ++i)
         dst->shares[2 * dst->n_shares + i] = src->shares[i] + draw0;
     dst->n_shares += src->n_shares;
-    memcpy(dst->loops + loops0, src->loops, src->n_loops * sizeof *src->loops);
+    if (src->n_loops > 0)
+        memcpy(dst->loops + loops0, src->loops, src->n_loops * sizeof *src->loops);
     dst->n_loops += src->n_loops;
     src->n_loops = 0; /* moved */
     for (size_t i = 0; i < src->n_recs; ++i) {
@@ -151,7 +153,8 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
         rec.draw += (int32_t)draw0;
         dst->recs[dst->n_recs++] = rec;
     }
-    memcpy(dst->cps + 4 * cps0, src->cps, 4 * src->n_cps * sizeof *src->cps);
+    if (src->n_cps > 0)
+        memcpy(dst->cps + 4 * cps0, src->cps, 4 * src->n_cps * sizeof *src->cps);
     dst->n_cps += src->n_cps;
     dst->gpu_vertices += src->gpu_vertices;
     dst->border_triangles += src->border_triangles;

@@ -354,6 +354,12 @@ static void check_atlas(sw_gpu_context *ctx, const stages *s, const char *name)
  * thread's geometry item for item: every chunk appended in order with its vertex, index, draw,
  * loop and control-point numbers rebased. Planted fault seen failing: the records' draw index not
  * rebased in append_geometry (stage_tessellate_parallel.c). */
+/* memcmp of n bytes, which wants real pointers even for n = 0 */
+static int same_bytes(const void *a, const void *b, size_t n)
+{
+    return n == 0 || memcmp(a, b, n) == 0;
+}
+
 static int same_draw(const sw__gpu_draw *a, const sw__gpu_draw *b)
 {
     return a->first_idx == b->first_idx && a->n_idx == b->n_idx &&
@@ -375,7 +381,7 @@ static int same_loops(const face_loops *a, const face_loops *b)
         return 0;
     for (uint32_t k = 0; k < a->n; ++k)
         if (a->loops[k].count != b->loops[k].count ||
-            memcmp(a->loops[k].uv, b->loops[k].uv, 2 * a->loops[k].count * sizeof(double)) != 0)
+            !same_bytes(a->loops[k].uv, b->loops[k].uv, 2 * a->loops[k].count * sizeof(double)))
             return 0;
     return 1;
 }
@@ -383,9 +389,9 @@ static int same_loops(const face_loops *a, const face_loops *b)
 static size_t first_mismatch(const sw__fr_geometry *a, const sw__fr_geometry *b)
 {
     const sw__gpu_mesh *m = &a->mesh, *n = &b->mesh;
-    if (m->n_v != n->n_v || memcmp(m->v, n->v, m->n_v * sizeof *m->v) != 0)
+    if (m->n_v != n->n_v || !same_bytes(m->v, n->v, m->n_v * sizeof *m->v))
         return 1;
-    if (m->n_idx != n->n_idx || memcmp(m->idx, n->idx, m->n_idx * sizeof *m->idx) != 0)
+    if (m->n_idx != n->n_idx || !same_bytes(m->idx, n->idx, m->n_idx * sizeof *m->idx))
         return 2;
     if (a->n_draws != b->n_draws)
         return 3;
@@ -398,16 +404,16 @@ static size_t first_mismatch(const sw__fr_geometry *a, const sw__fr_geometry *b)
         if (!same_trim(&a->trims[i], &b->trims[i]))
             return 4;
     if (a->n_shares != b->n_shares ||
-        memcmp(a->shares, b->shares, 2 * a->n_shares * sizeof *a->shares) != 0)
+        !same_bytes(a->shares, b->shares, 2 * a->n_shares * sizeof *a->shares))
         return 5;
     if (a->n_loops != b->n_loops)
         return 6;
     for (size_t i = 0; i < a->n_loops; ++i)
         if (!same_loops(&a->loops[i], &b->loops[i]))
             return 6;
-    if (a->n_recs != b->n_recs || memcmp(a->recs, b->recs, a->n_recs * sizeof *a->recs) != 0)
+    if (a->n_recs != b->n_recs || !same_bytes(a->recs, b->recs, a->n_recs * sizeof *a->recs))
         return 7;
-    if (a->n_cps != b->n_cps || memcmp(a->cps, b->cps, 4 * a->n_cps * sizeof *a->cps) != 0)
+    if (a->n_cps != b->n_cps || !same_bytes(a->cps, b->cps, 4 * a->n_cps * sizeof *a->cps))
         return 8;
     return a->gpu_vertices != b->gpu_vertices || a->border_triangles != b->border_triangles ? 9 : 0;
 }
