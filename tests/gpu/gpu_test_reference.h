@@ -352,4 +352,29 @@ static inline sw_test_ref_diff sw_test_ref_compare(const sw_gpu_image *ref,
     return r;
 }
 
+/* A frame against the reference: coverage and depth errors within 4 + 0.1 % of the covered
+ * pixels (isolated pixels at occluding edges), at least 2 % of the frame covered. Prints the
+ * figures under `label`; on failure writes PREFIX_ref.png and PREFIX_LABEL.png. 1: it passes. */
+static inline int sw_test_ref_check(const sw_gpu_image *ref, const sw_gpu_image *img,
+                                    size_t ref_tris, const char *label, const char *prefix)
+{
+    const sw_test_ref_diff df = sw_test_ref_compare(ref, img);
+    const long limit = 4 + df.covered / 1000;
+    const int good = df.covered > (long)img->width * img->height / 50 &&
+                     df.coverage_errors <= limit && df.depth_errors <= limit;
+    printf("  vs reference (%zu triangles) %dx%d, %s: %ld covered, coverage errors %ld, "
+           "depth errors %ld (limit %ld; worst depth difference %.2f %%)%s\n",
+           ref_tris, img->width, img->height, label, df.covered, df.coverage_errors,
+           df.depth_errors, limit, 100.0 * df.worst_depth_rel, good ? "" : "  <-- FAIL");
+    if (!good) {
+        char path[1100];
+        sw_status st = {0};
+        snprintf(path, sizeof path, "%s_ref.png", prefix);
+        sw_gpu_image_write(ref, path, &st);
+        snprintf(path, sizeof path, "%s_%s.png", prefix, label);
+        sw_gpu_image_write(img, path, &st);
+    }
+    return good;
+}
+
 #endif

@@ -69,25 +69,9 @@ static int reference_view(sw_gpu_context *ctx, const sw_sg_scene *scene,
             ok = 0;
             break;
         }
-        sw_test_ref_diff df = sw_test_ref_compare(&ref, &img);
-        const long limit = 4 + df.covered / 1000; /* isolated pixels at occluding edges */
-        const int good = df.covered > (long)desc.width * desc.height / 50 &&
-                         df.coverage_errors <= limit && df.depth_errors <= limit;
-        printf("  vs reference (%zu triangles) %dx%d, %s: %ld covered, coverage errors %ld, "
-               "depth errors %ld (limit %ld; worst depth difference %.2f %%)%s\n",
-               ref_tris, desc.width, desc.height, m ? "gpu" : "cpu grids", df.covered,
-               df.coverage_errors, df.depth_errors, limit, 100.0 * df.worst_depth_rel,
-               good ? "" : "  <-- FAIL");
-        ok = good;
-        if (!good) {
-            char path[1100];
-            sw_status st = {0};
-            snprintf(path, sizeof path, "%s_%s_ref.png", prefix, iso ? "iso" : "front");
-            sw_gpu_image_write(&ref, path, &st);
-            snprintf(path, sizeof path, "%s_%s_ref_%s.png", prefix, iso ? "iso" : "front",
-                     m ? "gpu" : "cpu");
-            sw_gpu_image_write(&img, path, &st);
-        }
+        char prefix_view[1040];
+        snprintf(prefix_view, sizeof prefix_view, "%s_%s", prefix, iso ? "iso" : "front");
+        ok = sw_test_ref_check(&ref, &img, ref_tris, m ? "gpu" : "cpu_grids", prefix_view);
         sw_gpu_image_free(&img);
     }
     sw__gpu_set_crack_fill(ctx, 1);
