@@ -19,6 +19,7 @@
  * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--workers W] FILE...
  *        (.brep/.step/.igs imported, .sws opened)
  */
+#include "bench_stats.h"
 #include "sw_gpu_internal.h"
 #include "sw_lod_cache.h"
 #include "sw_sg_import.h"
@@ -42,18 +43,6 @@ static double clock_ms(clockid_t id)
 enum { WALL, THREAD, PROCESS, N_CLOCKS };
 static const clockid_t k_clocks[N_CLOCKS] = {CLOCK_MONOTONIC, CLOCK_THREAD_CPUTIME_ID,
                                              CLOCK_PROCESS_CPUTIME_ID};
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static sw_gpu_camera orbit_camera(const double box[6], int i, int n)
 {
@@ -108,7 +97,8 @@ static int pass(bench *b, series *s)
 static void print_series(const char *name, series *s)
 {
     printf("    %-24s wall %8.2f  thread CPU %8.2f  process CPU %8.2f ms\n", name,
-           median(s->ms[WALL], s->n), median(s->ms[THREAD], s->n), median(s->ms[PROCESS], s->n));
+           bench_quantile(s->ms[WALL], s->n, 0.5), bench_quantile(s->ms[THREAD], s->n, 0.5),
+           bench_quantile(s->ms[PROCESS], s->n, 0.5));
 }
 
 /* Alternating passes of two variants set by set(b, 0 or 1), side by side; prints both. */
