@@ -202,8 +202,8 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
     return SW_OK;
 }
 
-sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
-                              sw_gpu_frame_stats *stats, sw_status *status)
+sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
+                                   sw_gpu_frame_stats *stats, sw_status *status)
 {
     memset(out, 0, sizeof *out);
     const sw_th_wait_count w0 = sw_th_thread_waits();
@@ -258,9 +258,18 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
     plan_release_reader(plan);
     if (cache)
         sw_lod_cache_collect(cache);
-    sw_gpu_frame_plan_free(plan);
+    plan->env.scene = NULL; /* spent: what is left is plain memory */
+    plan->env.ctx = NULL;
     if (r == SW_OK)
         sw__status_ok(status);
+    return r;
+}
+
+sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
+                              sw_gpu_frame_stats *stats, sw_status *status)
+{
+    sw_result r = sw_gpu_frame_submit_keep(ctx, plan, out, stats, status);
+    sw_gpu_frame_plan_free(plan);
     return r;
 }
 

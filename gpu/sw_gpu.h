@@ -111,10 +111,10 @@ typedef struct sw_gpu_frame_desc {
                               these occurrences of the scene's faces, culled one by one (bvh
                               ignored); read during prepare only */
     size_t n_occurrences;
-    int32_t present_depth; /* with present: the frame's depth written too, and only the surfaces'
-                              pixels that pass GL_GREATER against the host's depth buffer; the
-                              background leaves the host's pixels alone (sw__gpu_present) */
-    double near_plane;     /* > 0: the projection's near plane; 0: from the scene's box */
+    int32_t present_depth;   /* with present: the frame's depth written too, and only the surfaces'
+                                pixels that pass GL_GREATER against the host's depth buffer; the
+                                background leaves the host's pixels alone (sw__gpu_present) */
+    double near_plane;       /* > 0: the projection's near plane; 0: from the scene's box */
     struct sw_th_pool *pool; /* NULL: prepare runs on the calling thread alone; else the
                               per-frame faces are tessellated in chunks by the caller and this
                               pool's workers together (the output in the same order as on one
@@ -219,6 +219,11 @@ sw_result sw_gpu_render_scene(sw_gpu_context *ctx, const sw_sg_scene *scene,
  *    owner submits another plan. At most one prepare per context at a time. desc is copied.
  *  - sw_gpu_frame_submit: trim atlas, upload, draw, present, readback. The context's thread only;
  *    the plan is consumed (freed) whatever the result. The scene must outlive the plan.
+ *  - sw_gpu_frame_submit_keep: the same, but the plan is left spent rather than freed: its
+ *    memory (a frame's arrays, thousands of blocks: up to ~1 ms to free on a 10^3-face frame) is
+ *    released by sw_gpu_frame_plan_free on any thread, e.g. the one preparing the next frame, so
+ *    the submitting thread does not pay for it. A spent plan no longer refers to the scene,
+ *    the context or the hierarchy cache.
  * sw_gpu_render_scene is prepare then submit. Errors as for sw_gpu_render_scene; submit adds
  * SW_ERR_INVALID_ARGUMENT for a plan of another context. */
 typedef struct sw_gpu_frame_plan sw_gpu_frame_plan;
@@ -227,7 +232,10 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
                                sw_status *status);
 sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
                               sw_gpu_frame_stats *stats, sw_status *status);
-void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan);       /* an unsubmitted plan; NULL allowed */
+sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,
+                                   sw_gpu_frame_stats *stats, sw_status *status);
+/* An unsubmitted or spent plan; NULL allowed. */
+void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan);
 double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan); /* prepare's wall time */
 
 /* Renders plain triangles (world-space double positions, 3 per vertex) through the same camera,

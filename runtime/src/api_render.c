@@ -44,6 +44,8 @@ typedef struct sw_rt_renderer {
     int time_pool_tasks;      /* sw_rt_renderer_time_pool_tasks: the pool times its tasks */
     sw_rt_pipeline *pipeline; /* the visibility thread, started by the first prepare */
     uint32_t in_flight;       /* prepared frames not submitted yet */
+    /* the last submitted frame's spent plan, handed to V with the next prepare (V frees it) */
+    sw_gpu_frame_plan *spent;
     uint64_t frames_prepared;
     struct sw_rt_immediate *immediate; /* api_immediate.c; NULL until the first immediate call */
 } sw_rt_renderer;
@@ -263,6 +265,7 @@ sw_result sw_renderer_destroy(sw_renderer renderer)
         rr->in_flight--;
     }
     sw_rt_pipeline_stop(rr->pipeline);
+    sw_gpu_frame_plan_free(rr->spent);
     sw__rt_immediate_free(rr->immediate, rr->gpu);
     drop_cache(rr);
     sw_th_pool_destroy(rr->pool);
@@ -676,6 +679,8 @@ sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, s
         return status ? status->result : SW_ERR_INVALID_ARGUMENT;
     j->job.pool_waits_before = sw_th_thread_waits().waits - w0;
     j->job.frame = ++r->frames_prepared;
+    j->job.spent = r->spent;
+    r->spent = NULL;
     r->in_flight++;
     sw_rt_pipeline_push(r->pipeline, &j->job);
     sw__status_ok(status);
@@ -705,8 +710,12 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     }
     sw_gpu_image image = {0};
     sw_gpu_frame_stats gstats = {0};
-    res = sw_gpu_frame_submit(r->gpu, j->job.plan, &image, &gstats, status);
-    j->job.plan = NULL; /* consumed */
+    res = sw_gpu_frame_submit_keep(r->gpu, j->job.plan, &image, &gstats, status);
+    /* freed by V with the next prepare; a spent plan older than that (no prepare in between) is
+     * freed here */
+    sw_gpu_frame_plan_free(r->spent);
+    r->spent = j->job.plan;
+    j->job.plan = NULL;
     if (res == SW_OK)
         res = finish_frame(&image, j->output_path, &j->job.desc, &gstats, t0, &w0,
                            j->job.pool_waits + j->job.pool_waits_before, stats, status);

@@ -365,9 +365,11 @@ static void set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, sta
  * submitted. */
 static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camera_path *path,
                            uint32_t i, uint32_t n, sw_frame_desc *frame, staging *st,
-                           sw_rt_profile *p, sw_frame_stats *stats, sw_status *status)
+                           sw_rt_profile *p, sw_frame_stats *stats, double *prepare_ms,
+                           sw_status *status)
 {
     char file[4200];
+    *prepare_ms = 0.0;
     if (!threaded) {
         set_frame(path, i, n, st, p, frame, file);
         return sw_renderer_draw(renderer, frame, stats, status);
@@ -375,7 +377,9 @@ static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camer
     sw_result r = SW_OK;
     if (i + 1 < n) {
         set_frame(path, i + 1, n, st, p, frame, file);
+        const double t0 = sw_cli_now_ms();
         r = sw_renderer_prepare(renderer, frame, status);
+        *prepare_ms = sw_cli_now_ms() - t0;
     }
     return r == SW_OK ? sw_renderer_submit(renderer, stats, status) : r;
 }
@@ -429,9 +433,10 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
     for (uint32_t i = 0; i < n && r == SW_OK; i++) {
         sw_frame_stats stats = {0};
         pool_sample pool_start, pool_end;
+        double prepare_ms;
         const double t0 = sw_cli_now_ms();
         pool_read(renderer, 0, &pool_start);
-        r = one_frame(renderer, threaded, path, i, n, frame, st, p, &stats, status);
+        r = one_frame(renderer, threaded, path, i, n, frame, st, p, &stats, &prepare_ms, status);
         pool_read(renderer, 1, &pool_end);
         const double ms = sw_cli_now_ms() - t0;
         const double t = sw_rt_path_frame_time(path, i, n);
@@ -442,7 +447,7 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
             break;
         }
         sw_rt_prof_row row;
-        sw_rt_profile_row(&stats, i, t, ms, resident_bytes(), is_capture(p, i), &row);
+        sw_rt_profile_row(&stats, i, t, ms, prepare_ms, resident_bytes(), is_capture(p, i), &row);
         pool_columns(&pool_start, &pool_end, &row);
         if (sw_rt_profile_push(p, &row) != 0)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");

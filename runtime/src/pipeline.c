@@ -31,6 +31,8 @@ struct sw_rt_pipeline {
 
 static void prepare_job(sw_rt_pipeline *p, sw_rt_frame_job *job)
 {
+    sw_gpu_frame_plan_free(job->spent);
+    job->spent = NULL;
     const uint64_t w0 = sw_th_thread_waits().waits; /* V's blocking on the pool: the frame's */
     job->result = sw_gpu_frame_prepare(p->gpu, job->sg, &job->desc, &job->plan, &job->status);
     job->ms_visibility = job->plan ? sw_gpu_frame_plan_ms(job->plan) : 0.0;

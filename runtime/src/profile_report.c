@@ -21,7 +21,7 @@ static const col_info k_cols[SW_RT_COL_COUNT] = {
 };
 
 /* Stage colours, in stacking order (hierarchy at the bottom, other on top). */
-static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#59a14f",
+static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#76b7b2", "#59a14f",
                                              "#f28e2b", "#e15759", "#b07aa1", "#a0a0a0"};
 #define FIRST_STAGE SW_RT_COL_HIERARCHY_MS
 #define N_STAGES (SW_RT_COL_OTHER_MS - SW_RT_COL_HIERARCHY_MS + 1)
@@ -33,9 +33,8 @@ _Static_assert(SW_RT_COL_POOL_FIRST_TASKS - SW_RT_COL_POOL_FIRST_MS == SW_TH_TAS
                    SW_RT_COL_POOL_QUEUED - SW_RT_COL_POOL_FIRST_TASKS == SW_TH_TASK_KIND_COUNT,
                "one ms and one tasks column per pool task kind, in order");
 /* Pool kinds' colours (same order as the kinds). */
-static const char *const k_pool_colour[] = {"#a0a0a0", "#4c8bd6", "#9ecae9", "#8e6bbf",
-                                            "#59a14f", "#edc948", "#f28e2b", "#e15759",
-                                            "#76b7b2"};
+static const char *const k_pool_colour[] = {"#a0a0a0", "#4c8bd6", "#9ecae9", "#8e6bbf", "#59a14f",
+                                            "#edc948", "#f28e2b", "#e15759", "#76b7b2"};
 _Static_assert(sizeof k_pool_colour / sizeof k_pool_colour[0] == SW_TH_TASK_KIND_COUNT,
                "one colour per pool task kind");
 
@@ -59,7 +58,7 @@ sw_rt_prof_kind sw_rt_prof_col_kind(sw_rt_prof_col col)
 
 /* ---- rows and statistics --------------------------------------------------------------------- */
 void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, double frame_ms,
-                       double resident_bytes, int captured, sw_rt_prof_row *out)
+                       double prepare_ms, double resident_bytes, int captured, sw_rt_prof_row *out)
 {
     double *v = out->v;
     memset(out, 0, sizeof *out);
@@ -72,6 +71,7 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_VIS_MS] = st->ms_visibility;
     v[SW_RT_COL_VIS_JOIN_MS] = st->ms_join;
     v[SW_RT_COL_WAIT_VISIBILITY_MS] = st->ms_wait_visibility;
+    v[SW_RT_COL_PREPARE_MS] = prepare_ms;
     v[SW_RT_COL_TRIM_MS] = st->ms_trim;
     v[SW_RT_COL_DRAW_MS] = st->ms_draw;
     v[SW_RT_COL_READBACK_MS] = st->ms_readback;
@@ -253,7 +253,7 @@ static void json_string(FILE *f, const char *s)
 
 static const char *kind_name(sw_rt_prof_kind k)
 {
-    static const char *const names[] = {"index", "seconds", "frame", "stage", "visibility stage",
+    static const char *const names[] = {"index", "seconds", "frame",  "stage", "visibility stage",
                                         "gpu",   "pool",    "pixels", "count"};
     _Static_assert(sizeof names / sizeof names[0] == SW_RT_KIND_COUNT + 1,
                    "a name per kind (SW_RT_KIND_COUNT, the count kind, is the last)");

@@ -44,6 +44,8 @@
       "culling, traversal, bounds, CPU grids, requests (0 when on the visibility thread)")         \
     X(WAIT_VISIBILITY_MS, "wait_visibility_ms", STAGE,                                             \
       "threaded: waiting for the visibility thread to finish the frame")                           \
+    X(PREPARE_MS, "prepare_ms", STAGE,                                                             \
+      "threaded: handing the next frame to the visibility thread (sw_renderer_prepare)")           \
     X(TRIM_MS, "trim_ms", STAGE, "trim-texture generation into the atlas")                         \
     X(DRAW_MS, "draw_ms", STAGE, "draw submission until glFinish")                                 \
     X(READBACK_MS, "readback_ms", STAGE, "glReadPixels of the frame")                              \
@@ -139,12 +141,13 @@ typedef struct sw_rt_profile {
     sw_rt_prof_stat summary[SW_RT_COL_COUNT]; /* after sw_rt_profile_summarize */
 } sw_rt_profile;
 
-/* A frame's row from the renderer's stats, the submitting thread's wall time for it and resident
- * memory; OTHER_MS is frame_ms minus the measured stages. A split frame (prepared on the
- * visibility thread: st->ms_visibility > 0) has its hierarchy and tessellate times in the VIS_
- * columns, a frame drawn in one call in the stage columns. */
+/* A frame's row from the renderer's stats, the submitting thread's wall time for it, the part of
+ * that time it spent preparing the next frame (threaded; 0 otherwise) and resident memory; OTHER_MS
+ * is frame_ms minus the measured stages. A split frame (prepared on the visibility thread:
+ * st->ms_visibility > 0) has its hierarchy and tessellate times in the VIS_ columns, a frame drawn
+ * in one call in the stage columns. */
 void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, double frame_ms,
-                       double resident_bytes, int captured, sw_rt_prof_row *out);
+                       double prepare_ms, double resident_bytes, int captured, sw_rt_prof_row *out);
 /* The pool columns of a row: per kind, `now` minus `before` (two samples of the pool's
  * statistics, at the end of the previous frame and of this one; zeros before the pool exists),
  * the tasks queued at this frame's end (sw_th_pool_queued) and the injection queue's peak

@@ -20,6 +20,9 @@ typedef struct sw_rt_frame_job {
     const sw_sg_scene *sg;
     sw_gpu_frame_desc desc;
     void *user; /* P's own per-frame data (the scene reference, the output path) */
+    /* an earlier frame's spent plan (sw_gpu_frame_submit_keep) or NULL: V frees it before it
+     * prepares this job, so that P's frames do not pay for freeing plans */
+    sw_gpu_frame_plan *spent;
     /* out: set by V */
     sw_gpu_frame_plan *plan; /* NULL on failure */
     sw_result result;

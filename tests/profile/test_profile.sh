@@ -23,7 +23,9 @@ for tool in xmllint jq awk; do
   command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
 done
 
-columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,vis_join_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_frame_stage_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_frame_stage_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,prepare_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,vis_join_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_frame_stage_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_frame_stage_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
+# col NAME: NAME's field number in profile.csv (the stages lie between frame_ms and other_ms)
+col() { echo "$columns" | tr , '\n' | grep -nx "$1" | cut -d: -f1; }
 
 # ---- help and usage ---------------------------------------------------------------------------
 "$sw" --help | grep -q '^  profile' || fail "splinewalk --help does not list profile"
@@ -62,12 +64,12 @@ check_run() {
   local dir=$1 n=$2
   [ "$(head -1 "$dir/profile.csv")" = "$columns" ] || fail "$dir: CSV header: $(head -1 "$dir/profile.csv")"
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
-  awk -F, -v n=58 'NR > 1 {
+  awk -F, -v n=59 -v n_other="$(col other_ms)" 'NR > 1 {
       if (NF != n) { print "row " NR ": " NF " fields"; bad = 1 }
       for (i = 1; i <= NF; i++) if ($i !~ /^-?[0-9]+(\.[0-9]+)?$/) { print "row " NR " field " i ": " $i; bad = 1 }
       if ($1 != NR - 2) { print "row " NR ": frame " $1; bad = 1 }
-      stages = $4 + $5 + $6 + $7 + $8 + $9 + $10
-      if (($3 - stages - $11) > 0.002 || ($3 - stages - $11) < -0.002) { print "row " NR ": other " $11 " != " $3 - stages; bad = 1 }
+      stages = 0; for (i = 4; i < n_other; i++) stages += $i
+      if (($3 - stages - $n_other) > 0.002 || ($3 - stages - $n_other) < -0.002) { print "row " NR ": other " $n_other " != " $3 - stages; bad = 1 }
       if (NR > 2 && $2 <= prev_t) { print "row " NR ": t_s not increasing"; bad = 1 }
       prev_t = $2
     } END { exit bad }' "$dir/profile.csv" >awk.txt || { fail "$dir: CSV rows"; head -5 awk.txt; }
@@ -153,10 +155,10 @@ column() { awk -F, -v c="$2" 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == c) k
 # stages_add_up DIR ROW: on the ROW-th fastest frame (the median), the submitting thread's stages
 # add up to frame_ms within 5 % (other <= 5 %).
 stages_add_up() {
-  tail -n +2 "$1/profile.csv" | sort -t, -k3 -g | sed -n "$2p" | awk -F, '{
-    stages = $4 + $5 + $6 + $7 + $8 + $9 + $10
-    printf "median frame %d: frame %.3f ms, stages %.3f ms, other %.3f ms (%.2f %%)\n", $1, $3, stages, $11, 100 * $11 / $3
-    exit !($3 > 0 && stages >= 0.95 * $3 && stages <= 1.05 * $3 && $11 <= 0.05 * $3) }'
+  tail -n +2 "$1/profile.csv" | sort -t, -k3 -g | sed -n "$2p" | awk -F, -v o="$(col other_ms)" '{
+    stages = 0; for (i = 4; i < o; i++) stages += $i
+    printf "median frame %d: frame %.3f ms, stages %.3f ms, other %.3f ms (%.2f %%)\n", $1, $3, stages, $o, 100 * $o / $3
+    exit !($3 > 0 && stages >= 0.95 * $3 && stages <= 1.05 * $3 && $o <= 0.05 * $3) }'
 }
 
 # ---- walkthrough (the default mode), threaded: the visibility thread prepares the next frame ----
