@@ -234,23 +234,15 @@ static sw_result read_color(const float in[4], const char *fn, float out[4], sw_
     return SW_OK;
 }
 
+/* A node camera is always given (no fitted default): the all-zero camera is refused too. */
 static sw_result check_camera(const sw_camera *c, const char *fn, sw_status *status)
 {
-    double d[3], x[3], dd = 0.0, xx = 0.0;
-    for (int k = 0; k < 3; k++)
-        d[k] = c->target[k] - c->eye[k];
-    for (int k = 0; k < 3; k++) {
-        x[k] = d[(k + 1) % 3] * c->up[(k + 2) % 3] - d[(k + 2) % 3] * c->up[(k + 1) % 3];
-        dd += d[k] * d[k];
-        xx += x[k] * x[k];
-    }
-    int finite = all_finite(c->eye, 3) && all_finite(c->target, 3) && all_finite(c->up, 3);
-    if (!finite || !(dd > 0.0) || !(xx > 0.0) ||
-        (c->fovy_deg != 0.0 && !(c->fovy_deg >= SW_FOVY_MIN_DEG && c->fovy_deg < 180.0)))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "%s: camera not finite, eye = target, up parallel to the view, or fovy "
-                        "out of [%g, 180)",
-                        fn, SW_FOVY_MIN_DEG);
+    sw_camera given = *c;
+    if (given.fovy_deg == 0.0)
+        given.fovy_deg = SW_DEFAULT_FOVY_DEG;
+    const char *problem = sw_rt_camera_problem(&given);
+    if (problem)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: camera: %s", fn, problem);
     return SW_OK;
 }
 

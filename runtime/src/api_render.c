@@ -323,17 +323,9 @@ static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
                         "screen-space error %g px must be finite and at least %g px (the floor "
                         "below which refinement outgrows the arithmetic)",
                         desc->error_px, SW_ERROR_MIN_PX);
-    if (desc->camera.fovy_deg != 0.0 &&
-        !(desc->camera.fovy_deg >= SW_FOVY_MIN_DEG && desc->camera.fovy_deg < 180.0))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "field of view %g° out of [%g, 180) (the floor below which refinement "
-                        "outgrows the arithmetic)",
-                        desc->camera.fovy_deg, SW_FOVY_MIN_DEG);
-    for (int k = 0; k < 3; k++) {
-        if (!isfinite(desc->camera.eye[k]) || !isfinite(desc->camera.target[k]) ||
-            !isfinite(desc->camera.up[k]))
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera has a non-finite coordinate");
-    }
+    sw_result res = sw_camera_check(&desc->camera, status);
+    if (res != SW_OK)
+        return res;
     if (desc->near_plane != 0.0 && !(desc->near_plane > 0.0 && isfinite(desc->near_plane)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "near plane %g must be positive and finite (0: from the scene's box)",
@@ -388,35 +380,41 @@ static int camera_is_zero(const sw_camera *c)
     return c->fovy_deg == 0.0;
 }
 
+sw_result sw_camera_check(const sw_camera *camera, sw_status *status)
+{
+    if (!camera)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_camera_check: NULL camera");
+    if (camera_is_zero(camera))
+        return SW_OK;
+    sw_camera c = *camera;
+    if (c.fovy_deg == 0.0)
+        c.fovy_deg = SW_DEFAULT_FOVY_DEG;
+    const char *problem = sw_rt_camera_problem(&c);
+    if (problem)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera: %s", problem);
+    return SW_OK;
+}
+
 /* The frame's camera: a zero camera means the iso preset fitted to the scene (zero = default);
  * otherwise eye, target and up must span a view (a degenerate one would yield NaN matrices and an
- * empty image instead of an error). */
+ * empty image instead of an error), checked again after the fit (a degenerate scene box). */
 static sw_result resolve_camera(const sw_camera *in, const sw_rt_scene *scene, sw_gpu_camera *out,
                                 sw_status *status)
 {
     sw_camera c = *in;
     if (camera_is_zero(&c))
         sw_rt_camera_fit_box(scene->stats.bbox, SW_VIEW_ISO, &c);
-    double d[3], cross[3], dd = 0.0, uu = 0.0, cc = 0.0;
-    for (int k = 0; k < 3; k++)
-        d[k] = c.target[k] - c.eye[k];
-    for (int k = 0; k < 3; k++) {
-        cross[k] = d[(k + 1) % 3] * c.up[(k + 2) % 3] - d[(k + 2) % 3] * c.up[(k + 1) % 3];
-        dd += d[k] * d[k];
-        uu += c.up[k] * c.up[k];
-        cc += cross[k] * cross[k];
-    }
-    if (!(dd > 0.0))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera: eye equals target");
-    if (!(cc > 1e-24 * dd * uu))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "camera: up is zero or parallel to the view direction");
+    if (c.fovy_deg == 0.0)
+        c.fovy_deg = SW_DEFAULT_FOVY_DEG;
+    const char *problem = sw_rt_camera_problem(&c);
+    if (problem)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera: %s", problem);
     for (int k = 0; k < 3; k++) {
         out->eye[k] = c.eye[k];
         out->target[k] = c.target[k];
         out->up[k] = c.up[k];
     }
-    out->fovy_deg = c.fovy_deg > 0.0 ? c.fovy_deg : SW_DEFAULT_FOVY_DEG;
+    out->fovy_deg = c.fovy_deg;
     return SW_OK;
 }
 

@@ -35,29 +35,6 @@ static double norm3(const double a[3])
     return sqrt(dot3(a, a));
 }
 
-/* A camera the renderer accepts: eye away from target relative to the coordinates' size, up
- * neither zero nor along the view (gpu/camera.c rejects both), fovy in [SW_FOVY_MIN_DEG, 180°).
- * Returns NULL or what is wrong. */
-static const char *camera_problem(const sw_camera *c)
-{
-    double d[3], scale = 1.0;
-    for (int k = 0; k < 3; k++) {
-        d[k] = c->target[k] - c->eye[k];
-        scale = fmax(scale, fmax(fabs(c->eye[k]), fabs(c->target[k])));
-    }
-    const double dn = norm3(d), un = norm3(c->up);
-    if (!(c->fovy_deg >= SW_FOVY_MIN_DEG && c->fovy_deg < 180.0))
-        return "the field of view is outside [0.01, 180) degrees (SW_FOVY_MIN_DEG)";
-    if (!(dn > 1e-9 * scale))
-        return "the eye coincides with the target";
-    if (!(un > 0.0))
-        return "the up vector is zero";
-    const double cosang = dot3(d, c->up) / (dn * un);
-    if (!(1.0 - fabs(cosang) > 1e-9)) /* sin² < 2e-9: the view basis is lost in rounding */
-        return "the up vector points along the view direction";
-    return NULL;
-}
-
 /* ---- lines and fields ------------------------------------------------------------------------ */
 typedef struct lexer {
     const char *p, *end;
@@ -144,14 +121,15 @@ static sw_result wrong_count(lexer *lx, const char *record, int expected)
 
 static sw_result field_double(lexer *lx, int i, const char *what, double *out)
 {
-    char *end = NULL;
-    errno = 0;
-    const double x = strtod(lx->f[i], &end);
-    if (end == lx->f[i] || *end != '\0')
-        return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: expected %s (a number), found '%s'",
-                        lx->name, lx->line, what, lx->f[i]);
-    if (!isfinite(x) || errno == ERANGE)
-        return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: %s is '%s', not a finite number",
+    const char *end;
+    double x = 0.0;
+    const int got = sw_rt_parse_decimal(lx->f[i], &end, &x);
+    if (got == SW_RT_DECIMAL_NOT_A_NUMBER || *end != '\0')
+        return sw__fail(lx->status, SW_ERR_FORMAT,
+                        "%s:%u: expected %s (a decimal number), found '%s'", lx->name, lx->line,
+                        what, lx->f[i]);
+    if (got != SW_RT_DECIMAL_OK)
+        return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: %s is '%s', beyond a double's range",
                         lx->name, lx->line, what, lx->f[i]);
     *out = x;
     return SW_OK;
@@ -324,7 +302,7 @@ static sw_result validate_keys(const sw_rt_camera_path *p, const char *name, sw_
 {
     for (uint32_t i = 0; i < p->n_keys; i++) {
         const sw_rt_path_key *k = &p->keys[i];
-        const char *problem = camera_problem(&k->camera);
+        const char *problem = sw_rt_camera_problem(&k->camera);
         if (problem)
             return sw__fail(status, SW_ERR_FORMAT, "%s:%u: %s", name, k->line, problem);
         if (i == 0)
@@ -369,7 +347,7 @@ static sw_result validate_segments(const sw_rt_camera_path *p, const char *name,
             const double t = a + (b - a) * s / CHECK_SAMPLES;
             sw_camera c;
             sw_rt_path_eval(p, t, &c);
-            const char *problem = camera_problem(&c);
+            const char *problem = sw_rt_camera_problem(&c);
             if (problem)
                 return sw__fail(status, SW_ERR_FORMAT,
                                 "%s:%u: between this key and the next "
@@ -441,11 +419,42 @@ static int write_path(FILE *f, const void *ctx)
     return ferror(f) ? -1 : 0;
 }
 
+/* The path's text, read back through the parser before anything is written: a path with keys
+ * the parser would refuse (a time that overflowed, a degenerate camera) is never written. */
+static sw_result path_text(const sw_rt_camera_path *path, const char *file, char **text,
+                           size_t *len, sw_status *status)
+{
+    FILE *f = open_memstream(text, len);
+    if (!f)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", file);
+    const int bad = write_path(f, path);
+    if (fclose(f) != 0 || bad) {
+        free(*text); /* open_memstream's buffer: the C library's malloc */
+        *text = NULL;
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", file);
+    }
+    char name[4200];
+    snprintf(name, sizeof name, "%s (not written)", file);
+    sw_rt_camera_path back;
+    sw_result r = sw_rt_path_parse(*text, *len, name, &back, status);
+    sw_rt_path_free(&back);
+    if (r != SW_OK) {
+        free(*text);
+        *text = NULL;
+    }
+    return r;
+}
+
 sw_result sw_rt_path_save(const sw_rt_camera_path *path, const char *file, unsigned flags,
                           sw_status *status)
 {
     assert(path && file);
-    sw_result r = sw__write_file_printed(file, write_path, path, flags, status);
+    char *text = NULL;
+    size_t len = 0;
+    sw_result r = path_text(path, file, &text, &len, status);
+    if (r == SW_OK)
+        r = sw__write_file(file, text, len, flags, status);
+    free(text);
     if (r == SW_OK)
         sw__status_ok(status);
     return r;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Helpers shared by the splinewalk subcommands: argument parsing, progress, error reports. */
 #include "cli.h"
+#include "sw_rt.h"
 
 #include "sw_safe_write.h"
 
@@ -31,7 +32,8 @@ int sw_cli_print_help(int argc, char **argv, const char *usage)
 int sw_cli_report(const char *cmd, const sw_status *status)
 {
     fprintf(stderr, "splinewalk %s: %s (%s): %s\n", cmd, sw_result_str(status->result),
-            sw_result_id_str(status->result), status->message[0] ? status->message : "(no details)");
+            sw_result_id_str(status->result),
+            status->message[0] ? status->message : "(no details)");
     return 1;
 }
 
@@ -56,8 +58,9 @@ void sw_cli_progress(void *user_data, double fraction, const char *stage)
         fraction = 1.0;
     if (isatty(STDERR_FILENO)) {
         int filled = (int)(fraction * 30.0);
-        fprintf(stderr, "\r[%.*s%*s] %3d%% %-40.40s", filled, "==============================",
-                30 - filled, "", (int)(fraction * 100.0), stage ? stage : "");
+        fprintf(stderr, "\r[%.*s%*s] %3d%% %-40.40s", filled,
+                "==============================", 30 - filled, "", (int)(fraction * 100.0),
+                stage ? stage : "");
         g_progress.active = 1;
         return;
     }
@@ -125,8 +128,8 @@ void sw_cli_print_import_notes(FILE *f, const char *cmd, const sw_scene_info *in
 {
     if (!info->faces_skipped && !info->faces_repaired && !info->partial)
         return;
-    fprintf(f, "%s: %u faces skipped, %u repaired (each named in a warning above)%s\n",
-            cmd, info->faces_skipped, info->faces_repaired,
+    fprintf(f, "%s: %u faces skipped, %u repaired (each named in a warning above)%s\n", cmd,
+            info->faces_skipped, info->faces_repaired,
             info->partial ? "; the file is truncated and was imported in part (--partial)" : "");
 }
 
@@ -139,8 +142,26 @@ int sw_cli_report_load(const char *cmd, const sw_status *status)
     return rc;
 }
 
+/* Why the last sw_cli_parse_* call refused its text, when more than "not of the form" ("" else):
+ * the command-line tools are single-threaded. */
+static char g_parse_reason[160];
+
+static int refuse(const char *why)
+{
+    snprintf(g_parse_reason, sizeof g_parse_reason, "%s", why);
+    return -1;
+}
+
+int sw_cli_bad_value(const char *cmd, const char *arg, const char *val, const char *usage)
+{
+    fprintf(stderr, "splinewalk %s: bad value '%s' for %s%s%s\n%s", cmd, val, arg,
+            g_parse_reason[0] ? ": " : "", g_parse_reason, usage ? usage : "");
+    return 2;
+}
+
 int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h)
 {
+    g_parse_reason[0] = '\0';
     char *end;
     errno = 0;
     long a = strtol(text, &end, 10);
@@ -157,13 +178,12 @@ int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h)
 
 int sw_cli_parse_camera(const char *text, sw_camera *out)
 {
+    g_parse_reason[0] = '\0';
     double v[10];
     const char *p = text;
     for (int i = 0; i < 10; i++) {
-        char *end;
-        errno = 0;
-        v[i] = strtod(p, &end);
-        if (errno || end == p || !isfinite(v[i]))
+        const char *end;
+        if (sw_rt_parse_decimal(p, &end, &v[i]) != SW_RT_DECIMAL_OK)
             return -1;
         if (i < 9 && *end != ',')
             return -1;
@@ -177,18 +197,13 @@ int sw_cli_parse_camera(const char *text, sw_camera *out)
         out->up[k] = v[6 + k];
     }
     out->fovy_deg = v[9];
-    if (!(v[9] > 0.0 && v[9] < 180.0))
-        return -1;
-    double d2 = 0.0, u2 = 0.0;
-    for (int k = 0; k < 3; k++) {
-        d2 += (v[3 + k] - v[k]) * (v[3 + k] - v[k]);
-        u2 += v[6 + k] * v[6 + k];
-    }
-    return d2 > 0.0 && u2 > 0.0 ? 0 : -1;
+    const char *problem = sw_rt_camera_problem(out); /* every frame's check (fovy given here) */
+    return problem ? refuse(problem) : 0;
 }
 
 int sw_cli_parse_count(const char *text, int lo, int hi, int *out)
 {
+    g_parse_reason[0] = '\0';
     char *end;
     errno = 0;
     long v = strtol(text, &end, 10);
@@ -200,11 +215,22 @@ int sw_cli_parse_count(const char *text, int lo, int hi, int *out)
 
 int sw_cli_parse_positive(const char *text, double *out)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (errno || end == text || *end != '\0' || !(v > 0.0) || !isfinite(v))
+    g_parse_reason[0] = '\0';
+    const char *end;
+    double v;
+    if (sw_rt_parse_decimal(text, &end, &v) != SW_RT_DECIMAL_OK || *end != '\0' || !(v > 0.0))
         return -1;
+    *out = v;
+    return 0;
+}
+
+int sw_cli_parse_error_px(const char *text, double *out)
+{
+    double v;
+    if (sw_cli_parse_positive(text, &v) != 0)
+        return -1;
+    if (!(v >= SW_ERROR_MIN_PX))
+        return refuse("a screen-space error must be at least 0.01 px (SW_ERROR_MIN_PX)");
     *out = v;
     return 0;
 }
@@ -219,15 +245,15 @@ double sw_cli_now_ms(void)
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
 {
     printf("%s: patches drawn trimmed by trim textures %llu, untrimmed %llu, culled %llu "
-           "(%llu evaluated on the GPU, %llu by the exact path); faces drawn %llu, culled %llu; %llu triangles; "
+           "(%llu evaluated on the GPU, %llu by the exact path); faces drawn %llu, culled %llu; "
+           "%llu triangles; "
            "%llu trim textures (%llu texels, %llu kept from earlier frames, %llu atlas pages)\n",
            label, (unsigned long long)s->patches_trimmed, (unsigned long long)s->patches_untrimmed,
            (unsigned long long)s->patches_culled, (unsigned long long)s->patches_gpu_evaluated,
-           (unsigned long long)s->patches_exact,
-           (unsigned long long)s->faces_drawn, (unsigned long long)s->faces_culled,
-           (unsigned long long)s->triangles, (unsigned long long)s->trim_textures,
-           (unsigned long long)s->trim_texels, (unsigned long long)s->trim_reused,
-           (unsigned long long)s->atlas_pages);
+           (unsigned long long)s->patches_exact, (unsigned long long)s->faces_drawn,
+           (unsigned long long)s->faces_culled, (unsigned long long)s->triangles,
+           (unsigned long long)s->trim_textures, (unsigned long long)s->trim_texels,
+           (unsigned long long)s->trim_reused, (unsigned long long)s->atlas_pages);
     if (s->hierarchy_nodes > 0)
         printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
                (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);

@@ -20,7 +20,7 @@ static const char k_usage[] =
     "  -o, --output DIR   where the scene and frames go (default demo-out)\n"
     "  --data DIR         OpenCASCADE sample data (default /usr/share/opencascade/data)\n"
     "  --size WxH         frame size (default 1280x720)\n"
-    "  --error PX         screen-space error bound in pixels (default 0.5)\n"
+    "  --error PX         screen-space error bound in pixels, at least 0.01 (default 0.5)\n"
     "  -h, --help         this text\n";
 
 typedef struct demo_args {
@@ -41,14 +41,13 @@ static int parse_args(int argc, char **argv, demo_args *a)
         else if (!strcmp(argv[i], "--size") && val)
             bad = sw_cli_parse_size(val, &a->width, &a->height);
         else if (!strcmp(argv[i], "--error") && val)
-            bad = sw_cli_parse_positive(val, &a->error_px);
+            bad = sw_cli_parse_error_px(val, &a->error_px);
         else {
             fprintf(stderr, "splinewalk demo: unexpected argument '%s'\n%s", argv[i], k_usage);
             return 2;
         }
         if (bad) {
-            fprintf(stderr, "splinewalk demo: bad value '%s' for %s\n", val, argv[i]);
-            return 2;
+            return sw_cli_bad_value("demo", argv[i], val, NULL);
         }
         i++;
     }

@@ -54,8 +54,7 @@ static int parse_args(int argc, char **argv, path_args *a)
             return 2;
         }
         if (bad) {
-            fprintf(stderr, "splinewalk path: bad value '%s' for %s\n%s", val, arg, k_usage);
-            return 2;
+            return sw_cli_bad_value("path", arg, val, k_usage);
         }
         i++;
     }

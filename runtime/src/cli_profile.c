@@ -50,7 +50,7 @@ static const char k_usage[] =
     "  --frames N        frames spread evenly over the path (default: the path's 'frames', else\n"
     "                    100)\n"
     "  --size WxH        frame size (default 1280x720)\n"
-    "  --error PX        screen-space error bound in pixels (default 0.5)\n"
+    "  --error PX        screen-space error bound in pixels, at least 0.01 (default 0.5)\n"
     "  --converged       every frame waits for the hierarchy builds and refinements it asks for\n"
     "                    (default: walkthrough mode, frames never wait; what is not ready is\n"
     "                    drawn coarser and queued)\n"
@@ -85,7 +85,7 @@ static int parse_option(profile_args *a, const char *arg, const char *val)
     else if (!strcmp(arg, "--size"))
         return sw_cli_parse_size(val, &a->frame.width, &a->frame.height);
     else if (!strcmp(arg, "--error"))
-        return sw_cli_parse_positive(val, &a->frame.error_px);
+        return sw_cli_parse_error_px(val, &a->frame.error_px);
     else if (!strcmp(arg, "--threads"))
         return sw_cli_parse_count(val, 1, 1024, &a->threads);
     else if (!strcmp(arg, "--eval")) {
@@ -124,8 +124,7 @@ static int parse_args(int argc, char **argv, profile_args *a)
             return 2;
         }
         if (bad) {
-            fprintf(stderr, "splinewalk profile: bad value '%s' for %s\n%s", val, arg, k_usage);
-            return 2;
+            return sw_cli_bad_value("profile", arg, val, k_usage);
         }
         i++;
     }

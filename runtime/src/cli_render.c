@@ -28,7 +28,7 @@ static const char k_usage[] =
     "                      iso from (+1,+1,+1) up +Z, front from -Y up +Z, top from +Z up +Y,\n"
     "                      right from +X up +Z\n"
     "  --camera LIST       eye, target, up and vertical field of view in degrees (overrides --view)\n"
-    "  --error PX          screen-space error bound in pixels (default 0.5)\n"
+    "  --error PX          screen-space error bound in pixels, at least 0.01 (default 0.5)\n"
     "  --eval MODE         hierarchy (default): each face drawn from its hierarchy of rational\n"
     "                      bicubic patches (Guthe et al. 2005), nodes as coarse as the error\n"
     "                      allows, built in a worker pool and evaluated in the vertex shader;\n"
@@ -86,7 +86,7 @@ static int parse_args(int argc, char **argv, render_args *a)
             a->frame.eval_exact = strcmp(val, "exact") == 0;
             a->frame.no_hierarchy = strcmp(val, "bezier") == 0;
         } else if (!strcmp(arg, "--error") && val) {
-            bad = sw_cli_parse_positive(val, &a->frame.error_px);
+            bad = sw_cli_parse_error_px(val, &a->frame.error_px);
         } else if (arg[0] != '-' && !a->scene) {
             a->scene = arg;
             continue;
@@ -95,8 +95,7 @@ static int parse_args(int argc, char **argv, render_args *a)
             return 2;
         }
         if (bad) {
-            fprintf(stderr, "splinewalk render: bad value '%s' for %s\n%s", val, arg, k_usage);
-            return 2;
+            return sw_cli_bad_value("render", arg, val, k_usage);
         }
         i++;
     }

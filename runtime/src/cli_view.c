@@ -47,7 +47,7 @@ static const char k_usage[] =
     "\n"
     "options:\n"
     "  --size WxH        window size (default 1280x720)\n"
-    "  --error PX        screen-space error bound in pixels (default 0.5)\n"
+    "  --error PX        screen-space error bound in pixels, at least 0.01 (default 0.5)\n"
     "  --speed S         walking speed in scene diagonals per second (default 0.1)\n"
     "  --record PATH     on close, write the keys set with K as a camera path "
     "(docs/camera-path.md)\n"
@@ -78,7 +78,7 @@ static int parse_value(view_args *a, const char *arg, const char *val)
     if (!strcmp(arg, "--size"))
         return sw_cli_parse_size(val, &a->w, &a->h);
     if (!strcmp(arg, "--error"))
-        return sw_cli_parse_positive(val, &a->error_px);
+        return sw_cli_parse_error_px(val, &a->error_px);
     if (!strcmp(arg, "--speed"))
         return sw_cli_parse_positive(val, &a->speed);
     if (!strcmp(arg, "--frames"))
@@ -123,8 +123,7 @@ static int parse_args(int argc, char **argv, view_args *a)
             return 2;
         }
         if (bad) {
-            fprintf(stderr, "splinewalk view: bad value '%s' for %s\n%s", val, arg, k_usage);
-            return 2;
+            return sw_cli_bad_value("view", arg, val, k_usage);
         }
         i++;
     }

@@ -49,8 +49,10 @@ sw_result sw_rt_path_parse(const char *text, size_t len, const char *name, sw_rt
 sw_result sw_rt_path_load(const char *file, sw_rt_camera_path *out, sw_status *status);
 /* Writes the path (17 significant digits: it reads back bit-identical) to `file` through the
  * project's one writer (sw_safe_write.h: replaced whole or left as it was); flags
- * SW__OUT_DASH_STDOUT makes "-" standard output. Errors: SW_ERR_IO (a full disk too; nothing is
- * left behind), SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE, SW_ERR_OUT_OF_MEMORY. */
+ * SW__OUT_DASH_STDOUT makes "-" standard output. The text is parsed back first: a path that
+ * sw_rt_path_parse would refuse is never written (SW_ERR_FORMAT, its message as the parser's,
+ * "FILE (not written):LINE: ..."). Errors also: SW_ERR_IO (a full disk too; nothing is left
+ * behind), SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE, SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_rt_path_save(const sw_rt_camera_path *path, const char *file, unsigned flags,
                           sw_status *status);
 void sw_rt_path_free(sw_rt_camera_path *path);

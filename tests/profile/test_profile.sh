@@ -246,6 +246,13 @@ bad frames_zero 2 SW_ERR_FORMAT "splinewalk-path 1\nframes 0\n$key\n"
 bad twice_closed 3 SW_ERR_FORMAT "splinewalk-path 1\nclosed\nclosed\n$key\n"
 bad truncated 3 SW_ERR_TRUNCATED "splinewalk-path 1\n$key\nkey 1  0 10 0  0 0"
 bad binary 1 SW_ERR_FORMAT "\x01\x02\xff\xfe\x00garbage\n"
+# Numbers are decimal: strtod's hexadecimal and "infinity" forms are refused.
+bad hex 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  0x10 0 0  0 0 0  0 0 1  40\n"
+bad infinity 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  10 infinity 0  0 0 0  0 0 1  40\n"
+bad overflow 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  1e400 0 0  0 0 0  0 0 1  40\n"
+# A camera every frame would refuse is refused when the path is read (before, its first frame
+# failed with a misleading "up parallel to the view" after the output folder was made).
+bad far_eye 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  1e200 0 0  0 0 0  0 0 1  40\n"
 # Each key is fine, but the eye passes through the target half way between them.
 bad through_target 2 SW_ERR_FORMAT "splinewalk-path 1\nkey 0  0 0 0  10 0 0  0 0 1  40\nkey 1  20 0 0  10 0 0  0 0 1  40\n"
 # An existing output directory is left as it was.
@@ -255,6 +262,17 @@ printf 'splinewalk-path 1\nkey 0 1\n' >cut.path
 [ "$(ls -A keep)" = marker ] || fail "a failed run changed its output directory: $(ls -A keep)"
 "$sw" profile $scene --path no-such.path --out nothing >/dev/null 2>err.txt; [ $? -eq 1 ] &&
   grep -q SW_ERR_NOT_FOUND err.txt || fail "missing path file: $(cat err.txt)"
+# A subnormal coordinate is a (tiny) finite number, read as such.
+printf 'splinewalk-path 1\nkey 0  10 1e-310 0  0 0 0  0 0 1  40\n%s\n' "$key2" >tiny.path
+"$sw" profile $scene --path tiny.path --frames 2 --size 32x24 --out tiny >tiny.txt 2>&1 ||
+  { fail "a subnormal coordinate refused"; cat tiny.txt; }
+# `path` never writes a key it would refuse to read: 1e308 s overflows the key times.
+"$sw" path orbit $scene -o inf.path --seconds 1e308 >inf.txt 2>&1; rc=$?
+[ $rc -eq 1 ] && grep -q "inf.path (not written):.*'inf'" inf.txt && [ ! -e inf.path ] ||
+  fail "path orbit --seconds 1e308: exit $rc, $(cat inf.txt), $(ls inf.path* 2>&1)"
+# An --error below SW_ERROR_MIN_PX is refused before the output folder is made.
+"$sw" profile $scene --path orbit.path --error 0.001 --out tiny_error >/dev/null 2>err.txt; rc=$?
+[ $rc -eq 2 ] && [ ! -e tiny_error ] || fail "--error 0.001: exit $rc, $(cat err.txt)"
 pass "bad path files: file:line errors, exit 1, nothing written"
 
 [ $failures -eq 0 ] && echo "all profile tests passed" || echo "$failures failure(s)"

@@ -208,6 +208,15 @@ typedef struct sw_camera {
 
 /* The view's floors, SW_FOVY_MIN_DEG and SW_ERROR_MIN_PX, are in sw_defaults.h. */
 
+/* Checks a camera as every frame checks it, so that a front end (a camera path, a --camera option)
+ * can refuse it when it is read rather than when it is drawn: the all-zero camera (the fitted
+ * default) passes; otherwise every coordinate finite and at most SW_CAMERA_COORD_MAX in
+ * magnitude, fovy 0 or in [SW_FOVY_MIN_DEG, 180), the eye farther from the target than 1e-9 x
+ * the larger of 1 and their largest coordinate, up not zero and more than ~4.5e-5 rad away from
+ * the view direction (closer, the view basis is lost in rounding). Any thread. Errors:
+ * SW_ERR_INVALID_ARGUMENT (the message names the problem). */
+SW_API sw_result sw_camera_check(const sw_camera *camera, sw_status *status);
+
 typedef enum sw_view_preset {
     SW_VIEW_ISO = 0,   /* from (+1,+1,+1), up +Z */
     SW_VIEW_FRONT = 1, /* from -Y, up +Z */

@@ -21,5 +21,8 @@
  * degrees and ε_img >= 0.05 px render within the bounds of every refinement loop. */
 #define SW_FOVY_MIN_DEG 0.01
 #define SW_ERROR_MIN_PX 0.01
+/* The largest |coordinate| of a camera's eye, target and up, as of a scene's geometry: farther
+ * out a double resolves less than the frame needs and the view basis's squares overflow. */
+#define SW_CAMERA_COORD_MAX 1e30
 
 #endif
