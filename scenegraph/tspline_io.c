@@ -9,6 +9,7 @@
  * met (Sederberg 2003 §3, Figure 3); points may also carry explicit local knot vectors
  * (a point-based spline, §2). Every message names the file and line and what was expected.
  */
+#include "sw_decimal.h"
 #include "sw_sg_tspline.h"
 #include "sw_hooks.h"
 #include "sw_safe_read.h"
@@ -131,14 +132,15 @@ static sw_result read_double(lexer *lx, const char *what, double *out)
     size_t len;
     if (!next_token(lx, tok, &len))
         return fail_at(lx, SW_ERR_FORMAT, what, "the end of the line");
-    char *end = NULL;
-    errno = 0;
-    const double x = len < MAX_TOKEN ? strtod(tok, &end) : 0.0;
-    if (len >= MAX_TOKEN || end == tok || *end != '\0')
-        return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: expected %s (a number), found '%s'",
-                        lx->name, lx->line, what, tok);
-    if (!isfinite(x))
-        return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: %s is '%s', not a finite number",
+    const char *end = tok;
+    double x = 0.0;
+    const int got = len < MAX_TOKEN ? sw__parse_decimal(tok, &end, &x) : SW_DECIMAL_NOT_A_NUMBER;
+    if (got == SW_DECIMAL_NOT_A_NUMBER || *end != '\0')
+        return sw__fail(lx->status, SW_ERR_FORMAT,
+                        "%s:%u: expected %s (a decimal number), found '%s'", lx->name, lx->line,
+                        what, tok);
+    if (got != SW_DECIMAL_OK)
+        return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: %s is '%s', beyond a double's range",
                         lx->name, lx->line, what, tok);
     *out = x;
     return SW_OK;

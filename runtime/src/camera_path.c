@@ -4,6 +4,7 @@
 #include "sw_camera_path.h"
 #include "sw_hooks.h"
 
+#include "sw_decimal.h"
 #include "sw_rt.h"
 #include "sw_safe_read.h"
 #include "sw_safe_write.h"
@@ -123,12 +124,12 @@ static sw_result field_double(lexer *lx, int i, const char *what, double *out)
 {
     const char *end;
     double x = 0.0;
-    const int got = sw_rt_parse_decimal(lx->f[i], &end, &x);
-    if (got == SW_RT_DECIMAL_NOT_A_NUMBER || *end != '\0')
+    const int got = sw__parse_decimal(lx->f[i], &end, &x);
+    if (got == SW_DECIMAL_NOT_A_NUMBER || *end != '\0')
         return sw__fail(lx->status, SW_ERR_FORMAT,
                         "%s:%u: expected %s (a decimal number), found '%s'", lx->name, lx->line,
                         what, lx->f[i]);
-    if (got != SW_RT_DECIMAL_OK)
+    if (got != SW_DECIMAL_OK)
         return sw__fail(lx->status, SW_ERR_FORMAT, "%s:%u: %s is '%s', beyond a double's range",
                         lx->name, lx->line, what, lx->f[i]);
     *out = x;

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Helpers shared by the splinewalk subcommands: argument parsing, progress, error reports. */
 #include "cli.h"
+#include "sw_decimal.h"
 #include "sw_rt.h"
 
 #include "sw_safe_write.h"
@@ -183,7 +184,7 @@ int sw_cli_parse_camera(const char *text, sw_camera *out)
     const char *p = text;
     for (int i = 0; i < 10; i++) {
         const char *end;
-        if (sw_rt_parse_decimal(p, &end, &v[i]) != SW_RT_DECIMAL_OK)
+        if (sw__parse_decimal(p, &end, &v[i]) != SW_DECIMAL_OK)
             return -1;
         if (i < 9 && *end != ',')
             return -1;
@@ -218,7 +219,7 @@ int sw_cli_parse_positive(const char *text, double *out)
     g_parse_reason[0] = '\0';
     const char *end;
     double v;
-    if (sw_rt_parse_decimal(text, &end, &v) != SW_RT_DECIMAL_OK || *end != '\0' || !(v > 0.0))
+    if (sw__parse_decimal(text, &end, &v) != SW_DECIMAL_OK || *end != '\0' || !(v > 0.0))
         return -1;
     *out = v;
     return 0;

@@ -109,13 +109,6 @@ void sw_rt_scene_release(sw_rt_scene *scene); /* frees it when it was the last r
  * its call (a renderer's hierarchy cache). */
 void sw_rt_scene_retain(sw_rt_scene *scene);
 
-/* ---- numbers (decimal.c) --------------------------------------------------------------------- */
-enum { SW_RT_DECIMAL_OK = 0, SW_RT_DECIMAL_NOT_A_NUMBER = -1, SW_RT_DECIMAL_OUT_OF_RANGE = -2 };
-/* The decimal number at the start of text (no hexadecimal, inf or nan) into *out; *end: the first
- * character after it. An underflowing number is kept (rounded toward 0), an overflowing one is
- * out of range. Returns an SW_RT_DECIMAL_ code. */
-int sw_rt_parse_decimal(const char *text, const char **end, double *out);
-
 /* ---- cameras (camera.c) ---------------------------------------------------------------------- */
 /* Fits a preset to a world box (min xyz, max xyz) as sw_camera_fit documents. */
 void sw_rt_camera_fit_box(const double bbox[6], sw_view_preset view, sw_camera *out);

@@ -2,7 +2,7 @@
 /* Decimal numbers as the text formats and the command line write them: strtod alone would also
  * take hexadecimal ("0x10"), "inf", "nan" and locale forms, which no file of ours contains and a
  * user never means. */
-#include "sw_rt.h"
+#include "sw_decimal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -35,19 +35,19 @@ static size_t decimal_length(const char *s)
     return i;
 }
 
-int sw_rt_parse_decimal(const char *text, const char **end, double *out)
+int sw__parse_decimal(const char *text, const char **end, double *out)
 {
     const size_t n = decimal_length(text);
     *end = text + n;
     if (n == 0)
-        return SW_RT_DECIMAL_NOT_A_NUMBER;
+        return SW_DECIMAL_NOT_A_NUMBER;
     char *stop;
     errno = 0;
     const double x = strtod(text, &stop);
     /* an underflow (below DBL_MIN, e.g. 1e-310) is a tiny finite number, kept as strtod rounds
      * it; only an overflow is out of range */
     if (stop != *end || !isfinite(x))
-        return SW_RT_DECIMAL_OUT_OF_RANGE;
+        return SW_DECIMAL_OUT_OF_RANGE;
     *out = x;
-    return SW_RT_DECIMAL_OK;
+    return SW_DECIMAL_OK;
 }
