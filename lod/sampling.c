@@ -463,6 +463,81 @@ static void patch_part(int32_t p, int32_t q, const double *in, const double r[4]
         curve_part(out + (size_t)i * 4, q, (size_t)(p + 1) * 4, r[2], r[3]);
 }
 
+/* z_min and P of the bound over a net's control points (view frame, homogeneous): the nearest
+ * depth (not nearer than the near plane: only drawn points matter) and the largest lateral
+ * tangent (capped as the derivation says; infinite when a point is not in front of the eye). */
+static void depth_and_tangent(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
+                              double *zmin, double *pmax)
+{
+    *zmin = INFINITY;
+    *pmax = 0.0;
+    size_t n = (size_t)(p + 1) * (size_t)(q + 1);
+    for (size_t i = 0; i < n; ++i) {
+        const double *c = net + 4 * i;
+        double z = c[2] / c[3], lat = hypot(c[0], c[1]) / c[3];
+        *zmin = fmin(*zmin, z);
+        *pmax = z > 0.0 ? fmax(*pmax, lat / z) : INFINITY;
+    }
+    *pmax = fmin(*pmax, v->tan_corner + 2.0 * v->eps_px / v->focal_px);
+    *zmin = fmax(*zmin, v->near_plane);
+}
+
+/* Affine parts (a plane's patches: the most common face of a CAD model) skip the bound below.
+ * With equal weights, write the net as P_ij = A(i/p, j/q) + D_ij, A the affine map through the
+ * corner poles P_00, P_p0, P_0q and |D_ij| <= delta. The patch is S = A + D with |D| <= delta
+ * (convex hull), and a grid triangle interpolates S at its vertices: T = A + (interpolated D),
+ * A being reproduced exactly. So |e| = |T - S| <= 2 delta for any grid, |e_lat| and |e_f| too,
+ * and the screen error of the derivation above is at most (f / z_min) 2 delta (1 + P). When that
+ * is within eps_px the coarsest allowed grid is drawn; d1 bounds |A_s| + |D_s| with
+ * |D_s| <= 2 p delta (the derivative's net). Exact planes (delta at rounding level) take it at
+ * any distance; others fall through to the full bound. */
+static int g_affine_fast = 1;
+
+void sw_lod_screen_affine_fast(int on)
+{
+    g_affine_fast = on != 0;
+}
+
+static int affine_segments(int32_t p, int32_t q, const double *net, const double range[4],
+                           const sw_lod_screen_view *v, const int32_t *allowed,
+                           sw_lod_screen_density *out)
+{
+    const size_t n = (size_t)(p + 1) * (size_t)(q + 1);
+    const double w = net[3];
+    for (size_t i = 1; i < n; ++i)
+        if (net[4 * i + 3] != w)
+            return 0;
+    if (!(w > 0.0))
+        return 0;
+    const double *c00 = net, *cp0 = net + 4 * (size_t)p, *c0q = net + 4 * (size_t)q * (p + 1);
+    double a_s[3], a_t[3], delta = 0.0;
+    for (int k = 0; k < 3; ++k) {
+        a_s[k] = (cp0[k] - c00[k]) / w;
+        a_t[k] = (c0q[k] - c00[k]) / w;
+    }
+    for (int32_t j = 0; j <= q; ++j)
+        for (int32_t i = 0; i <= p; ++i) {
+            const double *c = net + 4 * ((size_t)j * (p + 1) + i);
+            double d2 = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                const double a = c00[k] / w + a_s[k] * i / p + a_t[k] * j / q;
+                d2 += (c[k] / w - a) * (c[k] / w - a);
+            }
+            delta = fmax(delta, sqrt(d2));
+        }
+    double zmin, pmax;
+    depth_and_tangent(p, q, net, v, &zmin, &pmax);
+    if (!(2.0 * delta * (1.0 + pmax) * v->focal_px <= v->eps_px * zmin))
+        return 0;
+    out->nu = out->nv = allowed[0];
+    out->eps_obj = sw_lod_object_tolerance(v->eps_px, zmin, v->focal_px, pmax, 0.0);
+    out->d1[0] = (sqrt(a_s[0] * a_s[0] + a_s[1] * a_s[1] + a_s[2] * a_s[2]) + 2.0 * p * delta) /
+                 (range[1] - range[0]);
+    out->d1[1] = (sqrt(a_t[0] * a_t[0] + a_t[1] * a_t[1] + a_t[2] * a_t[2]) + 2.0 * q * delta) /
+                 (range[3] - range[2]);
+    return 1;
+}
+
 static void sub_measure(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
                         double ku, double kv, sub_info *o)
 {
@@ -474,17 +549,7 @@ static void sub_measure(int32_t p, int32_t q, const double *net, const sw_lod_sc
         o->ml[k] = b[0].d2[k] * scale[k];
         o->mf[k] = b[1].d2[k] * scale[k];
     }
-    o->zmin = INFINITY;
-    o->pmax = 0.0;
-    size_t n = (size_t)(p + 1) * (size_t)(q + 1);
-    for (size_t i = 0; i < n; ++i) {
-        const double *c = net + 4 * i;
-        double z = c[2] / c[3], lat = hypot(c[0], c[1]) / c[3];
-        o->zmin = fmin(o->zmin, z);
-        o->pmax = z > 0.0 ? fmax(o->pmax, lat / z) : INFINITY;
-    }
-    o->pmax = fmin(o->pmax, v->tan_corner + 2.0 * v->eps_px / v->focal_px);
-    o->zmin = fmax(o->zmin, v->near_plane);
+    depth_and_tangent(p, q, net, v, &o->zmin, &o->pmax);
 }
 
 /* 1 when every cell of an nu x nv grid passes, from the k x k sub-patch measures. */
@@ -582,6 +647,12 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
         o[3] = c[3];
     }
     patch_part(deg_u, deg_v, view, range, part);
+    if (g_affine_fast && deg_u > 0 && deg_v > 0 &&
+        affine_segments(deg_u, deg_v, part, range, v, allowed, out)) {
+        if (mem != small)
+            sw__free(mem);
+        return 1;
+    }
     sub_info whole, subs[SUB_MAX * SUB_MAX];
     sub_measure(deg_u, deg_v, part, v, 1.0, 1.0, &whole);
     static const unsigned all = 7u;

@@ -81,6 +81,10 @@ typedef struct sw_lod_screen_density {
 int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, const double range[4],
                            const sw_lod_screen_view *v, const int32_t *allowed, int32_t n_allowed,
                            int32_t max_sub, sw_lod_screen_density *out);
+/* An affine part within the view's tolerance (sampling.c says when) takes the coarsest allowed
+ * grid without the bound's sub-patch analysis: on (default) or off, for the A/B of benchmarks
+ * and the test that compares both. Not thread-safe: set it before frames run. */
+void sw_lod_screen_affine_fast(int on);
 
 #ifdef __cplusplus
 }

@@ -12,13 +12,17 @@
  *              or sampled at the grid's cells as curved faces are (off), on one thread; one
  *              submitted frame per variant gives the triangles and the pixels they differ in;
  *   chunks     the faces tessellated by the preparing thread alone, or in chunks shared with a
- *              pool of --workers workers (desc.pool).
+ *              pool of --workers workers (desc.pool);
+ *   density    planes' patches given the coarsest grid by the affine test (fast, the default) or
+ *              by the full screen-space bound (lod/sampling.c sw_lod_screen_affine_fast), on one
+ *              thread, with the triangles and differing pixels of view 0 as for affine.
  * Each variant prints the median of the prepare's wall time, of the preparing thread's CPU time
  * and of the process's CPU time (every thread: the pool's share of the work included, so the
  * split's extra work shows).
  * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--workers W] FILE...
  *        (.brep/.step/.igs imported, .sws opened)
  */
+#include "sw_lod_sampling.h"
 #include "bench_stats.h"
 #include "sw_gpu_internal.h"
 #include "sw_lod_cache.h"
@@ -128,8 +132,14 @@ static void set_chunks(bench *b, int k)
     b->desc.pool = k ? b->pool : NULL;
 }
 
-/* View 0 submitted with the affine path on and off: triangles of each, differing pixels. */
-static int compare_images(bench *b)
+static void set_density(bench *b, int k)
+{
+    (void)b;
+    sw_lod_screen_affine_fast(k == 0);
+}
+
+/* View 0 submitted with a pair's two variants: triangles of each, differing pixels. */
+static int compare_images(bench *b, void (*set)(bench *, int))
 {
     sw_gpu_image img[2];
     sw_gpu_frame_stats fs[2];
@@ -137,7 +147,7 @@ static int compare_images(bench *b)
     b->desc.no_readback = 0;
     for (int k = 0; k < 2; ++k) {
         sw_status st = {0};
-        sw__gpu_set_border_affine(b->ctx, k == 0);
+        set(b, k);
         if (sw_gpu_render_scene(b->ctx, b->scene, &b->desc, &img[k], &fs[k], &st) != SW_OK) {
             fprintf(stderr, "render: %s\n", st.message);
             if (k)
@@ -152,7 +162,7 @@ static int compare_images(bench *b)
            (unsigned long long)fs[0].triangles, (unsigned long long)fs[1].triangles, differ, n);
     sw_gpu_image_free(&img[0]);
     sw_gpu_image_free(&img[1]);
-    sw__gpu_set_border_affine(b->ctx, 1);
+    set(b, 0);
     b->desc.no_readback = 1;
     return 1;
 }
@@ -161,10 +171,13 @@ static int run_mode(bench *b, const char *mode, int passes)
 {
     static const char *affine[2] = {"affine borders on", "affine borders off"};
     static const char *chunks[2] = {"one thread", "chunks with the pool"};
+    static const char *density[2] = {"affine densities fast", "affine densities bounded"};
     printf("  %s, medians of %d prepares per variant:\n", mode, passes * b->views);
     if (!pass(b, NULL)) /* warm-up: hierarchies built and refined, buffers grown */
         return 0;
-    if (!ab(b, passes, set_affine, affine) || !compare_images(b))
+    if (!ab(b, passes, set_affine, affine) || !compare_images(b, set_affine))
+        return 0;
+    if (!ab(b, passes, set_density, density) || !compare_images(b, set_density))
         return 0;
     return ab(b, passes, set_chunks, chunks);
 }
