@@ -1,11 +1,14 @@
-/* scaled_iges IN.brep|IN.step|IN.iges OUT.iges DIAGONAL [brep]
+/* scaled_iges IN.brep|IN.step|IN.iges OUT.iges|OUT.brep DIAGONAL [brep]
  *
  * Writes a copy of a part as IGES, uniformly scaled about its bounding-box centre so that the box
  * diagonal becomes DIAGONAL, the way a unit conversion does it (BRepBuilderAPI_Transform with a
  * gp_Trsf scale, copy = true; IGESControl_Writer turns the trims into B-spline pcurves). Issue 19:
  * such copies of real parts made the first frame's trim flattening recurse at a tolerance of
  * 1e-17; tests/cli/test_scaled_iges.sh renders them. A fifth argument `brep` writes the faces as
- * an IGES B-rep (write.iges.brep.mode 1) instead of trimmed surfaces. Exit status 0 on success. */
+ * an IGES B-rep (write.iges.brep.mode 1) instead of trimmed surfaces. DIAGONAL 0 keeps the
+ * part's size (a plain IGES export). OUT.brep writes the scaled
+ * shape as an OCCT BREP file instead (the conformance harness's scaled copies in their own
+ * format). Exit status 0 on success. */
 #include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
 #include <BRepTools.hxx>
@@ -57,7 +60,7 @@ int main(int argc, char **argv)
         return 2;
     }
     const double target = std::strtod(argv[3], nullptr);
-    if (!(target > 0.0) || !std::isfinite(target)) {
+    if (!(target >= 0.0) || !std::isfinite(target)) {
         std::fprintf(stderr, "scaled_iges: bad diagonal %s\n", argv[3]);
         return 2;
     }
@@ -73,12 +76,22 @@ int main(int argc, char **argv)
         box.Get(x0, y0, z0, x1, y1, z1);
         const double diag =
             std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
+        const double scale = target > 0.0 ? target / diag : 1.0; /* 0: the part's own size */
         gp_Trsf t;
-        t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), target / diag);
+        t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), scale);
         BRepBuilderAPI_Transform xf(shape, t, Standard_True);
         if (!xf.IsDone()) {
             std::fprintf(stderr, "scaled_iges: transform failed\n");
             return 1;
+        }
+        if (ends_with(argv[2], ".brep")) {
+            if (!BRepTools::Write(xf.Shape(), argv[2])) {
+                std::fprintf(stderr, "scaled_iges: cannot write %s\n", argv[2]);
+                return 1;
+            }
+            std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target,
+                        scale);
+            return 0;
         }
         IGESControl_Controller::Init();
         /* the defaults a user gets: trimmed surfaces (type 144); or B-rep faces (MSBO) */
@@ -88,7 +101,7 @@ int main(int argc, char **argv)
             return 1;
         }
         std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target,
-                    target / diag);
+                    scale);
     } catch (const Standard_Failure &e) {
         std::fprintf(stderr, "scaled_iges: OCCT: %s\n", e.GetMessageString());
         return 1;

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# The conformance harness: OCCT's sample models against an independent reference, the way users
+# bring them (their own files, other units, IGES from other systems).
+#   run_conformance.sh TEST_IMAGES SCALED_IGES DATA WORK quick|full [FILE...]
+# Each case is one model in one variant at one view, run by tests/images' test_images on the
+# hierarchy path (converged, default ε_img 0.5 px, default LODs) at 640x480: splinewalk's frame
+# against OCCT's BRepMesh at a deflection of 0.1 px at the view's nearest depth (tests/support),
+# silhouette and depth edges within 1 px both ways, crack pixels 0 where the B-rep is closed
+# (test_images says what it asserts). Variants: the file itself; an IGES copy at its own size
+# (IGESControl_Writer: trims become B-spline pcurves); BREP copies uniformly scaled to bounding
+# diagonals of 0.01, 10 and 10,000 (a unit conversion: scaled_iges). Views: whole, mid, close.
+#  - full: every .brep under DATA/occ and .step under DATA/step (or the FILEs given), every
+#    variant and view (label heavy: about two hours on 2 cores);
+#  - quick: a subset that must pass in `make test` (under 5 minutes).
+# A file without faces (wires only) is reported as skipped; a case whose reference or frame
+# takes over 180 s as "timeout" (a failure: nothing was checked). Prints one line per case and
+# a summary; exit 1 if any case failed. What it catches: any model, unit or exporter on which
+# the guarantee does not hold (found so far: see docs/conformance.md).
+set -u
+test_images=$1 scaled=$2 data=$3 work=$4 mode=$5
+shift 5
+mkdir -p "$work" && cd "$work" || exit 1
+export EGL_PLATFORM=surfaceless
+pass=0 failed=0 skipped=0
+: >cases.txt
+
+# run_case FILE NAME VIEWS: one test_images run, one line per view in cases.txt.
+run_case() {
+  local file=$1 name=$2 views=$3 log rc
+  log=$name.log
+  timeout 180 "$test_images" --hierarchy out 640x480 "$views" "$file" >"$log" 2>&1
+  rc=$?
+  if grep -q "no face could be imported" "$log"; then
+    echo "SKIP    $name: no faces" | tee -a cases.txt
+    skipped=$((skipped + 1))
+    return
+  fi
+  if [ $rc -eq 124 ]; then
+    echo "TIMEOUT $name $views: over 180 s" | tee -a cases.txt
+    failed=$((failed + 1))
+    return
+  fi
+  # test_images prints per view: "<out>/<stem> <view>:", two "<= 1 px" lines, FAIL: when it fails
+  awk -v name="$name" '
+    /^out\/[^ ]+ [a-z]+:/ { if (view != "") report(); view = $2; sub(":", "", view); lines = ""; bad = 0 }
+    /<= 1 px:/ { match($0, /[0-9.]+ %/); pct = substr($0, RSTART, RLENGTH - 2)
+                 match($0, /max [0-9.]+ px/); mx = substr($0, RSTART + 4, RLENGTH - 7)
+                 lines = lines sprintf(" %s%% max %s px", pct, mx) }
+    /FAIL:/ { bad = 1 }
+    function report() { printf "%s %s %s:%s\n", bad ? "FAIL   " : "ok     ", name, view, lines }
+    END { if (view != "") report() }' "$log" | tee -a cases.txt
+  [ $rc -eq 0 ] || grep -q "^ok.*$name\|^FAIL.*$name" cases.txt ||
+    echo "FAIL    $name: exit $rc, $(tail -n 1 "$log")" | tee -a cases.txt
+}
+
+# variants FILE LIST: the copies named in LIST (orig, iges, d0.01, d10, d10000) of FILE.
+variant_file() {
+  local file=$1 v=$2 stem out
+  stem=$(basename "${file%.*}")
+  case $v in
+    orig) echo "$file"; return ;;
+    iges) out=$stem.igs; "$scaled" "$file" "$out" 0 >/dev/null 2>&1 || return 1 ;;
+    d*) out=$stem-$v.brep; "$scaled" "$file" "$out" "${v#d}" >/dev/null 2>&1 || return 1 ;;
+  esac
+  echo "$out"
+}
+
+one_model() {
+  local file=$1 variants=$2 views=$3 v f
+  for v in $variants; do
+    if ! f=$(variant_file "$file" "$v"); then
+      echo "FAIL    $(basename "$file") $v: the copy could not be written" | tee -a cases.txt
+      continue
+    fi
+    run_case "$f" "$(basename "${file%.*}")-$v" "$views"
+  done
+}
+
+if [ "$mode" = quick ]; then
+  # views that hold today (docs/conformance.md lists the ones that do not)
+  one_model "$data/step/screw.step" "orig d10000" whole
+  one_model "$data/occ/bottle.brep" "iges" whole,mid
+  one_model "$data/occ/Pump_Nut.brep" "orig d10" whole,mid
+  one_model "$data/occ/Motor-c.brep" "orig" whole
+else
+  files=("$@")
+  [ ${#files[@]} -gt 0 ] || files=("$data"/occ/*.brep "$data"/step/*.step)
+  for f in "${files[@]}"; do
+    one_model "$f" "orig iges d0.01 d10 d10000" whole,mid,close
+  done
+fi
+pass=$(grep -c '^ok' cases.txt)
+failed=$((failed + $(grep -c '^FAIL' cases.txt)))
+skipped=$(grep -c '^SKIP' cases.txt)
+timeouts=$(grep -c '^TIMEOUT' cases.txt)
+echo "conformance ($mode): $pass views ok, $((failed - timeouts)) failed, $timeouts timed out, $skipped files without faces"
+exit $((failed > 0))
