@@ -20,7 +20,7 @@
 set -u
 test_images=$1 scaled=$2 data=$3 work=$4 mode=$5
 shift 5
-mkdir -p "$work" && cd "$work" || exit 1
+mkdir -p "$work/out" && cd "$work" || exit 1
 export EGL_PLATFORM=surfaceless
 pass=0 failed=0 skipped=0
 : >cases.txt
