@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 DEMO_OUT ?= demo-out
 
-.PHONY: all deps configure build demo test clean
+.PHONY: all deps configure build demo test conformance clean
 
 all: build
 
@@ -22,6 +22,13 @@ demo: build
 
 test: build
 	cd $(BUILD) && EGL_PLATFORM=surfaceless ctest --output-on-failure -j $(JOBS) $(CTEST_FLAGS)
+
+# The full conformance sweep (tests/conformance/run_conformance.sh; about two hours on 2 cores):
+# every sample model, its IGES export and scaled copies, three views, against BRepMesh.
+conformance: build
+	EGL_PLATFORM=surfaceless LP_NUM_THREADS=2 tests/conformance/run_conformance.sh \
+	  $(BUILD)/bin/test_images $(BUILD)/bin/scaled_iges /usr/share/opencascade/data \
+	  $(BUILD)/conformance full
 
 clean:
 	rm -rf $(BUILD) $(DEMO_OUT)
