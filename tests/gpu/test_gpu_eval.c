@@ -44,39 +44,19 @@ static int render(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_gpu_fr
     return 1;
 }
 
+/* CPU grids (way 0) or the default vertex-shader evaluation (way 1). */
+static int draw_way(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_gpu_frame_desc *desc,
+                    int way, sw_gpu_image *img, sw_gpu_frame_stats *fs)
+{
+    return render(ctx, scene, desc, way ? SW__GPU_EVAL_AUTO : SW__GPU_EVAL_CPU_GRIDS, img, fs);
+}
+
 /* Both paths at a quarter of the view's size against the independent reference. */
 static int reference_view(sw_gpu_context *ctx, const sw_sg_scene *scene,
                           const sw_gpu_frame_desc *full, const char *prefix, int iso)
 {
-    sw_gpu_frame_desc desc = *full;
-    desc.width = full->width / 4;
-    desc.height = full->height / 4;
-    desc.want_depth = 1;
-    sw_gpu_image ref = {0};
-    size_t ref_tris = 0;
-    if (!sw_test_ref_render(ctx, scene, &desc, &ref, &ref_tris))
-        return 0;
-    /* without fat borders (crack_fill.c): they extend faces beyond their exact boundaries on
-     * purpose, over whatever lies behind (linkrods, front view: 98 pixels up to 2.3 % nearer than
-     * the surface they cover, >= 2 px beyond face 23's edge); the surfaces alone are compared */
-    sw__gpu_set_crack_fill(ctx, 0);
-    int ok = 1;
-    static const sw__gpu_eval_mode modes[2] = {SW__GPU_EVAL_CPU_GRIDS, SW__GPU_EVAL_AUTO};
-    for (int m = 0; m < 2 && ok; ++m) {
-        sw_gpu_image img = {0};
-        sw_gpu_frame_stats fs;
-        if (!render(ctx, scene, &desc, modes[m], &img, &fs)) {
-            ok = 0;
-            break;
-        }
-        char prefix_view[1040];
-        snprintf(prefix_view, sizeof prefix_view, "%s_%s", prefix, iso ? "iso" : "front");
-        ok = sw_test_ref_check(&ref, &img, ref_tris, m ? "gpu" : "cpu_grids", prefix_view);
-        sw_gpu_image_free(&img);
-    }
-    sw__gpu_set_crack_fill(ctx, 1);
-    sw_gpu_image_free(&ref);
-    return ok;
+    static const char *const names[2] = {"cpu_grids", "gpu"};
+    return sw_test_ref_view(ctx, scene, full, prefix, iso, draw_way, names);
 }
 
 typedef struct totals {

@@ -32,12 +32,13 @@
 
 static const int k_color_tol = 8;
 
-static int render(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_gpu_frame_desc *desc, int exact,
-                  sw_gpu_image *img, sw_gpu_frame_stats *fs)
+static int render(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_gpu_frame_desc *desc,
+                  int exact, sw_gpu_image *img, sw_gpu_frame_stats *fs)
 {
     sw_status st = {0};
-    desc->eval_exact = exact;
-    if (sw_gpu_render_scene(ctx, scene, desc, img, fs, &st) != SW_OK) {
+    sw_gpu_frame_desc d = *desc;
+    d.eval_exact = exact;
+    if (sw_gpu_render_scene(ctx, scene, &d, img, fs, &st) != SW_OK) {
         fprintf(stderr, "render (%s): %s\n", exact ? "exact" : "bezier", st.message);
         return 0;
     }
@@ -48,34 +49,8 @@ static int render(sw_gpu_context *ctx, const sw_sg_scene *scene, sw_gpu_frame_de
 static int reference_view(sw_gpu_context *ctx, const sw_sg_scene *scene,
                           const sw_gpu_frame_desc *full, const char *prefix, int iso)
 {
-    sw_gpu_frame_desc desc = *full;
-    desc.width = full->width / 4;
-    desc.height = full->height / 4;
-    desc.want_depth = 1;
-    sw_gpu_image ref = {0};
-    size_t ref_tris = 0;
-    if (!sw_test_ref_render(ctx, scene, &desc, &ref, &ref_tris))
-        return 0;
-    /* without fat borders (crack_fill.c): they extend faces beyond their exact boundaries on
-     * purpose, over whatever lies behind (linkrods, front view: 98 pixels up to 2.3 % nearer than
-     * the surface they cover, >= 2 px beyond face 23's edge); the surfaces alone are compared */
-    sw__gpu_set_crack_fill(ctx, 0);
-    int ok = 1;
-    for (int exact = 0; exact < 2 && ok; ++exact) {
-        sw_gpu_image img = {0};
-        sw_gpu_frame_stats fs;
-        if (!render(ctx, scene, &desc, exact, &img, &fs)) {
-            ok = 0;
-            break;
-        }
-        char prefix_view[1040];
-        snprintf(prefix_view, sizeof prefix_view, "%s_%s", prefix, iso ? "iso" : "front");
-        ok = sw_test_ref_check(&ref, &img, ref_tris, exact ? "exact" : "bezier", prefix_view);
-        sw_gpu_image_free(&img);
-    }
-    sw__gpu_set_crack_fill(ctx, 1);
-    sw_gpu_image_free(&ref);
-    return ok;
+    static const char *const names[2] = {"bezier", "exact"};
+    return sw_test_ref_view(ctx, scene, full, prefix, iso, render, names);
 }
 
 static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const double box[6], int iso,
@@ -113,7 +88,6 @@ static int run_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const double 
     sw_gpu_image_free(&bez);
     sw_gpu_image_free(&ex);
     ok = ok && fe.patches_exact == drawn && drawn > 0 && fb.patches_exact == 0;
-    desc.eval_exact = 0;
     ok = ok && reference_view(ctx, scene, &desc, prefix, iso);
     return ok && frac <= 0.001 && covered > (long)n / 50;
 }
