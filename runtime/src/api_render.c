@@ -404,17 +404,15 @@ static sw_result resolve_camera(const sw_camera *in, const sw_rt_scene *scene, s
     sw_camera c = *in;
     if (camera_is_zero(&c))
         sw_rt_camera_fit_box(scene->stats.bbox, SW_VIEW_ISO, &c);
-    if (c.fovy_deg == 0.0)
-        c.fovy_deg = SW_DEFAULT_FOVY_DEG;
-    const char *problem = sw_rt_camera_problem(&c);
-    if (problem)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "camera: %s", problem);
+    sw_result res = sw_camera_check(&c, status);
+    if (res != SW_OK)
+        return res;
     for (int k = 0; k < 3; k++) {
         out->eye[k] = c.eye[k];
         out->target[k] = c.target[k];
         out->up[k] = c.up[k];
     }
-    out->fovy_deg = c.fovy_deg;
+    out->fovy_deg = c.fovy_deg > 0.0 ? c.fovy_deg : SW_DEFAULT_FOVY_DEG;
     return SW_OK;
 }
 
