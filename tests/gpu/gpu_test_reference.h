@@ -27,6 +27,7 @@
 #define SW_TESTS_GPU_REFERENCE_H
 
 #include "sw_gpu_internal.h"
+#include "sw_hooks.h"
 #include "sw_sg_trim.h"
 
 #include <math.h>
@@ -56,21 +57,6 @@ typedef struct sw_test_ref_mesh {
     size_t cap_xs, cap_keep;
     int failed;
 } sw_test_ref_mesh;
-
-static inline int sw__ref_grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap : 4096;
-    while (c < need)
-        c *= 2;
-    void *q = realloc(*p, c * elem);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
 
 /* Pixel position of an eye-relative point; 0 when it is behind the eye. */
 static inline int sw__ref_project(const sw__gpu_view *v, const double p[3], double px[2])
@@ -179,7 +165,7 @@ static inline int sw__ref_row(sw_test_ref_mesh *m, const sw_sg_polyline *loops, 
             const double ui = p[2 * i], vi = p[2 * i + 1], uj = p[2 * j], vj = p[2 * j + 1];
             if ((vi > v) == (vj > v))
                 continue;
-            if (!sw__ref_grow((void **)&m->xs, &m->cap_xs, nx + 1, sizeof *m->xs))
+            if (!sw__gpu_grow((void **)&m->xs, &m->cap_xs, nx + 1, sizeof *m->xs))
                 return 0;
             m->xs[nx++] = ui + (v - vi) * (uj - ui) / (vj - vi);
         }
@@ -211,8 +197,8 @@ static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12]
     int32_t nu, nv;
     sw__ref_cells(m, &s, world, b, &nu, &nv);
     const size_t base = m->n_pos / 3, nvert = (size_t)(nu + 1) * (size_t)(nv + 1);
-    if (!sw__ref_grow((void **)&m->pos, &m->cap_pos, m->n_pos + 3 * nvert, sizeof *m->pos) ||
-        !sw__ref_grow((void **)&m->idx, &m->cap_idx, m->n_idx + 6 * (size_t)nu * (size_t)nv,
+    if (!sw__gpu_grow((void **)&m->pos, &m->cap_pos, m->n_pos + 3 * nvert, sizeof *m->pos) ||
+        !sw__gpu_grow((void **)&m->idx, &m->cap_idx, m->n_idx + 6 * (size_t)nu * (size_t)nv,
                       sizeof *m->idx)) {
         m->failed = 1;
         return 1;
@@ -226,7 +212,7 @@ static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12]
             m->n_pos += 3;
         }
     const double du = (b[1] - b[0]) / nu, dv = (b[3] - b[2]) / nv;
-    if (!sw__ref_grow((void **)&m->keep, &m->cap_keep, 2 * (size_t)nu, 1)) {
+    if (!sw__gpu_grow((void **)&m->keep, &m->cap_keep, 2 * (size_t)nu, 1)) {
         m->failed = 1;
         return 1;
     }
@@ -292,10 +278,10 @@ static inline int sw_test_ref_render(sw_gpu_context *ctx, const sw_sg_scene *sce
     }
     free(m.loops);
     free(m.n_loops);
-    free(m.pos);
-    free(m.idx);
-    free(m.xs);
-    free(m.keep);
+    sw__free(m.pos); /* the arrays sw__gpu_grow grew */
+    sw__free(m.idx);
+    sw__free(m.xs);
+    sw__free(m.keep);
     return ok;
 }
 
