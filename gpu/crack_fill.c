@@ -183,6 +183,15 @@ static size_t thin_samples(const sw__gpu_view *v, border_point *bp, size_t n, do
     return kept;
 }
 
+/* |(x, y)| of screen vectors: hypot guards against overflow and underflow at several times the
+ * cost of the plain root (it was 5 % of a building's prepare), so it only takes the cases where
+ * the squares leave the range of double. */
+static double length2(double x, double y)
+{
+    const double r = sqrt(x * x + y * y);
+    return r > 0.0 && r < INFINITY ? r : hypot(x, y);
+}
+
 /* Screen-space derivative (pixels) of the projection at eye-relative p along direction w. */
 static void screen_deriv(const sw__gpu_view *v, const double p[3], const double w[3], double out[2])
 {
@@ -212,7 +221,7 @@ static double inward_length(const sw__gpu_view *v, const double p[3], const doub
     double ts[2], is[2];
     screen_deriv(v, p, t, ts);
     screen_deriv(v, p, in, is);
-    double tl = hypot(ts[0], ts[1]);
+    double tl = length2(ts[0], ts[1]);
     if (!(tl > 0.0))
         return 0.0;
     double perp = fabs(is[0] * ts[1] - is[1] * ts[0]) / tl; /* pixels per unit of `in` */
@@ -221,6 +230,7 @@ static double inward_length(const sw__gpu_view *v, const double p[3], const doub
 }
 
 /* ---- the loop's segments in a uniform grid over its (u, v) box, for ray casts ---------------- */
+enum { SMALL_LOOP = 16 }; /* segments a ray cast tests one by one (one cell, no allocation) */
 typedef struct loop_grid {
     const double *uv;
     size_t n;
@@ -228,6 +238,7 @@ typedef struct loop_grid {
     int32_t g[2];
     uint32_t *start; /* g[0] g[1] + 1 offsets into items */
     uint32_t *items; /* segment indices, cell by cell */
+    uint32_t small_start[2], small_items[SMALL_LOOP]; /* a small loop's, in place */
 } loop_grid;
 
 static int32_t grid_cell(const loop_grid *gr, int k, double x)
@@ -243,12 +254,30 @@ static int32_t grid_cell(const loop_grid *gr, int k, double x)
         for (int32_t cx = grid_cell(gr, 0, fmin(a[0], b[0]));                                      \
              cx <= grid_cell(gr, 0, fmax(a[0], b[0])); ++cx)
 
+/* A loop of at most SMALL_LOOP segments (a window, a rectangle: most loops of a building) in one
+ * cell: testing them all costs less than filing them, and nothing is allocated per ribbon. */
+static void loop_grid_small(loop_grid *gr)
+{
+    gr->g[0] = gr->g[1] = 1;
+    gr->cell[0] = gr->cell[1] = 1.0;
+    gr->start = gr->small_start;
+    gr->items = gr->small_items;
+    gr->start[0] = 0;
+    gr->start[1] = (uint32_t)gr->n;
+    for (size_t i = 0; i < gr->n; ++i)
+        gr->items[i] = (uint32_t)i;
+}
+
 /* About one segment per cell; segments are filed under every cell their box meets. */
 static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
 {
     memset(gr, 0, sizeof *gr);
     gr->uv = uv;
     gr->n = n;
+    if (n <= SMALL_LOOP) {
+        loop_grid_small(gr);
+        return 1;
+    }
     double hi[2] = {uv[0], uv[1]};
     gr->lo[0] = uv[0];
     gr->lo[1] = uv[1];
@@ -296,6 +325,8 @@ static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
 
 static void loop_grid_free(loop_grid *gr)
 {
+    if (gr->start == gr->small_start)
+        return;
     sw__free(gr->start);
     sw__free(gr->items);
 }
@@ -349,8 +380,9 @@ typedef struct ribbon_ctx {
     const loop_grid *grid;
     double side, width_px;
     const double *st_box; /* trim lookup's rectangle, or NULL (st = 0) */
-    int affine;           /* the surface is affine in (u, v): su, sv its world derivatives */
-    double su[3], sv[3];
+    int affine;           /* the surface is affine in (u, v): su, sv its world derivatives, */
+    double su[3], sv[3];  /* so its eye-relative point at (0, 0), sn its world normal (as */
+    double so[3], sn[3];  /* eval_point scales it) */
 } ribbon_ctx;
 
 /* An affine surface (a plane, as CAD files store most faces) needs no evaluation along the step:
@@ -361,10 +393,33 @@ static void ribbon_affine(ribbon_ctx *c)
     c->affine = sw_sg_surface_affine(c->srf, o, du, dv);
     if (!c->affine)
         return;
+    /* eval_point's normal is (w^2 S_u) x (w^2 S_v) of the homogeneous form; the weight is one
+     * constant on an affine surface */
+    const double w = c->srf->cpw[3], w4 = w * w * w * w;
+    const double n[3] = {w4 * (du[1] * dv[2] - du[2] * dv[1]), w4 * (du[2] * dv[0] - du[0] * dv[2]),
+                         w4 * (du[0] * dv[1] - du[1] * dv[0])};
     for (int r = 0; r < 3; ++r) {
         const double *m = c->world + 4 * r;
         c->su[r] = m[0] * du[0] + m[1] * du[1] + m[2] * du[2];
         c->sv[r] = m[0] * dv[0] + m[1] * dv[1] + m[2] * dv[2];
+        c->so[r] = m[0] * o[0] + m[1] * o[1] + m[2] * o[2] + m[3] - c->v->eye[r];
+        c->sn[r] = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+    }
+}
+
+/* eval_point on an affine surface: the map itself, no B-spline evaluation (half of a building's
+ * ribbon samples lie on planes). */
+static void eval_point_affine(const ribbon_ctx *c, double u, double v, const double in_uv[2],
+                              border_point *out)
+{
+    out->uv[0] = u;
+    out->uv[1] = v;
+    out->in_uv[0] = in_uv[0];
+    out->in_uv[1] = in_uv[1];
+    for (int r = 0; r < 3; ++r) {
+        out->p[r] = c->so[r] + u * c->su[r] + v * c->sv[r];
+        out->n[r] = c->sn[r];
+        out->in[r] = c->su[r] * in_uv[0] + c->sv[r] * in_uv[1];
     }
 }
 
@@ -410,7 +465,7 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const doub
         for (int i = 0; i < 3; ++i)
             chord[i] = 0.5 * (e->p[i] + q[i]);
         if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm) && screen_of(c->v, chord, sc) &&
-            hypot(sm[0] - sc[0], sm[1] - sc[1]) <= tol) {
+            length2(sm[0] - sc[0], sm[1] - sc[1]) <= tol) {
             memcpy(out, q, sizeof q);
             return s;
         }
@@ -425,7 +480,7 @@ static double depth_per_px(const sw__gpu_view *v, const double a[3], const doubl
     double sa[2], sb[2];
     if (!screen_of(v, a, sa) || !screen_of(v, b, sb))
         return 0.0;
-    double px = hypot(sb[0] - sa[0], sb[1] - sa[1]), dz = 0.0;
+    double px = length2(sb[0] - sa[0], sb[1] - sa[1]), dz = 0.0;
     for (int k = 0; k < 3; ++k)
         dz += v->fwd[k] * (b[k] - a[k]);
     return px > 0.0 ? fabs(dz) / px : 0.0;
@@ -512,7 +567,12 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
 {
     if (n < 2 || !(du > 0.0) || !(dv > 0.0))
         return SW_OK;
-    ribbon_ctx c = {v, srf, world, NULL, left_inside ? 1.0 : -1.0, width_px, st_box, 0, {0}, {0}};
+    ribbon_ctx c = {.v = v,
+                    .srf = srf,
+                    .world = world,
+                    .side = left_inside ? 1.0 : -1.0,
+                    .width_px = width_px,
+                    .st_box = st_box};
     if (affine)
         ribbon_affine(&c);
     /* On an affine surface a straight uv segment is a straight line on screen, drawn exactly by
@@ -551,7 +611,11 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
         prev_direction(uv, n, i, before);
         for (int32_t j = 0; j < pieces; ++j, ++at) {
             double f = (double)j / pieces;
-            eval_point(srf, world, v->eye, a[0] + f * t[0], a[1] + f * t[1], in_uv, &bp[at]);
+            const double u_at = a[0] + f * t[0], v_at = a[1] + f * t[1];
+            if (c.affine)
+                eval_point_affine(&c, u_at, v_at, in_uv, &bp[at]);
+            else
+                eval_point(srf, world, v->eye, u_at, v_at, in_uv, &bp[at]);
             memcpy(bp[at].d_prev, j == 0 ? before : t, sizeof before);
             memcpy(bp[at].d_next, t, sizeof t);
         }
