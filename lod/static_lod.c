@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Static LODs of a super-surface, Kumar et al. 1997 §4.1-§4.3: the adaptive trimmed tessellation
- * (level 0), the simplified levels (lod/static_lod_openmesh.cpp) and the two-sided measurement
- * that declares each level's ε_k.
+ * (level 0) and the chain of levels, simplified by lod/static_lod_openmesh.cpp and each declared
+ * with its ε_k by the two-sided measurement of static_lod_measure.c. The faces' domains (cells,
+ * scalings, flattened loops) are static_lod_domain.c's.
  *
  * Level 0 within δ, and why it holds. δ is split: δ_tri = 3/4 δ for the triangles against the
  * surface over their own (u, v) triangles, δ_trim = 1/4 δ for the trim loops.
@@ -28,18 +29,12 @@
  * in the face's scaled coordinates, so that Delaunay's round triangles are round in the bound's
  * metric.
  *
- * ε_k of the simplified levels is measured (sw_lod_static_measure): the maximum over lattice and
- * random samples of both distances, times desc.safety. Mesh-to-surface values are upper bounds
- * at each sample (a surface point found by Newton's iteration, or level 0 plus δ); the
- * surface-to-mesh side is exact per sample (CGAL AABB tree). Neither side is a bound between
- * samples: that is what the safety factor and the independent re-measurement in the tests are for.
- *
  * Where the paper is loose: §4.1 obtains M1..M3 by solving polynomial systems (elimination
  * theory); we use the rigorous but coarser control-net bounds of lod/sampling.c over each patch.
  * §4.3 says trimming curves "are treated like boundary curves" without saying how finely they are
  * sampled; ours are sampled for δ_trim in object space.
  */
-#include "sw_lod_static.h"
+#include "sw_lod_static_internal.h"
 #include "sw_hooks.h"
 #include "sw_lod_supersurface.h"
 
@@ -66,502 +61,13 @@ enum {
     TAG_REFINE = 4u,
 };
 
-#define STATIC_MAX_CELLS 4096 /* grid segments per patch side */
-#define STATIC_MAX_ROUNDS 48  /* refinement passes */
-#define STATIC_TRIM_MAX_VERTICES (1u << 22)
+#define STATIC_MAX_ROUNDS 48 /* refinement passes */
 
 static double now_seconds(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* ---- even-odd classification against many loop segments, bucketed by v ----------------------
- * sw_sg_trim_classify walks every segment; a face with long loops and many grid points needs the
- * same rule (crossing a ray towards +u, half-open in v) restricted to the segments whose v-range
- * meets the point's strip. */
-typedef struct strip_classifier {
-    double v0, inv_h;
-    uint32_t n_strips;
-    uint32_t *start; /* n_strips + 1 */
-    double *seg;     /* 4 per entry: ui, vi, uj, vj */
-} strip_classifier;
-
-static void strips_free(strip_classifier *c)
-{
-    sw__free(c->start);
-    sw__free(c->seg);
-    memset(c, 0, sizeof *c);
-}
-
-static uint32_t strip_of(const strip_classifier *c, double v)
-{
-    double x = (v - c->v0) * c->inv_h;
-    if (!(x > 0.0))
-        return 0;
-    return x >= (double)(c->n_strips - 1) ? c->n_strips - 1 : (uint32_t)x;
-}
-
-static int strips_build(strip_classifier *c, const sw_sg_polyline *loops, uint32_t n_loops)
-{
-    memset(c, 0, sizeof *c);
-    size_t n_seg = 0;
-    double lo = DBL_MAX, hi = -DBL_MAX;
-    for (uint32_t l = 0; l < n_loops; ++l) {
-        n_seg += loops[l].count;
-        for (uint32_t i = 0; i < loops[l].count; ++i) {
-            lo = fmin(lo, loops[l].uv[2 * i + 1]);
-            hi = fmax(hi, loops[l].uv[2 * i + 1]);
-        }
-    }
-    if (n_seg == 0)
-        return 1;
-    c->n_strips = (uint32_t)fmin(4096.0, fmax(1.0, sqrt((double)n_seg)));
-    c->v0 = lo;
-    c->inv_h = hi > lo ? (double)c->n_strips / (hi - lo) : 0.0;
-    uint32_t *count = sw__calloc((size_t)c->n_strips + 1, sizeof *count);
-    if (!count)
-        return 0;
-    for (int pass = 0; pass < 2; ++pass) {
-        for (uint32_t l = 0; l < n_loops; ++l) {
-            const double *p = loops[l].uv;
-            for (uint32_t i = 0, j = loops[l].count - 1; i < loops[l].count; j = i++) {
-                uint32_t a = strip_of(c, fmin(p[2 * i + 1], p[2 * j + 1]));
-                uint32_t b = strip_of(c, fmax(p[2 * i + 1], p[2 * j + 1]));
-                for (uint32_t s = a; s <= b; ++s) {
-                    if (pass == 0) {
-                        count[s]++;
-                        continue;
-                    }
-                    double *e = c->seg + 4 * (size_t)(c->start[s] + count[s]++);
-                    e[0] = p[2 * i], e[1] = p[2 * i + 1], e[2] = p[2 * j], e[3] = p[2 * j + 1];
-                }
-            }
-        }
-        if (pass == 0) {
-            c->start = sw__malloc(((size_t)c->n_strips + 1) * sizeof *c->start);
-            size_t total = 0;
-            for (uint32_t s = 0; s < c->n_strips; ++s)
-                total += count[s];
-            c->seg = sw__malloc((total ? total : 1) * 4 * sizeof *c->seg);
-            if (!c->start || !c->seg || total > UINT32_MAX) {
-                sw__free(count);
-                strips_free(c);
-                return 0;
-            }
-            c->start[0] = 0;
-            for (uint32_t s = 0; s < c->n_strips; ++s)
-                c->start[s + 1] = c->start[s] + count[s];
-            memset(count, 0, ((size_t)c->n_strips + 1) * sizeof *count);
-        }
-    }
-    sw__free(count);
-    return 1;
-}
-
-static int strips_inside(const strip_classifier *c, double u, double v)
-{
-    if (c->n_strips == 0)
-        return 0;
-    const uint32_t s = strip_of(c, v);
-    int inside = 0;
-    for (uint32_t k = c->start[s]; k < c->start[s + 1]; ++k) {
-        const double *e = c->seg + 4 * (size_t)k;
-        if ((e[1] > v) != (e[3] > v) && u < e[0] + (v - e[1]) * (e[2] - e[0]) / (e[3] - e[1]))
-            inside ^= 1;
-    }
-    return inside;
-}
-
-/* ---- one face of the super-surface ---------------------------------------------------------- */
-typedef struct face_dom {
-    uint32_t face;
-    sw_sg_surface s;
-    int reversed;
-    int has_loops;
-    sw_sg_bezier_set set;
-    int32_t pnu, pnv;  /* the Bézier grid */
-    double *pub, *pvb; /* its patch rectangles' breakpoints (cut to uv_box): pnu + 1, pnv + 1 */
-    uint8_t *psel;     /* pnu * pnv: patch selected */
-    int32_t sub;       /* cells per patch side (face_dom_refine) */
-    int32_t nu, nv;    /* the cell grid: sub x sub cells per patch */
-    double *ub, *vb;   /* nu + 1, nv + 1 */
-    uint8_t *sel;      /* nu * nv: the cell's patch is selected */
-    uint32_t n_sel;
-    int outside_sel; /* what lies beyond the grid counts as selected (full face with loops) */
-    double *scale;   /* 2 per cell: A, B of the header comment */
-    double grad;     /* G: |dS| per unit (du, dv), over the selected cells */
-    double au, av;   /* max of A / (u length), B / (v length): scaled length per parameter */
-    double box[6];   /* control points of the selected patches */
-    sw_sg_polyline *loops;
-    uint32_t n_loops;
-    strip_classifier cls;
-} face_dom;
-
-static void face_dom_free(face_dom *fd)
-{
-    sw_sg_bezier_set_free(&fd->set);
-    sw__free(fd->pub);
-    sw__free(fd->pvb);
-    sw__free(fd->psel);
-    sw__free(fd->ub);
-    sw__free(fd->vb);
-    sw__free(fd->sel);
-    sw__free(fd->scale);
-    for (uint32_t l = 0; l < fd->n_loops; ++l)
-        sw_sg_polyline_free(&fd->loops[l]);
-    sw__free(fd->loops);
-    strips_free(&fd->cls);
-    memset(fd, 0, sizeof *fd);
-}
-
-static int sel_at(const face_dom *fd, int32_t i, int32_t j)
-{
-    if (i < 0 || j < 0 || i >= fd->nu || j >= fd->nv)
-        return fd->outside_sel;
-    return fd->sel[j * fd->nu + i];
-}
-
-static int32_t locate(const double *b, int32_t n, double x)
-{
-    int32_t lo = 0, hi = n - 1; /* last cell whose start <= x */
-    while (lo < hi) {
-        int32_t mid = (lo + hi + 1) / 2;
-        if (b[mid] <= x)
-            lo = mid;
-        else
-            hi = mid - 1;
-    }
-    return lo;
-}
-
-static int in_domain(const face_dom *fd, double u, double v)
-{
-    if (!(u >= fd->ub[0] && u <= fd->ub[fd->nu] && v >= fd->vb[0] && v <= fd->vb[fd->nv]))
-        return 0;
-    if (!fd->sel[locate(fd->vb, fd->nv, v) * fd->nu + locate(fd->ub, fd->nu, u)])
-        return 0;
-    return !fd->has_loops || strips_inside(&fd->cls, u, v);
-}
-
-/* The scaling of the header comment for one cell's bounds: k from a geometric set, the one
- * needing the fewest grid points at cell size c (c <= 0: the k of the smallest cell area). */
-static void patch_scale(const sw_lod_patch_bounds *pb, double c, double *a, double *b)
-{
-    const double m = fmax(fmax(pb->d2[0], pb->d2[2]), pb->d2[1]);
-    const double eta = 1e-6 * m + 1e-300;
-    const double mss = fmax(pb->d2[0], eta), mtt = fmax(pb->d2[2], eta), mst = pb->d2[1];
-    double k = fmin(1e4, fmax(1e-4, sqrt(mss / mtt)));
-    *a = sqrt(mss + k * mst), *b = sqrt(mtt + mst / k);
-    if (!(c > 0.0) || mst == 0.0)
-        return;
-    double best = (ceil(*a / c) + 1.0) * (ceil(*b / c) + 1.0);
-    for (int i = -20; i <= 20; ++i) {
-        k = pow(10.0, i / 5.0);
-        const double ka = sqrt(mss + k * mst), kb = sqrt(mtt + mst / k);
-        const double e = (ceil(ka / c) + 1.0) * (ceil(kb / c) + 1.0);
-        if (e < best)
-            best = e, *a = ka, *b = kb;
-    }
-}
-
-/* Bounds of the selected patches split into sub x sub cells (de Casteljau restriction of each
- * cut net): per cell the scaling A, B, and over them G, au, av. With c > 0, *est receives the grid
- * points the cells would need at cell size c. scale: (nu * sub) * (nv * sub) * 2 doubles, or NULL.
- */
-static void cell_bounds(const face_dom *fd, int32_t sub, double c, double *scale, double *est,
-                        double *grad, double *au, double *av)
-{
-    double e = 0.0, g = 0.0, mu = 0.0, mv = 0.0;
-    double net[(SW_SG_MAX_DEGREE + 1) * (SW_SG_MAX_DEGREE + 1) * 4];
-    const int32_t cnu = fd->pnu * sub;
-    for (int32_t j = 0; j < fd->pnv; ++j)
-        for (int32_t i = 0; i < fd->pnu; ++i) {
-            if (!fd->psel[j * fd->pnu + i])
-                continue;
-            const sw_sg_bezier_patch *p = &fd->set.patches[j * fd->pnu + i];
-            const double lu = (fd->pub[i + 1] - fd->pub[i]) / sub;
-            const double lv = (fd->pvb[j + 1] - fd->pvb[j]) / sub;
-            for (int32_t b = 0; b < sub; ++b)
-                for (int32_t a = 0; a < sub; ++a) {
-                    const double rect[4] = {(double)a / sub, (double)(a + 1) / sub, (double)b / sub,
-                                            (double)(b + 1) / sub};
-                    const double *cp = p->cpw;
-                    if (sub > 1) {
-                        sw_lod_bez_restrict(p->deg_u, p->deg_v, 4, p->cpw, rect, net);
-                        cp = net;
-                    }
-                    sw_lod_patch_bounds pb;
-                    sw_lod_rational_bezier_bounds(p->deg_u, p->deg_v, cp, &pb);
-                    double sa, sb;
-                    patch_scale(&pb, c, &sa, &sb);
-                    if (scale) {
-                        double *sc = scale + 2 * ((size_t)(j * sub + b) * cnu + i * sub + a);
-                        sc[0] = sa, sc[1] = sb;
-                    }
-                    mu = fmax(mu, sa / lu), mv = fmax(mv, sb / lv);
-                    g = fmax(g, hypot(pb.d1[0] / lu, pb.d1[1] / lv));
-                    if (c > 0.0)
-                        e += (fmin(STATIC_MAX_CELLS, ceil(sa / c)) + 1.0) *
-                             (fmin(STATIC_MAX_CELLS, ceil(sb / c)) + 1.0);
-                }
-        }
-    if (est)
-        *est = e;
-    *grad = g, *au = mu, *av = mv;
-}
-
-/* Sets the cell grid of the face to sub x sub cells per patch. */
-static int set_cells(face_dom *fd, int32_t sub, double *scale)
-{
-    sw__free(fd->ub), sw__free(fd->vb), sw__free(fd->sel), sw__free(fd->scale);
-    fd->sub = sub;
-    fd->nu = fd->pnu * sub, fd->nv = fd->pnv * sub;
-    fd->ub = sw__malloc(((size_t)fd->nu + 1) * sizeof *fd->ub);
-    fd->vb = sw__malloc(((size_t)fd->nv + 1) * sizeof *fd->vb);
-    fd->sel = sw__malloc((size_t)fd->nu * fd->nv);
-    fd->scale = scale;
-    if (!fd->ub || !fd->vb || !fd->sel || !scale)
-        return 0;
-    for (int32_t i = 0; i < fd->nu; ++i) {
-        const int32_t pi = i / sub, k = i % sub;
-        fd->ub[i] = k == 0 ? fd->pub[pi] : fd->pub[pi] + (fd->pub[pi + 1] - fd->pub[pi]) * k / sub;
-    }
-    fd->ub[fd->nu] = fd->pub[fd->pnu];
-    for (int32_t j = 0; j < fd->nv; ++j) {
-        const int32_t pj = j / sub, k = j % sub;
-        fd->vb[j] = k == 0 ? fd->pvb[pj] : fd->pvb[pj] + (fd->pvb[pj + 1] - fd->pvb[pj]) * k / sub;
-    }
-    fd->vb[fd->nv] = fd->pvb[fd->pnv];
-    for (int32_t j = 0; j < fd->nv; ++j)
-        for (int32_t i = 0; i < fd->nu; ++i)
-            fd->sel[j * fd->nu + i] = fd->psel[(j / sub) * fd->pnu + i / sub];
-    return 1;
-}
-
-/* The control-net bounds of a whole patch can be far above the surface's true derivatives
- * (rational patches, high degrees); bounds of its quarters are never larger and often much
- * smaller. Splits the face's patches into 2, 4 or 8 cells per side while that saves at least
- * 30 % of the grid points at cell size c. */
-static int face_dom_refine(face_dom *fd, double c)
-{
-    double est, g, mu, mv;
-    cell_bounds(fd, fd->sub, c, NULL, &est, &g, &mu, &mv);
-    int32_t best = fd->sub;
-    for (int32_t sub = 2 * fd->sub; sub <= 8 && (int64_t)fd->pnu * fd->pnv * sub * sub <= 1 << 20;
-         sub *= 2) {
-        double e2;
-        cell_bounds(fd, sub, c, NULL, &e2, &g, &mu, &mv);
-        if (!(e2 < 0.7 * est))
-            break;
-        est = e2, best = sub;
-    }
-    double *scale = sw__calloc(2 * (size_t)fd->pnu * fd->pnv * best * best, sizeof *scale);
-    if (scale)
-        cell_bounds(fd, best, c, scale, NULL, &fd->grad, &fd->au, &fd->av);
-    return set_cells(fd, best, scale);
-}
-
-/* The face's patches as the hierarchy and the super-surfaces see them (sw_lod_face_patches: over
- * its uv_box, cut to it) and the selected ones. patches[0..n) are this face's, sorted. */
-static sw_result face_dom_init(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
-                               uint32_t n, face_dom *fd, sw_status *status)
-{
-    const sw_sg_scene_view *view = sw_sg_scene_view_ptr(scene);
-    const uint32_t face = patches[0].face;
-    const sw_sg_face_rec *fr = &view->faces[face];
-    memset(fd, 0, sizeof *fd);
-    fd->face = face;
-    fd->reversed = (fr->flags & SW_SG_FACE_REVERSED) != 0;
-    sw_sg_scene_face_surface(scene, face, &fd->s);
-    sw_result r = sw_lod_face_patches(scene, face, &fd->set, status);
-    if (r != SW_OK)
-        return r;
-    fd->pnu = fd->set.n_u, fd->pnv = fd->set.n_v;
-    const size_t np = (size_t)fd->pnu * fd->pnv;
-    fd->pub = sw__malloc(((size_t)fd->pnu + 1) * sizeof *fd->pub);
-    fd->pvb = sw__malloc(((size_t)fd->pnv + 1) * sizeof *fd->pvb);
-    fd->psel = sw__calloc(np, 1);
-    if (!fd->pub || !fd->pvb || !fd->psel)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", face);
-    for (int32_t i = 0; i < fd->pnu; ++i) {
-        fd->pub[i] = fd->set.patches[i].u0;
-        fd->pub[i + 1] = fd->set.patches[i].u1;
-    }
-    for (int32_t j = 0; j < fd->pnv; ++j) {
-        fd->pvb[j] = fd->set.patches[j * fd->pnu].v0;
-        fd->pvb[j + 1] = fd->set.patches[j * fd->pnu].v1;
-    }
-    for (uint32_t k = 0; k < n; ++k) {
-        if (patches[k].iu >= fd->pnu || patches[k].iv >= fd->pnv)
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                            "static lod: face %u has %d x %d patches, not (%u, %u)", face,
-                            (int)fd->pnu, (int)fd->pnv, patches[k].iu, patches[k].iv);
-        fd->psel[patches[k].iv * fd->pnu + patches[k].iu] = 1;
-    }
-    for (int c = 0; c < 3; ++c)
-        fd->box[c] = DBL_MAX, fd->box[3 + c] = -DBL_MAX;
-    for (int32_t j = 0; j < fd->pnv; ++j)
-        for (int32_t i = 0; i < fd->pnu; ++i) {
-            if (!fd->psel[j * fd->pnu + i])
-                continue;
-            fd->n_sel++;
-            const sw_sg_bezier_patch *p = &fd->set.patches[j * fd->pnu + i]; /* cut already */
-            const int32_t ncp = (p->deg_u + 1) * (p->deg_v + 1);
-            for (int32_t q = 0; q < ncp; ++q)
-                for (int c = 0; c < 3; ++c) {
-                    const double x = p->cpw[4 * q + c] / p->cpw[4 * q + 3];
-                    fd->box[c] = fmin(fd->box[c], x);
-                    fd->box[3 + c] = fmax(fd->box[3 + c], x);
-                }
-        }
-    fd->has_loops = fr->n_loops > 0;
-    fd->outside_sel = fd->has_loops && fd->n_sel == np;
-    double *scale = sw__calloc(2 * np, sizeof *scale);
-    if (scale)
-        cell_bounds(fd, 1, 0.0, scale, NULL, &fd->grad, &fd->au, &fd->av);
-    if (!set_cells(fd, 1, scale))
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", face);
-    sw__status_ok(status);
-    return SW_OK;
-}
-
-/* Rounding noise of the rational evaluation leaves a flattened iso-line (a seam, a domain edge)
- * bent by ~1e-15; the constrained triangulation then fills the sliver pocket under the bend with
- * long zero-area triangles that no refinement can shorten. Coordinates within 1e-12 of the
- * parameter range of a knot line, or of the previous vertex, are made equal to it. */
-static void snap_loop(const face_dom *fd, sw_sg_polyline *pl)
-{
-    const double tol[2] = {1e-12 * (fd->ub[fd->nu] - fd->ub[0]),
-                           1e-12 * (fd->vb[fd->nv] - fd->vb[0])};
-    for (int a = 0; a < 2; ++a) {
-        const double *b = a == 0 ? fd->ub : fd->vb;
-        const int32_t nb = a == 0 ? fd->nu : fd->nv;
-        for (uint32_t i = 0; i < pl->count; ++i) {
-            double *x = &pl->uv[2 * i + a];
-            const int32_t k = locate(b, nb, *x);
-            if (fabs(*x - b[k]) <= tol[a])
-                *x = b[k];
-            else if (fabs(*x - b[k + 1]) <= tol[a])
-                *x = b[k + 1];
-            else if (i > 0 && fabs(*x - pl->uv[2 * (i - 1) + a]) <= tol[a])
-                *x = pl->uv[2 * (i - 1) + a];
-        }
-    }
-}
-
-/* Flattens the face's loops within tol (parameter units) and builds the classifier. */
-static sw_result face_dom_flatten(const sw_sg_scene *scene, face_dom *fd, double tol,
-                                  sw_status *status)
-{
-    const sw_sg_face_rec *fr = &sw_sg_scene_view_ptr(scene)->faces[fd->face];
-    for (uint32_t l = 0; l < fd->n_loops; ++l)
-        sw_sg_polyline_free(&fd->loops[l]);
-    sw__free(fd->loops);
-    strips_free(&fd->cls);
-    fd->n_loops = 0;
-    fd->loops = sw__calloc(fr->n_loops ? fr->n_loops : 1, sizeof *fd->loops);
-    if (!fd->loops)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u", fd->face);
-    for (uint32_t l = 0; l < fr->n_loops; ++l) {
-        sw_result r = sw_sg_trim_flatten_loop(scene, fr->first_loop + l, tol,
-                                              STATIC_TRIM_MAX_VERTICES, &fd->loops[l], status);
-        if (r != SW_OK)
-            return r;
-        snap_loop(fd, &fd->loops[l]);
-        fd->n_loops++;
-    }
-    if (!strips_build(&fd->cls, fd->loops, fd->n_loops))
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u loops", fd->face);
-    sw__status_ok(status);
-    return SW_OK;
-}
-
-/* The faces of a patch list, each with its patches: sorted copy, one face_dom per face. */
-typedef struct patch_set {
-    sw_lod_static_patch *p; /* sorted by (face, iv, iu), unique */
-    uint32_t n;
-    face_dom *faces;
-    uint32_t n_faces;
-    double box[6];
-} patch_set;
-
-static void patch_set_free(patch_set *ps)
-{
-    for (uint32_t f = 0; f < ps->n_faces; ++f)
-        face_dom_free(&ps->faces[f]);
-    sw__free(ps->faces);
-    sw__free(ps->p);
-    memset(ps, 0, sizeof *ps);
-}
-
-static int patch_cmp(const void *a, const void *b)
-{
-    const sw_lod_static_patch *x = a, *y = b;
-    if (x->face != y->face)
-        return x->face < y->face ? -1 : 1;
-    if (x->iv != y->iv)
-        return x->iv < y->iv ? -1 : 1;
-    return (x->iu > y->iu) - (x->iu < y->iu);
-}
-
-static sw_result patch_set_init(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
-                                uint32_t n, patch_set *ps, sw_status *status)
-{
-    memset(ps, 0, sizeof *ps);
-    const sw_sg_scene_view *view = sw_sg_scene_view_ptr(scene);
-    if (n == 0 || !patches)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: no patches");
-    for (uint32_t k = 0; k < n; ++k)
-        if (patches[k].face >= view->n_faces)
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: patch %u: face %u of %u",
-                            k, patches[k].face, view->n_faces);
-    ps->p = sw__malloc((size_t)n * sizeof *ps->p);
-    if (!ps->p)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: %u patches", n);
-    memcpy(ps->p, patches, (size_t)n * sizeof *ps->p);
-    qsort(ps->p, n, sizeof *ps->p, patch_cmp);
-    uint32_t m = 0, nf = 0;
-    for (uint32_t k = 0; k < n; ++k)
-        if (m == 0 || patch_cmp(&ps->p[m - 1], &ps->p[k]) != 0) {
-            nf += m == 0 || ps->p[m - 1].face != ps->p[k].face;
-            ps->p[m++] = ps->p[k];
-        }
-    ps->n = m;
-    ps->faces = sw__calloc(nf, sizeof *ps->faces);
-    if (!ps->faces)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: %u faces", nf);
-    for (int c = 0; c < 3; ++c)
-        ps->box[c] = DBL_MAX, ps->box[3 + c] = -DBL_MAX;
-    for (uint32_t k = 0; k < m;) {
-        uint32_t e = k;
-        while (e < m && ps->p[e].face == ps->p[k].face)
-            ++e;
-        face_dom *fd = &ps->faces[ps->n_faces++];
-        sw_result r = face_dom_init(scene, ps->p + k, e - k, fd, status);
-        if (r != SW_OK)
-            return r;
-        for (int c = 0; c < 3; ++c) {
-            ps->box[c] = fmin(ps->box[c], fd->box[c]);
-            ps->box[3 + c] = fmax(ps->box[3 + c], fd->box[3 + c]);
-        }
-        k = e;
-    }
-    return SW_OK;
-}
-
-static const face_dom *find_face(const patch_set *ps, uint32_t face)
-{
-    uint32_t lo = 0, hi = ps->n_faces;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (ps->faces[mid].face < face)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo < ps->n_faces && ps->faces[lo].face == face ? &ps->faces[lo] : NULL;
 }
 
 /* ---- level 0: the adaptive tessellation ------------------------------------------------------ */
@@ -718,8 +224,8 @@ static int grid_build(const face_dom *fd, double c, grid *g)
 /* Whether a knot-grid corner (i, j) is where the selection's border turns. */
 static int sel_turn(const face_dom *fd, int32_t i, int32_t j)
 {
-    const int a = sel_at(fd, i - 1, j - 1), b = sel_at(fd, i, j - 1), c = sel_at(fd, i - 1, j),
-              d = sel_at(fd, i, j);
+    const int a = sw__sl_sel_at(fd, i - 1, j - 1), b = sw__sl_sel_at(fd, i, j - 1),
+              c = sw__sl_sel_at(fd, i - 1, j), d = sw__sl_sel_at(fd, i, j);
     const int n = a + b + c + d;
     return n == 1 || n == 3 || (n == 2 && a == d);
 }
@@ -728,12 +234,12 @@ static int sel_turn(const face_dom *fd, int32_t i, int32_t j)
 static int on_sel_border(const face_dom *fd, double u, double v)
 {
     const double tu = 1e-9 * (fd->ub[fd->nu] - fd->ub[0]), tv = 1e-9 * (fd->vb[fd->nv] - fd->vb[0]);
-    const int32_t i = locate(fd->ub, fd->nu, u), j = locate(fd->vb, fd->nv, v);
+    const int32_t i = sw__sl_locate(fd->ub, fd->nu, u), j = sw__sl_locate(fd->vb, fd->nv, v);
     for (int32_t ii = i; ii <= i + 1; ++ii)
-        if (fabs(u - fd->ub[ii]) <= tu && sel_at(fd, ii - 1, j) != sel_at(fd, ii, j))
+        if (fabs(u - fd->ub[ii]) <= tu && sw__sl_sel_at(fd, ii - 1, j) != sw__sl_sel_at(fd, ii, j))
             return 1;
     for (int32_t jj = j; jj <= j + 1; ++jj)
-        if (fabs(v - fd->vb[jj]) <= tv && sel_at(fd, i, jj - 1) != sel_at(fd, i, jj))
+        if (fabs(v - fd->vb[jj]) <= tv && sw__sl_sel_at(fd, i, jj - 1) != sw__sl_sel_at(fd, i, jj))
             return 1;
     return 0;
 }
@@ -791,7 +297,7 @@ static int add_grid(const face_dom *fd, const grid *g, pts *p, pairs *cons)
             for (int32_t l = v0; l <= v1; ++l)
                 for (int32_t k = u0; k <= u1; ++k) {
                     const double u = g->gu[k], v = g->gv[l];
-                    if (fd->has_loops && !strips_inside(&fd->cls, u, v))
+                    if (fd->has_loops && !sw__sl_strips_inside(&fd->cls, u, v))
                         continue;
                     const int corner = (k == u0 || k == u1) && (l == v0 || l == v1) &&
                                        sel_turn(fd, k == u0 ? i : i + 1, l == v0 ? j : j + 1);
@@ -851,9 +357,9 @@ static double tri_bound(const face_dom *fd, const double *uv0, const double *uv1
                         double refine[2])
 {
     const double cu = (uv0[0] + uv1[0] + uv2[0]) / 3.0, cv = (uv0[1] + uv1[1] + uv2[1]) / 3.0;
-    if (!in_domain(fd, cu, cv))
+    if (!sw__sl_in_domain(fd, cu, cv))
         return -1.0;
-    const int32_t i = locate(fd->ub, fd->nu, cu), j = locate(fd->vb, fd->nv, cv);
+    const int32_t i = sw__sl_locate(fd->ub, fd->nu, cu), j = sw__sl_locate(fd->vb, fd->nv, cv);
     const double *sc = fd->scale + 2 * ((size_t)j * fd->nu + i);
     const double ku = sc[0] / (fd->ub[i + 1] - fd->ub[i]), kv = sc[1] / (fd->vb[j + 1] - fd->vb[j]);
     const double a[2] = {(uv0[0] - cu) * ku, (uv0[1] - cv) * kv};
@@ -1043,378 +549,6 @@ done:
     return r;
 }
 
-/* ---- measurement ---------------------------------------------------------------------------- */
-
-typedef struct rng {
-    uint64_t s;
-} rng;
-
-static double rng_next(rng *r)
-{
-    r->s = r->s * 6364136223846793005ull + 1442695040888963407ull;
-    return (double)(r->s >> 11) * (1.0 / 9007199254740992.0);
-}
-
-/* The point of the loops nearest to (u, v) in parameter space: strips are searched outwards
- * from the point's own until they are farther in v than the best segment found. */
-static void nearest_on_loops(const strip_classifier *c, double u, double v, double out[2])
-{
-    double best = INFINITY;
-    out[0] = u, out[1] = v;
-    const int64_t s0 = strip_of(c, v), n = c->n_strips;
-    const double h = c->inv_h > 0.0 ? 1.0 / c->inv_h : INFINITY;
-    for (int64_t off = 0; off < n; ++off) {
-        const double gap = off == 0 ? 0.0 : (double)(off - 1) * h;
-        if (gap * gap >= best)
-            break;
-        for (int side = -1; side <= 1; side += 2) {
-            const int64_t s = s0 + side * off;
-            if (s < 0 || s >= n || (off == 0 && side == 1))
-                continue;
-            for (uint32_t k = c->start[s]; k < c->start[s + 1]; ++k) {
-                const double *e = c->seg + 4 * (size_t)k;
-                const double dx = e[2] - e[0], dy = e[3] - e[1], l2 = dx * dx + dy * dy;
-                double t = l2 > 0.0 ? ((u - e[0]) * dx + (v - e[1]) * dy) / l2 : 0.0;
-                t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-                const double x = e[0] + t * dx, y = e[1] + t * dy;
-                const double d2 = (x - u) * (x - u) + (y - v) * (y - v);
-                if (d2 < best)
-                    best = d2, out[0] = x, out[1] = y;
-            }
-        }
-    }
-}
-
-static double dist_at(const face_dom *fd, const double p[3], double u, double v)
-{
-    double x[3];
-    sw_sg_surface_eval(&fd->s, u, v, x);
-    return sqrt((x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) +
-                (x[2] - p[2]) * (x[2] - p[2]));
-}
-
-/* Upper bound of the distance from p to the face's trimmed surface: Newton's iteration on
- * |S(u, v) - p|^2 from (u, v) over the uv_box; the best iterate inside the domain, or, when the
- * foot lies outside, the surface point at the nearest point of the selected patch (of the start)
- * and of the loops (flattened within 1 % of the level's ε: a border point of the surface). */
-static double project(const face_dom *fd, const double p[3], double u, double v, int *inside)
-{
-    double best = INFINITY;
-    const double lu = fd->ub[fd->nu] - fd->ub[0], lv = fd->vb[fd->nv] - fd->vb[0];
-    const int32_t pi = locate(fd->ub, fd->nu, u), pj = locate(fd->vb, fd->nv, v);
-    for (int it = 0; it < 8; ++it) {
-        sw_sg_surface_d2 d;
-        sw_sg_surface_eval_d2(&fd->s, u, v, &d);
-        const double r[3] = {d.p[0] - p[0], d.p[1] - p[1], d.p[2] - p[2]};
-        const double dist = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
-        if (dist < best && in_domain(fd, u, v))
-            best = dist;
-        double g0 = 0, g1 = 0, h00 = 0, h01 = 0, h11 = 0, k00 = 0, k01 = 0, k11 = 0;
-        for (int c = 0; c < 3; ++c) {
-            g0 += r[c] * d.du[c], g1 += r[c] * d.dv[c];
-            h00 += d.du[c] * d.du[c], h01 += d.du[c] * d.dv[c], h11 += d.dv[c] * d.dv[c];
-            k00 += r[c] * d.duu[c], k01 += r[c] * d.duv[c], k11 += r[c] * d.dvv[c];
-        }
-        double a = h00 + k00, b = h01 + k01, e = h11 + k11;
-        if (!(a > 0.0 && a * e - b * b > 0.0)) /* not convex here: Gauss-Newton */
-            a = h00, b = h01, e = h11;
-        const double det = a * e - b * b;
-        if (!(det > 0.0))
-            break;
-        const double du = -(e * g0 - b * g1) / det, dv = -(a * g1 - b * g0) / det;
-        u = fmin(fd->ub[fd->nu], fmax(fd->ub[0], u + du));
-        v = fmin(fd->vb[fd->nv], fmax(fd->vb[0], v + dv));
-        if (fabs(du) <= 1e-13 * lu && fabs(dv) <= 1e-13 * lv)
-            break;
-    }
-    *inside = in_domain(fd, u, v);
-    if (*inside)
-        return fmin(best, dist_at(fd, p, u, v));
-    if (!fd->sel[locate(fd->vb, fd->nv, v) * fd->nu + locate(fd->ub, fd->nu, u)]) {
-        if (!fd->sel[pj * fd->nu + pi])
-            return best;
-        u = fmin(fd->ub[pi + 1], fmax(fd->ub[pi], u));
-        v = fmin(fd->vb[pj + 1], fmax(fd->vb[pj], v));
-    }
-    if (fd->has_loops && !strips_inside(&fd->cls, u, v)) {
-        double q[2];
-        nearest_on_loops(&fd->cls, u, v, q);
-        u = q[0], v = q[1];
-    }
-    return fmin(best, dist_at(fd, p, u, v));
-}
-
-static void measure_desc_defaults(const sw_lod_static_measure_desc *in,
-                                  sw_lod_static_measure_desc *d)
-{
-    *d = in ? *in : (sw_lod_static_measure_desc){0};
-    if (d->seed == 0)
-        d->seed = 1;
-    if (d->patch_samples <= 0)
-        d->patch_samples = 10;
-    if (d->triangle_samples <= 0)
-        d->triangle_samples = 6;
-}
-
-/* Surface -> mesh over one face: lattice (or random points) per selected patch inside the loops,
- * the loop vertices (points of the exact curves) and the selection's border sides. */
-static void measure_face_surface(const face_dom *fd, const sw_lod_mesh_distance *md,
-                                 const sw_lod_static_measure_desc *d, int32_t m, rng *rg,
-                                 sw_lod_static_distance *out)
-{
-    const double ox = fmod(0.5 + 0.6180339887498949 * d->seed, 1.0);
-    const double oy = fmod(0.5 + 0.4142135623730950 * d->seed, 1.0);
-    double x[3];
-    for (int32_t j = 0; j < fd->nv; ++j)
-        for (int32_t i = 0; i < fd->nu; ++i) {
-            if (!fd->sel[j * fd->nu + i])
-                continue;
-            const double u0 = fd->ub[i], lu = fd->ub[i + 1] - u0;
-            const double v0 = fd->vb[j], lv = fd->vb[j + 1] - v0;
-            for (int32_t b = 0; b <= m; ++b)
-                for (int32_t a = 0; a <= m; ++a) {
-                    double s, t;
-                    if (d->random)
-                        s = rng_next(rg), t = rng_next(rg);
-                    else if (a == m || b == m)
-                        continue;
-                    else
-                        s = (a + ox) / m, t = (b + oy) / m;
-                    /* borders of the selection: the patch sides there, sampled too */
-                    const double u = u0 + s * lu, v = v0 + t * lv;
-                    if (!in_domain(fd, u, v))
-                        continue;
-                    sw_sg_surface_eval(&fd->s, u, v, x);
-                    out->surface_to_mesh =
-                        fmax(out->surface_to_mesh, sw_lod_mesh_distance_query(md, x));
-                    out->n_surface++;
-                }
-            const int border[4] = {!sel_at(fd, i, j - 1), !sel_at(fd, i - 1, j),
-                                   !sel_at(fd, i, j + 1), !sel_at(fd, i + 1, j)};
-            for (int sd = 0; sd < 4; ++sd) {
-                if (!border[sd])
-                    continue;
-                for (int32_t a = 0; a < 4 * m; ++a) {
-                    const double s = d->random ? rng_next(rg) : (a + ox) / (4 * m);
-                    const double u = sd == 1 ? u0 : sd == 3 ? u0 + lu : u0 + s * lu;
-                    const double v = sd == 0 ? v0 : sd == 2 ? v0 + lv : v0 + s * lv;
-                    if (fd->has_loops && !strips_inside(&fd->cls, u, v))
-                        continue;
-                    sw_sg_surface_eval(&fd->s, u, v, x);
-                    out->surface_to_mesh =
-                        fmax(out->surface_to_mesh, sw_lod_mesh_distance_query(md, x));
-                    out->n_surface++;
-                }
-            }
-        }
-    for (uint32_t l = 0; l < fd->n_loops; ++l) {
-        const sw_sg_polyline *pl = &fd->loops[l];
-        for (uint32_t k = 0; k < pl->count; ++k) {
-            const double u = pl->uv[2 * k], v = pl->uv[2 * k + 1];
-            if (!(u >= fd->ub[0] && u <= fd->ub[fd->nu] && v >= fd->vb[0] && v <= fd->vb[fd->nv]))
-                continue;
-            if (!fd->sel[locate(fd->vb, fd->nv, v) * fd->nu + locate(fd->ub, fd->nu, u)])
-                continue;
-            sw_sg_surface_eval(&fd->s, u, v, x);
-            out->surface_to_mesh = fmax(out->surface_to_mesh, sw_lod_mesh_distance_query(md, x));
-            out->n_surface++;
-        }
-    }
-}
-
-static double longest2(const sw_lod_static_level *lv, uint32_t t)
-{
-    const uint32_t *tv = lv->triangles + 3 * (size_t)t;
-    double l = 0.0;
-    for (int c = 0; c < 3; ++c) {
-        const double *a = lv->positions + 3 * (size_t)tv[c];
-        const double *b = lv->positions + 3 * (size_t)tv[(c + 1) % 3];
-        l = fmax(l, (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                        (a[2] - b[2]) * (a[2] - b[2]));
-    }
-    return l;
-}
-
-/* Upper bound of the distance to the surface of the triangle point with barycentric (w0, w1). */
-typedef struct mesh_ref {
-    const sw_lod_mesh_distance *level0; /* may be NULL */
-    double delta;
-} mesh_ref;
-
-static double mesh_point_distance(const face_dom *fd, const mesh_ref *ref, const double *const P[3],
-                                  const double *const UV[3], double w0, double w1)
-{
-    const double w2 = 1.0 - w0 - w1;
-    double x[3], uv[2];
-    for (int c = 0; c < 3; ++c)
-        x[c] = w0 * P[0][c] + w1 * P[1][c] + w2 * P[2][c];
-    for (int c = 0; c < 2; ++c)
-        uv[c] = w0 * UV[0][c] + w1 * UV[1][c] + w2 * UV[2][c];
-    /* a foot outside the domain gives a loose bound: retry from the vertices */
-    int inside;
-    double dist = project(fd, x, uv[0], uv[1], &inside);
-    for (int c = 0; c < 3 && !inside; ++c)
-        dist = fmin(dist, project(fd, x, UV[c][0], UV[c][1], &inside));
-    if (!(dist < INFINITY)) /* no start in the domain: the nearest vertex bounds it */
-        for (int c = 0; c < 3; ++c)
-            dist = fmin(dist, sqrt((x[0] - P[c][0]) * (x[0] - P[c][0]) +
-                                   (x[1] - P[c][1]) * (x[1] - P[c][1]) +
-                                   (x[2] - P[c][2]) * (x[2] - P[c][2])));
-    /* Newton finds a local foot only: where the surface folds back (a thread's next turn) the
-     * nearest point lies elsewhere. Level 0 is within delta of the surface everywhere (a
-     * rigorous bound), so the exact distance to it plus delta also bounds the distance. */
-    if (ref->level0)
-        dist = fmin(dist, sw_lod_mesh_distance_query(ref->level0, x) + ref->delta);
-    return dist;
-}
-
-/* Mesh -> surface: points of each triangle, projected by Newton from their interpolated (u, v). */
-static void measure_mesh(const patch_set *ps, const mesh_ref *ref, const sw_lod_static_level *lv,
-                         const sw_lod_static_measure_desc *d, rng *rg, sw_lod_static_distance *out)
-{
-    /* Samples in proportion to the triangles' squared longest edges (an area that does not
-     * vanish for slivers), at least 3 per triangle (its edge midpoints in the lattice), in all
-     * max(3 per triangle, min(20k, max(4k, 64 per triangle))) x triangle_samples / 6: a
-     * coarse level's few large triangles are sampled densely. */
-    double sum = 0.0;
-    for (uint32_t t = 0; t < lv->n_triangles; ++t)
-        sum += longest2(lv, t);
-    const double budget =
-        fmax(3.0 * lv->n_triangles, fmin(20000.0, fmax(4000.0, 64.0 * lv->n_triangles))) *
-        d->triangle_samples / 6.0;
-    for (uint32_t t = 0; t < lv->n_triangles; ++t) {
-        const uint32_t *tv = lv->triangles + 3 * (size_t)t;
-        const face_dom *fd = find_face(ps, lv->face[tv[0]]);
-        if (!fd)
-            continue;
-        const double *P[3], *UV[3];
-        for (int c = 0; c < 3; ++c) {
-            P[c] = lv->positions + 3 * (size_t)tv[c];
-            UV[c] = lv->uv + 2 * (size_t)tv[c];
-        }
-        const double want =
-            fmin(4096.0, fmax(3.0, budget * longest2(lv, t) / (sum > 0.0 ? sum : 1.0)));
-        int32_t k = 2; /* lattice order: (k + 1)(k + 2) / 2 - 3 points besides the vertices */
-        while ((k + 1) * (k + 2) / 2 - 3 < want)
-            ++k;
-        const int32_t n_pts = (k + 1) * (k + 2) / 2;
-        double tbest = 0.0, bw0 = 1.0 / 3.0, bw1 = 1.0 / 3.0;
-        for (int32_t q = 0; q < n_pts; ++q) {
-            double w0, w1;
-            if (d->random) {
-                double r1 = sqrt(rng_next(rg)), r2 = rng_next(rg);
-                w0 = 1.0 - r1, w1 = r1 * (1.0 - r2);
-            } else {
-                int32_t row = 0, rem = q; /* (i, j) with i + j <= k, enumerated by rows */
-                while (rem > k - row)
-                    rem -= k - row + 1, ++row;
-                w0 = (double)row / k, w1 = (double)rem / k;
-            }
-            const double w2 = 1.0 - w0 - w1;
-            if (w0 == 1.0 || w1 == 1.0 || w2 == 1.0)
-                continue; /* a vertex: on the surface by construction */
-            const double dist = mesh_point_distance(fd, ref, P, UV, w0, w1);
-            if (dist > tbest)
-                tbest = dist, bw0 = w0, bw1 = w1;
-            out->mesh_to_surface = fmax(out->mesh_to_surface, dist);
-            out->n_mesh++;
-        }
-        /* Coarse levels: a pattern search from the triangle's worst sample, since the peak of a
-         * needle triangle is narrow (one-sided decimation lets such triangles leave the surface).
-         */
-        if (lv->n_triangles > 20000 || !(tbest > 0.0))
-            continue;
-        for (double h = 0.5 / k; h > 0.02 / k; h *= 0.5)
-            for (int improved = 1; improved;) {
-                improved = 0;
-                static const double dir[6][2] = {{1, 0},  {-1, 0}, {0, 1},
-                                                 {0, -1}, {1, -1}, {-1, 1}};
-                for (int q = 0; q < 6; ++q) {
-                    const double w0 = bw0 + h * dir[q][0], w1 = bw1 + h * dir[q][1];
-                    if (w0 < 0.0 || w1 < 0.0 || w0 + w1 > 1.0)
-                        continue;
-                    const double dist = mesh_point_distance(fd, ref, P, UV, w0, w1);
-                    out->n_mesh++;
-                    if (dist > tbest) {
-                        tbest = dist, bw0 = w0, bw1 = w1, improved = 1;
-                        out->mesh_to_surface = fmax(out->mesh_to_surface, dist);
-                    }
-                }
-            }
-    }
-}
-
-/* level0: the tree of level 0 for the mesh -> surface fallback, NULL when lv is level 0 */
-static sw_result measure_with(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
-                              const sw_lod_mesh_distance *level0, double delta, double eps_hint,
-                              const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
-                              sw_status *status)
-{
-    sw_lod_static_measure_desc d;
-    measure_desc_defaults(din, &d);
-    memset(out, 0, sizeof *out);
-    if (lv->n_triangles == 0)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: empty level");
-    for (uint32_t f = 0; f < ps->n_faces; ++f) {
-        face_dom *fd = &ps->faces[f];
-        /* a floor: a level measured exact (a plane) must not flatten at rounding level */
-        const double range = fmax(fd->ub[fd->nu] - fd->ub[0], fd->vb[fd->nv] - fd->vb[0]);
-        const double tol = fmax(0.01 * eps_hint / (fd->grad > 0.0 ? fd->grad : 1.0), 1e-9 * range);
-        sw_result r = face_dom_flatten(scene, fd, tol, status);
-        if (r != SW_OK)
-            return r;
-    }
-    sw_lod_mesh_distance *md = NULL;
-    sw_result r =
-        sw_lod_mesh_distance_create(lv->positions, lv->triangles, lv->n_triangles, &md, status);
-    if (r != SW_OK)
-        return r;
-    rng rg = {0x9e3779b97f4a7c15ull * d.seed + 1};
-    const int32_t m =
-        (int32_t)fmin(64.0, fmax((double)d.patch_samples, ceil(sqrt(20000.0 / (double)ps->n))));
-    for (uint32_t f = 0; f < ps->n_faces; ++f) {
-        const int32_t sub = ps->faces[f].sub;
-        measure_face_surface(&ps->faces[f], md, &d, (m + sub - 1) / sub, &rg, out);
-    }
-    sw_lod_mesh_distance_free(md);
-    const mesh_ref ref = {level0, delta};
-    measure_mesh(ps, &ref, lv, &d, &rg, out);
-    sw__status_ok(status);
-    return SW_OK;
-}
-
-static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
-                             const sw_lod_static_level *level0, double delta, double eps_hint,
-                             const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
-                             sw_status *status)
-{
-    sw_lod_mesh_distance *tree = NULL;
-    sw_result r = SW_OK;
-    if (level0 && level0 != lv && level0->n_triangles > 0)
-        r = sw_lod_mesh_distance_create(level0->positions, level0->triangles, level0->n_triangles,
-                                        &tree, status);
-    if (r == SW_OK)
-        r = measure_with(scene, ps, lv, tree, delta, eps_hint, din, out, status);
-    sw_lod_mesh_distance_free(tree);
-    return r;
-}
-
-sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
-                                uint32_t n, const sw_lod_static_level *level,
-                                const sw_lod_static_level *level0, double delta, double eps_hint,
-                                const sw_lod_static_measure_desc *desc, sw_lod_static_distance *out,
-                                sw_status *status)
-{
-    patch_set ps;
-    sw_result r = patch_set_init(scene, patches, n, &ps, status);
-    if (r == SW_OK && !(eps_hint > 0.0))
-        r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: eps_hint %g", eps_hint);
-    if (r == SW_OK)
-        r = measure_set(scene, &ps, level, level0, delta, eps_hint, desc, out, status);
-    patch_set_free(&ps);
-    return r;
-}
-
 /* ---- the chain --------------------------------------------------------------------------------
  */
 
@@ -1554,11 +688,11 @@ static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
         r = sw_lod_mesh_distance_create(l0->positions, l0->triangles, l0->n_triangles, &b->level0,
                                         b->status);
     if (r == SW_OK)
-        r = measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, NULL, &dist,
-                         b->status);
+        r = sw__sl_measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, NULL, &dist,
+                                b->status);
     if (r == SW_OK)
-        r = measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, &random, &dr,
-                         b->status);
+        r = sw__sl_measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, &random, &dr,
+                                b->status);
     b->t_measure += now_seconds() - t0;
     if (r != SW_OK)
         return r;
@@ -1588,10 +722,9 @@ static int on_level(void *ctx, int32_t level, const uint32_t *tri, uint32_t n_tr
 
 double sw_lod_static_default_delta(const double box[6])
 {
-    const double d = SW_LOD_STATIC_DELTA_REL *
-                     sqrt((box[3] - box[0]) * (box[3] - box[0]) +
-                          (box[4] - box[1]) * (box[4] - box[1]) +
-                          (box[5] - box[2]) * (box[5] - box[2]));
+    const double d = SW_LOD_STATIC_DELTA_REL * sqrt((box[3] - box[0]) * (box[3] - box[0]) +
+                                                    (box[4] - box[1]) * (box[4] - box[1]) +
+                                                    (box[5] - box[2]) * (box[5] - box[2]));
     return d > 0.0 ? d : 1e-12; /* a super-surface collapsed to a point */
 }
 
@@ -1638,7 +771,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
     mesh_buf m = {0};
     sw_lod_static_desc d;
     sw_lod_static_chain *chain = NULL;
-    sw_result r = patch_set_init(scene, patches, n, &ps, status);
+    sw_result r = sw__sl_patch_set_init(scene, patches, n, &ps, status);
     if (r == SW_OK)
         r = sw_lod_static_desc_resolve(desc, &d, status);
     if (r == SW_OK && d.delta == 0.0)
@@ -1646,12 +779,12 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
     const uint32_t max_vertices = r == SW_OK ? vertex_limit(&d, ps.n) : 0;
     for (uint32_t f = 0; r == SW_OK && f < ps.n_faces; ++f) {
         face_dom *fd = &ps.faces[f];
-        if (!face_dom_refine(fd, sqrt(2.4 * 0.75 * d.delta))) {
+        if (!sw__sl_face_dom_refine(fd, sqrt(2.4 * 0.75 * d.delta))) {
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: face %u cells", fd->face);
             break;
         }
         const double tol = 0.25 * d.delta / (fd->grad > 0.0 ? fd->grad : 1.0);
-        r = face_dom_flatten(scene, fd, tol, status);
+        r = sw__sl_face_dom_flatten(scene, fd, tol, status);
         if (r == SW_OK)
             r = tessellate_face(scene, fd, 0.75 * d.delta, max_vertices, &m, status);
     }
@@ -1695,8 +828,8 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         const double t1 = now_seconds();
         sw_lod_static_distance dist;
         if (r == SW_OK)
-            r = measure_set(scene, &ps, &chain->levels[0], NULL, d.delta, d.delta, NULL, &dist,
-                            status);
+            r = sw__sl_measure_set(scene, &ps, &chain->levels[0], NULL, d.delta, d.delta, NULL,
+                                   &dist, status);
         if (r == SW_OK) {
             chain->levels[0].measured[0] = dist.surface_to_mesh;
             chain->levels[0].measured[1] = dist.mesh_to_surface;
@@ -1704,7 +837,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         chain->seconds[2] = b.t_measure + now_seconds() - t1;
     }
     mesh_buf_free(&m);
-    patch_set_free(&ps);
+    sw__sl_patch_set_free(&ps);
     if (r != SW_OK) {
         sw_lod_static_free(chain);
         return r;
