@@ -391,7 +391,7 @@ void sw__sl_patch_set_free(patch_set *ps)
     memset(ps, 0, sizeof *ps);
 }
 
-static int patch_cmp(const void *a, const void *b)
+int sw__sl_patch_cmp(const void *a, const void *b)
 {
     const sw_lod_static_patch *x = a, *y = b;
     if (x->face != y->face)
@@ -416,10 +416,10 @@ sw_result sw__sl_patch_set_init(const sw_sg_scene *scene, const sw_lod_static_pa
     if (!ps->p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: %u patches", n);
     memcpy(ps->p, patches, (size_t)n * sizeof *ps->p);
-    qsort(ps->p, n, sizeof *ps->p, patch_cmp);
+    qsort(ps->p, n, sizeof *ps->p, sw__sl_patch_cmp);
     uint32_t m = 0, nf = 0;
     for (uint32_t k = 0; k < n; ++k)
-        if (m == 0 || patch_cmp(&ps->p[m - 1], &ps->p[k]) != 0) {
+        if (m == 0 || sw__sl_patch_cmp(&ps->p[m - 1], &ps->p[k]) != 0) {
             nf += m == 0 || ps->p[m - 1].face != ps->p[k].face;
             ps->p[m++] = ps->p[k];
         }

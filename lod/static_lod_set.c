@@ -2,6 +2,7 @@
 /* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
  * units are formed and how slots are published). */
 #include "sw_lod_static_set.h"
+#include "sw_lod_static_internal.h"
 #include "sw_hooks.h"
 
 #include "sw_sg_geom.h"
@@ -79,16 +80,6 @@ static int home_clusters(const sw_lod_supersurfaces *ss, uint32_t n_faces, uint3
     return 1;
 }
 
-static int patch_cmp(const void *a, const void *b)
-{
-    const sw_lod_static_patch *p = a, *q = b;
-    if (p->face != q->face)
-        return p->face < q->face ? -1 : 1;
-    if (p->iv != q->iv)
-        return p->iv < q->iv ? -1 : 1;
-    return (p->iu > q->iu) - (p->iu < q->iu);
-}
-
 /* Renumbers home clusters into units (in cluster order, so deterministic) and fills faces[],
  * patches[] and the units' ranges. */
 static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_status *status)
@@ -149,7 +140,7 @@ static sw_result form_units(sw_lod_static_set *s, const uint32_t *home, sw_statu
     }
     for (uint32_t u = 0; u < s->n_units; ++u)
         qsort(s->patches + s->units[u].first_patch, s->units[u].n_patches, sizeof *s->patches,
-              patch_cmp);
+              sw__sl_patch_cmp);
     sw__free(unit_of_cluster);
     return SW_OK;
 }

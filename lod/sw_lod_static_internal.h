@@ -76,6 +76,8 @@ int sw__sl_face_dom_refine(face_dom *fd, double c);
 sw_result sw__sl_face_dom_flatten(const sw_sg_scene *scene, face_dom *fd, double tol,
                                   sw_status *status);
 void sw__sl_patch_set_free(patch_set *ps);
+/* qsort order of sw_lod_static_patch: by face, then iv, then iu. */
+int sw__sl_patch_cmp(const void *a, const void *b);
 /* The faces of a patch list, each with its selected patches and its cell grid. */
 sw_result sw__sl_patch_set_init(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
                                 uint32_t n, patch_set *ps, sw_status *status);
