@@ -538,12 +538,16 @@ static int affine_segments(int32_t p, int32_t q, const double *net, const double
     return 1;
 }
 
+/* all (not NULL): also the bounds of the whole image (every component), from the same products:
+ * they depend on the mask only through the final norms. */
 static void sub_measure(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
-                        double ku, double kv, sub_info *o)
+                        double ku, double kv, sub_info *o, sw_lod_patch_bounds *all)
 {
-    static const unsigned masks[2] = {3u, 4u};
-    sw_lod_patch_bounds b[2];
-    bounds_masked(p, q, net, masks, 2, b);
+    static const unsigned masks[3] = {3u, 4u, 7u};
+    sw_lod_patch_bounds b[3];
+    bounds_masked(p, q, net, masks, all ? 3 : 2, b);
+    if (all)
+        *all = b[2];
     double scale[3] = {ku * ku, ku * kv, kv * kv};
     for (int k = 0; k < 3; ++k) {
         o->ml[k] = b[0].d2[k] * scale[k];
@@ -654,10 +658,8 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
         return 1;
     }
     sub_info whole, subs[SUB_MAX * SUB_MAX];
-    sub_measure(deg_u, deg_v, part, v, 1.0, 1.0, &whole);
-    static const unsigned all = 7u;
     sw_lod_patch_bounds rb;
-    bounds_masked(deg_u, deg_v, part, &all, 1, &rb);
+    sub_measure(deg_u, deg_v, part, v, 1.0, 1.0, &whole, &rb);
     out->d1[0] = rb.d1[0] / (range[1] - range[0]);
     out->d1[1] = rb.d1[1] / (range[3] - range[2]);
     /* pmax bounds |tan| of every view direction into the part: the one tangent of the rule */
@@ -675,7 +677,7 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
                 double r[4] = {(double)a / k, (double)(a + 1) / k, (double)b / k,
                                (double)(b + 1) / k};
                 patch_part(deg_u, deg_v, part, r, sub);
-                sub_measure(deg_u, deg_v, sub, v, k, k, &subs[b * k + a]);
+                sub_measure(deg_u, deg_v, sub, v, k, k, &subs[b * k + a], NULL);
             }
         found = choose_segments(&whole, subs, k, v, allowed, n_allowed, guess);
     }
