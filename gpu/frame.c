@@ -247,6 +247,7 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     double t4 = sw__gpu_now_ms();
 
     st->triangles += geo->mesh.n_idx / 3 - geo->border_triangles;
+    st->border_triangles = geo->border_triangles;
     st->ms_trim = t2 - t1;
     st->ms_draw = t3 - t2;
     st->ms_readback = t4 - t3;

@@ -128,7 +128,8 @@ typedef struct sw_gpu_frame_stats {
     uint64_t patches_trimmed;           /* Bézier patches drawn with a trim-texture lookup */
     uint64_t patches_untrimmed;         /* drawn without one */
     uint64_t patches_culled; /* outside the view frustum, or outside their face's trim box */
-    uint64_t triangles;
+    uint64_t triangles;        /* every triangle drawn, fat borders included */
+    uint64_t border_triangles; /* of triangles: the fat borders' (Guthe §7.1 crack filling) */
     uint64_t trim_textures, trim_texels;
     double ms_tessellate; /* traversal, bounds, CPU grids (without ms_hierarchy) */
     double ms_trim;       /* trim-texture generation */

@@ -369,6 +369,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->tess_chunks = g->tess_chunks;
     out->tess_chunks_by_pool = g->tess_chunks_by_pool;
     out->ms_join = g->ms_join;
+    out->border_triangles = g->border_triangles;
 }
 
 static int camera_is_zero(const sw_camera *c)

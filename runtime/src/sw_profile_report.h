@@ -65,7 +65,8 @@
     X(FACES_CULLED, "faces_culled", COUNT, "face occurrences culled")                              \
     X(HIERARCHY_NODES, "hierarchy_nodes", COUNT, "hierarchy nodes drawn")                          \
     X(REFINE_ROUNDS, "refine_rounds", COUNT, "refinement rounds waited for")                       \
-    X(TRIANGLES, "triangles", COUNT, "triangles drawn (fat borders excluded)")                     \
+    X(TRIANGLES, "triangles", COUNT, "triangles drawn (fat borders included)")                     \
+    X(BORDER_TRIANGLES, "border_triangles", COUNT, "of those, the fat borders' (crack filling)")   \
     X(TRIM_TEXTURES, "trim_textures", COUNT, "trim textures used")                                 \
     X(TRIM_TEXELS, "trim_texels", COUNT, "texels of those trim textures")                          \
     X(TRIM_REUSED, "trim_reused", COUNT, "trim textures kept from earlier frames")                 \

@@ -24,7 +24,7 @@ for tool in xmllint jq awk; do
   command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
 done
 
-columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,prepare_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,vis_join_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_frame_stage_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_frame_stage_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,prepare_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,vis_join_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,border_triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_frame_stage_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_frame_stage_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
 # col NAME: NAME's field number in profile.csv (the stages lie between frame_ms and other_ms)
 col() { echo "$columns" | tr , '\n' | grep -nx "$1" | cut -d: -f1; }
 
@@ -65,7 +65,12 @@ check_run() {
   local dir=$1 n=$2
   [ "$(head -1 "$dir/profile.csv")" = "$columns" ] || fail "$dir: CSV header: $(head -1 "$dir/profile.csv")"
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
-  awk -F, -v n=59 -v n_other="$(col other_ms)" 'NR > 1 {
+  # border_triangles: some in every run (every face drawn gets its fat borders), never more than
+  # the triangles they are counted in (a field left unset or counted apart fails here)
+  awk -F, -v n=60 -v n_other="$(col other_ms)" -v n_tri="$(col triangles)" \
+      -v n_border="$(col border_triangles)" 'NR > 1 {
+      if ($n_border > $n_tri) { print "row " NR ": " $n_border " border triangles of " $n_tri; bad = 1 }
+      borders += $n_border
       if (NF != n) { print "row " NR ": " NF " fields"; bad = 1 }
       for (i = 1; i <= NF; i++) if ($i !~ /^-?[0-9]+(\.[0-9]+)?$/) { print "row " NR " field " i ": " $i; bad = 1 }
       if ($1 != NR - 2) { print "row " NR ": frame " $1; bad = 1 }
@@ -73,7 +78,8 @@ check_run() {
       if (($3 - stages - $n_other) > 0.002 || ($3 - stages - $n_other) < -0.002) { print "row " NR ": other " $n_other " != " $3 - stages; bad = 1 }
       if (NR > 2 && $2 <= prev_t) { print "row " NR ": t_s not increasing"; bad = 1 }
       prev_t = $2
-    } END { exit bad }' "$dir/profile.csv" >awk.txt || { fail "$dir: CSV rows"; head -5 awk.txt; }
+    } END { if (!(borders > 0)) { print "no fat-border triangles in any frame"; bad = 1 }
+            exit bad }' "$dir/profile.csv" >awk.txt || { fail "$dir: CSV rows"; head -5 awk.txt; }
   jq -e ".frame_count == $n and (.frames | length) == $n" "$dir/profile.json" >/dev/null ||
     fail "$dir: profile.json is not valid JSON or has not $n frames"
   local med_csv med_json

@@ -402,6 +402,9 @@ typedef struct sw_frame_stats {
      * no other task meanwhile) */
     uint64_t tess_chunks, tess_chunks_by_pool;
     double ms_join;
+    /* of triangles: the fat borders drawn along the faces' boundaries to close cracks between
+     * independently tessellated faces (Guthe et al. 2005 §7.1); a resident mesh has none */
+    uint64_t border_triangles;
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so
