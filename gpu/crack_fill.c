@@ -380,9 +380,10 @@ typedef struct ribbon_ctx {
     const loop_grid *grid;
     double side, width_px;
     const double *st_box; /* trim lookup's rectangle, or NULL (st = 0) */
-    int affine;           /* the surface is affine in (u, v): su, sv its world derivatives, */
-    double su[3], sv[3];  /* so its eye-relative point at (0, 0), sn its world normal (as */
-    double so[3], sn[3];  /* eval_point scales it) */
+    int affine;           /* the surface is affine in (u, v); then, in the world: */
+    double su[3], sv[3];  /* its derivatives */
+    double so[3];         /* its point at (0, 0), eye-relative */
+    double sn[3];         /* its normal, scaled as eval_point's */
 } ribbon_ctx;
 
 /* An affine surface (a plane, as CAD files store most faces) needs no evaluation along the step:
