@@ -236,8 +236,8 @@ typedef struct loop_grid {
     size_t n;
     double lo[2], cell[2];
     int32_t g[2];
-    uint32_t *start; /* g[0] g[1] + 1 offsets into items */
-    uint32_t *items; /* segment indices, cell by cell */
+    uint32_t *start;                                  /* g[0] g[1] + 1 offsets into items */
+    uint32_t *items;                                  /* segment indices, cell by cell */
     uint32_t small_start[2], small_items[SMALL_LOOP]; /* a small loop's, in place */
 } loop_grid;
 
