@@ -237,16 +237,23 @@ static void binomials(int32_t n, double *b)
         b[k] = b[k - 1] * (double)(n - k + 1) / (double)k;
 }
 
-/* Largest norm (components in mask) of the Bernstein coefficients. */
-static double bp_max_norm(const bpoly *p, unsigned mask)
+/* Per mask, the largest norm (components in the mask) of the Bernstein coefficients, in one pass
+ * over them. Norms are never NaN, so the plain comparison keeps what fmax would. */
+static void bp_max_norms(const bpoly *p, const unsigned *masks, int n_masks, double *out)
 {
-    double bm[BMAX + 1], bn[BMAX + 1], m = 0.0;
+    double bm[BMAX + 1], bn[BMAX + 1];
     binomials(p->m, bm);
     binomials(p->n, bn);
+    for (int k = 0; k < n_masks; ++k)
+        out[k] = 0.0;
     for (int32_t j = 0; j <= p->n; ++j)
-        for (int32_t i = 0; i <= p->m; ++i)
-            m = fmax(m, norm_mask(bp_at(p, i, j), mask) / (bm[i] * bn[j]));
-    return m;
+        for (int32_t i = 0; i <= p->m; ++i) {
+            const double *c = bp_at(p, i, j), d = bm[i] * bn[j];
+            for (int k = 0; k < n_masks; ++k) {
+                const double x = norm_mask(c, masks[k]) / d;
+                out[k] = x > out[k] ? x : out[k];
+            }
+        }
 }
 
 /* Smallest Bernstein coefficient of a scalar polynomial. */
@@ -301,12 +308,18 @@ static int product_bounds(int32_t p, int32_t q, const double *cpw, const double 
     bpoly kst = bp_cross_diff(&a, &nts, &w, 2.0, &nt, &ws);
     bpoly ktt = bp_cross_diff(&a, &ntt, &w, 2.0, &nt, &wt);
     double m2 = bp_min(&w2), m3 = bp_min(&w3);
+    double n_s[3], n_t[3], n_ss[3], n_st[3], n_tt[3];
+    bp_max_norms(&ns, masks, n_masks, n_s);
+    bp_max_norms(&nt, masks, n_masks, n_t);
+    bp_max_norms(&kss, masks, n_masks, n_ss);
+    bp_max_norms(&kst, masks, n_masks, n_st);
+    bp_max_norms(&ktt, masks, n_masks, n_tt);
     for (int k = 0; k < n_masks; ++k) {
-        out[k].d1[0] = bp_max_norm(&ns, masks[k]) / m2;
-        out[k].d1[1] = bp_max_norm(&nt, masks[k]) / m2;
-        out[k].d2[0] = bp_max_norm(&kss, masks[k]) / m3;
-        out[k].d2[1] = bp_max_norm(&kst, masks[k]) / m3;
-        out[k].d2[2] = bp_max_norm(&ktt, masks[k]) / m3;
+        out[k].d1[0] = n_s[k] / m2;
+        out[k].d1[1] = n_t[k] / m2;
+        out[k].d2[0] = n_ss[k] / m3;
+        out[k].d2[1] = n_st[k] / m3;
+        out[k].d2[2] = n_tt[k] / m3;
     }
     if (a.mem != stack_mem)
         sw__free(a.mem);
