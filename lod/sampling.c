@@ -238,7 +238,8 @@ static void binomials(int32_t n, double *b)
 }
 
 /* Per mask, the largest norm (components in the mask) of the Bernstein coefficients, in one pass
- * over them. Norms are never NaN, so the plain comparison keeps what fmax would. */
+ * over them. The comparison skips a NaN norm as fmax(out, NaN) does, and out never becomes NaN,
+ * so the result is fmax's. */
 static void bp_max_norms(const bpoly *p, const unsigned *masks, int n_masks, double *out)
 {
     double bm[BMAX + 1], bn[BMAX + 1];
@@ -268,8 +269,9 @@ static double bp_min(const bpoly *p)
     return m;
 }
 
-/* The Bernstein-product bounds (see the top of the file), one set per mask; 0 when out of memory
- * or too high a degree (the caller keeps the other bound then). */
+/* The Bernstein-product bounds (see the top of the file), one set per mask (at most 3:
+ * bounds_masked calls it with no more); 0 when out of memory or too high a degree (the caller keeps
+ * the other bound then). */
 static int product_bounds(int32_t p, int32_t q, const double *cpw, const double c[3],
                           const unsigned *masks, int n_masks, sw_lod_patch_bounds *out)
 {
