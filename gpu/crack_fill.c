@@ -186,7 +186,7 @@ static size_t thin_samples(const sw__gpu_view *v, border_point *bp, size_t n, do
 /* |(x, y)| of screen vectors: hypot guards against overflow and underflow at several times the
  * cost of the plain root (it was 5 % of a building's prepare), so it only takes the cases where
  * the squares leave the range of double. */
-static double length2(double x, double y)
+static double screen_length(double x, double y)
 {
     const double r = sqrt(x * x + y * y);
     return r > 0.0 && r < INFINITY ? r : hypot(x, y);
@@ -221,7 +221,7 @@ static double inward_length(const sw__gpu_view *v, const double p[3], const doub
     double ts[2], is[2];
     screen_deriv(v, p, t, ts);
     screen_deriv(v, p, in, is);
-    double tl = length2(ts[0], ts[1]);
+    double tl = screen_length(ts[0], ts[1]);
     if (!(tl > 0.0))
         return 0.0;
     double perp = fabs(is[0] * ts[1] - is[1] * ts[0]) / tl; /* pixels per unit of `in` */
@@ -466,7 +466,7 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const doub
         for (int i = 0; i < 3; ++i)
             chord[i] = 0.5 * (e->p[i] + q[i]);
         if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm) && screen_of(c->v, chord, sc) &&
-            length2(sm[0] - sc[0], sm[1] - sc[1]) <= tol) {
+            screen_length(sm[0] - sc[0], sm[1] - sc[1]) <= tol) {
             memcpy(out, q, sizeof q);
             return s;
         }
@@ -481,7 +481,7 @@ static double depth_per_px(const sw__gpu_view *v, const double a[3], const doubl
     double sa[2], sb[2];
     if (!screen_of(v, a, sa) || !screen_of(v, b, sb))
         return 0.0;
-    double px = length2(sb[0] - sa[0], sb[1] - sa[1]), dz = 0.0;
+    double px = screen_length(sb[0] - sa[0], sb[1] - sa[1]), dz = 0.0;
     for (int k = 0; k < 3; ++k)
         dz += v->fwd[k] * (b[k] - a[k]);
     return px > 0.0 ? fabs(dz) / px : 0.0;
