@@ -24,6 +24,7 @@
  * behind it — the test could only answer "not outside". An instance none of whose faces is shown
  * is culled whole: no level is chosen, asked for or drawn. */
 #include "frame_stages.h"
+#include "occlusion.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
 
@@ -258,6 +259,160 @@ static sw_result collect_bvh(const sw__fr_env *env, const sw_sg_bvh *bvh, sw__fr
     return SW_OK;
 }
 
+/* ---- the faces' BVH with occlusion culling (gpu/occlusion.h) -------------------------------
+ * The BVH is walked near to far (the nearer child first), so that the planes found visible first
+ * hide what lies behind them: a node hidden by the occlusion map is culled with its subtree, a
+ * face occurrence hidden by it is culled, and a visible planar one is drawn into the map. Back
+ * faces are culled on the way (not drawn into the map: they are not drawn). The visible items are
+ * then taken in increasing index order, as sw_sg_bvh_cull reports them, so that the frame draws
+ * the faces it keeps in the order it draws them without occlusion culling. */
+enum { OCC_STACK = 128 };
+
+typedef struct occ_walk {
+    const sw__fr_env *env;
+    const sw_sg_bvh *bvh;
+    const sw_gpu_occluders *oc;
+    const sw_lod_face_cones *fc;
+    sw_sg_frustum fr;
+    sw__occ_map map;
+    uint32_t *kept; /* visible items */
+    size_t n_kept, cap_kept;
+    sw_sg_bvh_cull_stats cs;
+    uint64_t back, nodes_occluded, faces_occluded;
+    int oom;
+} occ_walk;
+
+static int hidden(occ_walk *w, const double world_box[6])
+{
+    double eb[6];
+    sw__fr_eye_box(w->env->view.eye, world_box, eb);
+    return sw__occ_map_box_hidden(&w->map, eb);
+}
+
+/* One item of a leaf: frustum (unless its node is inside), occlusion, back face; kept ones are
+ * drawn into the map. */
+static void occ_item(occ_walk *w, uint32_t item, int inside)
+{
+    const sw_sg_bvh_item *it = &w->bvh->items[item];
+    if (!inside) {
+        w->cs.items_tested++;
+        if (sw_sg_frustum_classify(&w->fr, it->box) == SW_SG_CULL_OUTSIDE)
+            return;
+    }
+    w->cs.items_visible++;
+    if (hidden(w, it->box)) {
+        w->faces_occluded++;
+        return;
+    }
+    if (w->fc) {
+        occurrence o;
+        double eb[6];
+        sw__fr_occurrence_init(&o, it->face, it->world, it->color);
+        sw__fr_eye_box(w->env->view.eye, it->box, eb);
+        if (sw__fr_face_back_facing(w->fc, &o, eb)) {
+            w->back++;
+            return;
+        }
+    }
+    if (!sw__gpu_grow((void **)&w->kept, &w->cap_kept, w->n_kept + 1, sizeof *w->kept) ||
+        sw__occ_map_add_face(&w->map, w->oc, it->face, it->world, w->env->view.eye) < 0) {
+        w->oom = 1;
+        return;
+    }
+    w->kept[w->n_kept++] = item;
+}
+
+static double node_distance(const occ_walk *w, int32_t node)
+{
+    double eb[6];
+    sw__fr_eye_box(w->env->view.eye, w->bvh->nodes[node].box, eb);
+    return sw__gpu_box_distance(eb);
+}
+
+static void occ_walk_bvh(occ_walk *w)
+{
+    uint32_t stack[OCC_STACK];
+    uint8_t inside_of[OCC_STACK];
+    uint32_t n = w->bvh->n_nodes ? 1 : 0;
+    stack[0] = 0;
+    inside_of[0] = 0;
+    while (n > 0 && !w->oom) {
+        --n;
+        const sw_sg_bvh_node *node = &w->bvh->nodes[stack[n]];
+        int inside = inside_of[n];
+        w->cs.nodes_visited++;
+        if (!inside) {
+            const sw_sg_cull_class k = sw_sg_frustum_classify(&w->fr, node->box);
+            if (k == SW_SG_CULL_OUTSIDE) {
+                w->cs.nodes_outside++;
+                continue;
+            }
+            inside = k == SW_SG_CULL_INSIDE;
+        }
+        *(inside ? &w->cs.nodes_inside : &w->cs.nodes_partly) += 1;
+        if (hidden(w, node->box)) {
+            w->nodes_occluded++;
+            w->faces_occluded += node->count;
+            continue;
+        }
+        if (node->child[0] < 0 || n + 2 > OCC_STACK) {
+            for (uint32_t i = node->first; i < node->first + node->count && !w->oom; ++i)
+                occ_item(w, i, inside);
+            continue;
+        }
+        /* the nearer child on top of the stack */
+        const int near1 = node_distance(w, node->child[1]) < node_distance(w, node->child[0]);
+        stack[n] = (uint32_t)node->child[near1 ? 0 : 1];
+        inside_of[n++] = (uint8_t)inside;
+        stack[n] = (uint32_t)node->child[near1 ? 1 : 0];
+        inside_of[n++] = (uint8_t)inside;
+    }
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bvh,
+                                      const sw_gpu_occluders *oc, const sw_lod_face_cones *fc,
+                                      sw__fr_faces *faces, sw_gpu_frame_stats *st,
+                                      sw_status *status)
+{
+    occ_walk w;
+    memset(&w, 0, sizeof w);
+    w.env = env;
+    w.bvh = bvh;
+    w.oc = oc;
+    w.fc = fc;
+    view_frustum(env, &w.fr);
+    if (!sw__occ_map_init(&w.map, &env->view, env->eps_px))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
+    occ_walk_bvh(&w);
+    qsort(w.kept, w.n_kept, sizeof *w.kept, cmp_u32);
+    for (size_t i = 0; i < w.n_kept && !w.oom; ++i) {
+        const sw_sg_bvh_item *it = &bvh->items[w.kept[i]];
+        occurrence o;
+        double box[6];
+        sw__fr_occurrence_init(&o, it->face, it->world, it->color);
+        sw__fr_eye_box(env->view.eye, it->box, box);
+        w.oom = !sw__fr_faces_push(faces, &o, box);
+    }
+    st->faces_culled += bvh->n_items - w.n_kept;
+    st->faces_backculled += w.back;
+    st->occlusion_tests += w.map.tests;
+    st->nodes_occluded += w.nodes_occluded;
+    st->faces_occluded += w.faces_occluded;
+    st->occluders_drawn += w.map.occluders_drawn;
+    add_bvh_stats(st, &w.cs);
+    sw__free(w.kept);
+    sw__occ_map_free(&w.map);
+    if (w.oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    return SW_OK;
+}
+
 /* ---- back-patch culling ------------------------------------------------------------------ */
 int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6])
 {
@@ -408,11 +563,18 @@ sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__
 {
     const sw_lod_face_cones *fc = desc->face_cones;
     sw_result r = fc ? check_cones(env, fc, status) : SW_OK;
+    const int occlusion = desc->occluders && face_bvh(desc) && !static_instances(env);
+    if (r == SW_OK && desc->occluders &&
+        desc->occluders->scene_serial != sw_sg_scene_serial(env->scene))
+        r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "frame: occluders of another scene");
     if (r == SW_OK && static_instances(env))
         r = collect_instances(env, fc, vis, st, status);
+    else if (r == SW_OK && occlusion)
+        r = collect_bvh_occluded(env, face_bvh(desc), desc->occluders, fc, &vis->faces, st,
+                                 status);
     else if (r == SW_OK && face_bvh(desc))
         r = collect_bvh(env, face_bvh(desc), &vis->faces, st, status);
-    if (r == SW_OK && fc)
+    if (r == SW_OK && fc && !occlusion)
         cull_back_faces(fc, &vis->faces, st);
     if (r == SW_OK)
         cull_meshes(env, vis, st);

@@ -119,7 +119,20 @@ typedef struct sw_gpu_frame_desc {
                               per-frame faces are tessellated in chunks by the caller and this
                               pool's workers together (the output in the same order as on one
                               thread); the caller never runs another task while it joins them */
+    const struct sw_gpu_occluders *occluders; /* NULL: no occlusion culling; else the scene's
+                              planar faces as occluders (sw_gpu_occluders_build, once per scene):
+                              the BVH is walked near to far and what the visible planes hide
+                              is culled, conservatively (gpu/occlusion.h). With desc.bvh only */
 } sw_gpu_frame_desc;
+
+/* The planar faces of a scene as occluders: their outlines in object space, built once per scene
+ * (their trim loops flattened). Errors: SW_ERR_OUT_OF_MEMORY. *out owned by the caller. */
+typedef struct sw_gpu_occluders sw_gpu_occluders;
+sw_result sw_gpu_occluders_build(const struct sw_sg_scene *scene, sw_gpu_occluders **out,
+                                 sw_status *status);
+void sw_gpu_occluders_free(sw_gpu_occluders *oc); /* NULL allowed */
+size_t sw_gpu_occluders_memory(const sw_gpu_occluders *oc);
+uint32_t sw_gpu_occluders_count(const sw_gpu_occluders *oc); /* faces that are occluders */
 
 enum { SW_GPU_EXACT_MAX_DEGREE = 15 }; /* per direction; larger faces fail with SW_ERR_LIMIT */
 
@@ -196,6 +209,10 @@ typedef struct sw_gpu_frame_stats {
      * time the preparing thread waited at the join for chunks a worker was still running */
     uint64_t tess_chunks, tess_chunks_by_pool;
     double ms_join;
+    /* occlusion culling (desc.occluders): boxes tested against the occlusion map, BVH nodes and
+     * face occurrences found hidden (of faces_culled: the occurrences under those nodes too),
+     * planar faces drawn into the map */
+    uint64_t occlusion_tests, nodes_occluded, faces_occluded, occluders_drawn;
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

@@ -32,6 +32,7 @@ typedef struct sw_rt_renderer {
     sw_lod_cache *cache;      /* of cache_scene */
     sw_sg_bvh *bvh;           /* of cache_scene */
     sw_lod_face_cones *cones; /* of cache_scene: back-patch culling of closed shells */
+    sw_gpu_occluders *occluders; /* of cache_scene: built on the first occlusion-culled frame */
     /* of cache_scene: static LODs (Kumar §3-§4), the set made by a pool task on the first frame
      * that asks for them and published by one pointer store; statics_state: 0 none, 1 being
      * made, 2 ready, 3 failed (statics_failure says why) */
@@ -213,6 +214,8 @@ static void drop_cache(sw_rt_renderer *r)
     r->bvh = NULL;
     sw_lod_face_cones_free(r->cones);
     r->cones = NULL;
+    sw_gpu_occluders_free(r->occluders);
+    r->occluders = NULL;
     if (r->cache_scene)
         sw_rt_scene_release(r->cache_scene);
     r->cache_scene = NULL;
@@ -370,6 +373,10 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->tess_chunks_by_pool = g->tess_chunks_by_pool;
     out->ms_join = g->ms_join;
     out->border_triangles = g->border_triangles;
+    out->occlusion_tests = g->occlusion_tests;
+    out->nodes_occluded = g->nodes_occluded;
+    out->faces_occluded = g->faces_occluded;
+    out->occluders_drawn = g->occluders_drawn;
 }
 
 static int camera_is_zero(const sw_camera *c)
@@ -512,7 +519,10 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
     frame->pool = r->pool;
     frame->lod_colors = desc->lod_colors != 0;
     frame->static_force = desc->static_force > 0 ? desc->static_force : 0;
-    if (desc->static_lods && !frame->eval_exact)
+    if (desc->occlusion_culling && !r->occluders)
+        res = sw_gpu_occluders_build(scene->sg, &r->occluders, status);
+    frame->occluders = desc->occlusion_culling ? r->occluders : NULL;
+    if (res == SW_OK && desc->static_lods && !frame->eval_exact)
         res = frame_statics(r, frame, status);
     return res;
 }

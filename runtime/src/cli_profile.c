@@ -25,6 +25,7 @@ static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
     "                          [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
+    "                          [--occlusion]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
     "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
@@ -64,6 +65,8 @@ static const char k_usage[] =
     "                    built in the pool on first need: static_drawn, static_faces,\n"
     "                    static_triangles, static_requests columns\n"
     "  --lod-colors      colour by representation, as for `render`\n"
+    "  --occlusion       cull what visible planar faces hide (as for `render`):\n"
+    "                    occlusion_tests, nodes_occluded, faces_occluded columns\n"
     "  -h, --help        this text\n";
 
 typedef struct profile_args {
@@ -104,6 +107,10 @@ static int parse_args(int argc, char **argv, profile_args *a)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(arg, "--occlusion")) {
+            a->frame.occlusion_culling = 1;
+            continue;
+        }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
             *(!strcmp(arg, "--static-lod") ? &a->frame.static_lods : &a->frame.lod_colors) = 1;
             continue;

@@ -11,7 +11,7 @@ static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
-    "                         [--static-force K] [--partial]\n"
+    "                         [--static-force K] [--occlusion] [--partial]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as EXR\n"
@@ -44,6 +44,9 @@ static const char k_usage[] =
     "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
     "                      (i + K) mod (n + 1) of its n levels good enough for the view, the last\n"
     "                      choice meaning per-frame: neighbours at different levels\n"
+    "  --occlusion         cull what the visible planar faces hide before tessellating it (a\n"
+    "                      depth map of them on the visibility thread; the image is the same);\n"
+    "                      not with --static-lod\n"
     "  --partial           import what is whole of a truncated file (see `import --help`)\n"
     "  -h, --help          this text\n";
 
@@ -63,6 +66,10 @@ static int parse_args(int argc, char **argv, render_args *a)
         int bad = 0;
         if (!strcmp(arg, "--partial")) {
             a->load_flags |= SW_LOAD_PARTIAL;
+            continue;
+        }
+        if (!strcmp(arg, "--occlusion")) {
+            a->frame.occlusion_culling = 1;
             continue;
         }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {

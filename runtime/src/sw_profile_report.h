@@ -82,6 +82,11 @@
       "pieces drawn whose error bound exceeds the screen-space error (capped grids, floors)")      \
     X(BOUND_EXCESS_PX, "bound_excess_px", PIXELS,                                                  \
       "the worst known bound over the screen-space error, in pixels")                              \
+    X(OCCLUSION_TESTS, "occlusion_tests", COUNT,                                                   \
+      "--occlusion: boxes tested against the occlusion map")                                       \
+    X(NODES_OCCLUDED, "nodes_occluded", COUNT, "--occlusion: hierarchy (BVH) nodes found hidden")  \
+    X(FACES_OCCLUDED, "faces_occluded", COUNT,                                                     \
+      "--occlusion: face occurrences culled as hidden (of faces_culled)")                          \
     SW_TH_TASK_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \
     SW_TH_TASK_KINDS(SW_RT__POOL_TASKS_COLUMN, X)                                                  \
     X(POOL_QUEUED, "pool_queued", COUNT,                                                           \

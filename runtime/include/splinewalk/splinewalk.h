@@ -351,6 +351,14 @@ typedef struct sw_frame_desc {
                                 nearer is clipped); 0: chosen per frame from the scene's box
                                 (max(1e-4 x its diagonal, half the eye's distance to it)), given
                                 back in sw_frame_stats.near_plane */
+    int32_t occlusion_culling; /* 1: what the visible planar faces hide is culled before it is
+                                tessellated: the scene's bounding-volume hierarchy is walked near
+                                to far and each planar face found visible is drawn into a
+                                quarter-resolution depth map on the visibility thread, against
+                                which the boxes behind are tested. Conservative: the image is
+                                the one without it. The outlines are built once per scene, on
+                                the first frame that asks. Not with static_lods (their units are
+                                culled by the frustum only). 0: frustum and back-patch culling */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -405,6 +413,10 @@ typedef struct sw_frame_stats {
     /* of triangles: the fat borders drawn along the faces' boundaries to close cracks between
      * independently tessellated faces (Guthe et al. 2005 §7.1); a resident mesh has none */
     uint64_t border_triangles;
+    /* occlusion culling (sw_frame_desc.occlusion_culling): boxes tested against the occlusion
+     * map, hierarchy nodes and face occurrences found hidden (of faces_culled, the occurrences
+     * under those nodes included), planar faces drawn into the map */
+    uint64_t occlusion_tests, nodes_occluded, faces_occluded, occluders_drawn;
 } sw_frame_stats;
 
 /* Renders one frame: converged by default (every refinement done before the frame is drawn, so
