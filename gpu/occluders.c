@@ -52,14 +52,14 @@ static int push_loop(builder *b, uint32_t first, uint32_t count)
 /* The face's trim loops flattened within tol in (u, v): 1, or 0 when they cannot serve (too many
  * points, a loop flattened at its floor: its distance from the curve is not known), -1 when out
  * of memory. loops[] is filled as far as it got (the caller frees it). */
-static int flatten_loops(const sw_sg_scene *scene, const sw_sg_face_rec *rec,
-                         sw_sg_polyline *loops, double tol)
+static int flatten_loops(const sw_sg_scene *scene, const sw_sg_face_rec *rec, sw_sg_polyline *loops,
+                         double tol)
 {
     size_t total = 0;
     for (uint32_t k = 0; k < rec->n_loops; ++k) {
         sw_status st = {0};
-        sw_result r = sw_sg_trim_flatten_loop(scene, rec->first_loop + k, tol, MAX_POINTS,
-                                              &loops[k], &st);
+        sw_result r =
+            sw_sg_trim_flatten_loop(scene, rec->first_loop + k, tol, MAX_POINTS, &loops[k], &st);
         if (r == SW_ERR_OUT_OF_MEMORY)
             return -1;
         if (r != SW_OK || loops[k].below_floor || loops[k].depth_capped)
@@ -91,8 +91,8 @@ static int add_face(builder *b, const sw_sg_scene *scene, uint32_t f)
     const size_t loops0 = oc->n_loops, points0 = oc->n_points;
     int ok = 1;
     if (!(rec->flags & SW_SG_FACE_TRIMMED) || rec->n_loops == 0) {
-        const double c[4][2] = {{box[0], box[2]}, {box[1], box[2]}, {box[1], box[3]},
-                                {box[0], box[3]}};
+        const double c[4][2] = {
+            {box[0], box[2]}, {box[1], box[2]}, {box[1], box[3]}, {box[0], box[3]}};
         for (int i = 0; i < 4 && ok; ++i)
             ok = push_point(b, o, du, dv, c[i][0], c[i][1]);
         ok = ok && push_loop(b, (uint32_t)points0, 4);

@@ -43,33 +43,33 @@ typedef struct sw__occ_face {
 struct sw_gpu_occluders {
     uint64_t scene_serial; /* sw_sg_scene_serial of the scene it was built for */
     uint32_t n_faces, n_occluders;
-    sw__occ_face *faces;                /* n_faces */
-    uint32_t *loop_first, *loop_count;  /* per loop: its first point and its point count */
-    double *points;                     /* 3 per point, object space */
+    sw__occ_face *faces;               /* n_faces */
+    uint32_t *loop_first, *loop_count; /* per loop: its first point and its point count */
+    double *points;                    /* 3 per point, object space */
     size_t n_loops, n_points;
 };
 
 /* ---- per frame: the map (occlusion.c) ------------------------------------------------------ */
 typedef struct sw__occ_map {
-    int32_t w, h;         /* map pixels */
-    int32_t tw, th;       /* 8 x 8 tiles */
-    float *depth;         /* w x h: depth beyond which the pixel is hidden; INFINITY: not covered */
-    float *tile_max;      /* tw x th: the largest depth of the tile's pixels */
-    double scale;         /* full-frame pixels per map pixel */
-    double f, cx, cy;     /* focal length and centre in map pixels */
+    int32_t w, h;     /* map pixels */
+    int32_t tw, th;   /* 8 x 8 tiles */
+    float *depth;     /* w x h: depth beyond which the pixel is hidden; INFINITY: not covered */
+    float *tile_max;  /* tw x th: the largest depth of the tile's pixels */
+    double scale;     /* full-frame pixels per map pixel */
+    double f, cx, cy; /* focal length and centre in map pixels */
     double right[3], up[3], fwd[3], near_plane;
-    double edge_margin;   /* map pixels an outline edge keeps from a covered pixel (ε_img + 1
-                             full-frame pixel), without the outline's own error */
-    double box_margin;    /* map pixels a tested box's rectangle grows by */
-    double min_extent;    /* map pixels an occluder's rectangle must span in x and y */
+    double edge_margin; /* map pixels an outline edge keeps from a covered pixel (ε_img + 1
+                           full-frame pixel), without the outline's own error */
+    double box_margin;  /* map pixels a tested box's rectangle grows by */
+    double min_extent;  /* map pixels an occluder's rectangle must span in x and y */
     /* scratch of one occluder */
-    double *pts;          /* projected points, 3 per point (x, y, depth) */
+    double *pts; /* projected points, 3 per point (x, y, depth) */
     size_t cap_pts;
     uint32_t *counts;
     size_t cap_counts;
-    uint8_t *band;        /* the occluder rectangle's pixels touched by an edge's margin */
+    uint8_t *band; /* the occluder rectangle's pixels touched by an edge's margin */
     size_t cap_band;
-    double *xs;           /* one row's crossings */
+    double *xs; /* one row's crossings */
     size_t cap_xs;
     /* counters of the frame */
     uint64_t occluders_drawn, tests, hidden;
