@@ -602,8 +602,10 @@ sw_result sw_rt_path_orbit(const double bbox[6], double seconds, uint32_t frames
     return SW_OK;
 }
 
-sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
-                         sw_rt_camera_path *out, sw_status *status)
+/* A straight pass through the box along its longer horizontal side, weaving sideways and looking
+ * a quarter of the run ahead, the eye at height z above the box's bottom (fly and walk). */
+static sw_result straight_pass(const double bbox[6], double z, double seconds, uint32_t frames,
+                               sw_rt_camera_path *out, sw_status *status)
 {
     enum { N = 9 };
     assert(seconds > 0.0);
@@ -618,11 +620,9 @@ sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
     double diag = norm3(e);
     if (!(diag > 0.0))
         diag = 1.0; /* a point-sized scene still gets a usable path */
-    /* Along the longer horizontal side; flat or thin boxes get a floor so the eye moves and sits
-     * above the geometry's plane rather than in it. */
+    /* flat or thin boxes get a floor so the eye moves */
     const int a = e[0] >= e[1] ? 0 : 1, b = 1 - a;
     const double len = fmax(e[a], 0.1 * diag), wide = fmax(e[b], 0.1 * diag);
-    const double height = fmax(e[2], 0.1 * diag);
     const double start = c[a] - 0.45 * len, run = 0.9 * len, ahead = 0.25;
     for (uint32_t i = 0; i < N; i++) {
         sw_rt_path_key *k = &out->keys[i];
@@ -630,7 +630,7 @@ sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
         k->t = seconds * s;
         k->camera.eye[a] = start + run * s;
         k->camera.eye[b] = c[b] + 0.15 * wide * sin(2.0 * M_PI * s);
-        k->camera.eye[2] = bbox[2] + 0.3 * height;
+        k->camera.eye[2] = bbox[2] + z;
         k->camera.target[a] = start + run * s2; /* where the eye will be a quarter run later */
         k->camera.target[b] = c[b] + 0.15 * wide * sin(2.0 * M_PI * s2);
         k->camera.target[2] = k->camera.eye[2];
@@ -639,4 +639,23 @@ sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
     }
     out->frames = frames;
     return SW_OK;
+}
+
+sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
+                         sw_rt_camera_path *out, sw_status *status)
+{
+    double e[3];
+    for (int k = 0; k < 3; k++)
+        e[k] = bbox[3 + k] - bbox[k];
+    double diag = norm3(e);
+    if (!(diag > 0.0))
+        diag = 1.0;
+    /* thin boxes: the eye above the geometry's plane rather than in it */
+    return straight_pass(bbox, 0.3 * fmax(e[2], 0.1 * diag), seconds, frames, out, status);
+}
+
+sw_result sw_rt_path_walk(const double bbox[6], double eye_height, double seconds, uint32_t frames,
+                          sw_rt_camera_path *out, sw_status *status)
+{
+    return straight_pass(bbox, eye_height, seconds, frames, out, status);
 }

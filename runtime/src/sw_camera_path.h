@@ -71,10 +71,14 @@ void sw_rt_path_eval(const sw_rt_camera_path *path, double t, sw_camera *out);
  * `seconds` (> 0) duration and `frames` suggested frames. Orbit: 16 keys on a closed circle
  * around the box centre, 25° above its horizontal plane, at the preset fit distance, looking at
  * the centre. Fly: a low pass through the box along its longer horizontal side, eye at 30 % of its
- * height weaving sideways, looking ahead along the path. Errors: SW_ERR_OUT_OF_MEMORY. */
+ * height weaving sideways, looking ahead along the path. Walk: the same pass with the eye
+ * eye_height above the box's bottom (through the rooms of a building). Errors:
+ * SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_rt_path_orbit(const double bbox[6], double seconds, uint32_t frames,
                            sw_rt_camera_path *out, sw_status *status);
 sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
                          sw_rt_camera_path *out, sw_status *status);
+sw_result sw_rt_path_walk(const double bbox[6], double eye_height, double seconds,
+                          uint32_t frames, sw_rt_camera_path *out, sw_status *status);
 
 #endif

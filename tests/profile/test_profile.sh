@@ -24,7 +24,7 @@ for tool in xmllint jq awk; do
   command -v $tool >/dev/null || { echo "FAIL: $tool not installed (scripts/install-deps.sh)"; exit 1; }
 done
 
-columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,prepare_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,vis_join_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,border_triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_frame_stage_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_frame_stage_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
+columns="frame,t_s,frame_ms,hierarchy_ms,tessellate_ms,wait_visibility_ms,prepare_ms,trim_ms,draw_ms,readback_ms,write_ms,other_ms,vis_ms,vis_hierarchy_ms,vis_tessellate_ms,vis_join_ms,patches,patches_trimmed,patches_culled,faces_drawn,faces_culled,hierarchy_nodes,refine_rounds,triangles,border_triangles,trim_textures,trim_texels,trim_reused,atlas_pages,fallback_draws,pool_waits,gpu_ms,static_drawn,static_faces,static_triangles,static_requests,bound_exceeded,bound_excess_px,occlusion_tests,nodes_occluded,faces_occluded,pool_other_ms,pool_hierarchy_ms,pool_hierarchy_wait_ms,pool_refine_ms,pool_static_cluster_ms,pool_static_build_ms,pool_static_retire_ms,pool_compile_ms,pool_frame_stage_ms,pool_other_tasks,pool_hierarchy_tasks,pool_hierarchy_wait_tasks,pool_refine_tasks,pool_static_cluster_tasks,pool_static_build_tasks,pool_static_retire_tasks,pool_compile_tasks,pool_frame_stage_tasks,pool_queued,pool_inject_peak,resident_bytes,captured"
 # col NAME: NAME's field number in profile.csv (the stages lie between frame_ms and other_ms)
 col() { echo "$columns" | tr , '\n' | grep -nx "$1" | cut -d: -f1; }
 
@@ -52,12 +52,14 @@ surfaces=$("$sw" info $scene | awk '$1 == "surfaces" { print $2 }')
 [ "$surfaces" -gt 0 ] 2>/dev/null || fail "splinewalk info: no surface count"
 "$sw" path orbit $scene -o orbit.path --frames 40 --seconds 8 >path.txt 2>&1 || { fail "path orbit"; cat path.txt; }
 "$sw" path fly $scene -o fly.path --frames 8 >>path.txt 2>&1 || { fail "path fly"; cat path.txt; }
+"$sw" path walk $scene -o walk.path --eye-height 0.5 >>path.txt 2>&1 || { fail "path walk"; cat path.txt; }
+[ "$(grep -c '^key ' walk.path)" -eq 9 ] || fail "walk.path: expected 9 keys"
 head -1 orbit.path | grep -qx 'splinewalk-path 1' || fail "orbit.path header: $(head -1 orbit.path)"
 grep -qx closed orbit.path || fail "orbit.path is not closed"
 grep -qx 'frames 40' orbit.path || fail "orbit.path does not suggest 40 frames"
 [ "$(grep -c '^key ' orbit.path)" -eq 17 ] || fail "orbit.path: expected 16 keys + the closing one"
 ls orbit.path.tmp-* >/dev/null 2>&1 && fail "path left a temporary file"
-pass "path orbit / fly"
+pass "path orbit / fly / walk"
 
 # ---- checks on one run's files ------------------------------------------------------------------
 # check_run DIR N: columns, N numeric rows, other = frame - stages, JSON = CSV, XML, captures.
@@ -67,7 +69,7 @@ check_run() {
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
   # border_triangles: some in every run (every face drawn gets its fat borders), never more than
   # the triangles they are counted in (a field left unset or counted apart fails here)
-  awk -F, -v n=60 -v n_other="$(col other_ms)" -v n_tri="$(col triangles)" \
+  awk -F, -v n=63 -v n_other="$(col other_ms)" -v n_tri="$(col triangles)" \
       -v n_border="$(col border_triangles)" 'NR > 1 {
       if ($n_border > $n_tri) { print "row " NR ": " $n_border " border triangles of " $n_tri; bad = 1 }
       borders += $n_border
@@ -219,11 +221,14 @@ stages_add_up seq 3 >median.txt || fail "--sequential: stages do not add up: $(c
 echo "      sequential: $(cat median.txt)"
 jq -e '.worker_threads == 1 and .sequential == true and .mode == "converged"' seq/profile.json \
   >/dev/null || fail "--sequential: not one worker, converged: $(jq -c '[.worker_threads, .sequential, .mode]' seq/profile.json)"
-"$sw" profile $scene --path fly.path --size 160x120 --out fly --threads 1 >fly.txt 2>&1 ||
+"$sw" profile $scene --path fly.path --size 160x120 --out fly --threads 1 --occlusion >fly.txt 2>&1 ||
   { fail "profile along fly.path"; cat fly.txt; }
 check_run fly 8
 jq -e '.worker_threads == 1' fly/profile.json >/dev/null || fail "--threads 1 not passed through"
-pass "sequential and fly-through runs"
+# --occlusion reaches the frame: boxes tested against the occlusion map in every frame
+column fly occlusion_tests | awk '!($1 > 0) { bad = 1 } END { exit bad }' ||
+  fail "--occlusion: a frame without occlusion tests: $(column fly occlusion_tests | tr '\n' ' ')"
+pass "sequential and fly-through runs (occlusion culling on)"
 
 # ---- bad path files -----------------------------------------------------------------------------
 key2='key 1  0 10 0  0 0 0  0 0 1  40'
