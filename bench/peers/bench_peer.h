@@ -46,6 +46,7 @@ typedef struct bp_job {
     const sw_rt_camera_path *path; /* NULL: a stock path of the scene's box made in the child */
     int fly; /* with path NULL: 0 = orbit (sw_rt_path_orbit), 1 = fly-through (sw_rt_path_fly) */
     int static_lods; /* splinewalk: sw_frame_desc.static_lods (Kumar et al. 1997 static LODs) */
+    int occlusion;   /* splinewalk: sw_frame_desc.occlusion_culling */
     uint32_t frames, warmup_passes, passes;
     int32_t width, height;
     double error_px;

@@ -59,6 +59,8 @@ static const char k_usage[] =
     "  --static-lods   splinewalk with its static LODs (sw_frame_desc.static_lods: Kumar et al.\n"
     "                  1997 super-surface meshes for what the error allows; default: off, as\n"
     "                  in the renderer)\n"
+    "  --occlusion     splinewalk with occlusion culling (sw_frame_desc.occlusion_culling: what\n"
+    "                  the visible planar faces hide is culled; default: off, as in the renderer)\n"
     "  --csv FILE      also write the rows as CSV (written aside, then renamed)\n"
     "  -h, --help      this text\n";
 
@@ -68,7 +70,7 @@ static const bp_peer_fn k_peer_fns[N_PEERS] = {bp_peer_splinewalk, bp_peer_glu, 
 
 typedef struct args {
     int use[N_PEERS];
-    int static_lods;
+    int static_lods, occlusion;
     uint32_t frames, warmup, passes;
     int32_t w, h;
     double error_px;
@@ -95,7 +97,8 @@ static int parse_peers(const char *list, int use[N_PEERS])
 
 static int parse(int argc, char **argv, args *a)
 {
-    *a = (args){{1, 1, 1}, 0, 120, 1, 1, 1280, 720, 0.5, NULL, NULL, NULL, NULL, 0};
+    *a = (args){.use = {1, 1, 1}, .frames = 120, .warmup = 1, .passes = 1, .w = 1280, .h = 720,
+                .error_px = 0.5};
     a->scenes = calloc((size_t)argc, sizeof *a->scenes);
     for (int i = 1; i < argc && a->scenes; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -104,6 +107,10 @@ static int parse(int argc, char **argv, args *a)
             return 1;
         if (!strcmp(o, "--static-lods")) {
             a->static_lods = 1;
+            continue;
+        }
+        if (!strcmp(o, "--occlusion")) {
+            a->occlusion = 1;
             continue;
         }
         if (o[0] != '-') {
@@ -228,7 +235,8 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
                   .width = a->w,
                   .height = a->h,
                   .error_px = a->error_px,
-                  .static_lods = a->static_lods};
+                  .static_lods = a->static_lods,
+                  .occlusion = a->occlusion};
     sw_rt_camera_path path;
     memset(&path, 0, sizeof path);
     if (bp_job_path(&job, a->path_file, &path, err, sizeof err) != 0) {
@@ -243,10 +251,11 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
             fprintf(stderr, "bench_peers: %s: %s: %s\n", scene, k_peer_names[p], res[p].note);
             failed = 1;
         }
-    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s\n", scene,
+    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s%s\n", scene,
            job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
            a->path_file ? a->path_file : "orbit of the scene box",
-           a->static_lods ? "; splinewalk with static LODs" : "");
+           a->static_lods ? "; splinewalk with static LODs" : "",
+           a->occlusion ? "; splinewalk with occlusion culling" : "");
     printf("  peer       |  frame ms: median      p99 | first (ms) | peak RSS MB | triangles | "
            "splinewalk / peer: median p99 first RSS triangles\n");
     for (int p = 0; p < N_PEERS; ++p)

@@ -23,6 +23,7 @@ static sw_frame_desc frame_at(const sw_run *r, uint32_t i)
     f.error_px = r->job.error_px;
     f.walkthrough = 1;
     f.static_lods = r->job.static_lods;
+    f.occlusion_culling = r->job.occlusion;
     bp_frame_camera(&r->job, i, &f.camera);
     return f;
 }
