@@ -129,23 +129,11 @@ static void mark_edge(sw__occ_map *m, const rect *r, const double *a, const doub
     j1 = j1 < r->y1 ? j1 : r->y1;
     for (int32_t j = j0; j <= j1; ++j) {
         /* the part of the segment with y in the row's band [j - margin, j + 1 + margin] */
-        double t0 = 0.0, t1 = 1.0;
-        const double dy = b[1] - a[1], lo = j - margin, hi = j + 1.0 + margin;
-        if (dy != 0.0) {
-            double ta = (lo - a[1]) / dy, tb = (hi - a[1]) / dy;
-            if (ta > tb) {
-                double s = ta;
-                ta = tb;
-                tb = s;
-            }
-            t0 = fmax(t0, ta);
-            t1 = fmin(t1, tb);
-            if (t0 > t1)
-                continue;
-        } else if (a[1] < lo || a[1] > hi) {
+        const double band[4] = {-INFINITY, INFINITY, j - margin, j + 1.0 + margin};
+        double t[2];
+        if (!sw__gpu_segment_clip(a, b, band, t))
             continue;
-        }
-        const double xa = a[0] + t0 * (b[0] - a[0]), xb = a[0] + t1 * (b[0] - a[0]);
+        const double xa = a[0] + t[0] * (b[0] - a[0]), xb = a[0] + t[1] * (b[0] - a[0]);
         int32_t i0 = (int32_t)floor(fmin(xa, xb) - margin),
                 i1 = (int32_t)floor(fmax(xa, xb) + margin);
         i0 = i0 > r->x0 ? i0 : r->x0;

@@ -237,6 +237,10 @@ typedef struct sw__gpu_mesh {
 /* Grows *p (capacity *cap elements of elem bytes) to hold `need`, doubling; 0 when out of memory
  * (*p and *cap unchanged). */
 int sw__gpu_grow(void **p, size_t *cap, size_t need, size_t elem);
+/* Liang–Barsky: 1 when segment ab meets the closed rectangle r = {x0, x1, y0, y1} (infinite
+ * sides allowed), with t the parameter range of ab inside it; 0 when it misses (t untouched).
+ * trim_tiles.c. */
+int sw__gpu_segment_clip(const double a[2], const double b[2], const double r[4], double t[2]);
 void sw__gpu_mesh_free(sw__gpu_mesh *m);
 sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, sw_status *status);
 

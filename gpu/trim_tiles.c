@@ -18,8 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* 1 when segment ab meets the closed rectangle r = {u0, u1, v0, v1} (Liang–Barsky). */
-static int segment_meets_rect(const double a[2], const double b[2], const double r[4])
+int sw__gpu_segment_clip(const double a[2], const double b[2], const double r[4], double t[2])
 {
     double t0 = 0.0, t1 = 1.0, d[2] = {b[0] - a[0], b[1] - a[1]};
     for (int k = 0; k < 2; ++k) {
@@ -40,7 +39,15 @@ static int segment_meets_rect(const double a[2], const double b[2], const double
         if (t0 > t1)
             return 0;
     }
+    t[0] = t0;
+    t[1] = t1;
     return 1;
+}
+
+static int segment_meets_rect(const double a[2], const double b[2], const double r[4])
+{
+    double t[2];
+    return sw__gpu_segment_clip(a, b, r, t);
 }
 
 static int loop_meets_rect(const sw_sg_polyline *l, const double r[4])
