@@ -163,7 +163,8 @@ static long row_crossings(sw__occ_map *m, uint32_t n_loops, double yc)
                 return -1;
             m->xs[n++] = a[0] + (yc - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
         }
-    qsort(m->xs, n, sizeof *m->xs, cmp_double);
+    if (n > 1) /* xs may still be NULL */
+        qsort(m->xs, n, sizeof *m->xs, cmp_double);
     return (long)n;
 }
 

@@ -390,7 +390,8 @@ static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bv
     if (!sw__occ_map_init(&w.map, &env->view, env->eps_px))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
     occ_walk_bvh(&w);
-    qsort(w.kept, w.n_kept, sizeof *w.kept, cmp_u32);
+    if (w.n_kept > 1) /* kept may be NULL */
+        qsort(w.kept, w.n_kept, sizeof *w.kept, cmp_u32);
     for (size_t i = 0; i < w.n_kept && !w.oom; ++i) {
         const sw_sg_bvh_item *it = &bvh->items[w.kept[i]];
         occurrence o;
@@ -570,8 +571,7 @@ sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__
     if (r == SW_OK && static_instances(env))
         r = collect_instances(env, fc, vis, st, status);
     else if (r == SW_OK && occlusion)
-        r = collect_bvh_occluded(env, face_bvh(desc), desc->occluders, fc, &vis->faces, st,
-                                 status);
+        r = collect_bvh_occluded(env, face_bvh(desc), desc->occluders, fc, &vis->faces, st, status);
     else if (r == SW_OK && face_bvh(desc))
         r = collect_bvh(env, face_bvh(desc), &vis->faces, st, status);
     if (r == SW_OK && fc && !occlusion)
