@@ -57,6 +57,7 @@ void sw__occ_map_free(sw__occ_map *m)
     sw__free(m->counts);
     sw__free(m->band);
     sw__free(m->xs);
+    sw__free(m->vp);
     memset(m, 0, sizeof *m);
 }
 
@@ -231,40 +232,29 @@ static long view_loops(sw__occ_map *m, const sw_gpu_occluders *oc, const sw__occ
 {
     size_t n = 0;
     long kept = 0;
-    double *vp = NULL;
-    size_t cap_vp = 0;
     for (uint32_t l = 0; l < of->n_loops; ++l) {
         const uint32_t first = oc->loop_first[of->first_loop + l],
                        count = oc->loop_count[of->first_loop + l];
-        if (!sw__gpu_grow((void **)&vp, &cap_vp, 3 * (size_t)count, sizeof *vp)) {
-            sw__free(vp);
+        if (!sw__gpu_grow((void **)&m->vp, &m->cap_vp, 3 * (size_t)count, sizeof *m->vp))
             return -1;
-        }
         for (uint32_t i = 0; i < count; ++i) {
             const double *p = oc->points + 3 * (size_t)(first + i);
-            double w[3];
-            for (int r = 0; r < 3; ++r)
-                w[r] = world[4 * r] * p[0] + world[4 * r + 1] * p[1] + world[4 * r + 2] * p[2] +
-                       world[4 * r + 3] - eye[r];
-            to_view(m, w, vp + 3 * i);
+            const double h[4] = {p[0], p[1], p[2], 1.0};
+            double w[4];
+            sw__fr_xform_h(world, eye, h, w);
+            to_view(m, w, m->vp + 3 * i);
         }
         if (l == 0)
-            loop_plane(vp, count, vp_plane, d);
-        const long c = clip_loop(m, vp, count, &n);
-        if (c < 0) {
-            sw__free(vp);
+            loop_plane(m->vp, count, vp_plane, d);
+        const long c = clip_loop(m, m->vp, count, &n);
+        if (c < 0)
             return -1;
-        }
         if (c == 0)
             continue;
-        if (!sw__gpu_grow((void **)&m->counts, &m->cap_counts, (size_t)kept + 1,
-                          sizeof *m->counts)) {
-            sw__free(vp);
+        if (!sw__gpu_grow((void **)&m->counts, &m->cap_counts, (size_t)kept + 1, sizeof *m->counts))
             return -1;
-        }
         m->counts[kept++] = (uint32_t)c;
     }
-    sw__free(vp);
     return kept;
 }
 

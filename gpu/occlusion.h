@@ -71,6 +71,8 @@ typedef struct sw__occ_map {
     size_t cap_band;
     double *xs; /* one row's crossings */
     size_t cap_xs;
+    double *vp; /* one loop's points in view space, before clipping */
+    size_t cap_vp;
     /* counters of the frame */
     uint64_t occluders_drawn, tests, hidden;
 } sw__occ_map;
