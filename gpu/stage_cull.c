@@ -265,7 +265,8 @@ static sw_result collect_bvh(const sw__fr_env *env, const sw_sg_bvh *bvh, sw__fr
  * face occurrence hidden by it is culled, and a visible planar one is drawn into the map. Back
  * faces are culled on the way (not drawn into the map: they are not drawn). The visible items are
  * then taken in increasing index order, as sw_sg_bvh_cull reports them, so that the frame draws
- * the faces it keeps in the order it draws them without occlusion culling. */
+ * the faces it keeps in the order it draws them without occlusion culling. Not for wireframe
+ * frames (sw__fr_cull). */
 enum { OCC_STACK = 128 };
 
 typedef struct occ_walk {
@@ -282,13 +283,6 @@ typedef struct occ_walk {
     int oom;
 } occ_walk;
 
-static int hidden(occ_walk *w, const double world_box[6])
-{
-    double eb[6];
-    sw__fr_eye_box(w->env->view.eye, world_box, eb);
-    return sw__occ_map_box_hidden(&w->map, eb);
-}
-
 /* One item of a leaf: frustum (unless its node is inside), occlusion, back face; kept ones are
  * drawn into the map. */
 static void occ_item(occ_walk *w, uint32_t item, int inside)
@@ -300,15 +294,15 @@ static void occ_item(occ_walk *w, uint32_t item, int inside)
             return;
     }
     w->cs.items_visible++;
-    if (hidden(w, it->box)) {
+    double eb[6];
+    sw__fr_eye_box(w->env->view.eye, it->box, eb);
+    if (sw__occ_map_box_hidden(&w->map, eb)) {
         w->faces_occluded++;
         return;
     }
     if (w->fc) {
         occurrence o;
-        double eb[6];
         sw__fr_occurrence_init(&o, it->face, it->world, it->color);
-        sw__fr_eye_box(w->env->view.eye, it->box, eb);
         if (sw__fr_face_back_facing(w->fc, &o, eb)) {
             w->back++;
             return;
@@ -350,7 +344,9 @@ static void occ_walk_bvh(occ_walk *w)
             inside = k == SW_SG_CULL_INSIDE;
         }
         *(inside ? &w->cs.nodes_inside : &w->cs.nodes_partly) += 1;
-        if (hidden(w, node->box)) {
+        double eb[6];
+        sw__fr_eye_box(w->env->view.eye, node->box, eb);
+        if (sw__occ_map_box_hidden(&w->map, eb)) {
             w->nodes_occluded++;
             w->faces_occluded += node->count;
             continue;
@@ -564,7 +560,9 @@ sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__
 {
     const sw_lod_face_cones *fc = desc->face_cones;
     sw_result r = fc ? check_cones(env, fc, status) : SW_OK;
-    const int occlusion = desc->occluders && face_bvh(desc) && !static_instances(env);
+    /* a wireframe frame shows what lies behind its faces' triangles: nothing occludes there */
+    const int occlusion =
+        desc->occluders && face_bvh(desc) && !static_instances(env) && !desc->wireframe;
     if (r == SW_OK && desc->occluders &&
         desc->occluders->scene_serial != sw_sg_scene_serial(env->scene))
         r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "frame: occluders of another scene");

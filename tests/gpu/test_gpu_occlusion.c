@@ -12,7 +12,9 @@
  *  2. Frames of a generated building (a .sws given on the command line), converged at 320 x 240
  *     through its BVH: a walk through its rooms at eye height and views from outside, each drawn
  *     with and without occlusion culling, must be identical pixel for pixel, while the walk culls
- *     most of its faces as hidden (at least half of those the frustum keeps, over the walk).
+ *     most of its faces as hidden (at least half of those the frustum keeps, over the walk). The
+ *     walk's first view is drawn as a wireframe too, where nothing may be culled (lines hide
+ *     nothing: culling there drops the rooms seen through them).
  * Usage: test_gpu_occlusion OUTDIR BUILDING.sws */
 #include "gpu_test_compare.h"
 #include "occlusion.h"
@@ -283,8 +285,8 @@ enum { W = 320, H = 240, WALK = 30 };
 
 static sw_result frame(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_sg_bvh *bvh,
                        const sw_lod_face_cones *fc, const sw_gpu_occluders *oc,
-                       const sw_gpu_camera *cam, sw_gpu_image *img, sw_gpu_frame_stats *fs,
-                       sw_status *st)
+                       const sw_gpu_camera *cam, int wireframe, sw_gpu_image *img,
+                       sw_gpu_frame_stats *fs, sw_status *st)
 {
     sw_gpu_frame_desc d;
     memset(&d, 0, sizeof d);
@@ -295,6 +297,7 @@ static sw_result frame(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_s
     d.bvh = bvh;
     d.face_cones = fc;
     d.occluders = oc;
+    d.wireframe = wireframe;
     return sw_gpu_render_scene(ctx, scene, &d, img, fs, st);
 }
 
@@ -334,12 +337,16 @@ static void frames_case(sw_gpu_context *ctx, const char *path)
     CHECK(sw_gpu_occluders_count(oc) > 0, "no occluder in a building");
     const double *b = bvh->nodes[0].box;
     uint64_t kept_off = 0, kept_on = 0, occluded = 0;
-    for (int k = 0; k < WALK + 2; ++k) {
-        const sw_gpu_camera cam = k < WALK ? walk_camera(b, k) : sw_test_view_camera(b, k == WALK);
+    for (int k = 0; k < WALK + 3; ++k) {
+        const sw_gpu_camera cam = k < WALK       ? walk_camera(b, k)
+                                  : k < WALK + 2 ? sw_test_view_camera(b, k == WALK)
+                                                 : walk_camera(b, 0);
         sw_gpu_image off = {0}, on = {0};
         sw_gpu_frame_stats s_off, s_on;
-        if (frame(ctx, scene, bvh, fc, NULL, &cam, &off, &s_off, &st) != SW_OK ||
-            frame(ctx, scene, bvh, fc, oc, &cam, &on, &s_on, &st) != SW_OK) {
+        /* the first frame also as a wireframe, where the rooms behind show through the lines */
+        const int wire = k == WALK + 2;
+        if (frame(ctx, scene, bvh, fc, NULL, &cam, wire, &off, &s_off, &st) != SW_OK ||
+            frame(ctx, scene, bvh, fc, oc, &cam, wire, &on, &s_on, &st) != SW_OK) {
             CHECK(0, "frame %d: %s", k, st.message);
             sw_gpu_image_free(&off);
             sw_gpu_image_free(&on);

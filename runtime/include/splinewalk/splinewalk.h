@@ -358,7 +358,8 @@ typedef struct sw_frame_desc {
                                 which the boxes behind are tested. Conservative: the image is
                                 the one without it. The outlines are built once per scene, on
                                 the first frame that asks. Not with static_lods (their units are
-                                culled by the frustum only). 0: frustum and back-patch culling */
+                                culled by the frustum only) nor wireframe (lines hide nothing).
+                                0: frustum and back-patch culling */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
