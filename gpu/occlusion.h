@@ -16,7 +16,8 @@
  *    near plane. A map pixel counts as covered only when its square lies inside the outline and
  *    farther than `margin` pixels from every outline edge, the margin being that flattening error
  *    on screen plus the frame's ε_img plus a pixel of the full frame: the drawn face, with its trim
- *    texture, covers at least that shrunk region.
+ *    texture at the resolution its error bound needs, covers at least that shrunk region (a trim
+ *    texture drawn coarser — the frame's atlas budget — is counted in bound_exceeded).
  *  - Its depth over a covered pixel is the largest of the plane's depths at the pixel's four
  *    corners (1 / depth is affine in screen coordinates on a plane, so the corners bound it), with
  *    a relative allowance for the depth buffer's and the float evaluation's rounding.

@@ -117,6 +117,10 @@ sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_f
         pending_trim *p = &geo->trims[i];
         p->w = sw__fr_class_texels(p->width * scale, max_entry);
         p->h = sw__fr_class_texels(p->height * scale, max_entry);
+        /* coarser than its need (the budget's scale, an entry's size limit): its edge may move by
+         * more than the object tolerance, which the error bound and occlusion culling assume */
+        if (p->w < p->width || p->h < p->height)
+            st->bound_exceeded++;
         if (!p->clip)
             r = plan_whole_box(&t, i, status);
     }

@@ -141,7 +141,7 @@ typedef struct sw_gpu_frame_stats {
     uint64_t faces_drawn, faces_culled; /* face occurrences */
     uint64_t patches_trimmed;           /* Bézier patches drawn with a trim-texture lookup */
     uint64_t patches_untrimmed;         /* drawn without one */
-    uint64_t patches_culled; /* outside the view frustum, or outside their face's trim box */
+    uint64_t patches_culled;   /* outside the view frustum, or outside their face's trim box */
     uint64_t triangles;        /* every triangle drawn, fat borders included */
     uint64_t border_triangles; /* of triangles: the fat borders' (Guthe §7.1 crack filling) */
     uint64_t trim_textures, trim_texels;
@@ -166,8 +166,9 @@ typedef struct sw_gpu_frame_stats {
      * limit capped (the bound it needed is not known), a hierarchy node whose approximation
      * error left less than a quarter of ε_img to its sampling (the sampling floor), a trim loop
      * flattened at the rounding floor or depth cap (trim_loops_floored), a fat border sampled
-     * coarser than its cells (borders_capped); the worst known total bound over ε_img, in pixels
-     * (0 when none is known) */
+     * coarser than its cells (borders_capped), a trim texture coarser than its need (the frame's
+     * atlas budget scaled it down, or an atlas entry's size limit); the worst known total bound
+     * over ε_img, in pixels (0 when none is known) */
     uint64_t bound_exceeded;
     double bound_excess_px;
     uint64_t hlod_over_budget;     /* nodes drawn although their error exceeds their share of

@@ -379,7 +379,10 @@ typedef struct sw_frame_stats {
                                 on every thread that worked on it; 0 in walkthrough mode unless
                                 a walkthrough frame blocked */
     uint64_t bound_exceeded; /* pieces drawn whose error bound exceeds ε_img: grids capped at the
-                                segment limit, hierarchy nodes at the sampling floor */
+                                segment limit, hierarchy nodes at the sampling floor, trim loops
+                                flattened at their floor, fat borders sampled coarser than their
+                                cells, trim textures coarser than their need (the frame's atlas
+                                budget) */
     double bound_excess_px;  /* the worst known bound over ε_img of those, in pixels */
     double ms_hierarchy;     /* blocked waiting for hierarchy builds and refinements (both
                                 modes; 0 when none was waited for) */
