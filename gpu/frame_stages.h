@@ -39,9 +39,18 @@ enum {
     MAX_BOUND_SUBDIVISION = 4, /* sub-patches per direction for the derivative bounds */
 };
 static const double k_max_frame_vertices = 48e6; /* ~1.5 GB of grid vertices */
-static const double k_tile_texels = 1024.0;      /* wanted trim texels per direction above which a
-                                                    face's trim box is split into tiles, or a
-                                                    hierarchy node into parts */
+/* Wanted trim texels per direction above which a face's trim box is split into tiles, each with
+ * its own texture at the resolution its part of the surface needs, a hierarchy node into parts,
+ * and a hierarchy-drawn face gets a texture per node. A texture is sized for the nearest point of
+ * its rectangle, so smaller tiles render fewer texels in a close-up, at the cost of more draws and
+ * grid cells (the 10^5 building's interior walk: 42 M texels a frame at 1024, 22 M at 512, 12 M
+ * at 256; at 256 a hierarchy view of Motor-c had one border pixel deeper than the crack test
+ * allows). */
+static const double k_tile_texels = 512.0;
+/* Wanted trim texels per direction above which the hierarchy's cut visits a node's children
+ * rather than cutting the node into parts: refining also sets the geometry, and a deeper cut
+ * draws more triangles and fat borders than parts of the same bicubic. */
+static const double k_node_texels = 1024.0;
 
 /* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
  * for predefined grids (§4.2) the counts a grid class, or pieces of one class, can draw. */

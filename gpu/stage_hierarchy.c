@@ -6,7 +6,8 @@
  * frustum is culled; a node is chosen when its approximation error, in world units, is at most
  * half the object-space tolerance ε_obj that ε_img allows at the nearest depth of its box (§7
  * splits ε equally between approximation and sampling), and — on a trimmed face — when its own
- * trim texture needs at most k_tile_texels per direction; otherwise its children are visited. A
+ * trim texture needs at most k_tile_texels per direction; otherwise its children are visited, or,
+ * when it is fine enough and its texture needs at most k_node_texels, it is cut into parts. A
  * leaf that is still too coarse is refined below itself in the pool (sw_lod_cache_refine;
  * converged mode waits for it, sw__fr_hierarchy_prepare); a leaf whose trim texture would be too
  * large is cut into parts of its own bicubic (same error bound, smaller box and texture), which is
@@ -203,6 +204,13 @@ static void visit(hl_face *hf, const hl_item *it)
     }
     int approx_ok = err_w <= 0.5 * eps_obj;
     int texture_ok = need.u <= k_tile_texels && need.v <= k_tile_texels;
+    /* a node fine enough whose texture is too large for a tile but not for a node is cut into
+     * parts of itself (same approximation, smaller textures) rather than refined */
+    if (approx_ok && !texture_ok && need.u <= k_node_texels && need.v <= k_node_texels &&
+        it->part_depth < MAX_PART_DEPTH) {
+        split_part(hf, it, &need);
+        return;
+    }
     if (approx_ok && texture_ok) {
         if (!planning)
             choose(hf, it, cpw, err_w, eps_obj, &need);

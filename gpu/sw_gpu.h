@@ -155,6 +155,8 @@ typedef struct sw_gpu_frame_stats {
     uint64_t atlas_texels;   /* texels of those pages */
     uint64_t trim_reused;    /* trim textures kept from an earlier frame (of trim_textures) */
     uint64_t atlas_switches; /* render-target switches for trim generation in this frame */
+    uint64_t atlas_allocations; /* array textures the atlas allocated in this frame (growth, or a
+                                   repack to another page size or count) */
     uint64_t patches_gpu_evaluated; /* drawn patches evaluated in the vertex shader (§4.2); the
                                        others are CPU grids */
     uint64_t patches_exact; /* of those, evaluated from knots and control points (eval_exact) */

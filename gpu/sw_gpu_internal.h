@@ -321,6 +321,7 @@ typedef struct sw__gpu_atlas_stats {
     uint32_t rendered;     /* rendered this frame */
     uint32_t switches;     /* render-target switches this frame */
     uint32_t repacks;      /* full repacks this frame (0 or 1) */
+    uint32_t allocations;  /* array textures allocated this frame */
     uint64_t entry_texels; /* texels of the entries used this frame */
 } sw__gpu_atlas_stats;
 

@@ -17,8 +17,11 @@
  * frame does not use, the height a shelf gives its shorter entries) is at least the space this
  * frame's entries need: growing would then copy pages of mostly dead texels, and with a new set
  * of textures every frame (an animated surface, a new scene per frame) add a page per frame up to
- * the texel limit. A repack keeps the array texture when its page size is right and it has at most
- * twice the pages needed (no copy), else allocates one of the size needed. Entries unused for
+ * the texel limit. A new array texture is the atlas's dearest step (on llvmpipe ~50 ms per 4096^2
+ * page: storage allocated and touched, old pages copied), so its size follows the need with
+ * hysteresis: it grows by at least half its pages, and a repack keeps it while its page size is
+ * right and it holds the pages needed, unless more than half of it has gone unused for
+ * k_max_idle_frames frames (then the memory is given back). Entries unused for
  * k_max_idle_frames frames are dropped at the next begin (their loops freed; their texels stay dead
  * space until a repack).
  *
@@ -78,6 +81,7 @@ struct sw__gpu_atlas {
     int32_t *table; /* open addressing over entries, -1 empty */
     uint32_t table_size;
     uint64_t frame;
+    uint64_t busy_frame;    /* last frame that needed more than half of the allocated pages */
     struct sort_key *order; /* scratch */
     int32_t cap_order;
     float *clip; /* scratch: page vertices */
@@ -404,6 +408,7 @@ static sw_result alloc_layers(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int3
     a->tex = tex;
     a->tex_side = a->side;
     a->cap_layers = layers;
+    a->st.allocations++;
     (void)ctx;
     return sw__gpu_check(status, "trim atlas allocation");
 }
@@ -443,6 +448,15 @@ static int32_t page_limit(const struct sw__gpu_atlas *a)
     return n < 1 ? 1 : (n > MAX_PAGES ? MAX_PAGES : n);
 }
 
+/* Layers for an array texture that must hold a->n_pages pages: half as many again as it has at
+ * least, so that a walk needing ever more pages reallocates a logarithmic number of times. */
+static int32_t grown_layers(const struct sw__gpu_atlas *a, int32_t limit)
+{
+    int32_t want = a->cap_layers + (a->cap_layers + 1) / 2;
+    want = want > limit ? limit : want;
+    return want > a->n_pages ? want : a->n_pages;
+}
+
 /* Every entry used this frame packed from scratch into a fresh, cleared array texture. */
 static sw_result repack(sw_gpu_context *ctx, struct sw__gpu_atlas *a, sw_status *status)
 {
@@ -461,12 +475,15 @@ static sw_result repack(sw_gpu_context *ctx, struct sw__gpu_atlas *a, sw_status 
                             (int)limit, (int)a->side);
     a->st.repacks++;
     /* every footprint is cleared before it is rendered: the old texture serves as it is unless
-     * its pages have the wrong size or are too few, or more than twice too many (after a frame
-     * that needed many, the memory is given back) */
-    if (a->tex && a->side == a->tex_side && a->cap_layers >= a->n_pages &&
-        a->cap_layers <= 2 * a->n_pages)
+     * its pages have the wrong size or are too few, or it has been more than twice too large for
+     * a while */
+    const int oversized =
+        a->cap_layers > 2 * a->n_pages && a->frame - a->busy_frame > k_max_idle_frames;
+    if (a->tex && a->side == a->tex_side && a->cap_layers >= a->n_pages && !oversized)
         return SW_OK;
-    return alloc_layers(ctx, a, a->n_pages, 0, status);
+    const int32_t layers =
+        oversized || a->side != a->tex_side ? a->n_pages : grown_layers(a, limit);
+    return alloc_layers(ctx, a, layers, 0, status);
 }
 
 /* Places the entries of order[0..n) not placed yet within the first max_pages pages; 1 when all
@@ -531,8 +548,8 @@ static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int
         *fits = 0;
         return SW_OK;
     }
-    if (a->n_pages > a->cap_layers) /* pages are large: grow by what is needed only */
-        r = alloc_layers(ctx, a, a->n_pages, 1, status);
+    if (a->n_pages > a->cap_layers)
+        r = alloc_layers(ctx, a, grown_layers(a, limit), 1, status);
     return r;
 }
 
@@ -616,6 +633,8 @@ sw_result sw__gpu_atlas_commit(sw_gpu_context *ctx, sw__gpu_atlas_stats *stats, 
         a->st.entry_texels += (uint64_t)e->w * (uint64_t)e->h;
     }
     a->st.reused = a->st.entries - a->st.rendered;
+    if (2 * a->n_pages > a->cap_layers)
+        a->busy_frame = a->frame;
     a->st.pages = (uint32_t)a->cap_layers;
     a->st.side = a->side;
     if (stats)

@@ -241,10 +241,10 @@ int main(int argc, char **argv)
            (unsigned long long)fs.patches_culled, (unsigned long long)fs.triangles,
            (unsigned long long)fs.trim_textures, (unsigned long long)fs.trim_texels,
            fs.ms_tessellate, fs.ms_trim, fs.ms_draw, fs.ms_readback);
-    /* One trim texture for the face, or one per tile when its trim box needs more than 1024
-     * texels per direction (frame.c): 2 x 2 tiles at most at this distance. */
+    /* One trim texture for the face, or one per tile when its trim box needs more than
+     * k_tile_texels (512) texels per direction: 4 x 4 tiles at most at this distance. */
     int ok = check_frame(&img) && fs.patches_trimmed == 4 && fs.trim_textures >= 1 &&
-             fs.trim_textures <= 4;
+             fs.trim_textures <= 16;
     if (check_writes(&img, dir))
         ok = 0;
     sw_gpu_image_free(&img);

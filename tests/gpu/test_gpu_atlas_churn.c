@@ -10,6 +10,10 @@
  *   images  every frame is the same as the frame rendered by a fresh atlas (the same textures at
  *           other places in other pages; texel coordinates are offsets by whole texels, so the
  *           rasterised fans are the same): at most k_max_diff_px pixels differ;
+ *   churn   a new array texture is the atlas's dearest step (its pages allocated and, when it
+ *           grows, copied), so the kept atlas never gives pages back within the sequence (48
+ *           renders, fewer than the idle frames after which it may) and grows by half its pages
+ *           at least: at most 1 + log_1.5(pages) allocations;
  *   reuse   the same scene drawn again with the same camera reuses every trim texture
  *           (trim_reused == trim_textures) and gives the identical image: textures are kept
  *           across frames while their resolution class is unchanged.
@@ -139,6 +143,8 @@ typedef struct run {
     sw_sg_scene *scenes[N_FRAMES];
     sw_gpu_image kept[N_FRAMES];
     uint64_t pages_kept[N_FRAMES], pages_fresh[N_FRAMES];
+    uint64_t allocations; /* array textures the kept atlas allocated over the sequence */
+    int shrank;           /* the kept atlas had fewer pages after a render than before it */
     long diff[N_FRAMES];
 } run;
 
@@ -148,6 +154,7 @@ static int run_kept(run *r)
     sw_status st = {0};
     sw__gpu_atlas_set_max_side(r->ctx, PAGE_SIDE);
     int ok = 1;
+    uint64_t last_pages = 0;
     for (int f = 0; f < N_FRAMES && ok; ++f) {
         sw_gpu_frame_stats a, b;
         sw_gpu_image again;
@@ -156,6 +163,9 @@ static int run_kept(run *r)
             return fail("render (kept atlas)", &st);
         sw_test_image_diff d = sw_test_compare_images(&r->kept[f], &again, 0);
         r->pages_kept[f] = b.atlas_pages > a.atlas_pages ? b.atlas_pages : a.atlas_pages;
+        r->allocations += a.atlas_allocations + b.atlas_allocations;
+        r->shrank |= a.atlas_pages < last_pages || b.atlas_pages < a.atlas_pages;
+        last_pages = b.atlas_pages;
         if (a.trim_textures == 0 || a.trim_reused != 0 || b.trim_reused != b.trim_textures ||
             d.any != 0) {
             fprintf(stderr,
@@ -200,9 +210,17 @@ static int check(const run *r)
                (unsigned long long)r->pages_kept[f], (unsigned long long)r->pages_fresh[f],
                r->diff[f]);
     }
-    printf("pages: at most %llu kept, %llu for one frame; pixels differing at most %ld\n",
-           (unsigned long long)most, (unsigned long long)need, worst);
-    int ok = need >= 2 && most <= 2 * need && worst <= k_max_diff_px;
+    printf("pages: at most %llu kept, %llu for one frame; pixels differing at most %ld; %llu "
+           "array textures allocated\n",
+           (unsigned long long)most, (unsigned long long)need, worst,
+           (unsigned long long)r->allocations);
+    const double max_allocations = 1.0 + ceil(log((double)most) / log(1.5));
+    int ok = need >= 2 && most <= 2 * need && worst <= k_max_diff_px && !r->shrank &&
+             (double)r->allocations <= max_allocations;
+    if (r->shrank || (double)r->allocations > max_allocations)
+        fprintf(stderr, "FAIL the kept atlas %s, %llu array textures allocated (at most %.0f)\n",
+                r->shrank ? "gave pages back" : "kept its pages",
+                (unsigned long long)r->allocations, max_allocations);
     if (need < 2)
         fprintf(stderr, "FAIL the frames fit one page: the test would not see growth\n");
     return ok;
