@@ -44,7 +44,8 @@ typedef struct bp_job {
     const char *scene;             /* what sw_scene_load reads (.sws, .brep, .step, .iges) */
     const char *brep;              /* OCCT: the same geometry as BREP (NULL: none) */
     const sw_rt_camera_path *path; /* NULL: a stock path of the scene's box made in the child */
-    int fly; /* with path NULL: 0 = orbit (sw_rt_path_orbit), 1 = fly-through (sw_rt_path_fly) */
+    int fly; /* with path NULL: 0 = orbit (sw_rt_path_orbit), 1 = fly-through (sw_rt_path_fly),
+                2 = walk at eye height 160 (sw_rt_path_walk: a generated building's rooms) */
     int static_lods; /* splinewalk: sw_frame_desc.static_lods (Kumar et al. 1997 static LODs) */
     int occlusion;   /* splinewalk: sw_frame_desc.occlusion_culling */
     uint32_t frames, warmup_passes, passes;

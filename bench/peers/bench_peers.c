@@ -59,8 +59,8 @@ static const char k_usage[] =
     "  --static-lods   splinewalk with its static LODs (sw_frame_desc.static_lods: Kumar et al.\n"
     "                  1997 super-surface meshes for what the error allows; default: off, as\n"
     "                  in the renderer)\n"
-    "  --occlusion     splinewalk with occlusion culling (sw_frame_desc.occlusion_culling: what\n"
-    "                  the visible planar faces hide is culled; default: off, as in the renderer)\n"
+    "  --no-occlusion  splinewalk without occlusion culling (sw_frame_desc.occlusion_culling:\n"
+    "                  what the visible planar faces hide is culled; default: on, as in the CLI)\n"
     "  --csv FILE      also write the rows as CSV (written aside, then renamed)\n"
     "  -h, --help      this text\n";
 
@@ -97,8 +97,14 @@ static int parse_peers(const char *list, int use[N_PEERS])
 
 static int parse(int argc, char **argv, args *a)
 {
-    *a = (args){.use = {1, 1, 1}, .frames = 120, .warmup = 1, .passes = 1, .w = 1280, .h = 720,
-                .error_px = 0.5};
+    *a = (args){.use = {1, 1, 1},
+                .frames = 120,
+                .warmup = 1,
+                .passes = 1,
+                .w = 1280,
+                .h = 720,
+                .error_px = 0.5,
+                .occlusion = 1};
     a->scenes = calloc((size_t)argc, sizeof *a->scenes);
     for (int i = 1; i < argc && a->scenes; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -109,8 +115,8 @@ static int parse(int argc, char **argv, args *a)
             a->static_lods = 1;
             continue;
         }
-        if (!strcmp(o, "--occlusion")) {
-            a->occlusion = 1;
+        if (!strcmp(o, "--occlusion") || !strcmp(o, "--no-occlusion")) {
+            a->occlusion = !strcmp(o, "--occlusion");
             continue;
         }
         if (o[0] != '-') {
@@ -255,7 +261,7 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
            job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
            a->path_file ? a->path_file : "orbit of the scene box",
            a->static_lods ? "; splinewalk with static LODs" : "",
-           a->occlusion ? "; splinewalk with occlusion culling" : "");
+           a->occlusion ? "" : "; splinewalk without occlusion culling");
     printf("  peer       |  frame ms: median      p99 | first (ms) | peak RSS MB | triangles | "
            "splinewalk / peer: median p99 first RSS triangles\n");
     for (int p = 0; p < N_PEERS; ++p)

@@ -72,9 +72,11 @@ static int load(sw_run *r, sw_rt_camera_path *own_path, bp_result *out)
             r->job.scene_box[k] = info.bbox_min[k];
             r->job.scene_box[3 + k] = info.bbox_max[k];
         }
-        sw_result pr =
-            r->job.fly ? sw_rt_path_fly(r->job.scene_box, 10.0, r->job.frames, own_path, &r->st)
-                       : sw_rt_path_orbit(r->job.scene_box, 10.0, r->job.frames, own_path, &r->st);
+        const double *box = r->job.scene_box;
+        sw_result pr = r->job.fly == 2
+                           ? sw_rt_path_walk(box, 160.0, 10.0, r->job.frames, own_path, &r->st)
+                       : r->job.fly ? sw_rt_path_fly(box, 10.0, r->job.frames, own_path, &r->st)
+                                    : sw_rt_path_orbit(box, 10.0, r->job.frames, own_path, &r->st);
         if (pr != SW_OK)
             return -1;
         r->job.path = own_path;

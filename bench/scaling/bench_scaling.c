@@ -45,6 +45,9 @@ static const char k_usage[] =
     "  --error PX       eps_img in pixels (default 0.5)\n"
     "  --fly            the low fly-through `splinewalk path fly` makes for each box instead of\n"
     "                   the orbit (what is visible then grows less than the scene)\n"
+    "  --walk           the walk `splinewalk path walk` makes (eye height 160, through the\n"
+    "                   ground floor's rooms) instead of the orbit\n"
+    "  --no-occlusion   without occlusion culling (default: on, as in the CLI)\n"
     "  --dir DIR        where the scenes are generated (default bench-scaling-scenes)\n"
     "  --splinewalk B   the CLI that generates them (default: splinewalk beside this program)\n"
     "  --csv FILE       the rows as CSV (default: none; written aside, then renamed)\n"
@@ -57,19 +60,30 @@ typedef struct args {
     int32_t w, h;
     double error_px;
     const char *dir, *csv, *svg;
-    int fly;
+    int fly; /* bp_job.fly: 0 orbit, 1 fly-through, 2 walk */
+    int no_occlusion;
     char splinewalk[PATH_MAX];
 } args;
 
+static const char *path_name(int fly)
+{
+    return fly == 2 ? "walk" : fly ? "fly-through" : "orbit";
+}
+
 static int parse(int argc, char **argv, args *a)
 {
-    *a = (args){1000, 100000, 120, 1, 1, 1280, 720, 0.5, "bench-scaling-scenes", NULL, NULL, 0, ""};
+    *a = (args){1000, 100000, 120, 1, 1, 1280, 720, 0.5, "bench-scaling-scenes",
+                NULL, NULL,   0,   0, ""};
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "-h") || !strcmp(o, "--help"))
             return 1;
-        if (!strcmp(o, "--fly")) {
-            a->fly = 1;
+        if (!strcmp(o, "--fly") || !strcmp(o, "--walk")) {
+            a->fly = !strcmp(o, "--fly") ? 1 : 2;
+            continue;
+        }
+        if (!strcmp(o, "--no-occlusion")) {
+            a->no_occlusion = 1;
             continue;
         }
         if (!v)
@@ -197,7 +211,7 @@ static int write_svg(const char *path, const uint64_t *ns, const bp_result *r, u
     snprintf(title, sizeof title,
              "splinewalk: generated buildings, %s of each box, %dx%d, eps %g px, threaded "
              "walkthrough",
-             a->fly ? "fly-through" : "orbit", a->w, a->h, a->error_px);
+             path_name(a->fly), a->w, a->h, a->error_px);
     snprintf(tmp, sizeof tmp, "%s.tmp-%ld", path, (long)getpid());
     FILE *f = fopen(tmp, "w");
     if (!f)
@@ -224,11 +238,12 @@ int main(int argc, char **argv)
         return 1;
     }
     const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
-    printf("bench_scaling: %s of each box, %dx%d, eps_img %g px, %u frames x %u counted passes "
-           "after %u warm-up, "
+    printf("bench_scaling: %s of each box, %dx%d, eps_img %g px, occlusion culling %s, %u frames "
+           "x %u counted passes after %u warm-up, "
            "LP_NUM_THREADS=%s, EGL_PLATFORM=%s, %ld processors online\n",
-           a.fly ? "fly-through" : "orbit", a.w, a.h, a.error_px, a.frames, a.passes, a.warmup,
-           lp ? lp : "(unset)", egl ? egl : "(unset)", sysconf(_SC_NPROCESSORS_ONLN));
+           path_name(a.fly), a.w, a.h, a.error_px, a.no_occlusion ? "off" : "on", a.frames,
+           a.passes, a.warmup, lp ? lp : "(unset)", egl ? egl : "(unset)",
+           sysconf(_SC_NPROCESSORS_ONLN));
     printf("  surfaces | occurrences | scene MB | frame ms: median     p99 | first (ms) | peak RSS "
            "MB | triangles\n");
     uint64_t ns[16];
@@ -241,6 +256,7 @@ int main(int argc, char **argv)
             return 1;
         bp_job job = {.scene = scene,
                       .fly = a.fly,
+                      .occlusion = !a.no_occlusion,
                       .frames = a.frames,
                       .warmup_passes = a.warmup,
                       .passes = a.passes,

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* splinewalk demo: the built-in default scene, imported, saved, reloaded and rendered headlessly. */
+/* splinewalk demo: the built-in default scene, imported, saved, reloaded and rendered headlessly.
+ */
 #include "cli.h"
 
 #include <errno.h>
@@ -56,11 +57,11 @@ static int parse_args(int argc, char **argv, demo_args *a)
 
 typedef struct demo_view {
     const char *name;
-    int preset;          /* sw_view_preset, or -1 for the fixed interior camera */
+    int preset; /* sw_view_preset, or -1 for the fixed interior camera */
 } demo_view;
 
-static const demo_view k_views[] = {{"iso", SW_VIEW_ISO}, {"front", SW_VIEW_FRONT},
-                                    {"top", SW_VIEW_TOP}, {"inside", -1}};
+static const demo_view k_views[] = {
+    {"iso", SW_VIEW_ISO}, {"front", SW_VIEW_FRONT}, {"top", SW_VIEW_TOP}, {"inside", -1}};
 
 /* Standing in the room's south-east corner at eye height, looking at the table. */
 static const sw_camera k_inside = {{380.0, 20.0, 160.0}, {190.0, 230.0, 50.0}, {0, 0, 1}, 60.0};
@@ -84,6 +85,7 @@ static int render_views(sw_scene scene, const demo_args *a)
         frame.height = a->height;
         frame.error_px = a->error_px;
         frame.output_path = path;
+        frame.occlusion_culling = 1;
         frame.camera = k_inside;
         sw_result r = SW_OK;
         if (k_views[i].preset >= 0)
@@ -121,8 +123,7 @@ int sw_cli_demo(int argc, char **argv)
     sw_status status = {0};
     sw_scene built;
     double t0 = sw_cli_now_ms();
-    printf("building the default scene from %s\n",
-           a.data ? a.data : "/usr/share/opencascade/data");
+    printf("building the default scene from %s\n", a.data ? a.data : "/usr/share/opencascade/data");
     sw_scene_load_desc desc = {NULL, sw_cli_progress, sw_cli_warning, NULL, NULL, 0};
     sw_result r = sw_scene_load_default(a.data, &desc, &built, &status);
     sw_cli_progress_end();

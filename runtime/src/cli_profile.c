@@ -25,7 +25,7 @@ static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
     "                          [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
-    "                          [--occlusion]\n"
+    "                          [--no-occlusion]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
     "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
@@ -65,8 +65,9 @@ static const char k_usage[] =
     "                    built in the pool on first need: static_drawn, static_faces,\n"
     "                    static_triangles, static_requests columns\n"
     "  --lod-colors      colour by representation, as for `render`\n"
-    "  --occlusion       cull what visible planar faces hide (as for `render`):\n"
-    "                    occlusion_tests, nodes_occluded, faces_occluded columns\n"
+    "  --no-occlusion    draw what visible planar faces hide too (culled by default, as for\n"
+    "                    `render`: occlusion_tests, nodes_occluded, faces_occluded columns; a\n"
+    "                    frame that hides nothing makes the next 1, 3, 7 or 15 go without it)\n"
     "  -h, --help        this text\n";
 
 typedef struct profile_args {
@@ -107,8 +108,8 @@ static int parse_args(int argc, char **argv, profile_args *a)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i];
         const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(arg, "--occlusion")) {
-            a->frame.occlusion_culling = 1;
+        if (!strcmp(arg, "--occlusion") || !strcmp(arg, "--no-occlusion")) {
+            a->frame.occlusion_culling = !strcmp(arg, "--occlusion");
             continue;
         }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
@@ -530,6 +531,7 @@ int sw_cli_profile(int argc, char **argv)
     if (sw_cli_print_help(argc, argv, k_usage))
         return 0;
     profile_args a = {0};
+    a.frame.occlusion_culling = 1;
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;

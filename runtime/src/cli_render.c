@@ -11,12 +11,14 @@ static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
-    "                         [--static-force K] [--occlusion] [--partial]\n"
+    "                         [--static-force K] [--no-occlusion] [--partial]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
-    "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as EXR\n"
+    "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as "
+    "EXR\n"
     "with a depth channel when FRAME ends in .exr. Prints how many patches were drawn trimmed by\n"
-    "trim textures, untrimmed, and culled, and how long each step took. A CAD file's faces skipped\n"
+    "trim textures, untrimmed, and culled, and how long each step took. A CAD file's faces "
+    "skipped\n"
     "or repaired by the import are each named in a warning on stderr and counted (as `import`\n"
     "does); a truncated IGES file is refused unless --partial.\n"
     "\n"
@@ -27,7 +29,8 @@ static const char k_usage[] =
     "                      target = box centre, distance = diagonal / (2 tan 20°) x 1.1;\n"
     "                      iso from (+1,+1,+1) up +Z, front from -Y up +Z, top from +Z up +Y,\n"
     "                      right from +X up +Z\n"
-    "  --camera LIST       eye, target, up and vertical field of view in degrees (overrides --view)\n"
+    "  --camera LIST       eye, target, up and vertical field of view in degrees (overrides "
+    "--view)\n"
     "  --error PX          screen-space error bound in pixels, at least 0.01 (default 0.5)\n"
     "  --eval MODE         hierarchy (default): each face drawn from its hierarchy of rational\n"
     "                      bicubic patches (Guthe et al. 2005), nodes as coarse as the error\n"
@@ -44,9 +47,9 @@ static const char k_usage[] =
     "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
     "                      (i + K) mod (n + 1) of its n levels good enough for the view, the last\n"
     "                      choice meaning per-frame: neighbours at different levels\n"
-    "  --occlusion         cull what the visible planar faces hide before tessellating it (a\n"
-    "                      depth map of them on the visibility thread; the image is the same);\n"
-    "                      not with --static-lod\n"
+    "  --no-occlusion      draw what the visible planar faces hide too (by default it is culled\n"
+    "                      before it is tessellated, by a depth map of those faces on the\n"
+    "                      visibility thread; the image is the same; not with --static-lod)\n"
     "  --partial           import what is whole of a truncated file (see `import --help`)\n"
     "  -h, --help          this text\n";
 
@@ -68,8 +71,8 @@ static int parse_args(int argc, char **argv, render_args *a)
             a->load_flags |= SW_LOAD_PARTIAL;
             continue;
         }
-        if (!strcmp(arg, "--occlusion")) {
-            a->frame.occlusion_culling = 1;
+        if (!strcmp(arg, "--occlusion") || !strcmp(arg, "--no-occlusion")) {
+            a->frame.occlusion_culling = !strcmp(arg, "--occlusion");
             continue;
         }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
@@ -119,6 +122,7 @@ int sw_cli_render(int argc, char **argv)
         return 0;
     render_args a = {0};
     a.view = SW_VIEW_ISO;
+    a.frame.occlusion_culling = 1;
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* splinewalk view SCENE: the interactive viewer (issue 5). A GLFW window is the host: its context
+/* splinewalk view SCENE: the interactive viewer. A GLFW window is the host: its context
  * is current on this thread, a renderer is made on it (sw_renderer_desc.use_current_context), and
  * each frame is drawn in walkthrough mode — the same pipeline as `profile` and the embedding API —
  * then presented into the window (sw_frame_desc.present). --script replays a camera path for a
@@ -37,6 +37,8 @@ static const char k_usage[] =
     "  K             add the current camera as a key to the recording (--record)\n"
     "  L             wireframe on / off (the tessellation the error bound chose)\n"
     "  T             static LODs of super-surfaces on / off (Kumar et al. 1997; --static-lod)\n"
+    "  O             occlusion culling on / off: what visible planar faces hide is not drawn\n"
+    "                (on unless --no-occlusion; the image is the same, the frame cheaper)\n"
     "  C             LOD colouring on / off: static levels fine to coarse blue, teal, green,\n"
     "                yellow, orange, pink; per-frame tessellation grey\n"
     "  A             trim-atlas overlay: the next page of the trim-texture atlas in the upper\n"
@@ -60,6 +62,7 @@ static const char k_usage[] =
     "  --overlay         with --script: draw the frame-time overlay too (interactive: always,\n"
     "                    F toggles it)\n"
     "  --wireframe       start with the wireframe on (L toggles it)\n"
+    "  --no-occlusion    start with occlusion culling off (O toggles it)\n"
     "  --static-lod      start with static LODs on (T toggles them; built in the pool as\n"
     "                    needed, or read from the scene's `build-lod` cache)\n"
     "  --lod-colors      start with LOD colouring on (C toggles it)\n"
@@ -69,7 +72,7 @@ static const char k_usage[] =
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot;
     int32_t w, h;
-    int frames, settle, overlay, wireframe, static_lods, lod_colors, atlas_overlay;
+    int frames, settle, overlay, wireframe, static_lods, lod_colors, atlas_overlay, no_occlusion;
     double error_px, speed;
 } view_args;
 
@@ -108,6 +111,7 @@ static int parse_args(int argc, char **argv, view_args *a)
                     : !strcmp(arg, "--static-lod")    ? &a->static_lods
                     : !strcmp(arg, "--lod-colors")    ? &a->lod_colors
                     : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
+                    : !strcmp(arg, "--no-occlusion")  ? &a->no_occlusion
                                                       : NULL;
         if (flag) {
             *flag = 1;
@@ -208,7 +212,7 @@ typedef struct viewer {
     sw_cli_overlay overlay;
     sw_cli_atlas_view atlas;
     sw_renderer renderer;
-    int wireframe, static_lods, lod_colors;
+    int wireframe, static_lods, lod_colors, occlusion;
 } viewer;
 
 static void record_key(viewer *v)
@@ -250,6 +254,8 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         v->wireframe = !v->wireframe;
     else if (key == GLFW_KEY_T)
         v->static_lods = !v->static_lods;
+    else if (key == GLFW_KEY_O)
+        v->occlusion = !v->occlusion;
     else if (key == GLFW_KEY_C)
         v->lod_colors = !v->lod_colors;
     else if (key == GLFW_KEY_A) {
@@ -323,6 +329,7 @@ static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int conver
     fd.wireframe = v->wireframe;
     fd.static_lods = v->static_lods;
     fd.lod_colors = v->lod_colors;
+    fd.occlusion_culling = v->occlusion;
     fd.output_path = output;
     return sw_renderer_draw(r, &fd, fs, st);
 }
@@ -450,7 +457,8 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
                 .error_px = a->error_px,
                 .wireframe = a->wireframe,
                 .static_lods = a->static_lods,
-                .lod_colors = a->lod_colors};
+                .lod_colors = a->lod_colors,
+                .occlusion = !a->no_occlusion};
     if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)
         return sw_cli_report("view", &st);
     walker_look_from(&v.wk, &v.home);

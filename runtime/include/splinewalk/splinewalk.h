@@ -359,6 +359,9 @@ typedef struct sw_frame_desc {
                                 the one without it. The outlines are built once per scene, on
                                 the first frame that asks. Not with static_lods (their units are
                                 culled by the frustum only) nor wireframe (lines hide nothing).
+                                Where a frame hides nothing the renderer rests it for the next
+                                1, 3, 7 or 15 frames (the image is the same either way). The
+                                CLI turns it on unless --no-occlusion.
                                 0: frustum and back-patch culling */
 } sw_frame_desc;
 
