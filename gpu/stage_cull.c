@@ -269,19 +269,26 @@ static sw_result collect_bvh(const sw__fr_env *env, const sw_sg_bvh *bvh, sw__fr
  * frames (sw__fr_cull). */
 enum { OCC_STACK = 128 };
 
-typedef struct occ_walk {
+typedef struct occ_walk occ_walk;
+struct occ_walk {
     const sw__fr_env *env;
-    const sw_sg_bvh *bvh;
+    const sw_sg_bvh *bvh; /* the faces' BVH, or the static set's of unit instances */
     const sw_gpu_occluders *oc;
     const sw_lod_face_cones *fc;
     sw_sg_frustum fr;
     sw__occ_map map;
+    /* a leaf's item not outside the frustum (inside: its node is wholly inside) */
+    void (*item)(occ_walk *w, uint32_t item, int inside);
     uint32_t *kept; /* visible items */
     size_t n_kept, cap_kept;
     sw_sg_bvh_cull_stats cs;
     uint64_t back, nodes_occluded, faces_occluded;
+    /* the unit-instance BVH: its taker (instances, frustum, cones, output) */
+    struct instance_taker *taker;
+    const sw_lod_static_instances *in;
+    uint64_t faces_taken;
     int oom;
-} occ_walk;
+};
 
 /* One item of a leaf: frustum (unless its node is inside), occlusion, back face; kept ones are
  * drawn into the map. */
@@ -316,6 +323,17 @@ static void occ_item(occ_walk *w, uint32_t item, int inside)
     w->kept[w->n_kept++] = item;
 }
 
+/* Face occurrences under a BVH node: its items, or its instances' occurrences. */
+static uint64_t node_occurrences(const occ_walk *w, const sw_sg_bvh_node *node)
+{
+    if (!w->in)
+        return node->count;
+    uint64_t n = 0;
+    for (uint32_t i = node->first; i < node->first + node->count; ++i)
+        n += w->in->instances[w->bvh->items[i].face].n_occ;
+    return n;
+}
+
 static double node_distance(const occ_walk *w, int32_t node)
 {
     double eb[6];
@@ -348,12 +366,12 @@ static void occ_walk_bvh(occ_walk *w)
         sw__fr_eye_box(w->env->view.eye, node->box, eb);
         if (sw__occ_map_box_hidden(&w->map, eb)) {
             w->nodes_occluded++;
-            w->faces_occluded += node->count;
+            w->faces_occluded += node_occurrences(w, node);
             continue;
         }
         if (node->child[0] < 0 || n + 2 > OCC_STACK) {
             for (uint32_t i = node->first; i < node->first + node->count && !w->oom; ++i)
-                occ_item(w, i, inside);
+                w->item(w, i, inside);
             continue;
         }
         /* the nearer child on top of the stack */
@@ -382,6 +400,7 @@ static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bv
     w.bvh = bvh;
     w.oc = oc;
     w.fc = fc;
+    w.item = occ_item;
     view_frustum(env, &w.fr);
     if (!sw__occ_map_init(&w.map, &env->view, env->eps_px))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
@@ -555,6 +574,118 @@ static sw_result collect_instances(const sw__fr_env *env, const sw_lod_face_cone
     return SW_OK;
 }
 
+/* ---- the unit-instance BVH with occlusion culling --------------------------------------------
+ * The walk of the faces' BVH with occlusion culling over the unit instances: near to far, a
+ * hidden node or instance is culled whole, a visible instance's faces are classified one by one
+ * (frustum when it is partly inside, back face, the map) and its shown planar faces are drawn
+ * into the map. A face drawn from a static level is within ε_img of its exact surface on screen
+ * (the level was chosen so), as a per-frame tessellation is, so the map's margins hold for it.
+ * The instances are then put in increasing item order, as sw_sg_bvh_cull reports them. */
+static void occ_instance_faces(occ_walk *w, const sw_lod_static_instance *in,
+                               const sw_sg_bvh_item *it, uint32_t item, sw_sg_cull_class cls)
+{
+    sw__fr_visible *vis = w->taker->vis;
+    const size_t first = vis->unit_faces.n;
+    for (uint32_t k = 0; k < in->n_occ && !w->oom; ++k) {
+        occurrence o;
+        double eb[6];
+        const int shown = face_shown(w->taker, in, it, k, cls, &o, eb);
+        w->back += shown == FACE_BACK;
+        if (shown != FACE_SHOWN)
+            continue;
+        w->cs.items_tested++; /* the face's own box against the map */
+        if (sw__occ_map_box_hidden(&w->map, eb)) {
+            w->faces_occluded++;
+            continue;
+        }
+        if (!sw__fr_faces_push(&vis->unit_faces, &o, eb) ||
+            sw__occ_map_add_face(&w->map, w->oc, o.face, it->world, w->env->view.eye) < 0)
+            w->oom = 1;
+    }
+    const size_t n = vis->unit_faces.n - first;
+    w->faces_taken += n;
+    if (n == 0 || w->oom)
+        return;
+    if (!sw__gpu_grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
+                      sizeof *vis->instances)) {
+        w->oom = 1;
+        return;
+    }
+    vis->instances[vis->n_instances++] = (sw__fr_instance){item, first, n};
+}
+
+static void occ_instance(occ_walk *w, uint32_t item, int inside)
+{
+    const sw_sg_bvh_item *it = &w->bvh->items[item];
+    sw_sg_cull_class cls = SW_SG_CULL_INSIDE;
+    if (!inside) {
+        w->cs.items_tested++;
+        cls = sw_sg_frustum_classify(&w->fr, it->box);
+        if (cls == SW_SG_CULL_OUTSIDE)
+            return;
+    }
+    w->cs.items_visible++;
+    const sw_lod_static_instance *in = &w->in->instances[it->face];
+    double eb[6];
+    sw__fr_eye_box(w->env->view.eye, it->box, eb);
+    if (sw__occ_map_box_hidden(&w->map, eb)) {
+        w->faces_occluded += in->n_occ;
+        return;
+    }
+    if (in->unit != SW_LOD_STATIC_NO_UNIT && w->fc &&
+        instance_back_facing(w->taker, sw_lod_static_set_unit(w->env->statics, in->unit), it)) {
+        w->back += in->n_occ;
+        return;
+    }
+    occ_instance_faces(w, in, it, item, cls);
+}
+
+static int cmp_instance(const void *a, const void *b)
+{
+    const uint32_t x = ((const sw__fr_instance *)a)->item, y = ((const sw__fr_instance *)b)->item;
+    return (x > y) - (x < y);
+}
+
+static sw_result collect_instances_occluded(const sw__fr_env *env, const sw_gpu_occluders *oc,
+                                            const sw_lod_face_cones *fc, sw__fr_visible *vis,
+                                            sw_gpu_frame_stats *st, sw_status *status)
+{
+    instance_taker t;
+    memset(&t, 0, sizeof t);
+    t.env = env;
+    t.in = sw_lod_static_set_instances(env->statics);
+    t.fc = fc;
+    t.vis = vis;
+    t.st = st;
+    view_frustum(env, &t.fr);
+    occ_walk w;
+    memset(&w, 0, sizeof w);
+    w.env = env;
+    w.bvh = t.in->bvh;
+    w.oc = oc;
+    w.fc = fc;
+    w.fr = t.fr;
+    w.item = occ_instance;
+    w.taker = &t;
+    w.in = t.in;
+    if (!sw__occ_map_init(&w.map, &env->view, env->eps_px))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
+    occ_walk_bvh(&w);
+    if (vis->n_instances > 1)
+        qsort(vis->instances, vis->n_instances, sizeof *vis->instances, cmp_instance);
+    st->faces_culled += t.in->n_occs - w.faces_taken;
+    st->faces_backculled += w.back;
+    st->occlusion_tests += w.map.tests;
+    st->nodes_occluded += w.nodes_occluded;
+    st->faces_occluded += w.faces_occluded;
+    st->occluders_drawn += w.map.occluders_drawn;
+    add_bvh_stats(st, &w.cs);
+    sw__occ_map_free(&w.map);
+    if (w.oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    return SW_OK;
+}
+
 sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__fr_visible *vis,
                       sw_gpu_frame_stats *st, sw_status *status)
 {
@@ -562,12 +693,13 @@ sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__
     sw_result r = fc ? check_cones(env, fc, status) : SW_OK;
     /* a wireframe frame shows what lies behind its faces' triangles: nothing occludes there */
     const int occlusion =
-        desc->occluders && face_bvh(desc) && !static_instances(env) && !desc->wireframe;
+        desc->occluders && (face_bvh(desc) || static_instances(env)) && !desc->wireframe;
     if (r == SW_OK && desc->occluders &&
         desc->occluders->scene_serial != sw_sg_scene_serial(env->scene))
         r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "frame: occluders of another scene");
     if (r == SW_OK && static_instances(env))
-        r = collect_instances(env, fc, vis, st, status);
+        r = occlusion ? collect_instances_occluded(env, desc->occluders, fc, vis, st, status)
+                      : collect_instances(env, fc, vis, st, status);
     else if (r == SW_OK && occlusion)
         r = collect_bvh_occluded(env, face_bvh(desc), desc->occluders, fc, &vis->faces, st, status);
     else if (r == SW_OK && face_bvh(desc))

@@ -122,8 +122,9 @@ typedef struct sw_gpu_frame_desc {
     const struct sw_gpu_occluders *occluders; /* NULL: no occlusion culling; else the scene's
                               planar faces as occluders (sw_gpu_occluders_build, once per scene):
                               the BVH is walked near to far and what the visible planes hide
-                              is culled, conservatively (gpu/occlusion.h). With desc.bvh only;
-                              ignored with static_lods and with wireframe */
+                              is culled, conservatively (gpu/occlusion.h). With desc.bvh, or
+                              with static_lods over its BVH of unit instances; ignored with
+                              wireframe */
 } sw_gpu_frame_desc;
 
 /* The planar faces of a scene as occluders: their outlines in object space, built once per scene

@@ -49,7 +49,7 @@ static const char k_usage[] =
     "                      choice meaning per-frame: neighbours at different levels\n"
     "  --no-occlusion      draw what the visible planar faces hide too (by default it is culled\n"
     "                      before it is tessellated, by a depth map of those faces on the\n"
-    "                      visibility thread; the image is the same; not with --static-lod)\n"
+    "                      visibility thread; the image is the same)\n"
     "  --partial           import what is whole of a truncated file (see `import --help`)\n"
     "  -h, --help          this text\n";
 

@@ -15,10 +15,16 @@
  *     most of its faces as hidden (at least half of those the frustum keeps, over the walk). The
  *     walk's first view is drawn as a wireframe too, where nothing may be culled (lines hide
  *     nothing: culling there drops the rooms seen through them).
- * Usage: test_gpu_occlusion OUTDIR BUILDING.sws */
+ *  3. The same with static LODs (Kumar et al. 1997: the frame culls the set's BVH of unit
+ *     instances, each drawn from a static level or per frame): every third frame of the walk and
+ *     the outside views identical with and without occlusion culling, and the walk culling at
+ *     least half of its faces as hidden.
+ * Usage: test_gpu_occlusion OUTDIR BUILDING.sws [--static]   (--static: part 3 only) */
 #include "gpu_test_compare.h"
+#include "hierarchy_support.h"
 #include "occlusion.h"
 #include "sw_lod_face_cones.h"
+#include "sw_lod_static_set.h"
 #include "sw_sg_bvh.h"
 
 #include <math.h>
@@ -283,8 +289,16 @@ static void map_case(int c)
 /* ---- 2. frames of a building ---------------------------------------------------------------- */
 enum { W = 320, H = 240, WALK = 30 };
 
-static sw_result frame(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_sg_bvh *bvh,
-                       const sw_lod_face_cones *fc, const sw_gpu_occluders *oc,
+/* The scene's BVH, cones, occluders and (made on first need) static LODs. */
+typedef struct scene_set {
+    sw_sg_scene *scene;
+    sw_sg_bvh *bvh;
+    sw_lod_face_cones *fc;
+    sw_gpu_occluders *oc;
+    sw_lod_static_set *statics; /* NULL: per-frame tessellation only */
+} scene_set;
+
+static sw_result frame(sw_gpu_context *ctx, const scene_set *s, int occlude,
                        const sw_gpu_camera *cam, int wireframe, sw_gpu_image *img,
                        sw_gpu_frame_stats *fs, sw_status *st)
 {
@@ -294,11 +308,12 @@ static sw_result frame(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_s
     d.height = H;
     d.camera = *cam;
     d.background[0] = d.background[1] = d.background[2] = d.background[3] = 1.0f;
-    d.bvh = bvh;
-    d.face_cones = fc;
-    d.occluders = oc;
+    d.bvh = s->bvh;
+    d.face_cones = s->fc;
+    d.occluders = occlude ? s->oc : NULL;
+    d.static_lods = s->statics;
     d.wireframe = wireframe;
-    return sw_gpu_render_scene(ctx, scene, &d, img, fs, st);
+    return sw_gpu_render_scene(ctx, s->scene, &d, img, fs, st);
 }
 
 /* Camera k of the walk: eye height 160 (the generator's centimetres) through the rooms along x,
@@ -317,85 +332,116 @@ static sw_gpu_camera walk_camera(const double b[6], int k)
     return c;
 }
 
-static void frames_case(sw_gpu_context *ctx, const char *path)
+/* One view off and on: the images must be identical; adds the faces drawn to the sums. */
+static int compare_view(sw_gpu_context *ctx, const scene_set *s, int k, const sw_gpu_camera *cam,
+                        int wire, uint64_t sums[3])
 {
     sw_status st = {0};
-    sw_sg_scene *scene = NULL;
-    sw_sg_bvh *bvh = NULL;
-    sw_lod_face_cones *fc = NULL;
-    sw_gpu_occluders *oc = NULL;
-    if (sw_sg_scene_open(path, &scene, &st) != SW_OK ||
-        sw_sg_bvh_build(scene, &bvh, &st) != SW_OK ||
-        sw_lod_face_cones_build(scene, &fc, &st) != SW_OK ||
-        sw_gpu_occluders_build(scene, &oc, &st) != SW_OK) {
+    sw_gpu_image off = {0}, on = {0};
+    sw_gpu_frame_stats s_off, s_on;
+    if (frame(ctx, s, 0, cam, wire, &off, &s_off, &st) != SW_OK ||
+        frame(ctx, s, 1, cam, wire, &on, &s_on, &st) != SW_OK) {
+        CHECK(0, "frame %d: %s", k, st.message);
+        sw_gpu_image_free(&off);
+        sw_gpu_image_free(&on);
+        return 0;
+    }
+    const sw_test_image_diff d = sw_test_compare_images(&off, &on, 0);
+    CHECK(d.any == 0, "%sframe %d: %ld pixels differ with occlusion culling (%ld covered)",
+          s->statics ? "static LODs, " : "", k, d.any, d.covered);
+    if (k < WALK) {
+        sums[0] += s_off.faces_drawn;
+        sums[1] += s_on.faces_drawn;
+        sums[2] += s_on.faces_occluded;
+    }
+    if (k % 10 == 0 || k >= WALK)
+        printf("  frame %d: faces drawn %llu -> %llu (%llu occluded, %llu occluders, %llu "
+               "tests), %ld pixels covered\n",
+               k, (unsigned long long)s_off.faces_drawn, (unsigned long long)s_on.faces_drawn,
+               (unsigned long long)s_on.faces_occluded, (unsigned long long)s_on.occluders_drawn,
+               (unsigned long long)s_on.occlusion_tests, d.covered);
+    if (s->statics && (k % 10 == 0 || k >= WALK))
+        printf("    static units drawn %llu -> %llu\n",
+               (unsigned long long)s_off.static_units_drawn,
+               (unsigned long long)s_on.static_units_drawn);
+    sw_gpu_image_free(&off);
+    sw_gpu_image_free(&on);
+    return 1;
+}
+
+/* The walk (every `step`-th frame) and the outside views; the first view as a wireframe too
+ * (only without static LODs: the unit-instance path draws no wireframe of its own kind). */
+static void walk_views(sw_gpu_context *ctx, const scene_set *s, int step)
+{
+    const double *b = s->bvh->nodes[0].box;
+    uint64_t sums[3] = {0, 0, 0}; /* faces drawn off, on; occluded */
+    const int last = s->statics ? WALK + 2 : WALK + 3;
+    for (int k = 0; k < last; k += k < WALK ? step : 1) {
+        const sw_gpu_camera cam = k < WALK       ? walk_camera(b, k)
+                                  : k < WALK + 2 ? sw_test_view_camera(b, k == WALK)
+                                                 : walk_camera(b, 0);
+        if (!compare_view(ctx, s, k, &cam, k == WALK + 2, sums))
+            break;
+    }
+    printf("  walk: faces drawn %llu without, %llu with occlusion culling (%llu occluded)\n",
+           (unsigned long long)sums[0], (unsigned long long)sums[1], (unsigned long long)sums[2]);
+    CHECK(sums[1] * 2 <= sums[0], "the walk culls less than half its faces as hidden%s",
+          s->statics ? " (static LODs)" : "");
+}
+
+static void frames_case(sw_gpu_context *ctx, const char *path, int with_statics)
+{
+    sw_status st = {0};
+    scene_set s = {0};
+    sw_test_hierarchies *h = NULL;
+    if (sw_sg_scene_open(path, &s.scene, &st) != SW_OK ||
+        sw_sg_bvh_build(s.scene, &s.bvh, &st) != SW_OK ||
+        sw_lod_face_cones_build(s.scene, &s.fc, &st) != SW_OK ||
+        sw_gpu_occluders_build(s.scene, &s.oc, &st) != SW_OK) {
         CHECK(0, "%s: %s", path, st.message);
         goto done;
     }
     printf("%s: %u faces, %u occluders, %zu bytes of outlines\n", path,
-           sw_sg_scene_view_ptr(scene)->n_faces, sw_gpu_occluders_count(oc),
-           sw_gpu_occluders_memory(oc));
-    CHECK(sw_gpu_occluders_count(oc) > 0, "no occluder in a building");
-    const double *b = bvh->nodes[0].box;
-    uint64_t kept_off = 0, kept_on = 0, occluded = 0;
-    for (int k = 0; k < WALK + 3; ++k) {
-        const sw_gpu_camera cam = k < WALK       ? walk_camera(b, k)
-                                  : k < WALK + 2 ? sw_test_view_camera(b, k == WALK)
-                                                 : walk_camera(b, 0);
-        sw_gpu_image off = {0}, on = {0};
-        sw_gpu_frame_stats s_off, s_on;
-        /* the first frame also as a wireframe, where the rooms behind show through the lines */
-        const int wire = k == WALK + 2;
-        if (frame(ctx, scene, bvh, fc, NULL, &cam, wire, &off, &s_off, &st) != SW_OK ||
-            frame(ctx, scene, bvh, fc, oc, &cam, wire, &on, &s_on, &st) != SW_OK) {
-            CHECK(0, "frame %d: %s", k, st.message);
-            sw_gpu_image_free(&off);
-            sw_gpu_image_free(&on);
-            break;
-        }
-        const sw_test_image_diff d = sw_test_compare_images(&off, &on, 0);
-        CHECK(d.any == 0, "frame %d: %ld pixels differ with occlusion culling (%ld covered)", k,
-              d.any, d.covered);
-        if (k < WALK) {
-            kept_off += s_off.faces_drawn;
-            kept_on += s_on.faces_drawn;
-            occluded += s_on.faces_occluded;
-        }
-        if (k % 10 == 0 || k >= WALK)
-            printf("  frame %d: faces drawn %llu -> %llu (%llu occluded, %llu occluders, %llu "
-                   "tests), %ld pixels covered\n",
-                   k, (unsigned long long)s_off.faces_drawn, (unsigned long long)s_on.faces_drawn,
-                   (unsigned long long)s_on.faces_occluded,
-                   (unsigned long long)s_on.occluders_drawn,
-                   (unsigned long long)s_on.occlusion_tests, d.covered);
-        sw_gpu_image_free(&off);
-        sw_gpu_image_free(&on);
+           sw_sg_scene_view_ptr(s.scene)->n_faces, sw_gpu_occluders_count(s.oc),
+           sw_gpu_occluders_memory(s.oc));
+    CHECK(sw_gpu_occluders_count(s.oc) > 0, "no occluder in a building");
+    if (!with_statics) {
+        walk_views(ctx, &s, 1);
+        goto done;
     }
-    printf("  walk: faces drawn %llu without, %llu with occlusion culling (%llu occluded)\n",
-           (unsigned long long)kept_off, (unsigned long long)kept_on, (unsigned long long)occluded);
-    CHECK(kept_on * 2 <= kept_off, "the walk culls less than half its faces as hidden");
+    puts("with static LODs");
+    h = sw_test_hierarchies_create(s.scene);
+    s.statics = h ? sw_test_hierarchies_statics(h) : NULL;
+    CHECK(s.statics != NULL, "static LODs of the building");
+    if (s.statics)
+        walk_views(ctx, &s, 3);
 done:
-    sw_gpu_occluders_free(oc);
-    sw_lod_face_cones_free(fc);
-    sw_sg_bvh_free(bvh);
-    sw_sg_scene_free(scene);
+    sw_test_hierarchies_free(h);
+    sw_gpu_occluders_free(s.oc);
+    sw_lod_face_cones_free(s.fc);
+    sw_sg_bvh_free(s.bvh);
+    sw_sg_scene_free(s.scene);
 }
 
 int main(int argc, char **argv)
 {
-    if (argc < 3) {
-        fprintf(stderr, "usage: %s OUTDIR BUILDING.sws\n", argv[0]);
+    if (argc < 3 || (argc > 3 && strcmp(argv[3], "--static"))) {
+        fprintf(stderr, "usage: %s OUTDIR BUILDING.sws [--static]\n", argv[0]);
         return 2;
     }
-    puts("the occlusion map against a dense reference");
-    for (int c = 0; c < 40; ++c)
-        map_case(c);
+    const int with_statics = argc > 3;
+    if (!with_statics) {
+        puts("the occlusion map against a dense reference");
+        for (int c = 0; c < 40; ++c)
+            map_case(c);
+    }
     sw_status st = {0};
     sw_gpu_context *ctx = NULL;
     if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK) {
         fprintf(stderr, "FAIL: %s\n", st.message);
         return 1;
     }
-    frames_case(ctx, argv[2]);
+    frames_case(ctx, argv[2], with_statics);
     sw_gpu_context_free(ctx);
     puts(g_failures ? "FAIL" : "PASS");
     return g_failures ? 1 : 0;

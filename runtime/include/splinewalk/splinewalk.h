@@ -357,8 +357,8 @@ typedef struct sw_frame_desc {
                                 quarter-resolution depth map on the visibility thread, against
                                 which the boxes behind are tested. Conservative: the image is
                                 the one without it. The outlines are built once per scene, on
-                                the first frame that asks. Not with static_lods (their units are
-                                culled by the frustum only) nor wireframe (lines hide nothing).
+                                the first frame that asks. With static_lods the unit instances
+                                are culled so. Not with wireframe (lines hide nothing).
                                 Where a frame hides nothing the renderer rests it for the next
                                 1, 3, 7 or 15 frames (the image is the same either way). The
                                 CLI turns it on unless --no-occlusion.
