@@ -389,6 +389,21 @@ static int cmp_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* The walk's counters into the frame's; its map freed. */
+static sw_result occ_walk_finish(occ_walk *w, sw_gpu_frame_stats *st, sw_status *status)
+{
+    st->faces_backculled += w->back;
+    st->occlusion_tests += w->map.tests;
+    st->nodes_occluded += w->nodes_occluded;
+    st->faces_occluded += w->faces_occluded;
+    st->occluders_drawn += w->map.occluders_drawn;
+    add_bvh_stats(st, &w->cs);
+    sw__occ_map_free(&w->map);
+    if (w->oom)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
+    return SW_OK;
+}
+
 static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bvh,
                                       const sw_gpu_occluders *oc, const sw_lod_face_cones *fc,
                                       sw__fr_faces *faces, sw_gpu_frame_stats *st,
@@ -416,17 +431,8 @@ static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bv
         w.oom = !sw__fr_faces_push(faces, &o, box);
     }
     st->faces_culled += bvh->n_items - w.n_kept;
-    st->faces_backculled += w.back;
-    st->occlusion_tests += w.map.tests;
-    st->nodes_occluded += w.nodes_occluded;
-    st->faces_occluded += w.faces_occluded;
-    st->occluders_drawn += w.map.occluders_drawn;
-    add_bvh_stats(st, &w.cs);
     sw__free(w.kept);
-    sw__occ_map_free(&w.map);
-    if (w.oom)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
-    return SW_OK;
+    return occ_walk_finish(&w, st, status);
 }
 
 /* ---- back-patch culling ------------------------------------------------------------------ */
@@ -510,6 +516,20 @@ static int face_shown(const instance_taker *t, const sw_lod_static_instance *in,
     return t->fc && sw__fr_face_back_facing(t->fc, o, eb) ? FACE_BACK : FACE_SHOWN;
 }
 
+/* Instance `item` with the unit faces from `first` on, unless it shows none (culled whole); 0
+ * when out of memory. */
+static int push_instance(sw__fr_visible *vis, uint32_t item, size_t first)
+{
+    const size_t n = vis->unit_faces.n - first;
+    if (n == 0)
+        return 1;
+    if (!sw__gpu_grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
+                      sizeof *vis->instances))
+        return 0;
+    vis->instances[vis->n_instances++] = (sw__fr_instance){item, first, n};
+    return 1;
+}
+
 /* The instance's shown faces into vis->unit_faces; culled whole when none is. */
 static void take_shown_faces(instance_taker *t, const sw_lod_static_instance *in,
                              const sw_sg_bvh_item *it, uint32_t item, sw_sg_cull_class cls)
@@ -528,14 +548,8 @@ static void take_shown_faces(instance_taker *t, const sw_lod_static_instance *in
     const size_t n = vis->unit_faces.n - first;
     t->st->faces_backculled += back;
     t->st->faces_culled += in->n_occ - n;
-    if (n == 0 || t->oom)
-        return;
-    if (!sw__gpu_grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
-                      sizeof *vis->instances)) {
+    if (!t->oom && !push_instance(vis, item, first))
         t->oom = 1;
-        return;
-    }
-    vis->instances[vis->n_instances++] = (sw__fr_instance){item, first, n};
 }
 
 static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
@@ -554,17 +568,24 @@ static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
     return t->oom;
 }
 
+static void instance_taker_init(instance_taker *t, const sw__fr_env *env,
+                                const sw_lod_face_cones *fc, sw__fr_visible *vis,
+                                sw_gpu_frame_stats *st)
+{
+    memset(t, 0, sizeof *t);
+    t->env = env;
+    t->in = sw_lod_static_set_instances(env->statics);
+    t->fc = fc;
+    t->vis = vis;
+    t->st = st;
+    view_frustum(env, &t->fr);
+}
+
 static sw_result collect_instances(const sw__fr_env *env, const sw_lod_face_cones *fc,
                                    sw__fr_visible *vis, sw_gpu_frame_stats *st, sw_status *status)
 {
     instance_taker t;
-    memset(&t, 0, sizeof t);
-    t.env = env;
-    t.in = sw_lod_static_set_instances(env->statics);
-    t.fc = fc;
-    t.vis = vis;
-    t.st = st;
-    view_frustum(env, &t.fr);
+    instance_taker_init(&t, env, fc, vis, st);
     sw_sg_bvh_cull_stats cs;
     sw_sg_bvh_cull(t.in->bvh, &t.fr, take_instance, &t, &cs);
     add_bvh_stats(st, &cs);
@@ -602,16 +623,9 @@ static void occ_instance_faces(occ_walk *w, const sw_lod_static_instance *in,
             sw__occ_map_add_face(&w->map, w->oc, o.face, it->world, w->env->view.eye) < 0)
             w->oom = 1;
     }
-    const size_t n = vis->unit_faces.n - first;
-    w->faces_taken += n;
-    if (n == 0 || w->oom)
-        return;
-    if (!sw__gpu_grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
-                      sizeof *vis->instances)) {
+    w->faces_taken += vis->unit_faces.n - first;
+    if (!w->oom && !push_instance(vis, item, first))
         w->oom = 1;
-        return;
-    }
-    vis->instances[vis->n_instances++] = (sw__fr_instance){item, first, n};
 }
 
 static void occ_instance(occ_walk *w, uint32_t item, int inside)
@@ -651,13 +665,7 @@ static sw_result collect_instances_occluded(const sw__fr_env *env, const sw_gpu_
                                             sw_gpu_frame_stats *st, sw_status *status)
 {
     instance_taker t;
-    memset(&t, 0, sizeof t);
-    t.env = env;
-    t.in = sw_lod_static_set_instances(env->statics);
-    t.fc = fc;
-    t.vis = vis;
-    t.st = st;
-    view_frustum(env, &t.fr);
+    instance_taker_init(&t, env, fc, vis, st);
     occ_walk w;
     memset(&w, 0, sizeof w);
     w.env = env;
@@ -674,16 +682,7 @@ static sw_result collect_instances_occluded(const sw__fr_env *env, const sw_gpu_
     if (vis->n_instances > 1)
         qsort(vis->instances, vis->n_instances, sizeof *vis->instances, cmp_instance);
     st->faces_culled += t.in->n_occs - w.faces_taken;
-    st->faces_backculled += w.back;
-    st->occlusion_tests += w.map.tests;
-    st->nodes_occluded += w.nodes_occluded;
-    st->faces_occluded += w.faces_occluded;
-    st->occluders_drawn += w.map.occluders_drawn;
-    add_bvh_stats(st, &w.cs);
-    sw__occ_map_free(&w.map);
-    if (w.oom)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "visible occurrences: out of memory");
-    return SW_OK;
+    return occ_walk_finish(&w, st, status);
 }
 
 sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__fr_visible *vis,
