@@ -37,8 +37,8 @@ typedef struct sw_rt_renderer {
      * outside): after a culled frame that hid nothing the next occlusion_rest frames go without
      * it, the rest growing 1, 3, 7, 15 while it keeps hiding nothing and ending at the first
      * frame that hides something. A frame without it draws a superset of the same image's faces,
-     * so resting never changes an image, only what the map costs (~4 % of the visibility stage
-     * where nothing is hidden). */
+     * so resting never changes an image, only what the map costs (4-10 % of the visibility
+     * stage where nothing is hidden). */
     uint32_t occlusion_rest, occlusion_rest_left;
     /* of cache_scene: static LODs (Kumar §3-§4), the set made by a pool task on the first frame
      * that asks for them and published by one pointer store; statics_state: 0 none, 1 being
