@@ -259,6 +259,19 @@ static sw_result collect_bvh(const sw__fr_env *env, const sw_sg_bvh *bvh, sw__fr
     return SW_OK;
 }
 
+/* Takes the unit instances of the static set's BVH into the frame's visible set (the
+ * unit-instance BVH section below). */
+typedef struct instance_taker {
+    const sw__fr_env *env;
+    const sw_lod_static_instances *in;
+    const sw_lod_face_cones *fc; /* NULL: no back-patch culling */
+    sw_sg_frustum fr;
+    sw__fr_visible *vis;
+    sw_gpu_frame_stats *st;
+    uint64_t occs_seen; /* face occurrences of the instances reported */
+    int oom;
+} instance_taker;
+
 /* ---- the faces' BVH with occlusion culling (gpu/occlusion.h) -------------------------------
  * The BVH is walked near to far (the nearer child first), so that the planes found visible first
  * hide what lies behind them: a node hidden by the occlusion map is culled with its subtree, a
@@ -284,8 +297,7 @@ struct occ_walk {
     sw_sg_bvh_cull_stats cs;
     uint64_t back, nodes_occluded, faces_occluded;
     /* the unit-instance BVH: its taker (instances, frustum, cones, output) */
-    struct instance_taker *taker;
-    const sw_lod_static_instances *in;
+    struct instance_taker *taker; /* NULL: the faces' BVH */
     uint64_t faces_taken;
     int oom;
 };
@@ -326,11 +338,11 @@ static void occ_item(occ_walk *w, uint32_t item, int inside)
 /* Face occurrences under a BVH node: its items, or its instances' occurrences. */
 static uint64_t node_occurrences(const occ_walk *w, const sw_sg_bvh_node *node)
 {
-    if (!w->in)
+    if (!w->taker)
         return node->count;
     uint64_t n = 0;
     for (uint32_t i = node->first; i < node->first + node->count; ++i)
-        n += w->in->instances[w->bvh->items[i].face].n_occ;
+        n += w->taker->in->instances[w->bvh->items[i].face].n_occ;
     return n;
 }
 
@@ -389,6 +401,26 @@ static int cmp_u32(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+/* A walk of `bvh` near to far with a fresh map, item by item; occ_walk_finish closes it. */
+static sw_result occ_walk_run(occ_walk *w, const sw__fr_env *env, const sw_sg_bvh *bvh,
+                              const sw_gpu_occluders *oc, const sw_lod_face_cones *fc,
+                              void (*item)(occ_walk *, uint32_t, int), struct instance_taker *taker,
+                              sw_status *status)
+{
+    memset(w, 0, sizeof *w);
+    w->env = env;
+    w->bvh = bvh;
+    w->oc = oc;
+    w->fc = fc;
+    w->item = item;
+    w->taker = taker;
+    view_frustum(env, &w->fr);
+    if (!sw__occ_map_init(&w->map, &env->view, env->eps_px))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
+    occ_walk_bvh(w);
+    return SW_OK;
+}
+
 /* The walk's counters into the frame's; its map freed. */
 static sw_result occ_walk_finish(occ_walk *w, sw_gpu_frame_stats *st, sw_status *status)
 {
@@ -410,16 +442,9 @@ static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bv
                                       sw_status *status)
 {
     occ_walk w;
-    memset(&w, 0, sizeof w);
-    w.env = env;
-    w.bvh = bvh;
-    w.oc = oc;
-    w.fc = fc;
-    w.item = occ_item;
-    view_frustum(env, &w.fr);
-    if (!sw__occ_map_init(&w.map, &env->view, env->eps_px))
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
-    occ_walk_bvh(&w);
+    sw_result r = occ_walk_run(&w, env, bvh, oc, fc, occ_item, NULL, status);
+    if (r != SW_OK)
+        return r;
     if (w.n_kept > 1) /* kept may be NULL */
         qsort(w.kept, w.n_kept, sizeof *w.kept, cmp_u32);
     for (size_t i = 0; i < w.n_kept && !w.oom; ++i) {
@@ -473,16 +498,6 @@ static void cull_back_faces(const sw_lod_face_cones *fc, sw__fr_faces *faces,
 }
 
 /* ---- the unit-instance BVH (see the top of the file) --------------------------------------- */
-typedef struct instance_taker {
-    const sw__fr_env *env;
-    const sw_lod_static_instances *in;
-    const sw_lod_face_cones *fc; /* NULL: no back-patch culling */
-    sw_sg_frustum fr;
-    sw__fr_visible *vis;
-    sw_gpu_frame_stats *st;
-    uint64_t occs_seen; /* face occurrences of the instances reported */
-    int oom;
-} instance_taker;
 
 /* Back-patch culling of a whole instance: the unit's outward cone in the world faces away from
  * every view direction into the instance's box (the cone is the full one unless the unit is part
@@ -614,7 +629,6 @@ static void occ_instance_faces(occ_walk *w, const sw_lod_static_instance *in,
         w->back += shown == FACE_BACK;
         if (shown != FACE_SHOWN)
             continue;
-        w->cs.items_tested++; /* the face's own box against the map */
         if (sw__occ_map_box_hidden(&w->map, eb)) {
             w->faces_occluded++;
             continue;
@@ -639,7 +653,7 @@ static void occ_instance(occ_walk *w, uint32_t item, int inside)
             return;
     }
     w->cs.items_visible++;
-    const sw_lod_static_instance *in = &w->in->instances[it->face];
+    const sw_lod_static_instance *in = &w->taker->in->instances[it->face];
     double eb[6];
     sw__fr_eye_box(w->env->view.eye, it->box, eb);
     if (sw__occ_map_box_hidden(&w->map, eb)) {
@@ -667,18 +681,9 @@ static sw_result collect_instances_occluded(const sw__fr_env *env, const sw_gpu_
     instance_taker t;
     instance_taker_init(&t, env, fc, vis, st);
     occ_walk w;
-    memset(&w, 0, sizeof w);
-    w.env = env;
-    w.bvh = t.in->bvh;
-    w.oc = oc;
-    w.fc = fc;
-    w.fr = t.fr;
-    w.item = occ_instance;
-    w.taker = &t;
-    w.in = t.in;
-    if (!sw__occ_map_init(&w.map, &env->view, env->eps_px))
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
-    occ_walk_bvh(&w);
+    sw_result r = occ_walk_run(&w, env, t.in->bvh, oc, fc, occ_instance, &t, status);
+    if (r != SW_OK)
+        return r;
     if (vis->n_instances > 1)
         qsort(vis->instances, vis->n_instances, sizeof *vis->instances, cmp_instance);
     st->faces_culled += t.in->n_occs - w.faces_taken;
