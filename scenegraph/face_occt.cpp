@@ -22,7 +22,9 @@
 #include <Geom2d_TrimmedCurve.hxx>
 #include <GeomConvert.hxx>
 #include <GProp_GProps.hxx>
+#include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
+#include <Geom_TrimmedCurve.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Reader.hxx>
@@ -378,6 +380,177 @@ void check_poles(const Handle(Geom_BSplineSurface) & s, const std::string &what)
     }
 }
 
+/* Knots beyond the scene's range (SW_SG_COORD_MAX) or not finite: OCCT's B-spline constructors
+ * compare neighbouring knots only, so a NaN passes them, and its span search then never ends. */
+void check_knots(const Handle(Geom_BSplineSurface) & s, const std::string &what)
+{
+    if (s.IsNull())
+        return;
+    for (int dir = 0; dir < 2; dir++)
+        for (int i = 1, n = dir ? s->NbVKnots() : s->NbUKnots(); i <= n; i++) {
+            const double k = dir ? s->VKnot(i) : s->UKnot(i);
+            if (!(std::fabs(k) <= SW_SG_COORD_MAX)) {
+                char buf[160];
+                std::snprintf(buf, sizeof buf, ": %c knot %d is %g, beyond %g", dir ? 'v' : 'u',
+                              i - 1, k, SW_SG_COORD_MAX);
+                throw face_error{what + buf};
+            }
+        }
+}
+
+/* One point of the face's source geometry: finite and inside the scene's range, else the face is
+ * refused before BRepBuilderAPI_NurbsConvert projects its pcurves onto it (a cone with a NaN
+ * angle kept OCCT's projection in an endless SVD). */
+void check_point(const double *c, int n, const char *of, const std::string &what)
+{
+    for (int k = 0; k < n; k++)
+        if (!(std::fabs(c[k]) <= SW_SG_COORD_MAX)) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf, ": %s has a coordinate %g, beyond %g", of, c[k],
+                          SW_SG_COORD_MAX);
+            throw face_error{what + buf};
+        }
+}
+
+/* A spline curve's knots, poles and weights finite and inside the scene's range, read without
+ * evaluating it (OCCT's span search never ends on a NaN knot); a trimmed curve is checked through
+ * its basis. Other curves have no such data. */
+int coords(const gp_Pnt2d &p, double *c)
+{
+    c[0] = p.X(), c[1] = p.Y();
+    return 2;
+}
+
+int coords(const gp_Pnt &p, double *c)
+{
+    c[0] = p.X(), c[1] = p.Y(), c[2] = p.Z();
+    return 3;
+}
+
+template <typename Spline, typename Trimmed, typename Curve>
+void check_spline_curve(const Handle(Curve) & c, const char *of, const std::string &what)
+{
+    Handle(Curve) basis = c;
+    while (Handle(Trimmed) t = Handle(Trimmed)::DownCast(basis))
+        basis = t->BasisCurve();
+    const Handle(Spline) bs = Handle(Spline)::DownCast(basis);
+    if (bs.IsNull())
+        return;
+    for (int i = 1; i <= bs->NbKnots(); i++) {
+        const double k = bs->Knot(i);
+        check_point(&k, 1, of, what);
+    }
+    for (int i = 1; i <= bs->NbPoles(); i++) {
+        double xyw[4];
+        const int n = coords(bs->Pole(i), xyw);
+        xyw[n] = bs->Weight(i);
+        check_point(xyw, n + 1, of, what);
+    }
+}
+
+void check_pcurve_data(const Handle(Geom2d_Curve) & c, const std::string &what)
+{
+    check_spline_curve<Geom2d_BSplineCurve, Geom2d_TrimmedCurve>(c, "an edge's pcurve", what);
+}
+
+void check_curve_data(const Handle(Geom_Curve) & c, const std::string &what)
+{
+    check_spline_curve<Geom_BSplineCurve, Geom_TrimmedCurve>(c, "an edge's curve", what);
+}
+
+/* The converted face's pcurves, before anything evaluates them (BRepTools_WireExplorer does):
+ * the conversion's projection can leave NaN in them. */
+void check_converted(const TopoDS_Face &cf, const std::string &what)
+{
+    for (TopExp_Explorer ex(cf, TopAbs_EDGE); ex.More(); ex.Next()) {
+        double t[2];
+        const Handle(Geom2d_Curve) pc =
+            BRep_Tool::CurveOnSurface(TopoDS::Edge(ex.Current()), cf, t[0], t[1]);
+        if (pc.IsNull())
+            continue;
+        check_point(t, 2, "an edge's converted pcurve range", what);
+        check_pcurve_data(pc, what);
+    }
+}
+
+/* The face's parameter box inside its surface's own domain in each direction that is not
+ * periodic, up to 5 % of the domain's span (pcurves of real files overshoot a little; the
+ * conversion snaps them): a sphere face whose v range lies beyond the poles kept OCCT's pcurve
+ * projection busy without end. Unbounded directions (planes) pass. */
+void check_in_domain(const double b[4], const Handle(Geom_Surface) & s, const std::string &what)
+{
+    double d[4];
+    s->Bounds(d[0], d[1], d[2], d[3]);
+    const bool periodic[2] = {s->IsUPeriodic() == Standard_True, s->IsVPeriodic() == Standard_True};
+    for (int dir = 0; dir < 2; dir++) {
+        const double lo = d[2 * dir], hi = d[2 * dir + 1], slack = 0.05 * (hi - lo);
+        if (periodic[dir] || !(b[2 * dir] < lo - slack || b[2 * dir + 1] > hi + slack))
+            continue;
+        char buf[200];
+        std::snprintf(buf, sizeof buf, ": its %c range [%g, %g] lies beyond its surface's [%g, %g]",
+                      dir ? 'v' : 'u', b[2 * dir], b[2 * dir + 1], lo, hi);
+        throw face_error{what + buf};
+    }
+}
+
+/* The face's parameter bounds, its surface on a 3 x 3 grid over them, and each edge's 3D curve
+ * and pcurve at both ends and the middle, checked with check_point: elementary and swept surfaces
+ * have no poles for check_poles to read, and their parameters (a radius, an angle, an axis) reach
+ * the conversion only through these values. */
+void check_values(const TopoDS_Face &f, const Handle(Geom_Surface) & s, const std::string &what)
+{
+    /* a point where the geometry is undefined (an offset surface's singular point) throws: that
+     * sample is left out, not the face */
+    auto sample = [&](auto eval, int n, const char *of) {
+        double c[3];
+        try {
+            eval(c);
+        } catch (const Standard_Failure &) {
+            return;
+        }
+        check_point(c, n, of, what);
+    };
+    double b[4];
+    BRepTools::UVBounds(f, b[0], b[1], b[2], b[3]);
+    check_point(b, 4, "the face's parameter box", what);
+    check_in_domain(b, s, what);
+    for (int i = 0; i <= 2; i++)
+        for (int j = 0; j <= 2; j++)
+            sample(
+                [&](double *c) {
+                    const gp_Pnt p =
+                        s->Value(b[0] + (b[1] - b[0]) * i / 2, b[2] + (b[3] - b[2]) * j / 2);
+                    c[0] = p.X(), c[1] = p.Y(), c[2] = p.Z();
+                },
+                3, "its surface");
+    for (TopExp_Explorer ex(f, TopAbs_EDGE); ex.More(); ex.Next()) {
+        const TopoDS_Edge &e = TopoDS::Edge(ex.Current());
+        double t[2];
+        if (Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(e, f, t[0], t[1]); !pc.IsNull()) {
+            check_point(t, 2, "an edge's pcurve range", what);
+            check_pcurve_data(pc, what);
+            for (int i = 0; i <= 2; i++)
+                sample(
+                    [&](double *c) {
+                        const gp_Pnt2d q = pc->Value(t[0] + (t[1] - t[0]) * i / 2);
+                        c[0] = q.X(), c[1] = q.Y();
+                    },
+                    2, "an edge's pcurve");
+        }
+        if (Handle(Geom_Curve) c3 = BRep_Tool::Curve(e, t[0], t[1]); !c3.IsNull()) {
+            check_point(t, 2, "an edge's curve range", what);
+            check_curve_data(c3, what);
+            for (int i = 0; i <= 2; i++)
+                sample(
+                    [&](double *c) {
+                        const gp_Pnt p = c3->Value(t[0] + (t[1] - t[0]) * i / 2);
+                        c[0] = p.X(), c[1] = p.Y(), c[2] = p.Z();
+                    },
+                    3, "an edge's curve");
+        }
+    }
+}
+
 /* Converts one face; throws face_error or Standard_Failure when it cannot. */
 face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what)
 {
@@ -393,7 +566,9 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     if (raw.IsNull())
         throw face_error{"the file's surface of this face could not be built by OCCT (invalid "
                          "surface data)"};
+    check_knots(Handle(Geom_BSplineSurface)::DownCast(raw), what);
     check_poles(Handle(Geom_BSplineSurface)::DownCast(raw), what);
+    check_values(f, raw, what);
 
     BRepBuilderAPI_NurbsConvert nc(f);
     if (!nc.IsDone())
@@ -409,6 +584,7 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     uv_domain d{fd.knots_u[fd.rec.deg_u], fd.knots_u[fd.rec.n_u], fd.knots_v[fd.rec.deg_v],
                 fd.knots_v[fd.rec.n_v]};
 
+    check_converted(converted, what);
     wire_loops(converted, fd);
     const double tol3 = std::max(fd.rec.tolerance, max_tolerance(converted, TopAbs_VERTEX));
     for (loop_data &ld : fd.loops) {

@@ -156,6 +156,9 @@ class importer
 
     sw_result run(uint32_t parent, const double xform[12], sw_sg_import_report *report,
                   sw_status *status);
+    /* The faces of a shape already in memory, as run() converts what it read (no XCAF). */
+    sw_result run_shape(const TopoDS_Shape &shape, uint32_t parent, const double xform[12],
+                        sw_sg_import_report *report, sw_status *status);
 
   private:
     sw_sg_builder *b_;
@@ -225,6 +228,8 @@ class importer
     sw_result read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape, bool step,
                        sw_status *status);
     void estimate_faces(const TopoDS_Shape &shape);
+    sw_result convert(const TopoDS_Shape &shape, uint32_t parent, const double xform[12],
+                      sw_status *status);
 
     void count_uses(const TopoDS_Shape &s, std::unordered_set<const void *> &seen);
     void add_shape(const TopoDS_Shape &s, uint32_t parent);
@@ -991,42 +996,60 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
                      e.DynamicType()->Name(), e.GetMessageString());
     }
     rep_.ms_read = now_ms() - t0;
-    if (r == SW_OK) {
-        progress(0.1, "convert");
-        t0 = now_ms();
-        TDF_LabelSequence free;
-        if (!st_.IsNull()) {
-            st_->GetFreeShapes(free);
-            TopoDS_Compound all;
-            BRep_Builder bb;
-            bb.MakeCompound(all);
-            for (const TDF_Label &l : free) {
-                bb.Add(all, st_->GetShape(l));
-                count_label_uses(l);
-            }
-            estimate_faces(all);
-        } else {
-            std::unordered_set<const void *> seen;
-            count_uses(shape, seen);
-            estimate_faces(shape);
+    if (r == SW_OK)
+        return run_shape(shape, parent, xform, report, status);
+    if (report)
+        *report = rep_;
+    return r;
+}
+
+/* The conversion of what was read: the part tree (XCAF labels where the reader made them, else the
+ * shape's own compounds), each face converted once, closed shells and adjacency. */
+sw_result importer::convert(const TopoDS_Shape &shape, uint32_t parent, const double xform[12],
+                            sw_status *status)
+{
+    progress(0.1, "convert");
+    const double t0 = now_ms();
+    TDF_LabelSequence free;
+    if (!st_.IsNull()) {
+        st_->GetFreeShapes(free);
+        TopoDS_Compound all;
+        BRep_Builder bb;
+        bb.MakeCompound(all);
+        for (const TDF_Label &l : free) {
+            bb.Add(all, st_->GetShape(l));
+            count_label_uses(l);
         }
-        uint32_t top = node(xform ? SW_SG_NODE_TRANSFORM : SW_SG_NODE_GROUP, parent, 0, xform,
-                            nullptr, name_.c_str());
-        if (!st_.IsNull()) {
-            for (const TDF_Label &l : free)
-                add_label(l, l, top, st_->GetLocation(l));
-        } else {
-            add_shape(shape, top);
-        }
-        mark_closed_faces();
-        for (const auto &a : adjacency_)
-            if (sw_sg_builder_add_adjacency(b_, a.first, a.second) == SW_SG_NONE)
-                throw oom_error{};
-        rep_.ms_convert = now_ms() - t0;
-        if (rep_.faces_converted == 0)
-            r = sw__fail(status, SW_ERR_FORMAT, "%s: no face could be imported (%u read)",
-                         path_.c_str(), rep_.faces_read);
+        estimate_faces(all);
+    } else {
+        std::unordered_set<const void *> seen;
+        count_uses(shape, seen);
+        estimate_faces(shape);
     }
+    uint32_t top = node(xform ? SW_SG_NODE_TRANSFORM : SW_SG_NODE_GROUP, parent, 0, xform,
+                        nullptr, name_.c_str());
+    if (!st_.IsNull()) {
+        for (const TDF_Label &l : free)
+            add_label(l, l, top, st_->GetLocation(l));
+    } else {
+        add_shape(shape, top);
+    }
+    mark_closed_faces();
+    for (const auto &a : adjacency_)
+        if (sw_sg_builder_add_adjacency(b_, a.first, a.second) == SW_SG_NONE)
+            throw oom_error{};
+    rep_.ms_convert = now_ms() - t0;
+    if (rep_.faces_converted == 0)
+        return sw__fail(status, SW_ERR_FORMAT, "%s: no face could be imported (%u read)",
+                        path_.c_str(), rep_.faces_read);
+    return SW_OK;
+}
+
+sw_result importer::run_shape(const TopoDS_Shape &shape, uint32_t parent,
+                              const double xform[12], sw_sg_import_report *report,
+                              sw_status *status)
+{
+    const sw_result r = convert(shape, parent, xform, status);
     if (report)
         *report = rep_;
     if (r == SW_OK) {
@@ -1038,16 +1061,11 @@ sw_result importer::run(uint32_t parent, const double xform[12], sw_sg_import_re
 
 } // namespace
 
-sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
-                               const sw_sg_import_desc *desc, sw_sg_import_report *report,
-                               sw_status *status, sw__occt_face_observer *observer)
+/* Runs one import, turning what escapes it into a status naming `path`. */
+template <typename F> sw_result guarded(const char *path, sw_status *status, F run)
 {
-    if (!b || !desc || !desc->path)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "import: no builder or no path");
-    const char *path = desc->path;
     try {
-        importer imp(b, desc, observer);
-        return imp.run(parent, xform, report, status);
+        return run();
     } catch (const oom_error &) {
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory while importing", path);
     } catch (const std::bad_alloc &) {
@@ -1060,6 +1078,30 @@ sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double x
     } catch (...) {
         return sw__fail(status, SW_ERR_INTERNAL, "%s: unknown exception while importing", path);
     }
+}
+
+sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
+                               const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                               sw_status *status, sw__occt_face_observer *observer)
+{
+    if (!b || !desc || !desc->path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "import: no builder or no path");
+    return guarded(desc->path, status, [&] {
+        importer imp(b, desc, observer);
+        return imp.run(parent, xform, report, status);
+    });
+}
+
+sw_result sw__occt_import_shape(sw_sg_builder *b, const TopoDS_Shape &shape,
+                                const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                                sw_status *status)
+{
+    if (!b || !desc || !desc->path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "import: no builder or no name");
+    return guarded(desc->path, status, [&] {
+        importer imp(b, desc, nullptr);
+        return imp.run_shape(shape, 0, nullptr, report, status);
+    });
 }
 
 sw_result sw__occt_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,

@@ -8,6 +8,7 @@
 #include "sw_sg_import.h"
 
 #include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
 
 struct sw__occt_face_observer {
     virtual ~sw__occt_face_observer() = default;
@@ -21,6 +22,13 @@ struct sw__occt_face_observer {
 sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
                                const sw_sg_import_desc *desc, sw_sg_import_report *report,
                                sw_status *status, sw__occt_face_observer *observer);
+/* The faces of a shape already in memory, converted, checked and repaired as an imported file's
+ * are (no XCAF names or colours), into b under its root; desc->path names the shape in messages
+ * and is not opened. The importer's conversion layer without a reader: its fuzz harness calls it.
+ */
+sw_result sw__occt_import_shape(sw_sg_builder *b, const TopoDS_Shape &shape,
+                                const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                                sw_status *status);
 sw_result sw__occt_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
                                sw_sg_import_report *report, sw_status *status,
                                sw__occt_face_observer *observer);

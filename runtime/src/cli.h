@@ -6,6 +6,8 @@
 
 #include <splinewalk/splinewalk.h>
 
+#include "cli_numbers.h"
+
 #include <stdio.h>
 
 int sw_cli_import(int argc, char **argv);
@@ -50,22 +52,6 @@ size_t sw_cli_face_notes(const sw_cli_face_note **out);
 void sw_cli_print_import_notes(FILE *f, const char *cmd, const sw_scene_info *info);
 /* sw_cli_report, with a hint at --partial for a truncated file (commands that take it). */
 int sw_cli_report_load(const char *cmd, const sw_status *status);
-/* "1280x720" → width, height (1..16384). Returns 0 on success. */
-int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h);
-/* "ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy" → camera, checked as every frame checks it (fovy given).
- * Returns 0 on success. */
-int sw_cli_parse_camera(const char *text, sw_camera *out);
-/* An integer in [lo, hi]. Returns 0 on success. */
-int sw_cli_parse_count(const char *text, int lo, int hi, int *out);
-/* "splinewalk CMD: bad value 'VAL' for ARG" on stderr, with the reason the last sw_cli_parse_*
- * call gave when it gave one (": the field of view is outside ..."), then usage (NULL: none).
- * Returns 2, the exit status of a usage error. */
-int sw_cli_bad_value(const char *cmd, const char *arg, const char *val, const char *usage);
-/* A positive finite decimal number. Returns 0 on success. */
-int sw_cli_parse_positive(const char *text, double *out);
-/* A screen-space error in pixels: a decimal number of at least SW_ERROR_MIN_PX (what every frame
- * accepts), so that a run refuses it before it creates any output. Returns 0 on success. */
-int sw_cli_parse_error_px(const char *text, double *out);
 double sw_cli_now_ms(void);
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s);
 

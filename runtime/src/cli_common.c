@@ -1,13 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /* Helpers shared by the splinewalk subcommands: argument parsing, progress, error reports. */
 #include "cli.h"
-#include "sw_decimal.h"
 #include "sw_rt.h"
 
 #include "sw_safe_write.h"
 
-#include <errno.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -141,99 +138,6 @@ int sw_cli_report_load(const char *cmd, const sw_status *status)
         fprintf(stderr, "splinewalk %s: --partial imports what is whole of a truncated file\n",
                 cmd);
     return rc;
-}
-
-/* Why the last sw_cli_parse_* call refused its text, when more than "not of the form" ("" else):
- * the command-line tools are single-threaded. */
-static char g_parse_reason[160];
-
-static int refuse(const char *why)
-{
-    snprintf(g_parse_reason, sizeof g_parse_reason, "%s", why);
-    return -1;
-}
-
-int sw_cli_bad_value(const char *cmd, const char *arg, const char *val, const char *usage)
-{
-    fprintf(stderr, "splinewalk %s: bad value '%s' for %s%s%s\n%s", cmd, val, arg,
-            g_parse_reason[0] ? ": " : "", g_parse_reason, usage ? usage : "");
-    return 2;
-}
-
-int sw_cli_parse_size(const char *text, int32_t *w, int32_t *h)
-{
-    g_parse_reason[0] = '\0';
-    char *end;
-    errno = 0;
-    long a = strtol(text, &end, 10);
-    if (errno || end == text || (*end != 'x' && *end != 'X'))
-        return -1;
-    const char *second = end + 1;
-    long b = strtol(second, &end, 10);
-    if (errno || end == second || *end != '\0' || a < 1 || b < 1 || a > 16384 || b > 16384)
-        return -1;
-    *w = (int32_t)a;
-    *h = (int32_t)b;
-    return 0;
-}
-
-int sw_cli_parse_camera(const char *text, sw_camera *out)
-{
-    g_parse_reason[0] = '\0';
-    double v[10];
-    const char *p = text;
-    for (int i = 0; i < 10; i++) {
-        const char *end;
-        if (sw__parse_decimal(p, &end, &v[i]) != SW_DECIMAL_OK)
-            return -1;
-        if (i < 9 && *end != ',')
-            return -1;
-        if (i == 9 && *end != '\0')
-            return -1;
-        p = end + 1;
-    }
-    for (int k = 0; k < 3; k++) {
-        out->eye[k] = v[k];
-        out->target[k] = v[3 + k];
-        out->up[k] = v[6 + k];
-    }
-    out->fovy_deg = v[9];
-    const char *problem = sw_rt_camera_problem(out); /* every frame's check (fovy given here) */
-    return problem ? refuse(problem) : 0;
-}
-
-int sw_cli_parse_count(const char *text, int lo, int hi, int *out)
-{
-    g_parse_reason[0] = '\0';
-    char *end;
-    errno = 0;
-    long v = strtol(text, &end, 10);
-    if (errno || end == text || *end != '\0' || v < lo || v > hi)
-        return -1;
-    *out = (int)v;
-    return 0;
-}
-
-int sw_cli_parse_positive(const char *text, double *out)
-{
-    g_parse_reason[0] = '\0';
-    const char *end;
-    double v;
-    if (sw__parse_decimal(text, &end, &v) != SW_DECIMAL_OK || *end != '\0' || !(v > 0.0))
-        return -1;
-    *out = v;
-    return 0;
-}
-
-int sw_cli_parse_error_px(const char *text, double *out)
-{
-    double v;
-    if (sw_cli_parse_positive(text, &v) != 0)
-        return -1;
-    if (!(v >= SW_ERROR_MIN_PX))
-        return refuse("a screen-space error must be at least 0.01 px (SW_ERROR_MIN_PX)");
-    *out = v;
-    return 0;
 }
 
 double sw_cli_now_ms(void)

@@ -9,7 +9,6 @@
 #include "sw_sg_generate.h"
 #include "sw_status_util.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -86,14 +85,6 @@ typedef struct gen_args {
     unsigned long long seed;
 } gen_args;
 
-static int parse_seed(const char *val, unsigned long long *out)
-{
-    char *end;
-    errno = 0;
-    *out = strtoull(val, &end, 10);
-    return errno || end == val || *end != '\0' || val[0] == '-' || val[0] == '+';
-}
-
 /* Numbers for one option; returns nonzero for a bad value. */
 static int parse_value(const char *arg, const char *val, gen_args *a)
 {
@@ -105,7 +96,7 @@ static int parse_value(const char *arg, const char *val, gen_args *a)
         return sw_cli_parse_count(val, SW_SG_BUILDING_MIN_SURFACES, SW_SG_BUILDING_MAX_SURFACES,
                                   &a->surfaces);
     if (!strcmp(arg, "--seed"))
-        return parse_seed(val, &a->seed);
+        return sw_cli_parse_seed(val, &a->seed);
     return sw_cli_parse_positive(val, &a->spacing);
 }
 
