@@ -412,9 +412,7 @@ void check_point(const double *c, int n, const char *of, const std::string &what
         }
 }
 
-/* A spline curve's knots, poles and weights finite and inside the scene's range, read without
- * evaluating it (OCCT's span search never ends on a NaN knot); a trimmed curve is checked through
- * its basis. Other curves have no such data. */
+/* A 2D or 3D point's coordinates into c; returns how many. */
 int coords(const gp_Pnt2d &p, double *c)
 {
     c[0] = p.X(), c[1] = p.Y();
@@ -427,6 +425,9 @@ int coords(const gp_Pnt &p, double *c)
     return 3;
 }
 
+/* A spline curve's knots, poles and weights finite and inside the scene's range, read without
+ * evaluating it (OCCT's span search never ends on a NaN knot); a trimmed curve is checked through
+ * its basis. Other curves have no such data. */
 template <typename Spline, typename Trimmed, typename Curve>
 void check_spline_curve(const Handle(Curve) & c, const char *of, const std::string &what)
 {
@@ -448,16 +449,6 @@ void check_spline_curve(const Handle(Curve) & c, const char *of, const std::stri
     }
 }
 
-void check_pcurve_data(const Handle(Geom2d_Curve) & c, const std::string &what)
-{
-    check_spline_curve<Geom2d_BSplineCurve, Geom2d_TrimmedCurve>(c, "an edge's pcurve", what);
-}
-
-void check_curve_data(const Handle(Geom_Curve) & c, const std::string &what)
-{
-    check_spline_curve<Geom_BSplineCurve, Geom_TrimmedCurve>(c, "an edge's curve", what);
-}
-
 /* The converted face's pcurves, before anything evaluates them (BRepTools_WireExplorer does):
  * the conversion's projection can leave NaN in them. */
 void check_converted(const TopoDS_Face &cf, const std::string &what)
@@ -469,7 +460,8 @@ void check_converted(const TopoDS_Face &cf, const std::string &what)
         if (pc.IsNull())
             continue;
         check_point(t, 2, "an edge's converted pcurve range", what);
-        check_pcurve_data(pc, what);
+        check_spline_curve<Geom2d_BSplineCurve, Geom2d_TrimmedCurve>(
+            pc, "an edge's converted pcurve", what);
     }
 }
 
@@ -497,57 +489,53 @@ void check_in_domain(const double b[4], const Handle(Geom_Surface) & s, const st
  * and pcurve at both ends and the middle, checked with check_point: elementary and swept surfaces
  * have no poles for check_poles to read, and their parameters (a radius, an angle, an axis) reach
  * the conversion only through these values. */
+/* One sampled point through check_point; a point where the geometry is undefined (an offset
+ * surface's singular point) throws: that sample is left out, not the face. */
+template <typename Eval> void check_sample(Eval point_at, const char *of, const std::string &what)
+{
+    double c[3];
+    int n;
+    try {
+        n = coords(point_at(), c);
+    } catch (const Standard_Failure &) {
+        return;
+    }
+    check_point(c, n, of, what);
+}
+
+/* An edge's curve (2D pcurve or 3D curve) over [t0, t1]: its range, its spline data, then its
+ * points at both ends and the middle. */
+template <typename Spline, typename Trimmed, typename Curve>
+void check_edge_curve(const Handle(Curve) & c, const double t[2], const char *of,
+                      const std::string &what)
+{
+    check_point(t, 2, of, what);
+    check_spline_curve<Spline, Trimmed>(c, of, what);
+    for (int i = 0; i <= 2; i++)
+        check_sample([&] { return c->Value(t[0] + (t[1] - t[0]) * i / 2); }, of, what);
+}
+
 void check_values(const TopoDS_Face &f, const Handle(Geom_Surface) & s, const std::string &what)
 {
-    /* a point where the geometry is undefined (an offset surface's singular point) throws: that
-     * sample is left out, not the face */
-    auto sample = [&](auto eval, int n, const char *of) {
-        double c[3];
-        try {
-            eval(c);
-        } catch (const Standard_Failure &) {
-            return;
-        }
-        check_point(c, n, of, what);
-    };
     double b[4];
     BRepTools::UVBounds(f, b[0], b[1], b[2], b[3]);
     check_point(b, 4, "the face's parameter box", what);
     check_in_domain(b, s, what);
     for (int i = 0; i <= 2; i++)
         for (int j = 0; j <= 2; j++)
-            sample(
-                [&](double *c) {
-                    const gp_Pnt p =
-                        s->Value(b[0] + (b[1] - b[0]) * i / 2, b[2] + (b[3] - b[2]) * j / 2);
-                    c[0] = p.X(), c[1] = p.Y(), c[2] = p.Z();
+            check_sample(
+                [&] {
+                    return s->Value(b[0] + (b[1] - b[0]) * i / 2, b[2] + (b[3] - b[2]) * j / 2);
                 },
-                3, "its surface");
+                "its surface", what);
     for (TopExp_Explorer ex(f, TopAbs_EDGE); ex.More(); ex.Next()) {
         const TopoDS_Edge &e = TopoDS::Edge(ex.Current());
         double t[2];
-        if (Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(e, f, t[0], t[1]); !pc.IsNull()) {
-            check_point(t, 2, "an edge's pcurve range", what);
-            check_pcurve_data(pc, what);
-            for (int i = 0; i <= 2; i++)
-                sample(
-                    [&](double *c) {
-                        const gp_Pnt2d q = pc->Value(t[0] + (t[1] - t[0]) * i / 2);
-                        c[0] = q.X(), c[1] = q.Y();
-                    },
-                    2, "an edge's pcurve");
-        }
-        if (Handle(Geom_Curve) c3 = BRep_Tool::Curve(e, t[0], t[1]); !c3.IsNull()) {
-            check_point(t, 2, "an edge's curve range", what);
-            check_curve_data(c3, what);
-            for (int i = 0; i <= 2; i++)
-                sample(
-                    [&](double *c) {
-                        const gp_Pnt p = c3->Value(t[0] + (t[1] - t[0]) * i / 2);
-                        c[0] = p.X(), c[1] = p.Y(), c[2] = p.Z();
-                    },
-                    3, "an edge's curve");
-        }
+        if (Handle(Geom2d_Curve) pc = BRep_Tool::CurveOnSurface(e, f, t[0], t[1]); !pc.IsNull())
+            check_edge_curve<Geom2d_BSplineCurve, Geom2d_TrimmedCurve>(pc, t, "an edge's pcurve",
+                                                                       what);
+        if (Handle(Geom_Curve) c3 = BRep_Tool::Curve(e, t[0], t[1]); !c3.IsNull())
+            check_edge_curve<Geom_BSplineCurve, Geom_TrimmedCurve>(c3, t, "an edge's curve", what);
     }
 }
 

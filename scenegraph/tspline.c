@@ -18,6 +18,7 @@
 
 #include <assert.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -351,6 +352,14 @@ static sw_result check_regions(const sw_sg_tspline *ts, const char *what, sw_sta
                                 "%s: region [%g, %g] x [%g, %g]: the blending functions vanish "
                                 "(%u influencing points); the T-mesh does not cover the domain",
                                 what, g->u0, g->u1, g->v0, g->v1, g->count);
+        /* the region's Bézier patch is a face of the scene: its weights must pass the scene's
+         * rule (knots nearly together blend weights of 1 into 1e17) */
+        char region[160];
+        snprintf(region, sizeof region, "%s: region [%g, %g] x [%g, %g]", what, g->u0, g->u1,
+                 g->v0, g->v1);
+        const sw_result res = sw_sg_weights_validate(w, 4, 4, region, status);
+        if (res != SW_OK)
+            return res;
     }
     return SW_OK;
 }

@@ -19,6 +19,7 @@
 #include "sw_sg_import_occt.hpp"
 #include "sw_sg_scene.h"
 
+#include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <Geom2d_BSplineCurve.hxx>
 #include <Geom2d_Circle.hxx>
@@ -400,6 +401,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             /* OCCT refused the parameters (a zero direction, decreasing knots, ...): no face */
         }
     }
+    if (const char *out = std::getenv("SW_FUZZ_WRITE_BREP")) /* the input as a BREP file */
+        BRepTools::Write(all, out);
     import_and_check(all);
     return 0;
 }
