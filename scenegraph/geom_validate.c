@@ -171,34 +171,6 @@ sw_result sw_sg_curve_validate(const sw_sg_curve *c, const char *what, sw_status
     return SW_OK;
 }
 
-sw_result sw_sg_weights_validate(const double *w, int32_t n_u, int32_t n_v, const char *what,
-                                 sw_status *status)
-{
-    weight_span span = {INFINITY, 0.0, 0, 0};
-    for (int32_t j = 0; j < n_v; j++)
-        for (int32_t i = 0; i < n_u; i++) {
-            const size_t at = (size_t)j * (size_t)n_u + (size_t)i;
-            int32_t coord = 0;
-            const int kind = bad_point(w + at, 1, &coord);
-            if (kind != PT_OK) {
-                char index[64];
-                snprintf(index, sizeof index, "(%d, %d)", (int)i, (int)j);
-                return fail_point(w + at, 1, kind, coord, what, index, status);
-            }
-            span_add(&span, w[at], at);
-        }
-    if (!span_ok(&span)) {
-        char lo[64], hi[64];
-        snprintf(lo, sizeof lo, "(%d, %d)", (int)(span.at_lo % (size_t)n_u),
-                 (int)(span.at_lo / (size_t)n_u));
-        snprintf(hi, sizeof hi, "(%d, %d)", (int)(span.at_hi % (size_t)n_u),
-                 (int)(span.at_hi / (size_t)n_u));
-        return fail_span(&span, what, lo, hi, status);
-    }
-    sw__status_ok(status);
-    return SW_OK;
-}
-
 sw_result sw_sg_surface_validate(const sw_sg_surface *s, const char *what, sw_status *status)
 {
     if (!what)

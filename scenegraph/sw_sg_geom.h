@@ -79,12 +79,6 @@ typedef struct sw_sg_surface_d2 {
  * `status` (may be NULL); `what` names the object in the message (e.g. "face 12"). */
 sw_result sw_sg_curve_validate(const sw_sg_curve *c, const char *what, sw_status *status);
 sw_result sw_sg_surface_validate(const sw_sg_surface *s, const char *what, sw_status *status);
-/* The weight rule alone, for a net of n_u x n_v weights (u fastest) made before its surface is:
- * each in [SW_SG_WEIGHT_MIN, SW_SG_WEIGHT_MAX], at most SW_SG_WEIGHT_RATIO_MAX apart. A T-spline
- * checks the Bézier weights of its regions with it when it is read, so that a file the scene
- * would refuse is refused with the file's name. Same errors as sw_sg_surface_validate. */
-sw_result sw_sg_weights_validate(const double *w, int32_t n_u, int32_t n_v, const char *what,
-                                 sw_status *status);
 
 /* ---- knot vectors ---------------------------------------------------------------------------- */
 /* Parameter domain [knots[degree], knots[n]]. */

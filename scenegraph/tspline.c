@@ -330,13 +330,18 @@ static sw_result list_region_points(sw_sg_tspline *ts, uint64_t total)
 }
 
 /* Every region must have a denominator sum w_i B_i > 0 everywhere: all Bernstein coefficients of
- * the weight positive (they are >= min w_i where the blending functions sum to one). */
+ * the weight positive (they are >= min w_i where the blending functions sum to one). And the
+ * region's Bézier patch is a face of the scene: it must pass the scene's own check
+ * (sw_sg_surface_validate), so that a file the scene would refuse is refused naming the file
+ * (points and weights within range blend into 1e17 weights and 1e98 coordinates where knots
+ * nearly meet). */
 static sw_result check_regions(const sw_sg_tspline *ts, const char *what, sw_status *status)
 {
+    static const double bezier_knots[8] = {0, 0, 0, 0, 1, 1, 1, 1};
     const sw_sg_tspline_view *v = &ts->v;
     for (uint32_t r = 0; r < v->n_regions; r++) {
         const sw_sg_tspline_region *g = &v->regions[r];
-        double w[16] = {0};
+        double cpw[64] = {0};
         for (uint32_t k = 0; k < g->count; k++) {
             const uint32_t i = v->region_points[g->first + k];
             double bu[4], bv[4];
@@ -344,20 +349,20 @@ static sw_result check_regions(const sw_sg_tspline *ts, const char *what, sw_sta
             sw__tspline_bernstein(v->knots_v + (size_t)i * 5, g->v0, g->v1, bv);
             for (int l = 0; l < 4; l++)
                 for (int j = 0; j < 4; j++)
-                    w[l * 4 + j] += v->cpw[(size_t)i * 4 + 3] * bu[j] * bv[l];
+                    for (int c = 0; c < 4; c++)
+                        cpw[(l * 4 + j) * 4 + c] += v->cpw[(size_t)i * 4 + c] * bu[j] * bv[l];
         }
         for (int j = 0; j < 16; j++)
-            if (!(w[j] > 0.0))
+            if (!(cpw[j * 4 + 3] > 0.0))
                 return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
                                 "%s: region [%g, %g] x [%g, %g]: the blending functions vanish "
                                 "(%u influencing points); the T-mesh does not cover the domain",
                                 what, g->u0, g->u1, g->v0, g->v1, g->count);
-        /* the region's Bézier patch is a face of the scene: its weights must pass the scene's
-         * rule (knots nearly together blend weights of 1 into 1e17) */
         char region[160];
         snprintf(region, sizeof region, "%s: region [%g, %g] x [%g, %g]", what, g->u0, g->u1,
                  g->v0, g->v1);
-        const sw_result res = sw_sg_weights_validate(w, 4, 4, region, status);
+        const sw_sg_surface patch = {3, 3, 4, 4, bezier_knots, bezier_knots, cpw};
+        const sw_result res = sw_sg_surface_validate(&patch, region, status);
         if (res != SW_OK)
             return res;
     }

@@ -24,6 +24,7 @@
 #include <Geom2d_BSplineCurve.hxx>
 #include <Geom2d_Circle.hxx>
 #include <Geom2d_Line.hxx>
+#include <GeomAPI.hxx>
 #include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_ConicalSurface.hxx>
@@ -45,6 +46,7 @@
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Vertex.hxx>
+#include <gp_Pln.hxx>
 #include <TopoDS_Wire.hxx>
 #include <gp_Ax2.hxx>
 #include <gp_Ax2d.hxx>
@@ -241,44 +243,81 @@ Handle(Geom2d_Curve) trim_curve(reader &r, double u0, double u1, double v0, doub
     }
 }
 
-/* The surface's point at (u, v), or the origin where OCCT cannot evaluate it. */
-gp_Pnt point_at(const Handle(Geom_Surface) & s, double u, double v)
+/* The surface's exact 3D curve at a constant parameter (an iso line), or none where OCCT
+ * cannot make it. */
+Handle(Geom_Curve) iso(const Handle(Geom_Surface) & s, bool along_u, double at)
 {
     try {
-        return s->Value(u, v);
+        return along_u ? s->VIso(at) : s->UIso(at);
     } catch (const Standard_Failure &) {
-        return gp_Pnt();
+        return nullptr;
     }
 }
 
-/* An edge of face f along the 2D curve c over [t0, t1], built as OCCT's BREP reader builds one
- * (BRep_Builder, no algorithm run on it): a pcurve, its range and end vertices, no 3D curve. */
-TopoDS_Edge edge_on(const TopoDS_Face &f, const Handle(Geom_Surface) & s,
-                    const Handle(Geom2d_Curve) & c, double t0, double t1)
+/* A corner vertex at the surface's point (u, v), or the origin where it cannot be evaluated. */
+TopoDS_Vertex vertex_at(const Handle(Geom_Surface) & s, double u, double v)
+{
+    gp_Pnt p;
+    try {
+        p = s->Value(u, v);
+    } catch (const Standard_Failure &) {
+    }
+    BRep_Builder bb;
+    TopoDS_Vertex vx;
+    bb.MakeVertex(vx, p, 1e-7);
+    return vx;
+}
+
+/* An edge of face f from vertex a to vertex b along the 2D curve c2 over [t0, t1], with the 3D
+ * curve c3 over the same range when there is one, built as OCCT's BREP reader builds an edge
+ * (BRep_Builder: no algorithm runs on it). */
+TopoDS_Edge edge_on(const TopoDS_Face &f, const Handle(Geom2d_Curve) & c2,
+                    const Handle(Geom_Curve) & c3, double t0, double t1, const TopoDS_Vertex &a,
+                    const TopoDS_Vertex &b)
 {
     BRep_Builder bb;
     TopoDS_Edge e;
     bb.MakeEdge(e);
-    bb.UpdateEdge(e, c, f, 1e-7);
-    bb.Range(e, f, t0, t1);
-    for (int end = 0; end < 2; end++) {
-        gp_Pnt2d q;
-        try {
-            q = c->Value(end ? t1 : t0);
-        } catch (const Standard_Failure &) {
-        }
-        TopoDS_Vertex v;
-        bb.MakeVertex(v, point_at(s, q.X(), q.Y()), 1e-7);
-        bb.Add(e, v.Oriented(end ? TopAbs_REVERSED : TopAbs_FORWARD));
-    }
+    if (!c3.IsNull())
+        bb.UpdateEdge(e, c3, 1e-7);
+    bb.UpdateEdge(e, c2, f, 1e-7);
+    bb.Range(e, t0, t1);
+    bb.Add(e, a.Oriented(TopAbs_FORWARD));
+    bb.Add(e, b.Oriented(TopAbs_REVERSED));
     bb.SameRange(e, Standard_True);
     bb.SameParameter(e, Standard_True);
     return e;
 }
 
-/* A face of the surface bounded by its parameter box from the input, sometimes with a hole
- * made of a closed 2D curve; built with BRep_Builder as a BREP file's face is, so that every
- * hostile value reaches the importer (OCCT's MakeFace evaluates, and crashes on some). */
+/* A hole made of one closed 2D curve from the input (a 3D curve only on a plane, where it is
+ * exact), added to f. */
+void add_hole(reader &r, TopoDS_Face &f, const Handle(Geom_Surface) & s, double u0, double u1,
+              double v0, double v1)
+{
+    BRep_Builder bb;
+    Handle(Geom2d_Curve) c = trim_curve(r, u0, u1, v0, v1);
+    double t0 = c->FirstParameter(), t1 = c->LastParameter();
+    t0 = std::isfinite(t0) ? t0 : r.value(), t1 = std::isfinite(t1) ? t1 : r.value();
+    Handle(Geom_Curve) c3;
+    if (Handle(Geom_Plane) pl = Handle(Geom_Plane)::DownCast(s); !pl.IsNull())
+        c3 = GeomAPI::To3d(c, pl->Pln());
+    gp_Pnt2d q0, q1;
+    try {
+        q0 = c->Value(t0), q1 = c->Value(t1);
+    } catch (const Standard_Failure &) {
+    }
+    TopoDS_Wire hole;
+    bb.MakeWire(hole);
+    bb.Add(hole,
+           edge_on(f, c, c3, t0, t1, vertex_at(s, q0.X(), q0.Y()), vertex_at(s, q1.X(), q1.Y())));
+    bb.Add(f, hole);
+}
+
+/* A face of the surface bounded by its parameter box from the input: four edges along iso lines
+ * (the 2D lines parametrised by u or v, the surface's iso curves as 3D curves), sometimes with a
+ * hole (add_hole); built with
+ * BRep_Builder as a BREP file's face is, so that every hostile value reaches the importer
+ * (OCCT's MakeFace evaluates, and crashes on some). */
 TopoDS_Face face(reader &r)
 {
     Handle(Geom_Surface) s = surface(r);
@@ -289,26 +328,23 @@ TopoDS_Face face(reader &r)
     BRep_Builder bb;
     TopoDS_Face f;
     bb.MakeFace(f, s, 1e-7);
-    const gp_Pnt2d corner[4] = {gp_Pnt2d(u0, v0), gp_Pnt2d(u1, v0), gp_Pnt2d(u1, v1),
-                                gp_Pnt2d(u0, v1)};
+    const TopoDS_Vertex c00 = vertex_at(s, u0, v0), c10 = vertex_at(s, u1, v0),
+                        c11 = vertex_at(s, u1, v1), c01 = vertex_at(s, u0, v1);
+    auto along_u = [&](double v) { return new Geom2d_Line(gp_Pnt2d(0.0, v), gp_Dir2d(1, 0)); };
+    auto along_v = [&](double u) { return new Geom2d_Line(gp_Pnt2d(u, 0.0), gp_Dir2d(0, 1)); };
     TopoDS_Wire outer;
     bb.MakeWire(outer);
-    for (int i = 0; i < 4; i++) {
-        const gp_Pnt2d &a = corner[i], &b = corner[(i + 1) % 4];
-        const gp_Vec2d d(a, b);
-        if (!(d.Magnitude() > 0.0)) /* gp_Dir2d would throw on a zero or NaN side */
-            return TopoDS_Face();
-        bb.Add(outer, edge_on(f, s, new Geom2d_Line(a, gp_Dir2d(d)), 0.0, d.Magnitude()));
-    }
+    bb.Add(outer, edge_on(f, along_u(v0), iso(s, true, v0), u0, u1, c00, c10));
+    bb.Add(outer, edge_on(f, along_v(u1), iso(s, false, u1), v0, v1, c10, c11));
+    bb.Add(outer, edge_on(f, along_u(v1), iso(s, true, v1), u0, u1, c01, c11).Reversed());
+    bb.Add(outer, edge_on(f, along_v(u0), iso(s, false, u0), v0, v1, c00, c01).Reversed());
     bb.Add(f, outer);
     if (r.byte() % 3 == 0) {
-        Handle(Geom2d_Curve) c = trim_curve(r, u0, u1, v0, v1);
-        const double t0 = c->FirstParameter(), t1 = c->LastParameter();
-        TopoDS_Wire hole;
-        bb.MakeWire(hole);
-        bb.Add(hole, edge_on(f, s, c, std::isfinite(t0) ? t0 : r.value(),
-                             std::isfinite(t1) ? t1 : r.value()));
-        bb.Add(f, hole);
+        try {
+            add_hole(r, f, s, u0, u1, v0, v1);
+        } catch (const Standard_Failure &) {
+            /* OCCT refused the hole's curve (a negative radius): the face stays without it */
+        }
     }
     return f;
 }
@@ -397,8 +433,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
             TopoDS_Face f = face(r);
             if (!f.IsNull())
                 bb.Add(all, f);
-        } catch (const Standard_Failure &) {
+        } catch (const Standard_Failure &e) {
             /* OCCT refused the parameters (a zero direction, decreasing knots, ...): no face */
+            if (std::getenv("SW_FUZZ_VERBOSE"))
+                std::fprintf(stderr, "no face: %s: %s\n", e.DynamicType()->Name(),
+                             e.GetMessageString());
         }
     }
     if (const char *out = std::getenv("SW_FUZZ_WRITE_BREP")) /* the input as a BREP file */
