@@ -359,8 +359,8 @@ static sw_result check_regions(const sw_sg_tspline *ts, const char *what, sw_sta
                                 "(%u influencing points); the T-mesh does not cover the domain",
                                 what, g->u0, g->u1, g->v0, g->v1, g->count);
         char region[160];
-        snprintf(region, sizeof region, "%s: region [%g, %g] x [%g, %g]", what, g->u0, g->u1,
-                 g->v0, g->v1);
+        snprintf(region, sizeof region, "%s: region [%g, %g] x [%g, %g]", what, g->u0, g->u1, g->v0,
+                 g->v1);
         const sw_sg_surface patch = {3, 3, 4, 4, bezier_knots, bezier_knots, cpw};
         const sw_result res = sw_sg_surface_validate(&patch, region, status);
         if (res != SW_OK)
