@@ -9,7 +9,9 @@
  * - a camera's ten numbers are each a decimal number and the camera passes the frame's own
  *   check (sw_rt_camera_problem, inside sw_camera_check), so the command line accepts no camera
  *   a frame refuses.
- * A refused text must leave the output untouched. */
+ * A refused text must leave the output untouched.
+ * Planted: counts read by strtol again (which takes a sign and leading space): it fails on "+3"
+ * within seconds. */
 #include "cli_numbers.h"
 #include "sw_decimal.h"
 #include "sw_rt.h"

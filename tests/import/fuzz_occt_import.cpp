@@ -15,6 +15,10 @@
 // - a finished scene's surfaces and trim curves evaluate to finite points inside the scene's
 //   coordinate limit at every sampled parameter (a face admitted with a NaN pole, a zero weight
 //   or a 1e308 coordinate would break this).
+// Planted: the Standard_Failure catch of the importer's face_index removed, the committed corpus
+// replayed: it fails (an exception escapes as SW_ERR_INTERNAL).
+// SW_FUZZ_VERBOSE=1 prints each import's outcome and skipped faces; SW_FUZZ_WRITE_BREP=FILE
+// writes the input's shape as a BREP file (to replay a finding through `splinewalk import`).
 #include "sw_sg_geom.h"
 #include "sw_sg_import_occt.hpp"
 #include "sw_sg_scene.h"
@@ -289,6 +293,24 @@ TopoDS_Edge edge_on(const TopoDS_Face &f, const Handle(Geom2d_Curve) & c2,
     return e;
 }
 
+/* Boxes that only make OCCT's pcurve projection slow are kept out, so that the fuzzer's time goes
+ * to the importer: at most one period in a periodic direction (a torus face wound 14 rad around
+ * both ways), and a cone face not across its apex (it converts in minutes). Each was a timeout
+ * of 60 s inside OCCT's ProjLib_ComputeApproxOnPolarSurface; real files do not have them. */
+void tame_box(const Handle(Geom_Surface) & s, double &u0, double &u1, double &v0, double &v1)
+{
+    if (s->IsUPeriodic() && u1 - u0 > s->UPeriod())
+        u1 = u0 + s->UPeriod();
+    if (s->IsVPeriodic() && v1 - v0 > s->VPeriod())
+        v1 = v0 + s->VPeriod();
+    if (Handle(Geom_ConicalSurface) cone = Handle(Geom_ConicalSurface)::DownCast(s);
+        !cone.IsNull() && std::sin(cone->SemiAngle()) != 0.0) {
+        const double apex = -cone->RefRadius() / std::sin(cone->SemiAngle());
+        if (v0 < apex && apex < v1)
+            v0 = apex + 0.25 * (v1 - apex);
+    }
+}
+
 /* A hole made of one closed 2D curve from the input (a 3D curve only on a plane, where it is
  * exact), added to f. */
 void add_hole(reader &r, TopoDS_Face &f, const Handle(Geom_Surface) & s, double u0, double u1,
@@ -323,8 +345,9 @@ TopoDS_Face face(reader &r)
     Handle(Geom_Surface) s = surface(r);
     if (s.IsNull())
         return TopoDS_Face();
-    const double u0 = r.value(), u1 = u0 + std::fabs(r.value()) + 0.5;
-    const double v0 = r.value(), v1 = v0 + std::fabs(r.value()) + 0.5;
+    double u0 = r.value(), u1 = u0 + std::fabs(r.value()) + 0.5;
+    double v0 = r.value(), v1 = v0 + std::fabs(r.value()) + 0.5;
+    tame_box(s, u0, u1, v0, v1);
     BRep_Builder bb;
     TopoDS_Face f;
     bb.MakeFace(f, s, 1e-7);
