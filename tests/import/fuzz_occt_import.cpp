@@ -294,15 +294,16 @@ TopoDS_Edge edge_on(const TopoDS_Face &f, const Handle(Geom2d_Curve) & c2,
 }
 
 /* Boxes that only make OCCT's pcurve projection slow are kept out, so that the fuzzer's time goes
- * to the importer: at most one period in a periodic direction (a torus face wound 14 rad around
- * both ways), and a cone face not across its apex (it converts in minutes). Each was a timeout
- * of 60 s inside OCCT's ProjLib_ComputeApproxOnPolarSurface; real files do not have them. */
+ * to the importer: less than a period in a periodic direction (two edges on the same seam, which
+ * a file's face would share as one seam edge, and a torus face wound 14 rad around both ways),
+ * and a cone face not across its apex. Each was a timeout of 60 s inside OCCT's
+ * ProjLib_ComputeApproxOnPolarSurface. */
 void tame_box(const Handle(Geom_Surface) & s, double &u0, double &u1, double &v0, double &v1)
 {
-    if (s->IsUPeriodic() && u1 - u0 > s->UPeriod())
-        u1 = u0 + s->UPeriod();
-    if (s->IsVPeriodic() && v1 - v0 > s->VPeriod())
-        v1 = v0 + s->VPeriod();
+    if (s->IsUPeriodic() && u1 - u0 > 0.75 * s->UPeriod())
+        u1 = u0 + 0.75 * s->UPeriod();
+    if (s->IsVPeriodic() && v1 - v0 > 0.75 * s->VPeriod())
+        v1 = v0 + 0.75 * s->VPeriod();
     if (Handle(Geom_ConicalSurface) cone = Handle(Geom_ConicalSurface)::DownCast(s);
         !cone.IsNull() && std::sin(cone->SemiAngle()) != 0.0) {
         const double apex = -cone->RefRadius() / std::sin(cone->SemiAngle());
