@@ -380,12 +380,26 @@ void check_poles(const Handle(Geom_BSplineSurface) & s, const std::string &what)
     }
 }
 
-/* Knots beyond the scene's range (SW_SG_COORD_MAX) or not finite: OCCT's B-spline constructors
- * compare neighbouring knots only, so a NaN passes them, and its span search then never ends. */
+/* Too few poles for the degree, or knots beyond the scene's range (SW_SG_COORD_MAX) or not
+ * finite: OCCT's B-spline constructors compare neighbouring knots only, so a NaN passes them, and
+ * its span search then never ends. */
 void check_knots(const Handle(Geom_BSplineSurface) & s, const std::string &what)
 {
     if (s.IsNull())
         return;
+    /* OCCT's constructor takes a periodic net with fewer poles than its degree needs (2 poles of
+     * degree 5); its iso curves then read past their knot arrays (seen in BSplCLib::KnotSequence
+     * under BRepTools::UVBounds) */
+    for (int dir = 0; dir < 2; dir++) {
+        const int poles = dir ? s->NbVPoles() : s->NbUPoles();
+        const int degree = dir ? s->VDegree() : s->UDegree();
+        if (poles < degree + 1) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, ": %d control points in %c for degree %d", poles,
+                          dir ? 'v' : 'u', degree);
+            throw face_error{what + buf};
+        }
+    }
     for (int dir = 0; dir < 2; dir++)
         for (int i = 1, n = dir ? s->NbVKnots() : s->NbUKnots(); i <= n; i++) {
             const double k = dir ? s->VKnot(i) : s->UKnot(i);
@@ -437,6 +451,8 @@ void check_spline_curve(const Handle(Curve) & c, const char *of, const std::stri
     const Handle(Spline) bs = Handle(Spline)::DownCast(basis);
     if (bs.IsNull())
         return;
+    if (bs->NbPoles() < bs->Degree() + 1) /* as check_knots: OCCT reads past its arrays */
+        throw face_error{what + ": " + of + " has fewer control points than its degree needs"};
     for (int i = 1; i <= bs->NbKnots(); i++) {
         const double k = bs->Knot(i);
         check_point(&k, 1, of, what);
