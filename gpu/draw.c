@@ -78,10 +78,10 @@ static void upload_exact(sw_gpu_context *ctx, const sw__gpu_patch_batch *batch)
     upload_ssbo(ctx->dcp_ssbo, 4, batch->n_dcps * 4 * sizeof *batch->dcps, batch->dcps);
 }
 
-/* Debug capture: a zeroed counter plus room for capture_max vertices (two vec4 each). */
+/* Debug capture: a zeroed counter plus room for capture_max vertices (two vec4 each); the
+ * programs are told the room by capture_program. */
 static void capture_begin(sw_gpu_context *ctx)
 {
-    glUniform1i(ctx->surf.loc_eval_capture, (GLint)ctx->capture_max);
     if (ctx->capture_max == 0)
         return;
     if (!ctx->capture_ssbo)
@@ -92,6 +92,11 @@ static void capture_begin(sw_gpu_context *ctx)
     static const uint32_t zero[4] = {0, 0, 0, 0};
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zero, zero);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, ctx->capture_ssbo);
+}
+
+static void capture_program(const sw_gpu_context *ctx, const sw__gpu_surface_program *prog)
+{
+    glUniform1i(prog->loc_capture, (GLint)ctx->capture_max);
 }
 
 void sw__gpu_set_capture(sw_gpu_context *ctx, uint32_t max_vertices)
@@ -135,7 +140,8 @@ sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out
 }
 
 /* The frame's GPU-evaluated patches (§4.2): records and control points into two shader storage
- * buffers, then one instanced draw per non-empty grid class, attribute-less. */
+ * buffers, then per trim variant (the untrimmed first, as the batch holds them) one instanced
+ * draw per non-empty grid class, attribute-less. */
 static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                          const sw__gpu_patch_batch *batch)
 {
@@ -147,32 +153,67 @@ static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                  batch->cps, GL_STREAM_DRAW);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ctx->patch_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx->cp_ssbo);
-    GLint loc_grid = ctx->surf.loc_eval_grid, loc_base = ctx->surf.loc_eval_base;
-    if (batch->exact) {
+    if (batch->exact)
         upload_exact(ctx, batch);
-        loc_grid = ctx->surf.loc_exact_grid;
-        loc_base = ctx->surf.loc_exact_base;
-    }
+    else
+        capture_begin(ctx);
     glBindVertexArray(ctx->vao);
     for (GLuint a = 0; a < 3; ++a)
         glDisableVertexAttribArray(a);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->grid_ibo);
-    glUseProgram(batch->exact ? ctx->surf.exact : ctx->surf.eval);
-    glUniformMatrix4fv(batch->exact ? ctx->surf.loc_exact_view_proj : ctx->surf.loc_eval_view_proj,
-                       1, GL_FALSE, view->view_proj);
-    glUniform1i(batch->exact ? ctx->surf.loc_exact_trim : ctx->surf.loc_eval_trim, 0);
-    if (!batch->exact)
-        capture_begin(ctx);
-    for (int b = 0; b < SW__GPU_GRID_CLASSES; ++b) {
-        for (int a = 0; a < SW__GPU_GRID_CLASSES; ++a) {
-            if (batch->count[b][a] == 0)
-                continue;
-            glUniform2i(loc_grid, sw__gpu_grid_segments[a], sw__gpu_grid_segments[b]);
-            glUniform1i(loc_base, (GLint)batch->first[b][a]);
-            glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)ctx->grid_count[b][a], GL_UNSIGNED_INT,
-                                    (const void *)(ctx->grid_first[b][a] * sizeof(uint32_t)),
-                                    (GLsizei)batch->count[b][a]);
+    static const int k_order[SW__GPU_TRIM_VARIANTS] = {SW__GPU_UNTRIMMED, SW__GPU_TRIMMED};
+    for (int k = 0; k < SW__GPU_TRIM_VARIANTS; ++k) {
+        const int t = k_order[k];
+        const sw__gpu_surface_program *prog =
+            batch->exact ? &ctx->surf.exact[t] : &ctx->surf.eval[t];
+        int used = 0;
+        for (int b = 0; b < SW__GPU_GRID_CLASSES; ++b) {
+            for (int a = 0; a < SW__GPU_GRID_CLASSES; ++a) {
+                if (batch->count[t][b][a] == 0)
+                    continue;
+                if (!used++) {
+                    glUseProgram(prog->prog);
+                    glUniformMatrix4fv(prog->loc_view_proj, 1, GL_FALSE, view->view_proj);
+                    glUniform1i(prog->loc_trim, 0);
+                    if (!batch->exact)
+                        capture_program(ctx, prog);
+                }
+                glUniform2i(prog->loc_grid, sw__gpu_grid_segments[a], sw__gpu_grid_segments[b]);
+                glUniform1i(prog->loc_base, (GLint)batch->first[t][b][a]);
+                glDrawElementsInstanced(GL_TRIANGLES, (GLsizei)ctx->grid_count[b][a],
+                                        GL_UNSIGNED_INT,
+                                        (const void *)(ctx->grid_first[b][a] * sizeof(uint32_t)),
+                                        (GLsizei)batch->count[t][b][a]);
+            }
         }
+    }
+}
+
+/* The mesh's draws of one trim variant, with that variant's mesh program. */
+static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
+                              const sw__gpu_draw *draws, size_t n_draws, int variant)
+{
+    const sw__gpu_surface_program *prog = &ctx->surf.mesh[variant];
+    int used = 0;
+    for (size_t d = 0; d < n_draws; ++d) {
+        const int trimmed = draws[d].trim_entry >= 0;
+        if (draws[d].n_idx == 0 || trimmed != (variant == SW__GPU_TRIMMED))
+            continue;
+        if (!used++) {
+            glUseProgram(prog->prog);
+            glUniformMatrix4fv(prog->loc_view_proj, 1, GL_FALSE, view->view_proj);
+            glUniform1i(prog->loc_trim, 0);
+        }
+        glUniform4fv(prog->loc_color, 1, draws[d].color);
+        glUniform4fv(prog->loc_uv_map, 1, draws[d].uv_map);
+        if (trimmed) {
+            sw__gpu_trim_rect tr;
+            sw__gpu_atlas_rect(ctx, draws[d].trim_entry, &tr);
+            glUniform4f(prog->loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
+            glUniform1f(prog->loc_trim_layer, (float)tr.layer);
+        }
+        glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
+                       (const void *)(draws[d].first_idx * sizeof(uint32_t)));
     }
 }
 
@@ -199,27 +240,13 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     /* Lines only for the surfaces: the trim textures were made before, with filled fans. */
     if (desc->wireframe)
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
-    bind_mesh(ctx, mesh);
-    glUseProgram(ctx->surf.mesh);
-    glUniformMatrix4fv(ctx->surf.loc_view_proj, 1, GL_FALSE, view->view_proj);
-    glUniform1i(ctx->surf.loc_trim, 0);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, sw__gpu_atlas_texture(ctx));
-    for (size_t d = 0; d < n_draws; ++d) {
-        if (draws[d].n_idx == 0)
-            continue;
-        glUniform4fv(ctx->surf.loc_color, 1, draws[d].color);
-        glUniform4fv(ctx->surf.loc_uv_map, 1, draws[d].uv_map);
-        sw__gpu_trim_rect tr = {0, 0, 0, 0, 0};
-        if (draws[d].trim_entry >= 0)
-            sw__gpu_atlas_rect(ctx, draws[d].trim_entry, &tr);
-        glUniform4f(ctx->surf.loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
-        glUniform1f(ctx->surf.loc_trim_layer, (float)tr.layer);
-        glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
-                       (const void *)(draws[d].first_idx * sizeof(uint32_t)));
-    }
     if (batch && batch->n_recs > 0)
         draw_patches(ctx, view, batch);
+    bind_mesh(ctx, mesh);
+    draw_mesh_variant(ctx, view, draws, n_draws, SW__GPU_UNTRIMMED);
+    draw_mesh_variant(ctx, view, draws, n_draws, SW__GPU_TRIMMED);
     if (desc->wireframe)
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     glFinish();

@@ -14,6 +14,7 @@
 #include "sw_status_util.h"
 
 #include <GL/glcorearb.h>
+#include <stdio.h>
 #include <string.h>
 
 static const char *const k_mesh_vs = sw_glsl_mesh_vert;
@@ -22,6 +23,7 @@ static const char *const k_surface_fs_interface = sw_glsl_surface_interface_frag
 static const char *const k_surface_fs_trim = sw_glsl_surface_trim_frag;
 static const char *const k_surface_fs_default_shade = sw_glsl_surface_shade_frag;
 static const char *const k_surface_fs_main = sw_glsl_surface_main_frag;
+static const char *const k_surface_fs_main_untrimmed = sw_glsl_surface_main_untrimmed_frag;
 static const char *const k_eval_vs = sw_glsl_eval_vert;
 static const char *const k_exact_vs = sw_glsl_exact_vert;
 static const char *const k_trim_vs = sw_glsl_trim_vert;
@@ -92,45 +94,66 @@ sw_result sw__gpu_program_link(const char *vs, const char *fs, const char *what,
     return link_parts(vs, &fs, 1, what, SW_ERR_GL, out, status);
 }
 
-/* The three surface programs around one shading function; on failure none is left. */
-static sw_result link_surfaces(const char *shade, sw_result fail, sw__gpu_surface_programs *p,
-                               sw_status *status)
+static void locate_uniforms(sw__gpu_surface_program *p)
+{
+    p->loc_view_proj = glGetUniformLocation(p->prog, "u_view_proj");
+    p->loc_trim = glGetUniformLocation(p->prog, "u_trim");
+    p->loc_color = glGetUniformLocation(p->prog, "u_color");
+    p->loc_trim_rect = glGetUniformLocation(p->prog, "u_trim_rect");
+    p->loc_trim_layer = glGetUniformLocation(p->prog, "u_trim_layer");
+    p->loc_uv_map = glGetUniformLocation(p->prog, "u_uv_map");
+    p->loc_grid = glGetUniformLocation(p->prog, "u_grid");
+    p->loc_base = glGetUniformLocation(p->prog, "u_base");
+    p->loc_capture = glGetUniformLocation(p->prog, "u_capture");
+}
+
+/* The programs of one trim variant: the vertex stages with the fragment parts `fs`. */
+static sw_result link_variant(const char *const fs[4], sw_result fail, sw__gpu_surface_programs *p,
+                              int variant, sw_status *status)
+{
+    static const char *const k_names[3] = {"mesh", "patch evaluation", "exact evaluation"};
+    const char *const vs[3] = {k_mesh_vs, k_eval_vs, k_exact_vs};
+    sw__gpu_surface_program *out[3] = {&p->mesh[variant], &p->eval[variant], &p->exact[variant]};
+    for (int k = 0; k < 3; ++k) {
+        char name[64];
+        snprintf(name, sizeof name, "%s%s", k_names[k],
+                 variant == SW__GPU_UNTRIMMED ? " (untrimmed)" : "");
+        sw_result r = link_parts(vs[k], fs, 4, name, fail, &out[k]->prog, status);
+        if (r != SW_OK)
+            return r;
+        locate_uniforms(out[k]);
+    }
+    return SW_OK;
+}
+
+/* The surface programs around one shading function, in both trim variants, or (host shading:
+ * `both` = 0) the trimmed variant named twice; on failure none is left. */
+static sw_result link_surfaces(const char *shade, sw_result fail, int both,
+                               sw__gpu_surface_programs *p, sw_status *status)
 {
     memset(p, 0, sizeof *p);
-    const char *fs[4] = {k_surface_fs_interface, k_surface_fs_trim, shade, k_surface_fs_main};
-    sw_result r = link_parts(k_mesh_vs, fs, 4, "mesh", fail, &p->mesh, status);
-    if (r == SW_OK)
-        r = link_parts(k_eval_vs, fs, 4, "patch evaluation", fail, &p->eval, status);
-    if (r == SW_OK)
-        r = link_parts(k_exact_vs, fs, 4, "exact evaluation", fail, &p->exact, status);
+    const char *const trimmed[4] = {k_surface_fs_interface, k_surface_fs_trim, shade,
+                                    k_surface_fs_main};
+    const char *const untrimmed[4] = {k_surface_fs_interface, k_surface_fs_trim, shade,
+                                      k_surface_fs_main_untrimmed};
+    sw_result r = link_variant(trimmed, fail, p, SW__GPU_TRIMMED, status);
+    if (r == SW_OK && both)
+        r = link_variant(untrimmed, fail, p, SW__GPU_UNTRIMMED, status);
     if (r != SW_OK) {
-        glDeleteProgram(p->mesh);
-        glDeleteProgram(p->eval);
-        glDeleteProgram(p->exact);
-        memset(p, 0, sizeof *p);
+        sw__gpu_shading_free(NULL, p);
         return r;
     }
-    p->loc_view_proj = glGetUniformLocation(p->mesh, "u_view_proj");
-    p->loc_color = glGetUniformLocation(p->mesh, "u_color");
-    p->loc_trim_rect = glGetUniformLocation(p->mesh, "u_trim_rect");
-    p->loc_trim_layer = glGetUniformLocation(p->mesh, "u_trim_layer");
-    p->loc_trim = glGetUniformLocation(p->mesh, "u_trim");
-    p->loc_uv_map = glGetUniformLocation(p->mesh, "u_uv_map");
-    p->loc_eval_view_proj = glGetUniformLocation(p->eval, "u_view_proj");
-    p->loc_eval_grid = glGetUniformLocation(p->eval, "u_grid");
-    p->loc_eval_base = glGetUniformLocation(p->eval, "u_base");
-    p->loc_eval_trim = glGetUniformLocation(p->eval, "u_trim");
-    p->loc_eval_capture = glGetUniformLocation(p->eval, "u_capture");
-    p->loc_exact_view_proj = glGetUniformLocation(p->exact, "u_view_proj");
-    p->loc_exact_grid = glGetUniformLocation(p->exact, "u_grid");
-    p->loc_exact_base = glGetUniformLocation(p->exact, "u_base");
-    p->loc_exact_trim = glGetUniformLocation(p->exact, "u_trim");
+    if (!both) {
+        p->mesh[SW__GPU_UNTRIMMED] = p->mesh[SW__GPU_TRIMMED];
+        p->eval[SW__GPU_UNTRIMMED] = p->eval[SW__GPU_TRIMMED];
+        p->exact[SW__GPU_UNTRIMMED] = p->exact[SW__GPU_TRIMMED];
+    }
     return SW_OK;
 }
 
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
 {
-    sw_result r = link_surfaces(k_surface_fs_default_shade, SW_ERR_GL, &ctx->surf, status);
+    sw_result r = link_surfaces(k_surface_fs_default_shade, SW_ERR_GL, 1, &ctx->surf, status);
     if (r != SW_OK)
         return r;
     r = sw__gpu_program_link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
@@ -145,9 +168,12 @@ sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
 void sw__gpu_shading_free(sw_gpu_context *ctx, sw__gpu_surface_programs *p)
 {
     (void)ctx; /* the context is current: its programs are deleted with it */
-    glDeleteProgram(p->mesh);
-    glDeleteProgram(p->eval);
-    glDeleteProgram(p->exact);
+    sw__gpu_surface_program *all[3] = {p->mesh, p->eval, p->exact};
+    for (int k = 0; k < 3; ++k) {
+        glDeleteProgram(all[k][SW__GPU_TRIMMED].prog);
+        if (all[k][SW__GPU_UNTRIMMED].prog != all[k][SW__GPU_TRIMMED].prog)
+            glDeleteProgram(all[k][SW__GPU_UNTRIMMED].prog);
+    }
     memset(p, 0, sizeof *p);
 }
 
@@ -166,7 +192,7 @@ sw_result sw__gpu_shading_create(sw_gpu_context *ctx, const char *shade_source,
     sw__gpu_make_current(ctx);
     while (glGetError() != GL_NO_ERROR) /* the host's errors before the call are not ours */
         ;
-    sw_result r = link_surfaces(shade_source, SW_ERR_INVALID_ARGUMENT, out, status);
+    sw_result r = link_surfaces(shade_source, SW_ERR_INVALID_ARGUMENT, 0, out, status);
     if (r == SW_OK && (r = sw__gpu_check(status, "host shading set-up")) != SW_OK)
         sw__gpu_shading_free(ctx, out);
     return r;

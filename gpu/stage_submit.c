@@ -9,8 +9,14 @@
 
 #include <string.h>
 
+static int trim_variant(const sw__gpu_draw *d)
+{
+    return d->trim_entry >= 0 ? SW__GPU_TRIMMED : SW__GPU_UNTRIMMED;
+}
+
 /* Fills the records' colour and trim rectangle from their draws (trim entries are known after the
- * atlas commit) and sorts them by grid class into ctx->recs_sorted (counting sort). */
+ * atlas commit) and sorts them by trim variant and grid class into ctx->recs_sorted (counting
+ * sort), the untrimmed first. */
 static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_patch_batch *b,
                              sw_status *status)
 {
@@ -33,21 +39,24 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_pa
             rec->trim_rect[3] = (float)tr.h;
             rec->layer = (float)tr.layer;
         }
-        b->count[rec->level_v][rec->level_u]++;
+        b->count[trim_variant(d)][rec->level_v][rec->level_u]++;
     }
-    uint32_t at = 0, next[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
-    for (int v = 0; v < SW__GPU_GRID_CLASSES; ++v)
-        for (int u = 0; u < SW__GPU_GRID_CLASSES; ++u) {
-            b->first[v][u] = next[v][u] = at;
-            at += b->count[v][u];
-        }
+    static const int k_order[SW__GPU_TRIM_VARIANTS] = {SW__GPU_UNTRIMMED, SW__GPU_TRIMMED};
+    uint32_t at = 0, next[SW__GPU_TRIM_VARIANTS][SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    for (int k = 0; k < SW__GPU_TRIM_VARIANTS; ++k)
+        for (int v = 0; v < SW__GPU_GRID_CLASSES; ++v)
+            for (int u = 0; u < SW__GPU_GRID_CLASSES; ++u) {
+                int t = k_order[k];
+                b->first[t][v][u] = next[t][v][u] = at;
+                at += b->count[t][v][u];
+            }
     int keep = ctx->capture_max > 0;
     if (keep && !sw__gpu_grow((void **)&ctx->rec_source, &ctx->cap_rec_source, g->n_recs,
                               sizeof *ctx->rec_source))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < g->n_recs; ++i) {
         const sw__gpu_patch_rec *rec = &g->recs[i];
-        uint32_t slot = next[rec->level_v][rec->level_u]++;
+        uint32_t slot = next[trim_variant(&g->draws[rec->draw])][rec->level_v][rec->level_u]++;
         ctx->recs_sorted[slot] = *rec;
         if (keep)
             ctx->rec_source[slot] = (uint32_t)i;

@@ -98,16 +98,31 @@ typedef void (*sw__gpu_patch_hook)(void *user, const sw__gpu_drawn_patch *p);
 /* Installs (fn != NULL) or removes the hook; called on the GL thread during sw_gpu_render_scene. */
 void sw__gpu_set_patch_hook(sw_gpu_context *ctx, sw__gpu_patch_hook fn, void *user);
 
-/* The three surface programs (mesh, Bézier evaluation, exact evaluation) and their uniform
- * locations. They share one fragment stage whose shading function is the library's or a host's
- * (sw__gpu_shading_create); the context draws with ctx->surf. */
+/* One surface program and the uniform locations the draws set (-1 where the program has no such
+ * uniform: GL ignores those). */
+typedef struct sw__gpu_surface_program {
+    GLuint prog;
+    GLint loc_view_proj, loc_trim;
+    GLint loc_color, loc_trim_rect, loc_trim_layer, loc_uv_map; /* the mesh program's */
+    GLint loc_grid, loc_base;                                   /* the evaluation programs' */
+    GLint loc_capture;                                          /* Bézier evaluation only */
+} sw__gpu_surface_program;
+
+/* Which fragment stage a surface program has: the trim lookup (§4.3) and its discard, or neither,
+ * for untrimmed draws. Without a texture read and a discard the rasteriser may test depth before
+ * shading, and the trim lookup's inputs are not interpolated: on llvmpipe that is a third of the
+ * fragment and setup work of a building's frame (docs/performance.md). */
+enum { SW__GPU_TRIMMED = 0, SW__GPU_UNTRIMMED = 1, SW__GPU_TRIM_VARIANTS = 2 };
+
+/* The three surface programs (mesh, Bézier evaluation, exact evaluation), each in both trim
+ * variants. They share one fragment stage whose shading function is the library's or a host's
+ * (sw__gpu_shading_create); the context draws with ctx->surf. A host's shading is linked into the
+ * trimmed variant only, and its untrimmed variant names the same programs: the host sets its
+ * uniforms on the three programs sw_renderer_shading_programs lists. */
 typedef struct sw__gpu_surface_programs {
-    GLuint mesh; /* grids and plain triangles */
-    GLint loc_view_proj, loc_color, loc_trim, loc_trim_rect, loc_trim_layer, loc_uv_map;
-    GLuint eval; /* vertex-shader evaluation of rational Bézier patches (§4.2) */
-    GLint loc_eval_view_proj, loc_eval_grid, loc_eval_base, loc_eval_trim, loc_eval_capture;
-    GLuint exact; /* exact evaluation from knots and control points (eval_exact) */
-    GLint loc_exact_view_proj, loc_exact_grid, loc_exact_base, loc_exact_trim;
+    sw__gpu_surface_program mesh[SW__GPU_TRIM_VARIANTS]; /* grids and plain triangles */
+    sw__gpu_surface_program eval[SW__GPU_TRIM_VARIANTS]; /* rational Bézier patches (§4.2) */
+    sw__gpu_surface_program exact[SW__GPU_TRIM_VARIANTS]; /* from knots (eval_exact) */
 } sw__gpu_surface_programs;
 
 struct sw_gpu_context {
@@ -379,7 +394,8 @@ typedef struct sw__gpu_draw {
                            m1 + st.y m3); zero: uv = 0 */
 } sw__gpu_draw;
 
-/* The frame's GPU-evaluated patches: records sorted by grid class, control points. */
+/* The frame's GPU-evaluated patches: records sorted by trim variant and grid class, control
+ * points. */
 typedef struct sw__gpu_patch_batch {
     const sw__gpu_patch_rec *recs;
     size_t n_recs;
@@ -393,8 +409,9 @@ typedef struct sw__gpu_patch_batch {
     size_t n_knots;
     const double *dcps; /* 4 doubles per control point */
     size_t n_dcps;
-    uint32_t first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* records of each class */
-    uint32_t count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    /* records of each trim variant (SW__GPU_TRIMMED, SW__GPU_UNTRIMMED) and grid class */
+    uint32_t first[SW__GPU_TRIM_VARIANTS][SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    uint32_t count[SW__GPU_TRIM_VARIANTS][SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
 } sw__gpu_patch_batch;
 
 /* Creates the grid classes' index buffer (grid_set.c). */

@@ -464,9 +464,9 @@ sw_result sw_renderer_shading_programs(sw_renderer renderer, uint32_t out[3], sw
     sw_result r = immediate_state(renderer, fn, 0, &im, &gpu, status);
     if (r != SW_OK)
         return r;
-    out[0] = im->has_shading ? im->shading.mesh : 0u;
-    out[1] = im->has_shading ? im->shading.eval : 0u;
-    out[2] = im->has_shading ? im->shading.exact : 0u;
+    out[0] = im->has_shading ? im->shading.mesh[SW__GPU_TRIMMED].prog : 0u;
+    out[1] = im->has_shading ? im->shading.eval[SW__GPU_TRIMMED].prog : 0u;
+    out[2] = im->has_shading ? im->shading.exact[SW__GPU_TRIMMED].prog : 0u;
     sw__status_ok(status);
     return SW_OK;
 }
