@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
-/* Draw submission and readback shared by the scene path and the plain-triangle path: one program,
- * reversed-Z depth (cleared to 0, GL_GREATER), trim-texture lookups for trimmed ranges (Guthe et
- * al. 2005 §4.3), glReadPixels with rows flipped to top-first and depth turned into eye-space
- * depth. Also sw_gpu_render_triangles, the path an independent reference mesh is drawn with.
+/* Draw submission and readback shared by the scene path and the plain-triangle path: the surface
+ * programs, reversed-Z depth (cleared to 0, GL_GREATER), trim-texture lookups for trimmed ranges
+ * only (Guthe et al. 2005 §4.3; untrimmed ranges are drawn by programs without it), glReadPixels
+ * with rows flipped to top-first and depth turned into eye-space depth. Also
+ * sw_gpu_render_triangles, the path an independent reference mesh is drawn with.
  */
 #include "sw_gpu_internal.h"
 #include "sw_hooks.h"

@@ -423,10 +423,12 @@ void sw__gpu_desc_defaults(const sw_gpu_frame_desc *in, sw_gpu_frame_desc *out);
 /* Near plane for a scene box in world coordinates seen from eye: max(1e-4 x diagonal, half the
  * eye's distance to the box), never 0. */
 double sw__gpu_near_plane(const double eye[3], const double world_box[6]);
-/* Clears the render target (desc->background), uploads `mesh` and draws every range with
- * reversed-Z depth (as lines with desc->wireframe), then the
- * batch's patches (NULL = none) with one instanced draw per grid class; waits for the GPU
- * (glFinish) so that the caller's timing is the real draw time. */
+/* Clears the render target (desc->background) and draws with reversed-Z depth (as lines with
+ * desc->wireframe) the batch's patches (NULL = none), one instanced draw per trim variant and grid
+ * class, then uploads `mesh` and draws its ranges, the untrimmed first. The patches go first: the
+ * mesh's fat borders lie behind them (crack_fill.c), so most of their fragments fail the depth
+ * test before they are shaded. Waits for the GPU (glFinish) so that the caller's timing is the
+ * real draw time. */
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
                              const sw__gpu_draw *draws, size_t n_draws,
