@@ -304,19 +304,41 @@ curve_data line_curve(double u0, double v0, double u1, double v1)
     return c;
 }
 
-void wire_loops(const TopoDS_Face &cf, face_data &fd)
+/* The face's loops: each wire's edges in the order BRepTools_WireExplorer walks them on the
+ * source face `f`, each edge's pcurve read from the converted face `cf` (nc's result). The walk
+ * is taken on the source face because the conversion re-approximates pcurves and edge
+ * tolerances: on a part scaled by 10^4 (a unit conversion) the explorer then stopped after the
+ * first of a wire's four edges, and the one-curve loop, snapped closed, cut triangular holes in
+ * the face. A wire the explorer cannot walk whole is refused (the face is skipped and named)
+ * rather than drawn with a loop that misses edges. */
+void wire_loops(const TopoDS_Face &f, const TopoDS_Face &cf, BRepBuilderAPI_NurbsConvert &nc,
+                face_data &fd)
 {
-    const TopoDS_Wire outer = BRepTools::OuterWire(cf);
-    for (TopoDS_Iterator it(cf); it.More(); it.Next()) {
+    const TopoDS_Wire outer = BRepTools::OuterWire(f);
+    int index = 0;
+    for (TopoDS_Iterator it(f); it.More(); it.Next()) {
         if (it.Value().ShapeType() != TopAbs_WIRE)
             continue;
         const TopoDS_Wire &w = TopoDS::Wire(it.Value());
         loop_data ld;
         ld.flags = w.IsSame(outer) ? (uint32_t)SW_SG_LOOP_OUTER : 0u;
-        for (BRepTools_WireExplorer ex(w, cf); ex.More(); ex.Next())
-            ld.curves.push_back(pcurve(ex.Current(), cf));
+        int walked = 0, edges = 0;
+        for (BRepTools_WireExplorer ex(w, f); ex.More(); ex.Next(), walked++) {
+            TopoDS_Shape converted = nc.ModifiedShape(ex.Current());
+            if (converted.IsNull() || converted.ShapeType() != TopAbs_EDGE)
+                throw face_error{"BRepBuilderAPI_NurbsConvert gave no edge for an edge of wire " +
+                                 std::to_string(index)};
+            converted.Orientation(ex.Current().Orientation());
+            ld.curves.push_back(pcurve(TopoDS::Edge(converted), cf));
+        }
+        for (TopExp_Explorer ex(w, TopAbs_EDGE); ex.More(); ex.Next())
+            edges++;
+        if (walked < edges)
+            throw face_error{"wire " + std::to_string(index) + ": its edges do not join (" +
+                             std::to_string(walked) + " of " + std::to_string(edges) + " walked)"};
         if (!ld.curves.empty())
             fd.loops.push_back(std::move(ld));
+        index++;
     }
 }
 
@@ -589,7 +611,7 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
                 fd.knots_v[fd.rec.n_v]};
 
     check_converted(converted, what);
-    wire_loops(converted, fd);
+    wire_loops(f, converted, nc, fd);
     const double tol3 = std::max(fd.rec.tolerance, max_tolerance(converted, TopAbs_VERTEX));
     for (loop_data &ld : fd.loops) {
         shift_into_domain(ld, d, period);
