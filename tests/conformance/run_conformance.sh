@@ -87,6 +87,7 @@ if [ "$mode" = quick ]; then
   one_model "$data/occ/bottle.brep" "iges" whole,mid
   one_model "$data/occ/Pump_Nut.brep" "orig d10" whole,mid
   one_model "$data/occ/Motor-c.brep" "orig" whole
+  one_model "$data/occ/shell1.brep" "d10000" whole
 else
   files=("$@")
   [ ${#files[@]} -gt 0 ] || files=("$data"/occ/*.brep "$data"/step/*.step)
