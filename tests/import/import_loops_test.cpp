@@ -14,15 +14,11 @@
  */
 #include "occt_test_util.hpp"
 
-#include <BRepBndLib.hxx>
-#include <BRepBuilderAPI_Transform.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
-#include <Bnd_Box.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Iterator.hxx>
-#include <gp_Trsf.hxx>
 
 #include <cmath>
 #include <sstream>
@@ -30,24 +26,6 @@
 
 namespace
 {
-
-/* The shape scaled about its box centre to a bounding diagonal of `diagonal`. */
-bool scaled(const TopoDS_Shape &shape, double diagonal, TopoDS_Shape &out)
-{
-    Bnd_Box box;
-    BRepBndLib::Add(shape, box);
-    double x0, y0, z0, x1, y1, z1;
-    box.Get(x0, y0, z0, x1, y1, z1);
-    const double diag =
-        std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
-    gp_Trsf t;
-    t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), diagonal / diag);
-    BRepBuilderAPI_Transform xf(shape, t, Standard_True);
-    if (!xf.IsDone())
-        return false;
-    out = xf.Shape();
-    return true;
-}
 
 /* Edges of each wire of a face, in the face's order of wires. */
 std::vector<int> wire_edges(const TopoDS_Face &f)
@@ -98,7 +76,7 @@ bool run(const std::string &path, double diagonal)
 {
     TopoDS_Shape shape, big;
     BRep_Builder b;
-    if (!BRepTools::Read(shape, path.c_str(), b) || !scaled(shape, diagonal, big)) {
+    if (!BRepTools::Read(shape, path.c_str(), b) || !ot::scale_to_diagonal(shape, diagonal, big)) {
         std::printf("FAIL %s: cannot read or scale\n", path.c_str());
         return false;
     }

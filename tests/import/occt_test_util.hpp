@@ -6,6 +6,14 @@
 
 #include "sw_sg_import_occt.hpp"
 
+#include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
+#include <Bnd_Box.hxx>
+#include <TopoDS_Shape.hxx>
+#include <gp_Trsf.hxx>
+
+#include <cmath>
+
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -86,6 +94,32 @@ inline bool import(const std::string &path, imported &out, sw_result *result = n
                     sw_result_str(r), st.message);
         return false;
     }
+    return true;
+}
+
+/* The shape scaled about its bounding box's centre so that the box's diagonal becomes
+ * `diagonal` (0: its own size), as a unit conversion does it: BRepBuilderAPI_Transform with a
+ * gp_Trsf scale, copy = true. *from gets the diagonal before, *scale the factor. */
+inline bool scale_to_diagonal(const TopoDS_Shape &shape, double diagonal, TopoDS_Shape &out,
+                              double *from = nullptr, double *scale = nullptr)
+{
+    Bnd_Box box;
+    BRepBndLib::Add(shape, box);
+    double x0, y0, z0, x1, y1, z1;
+    box.Get(x0, y0, z0, x1, y1, z1);
+    const double diag =
+        std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
+    const double k = diagonal > 0.0 ? diagonal / diag : 1.0;
+    gp_Trsf t;
+    t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), k);
+    BRepBuilderAPI_Transform xf(shape, t, Standard_True);
+    if (!xf.IsDone())
+        return false;
+    out = xf.Shape();
+    if (from)
+        *from = diag;
+    if (scale)
+        *scale = k;
     return true;
 }
 

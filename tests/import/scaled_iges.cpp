@@ -9,18 +9,16 @@
  * part's size (a plain IGES export). OUT.brep writes the scaled
  * shape as an OCCT BREP file instead (the conformance harness's scaled copies in their own
  * format). Exit status 0 on success. */
-#include <BRepBndLib.hxx>
-#include <BRepBuilderAPI_Transform.hxx>
+#include "occt_test_util.hpp"
+
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
-#include <Bnd_Box.hxx>
 #include <IGESControl_Controller.hxx>
 #include <IGESControl_Reader.hxx>
 #include <IGESControl_Writer.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
-#include <gp_Trsf.hxx>
 
 #include <cmath>
 #include <cstdio>
@@ -70,38 +68,28 @@ int main(int argc, char **argv)
             std::fprintf(stderr, "scaled_iges: cannot read %s\n", argv[1]);
             return 1;
         }
-        Bnd_Box box;
-        BRepBndLib::Add(shape, box);
-        double x0, y0, z0, x1, y1, z1;
-        box.Get(x0, y0, z0, x1, y1, z1);
-        const double diag =
-            std::sqrt((x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0) + (z1 - z0) * (z1 - z0));
-        const double scale = target > 0.0 ? target / diag : 1.0; /* 0: the part's own size */
-        gp_Trsf t;
-        t.SetScale(gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1)), scale);
-        BRepBuilderAPI_Transform xf(shape, t, Standard_True);
-        if (!xf.IsDone()) {
+        TopoDS_Shape scaled;
+        double diag = 0.0, scale = 1.0; /* target 0: the part's own size */
+        if (!ot::scale_to_diagonal(shape, target, scaled, &diag, &scale)) {
             std::fprintf(stderr, "scaled_iges: transform failed\n");
             return 1;
         }
         if (ends_with(argv[2], ".brep")) {
-            if (!BRepTools::Write(xf.Shape(), argv[2])) {
+            if (!BRepTools::Write(scaled, argv[2])) {
                 std::fprintf(stderr, "scaled_iges: cannot write %s\n", argv[2]);
                 return 1;
             }
-            std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target,
-                        scale);
+            std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target, scale);
             return 0;
         }
         IGESControl_Controller::Init();
         /* the defaults a user gets: trimmed surfaces (type 144); or B-rep faces (MSBO) */
         IGESControl_Writer w("MM", argc == 5 ? 1 : 0);
-        if (!w.AddShape(xf.Shape()) || (w.ComputeModel(), !w.Write(argv[2]))) {
+        if (!w.AddShape(scaled) || (w.ComputeModel(), !w.Write(argv[2]))) {
             std::fprintf(stderr, "scaled_iges: cannot write %s\n", argv[2]);
             return 1;
         }
-        std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target,
-                    scale);
+        std::printf("%s: diagonal %.6g -> %.6g (scale %.6g)\n", argv[2], diag, target, scale);
     } catch (const Standard_Failure &e) {
         std::fprintf(stderr, "scaled_iges: OCCT: %s\n", e.GetMessageString());
         return 1;
