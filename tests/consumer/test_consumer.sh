@@ -7,6 +7,8 @@
 # headlessly, and compare their frames with `splinewalk render` of the same scene and camera:
 # at most 0.1 % of pixels may differ. Negative controls prove the comparison sees a different
 # camera (another preset, and the same camera with a 1 % narrower field of view).
+# With SW_CONSUMER_FROM=debs the package comes from the Debian packages `cpack` builds (unpacked
+# into a scratch root) instead of `cmake --install`, and their dependency fields are checked.
 # usage: test_consumer.sh BUILD_DIR SOURCE_DIR PNG_DIFF DATA_DIR WORK_DIR [SANITIZE]
 set -euo pipefail
 build=$1 src=$2 png_diff=$3 data=$4 work=$5 sanitize=${6:-}
@@ -24,8 +26,30 @@ if [ -n "$sanitize" ]; then
   flags+=("-fsanitize=$sanitize" -fno-omit-frame-pointer)
 fi
 
-step "install to $prefix"
-cmake --install "$build" --prefix "$prefix" >/dev/null
+if [ "${SW_CONSUMER_FROM:-install}" = debs ]; then
+  # The Debian packages instead of `cmake --install`: built by cpack from the same build, unpacked
+  # into a scratch root (no dpkg database touched), used from its /usr.
+  step "build the Debian packages and unpack them into $work/root"
+  (cd "$build" && cpack -B "$work/debs" >/dev/null) || fail "cpack failed"
+  runtime=$(ls "$work"/debs/libsplinewalk[0-9]*_*.deb) dev=$(ls "$work"/debs/libsplinewalk-dev_*.deb)
+  tools=$(ls "$work"/debs/splinewalk-tools_*.deb)
+  for deb in "$runtime" "$dev" "$tools"; do
+    dpkg-deb -x "$deb" "$work/root"
+    echo "$(dpkg-deb -f "$deb" Package): $(dpkg-deb -f "$deb" Depends | cut -c1-160)"
+  done
+  version=$(dpkg-deb -f "$runtime" Version)
+  dpkg-deb -f "$dev" Depends | grep -q "$(dpkg-deb -f "$runtime" Package) (= $version)" ||
+    fail "libsplinewalk-dev does not depend on its library's exact version"
+  for lib in libc6 libegl1 libopengl0; do
+    dpkg-deb -f "$runtime" Depends | grep -q -w "$lib" || fail "the library's package does not depend on $lib"
+  done
+  dpkg-deb -c "$runtime" | awk '{print $6}' | grep -q -x './usr/lib/libsplinewalk.so' &&
+    fail "the unversioned link name is in the runtime package, not in -dev"
+  prefix=$work/root/usr
+else
+  step "install to $prefix"
+  cmake --install "$build" --prefix "$prefix" >/dev/null
+fi
 for f in lib/libsplinewalk.so include/splinewalk/splinewalk.h include/splinewalk/sw_result.h \
          lib/cmake/splinewalk/splinewalkConfig.cmake lib/cmake/splinewalk/splinewalkConfigVersion.cmake \
          lib/pkgconfig/splinewalk.pc bin/splinewalk; do
