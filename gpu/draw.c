@@ -207,12 +207,13 @@ static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
         }
         glUniform4fv(prog->loc_color, 1, draws[d].color);
         glUniform4fv(prog->loc_uv_map, 1, draws[d].uv_map);
-        if (trimmed) {
-            sw__gpu_trim_rect tr;
+        /* set for untrimmed draws too (w = 0: the lookup accepts all): a host's shading draws
+         * them with its trimmed program, which keeps the last trimmed draw's rectangle */
+        sw__gpu_trim_rect tr = {0, 0, 0, 0, 0};
+        if (trimmed)
             sw__gpu_atlas_rect(ctx, draws[d].trim_entry, &tr);
-            glUniform4f(prog->loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
-            glUniform1f(prog->loc_trim_layer, (float)tr.layer);
-        }
+        glUniform4f(prog->loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
+        glUniform1f(prog->loc_trim_layer, (float)tr.layer);
         glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
                        (const void *)(draws[d].first_idx * sizeof(uint32_t)));
     }
