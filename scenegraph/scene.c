@@ -452,7 +452,9 @@ void sw_sg_scene_free(sw_sg_scene *scene)
         return;
     for (int s = 0; s < SW__SG_SEC_COUNT; s++)
         sw__free(scene->owned[s]);
-    if (scene->map)
+    if (scene->map && scene->map_on_heap)
+        sw__free(scene->map);
+    else if (scene->map)
         munmap(scene->map, scene->map_size);
     sw__free(scene->path);
     sw__free(scene);

@@ -267,6 +267,12 @@ sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *
  * SW_ERR_TRUNCATED, SW_ERR_CHECKSUM (the header's own CRC over itself and the section table, or the
  * 16-byte META section, both checked at open); the message names the file and the byte offset. */
 sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status);
+/* The same checks on the bytes of a .sws file already in memory (copied: the caller keeps its
+ * buffer); `name` stands for the path in messages and sw_sg_scene_path_ptr. The scene then
+ * behaves as a mapped one. Errors: as sw_sg_scene_open's, but for those of the file system, and
+ * SW_ERR_OUT_OF_MEMORY. */
+sw_result sw_sg_scene_open_bytes(const void *data, size_t size, const char *name,
+                                 sw_sg_scene **out, sw_status *status);
 
 /* ---- statistics (scene_stats.c) -------------------------------------------------------------- */
 typedef struct sw_sg_scene_stats {

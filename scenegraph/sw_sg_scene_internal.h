@@ -47,8 +47,9 @@ struct sw_sg_scene {
     char *path;                    /* "" for a scene built in memory; always owned */
     void *owned[SW__SG_SEC_COUNT]; /* in-memory arrays (malloc), NULL when mapped */
     size_t owned_bytes;
-    void *map; /* mapped file, NULL in memory */
+    void *map; /* mapped file (or a heap copy of one: map_on_heap), NULL in memory */
     size_t map_size;
+    int map_on_heap; /* map is sw__malloc'd (sw_sg_scene_open_bytes), not mmap'd */
     sw__sg_section_info sec[SW__SG_SEC_COUNT]; /* mapped only; sec[SW__SG_SEC_LODS] is the
                                                   optional LODS section (size 0: none) */
     uint32_t verified;         /* sections whose checksum matched (sw_sg_section bits) */

@@ -426,19 +426,26 @@ static sw_result map_file(sw_sg_scene *scene, sw_status *status)
     return r;
 }
 
-sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status)
+/* A scene shell named `name` (NULL when out of memory). */
+static sw_sg_scene *scene_named(const char *name)
 {
-    *out = NULL;
     sw_sg_scene *scene = sw__calloc(1, sizeof *scene);
-    char *copy = sw__malloc(strlen(path) + 1);
+    char *copy = sw__malloc(strlen(name) + 1);
     if (!scene || !copy) {
         sw__free(scene);
         sw__free(copy);
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+        return NULL;
     }
-    scene->path = strcpy(copy, path);
+    scene->path = strcpy(copy, name);
     scene->serial = sw__sg_next_serial();
-    sw_result r = map_file(scene, status);
+    return scene;
+}
+
+/* The checks of an open on the scene's bytes (scene->map), then its view; frees the scene and
+ * clears *out on failure. */
+static sw_result open_mapped(sw_sg_scene *scene, sw_result r, sw_sg_scene **out, sw_status *status)
+{
+    const char *path = scene->path;
     if (r == SW_OK)
         r = check_ident(path, scene->map, scene->map_size, status);
     sws_header h;
@@ -456,6 +463,38 @@ sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *statu
     *out = scene;
     sw__status_ok(status);
     return SW_OK;
+}
+
+sw_result sw_sg_scene_open(const char *path, sw_sg_scene **out, sw_status *status)
+{
+    *out = NULL;
+    sw_sg_scene *scene = scene_named(path);
+    if (!scene)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+    return open_mapped(scene, map_file(scene, status), out, status);
+}
+
+sw_result sw_sg_scene_open_bytes(const void *data, size_t size, const char *name, sw_sg_scene **out,
+                                 sw_status *status)
+{
+    *out = NULL;
+    sw_sg_scene *scene = scene_named(name);
+    void *copy = scene && size ? sw__malloc(size) : NULL;
+    if (!scene || (size && !copy)) {
+        sw__free(scene ? scene->path : NULL);
+        sw__free(scene);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    sw_result r = SW_OK;
+    if (size == 0)
+        r = sw__fail(status, SW_ERR_TRUNCATED, "%s: offset 0: empty file", name);
+    else {
+        memcpy(copy, data, size);
+        scene->map = copy;
+        scene->map_size = size;
+        scene->map_on_heap = 1;
+    }
+    return open_mapped(scene, r, out, status);
 }
 
 /* ---- save ------------------------------------------------------------------------------------ */

@@ -1,24 +1,20 @@
 /* SPDX-License-Identifier: MIT */
-/* libFuzzer harness for .sws loading: every input is written to a temporary file, opened (mmap,
- * header and table checks) and, if that succeeds, fully required (checksums + validation), then
- * traversed. Each input is tried twice: as given, and with its checksums recomputed ("resealed")
- * where the table allows, so mutations reach the record validation behind the checksums. */
+/* libFuzzer harness for .sws loading: every input is opened from memory (sw_sg_scene_open_bytes:
+ * the header and table checks of a file's open, on a copy of the bytes; the file system's part of
+ * an open is the malformed corpus's) and, if that succeeds, fully required (checksums +
+ * validation), then traversed. Each input is tried twice: as given, and with its checksums
+ * recomputed ("resealed") where the table allows, so mutations reach the record validation behind
+ * the checksums. */
 #include "sw_crc32c.h"
 #include "sw_sg_scene.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 enum { HDR_TABLE = 32, HDR_CRC = 60, ENTRY = 40, N_SEC = 8, TABLE_BYTES = ENTRY * N_SEC };
 
-static char g_path[512];
-
-static void remove_temp(void)
-{
-    unlink(g_path);
-}
+static const char k_name[] = "fuzz input";
 
 static int count_visit(void *ctx, uint32_t face, const double world[12], const float color[4])
 {
@@ -26,20 +22,13 @@ static int count_visit(void *ctx, uint32_t face, const double world[12], const f
     return ++*(uint64_t *)ctx > 100000; /* instances can multiply occurrences exponentially */
 }
 
-static void try_file(const uint8_t *data, size_t size)
+static void try_bytes(const uint8_t *data, size_t size)
 {
-    FILE *f = fopen(g_path, "wb");
-    if (!f)
-        abort();
-    if (size && fwrite(data, 1, size, f) != size)
-        abort();
-    if (fclose(f) != 0)
-        abort();
     sw_sg_scene *s = NULL;
     sw_status st = {0};
-    if (sw_sg_scene_open(g_path, &s, &st) != SW_OK) {
-        if (s || st.result == SW_OK || !strstr(st.message, g_path))
-            abort(); /* a failure must come with no scene and a message naming the file */
+    if (sw_sg_scene_open_bytes(data, size, k_name, &s, &st) != SW_OK) {
+        if (s || st.result == SW_OK || !strstr(st.message, k_name))
+            abort(); /* a failure must come with no scene and a message naming the input */
         return;
     }
     if (sw_sg_scene_require(s, SW_SG_SEC_ALL, &st) == SW_OK) {
@@ -84,19 +73,13 @@ static int reseal(uint8_t *d, size_t size)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    if (!g_path[0]) {
-        const char *t = getenv("TMPDIR");
-        snprintf(g_path, sizeof g_path, "%s/fuzz-sws-%ld.sws", t && *t ? t : "/tmp",
-                 (long)getpid());
-        atexit(remove_temp);
-    }
-    try_file(data, size);
+    try_bytes(data, size);
     uint8_t *copy = malloc(size ? size : 1);
     if (!copy)
         return 0;
     memcpy(copy, data, size);
     if (reseal(copy, size))
-        try_file(copy, size);
+        try_bytes(copy, size);
     free(copy);
     return 0;
 }
