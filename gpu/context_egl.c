@@ -223,9 +223,15 @@ static sw_result context_create(sw_result (*make)(sw_gpu_context *, sw_status *)
 {
     *out = NULL;
     sw_gpu_context *ctx = sw__calloc(1, sizeof *ctx);
-    if (ctx)
+    if (ctx) {
         ctx->walk_token = sw__calloc(1, sizeof *ctx->walk_token);
-    if (!ctx || !ctx->walk_token) {
+        ctx->stash = sw__gpu_stash_new();
+    }
+    if (!ctx || !ctx->walk_token || !ctx->stash) {
+        if (ctx) {
+            sw__free(ctx->walk_token);
+            sw__gpu_stash_free(ctx->stash);
+        }
         sw__free(ctx);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
     }
@@ -298,6 +304,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         eglDestroyContext(ctx->egl_display, ctx->egl_context);
     }
     sw__free(ctx->walk_token);
+    sw__gpu_stash_free(ctx->stash);
     sw__free(ctx);
 }
 

@@ -95,6 +95,31 @@ void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan)
     sw__free(plan);
 }
 
+/* Every field zeroed but the stages' arrays, which are kept empty (frame_stash.c). */
+static void plan_empty(sw_gpu_frame_plan *p)
+{
+    plan_release_reader(p);
+    sw__fr_visible vis = p->vis;
+    sw__fr_selection sel = p->sel;
+    sw__fr_geometry geo = p->geo;
+    sw__fr_visible_empty(&vis);
+    sw__fr_selection_empty(&sel);
+    sw__fr_geometry_empty(&geo);
+    memset(p, 0, sizeof *p);
+    p->vis = vis;
+    p->sel = sel;
+    p->geo = geo;
+}
+
+void sw_gpu_frame_plan_recycle(sw_gpu_context *ctx, sw_gpu_frame_plan *plan)
+{
+    if (!plan)
+        return;
+    plan_empty(plan);
+    if (!sw__gpu_stash_put(ctx, SW__GPU_STASH_PLAN, plan))
+        sw_gpu_frame_plan_free(plan);
+}
+
 double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan)
 {
     return plan->ms_prepare;
@@ -179,7 +204,9 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
     *out = NULL;
     double t0 = sw__gpu_now_ms();
     const sw_th_wait_count w0 = sw_th_thread_waits(); /* every wait of the frame */
-    sw_gpu_frame_plan *p = sw__calloc(1, sizeof *p);
+    sw_gpu_frame_plan *p = sw__gpu_stash_take(ctx, SW__GPU_STASH_PLAN);
+    if (!p)
+        p = sw__calloc(1, sizeof *p);
     if (!p)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
     p->hy.reader = -1;
@@ -190,11 +217,12 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
     if (r == SW_OK)
         r = run_stages(p, status);
     if (r != SW_OK) {
-        sw_gpu_frame_plan_free(p);
+        sw_gpu_frame_plan_recycle(ctx, p);
         return r;
     }
-    /* the selection is consumed by the tessellation: only the geometry travels to submit */
-    sw__fr_selection_free(&p->sel);
+    /* the selection is consumed by the tessellation: only the geometry travels to submit (its
+     * arrays stay, for the frame this plan is recycled into) */
+    sw__fr_selection_empty(&p->sel);
     p->ms_prepare = sw__gpu_now_ms() - t0;
     p->st.ms_tessellate = p->ms_prepare - p->st.ms_hierarchy; /* the waits are counted apart */
     sw__gpu_waits_since(&w0, &p->st);
@@ -270,7 +298,7 @@ sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_g
                               sw_gpu_frame_stats *stats, sw_status *status)
 {
     sw_result r = sw_gpu_frame_submit_keep(ctx, plan, out, stats, status);
-    sw_gpu_frame_plan_free(plan);
+    sw_gpu_frame_plan_recycle(ctx, plan);
     return r;
 }
 

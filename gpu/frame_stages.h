@@ -132,7 +132,8 @@ typedef struct sw__fr_visible {
 } sw__fr_visible;
 
 /* Before the view: the scene box the near plane is chosen from (eye-relative), and the mesh
- * occurrences (their boxes join it). Needs env->view.eye only. */
+ * occurrences (their boxes join it). Needs env->view.eye only. vis: zeroed, or a spent frame's
+ * (its arrays reused). */
 sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *desc,
                                 sw__fr_visible *vis, double scene_box[6], sw_status *status);
 /* After the view: the visible face occurrences (desc.occurrences, the BVH, or every occurrence
@@ -141,6 +142,7 @@ sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *
 sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__fr_visible *vis,
                       sw_gpu_frame_stats *st, sw_status *status);
 void sw__fr_visible_free(sw__fr_visible *vis);
+void sw__fr_visible_empty(sw__fr_visible *vis); /* counts zeroed, arrays kept */
 /* Kumar §4.4's back-patch test of one face occurrence with its eye-relative box. */
 int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6]);
 
@@ -204,10 +206,11 @@ typedef struct sw__fr_hierarchy {
 /* Kumar §4 and Guthe §7: per visible unit instance the coarsest static level within the view's
  * tolerance (else its faces go to the per-frame path), per per-frame face occurrence its
  * hierarchy cut (converged: after the builds and refinements it needs, waited for; walkthrough:
- * requested). */
+ * requested). sel: zeroed, or a spent frame's (its arrays reused). */
 sw_result sw__fr_select(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw__fr_visible *vis,
                         sw__fr_selection *sel, sw_gpu_frame_stats *st, sw_status *status);
 void sw__fr_selection_free(sw__fr_selection *sel);
+void sw__fr_selection_empty(sw__fr_selection *sel); /* counts zeroed, arrays kept */
 /* LOD colouring: static level k (fine -> coarse), or -1 for the per-frame path. */
 void sw__fr_lod_color(int32_t level, float out[4]);
 /* The object-space tolerance of a unit under transform m at the view (frame-static's rule:
@@ -266,6 +269,12 @@ typedef struct sw__fr_geometry {
     uint64_t border_triangles; /* fat-border triangles (in stats.triangles already) */
 } sw__fr_geometry;
 void sw__fr_geometry_free(sw__fr_geometry *g);
+/* Zeroes every count, keeping the arrays (the per-face trim loops owned are freed). */
+void sw__fr_geometry_empty(sw__fr_geometry *g);
+/* A chunk's geometry from the context's stash (frame_stash.c; dst zeroed when none), and back:
+ * emptied into the stash, or freed when it is full; g is zeroed. */
+void sw__fr_chunk_geometry_take(sw_gpu_context *ctx, sw__fr_geometry *dst);
+void sw__fr_chunk_geometry_give(sw_gpu_context *ctx, sw__fr_geometry *g);
 
 /* The tessellation stage's working state. */
 typedef struct sw__fr_tess {
@@ -281,7 +290,7 @@ typedef struct sw__fr_tess {
 
 /* Everything selected, in order: static levels, per-frame faces, meshes. The per-frame faces
  * in chunks shared with env->pool's workers when there are enough of them
- * (stage_tessellate_parallel.c). */
+ * (stage_tessellate_parallel.c). geo: zeroed, or emptied (sw__fr_geometry_empty). */
 sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
                             const sw__fr_selection *sel, sw__fr_geometry *geo,
                             sw_gpu_frame_stats *st, sw_status *status);

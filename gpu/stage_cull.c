@@ -187,10 +187,16 @@ static void cull_meshes(const sw__fr_env *env, sw__fr_visible *vis, sw_gpu_frame
     vis->n_meshes = k;
 }
 
+void sw__fr_visible_empty(sw__fr_visible *vis)
+{
+    vis->faces.n = vis->unit_faces.n = 0;
+    vis->n_instances = vis->n_meshes = 0;
+}
+
 sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *desc,
                                 sw__fr_visible *vis, double scene_box[6], sw_status *status)
 {
-    memset(vis, 0, sizeof *vis);
+    sw__fr_visible_empty(vis);
     const sw_sg_bvh *bvh = face_bvh(desc);
     const sw_lod_static_instances *units = static_instances(env);
     sw_result r = SW_OK;

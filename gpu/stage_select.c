@@ -208,10 +208,15 @@ static sw_result pick_face(const sw__fr_env *env, sw__fr_hierarchy *hy, const oc
     return r;
 }
 
+void sw__fr_selection_empty(sw__fr_selection *sel)
+{
+    sel->n_statics = sel->n_faces = sel->n_items = 0;
+}
+
 sw_result sw__fr_select(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw__fr_visible *vis,
                         sw__fr_selection *sel, sw_gpu_frame_stats *st, sw_status *status)
 {
-    memset(sel, 0, sizeof *sel);
+    sw__fr_selection_empty(sel);
     sw__fr_faces perframe, shown;
     memset(&perframe, 0, sizeof perframe);
     memset(&shown, 0, sizeof shown);

@@ -37,6 +37,47 @@ void sw__fr_geometry_free(sw__fr_geometry *g)
     memset(g, 0, sizeof *g);
 }
 
+void sw__fr_geometry_empty(sw__fr_geometry *g)
+{
+    for (size_t i = 0; i < g->n_loops; ++i) {
+        for (uint32_t k = 0; k < g->loops[i].n; ++k)
+            sw_sg_polyline_free(&g->loops[i].loops[k]);
+        sw__free(g->loops[i].loops);
+    }
+    g->mesh.n_v = g->mesh.n_idx = 0;
+    g->mesh.border_capped = 0;
+    g->n_draws = g->n_trims = g->n_shares = g->n_loops = 0;
+    g->n_recs = g->n_cps = g->n_pieces = g->n_knots = g->n_dcps = 0;
+    g->gpu_vertices = 0.0;
+    g->border_triangles = 0;
+}
+
+void sw__fr_chunk_geometry_take(sw_gpu_context *ctx, sw__fr_geometry *dst)
+{
+    sw__fr_geometry *held = sw__gpu_stash_take(ctx, SW__GPU_STASH_CHUNK);
+    if (!held) {
+        memset(dst, 0, sizeof *dst);
+        return;
+    }
+    *dst = *held;
+    sw__free(held);
+}
+
+void sw__fr_chunk_geometry_give(sw_gpu_context *ctx, sw__fr_geometry *g)
+{
+    sw__fr_geometry *held = ctx ? sw__malloc(sizeof *held) : NULL;
+    if (held) {
+        sw__fr_geometry_empty(g);
+        *held = *g;
+        if (sw__gpu_stash_put(ctx, SW__GPU_STASH_CHUNK, held)) {
+            memset(g, 0, sizeof *g);
+            return;
+        }
+        sw__free(held);
+    }
+    sw__fr_geometry_free(g);
+}
+
 int sw__fr_face_trimmed(const sw__fr_env *env, uint32_t face)
 {
     const sw_sg_face_rec *rec = &env->sv->faces[face];
@@ -344,7 +385,6 @@ sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
                             const sw__fr_selection *sel, sw__fr_geometry *geo,
                             sw_gpu_frame_stats *st, sw_status *status)
 {
-    memset(geo, 0, sizeof *geo);
     sw__fr_tess t;
     memset(&t, 0, sizeof t);
     t.env = env;

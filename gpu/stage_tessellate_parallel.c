@@ -223,6 +223,7 @@ static tess_job *job_create(sw__fr_tess *t, const sw__fr_selection *sel, size_t 
     for (size_t c = 0; c < n_chunks; ++c) {
         chunks[c].first = first + n * c / n_chunks;
         chunks[c].end = first + n * (c + 1) / n_chunks;
+        sw__fr_chunk_geometry_take(t->env->ctx, &chunks[c].geo);
     }
     atomic_init(&job->refs, 1);
     atomic_init(&job->next, 0);
@@ -275,7 +276,7 @@ static sw_result merge_chunks(sw__fr_tess *t, tess_job *job, sw_status *status)
             add_stats(t->st, &ch->st);
             t->st->tess_chunks_by_pool += (uint64_t)ch->by_pool;
         }
-        sw__fr_geometry_free(&ch->geo);
+        sw__fr_chunk_geometry_give(t->env->ctx, &ch->geo);
     }
     t->st->tess_chunks += job->n_chunks;
     return r == SW_OK ? sw__fr_check_budget(t, status) : r;

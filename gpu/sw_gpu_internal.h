@@ -131,6 +131,8 @@ struct sw_gpu_context {
     struct sw_th_token *walk_token;  /* walkthrough frames' hierarchy requests; bumped every frame,
                                 so the requests of frames gone by are cancelled (a pointer: C++
                                 tests include this header, and the token is a C11 atomic) */
+    struct sw__gpu_stash *stash;     /* frame buffers kept between frames (frame_stash.c; atomics:
+                                        a pointer here, as for walk_token) */
     char description[256];
     GLint max_texture_size;
     sw__gpu_surface_programs surf; /* the surface programs frames draw with */
@@ -248,6 +250,15 @@ typedef struct sw__gpu_mesh {
     uint64_t border_capped; /* fat borders sampled coarser than their cells: the sample budget
                                of sw__gpu_fat_border was hit (counted, never reset here) */
 } sw__gpu_mesh;
+
+/* The context's stash of frame buffers (frame_stash.c): spent plans and chunk geometries, emptied
+ * with their arrays kept. take: an item of the role or NULL; put: 1 when stashed, 0 when the
+ * stash is full (the item stays the caller's). Any thread; ctx NULL: nothing kept. */
+typedef enum sw__gpu_stash_role { SW__GPU_STASH_PLAN, SW__GPU_STASH_CHUNK } sw__gpu_stash_role;
+struct sw__gpu_stash *sw__gpu_stash_new(void);    /* NULL when out of memory */
+void sw__gpu_stash_free(struct sw__gpu_stash *s); /* NULL allowed; frees what it holds */
+void *sw__gpu_stash_take(sw_gpu_context *ctx, sw__gpu_stash_role role);
+int sw__gpu_stash_put(sw_gpu_context *ctx, sw__gpu_stash_role role, void *item);
 
 /* Grows *p (capacity *cap elements of elem bytes) to hold `need`, doubling; 0 when out of memory
  * (*p and *cap unchanged). */

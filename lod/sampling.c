@@ -271,9 +271,10 @@ static double bp_min(const bpoly *p)
 
 /* The Bernstein-product bounds (see the top of the file), one set per mask (at most 3:
  * bounds_masked calls it with no more); 0 when out of memory or too high a degree (the caller keeps
- * the other bound then). */
+ * the other bound then). second = 0: the first derivatives only (the second-derivative products,
+ * of degree (3p, 3q), are most of the cost), d2 left infinite. */
 static int product_bounds(int32_t p, int32_t q, const double *cpw, const double c[3],
-                          const unsigned *masks, int n_masks, sw_lod_patch_bounds *out)
+                          const unsigned *masks, int n_masks, int second, sw_lod_patch_bounds *out)
 {
     if (p > PRODUCT_MAX_DEGREE || q > PRODUCT_MAX_DEGREE)
         return 0;
@@ -303,6 +304,19 @@ static int product_bounds(int32_t p, int32_t q, const double *cpw, const double 
     bpoly nt = bp_cross_diff(&a, &ht, &w, 1.0, &h, &wt);
     bpoly w2 = bp_new(&a, 2 * p, 2 * q, 1);
     bp_mul_add(&w, &w, 1.0, &w2);
+    if (!second) {
+        double m2 = bp_min(&w2), n_s[3], n_t[3];
+        bp_max_norms(&ns, masks, n_masks, n_s);
+        bp_max_norms(&nt, masks, n_masks, n_t);
+        for (int k = 0; k < n_masks; ++k) {
+            out[k].d1[0] = n_s[k] / m2;
+            out[k].d1[1] = n_t[k] / m2;
+            out[k].d2[0] = out[k].d2[1] = out[k].d2[2] = INFINITY;
+        }
+        if (a.mem != stack_mem)
+            sw__free(a.mem);
+        return 1;
+    }
     bpoly w3 = bp_new(&a, 3 * p, 3 * q, 1);
     bp_mul_add(&w2, &w, 1.0, &w3);
     bpoly nss = bp_deriv(&a, &ns, 0), nts = bp_deriv(&a, &nt, 0), ntt = bp_deriv(&a, &nt, 1);
@@ -359,15 +373,23 @@ static void difference_bounds(int32_t deg_u, int32_t deg_v, const double *cpw, u
     out->d2[2] = (a_tt + 2.0 * b_t * g_t + b_tt * r) / wmin;
 }
 
-/* Both bounds, the smaller kept, for each mask (at most 3). */
-static void bounds_masked(int32_t deg_u, int32_t deg_v, const double *cpw, const unsigned *masks,
-                          int n_masks, sw_lod_patch_bounds *out)
+/* The difference bounds for each mask; c: the centre the product bounds take. */
+static void difference_bounds_masked(int32_t deg_u, int32_t deg_v, const double *cpw,
+                                     const unsigned *masks, int n_masks, double c[3],
+                                     sw_lod_patch_bounds *out)
 {
-    double c[3];
     for (int k = 0; k < n_masks; ++k)
         difference_bounds(deg_u, deg_v, cpw, masks[k], c, &out[k]);
+}
+
+/* out (difference bounds) tightened by the product bounds, for each mask (at most 3); second:
+ * as product_bounds. */
+static void tighten_by_products(int32_t deg_u, int32_t deg_v, const double *cpw, const double c[3],
+                                const unsigned *masks, int n_masks, int second,
+                                sw_lod_patch_bounds *out)
+{
     sw_lod_patch_bounds pb[3];
-    if (n_masks <= 3 && product_bounds(deg_u, deg_v, cpw, c, masks, n_masks, pb)) {
+    if (n_masks <= 3 && product_bounds(deg_u, deg_v, cpw, c, masks, n_masks, second, pb)) {
         for (int m = 0; m < n_masks; ++m) {
             for (int k = 0; k < 2; ++k)
                 out[m].d1[k] = fmin(out[m].d1[k], pb[m].d1[k]);
@@ -375,6 +397,15 @@ static void bounds_masked(int32_t deg_u, int32_t deg_v, const double *cpw, const
                 out[m].d2[k] = fmin(out[m].d2[k], pb[m].d2[k]);
         }
     }
+}
+
+/* Both bounds, the smaller kept, for each mask (at most 3). */
+static void bounds_masked(int32_t deg_u, int32_t deg_v, const double *cpw, const unsigned *masks,
+                          int n_masks, sw_lod_patch_bounds *out)
+{
+    double c[3];
+    difference_bounds_masked(deg_u, deg_v, cpw, masks, n_masks, c, out);
+    tighten_by_products(deg_u, deg_v, cpw, c, masks, n_masks, 1, out);
 }
 
 void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *cpw,
@@ -553,21 +584,26 @@ static int affine_segments(int32_t p, int32_t q, const double *net, const double
     return 1;
 }
 
-/* all (not NULL): also the bounds of the whole image (every component), from the same products:
- * they depend on the mask only through the final norms. */
-static void sub_measure(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
-                        double ku, double kv, sub_info *o, sw_lod_patch_bounds *all)
+/* The lateral (mask 3), depth (mask 4) and whole (mask 7) images' bounds. */
+static const unsigned k_view_masks[3] = {3u, 4u, 7u};
+
+/* The measure's second-derivative bounds from those of the lateral and depth images (b[0],
+ * b[1]) of a sub-patch 1/ku x 1/kv of the range. */
+static void sub_bounds(const sw_lod_patch_bounds b[2], double ku, double kv, sub_info *o)
 {
-    static const unsigned masks[3] = {3u, 4u, 7u};
-    sw_lod_patch_bounds b[3];
-    bounds_masked(p, q, net, masks, all ? 3 : 2, b);
-    if (all)
-        *all = b[2];
     double scale[3] = {ku * ku, ku * kv, kv * kv};
     for (int k = 0; k < 3; ++k) {
         o->ml[k] = b[0].d2[k] * scale[k];
         o->mf[k] = b[1].d2[k] * scale[k];
     }
+}
+
+static void sub_measure(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
+                        double ku, double kv, sub_info *o)
+{
+    sw_lod_patch_bounds b[2];
+    bounds_masked(p, q, net, k_view_masks, 2, b);
+    sub_bounds(b, ku, kv, o);
     depth_and_tangent(p, q, net, v, &o->zmin, &o->pmax);
 }
 
@@ -645,6 +681,35 @@ static int choose_segments(const sub_info *whole, const sub_info *subs, int32_t 
     return best < INFINITY;
 }
 
+static int g_coarsest_fast = 1;
+
+void sw_lod_screen_coarsest_fast(int on)
+{
+    g_coarsest_fast = on != 0;
+}
+
+/* The whole range's measure and its image's bounds (all). The difference bounds come first: when
+ * they already pass the coarsest allowed grid, nothing the product bounds tighten can choose
+ * fewer cells, and only their first derivatives (all's d1) are taken — the second-derivative
+ * products are most of the cost of a far patch's density. Returns 1 then. */
+static int whole_measure(int32_t p, int32_t q, const double *net, const sw_lod_screen_view *v,
+                         int32_t coarsest, sub_info *o, sw_lod_patch_bounds *all)
+{
+    sw_lod_patch_bounds b[3];
+    double c[3];
+    difference_bounds_masked(p, q, net, k_view_masks, 3, c, b);
+    sub_bounds(b, 1.0, 1.0, o);
+    depth_and_tangent(p, q, net, v, &o->zmin, &o->pmax);
+    const int coarsest_passes = g_coarsest_fast && grid_passes(o, 1, coarsest, coarsest, v);
+    if (coarsest_passes)
+        tighten_by_products(p, q, net, c, k_view_masks + 2, 1, 0, b + 2);
+    else
+        tighten_by_products(p, q, net, c, k_view_masks, 3, 1, b);
+    sub_bounds(b, 1.0, 1.0, o);
+    *all = b[2];
+    return coarsest_passes;
+}
+
 int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, const double range[4],
                            const sw_lod_screen_view *v, const int32_t *allowed, int32_t n_allowed,
                            int32_t max_sub, sw_lod_screen_density *out)
@@ -674,17 +739,17 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
     }
     sub_info whole, subs[SUB_MAX * SUB_MAX];
     sw_lod_patch_bounds rb;
-    sub_measure(deg_u, deg_v, part, v, 1.0, 1.0, &whole, &rb);
+    const int coarsest = whole_measure(deg_u, deg_v, part, v, allowed[0], &whole, &rb);
     out->d1[0] = rb.d1[0] / (range[1] - range[0]);
     out->d1[1] = rb.d1[1] / (range[3] - range[2]);
     /* pmax bounds |tan| of every view direction into the part: the one tangent of the rule */
     out->eps_obj = sw_lod_object_tolerance(v->eps_px, whole.zmin, v->focal_px, whole.pmax, 0.0);
-    int32_t guess[2];
-    int found = choose_segments(&whole, NULL, 1, v, allowed, n_allowed, guess);
+    int32_t guess[2] = {allowed[0], allowed[0]};
+    int found = coarsest || choose_segments(&whole, NULL, 1, v, allowed, n_allowed, guess);
     /* Sub-patch bounds pay for themselves only on grids of many cells: a bound costs ~10 us,
      * about what drawing 50 triangles costs on llvmpipe. */
     double cells = found ? (double)guess[0] * guess[1] : INFINITY;
-    int32_t k = cells <= 32.0 ? 1 : cells <= 1024.0 ? 2 : SUB_MAX;
+    int32_t k = coarsest || cells <= 32.0 ? 1 : cells <= 1024.0 ? 2 : SUB_MAX;
     k = k < max_sub ? k : (max_sub > 1 ? max_sub : 1);
     if (k > 1) {
         for (int32_t b = 0; b < k; ++b)
@@ -692,7 +757,7 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
                 double r[4] = {(double)a / k, (double)(a + 1) / k, (double)b / k,
                                (double)(b + 1) / k};
                 patch_part(deg_u, deg_v, part, r, sub);
-                sub_measure(deg_u, deg_v, sub, v, k, k, &subs[b * k + a], NULL);
+                sub_measure(deg_u, deg_v, sub, v, k, k, &subs[b * k + a]);
             }
         found = choose_segments(&whole, subs, k, v, allowed, n_allowed, guess);
     }

@@ -85,6 +85,10 @@ int sw_lod_screen_segments(int32_t deg_u, int32_t deg_v, const double *cpw, cons
  * grid without the bound's sub-patch analysis: on (default) or off, for the A/B of benchmarks
  * and the test that compares both. Not thread-safe: set it before frames run. */
 void sw_lod_screen_affine_fast(int on);
+/* A range whose difference bounds already pass the coarsest allowed grid skips the
+ * second-derivative Bernstein products (sampling.c, whole_measure): the same result, cheaper. On
+ * (default) or off, for the test that compares both. Not thread-safe: set it before frames run. */
+void sw_lod_screen_coarsest_fast(int on);
 
 #ifdef __cplusplus
 }

@@ -40,8 +40,13 @@ typedef struct span_basis {
     double s[SW__ND][SW__P1];     /* s[k-1][i] = (p-k+1) / (t_{span+i+1} - t_{span-p+i+k}) */
 } span_basis;
 
-static void span_basis_init(span_basis *b, const double *knots, int32_t p, int32_t n, double t,
-                            int32_t nd)
+/* Inlined into every caller, with the degree a constant where surface_eval_h dispatches on it:
+ * the loops below run over the degree, and unrolled a plane's, cylinder's or bicubic's evaluation
+ * took 0.6-0.85 of the generic time (the same operations in the same order: the same bits). */
+#define SW__INLINE static inline __attribute__((always_inline))
+
+SW__INLINE void span_basis_init(span_basis *b, const double *knots, int32_t p, int32_t n, double t,
+                                int32_t nd)
 {
     assert(p >= 0 && p <= SW_SG_MAX_DEGREE && nd >= 0 && nd <= SW__ND);
     const int32_t span = sw_sg_knots_find_span(knots, p, n, t);
@@ -75,8 +80,8 @@ static void span_basis_init(span_basis *b, const double *knots, int32_t p, int32
 
 /* The control points of derivative k (count - 1 points) from those of derivative k - 1 (count
  * points), `dim` doubles each: the step of A3.3. */
-static void diff_points(const double *in, int32_t count, int32_t dim, const double *scale,
-                        double *out)
+SW__INLINE void diff_points(const double *in, int32_t count, int32_t dim, const double *scale,
+                            double *out)
 {
     for (int32_t i = 0; i + 1 < count; i++)
         for (int32_t d = 0; d < dim; d++)
@@ -84,8 +89,8 @@ static void diff_points(const double *in, int32_t count, int32_t dim, const doub
 }
 
 /* out[d] = sum_r basis[r] * pts[r * dim + d], r < count. */
-static void contract(const double *basis, const double *pts, int32_t count, int32_t dim,
-                     double *out)
+SW__INLINE void contract(const double *basis, const double *pts, int32_t count, int32_t dim,
+                         double *out)
 {
     for (int32_t d = 0; d < dim; d++)
         out[d] = 0.0;
@@ -143,7 +148,7 @@ typedef struct surface_acc {
 
 /* One row (local v index j) of the net differenced l times in v: adds its contribution to every
  * a[k][l] with k + l <= nd. */
-static void surface_add_row(surface_acc *acc, int32_t l, int32_t j, const double *row)
+SW__INLINE void surface_add_row(surface_acc *acc, int32_t l, int32_t j, const double *row)
 {
     const span_basis *bu = acc->bu;
     const int32_t p = bu->p;
@@ -165,13 +170,13 @@ static void surface_add_row(surface_acc *acc, int32_t l, int32_t j, const double
     }
 }
 
-static void surface_eval_h(const sw_sg_surface *s, double u, double v, int32_t nd,
-                           double a[SW__ND + 1][SW__ND + 1][4])
+/* The partials of a surface of degrees (p, q); p and q are constants in the instances below. */
+SW__INLINE void surface_eval_pq(const sw_sg_surface *s, double u, double v, int32_t nd, int32_t p_,
+                                int32_t q_, double a[SW__ND + 1][SW__ND + 1][4])
 {
-    assert(s && nd >= 0 && nd <= SW__ND);
     span_basis bu, bv;
-    span_basis_init(&bu, s->knots_u, s->deg_u, s->n_u, u, nd);
-    span_basis_init(&bv, s->knots_v, s->deg_v, s->n_v, v, nd);
+    span_basis_init(&bu, s->knots_u, p_, s->n_u, u, nd);
+    span_basis_init(&bv, s->knots_v, q_, s->n_v, v, nd);
     const int32_t p = bu.p, q = bv.p;
     surface_acc acc = {.bu = &bu, .bv = &bv, .nd = nd};
     double e1[2][SW__P1 * 4], e2[SW__P1 * 4];
@@ -196,6 +201,35 @@ static void surface_eval_h(const sw_sg_surface *s, double u, double v, int32_t n
         }
     }
     memcpy(a, acc.a, sizeof(acc.a));
+}
+
+/* Every other pair of degrees. */
+static void surface_eval_generic(const sw_sg_surface *s, double u, double v, int32_t nd,
+                                 double a[SW__ND + 1][SW__ND + 1][4])
+{
+    surface_eval_pq(s, u, v, nd, s->deg_u, s->deg_v, a);
+}
+
+/* Planes (1, 1), cylinders and cones (2, 1) or (1, 2), spheres and tori (2, 2) and bicubic
+ * B-splines (3, 3) take instances with constant degrees, which the compiler unrolls; the same
+ * operations in the same order as the generic instance, so the results are the same bits. */
+SW__INLINE void surface_eval_h(const sw_sg_surface *s, double u, double v, int32_t nd,
+                               double a[SW__ND + 1][SW__ND + 1][4])
+{
+    assert(s && nd >= 0 && nd <= SW__ND);
+    const int32_t p = s->deg_u, q = s->deg_v;
+    if (p == 1 && q == 1)
+        surface_eval_pq(s, u, v, nd, 1, 1, a);
+    else if (p == 2 && q == 1)
+        surface_eval_pq(s, u, v, nd, 2, 1, a);
+    else if (p == 1 && q == 2)
+        surface_eval_pq(s, u, v, nd, 1, 2, a);
+    else if (p == 2 && q == 2)
+        surface_eval_pq(s, u, v, nd, 2, 2, a);
+    else if (p == 3 && q == 3)
+        surface_eval_pq(s, u, v, nd, 3, 3, a);
+    else
+        surface_eval_generic(s, u, v, nd, a);
 }
 
 void sw_sg_surface_eval(const sw_sg_surface *s, double u, double v, double p[3])

@@ -88,7 +88,7 @@ static int pass(bench *b, series *s)
         }
         for (int k = 0; k < N_CLOCKS; ++k)
             t1[k] = clock_ms(k_clocks[k]);
-        sw_gpu_frame_plan_free(plan);
+        sw_gpu_frame_plan_recycle(b->ctx, plan); /* as the renderer's visibility thread does */
         if (!s)
             continue;
         for (int k = 0; k < N_CLOCKS; ++k)

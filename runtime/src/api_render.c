@@ -758,7 +758,7 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
         occlusion_feedback(r, &j->job.desc, &gstats);
     /* freed by V with the next prepare; a spent plan older than that (no prepare in between) is
      * freed here */
-    sw_gpu_frame_plan_free(r->spent);
+    sw_gpu_frame_plan_recycle(r->gpu, r->spent);
     r->spent = j->job.plan;
     j->job.plan = NULL;
     if (res == SW_OK)

@@ -31,7 +31,7 @@ struct sw_rt_pipeline {
 
 static void prepare_job(sw_rt_pipeline *p, sw_rt_frame_job *job)
 {
-    sw_gpu_frame_plan_free(job->spent);
+    sw_gpu_frame_plan_recycle(p->gpu, job->spent);
     job->spent = NULL;
     const uint64_t w0 = sw_th_thread_waits().waits; /* V's blocking on the pool: the frame's */
     job->result = sw_gpu_frame_prepare(p->gpu, job->sg, &job->desc, &job->plan, &job->status);

@@ -451,11 +451,16 @@ static void check_parallel(sw_gpu_context *ctx, const sw_sg_scene *scene,
     stages_free(&par);
 }
 
+/* The stages chained by hand against sw_gpu_render_scene on the same context. From a model's
+ * second view on, the reference frame starts from the plan of the frame before, recycled into
+ * the context with its arrays (frame_stash.c): an item or count kept from that frame shows here
+ * as pixels or triangles that the fresh stages do not have. */
 static void check_chain(sw_gpu_context *ctx, const sw_sg_scene *scene,
                         const sw_gpu_frame_desc *desc, stages *s, const char *name)
 {
     sw_status st = {0};
     sw_gpu_image by_hand = {0}, whole = {0};
+    sw_gpu_frame_stats whole_st = {0};
     sw_result r = sw__fr_trim_atlas(ctx, scene, &s->geo, &s->st, &st);
     if (r == SW_OK)
         check_atlas(ctx, s, name);
@@ -464,13 +469,23 @@ static void check_chain(sw_gpu_context *ctx, const sw_sg_scene *scene,
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &s->env.view, 0, &by_hand, &st);
     if (r == SW_OK)
-        r = sw_gpu_render_scene(ctx, scene, desc, &whole, NULL, &st);
+        r = sw_gpu_render_scene(ctx, scene, desc, &whole, &whole_st, &st);
     CHECK(r == SW_OK, "%s: atlas, submit or reference frame: %s", name, st.message);
     if (r == SW_OK) {
         const sw_test_image_diff d = sw_test_compare_images(&by_hand, &whole, 0);
         CHECK(d.any == 0 && d.covered > 0,
               "%s: the stages by hand differ from sw_gpu_render_scene in %ld pixels (%ld covered)",
               name, d.any, d.covered);
+        /* submit adds the mesh's own triangles to the stages' count (frame.c) */
+        const uint64_t triangles =
+            s->st.triangles + s->geo.mesh.n_idx / 3 - s->geo.border_triangles;
+        CHECK(whole_st.triangles == triangles &&
+                  whole_st.border_triangles == s->geo.border_triangles,
+              "%s: sw_gpu_render_scene counts %llu triangles (%llu of borders), the stages %llu "
+              "(%llu)",
+              name, (unsigned long long)whole_st.triangles,
+              (unsigned long long)whole_st.border_triangles, (unsigned long long)triangles,
+              (unsigned long long)s->geo.border_triangles);
     }
     sw_gpu_image_free(&by_hand);
     sw_gpu_image_free(&whole);

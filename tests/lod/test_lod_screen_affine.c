@@ -14,6 +14,11 @@
  *    the near plane, inside the frustum: the bound's P is capped by the frustum's corner).
  * Catches a fast-path test that is too lax (planted: 2 delta (1 + P) f <= 10 eps z: 8 of 400
  * near-affine patches over 0.5 px, up to 0.97 px) and a fast path taken for unequal weights.
+ * Also the coarsest-grid fast path (whole_measure: difference bounds first, the second-derivative
+ * products skipped when they already pass the coarsest grid): curved rational patches of degrees
+ * 1-7 and pieces of cylinders from near to far, with it on and off, must give the same grid,
+ * eps_obj and d1 bit for bit (catches the path skipping the first-derivative products: planted: 159
+ * of 400 differ in d1), and the coarsest grids chosen must be within eps_px measured as above.
  * Usage: test_lod_screen_affine [N] (N patches of each kind, default 400). */
 #include "sw_lod_sampling.h"
 #include "sw_sg_geom.h"
@@ -162,6 +167,91 @@ static double grid_error_px(const sw_sg_bezier_patch *bp, const double r[4], int
 static const int32_t k_allowed[] = {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256};
 enum { N_ALLOWED = sizeof k_allowed / sizeof k_allowed[0] };
 
+static int same_density(const sw_lod_screen_density *a, const sw_lod_screen_density *b)
+{
+    return a->nu == b->nu && a->nv == b->nv && a->eps_obj == b->eps_obj && a->d1[0] == b->d1[0] &&
+           a->d1[1] == b->d1[1];
+}
+
+/* A piece of a cylinder of radius ~0.5 as CAD files store it (rational quadratic arc x line,
+ * weights 1, cos(a/2), 1), randomly turned, around the origin moved by -eye: its first-derivative
+ * product bounds are tighter than the difference bounds, which random nets rarely show. */
+static void random_cylinder(const double eye[3], int32_t *p, int32_t *q, double *cpw)
+{
+    const double a = 0.3 + 1.8 * rnd(), r = 0.2 + 0.6 * rnd(), h = 0.2 + rnd(), w = cos(0.5 * a);
+    const double arc[3][3] = {{r, 0, 0}, {r, r * tan(0.5 * a), 0}, {r * cos(a), r * sin(a), 0}};
+    double x[3] = {rnd() - 0.5, rnd() - 0.5, rnd() - 0.5}, y[3], z[3], t[3] = {0, 0, 1};
+    normalize(x);
+    cross(x, t, y);
+    normalize(y);
+    cross(x, y, z);
+    *p = 2;
+    *q = 1;
+    for (int32_t j = 0; j <= 1; ++j)
+        for (int32_t i = 0; i <= 2; ++i) {
+            double *c = cpw + 4 * ((size_t)j * 3 + i), wi = i == 1 ? w : 1.0;
+            for (int e = 0; e < 3; ++e)
+                c[e] =
+                    (arc[i][0] * x[e] + arc[i][1] * y[e] + (j * h - 0.5 * h) * z[e] - eye[e]) * wi;
+            c[3] = wi;
+        }
+}
+
+/* The coarsest-grid fast path against the full analysis; returns the failures. */
+static int check_coarsest_fast(int n)
+{
+    int failures = 0, coarsest = 0;
+    double worst = 0.0;
+    for (int it = 0; it < n; ++it) {
+        int32_t p = 1 + (int32_t)(rnd() * 7), q = 1 + (int32_t)(rnd() * 7);
+        sw_lod_screen_view v;
+        double eye[3], cpw[8 * 8 * 4];
+        /* distances of 1.5 to ~6000 patch sizes: fine grids near, the coarsest far */
+        random_view(1.5 * pow(4000.0, rnd()), &v, eye);
+        if (it % 2)
+            random_cylinder(eye, &p, &q, cpw);
+        else
+            random_patch(CURVED, p, q, 0.0, eye, cpw);
+        double r0 = 0.5 * rnd(), r2 = 0.5 * rnd();
+        const double range[4] = {r0, r0 + (1.0 - r0) * (0.2 + 0.8 * rnd()), r2,
+                                 r2 + (1.0 - r2) * (0.2 + 0.8 * rnd())};
+        sw_lod_screen_density fast, full;
+        sw_lod_screen_coarsest_fast(1);
+        int ok_fast = sw_lod_screen_segments(p, q, cpw, range, &v, k_allowed, N_ALLOWED, 4, &fast);
+        sw_lod_screen_coarsest_fast(0);
+        int ok_full = sw_lod_screen_segments(p, q, cpw, range, &v, k_allowed, N_ALLOWED, 4, &full);
+        sw_lod_screen_coarsest_fast(1);
+        if (ok_fast != ok_full || !same_density(&fast, &full)) {
+            fprintf(stderr,
+                    "coarsest %d (%dx%d): fast %d x %d eps %.17g d1 %.17g %.17g, full %d x %d "
+                    "eps %.17g d1 %.17g %.17g\n",
+                    it, p, q, fast.nu, fast.nv, fast.eps_obj, fast.d1[0], fast.d1[1], full.nu,
+                    full.nv, full.eps_obj, full.d1[0], full.d1[1]);
+            failures++;
+        }
+        if (ok_fast && fast.nu == k_allowed[0] && fast.nv == k_allowed[0]) {
+            coarsest++;
+            sw_sg_bezier_patch bp = {p, q, 0, 0, 0, 1, 0, 1, cpw};
+            const double err = grid_error_px(&bp, range, fast.nu, fast.nv, &v);
+            worst = fmax(worst, err);
+            if (err > v.eps_px + 1e-9) {
+                fprintf(stderr, "coarsest %d (%dx%d): error %.4f px > %.2f\n", it, p, q, err,
+                        v.eps_px);
+                failures++;
+            }
+        }
+    }
+    printf("coarsest-grid fast path: %d of %d curved patches on the coarsest grid (worst %.4f "
+           "px), the same densities with it off\n",
+           coarsest, n, worst);
+    /* a quarter at least, or the comparison says little about the fast path */
+    if (coarsest < n / 4) {
+        fprintf(stderr, "only %d of %d patches took the coarsest grid\n", coarsest, n);
+        failures++;
+    }
+    return failures;
+}
+
 int main(int argc, char **argv)
 {
     const int n = argc > 1 ? atoi(argv[1]) : 400;
@@ -236,6 +326,7 @@ int main(int argc, char **argv)
     printf("%d planes on the fast path; near-planes: worst %.4f px, %d drawn coarser than the "
            "full bound would; curved: worst %.4f px (limit 0.5)\n",
            fast_taken, worst_near, near_fast, worst_curved);
+    failures += check_coarsest_fast(n);
     if (failures)
         fprintf(stderr, "%d failure(s)\n", failures);
     return failures != 0;
