@@ -92,11 +92,13 @@ static void centred(const double *cpw, int32_t nu, int32_t i, int32_t j, const d
     out[3] = p[3];
 }
 
-/* max over the net of the norm of a difference given by stencil offsets and coefficients. */
-static diff_max net_diff(const double *cpw, int32_t nu, int32_t nv, const double c[3], int di,
-                         int dj, int order_s, int order_t, unsigned mask)
+/* max over the net of the norm of a difference given by stencil offsets and coefficients, for
+ * each mask (the differences are the masks' common work: one pass). */
+static void net_diff(const double *cpw, int32_t nu, int32_t nv, const double c[3], int di, int dj,
+                     int order_s, int order_t, const unsigned *masks, int n_masks, diff_max *m)
 {
-    diff_max m = {0.0, 0.0};
+    for (int k = 0; k < n_masks; ++k)
+        m[k] = (diff_max){0.0, 0.0};
     for (int32_t j = 0; j + dj < nv; ++j) {
         for (int32_t i = 0; i + di < nu; ++i) {
             double a[4], b[4], e[4], d[4];
@@ -121,14 +123,15 @@ static diff_max net_diff(const double *cpw, int32_t nu, int32_t nv, const double
                 for (int k = 0; k < 4; ++k)
                     d[k] = b[k] - a[k];
             }
-            diff_update(&m, d, mask);
+            for (int k = 0; k < n_masks; ++k)
+                diff_update(&m[k], d, masks[k]);
         }
     }
-    return m;
 }
 
-static void net_centre_radius_wmin(const double *cpw, int32_t count, unsigned mask, double c[3],
-                                   double *radius, double *wmin)
+/* The net's box centre c, its radius about c per mask and its smallest weight. */
+static void net_centre_radius_wmin(const double *cpw, int32_t count, const unsigned *masks,
+                                   int n_masks, double c[3], double *radius, double *wmin)
 {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     *wmin = INFINITY;
@@ -143,11 +146,13 @@ static void net_centre_radius_wmin(const double *cpw, int32_t count, unsigned ma
     }
     for (int a = 0; a < 3; ++a)
         c[a] = 0.5 * (lo[a] + hi[a]);
-    *radius = 0.0;
+    for (int m = 0; m < n_masks; ++m)
+        radius[m] = 0.0;
     for (int32_t k = 0; k < count; ++k) {
         const double *p = cpw + (size_t)k * 4;
         double d[3] = {p[0] / p[3] - c[0], p[1] / p[3] - c[1], p[2] / p[3] - c[2]};
-        *radius = fmax(*radius, norm_mask(d, mask));
+        for (int m = 0; m < n_masks; ++m)
+            radius[m] = fmax(radius[m], norm_mask(d, masks[m]));
     }
 }
 
@@ -342,23 +347,13 @@ static int product_bounds(int32_t p, int32_t q, const double *cpw, const double 
     return 1;
 }
 
-/* The difference bounds of the linear image selected by `mask` (see the top of the file). */
-static void difference_bounds(int32_t deg_u, int32_t deg_v, const double *cpw, unsigned mask,
-                              double c[3], sw_lod_patch_bounds *out)
+/* The difference bounds of one linear image (see the top of the file) from its net's radius r
+ * about the centre, the smallest weight and the largest differences. */
+static void difference_bounds(int32_t deg_u, int32_t deg_v, double r, double wmin, diff_max ds,
+                              diff_max dt, diff_max dst, diff_max dss, diff_max dtt,
+                              sw_lod_patch_bounds *out)
 {
-    int32_t nu = deg_u + 1, nv = deg_v + 1;
-    double r, wmin;
-    net_centre_radius_wmin(cpw, nu * nv, mask, c, &r, &wmin);
-    double p = deg_u, q = deg_v;
-
-    diff_max ds = net_diff(cpw, nu, nv, c, 1, 0, 1, 0, mask);
-    diff_max dt = net_diff(cpw, nu, nv, c, 0, 1, 0, 1, mask);
-    diff_max dst = net_diff(cpw, nu, nv, c, 1, 1, 1, 1, mask);
-    diff_max dss = {0.0, 0.0}, dtt = {0.0, 0.0};
-    if (deg_u >= 2)
-        dss = net_diff(cpw, nu, nv, c, 2, 0, 2, 0, mask);
-    if (deg_v >= 2)
-        dtt = net_diff(cpw, nu, nv, c, 0, 2, 0, 2, mask);
+    const double p = deg_u, q = deg_v;
 
     double a_s = p * ds.q, b_s = p * ds.w, a_t = q * dt.q, b_t = q * dt.w;
     double g_s = (a_s + b_s * r) / wmin, g_t = (a_t + b_t * r) / wmin;
@@ -378,8 +373,19 @@ static void difference_bounds_masked(int32_t deg_u, int32_t deg_v, const double 
                                      const unsigned *masks, int n_masks, double c[3],
                                      sw_lod_patch_bounds *out)
 {
+    const int32_t nu = deg_u + 1, nv = deg_v + 1;
+    double r[3], wmin;
+    diff_max ds[3], dt[3], dst[3], dss[3] = {{0}}, dtt[3] = {{0}};
+    net_centre_radius_wmin(cpw, nu * nv, masks, n_masks, c, r, &wmin);
+    net_diff(cpw, nu, nv, c, 1, 0, 1, 0, masks, n_masks, ds);
+    net_diff(cpw, nu, nv, c, 0, 1, 0, 1, masks, n_masks, dt);
+    net_diff(cpw, nu, nv, c, 1, 1, 1, 1, masks, n_masks, dst);
+    if (deg_u >= 2)
+        net_diff(cpw, nu, nv, c, 2, 0, 2, 0, masks, n_masks, dss);
+    if (deg_v >= 2)
+        net_diff(cpw, nu, nv, c, 0, 2, 0, 2, masks, n_masks, dtt);
     for (int k = 0; k < n_masks; ++k)
-        difference_bounds(deg_u, deg_v, cpw, masks[k], c, &out[k]);
+        difference_bounds(deg_u, deg_v, r[k], wmin, ds[k], dt[k], dst[k], dss[k], dtt[k], &out[k]);
 }
 
 /* out (difference bounds) tightened by the product bounds, for each mask (at most 3); second:

@@ -228,6 +228,8 @@ SW__INLINE void surface_eval_h(const sw_sg_surface *s, double u, double v, int32
         surface_eval_pq(s, u, v, nd, 2, 2, a);
     else if (p == 3 && q == 3)
         surface_eval_pq(s, u, v, nd, 3, 3, a);
+    else if (p == 2) /* swept and revolved B-splines: 2 x 6..11 in the sample parts */
+        surface_eval_pq(s, u, v, nd, 2, q, a);
     else
         surface_eval_generic(s, u, v, nd, a);
 }
