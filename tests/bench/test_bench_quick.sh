@@ -4,9 +4,11 @@
 # usage errors exit 2, and CSVs with every column, one field per column and finite positive
 # figures where a figure must be positive; GLU's and OCCT's last frames cover the same pixels
 # (within 5 %: both within eps_img of the surfaces), the SVG is closed and holds its four lines.
-# usage: test_bench_quick.sh SPLINEWALK BENCH_PEERS BENCH_SCALING WORKDIR
+# make_assembly (when given): copies that share their part's geometry, which import turns into
+# instances of one prototype each (a copy by value would import as as many surfaces as faces).
+# usage: test_bench_quick.sh SPLINEWALK BENCH_PEERS BENCH_SCALING WORKDIR [MAKE_ASSEMBLY]
 set -u
-sw=$1 peers=$2 scaling=$3 work=$4
+sw=$1 peers=$2 scaling=$3 work=$4 assembly=${5:-}
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
 failures=0
 fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
@@ -82,6 +84,24 @@ grep -q "fly-through" fly.txt || fail "bench_scaling --fly does not say it flies
 check_csv fly.csv 1 surfaces median_ms p99_ms first_frame_ms peak_rss_bytes triangles_per_frame
 [ "$(grep -c '<polyline' scaling.svg)" -eq 4 ] && tail -n 1 scaling.svg | grep -q '</svg>' \
   && pass "scaling.svg: 4 lines, closed" || fail "scaling.svg malformed"
+
+# make_assembly: Pump_Nut (25 faces) and screw.step (10) taken in turn until 300 faces: 9 rounds,
+# 18 copies, 315 faces drawn from 35 prototype surfaces.
+occ=/usr/share/opencascade/data
+if [ -n "$assembly" ] && [ -f $occ/occ/Pump_Nut.brep ] && [ -f $occ/step/screw.step ]; then
+  "$assembly" --help | grep -q -- "--faces" || fail "make_assembly --help does not mention --faces"
+  "$assembly" --faces 0 -o x.brep $occ/occ/Pump_Nut.brep >/dev/null 2>&1
+  [ $? -eq 2 ] || fail "make_assembly --faces 0: not 2"
+  if "$assembly" $occ/occ/Pump_Nut.brep $occ/step/screw.step --faces 300 -o asm.brep >asm.txt 2>&1 \
+    && "$sw" import asm.brep -o asm.sws >imp.txt 2>&1 && "$sw" info asm.sws >info.txt 2>&1; then
+    grep -q "18 copies of 2 parts, 315 faces" asm.txt || { cat asm.txt; fail "make_assembly's count"; }
+    grep -Eq "^ +surfaces +35 " info.txt && grep -q "instances 18, surfaces drawn 315" info.txt \
+      && pass "make_assembly: 18 instances of 2 parts, 315 faces from 35 surfaces" \
+      || { cat info.txt; fail "make_assembly's copies are not instances of shared parts"; }
+  else
+    cat asm.txt imp.txt; fail "make_assembly, import or info exit status"
+  fi
+fi
 
 [ $failures -eq 0 ] && echo "all passed" || echo "$failures failed"
 [ $failures -eq 0 ]
