@@ -302,8 +302,8 @@ class quiet_messenger
 
 sw_result importer::read_brep(TopoDS_Shape &shape, sw_status *status)
 {
-    BRep_Builder bb;
-    if (!BRepTools::Read(shape, path_.c_str(), bb) || shape.IsNull())
+    shape = sw__occt_read_plain(path_.c_str());
+    if (shape.IsNull())
         return sw__fail(status, SW_ERR_FORMAT, "%s: not a readable OCCT BREP file", path_.c_str());
     return SW_OK;
 }
@@ -484,15 +484,7 @@ sw_result importer::read_cad(Handle(TDocStd_Document) & doc, TopoDS_Shape &shape
         st_.Nullify(), ct_.Nullify();
     }
     /* XCAF gave nothing: the plain reader, with the shape tree only. */
-    if (step) {
-        STEPControl_Reader r;
-        if (r.ReadFile(path_.c_str()) == IFSelect_RetDone && r.TransferRoots() > 0)
-            shape = r.OneShape();
-    } else {
-        IGESControl_Reader r;
-        if (r.ReadFile(path_.c_str()) == IFSelect_RetDone && r.TransferRoots() > 0)
-            shape = r.OneShape();
-    }
+    shape = sw__occt_read_plain(path_.c_str());
     if (shape.IsNull())
         return sw__fail(status, SW_ERR_FORMAT, "%s: the %s file holds no shape", path_.c_str(),
                         fmt);
@@ -1026,8 +1018,8 @@ sw_result importer::convert(const TopoDS_Shape &shape, uint32_t parent, const do
         count_uses(shape, seen);
         estimate_faces(shape);
     }
-    uint32_t top = node(xform ? SW_SG_NODE_TRANSFORM : SW_SG_NODE_GROUP, parent, 0, xform,
-                        nullptr, name_.c_str());
+    uint32_t top = node(xform ? SW_SG_NODE_TRANSFORM : SW_SG_NODE_GROUP, parent, 0, xform, nullptr,
+                        name_.c_str());
     if (!st_.IsNull()) {
         for (const TDF_Label &l : free)
             add_label(l, l, top, st_->GetLocation(l));
@@ -1045,9 +1037,8 @@ sw_result importer::convert(const TopoDS_Shape &shape, uint32_t parent, const do
     return SW_OK;
 }
 
-sw_result importer::run_shape(const TopoDS_Shape &shape, uint32_t parent,
-                              const double xform[12], sw_sg_import_report *report,
-                              sw_status *status)
+sw_result importer::run_shape(const TopoDS_Shape &shape, uint32_t parent, const double xform[12],
+                              sw_sg_import_report *report, sw_status *status)
 {
     const sw_result r = convert(shape, parent, xform, status);
     if (report)
@@ -1060,6 +1051,26 @@ sw_result importer::run_shape(const TopoDS_Shape &shape, uint32_t parent,
 }
 
 } // namespace
+
+TopoDS_Shape sw__occt_read_plain(const char *path)
+{
+    const std::string ext = lower_ext(path);
+    TopoDS_Shape shape;
+    if (ext == "brep") {
+        BRep_Builder bb;
+        if (!BRepTools::Read(shape, path, bb))
+            shape.Nullify();
+    } else if (ext == "step" || ext == "stp") {
+        STEPControl_Reader r;
+        if (r.ReadFile(path) == IFSelect_RetDone && r.TransferRoots() > 0)
+            shape = r.OneShape();
+    } else if (ext == "iges" || ext == "igs") {
+        IGESControl_Reader r;
+        if (r.ReadFile(path) == IFSelect_RetDone && r.TransferRoots() > 0)
+            shape = r.OneShape();
+    }
+    return shape;
+}
 
 /* Runs one import, turning what escapes it into a status naming `path`. */
 template <typename F> sw_result guarded(const char *path, sw_status *status, F run)

@@ -29,6 +29,11 @@ sw_result sw__occt_import_into(sw_sg_builder *b, uint32_t parent, const double x
 sw_result sw__occt_import_shape(sw_sg_builder *b, const TopoDS_Shape &shape,
                                 const sw_sg_import_desc *desc, sw_sg_import_report *report,
                                 sw_status *status);
+/* The shape of a BREP, STEP (.step, .stp) or IGES (.iges, .igs) file by OCCT's plain readers,
+ * the format by the extension: no XCAF names or colours, no partial reading, no message. A null
+ * shape when the file cannot be read, holds nothing or has another extension. The importer's
+ * fall-back, and the reader of tools that make inputs from sample parts. */
+TopoDS_Shape sw__occt_read_plain(const char *path);
 sw_result sw__occt_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
                                sw_sg_import_report *report, sw_status *status,
                                sw__occt_face_observer *observer);

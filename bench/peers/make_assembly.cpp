@@ -6,12 +6,12 @@
  * nodes of one prototype each, and OCCT's mesher meshes each part once. Copies are added, the
  * parts taken in turn, until the compound holds --faces faces. Deterministic: the same inputs
  * and options write the same file. */
+#include "sw_sg_import_occt.hpp"
+
 #include <BRepBndLib.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <Bnd_Box.hxx>
-#include <IFSelect_ReturnStatus.hxx>
-#include <STEPControl_Reader.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
@@ -39,39 +39,20 @@ struct part {
 
 const char *usage = "usage: make_assembly PART... -o OUT.brep [--faces N] [--spacing F]\n"
                     "\n"
-                    "Writes a BREP compound of located copies of the given parts (BREP or STEP),\n"
-                    "the parts taken in turn, each copy rotated about z and placed on a square\n"
-                    "grid, until the compound holds at least N faces (default 50000). Copies\n"
-                    "share their part's geometry: `splinewalk import` makes them instances.\n"
+                    "Writes a BREP compound of located copies of the given parts (BREP, STEP or\n"
+                    "IGES files), the parts taken in turn, each copy rotated about z and placed\n"
+                    "on a square grid, until the compound holds at least N faces (default\n"
+                    "50000). Copies share their part's geometry: `splinewalk import` makes\n"
+                    "them instances.\n"
                     "The grid's pitch is F (default 1.2) times the largest part's box diagonal.\n";
-
-bool has_suffix(const std::string &s, const char *suffix)
-{
-    size_t n = std::strlen(suffix);
-    if (s.size() < n)
-        return false;
-    return strcasecmp(s.c_str() + s.size() - n, suffix) == 0;
-}
-
-bool read_shape(const std::string &path, TopoDS_Shape &out)
-{
-    if (has_suffix(path, ".step") || has_suffix(path, ".stp")) {
-        STEPControl_Reader reader;
-        if (reader.ReadFile(path.c_str()) != IFSelect_RetDone)
-            return false;
-        reader.TransferRoots();
-        out = reader.OneShape();
-        return !out.IsNull();
-    }
-    BRep_Builder builder;
-    return BRepTools::Read(out, path.c_str(), builder) && !out.IsNull();
-}
 
 bool load_part(const std::string &path, part &p)
 {
     p.path = path;
-    if (!read_shape(path, p.shape)) {
-        std::fprintf(stderr, "make_assembly: %s: cannot be read as BREP or STEP\n", path.c_str());
+    p.shape = sw__occt_read_plain(path.c_str());
+    if (p.shape.IsNull()) {
+        std::fprintf(stderr, "make_assembly: %s: not a readable BREP, STEP or IGES file\n",
+                     path.c_str());
         return false;
     }
     for (TopExp_Explorer ex(p.shape, TopAbs_FACE); ex.More(); ex.Next())

@@ -14,9 +14,7 @@
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <IGESControl_Controller.hxx>
-#include <IGESControl_Reader.hxx>
 #include <IGESControl_Writer.hxx>
-#include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <TopoDS_Shape.hxx>
 
@@ -31,26 +29,6 @@ static bool ends_with(const std::string &s, const char *suffix)
     return s.size() >= x.size() && s.compare(s.size() - x.size(), x.size(), x) == 0;
 }
 
-static bool read_shape(const std::string &path, TopoDS_Shape &shape)
-{
-    if (ends_with(path, ".brep")) {
-        BRep_Builder b;
-        return BRepTools::Read(shape, path.c_str(), b);
-    }
-    if (ends_with(path, ".step") || ends_with(path, ".stp")) {
-        STEPControl_Reader r;
-        if (r.ReadFile(path.c_str()) != IFSelect_RetDone || r.TransferRoots() == 0)
-            return false;
-        shape = r.OneShape();
-        return !shape.IsNull();
-    }
-    IGESControl_Reader r;
-    if (r.ReadFile(path.c_str()) != IFSelect_RetDone || r.TransferRoots() == 0)
-        return false;
-    shape = r.OneShape();
-    return !shape.IsNull();
-}
-
 int main(int argc, char **argv)
 {
     if (argc != 4 && !(argc == 5 && std::string(argv[4]) == "brep")) {
@@ -63,8 +41,8 @@ int main(int argc, char **argv)
         return 2;
     }
     try {
-        TopoDS_Shape shape;
-        if (!read_shape(argv[1], shape)) {
+        const TopoDS_Shape shape = sw__occt_read_plain(argv[1]);
+        if (shape.IsNull()) {
             std::fprintf(stderr, "scaled_iges: cannot read %s\n", argv[1]);
             return 1;
         }
