@@ -19,14 +19,10 @@
 
 void sw__fr_geometry_free(sw__fr_geometry *g)
 {
+    sw__fr_geometry_empty(g); /* the trim loops it owns */
     sw__free(g->draws);
     sw__free(g->trims);
     sw__free(g->shares);
-    for (size_t i = 0; i < g->n_loops; ++i) {
-        for (uint32_t k = 0; k < g->loops[i].n; ++k)
-            sw_sg_polyline_free(&g->loops[i].loops[k]);
-        sw__free(g->loops[i].loops);
-    }
     sw__free(g->loops);
     sw__free(g->recs);
     sw__free(g->cps);

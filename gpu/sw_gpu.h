@@ -259,8 +259,9 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
                                    sw_gpu_frame_stats *stats, sw_status *status);
 /* An unsubmitted or spent plan; NULL allowed. */
 void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan);
-/* The same, but its geometry's buffers (megabytes, grown by doubling) are kept in ctx for a
- * later prepare on ctx instead of being freed; any thread, while ctx lives. */
+/* The same, but the plan's arrays (visible occurrences, choices, geometry: megabytes grown by
+ * doubling) are kept in ctx, emptied, for a later prepare on ctx instead of being freed (freed
+ * when ctx keeps enough already); any thread, while ctx lives. */
 void sw_gpu_frame_plan_recycle(sw_gpu_context *ctx, sw_gpu_frame_plan *plan);
 double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan); /* prepare's wall time */
 
