@@ -10,6 +10,9 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <cerrno>
+#include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -68,6 +71,28 @@ sw_result write_png(const sw_gpu_image *img, std::vector<unsigned char> &bytes, 
     return write_spec("png", bytes, spec, TypeDesc::UINT8, img->rgba, path, status);
 }
 
+// OpenEXR files carry a capture date (capDate), which OpenImageIO sets to the current second
+// unless the spec has a DateTime. With SOURCE_DATE_EPOCH set (the reproducible-builds
+// convention: seconds since 1970, UTC) that time is written instead, so the same frame gives
+// the same bytes on every run; otherwise the date stays the real capture time.
+void reproducible_date(ImageSpec &spec)
+{
+    const char *epoch = std::getenv("SOURCE_DATE_EPOCH");
+    if (!epoch || !*epoch)
+        return;
+    char *end = nullptr;
+    errno = 0;
+    long long seconds = std::strtoll(epoch, &end, 10);
+    if (errno != 0 || *end != '\0' || seconds < 0)
+        return; // not a date: keep the real one rather than invent one
+    std::time_t t = (std::time_t)seconds;
+    std::tm utc;
+    char text[32];
+    if (!gmtime_r(&t, &utc) || !std::strftime(text, sizeof text, "%Y:%m:%d %H:%M:%S", &utc))
+        return;
+    spec.attribute("DateTime", text);
+}
+
 sw_result write_exr(const sw_gpu_image *img, std::vector<unsigned char> &bytes, const char *path,
                     sw_status *status)
 {
@@ -80,6 +105,7 @@ sw_result write_exr(const sw_gpu_image *img, std::vector<unsigned char> &bytes, 
         spec.channelformats.push_back(TypeDesc::FLOAT);
         spec.z_channel = 4;
     }
+    reproducible_date(spec);
     size_t n = (size_t)img->width * (size_t)img->height;
     std::vector<float> px(n * (size_t)nc);
     for (size_t i = 0; i < n; ++i) {

@@ -285,7 +285,9 @@ void sw_gpu_trim_atlas_info(const sw_gpu_context *ctx, uint32_t *texture, int32_
  * encoded in memory, then through the project's one writer (sw_safe_write.h: replaced whole or
  * left as it was). Errors: SW_ERR_IO (a full disk too), SW_ERR_UNSUPPORTED (no or another
  * extension), SW_ERR_NOT_FOUND (no such directory), SW_ERR_NOT_REGULAR_FILE (a directory),
- * SW_ERR_INVALID_ARGUMENT (empty image), SW_ERR_INTERNAL. */
+ * SW_ERR_INVALID_ARGUMENT (empty image), SW_ERR_INTERNAL. An EXR's capture date is the current
+ * time, or SOURCE_DATE_EPOCH (seconds since 1970, UTC) when that is set, so that one frame
+ * gives the same bytes on every run. */
 sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *path, sw_status *status);
 
 #ifdef __cplusplus

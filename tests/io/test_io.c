@@ -21,6 +21,10 @@
  * SW_ERR_NOT_REGULAR_FILE, by the .sws, camera-path, .tsm and CAD readers; a sparse 2 GiB .tsm and
  * a 65 MiB camera path refused by size before they are read (SW_ERR_LIMIT, well under a second);
  * an image name without an extension says so.
+ * Reproducible EXR: with SOURCE_DATE_EPOCH set, two writes of one image a second apart give the
+ * same bytes and carry that date (catches: the encoder's capture date taken from the clock,
+ * which made the short-write comparison above fail whenever the second changed between its two
+ * writes); with it malformed, the real date stays.
  * usage: test_io WORKDIR */
 #define _GNU_SOURCE
 #include "cli.h"
@@ -533,6 +537,34 @@ static int setup(const char *work)
     return 0;
 }
 
+static void reproducible_exr(void)
+{
+    char first[1200], second[1200];
+    path_in(first, sizeof first, "date-1.exr");
+    path_in(second, sizeof second, "date-2.exr");
+    sw_status st = {0};
+    setenv("SOURCE_DATE_EPOCH", "1000000000", 1);
+    CHECK(write_exr(first, &st) == SW_OK, "EXR with SOURCE_DATE_EPOCH: %s", st.message);
+    nanosleep(&(struct timespec){1, 50000000}, NULL); /* the clock's second changes */
+    CHECK(write_exr(second, &st) == SW_OK, "EXR with SOURCE_DATE_EPOCH: %s", st.message);
+    size_t n1 = 0, n2 = 0;
+    unsigned char *a = read_all(first, &n1), *b = read_all(second, &n2);
+    CHECK(a && b && n1 == n2 && !memcmp(a, b, n1),
+          "two EXR writes of one image a second apart differ with SOURCE_DATE_EPOCH set");
+    static const char date[] = "2001:09:09 01:46:40"; /* 10^9 s after 1970, UTC */
+    CHECK(a && memmem(a, n1, date, sizeof date - 1), "the EXR does not carry SOURCE_DATE_EPOCH");
+    free(a);
+    free(b);
+    setenv("SOURCE_DATE_EPOCH", "12 o'clock", 1);
+    CHECK(write_exr(first, &st) == SW_OK, "EXR with a malformed SOURCE_DATE_EPOCH: %s", st.message);
+    a = read_all(first, &n1);
+    CHECK(a && !memmem(a, n1, "1970:01:01", 10) && !memmem(a, n1, "0012:", 5),
+          "a malformed SOURCE_DATE_EPOCH was taken for a date");
+    free(a);
+    setenv("SOURCE_DATE_EPOCH", "1000000000", 1);
+    printf("reproducible EXR: same bytes a second apart with SOURCE_DATE_EPOCH\n");
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -540,8 +572,11 @@ int main(int argc, char **argv)
         return 2;
     }
     setvbuf(stdout, NULL, _IOLBF, 0);
+    /* the format checks compare two encodings of one image byte for byte */
+    setenv("SOURCE_DATE_EPOCH", "1000000000", 1);
     if (setup(argv[1]) != 0)
         return 1;
+    reproducible_exr();
     for (int named = 0; named < 2; named++)
         for (size_t i = 0; i < sizeof k_formats / sizeof k_formats[0]; i++)
             full_disk_simulated(&k_formats[i], named);
