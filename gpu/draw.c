@@ -38,6 +38,24 @@ double sw__gpu_near_plane(const double eye[3], const double world_box[6])
     return n > 0.0 && isfinite(n) ? n : 1e-3;
 }
 
+/* Streams a frame's bytes into buf, bound to target. Storage is made by glBufferData only when
+ * the frame needs more than the buffer holds (with a quarter more room), and otherwise
+ * overwritten by glBufferSubData: llvmpipe allocates fresh storage on every glBufferData and
+ * clears it, which the submitting thread paid again each frame (page faults and memset). */
+static void stream_to(GLenum target, GLuint buf, size_t *capacity, size_t bytes, const void *data)
+{
+    glBindBuffer(target, buf);
+    if (bytes == 0)
+        bytes = 16; /* GL wants storage behind a bound storage buffer */
+    if (bytes > *capacity) {
+        const size_t grown = bytes + bytes / 4;
+        glBufferData(target, (GLsizeiptr)grown, NULL, GL_STREAM_DRAW);
+        *capacity = grown;
+    }
+    if (data)
+        glBufferSubData(target, 0, (GLsizeiptr)bytes, data);
+}
+
 static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
 {
     if (!ctx->mesh_vbo) {
@@ -45,12 +63,10 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
         glGenBuffers(1, &ctx->mesh_ibo);
     }
     glBindVertexArray(ctx->vao);
-    glBindBuffer(GL_ARRAY_BUFFER, ctx->mesh_vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_v * sizeof *mesh->v), mesh->v,
-                 GL_STREAM_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(mesh->n_idx * sizeof *mesh->idx), mesh->idx,
-                 GL_STREAM_DRAW);
+    stream_to(GL_ARRAY_BUFFER, ctx->mesh_vbo, &ctx->mesh_vbo_cap, mesh->n_v * sizeof *mesh->v,
+              mesh->v);
+    stream_to(GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo, &ctx->mesh_ibo_cap,
+              mesh->n_idx * sizeof *mesh->idx, mesh->idx);
     GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
@@ -64,19 +80,21 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
 }
 
 /* Exact path: pieces, knots and double control points into storage buffers 2, 3, 4. */
-static void upload_ssbo(GLuint buf, GLuint binding, size_t bytes, const void *data)
+static void upload_ssbo(GLuint buf, size_t *capacity, GLuint binding, size_t bytes,
+                        const void *data)
 {
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(bytes ? bytes : 16), bytes ? data : NULL,
-                 GL_STREAM_DRAW);
+    stream_to(GL_SHADER_STORAGE_BUFFER, buf, capacity, bytes, bytes ? data : NULL);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buf);
 }
 
 static void upload_exact(sw_gpu_context *ctx, const sw__gpu_patch_batch *batch)
 {
-    upload_ssbo(ctx->piece_ssbo, 2, batch->n_pieces * sizeof *batch->pieces, batch->pieces);
-    upload_ssbo(ctx->knot_ssbo, 3, batch->n_knots * sizeof *batch->knots, batch->knots);
-    upload_ssbo(ctx->dcp_ssbo, 4, batch->n_dcps * 4 * sizeof *batch->dcps, batch->dcps);
+    upload_ssbo(ctx->piece_ssbo, &ctx->piece_ssbo_cap, 2, batch->n_pieces * sizeof *batch->pieces,
+                batch->pieces);
+    upload_ssbo(ctx->knot_ssbo, &ctx->knot_ssbo_cap, 3, batch->n_knots * sizeof *batch->knots,
+                batch->knots);
+    upload_ssbo(ctx->dcp_ssbo, &ctx->dcp_ssbo_cap, 4, batch->n_dcps * 4 * sizeof *batch->dcps,
+                batch->dcps);
 }
 
 /* Debug capture: a zeroed counter plus room for capture_max vertices (two vec4 each); the
@@ -146,14 +164,10 @@ sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out
 static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                          const sw__gpu_patch_batch *batch)
 {
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->patch_ssbo);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(batch->n_recs * sizeof *batch->recs),
-                 batch->recs, GL_STREAM_DRAW);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, ctx->cp_ssbo);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(batch->n_cps * 4 * sizeof *batch->cps),
-                 batch->cps, GL_STREAM_DRAW);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, ctx->patch_ssbo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, ctx->cp_ssbo);
+    upload_ssbo(ctx->patch_ssbo, &ctx->patch_ssbo_cap, 0, batch->n_recs * sizeof *batch->recs,
+                batch->recs);
+    upload_ssbo(ctx->cp_ssbo, &ctx->cp_ssbo_cap, 1, batch->n_cps * 4 * sizeof *batch->cps,
+                batch->cps);
     if (batch->exact)
         upload_exact(ctx, batch);
     else

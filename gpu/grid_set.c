@@ -69,6 +69,8 @@ void sw__gpu_grids_free(sw_gpu_context *ctx)
     glDeleteBuffers(1, &ctx->knot_ssbo);
     glDeleteBuffers(1, &ctx->dcp_ssbo);
     ctx->piece_ssbo = ctx->knot_ssbo = ctx->dcp_ssbo = 0;
+    ctx->patch_ssbo_cap = ctx->cp_ssbo_cap = 0;
+    ctx->piece_ssbo_cap = ctx->knot_ssbo_cap = ctx->dcp_ssbo_cap = 0;
     glDeleteBuffers(1, &ctx->capture_ssbo);
     ctx->capture_ssbo = 0;
     sw__free(ctx->rec_source);

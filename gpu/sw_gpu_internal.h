@@ -147,6 +147,9 @@ struct sw_gpu_context {
     int32_t fbo_w, fbo_h;
     GLuint trim_fbo, trim_vbo;
     GLuint mesh_vbo, mesh_ibo;   /* per-frame streaming buffers */
+    /* bytes of storage each streaming buffer holds (draw.c stream_to grows it, never shrinks) */
+    size_t mesh_vbo_cap, mesh_ibo_cap, patch_ssbo_cap, cp_ssbo_cap;
+    size_t piece_ssbo_cap, knot_ssbo_cap, dcp_ssbo_cap;
     struct sw__gpu_atlas *atlas; /* trim-texture atlas kept across frames (trim_atlas.c) */
     int32_t atlas_max_side;      /* page side limit (tests); 0 = the default; set between frames */
     /* predefined grids of the Bézier evaluation (§4.2; grid_set.c) */
