@@ -226,11 +226,13 @@ static sw_result context_create(sw_result (*make)(sw_gpu_context *, sw_status *)
     if (ctx) {
         ctx->walk_token = sw__calloc(1, sizeof *ctx->walk_token);
         ctx->stash = sw__gpu_stash_new();
+        ctx->borders = sw__fr_border_cache_new();
     }
-    if (!ctx || !ctx->walk_token || !ctx->stash) {
+    if (!ctx || !ctx->walk_token || !ctx->stash || !ctx->borders) {
         if (ctx) {
             sw__free(ctx->walk_token);
             sw__gpu_stash_free(ctx->stash);
+            sw__fr_border_cache_free(ctx->borders);
         }
         sw__free(ctx);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "GL context: out of memory");
@@ -305,6 +307,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
     }
     sw__free(ctx->walk_token);
     sw__gpu_stash_free(ctx->stash);
+    sw__fr_border_cache_free(ctx->borders);
     sw__free(ctx);
 }
 

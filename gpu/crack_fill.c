@@ -69,35 +69,48 @@ typedef struct border_point {
     int in_front;
 } border_point;
 
+/* A loop sample in the surface's own space: what a ribbon takes from the surface there, for any
+ * view and placement (sw__gpu_border_loop keeps these between frames). */
+typedef struct border_sample {
+    double uv[2], in_uv[2], d_prev[2], d_next[2]; /* as border_point's */
+    double p[3], n[3], in[3];                     /* object space; unused on an affine surface */
+} border_sample;
+
 /* in_uv: a direction in (u, v) pointing into the face at this point. */
-static void eval_point(const sw_sg_surface *srf, const double world[12], const double eye[3],
-                       double u, double v, const double in_uv[2], border_point *out)
+static void eval_sample(const sw_sg_surface *srf, double u, double v, const double in_uv[2],
+                        border_sample *out)
 {
     double h[12];
     sw_sg_surface_eval_h1(srf, u, v, h);
-    double p[3], du[3], dv[3], n[3];
+    double du[3], dv[3];
     for (int k = 0; k < 3; ++k) {
-        p[k] = h[k] / h[3];
+        out->p[k] = h[k] / h[3];
         du[k] = h[4 + k] * h[3] - h[k] * h[7];
         dv[k] = h[8 + k] * h[3] - h[k] * h[11];
     }
-    n[0] = du[1] * dv[2] - du[2] * dv[1];
-    n[1] = du[2] * dv[0] - du[0] * dv[2];
-    n[2] = du[0] * dv[1] - du[1] * dv[0];
+    out->n[0] = du[1] * dv[2] - du[2] * dv[1];
+    out->n[1] = du[2] * dv[0] - du[0] * dv[2];
+    out->n[2] = du[0] * dv[1] - du[1] * dv[0];
     /* du, dv are w^2 S_u, w^2 S_v; `in` is the true derivative along in_uv, so that a length h
      * along `in` (inward_length) is the step h along in_uv in (u, v) that inner_point takes */
-    double in[3], w2 = h[3] * h[3];
+    const double w2 = h[3] * h[3];
     for (int k = 0; k < 3; ++k)
-        in[k] = (du[k] * in_uv[0] + dv[k] * in_uv[1]) / w2;
-    out->uv[0] = u;
-    out->uv[1] = v;
-    out->in_uv[0] = in_uv[0];
-    out->in_uv[1] = in_uv[1];
+        out->in[k] = (du[k] * in_uv[0] + dv[k] * in_uv[1]) / w2;
+}
+
+/* The sample placed by `world`, eye-relative. */
+static void place_sample(const border_sample *s, const double world[12], const double eye[3],
+                         border_point *out)
+{
+    memcpy(out->uv, s->uv, sizeof out->uv);
+    memcpy(out->in_uv, s->in_uv, sizeof out->in_uv);
+    memcpy(out->d_prev, s->d_prev, sizeof out->d_prev);
+    memcpy(out->d_next, s->d_next, sizeof out->d_next);
     for (int r = 0; r < 3; ++r) {
-        out->p[r] = world[4 * r] * p[0] + world[4 * r + 1] * p[1] + world[4 * r + 2] * p[2] +
-                    world[4 * r + 3] - eye[r];
-        out->n[r] = world[4 * r] * n[0] + world[4 * r + 1] * n[1] + world[4 * r + 2] * n[2];
-        out->in[r] = world[4 * r] * in[0] + world[4 * r + 1] * in[1] + world[4 * r + 2] * in[2];
+        const double *m = world + 4 * r;
+        out->p[r] = m[0] * s->p[0] + m[1] * s->p[1] + m[2] * s->p[2] + m[3] - eye[r];
+        out->n[r] = m[0] * s->n[0] + m[1] * s->n[1] + m[2] * s->n[2];
+        out->in[r] = m[0] * s->in[0] + m[1] * s->in[1] + m[2] * s->in[2];
     }
 }
 
@@ -127,7 +140,7 @@ static size_t count_samples(const double *uv, size_t n, double du, double dv)
 
 /* The most samples one ribbon may take: 64 per pixel of the frame's perimeter (a loop 32 times
  * around the frame at one sample per pixel), and never fewer than two per loop vertex. */
-static size_t border_budget(const sw__gpu_view *v, size_t n)
+size_t sw__gpu_border_budget(const sw__gpu_view *v, size_t n)
 {
     const size_t view =
         64u * ((size_t)(v->width > 0 ? v->width : 1) + (size_t)(v->height > 0 ? v->height : 1));
@@ -383,18 +396,15 @@ typedef struct ribbon_ctx {
     int affine;           /* the surface is affine in (u, v); then, in the world: */
     double su[3], sv[3];  /* its derivatives */
     double so[3];         /* its point at (0, 0), eye-relative */
-    double sn[3];         /* its normal, scaled as eval_point's */
+    double sn[3];         /* its normal, scaled as eval_sample's */
 } ribbon_ctx;
 
 /* An affine surface (a plane, as CAD files store most faces) needs no evaluation along the step:
- * its world derivatives once per ribbon. */
-static void ribbon_affine(ribbon_ctx *c)
+ * its world derivatives once per ribbon, from its map o + u du + v dv (object space). */
+static void ribbon_affine(ribbon_ctx *c, const double o[3], const double du[3], const double dv[3])
 {
-    double o[3], du[3], dv[3];
-    c->affine = sw_sg_surface_affine(c->srf, o, du, dv);
-    if (!c->affine)
-        return;
-    /* eval_point's normal is (w^2 S_u) x (w^2 S_v) of the homogeneous form; the weight is one
+    c->affine = 1;
+    /* eval_sample's normal is (w^2 S_u) x (w^2 S_v) of the homogeneous form; the weight is one
      * constant on an affine surface */
     const double w = c->srf->cpw[3], w4 = w * w * w * w;
     const double n[3] = {w4 * (du[1] * dv[2] - du[2] * dv[1]), w4 * (du[2] * dv[0] - du[0] * dv[2]),
@@ -408,7 +418,7 @@ static void ribbon_affine(ribbon_ctx *c)
     }
 }
 
-/* eval_point on an affine surface: the map itself, no B-spline evaluation (half of a building's
+/* place_sample on an affine surface: the map itself, no B-spline evaluation (half of a building's
  * ribbon samples lie on planes). */
 static void eval_point_affine(const ribbon_ctx *c, double u, double v, const double in_uv[2],
                               border_point *out)
@@ -561,6 +571,140 @@ static void prev_direction(const double *uv, size_t n, size_t i, double out[2])
     }
 }
 
+struct sw__gpu_border_loop {
+    sw_sg_surface srf;
+    const double *uv; /* the caller's loop, n points */
+    size_t n, n_samples;
+    int left_inside;
+    int capped; /* sampled coarser than asked, to stay within the sample budget */
+    int affine; /* the surface is o + u du + v dv (object space): */
+    double aff_o[3], aff_du[3], aff_dv[3];
+    loop_grid grid;
+    border_sample *s;
+};
+
+/* The loop's samples: each segment cut into pieces no longer than (du, dv), each piece's start
+ * sampled (on an affine surface only its (u, v), placed per view). */
+static void sample_loop(sw__gpu_border_loop *bl, double du, double dv)
+{
+    const double *uv = bl->uv;
+    const size_t n = bl->n;
+    size_t at = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const double *a = uv + 2 * i, *b = uv + 2 * ((i + 1) % n);
+        double k = fmax(fabs(b[0] - a[0]) / du, fabs(b[1] - a[1]) / dv);
+        int32_t pieces = (int32_t)ceil(fmin(fmax(k, 1.0), (double)MAX_PIECES_PER_SEGMENT));
+        double t[2] = {b[0] - a[0], b[1] - a[1]}, before[2];
+        double in_uv[2] = {bl->left_inside ? -t[1] : t[1], bl->left_inside ? t[0] : -t[0]};
+        prev_direction(uv, n, i, before);
+        for (int32_t j = 0; j < pieces; ++j, ++at) {
+            border_sample *o = &bl->s[at];
+            double f = (double)j / pieces;
+            o->uv[0] = a[0] + f * t[0];
+            o->uv[1] = a[1] + f * t[1];
+            memcpy(o->in_uv, in_uv, sizeof in_uv);
+            memcpy(o->d_prev, j == 0 ? before : t, sizeof before);
+            memcpy(o->d_next, t, sizeof t);
+            if (!bl->affine)
+                eval_sample(&bl->srf, o->uv[0], o->uv[1], in_uv, o);
+        }
+    }
+}
+
+sw_result sw__gpu_border_loop_make(const sw_sg_surface *srf, const double *uv, size_t n,
+                                   int left_inside, double du, double dv, int affine,
+                                   size_t max_samples, sw__gpu_border_loop **out, sw_status *status)
+{
+    *out = NULL;
+    sw__gpu_border_loop *bl = sw__calloc(1, sizeof *bl);
+    if (!bl)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "fat border: out of memory");
+    bl->srf = *srf;
+    bl->uv = uv;
+    bl->n = n;
+    bl->left_inside = left_inside;
+    bl->affine = affine && sw_sg_surface_affine(srf, bl->aff_o, bl->aff_du, bl->aff_dv);
+    /* On an affine surface a straight uv segment is a straight line on screen, drawn exactly by
+     * any grid: its ribbon needs its ends only (thinning would drop every sample between). */
+    if (bl->affine)
+        du = dv = INFINITY;
+    size_t m = count_samples(uv, n, du, dv);
+    /* The cap from the request: the view's pixels bound the samples a ribbon can use;
+     * cells shrunk by a deep refinement (fovy 1e-9 grew memory at ~600 MB/s here) are widened
+     * until the loop fits. Each segment keeps one sample, so m <= n + budget after one pass. */
+    if (m > max_samples) {
+        const double widen = (double)m / (double)max_samples;
+        du *= widen;
+        dv *= widen;
+        m = count_samples(uv, n, du, dv);
+        bl->capped = 1;
+    }
+    bl->n_samples = m;
+    bl->s = sw__malloc((m ? m : 1) * sizeof *bl->s);
+    if (!bl->s || !loop_grid_build(&bl->grid, uv, n)) {
+        sw__gpu_border_loop_free(bl);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "fat border: out of memory");
+    }
+    sample_loop(bl, du, dv);
+    *out = bl;
+    return SW_OK;
+}
+
+void sw__gpu_border_loop_free(sw__gpu_border_loop *bl)
+{
+    if (!bl)
+        return;
+    loop_grid_free(&bl->grid);
+    sw__free(bl->s);
+    sw__free(bl);
+}
+
+size_t sw__gpu_border_loop_bytes(const sw__gpu_border_loop *bl)
+{
+    const loop_grid *g = &bl->grid;
+    size_t grid = 0;
+    if (g->start != g->small_start)
+        grid = ((size_t)g->g[0] * (size_t)g->g[1] + 1) * sizeof *g->start +
+               (size_t)g->start[(size_t)g->g[0] * (size_t)g->g[1]] * sizeof *g->items;
+    return sizeof *bl + bl->n_samples * sizeof *bl->s + grid;
+}
+
+sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
+                                const sw__gpu_border_loop *bl, double width_px,
+                                const double *st_box, sw__gpu_mesh *mesh, sw_status *status)
+{
+    const size_t m = bl->n_samples;
+    mesh->border_capped += (uint64_t)bl->capped;
+    sw_result r = sw__gpu_mesh_reserve(mesh, 4 * m, 6 * m, status);
+    if (r != SW_OK)
+        return r;
+    border_point *bp = sw__malloc((m ? m : 1) * sizeof *bp);
+    if (!bp)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "fat border: out of memory");
+    ribbon_ctx c = {.v = v,
+                    .srf = &bl->srf,
+                    .world = world,
+                    .grid = &bl->grid,
+                    .side = bl->left_inside ? 1.0 : -1.0,
+                    .width_px = width_px,
+                    .st_box = st_box};
+    if (bl->affine)
+        ribbon_affine(&c, bl->aff_o, bl->aff_du, bl->aff_dv);
+    for (size_t i = 0; i < m; ++i) {
+        const border_sample *s = &bl->s[i];
+        if (c.affine) {
+            eval_point_affine(&c, s->uv[0], s->uv[1], s->in_uv, &bp[i]);
+            memcpy(bp[i].d_prev, s->d_prev, sizeof s->d_prev);
+            memcpy(bp[i].d_next, s->d_next, sizeof s->d_next);
+        } else {
+            place_sample(s, world, v->eye, &bp[i]);
+        }
+    }
+    emit_ribbon(&c, bp, thin_samples(v, bp, m, 0.25 * width_px), mesh);
+    sw__free(bp);
+    return SW_OK;
+}
+
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
                              double du, double dv, double width_px, const double *st_box,
@@ -568,62 +712,11 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
 {
     if (n < 2 || !(du > 0.0) || !(dv > 0.0))
         return SW_OK;
-    ribbon_ctx c = {.v = v,
-                    .srf = srf,
-                    .world = world,
-                    .side = left_inside ? 1.0 : -1.0,
-                    .width_px = width_px,
-                    .st_box = st_box};
-    if (affine)
-        ribbon_affine(&c);
-    /* On an affine surface a straight uv segment is a straight line on screen, drawn exactly by
-     * any grid: its ribbon needs its ends only (thinning would drop every sample between). */
-    if (c.affine)
-        du = dv = INFINITY;
-    size_t m = count_samples(uv, n, du, dv);
-    /* The cap from the request: the view's pixels bound the samples a ribbon can use;
-     * cells shrunk by a deep refinement (fovy 1e-9 grew memory at ~600 MB/s here) are widened
-     * until the loop fits. Each segment keeps one sample, so m <= n + budget after one pass. */
-    const size_t budget = border_budget(v, n);
-    if (m > budget) {
-        const double widen = (double)m / (double)budget;
-        du *= widen;
-        dv *= widen;
-        m = count_samples(uv, n, du, dv);
-        mesh->border_capped++;
-    }
-    sw_result r = sw__gpu_mesh_reserve(mesh, 4 * m, 6 * m, status);
-    if (r != SW_OK)
-        return r;
-    border_point *bp = sw__malloc(m * sizeof *bp);
-    loop_grid grid = {0};
-    if (!bp || !loop_grid_build(&grid, uv, n)) {
-        sw__free(bp);
-        loop_grid_free(&grid);
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "fat border: out of memory");
-    }
-    size_t at = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const double *a = uv + 2 * i, *b = uv + 2 * ((i + 1) % n);
-        double k = fmax(fabs(b[0] - a[0]) / du, fabs(b[1] - a[1]) / dv);
-        int32_t pieces = (int32_t)ceil(fmin(fmax(k, 1.0), (double)MAX_PIECES_PER_SEGMENT));
-        double t[2] = {b[0] - a[0], b[1] - a[1]}, before[2];
-        double in_uv[2] = {left_inside ? -t[1] : t[1], left_inside ? t[0] : -t[0]};
-        prev_direction(uv, n, i, before);
-        for (int32_t j = 0; j < pieces; ++j, ++at) {
-            double f = (double)j / pieces;
-            const double u_at = a[0] + f * t[0], v_at = a[1] + f * t[1];
-            if (c.affine)
-                eval_point_affine(&c, u_at, v_at, in_uv, &bp[at]);
-            else
-                eval_point(srf, world, v->eye, u_at, v_at, in_uv, &bp[at]);
-            memcpy(bp[at].d_prev, j == 0 ? before : t, sizeof before);
-            memcpy(bp[at].d_next, t, sizeof t);
-        }
-    }
-    c.grid = &grid;
-    emit_ribbon(&c, bp, thin_samples(v, bp, m, 0.25 * width_px), mesh);
-    loop_grid_free(&grid);
-    sw__free(bp);
-    return SW_OK;
+    sw__gpu_border_loop *bl = NULL;
+    sw_result r = sw__gpu_border_loop_make(srf, uv, n, left_inside, du, dv, affine,
+                                           sw__gpu_border_budget(v, n), &bl, status);
+    if (r == SW_OK)
+        r = sw__gpu_fat_border_of(v, world, bl, width_px, st_box, mesh, status);
+    sw__gpu_border_loop_free(bl);
+    return r;
 }

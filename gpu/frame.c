@@ -214,8 +214,12 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
     sw_result r = sw__fr_env_init(&p->env, ctx, scene, &p->desc, status);
     if (r == SW_OK)
         r = hierarchy_init(p, scene, status);
-    if (r == SW_OK)
+    if (r == SW_OK) {
+        p->env.borders = sw__fr_border_cache_begin(ctx->borders, scene);
         r = run_stages(p, status);
+        sw__fr_border_cache_end(p->env.borders);
+        p->env.borders = NULL; /* the plan outlives the frame's hold */
+    }
     if (r != SW_OK) {
         sw_gpu_frame_plan_recycle(ctx, p);
         return r;

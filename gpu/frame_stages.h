@@ -74,6 +74,7 @@ typedef struct sw__fr_env {
     int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
     sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
+    struct sw__fr_border_cache *borders; /* the context's, held by this frame; NULL: none */
 } sw__fr_env;
 
 /* The constants of a frame of desc (its defaults resolved by sw__gpu_desc_defaults) but the view:
@@ -241,10 +242,12 @@ typedef struct pending_trim {
     int32_t w, h;         /* texels of its class (the trim plan) */
 } pending_trim;
 
-/* A face occurrence's loops, flattened once. */
+/* A face occurrence's loops, flattened once (a copy of the border cache's when it has them). */
 typedef struct face_loops {
     sw_sg_polyline *loops;
     uint32_t n;
+    uint32_t face;
+    double tol; /* the flattening's (the border cache's key with face) */
 } face_loops;
 
 typedef struct sw__fr_geometry {
@@ -313,11 +316,40 @@ void sw__fr_report_patch(const sw__fr_tess *t, const occurrence *o, const sw__gp
 sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_patch *pt,
                            const double ub[4], double sign, int32_t draw, int trimmed,
                            sw_status *status);
+/* ---- the border cache: border_cache.c ---------------------------------------------------------
+ * A face's loops flattened at a tolerance and their border samples, kept between frames and
+ * shared by the face's occurrences. begin: at a prepare's start, on its thread (NULL: no cache
+ * for this frame: none, or another prepare of the context holds it); end: at its end. */
+typedef struct sw__fr_border_entry sw__fr_border_entry;
+sw__fr_border_cache *sw__fr_border_cache_begin(sw__fr_border_cache *c, const sw_sg_scene *scene);
+void sw__fr_border_cache_end(sw__fr_border_cache *c);
+void sw__fr_border_cache_set_budget(sw__fr_border_cache *c, size_t bytes); /* tests */
+size_t sw__fr_border_cache_bytes(const sw__fr_border_cache *c);
+/* The face's loops at tol (tol < 0: its parameter box as one loop), looked up or made; NULL when
+ * the frame has no cache, it is over its budget or full, or the loops fail (the caller then
+ * flattens them itself, and reports). Any thread of the frame's preparation. */
+const sw__fr_border_entry *sw__fr_border_entry_get(const sw__fr_env *env, uint32_t face,
+                                                   double tol);
+const sw_sg_polyline *sw__fr_border_entry_loops(const sw__fr_border_entry *e, uint32_t *n);
+/* Counts the entry's loops flattened farther than their tolerance, as a flattening does. */
+void sw__fr_border_entry_count(sw__fr_tess *t, const sw__fr_border_entry *e);
+/* The fat borders of the entry's loops under o, sampled at steps cell (§7.1). */
+sw_result sw__fr_border_entry_ribbons(sw__fr_tess *t, const occurrence *o,
+                                      const sw__fr_border_entry *e, const double cell[2],
+                                      sw_status *status);
+/* The fat border of a face's parameter box (an untrimmed face's), from the cache when it can. */
+sw_result sw__fr_box_border(sw__fr_tess *t, const occurrence *o, const double cell[2],
+                            sw_status *status);
+
 /* §7.1 fat border along a closed uv loop as its own draw. st_box NULL: untrimmed; else the draw
  * uses the trim texture of draw `share` (whose texture spans st_box). */
 sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *uv, size_t n,
                             int left_inside, const double cell[2], const double *st_box,
                             size_t share, sw_status *status);
+/* The same from a loop's samples made beforehand (gpu/crack_fill.c sw__gpu_border_loop_make). */
+sw_result sw__fr_placed_border(sw__fr_tess *t, const occurrence *o, const sw__gpu_border_loop *bl,
+                               const double cell[2], const double *st_box, size_t share,
+                               sw_status *status);
 /* The face's trim loops flattened at tolerance tol into a new geometry.loops entry, *index. */
 sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *index,
                             sw_status *status);

@@ -290,30 +290,20 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
     return SW_OK;
 }
 
-/* §7.1: a fat border along one closed uv loop of a drawn face, as its own draw. */
-sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *uv, size_t n,
-                            int left_inside, const double cell[2], const double *st_box,
-                            size_t share, sw_status *status)
+/* The ribbon appended to the mesh from index `first` as its own draw (none when empty). */
+static sw_result ribbon_draw(sw__fr_tess *t, const occurrence *o, size_t first, uint64_t capped,
+                             const double cell[2], const double *st_box, const double *st_rect,
+                             size_t share, sw_status *status)
 {
     sw__fr_geometry *g = t->geo;
-    sw_sg_surface srf;
-    sw_sg_scene_face_surface(t->env->scene, o->face, &srf);
-    const size_t first = g->mesh.n_idx;
-    const uint64_t capped = g->mesh.border_capped;
-    /* st over the face's uv box when the ribbon is drawn untrimmed: no lookup reads it, but the
-     * shading's uv (u_uv_map) does */
-    const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
-    sw_result r = sw__gpu_fat_border(&t->env->view, &srf, o->world, uv, n, left_inside, cell[0],
-                                     cell[1], 2.0 * t->env->eps_px, st_rect,
-                                     !t->env->ctx->border_affine_off, &g->mesh, status);
     /* sampled coarser than its cells (the view's sample budget): it may leave a crack open */
     t->st->borders_capped += g->mesh.border_capped - capped;
     t->st->bound_exceeded += g->mesh.border_capped - capped;
-    if (r != SW_OK || g->mesh.n_idx == first)
-        return r;
+    if (g->mesh.n_idx == first)
+        return SW_OK;
     trim_need none = {0.0, 0.0};
     size_t draw = g->n_draws;
-    r = sw__fr_add_draw(t, o, first, 0, &none, cell, status);
+    sw_result r = sw__fr_add_draw(t, o, first, 0, &none, cell, status);
     if (r == SW_OK) {
         const double *b = st_rect;
         const float uv_map[4] = {(float)b[0], (float)b[2], (float)(b[1] - b[0]),
@@ -333,6 +323,55 @@ sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *u
     return r;
 }
 
+/* §7.1: a fat border along one closed uv loop of a drawn face, as its own draw. */
+sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *uv, size_t n,
+                            int left_inside, const double cell[2], const double *st_box,
+                            size_t share, sw_status *status)
+{
+    sw__fr_geometry *g = t->geo;
+    sw_sg_surface srf;
+    sw_sg_scene_face_surface(t->env->scene, o->face, &srf);
+    const size_t first = g->mesh.n_idx;
+    const uint64_t capped = g->mesh.border_capped;
+    /* st over the face's uv box when the ribbon is drawn untrimmed: no lookup reads it, but the
+     * shading's uv (u_uv_map) does */
+    const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
+    sw_result r = sw__gpu_fat_border(&t->env->view, &srf, o->world, uv, n, left_inside, cell[0],
+                                     cell[1], 2.0 * t->env->eps_px, st_rect,
+                                     !t->env->ctx->border_affine_off, &g->mesh, status);
+    return r == SW_OK ? ribbon_draw(t, o, first, capped, cell, st_box, st_rect, share, status) : r;
+}
+
+sw_result sw__fr_placed_border(sw__fr_tess *t, const occurrence *o, const sw__gpu_border_loop *bl,
+                               const double cell[2], const double *st_box, size_t share,
+                               sw_status *status)
+{
+    sw__fr_geometry *g = t->geo;
+    const size_t first = g->mesh.n_idx;
+    const uint64_t capped = g->mesh.border_capped;
+    const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
+    sw_result r = sw__gpu_fat_border_of(&t->env->view, o->world, bl, 2.0 * t->env->eps_px, st_rect,
+                                        &g->mesh, status);
+    return r == SW_OK ? ribbon_draw(t, o, first, capped, cell, st_box, st_rect, share, status) : r;
+}
+
+/* The entry's loops copied into fl (the trim stage draws from them on the submitting thread,
+ * after the cache may have moved on). */
+static sw_result copy_loops(face_loops *fl, const sw__fr_border_entry *e, sw_status *status)
+{
+    uint32_t n = 0;
+    const sw_sg_polyline *src = sw__fr_border_entry_loops(e, &n);
+    for (; fl->n < n; ++fl->n) {
+        sw_sg_polyline *d = &fl->loops[fl->n];
+        *d = src[fl->n];
+        d->uv = sw__malloc((src[fl->n].count ? src[fl->n].count : 1) * 2 * sizeof *d->uv);
+        if (!d->uv)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", fl->face);
+        memcpy(d->uv, src[fl->n].uv, src[fl->n].count * 2 * sizeof *d->uv);
+    }
+    return SW_OK;
+}
+
 sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *index,
                             sw_status *status)
 {
@@ -342,10 +381,17 @@ sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     face_loops *fl = &g->loops[g->n_loops];
     fl->n = 0;
+    fl->face = face;
+    fl->tol = tol;
     fl->loops = sw__calloc(rec->n_loops ? rec->n_loops : 1, sizeof *fl->loops);
     if (!fl->loops)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     *index = (int64_t)g->n_loops++;
+    const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, face, tol);
+    if (e) {
+        sw__fr_border_entry_count(t, e);
+        return copy_loops(fl, e, status);
+    }
     sw_result r = SW_OK;
     for (uint32_t k = 0; k < rec->n_loops && r == SW_OK; ++k, ++fl->n) {
         r = sw_sg_trim_flatten_loop(t->env->scene, rec->first_loop + k, tol, MAX_TRIM_LOOP_VERTICES,
@@ -362,11 +408,25 @@ sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops
                               const double cell[2], sw_status *status)
 {
     const face_loops *fl = &t->geo->loops[loops];
+    const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, fl->face, fl->tol);
+    if (e)
+        return sw__fr_border_entry_ribbons(t, o, e, cell, status);
     sw_result r = SW_OK;
     for (uint32_t k = 0; r == SW_OK && !t->env->ctx->crack_fill_off && k < fl->n; ++k)
         r = sw__fr_fat_border(t, o, fl->loops[k].uv, fl->loops[k].count,
                               sw__fr_left_is_inside(fl->loops, fl->n, k), cell, NULL, 0, status);
     return r;
+}
+
+sw_result sw__fr_box_border(sw__fr_tess *t, const occurrence *o, const double cell[2],
+                            sw_status *status)
+{
+    const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, o->face, -1.0);
+    if (e)
+        return sw__fr_border_entry_ribbons(t, o, e, cell, status);
+    const double *ub = t->env->sv->faces[o->face].uv_box;
+    const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
+    return sw__fr_fat_border(t, o, box_loop, 4, 1, cell, NULL, 0, status);
 }
 
 sw_result sw__fr_tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,

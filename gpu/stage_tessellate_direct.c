@@ -570,12 +570,8 @@ sw_result sw__fr_tess_direct(sw__fr_tess *f, const occurrence *o, sw_status *sta
         }
         if (f->env->exact)
             f->st->patches_exact += drawn;
-        if (r == SW_OK && !trimmed && !f->env->ctx->crack_fill_off) {
-            const double *b = rec->uv_box;
-            const double box_loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
-            r = sw__fr_fat_border(f, o, box_loop, 4, 1, cell, NULL, 0,
-                                  status); /* counter-clockwise */
-        }
+        if (r == SW_OK && !trimmed && !f->env->ctx->crack_fill_off)
+            r = sw__fr_box_border(f, o, cell, status); /* counter-clockwise */
         f->st->faces_drawn++;
         if (trimmed)
             f->st->patches_trimmed += drawn;

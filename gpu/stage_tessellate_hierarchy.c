@@ -291,8 +291,7 @@ static sw_result draw_one_texture(hl_face *hf, sw__gpu_patch *pts, double sign, 
     }
     if (r == SW_OK && !hf->trimmed && !f->env->ctx->crack_fill_off) {
         /* a trimmed face's loops get theirs with its trim texture (the trim plan, stage_trim.c) */
-        const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
-        r = sw__fr_fat_border(f, hf->o, box_loop, 4, 1, cell_min, NULL, 0, status);
+        r = sw__fr_box_border(f, hf->o, cell_min, status);
     }
     return r;
 }

@@ -58,12 +58,17 @@ static sw_result face_borders(sw__fr_tess *t, const occurrence *o, double extent
     const double cells =
         fmin(fmax(ceil(extent_px / k_border_px), STATIC_BORDER_MIN_CELLS), STATIC_BORDER_MAX_CELLS);
     const double cell[2] = {(ub[1] - ub[0]) / cells, (ub[3] - ub[2]) / cells};
-    if (!sw__fr_face_trimmed(t->env, o->face)) {
-        const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
-        return sw__fr_fat_border(t, o, box_loop, 4, 1, cell, NULL, 0, status);
+    if (!sw__fr_face_trimmed(t->env, o->face))
+        return sw__fr_box_border(t, o, cell, status);
+    const double tol = 0.25 * fmin(cell[0], cell[1]);
+    /* the loops serve the borders only: the cache's own, no copy in the frame's geometry */
+    const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, o->face, tol);
+    if (e) {
+        sw__fr_border_entry_count(t, e);
+        return sw__fr_border_entry_ribbons(t, o, e, cell, status);
     }
     int64_t idx = -1;
-    sw_result r = sw__fr_face_loops(t, o->face, 0.25 * fmin(cell[0], cell[1]), &idx, status);
+    sw_result r = sw__fr_face_loops(t, o->face, tol, &idx, status);
     return r == SW_OK ? sw__fr_loop_borders(t, o, idx, cell, status) : r;
 }
 

@@ -133,6 +133,9 @@ struct sw_gpu_context {
                                 tests include this header, and the token is a C11 atomic) */
     struct sw__gpu_stash *stash;     /* frame buffers kept between frames (frame_stash.c; atomics:
                                         a pointer here, as for walk_token) */
+    /* fat borders' view-independent parts kept between frames (border_cache.c; held by one
+     * prepare at a time) */
+    struct sw__fr_border_cache *borders;
     char description[256];
     GLint max_texture_size;
     sw__gpu_surface_programs surf; /* the surface programs frames draw with */
@@ -254,6 +257,11 @@ typedef struct sw__gpu_mesh {
                                of sw__gpu_fat_border was hit (counted, never reset here) */
 } sw__gpu_mesh;
 
+/* The context's border cache (border_cache.c; frame_stages.h has its frame-side calls). */
+typedef struct sw__fr_border_cache sw__fr_border_cache;
+sw__fr_border_cache *sw__fr_border_cache_new(void); /* NULL: out of memory */
+void sw__fr_border_cache_free(sw__fr_border_cache *c);
+
 /* The context's stash of frame buffers (frame_stash.c): spent plans and chunk geometries, emptied
  * with their arrays kept. take: an item of the role or NULL; put: 1 when stashed, 0 when the
  * stash is full (the item stays the caller's). Any thread; ctx NULL: nothing kept. */
@@ -310,6 +318,25 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
                              double du, double dv, double width_px, const double *st_box,
                              int affine, sw__gpu_mesh *mesh, sw_status *status);
+/* The view-independent part of one loop's fat border: its samples on the surface in the
+ * surface's own space (at steps no longer than (du, dv), widened to at most max_samples and then
+ * counted as capped) and its segment grid, which sw__gpu_fat_border_of places under any view and
+ * transform. sw__gpu_fat_border is make, of, free; a caller that draws one loop under many views
+ * or transforms keeps it (stage_tessellate.c's border cache). uv is the caller's and must outlive
+ * it. Errors: SW_ERR_OUT_OF_MEMORY. */
+typedef struct sw__gpu_border_loop sw__gpu_border_loop;
+sw_result sw__gpu_border_loop_make(const sw_sg_surface *srf, const double *uv, size_t n,
+                                   int left_inside, double du, double dv, int affine,
+                                   size_t max_samples, sw__gpu_border_loop **out,
+                                   sw_status *status);
+void sw__gpu_border_loop_free(sw__gpu_border_loop *bl);
+size_t sw__gpu_border_loop_bytes(const sw__gpu_border_loop *bl);
+/* The most samples one ribbon may take in view v (a loop of n vertices). */
+size_t sw__gpu_border_budget(const sw__gpu_view *v, size_t n);
+/* The ribbon of a made loop (the same as sw__gpu_fat_border's with the make's arguments). */
+sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
+                                const sw__gpu_border_loop *bl, double width_px,
+                                const double *st_box, sw__gpu_mesh *mesh, sw_status *status);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 /* Fat borders of affine faces by their loop's vertices (default) or sampled as curved ones: the
