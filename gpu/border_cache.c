@@ -164,9 +164,11 @@ void sw__fr_border_cache_free(sw__fr_border_cache *c)
     sw__free(c);
 }
 
-void sw__fr_border_cache_set_budget(sw__fr_border_cache *c, size_t bytes)
+size_t sw__fr_border_cache_set_budget(sw__fr_border_cache *c, size_t bytes)
 {
+    const size_t was = c->budget;
     c->budget = bytes;
+    return was;
 }
 
 size_t sw__fr_border_cache_bytes(const sw__fr_border_cache *c)
@@ -337,11 +339,12 @@ static border_set *set_find(border_set *s, const double cell[2])
 /* The entry's samples at steps cell (made and published when absent); NULL: over the budget,
  * or out of memory (status set). */
 static border_set *set_get(const sw__fr_env *env, const sw__fr_border_entry *e,
-                           const double cell[2], sw_status *status)
+                           const double cell[2], int *made_here, sw_status *status)
 {
     sw__fr_border_entry *me = (sw__fr_border_entry *)e; /* only its atomic list changes */
     border_set *head = atomic_load_explicit(&me->sets, memory_order_acquire);
     border_set *s = set_find(head, cell);
+    *made_here = 0;
     if (s)
         return s;
     const sw__fr_border_cache *c = env->borders;
@@ -353,8 +356,10 @@ static border_set *set_get(const sw__fr_env *env, const sw__fr_border_entry *e,
     for (;;) {
         made->next = head;
         if (atomic_compare_exchange_weak_explicit(&me->sets, &head, made, memory_order_acq_rel,
-                                                  memory_order_acquire))
+                                                  memory_order_acquire)) {
+            *made_here = 1;
             return made;
+        }
         if ((s = set_find(head, cell))) { /* another thread published it meanwhile */
             atomic_fetch_sub(&((sw__fr_border_cache *)env->borders)->bytes, made->bytes);
             atomic_fetch_sub(&me->bytes, made->bytes);
@@ -371,7 +376,8 @@ sw_result sw__fr_border_entry_ribbons(sw__fr_tess *t, const occurrence *o,
     if (t->env->ctx->crack_fill_off || !(cell[0] > 0.0) || !(cell[1] > 0.0))
         return SW_OK;
     sw_status mine = {0};
-    const border_set *s = set_get(t->env, e, cell, &mine);
+    int made_here = 0;
+    const border_set *s = set_get(t->env, e, cell, &made_here, &mine);
     if (!s && mine.result != SW_OK) {
         *status = mine;
         return mine.result;
@@ -380,6 +386,10 @@ sw_result sw__fr_border_entry_ribbons(sw__fr_tess *t, const occurrence *o,
     for (uint32_t k = 0; !s && k < e->n && r == SW_OK; ++k)
         r = sw__fr_fat_border(t, o, e->loops[k].uv, e->loops[k].count, e->left_inside[k], cell,
                               NULL, 0, status);
+    if (s && made_here)
+        t->st->border_loops_made += e->n;
+    else if (s)
+        t->st->border_loops_kept += e->n;
     for (uint32_t k = 0; s && k < e->n && r == SW_OK; ++k)
         if (s->loop[k])
             r = sw__fr_placed_border(t, o, s->loop[k], cell, NULL, 0, status);

@@ -323,7 +323,8 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
 typedef struct sw__fr_border_entry sw__fr_border_entry;
 sw__fr_border_cache *sw__fr_border_cache_begin(sw__fr_border_cache *c, const sw_sg_scene *scene);
 void sw__fr_border_cache_end(sw__fr_border_cache *c);
-void sw__fr_border_cache_set_budget(sw__fr_border_cache *c, size_t bytes); /* tests */
+/* Tests and benchmarks, between frames: 0 turns it off. Returns the budget it had. */
+size_t sw__fr_border_cache_set_budget(sw__fr_border_cache *c, size_t bytes);
 size_t sw__fr_border_cache_bytes(const sw__fr_border_cache *c);
 /* The face's loops at tol (tol < 0: its parameter box as one loop), looked up or made; NULL when
  * the frame has no cache, it is over its budget or full, or the loops fail (the caller then

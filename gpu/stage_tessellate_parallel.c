@@ -168,7 +168,7 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 472,
+        sizeof(sw_gpu_frame_stats) == 488,
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;
@@ -187,6 +187,8 @@ static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
     d->faces_backculled += s->faces_backculled;
     d->trim_loops_floored += s->trim_loops_floored;
     d->borders_capped += s->borders_capped;
+    d->border_loops_kept += s->border_loops_kept;
+    d->border_loops_made += s->border_loops_made;
 }
 
 /* ---- the stage's entry --------------------------------------------------------------------- */

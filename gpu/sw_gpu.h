@@ -210,6 +210,9 @@ typedef struct sw_gpu_frame_stats {
                                     farther than the trim tolerance from the curve */
     uint64_t borders_capped;     /* fat borders sampled coarser than their cells: the view's
                                     sample budget (sw__gpu_mesh.border_capped) */
+    /* fat-border loops placed from samples kept in the border cache, and loops whose samples
+     * this frame made (and kept) */
+    uint64_t border_loops_kept, border_loops_made;
     /* the tessellation in chunks (desc.pool): chunks, those the pool's workers took, and the
      * time the preparing thread waited at the join for chunks a worker was still running */
     uint64_t tess_chunks, tess_chunks_by_pool;

@@ -15,7 +15,10 @@
  *              pool of --workers workers (desc.pool);
  *   density    planes' patches given the coarsest grid by the affine test (fast, the default) or
  *              by the full screen-space bound (lod/sampling.c sw_lod_screen_affine_fast), on one
- *              thread, with the triangles and differing pixels of view 0 as for affine.
+ *              thread, with the triangles and differing pixels of view 0 as for affine;
+ *   borders    the border cache (gpu/border_cache.c: loops and samples kept between frames) on,
+ *              the default, or off, on one thread; each variant's passes one after another, so
+ *              that the cache keeps what its own passes made (its first pass starts empty).
  * Each variant prints the median of the prepare's wall time, of the preparing thread's CPU time
  * and of the process's CPU time (every thread: the pool's share of the work included, so the
  * split's extra work shows).
@@ -24,6 +27,7 @@
  */
 #include "sw_lod_sampling.h"
 #include "bench_stats.h"
+#include "frame_stages.h"
 #include "sw_gpu_internal.h"
 #include "sw_lod_cache.h"
 #include "sw_sg_import.h"
@@ -138,6 +142,32 @@ static void set_density(bench *b, int k)
     sw_lod_screen_affine_fast(k == 0);
 }
 
+static void set_borders(bench *b, int k)
+{
+    static size_t budget;
+    if (k == 1)
+        budget = sw__fr_border_cache_set_budget(b->ctx->borders, 0);
+    else if (budget)
+        sw__fr_border_cache_set_budget(b->ctx->borders, budget);
+}
+
+/* The passes of each variant in a row (a cache's state carries over within them only). */
+static int in_turn(bench *b, int passes, void (*set)(bench *, int), const char *names[2])
+{
+    static series s[2];
+    for (int k = 0; k < 2; ++k) {
+        s[k].n = 0;
+        set(b, k);
+        for (int p = 0; p < passes; ++p)
+            if (!pass(b, &s[k]))
+                return 0;
+    }
+    set(b, 0);
+    for (int k = 0; k < 2; ++k)
+        print_series(names[k], &s[k]);
+    return 1;
+}
+
 /* View 0 submitted with a pair's two variants: triangles of each, differing pixels. */
 static int compare_images(bench *b, void (*set)(bench *, int))
 {
@@ -172,12 +202,15 @@ static int run_mode(bench *b, const char *mode, int passes)
     static const char *affine[2] = {"affine borders on", "affine borders off"};
     static const char *chunks[2] = {"one thread", "chunks with the pool"};
     static const char *density[2] = {"affine densities fast", "affine densities bounded"};
+    static const char *borders[2] = {"border cache on", "border cache off"};
     printf("  %s, medians of %d prepares per variant:\n", mode, passes * b->views);
     if (!pass(b, NULL)) /* warm-up: hierarchies built and refined, buffers grown */
         return 0;
     if (!ab(b, passes, set_affine, affine) || !compare_images(b, set_affine))
         return 0;
     if (!ab(b, passes, set_density, density) || !compare_images(b, set_density))
+        return 0;
+    if (!in_turn(b, passes, set_borders, borders) || !compare_images(b, set_borders))
         return 0;
     return ab(b, passes, set_chunks, chunks);
 }

@@ -381,6 +381,8 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->tess_chunks_by_pool = g->tess_chunks_by_pool;
     out->ms_join = g->ms_join;
     out->border_triangles = g->border_triangles;
+    out->border_loops_kept = g->border_loops_kept;
+    out->border_loops_made = g->border_loops_made;
     out->occlusion_tests = g->occlusion_tests;
     out->nodes_occluded = g->nodes_occluded;
     out->faces_occluded = g->faces_occluded;

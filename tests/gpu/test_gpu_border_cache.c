@@ -9,8 +9,9 @@
  *    set found for another step; both planted, both failed here). A stale entry kept across a
  *    scene change shows where a face keeps its key but not its loops: an edited node scene's
  *    next compiled version (planted: api_nodes_live fails).
- *  - It is used: the first frame leaves bytes in it, and the same view again adds none, every
- *    lookup a hit (catches: a cache that never keeps or never finds an entry).
+ *  - It is used: the first frame leaves bytes in it, and the same view again adds none and
+ *    places every loop from kept samples (catches: a cache that never keeps or never finds an
+ *    entry, counters that miscount).
  *  - Its budget holds: over the budget, the next frame keeps only what the last frame used
  *    (fewer bytes than before), and the cache does not grow while over it (views alternating
  *    between two distances over a budget of one byte), the images still the same (catches: a cache
@@ -72,9 +73,10 @@ static sw_gpu_frame_desc view_at(const scene_set *s, double scale)
     return d;
 }
 
-/* One frame on both contexts, compared. */
-static void frame_pair(sw_gpu_context *cached, sw_gpu_context *plain, const scene_set *s,
-                       const sw_gpu_frame_desc *d, const char *what)
+/* One frame on both contexts, compared; the cached frame's stats. */
+static sw_gpu_frame_stats frame_pair(sw_gpu_context *cached, sw_gpu_context *plain,
+                                     const scene_set *s, const sw_gpu_frame_desc *d,
+                                     const char *what)
 {
     sw_status st = {0};
     sw_gpu_image a = {0}, b = {0};
@@ -95,6 +97,7 @@ static void frame_pair(sw_gpu_context *cached, sw_gpu_context *plain, const scen
     }
     sw_gpu_image_free(&a);
     sw_gpu_image_free(&b);
+    return sa;
 }
 
 static void views(sw_gpu_context *cached, sw_gpu_context *plain, const scene_set *s,
@@ -110,10 +113,13 @@ static void views(sw_gpu_context *cached, sw_gpu_context *plain, const scene_set
     /* the first view again: every entry and sample set is there already */
     const sw_gpu_frame_desc d = view_at(s, scales[0]);
     const size_t before = sw__fr_border_cache_bytes(cached->borders);
-    frame_pair(cached, plain, s, &d, name);
+    const sw_gpu_frame_stats again = frame_pair(cached, plain, s, &d, name);
     const size_t after = sw__fr_border_cache_bytes(cached->borders);
     CHECK(before > 0 && after == before,
           "%s: the cache held %zu bytes, and %zu after the same view again", name, before, after);
+    CHECK(again.border_loops_kept > 0 && again.border_loops_made == 0,
+          "%s: the same view again placed %llu loops from kept samples and made %llu", name,
+          (unsigned long long)again.border_loops_kept, (unsigned long long)again.border_loops_made);
 }
 
 int main(int argc, char **argv)

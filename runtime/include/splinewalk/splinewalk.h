@@ -420,6 +420,9 @@ typedef struct sw_frame_stats {
     /* of triangles: the fat borders drawn along the faces' boundaries to close cracks between
      * independently tessellated faces (Guthe et al. 2005 §7.1); a resident mesh has none */
     uint64_t border_triangles;
+    /* fat-border loops placed from the samples the renderer keeps between frames and shares
+     * between a face's occurrences, and loops whose samples this frame made */
+    uint64_t border_loops_kept, border_loops_made;
     /* occlusion culling (sw_frame_desc.occlusion_culling): boxes tested against the occlusion
      * map, hierarchy nodes and face occurrences found hidden (of faces_culled, the occurrences
      * under those nodes included), planar faces drawn into the map */
