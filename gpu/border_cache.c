@@ -8,20 +8,20 @@
  * only the placement under the view (a 3 x 4 transform per sample, then the view-dependent
  * inner points) is left to the frame. The ribbons are the same, bit for bit.
  *
- * Keys: (face, tolerance) for an entry, (step u, step v) for a sample set of the entry; the
- * scene's serial for the whole cache (a new scene, or the next compiled version of a node scene,
- * empties it).
- * Concurrency: the preparing thread and the tessellation chunks of its frame look up and add
- * entries at once, without a lock: slots of an open-addressed table and the head of each entry's
- * list of sample sets are set by compare-and-swap; what is published is never changed (but its
- * last-use frame and byte count, atomics) or freed during a frame. Between frames
- * (sw__fr_border_cache_begin, on one preparing thread; a second prepare of the same context
- * meanwhile runs without the cache) the cache is emptied when the scene changed, and over its
- * byte budget it keeps only the entries the last frame used: a walkthrough's working set stays,
- * and a frame whose own set outgrows the budget adds no more than the budget and reuses what it
- * holds, rather than emptying and refilling it every frame. A table found full grows.
- * A frame's geometry keeps copies of the loops it hands to the trim stage (the submitting thread
- * draws trim textures from them), never the cache's. */
+ * Keys: (face, tolerance) for an entry of trim loops, (face, rectangle) for one rectangular loop
+ * (an untrimmed face's parameter box, a hierarchy node's part of its face), and (step u, step v)
+ * for a sample set of an entry; the scene's serial for the whole cache (a new scene, or the next
+ * compiled version of a node scene, empties it). Concurrency: the preparing thread and the
+ * tessellation chunks of its frame look up and add entries at once, without a lock: slots of an
+ * open-addressed table and the head of each entry's list of sample sets are set by
+ * compare-and-swap; what is published is never changed (but its last-use frame and byte count,
+ * atomics) or freed during a frame. Between frames (sw__fr_border_cache_begin, on one preparing
+ * thread; a second prepare of the same context meanwhile runs without the cache) the cache is
+ * emptied when the scene changed, and over its byte budget it keeps only the entries the last frame
+ * used: a walkthrough's working set stays, and a frame whose own set outgrows the budget adds no
+ * more than the budget and reuses what it holds, rather than emptying and refilling it every frame.
+ * A table found full grows. A frame's geometry keeps copies of the loops it hands to the trim stage
+ * (the submitting thread draws trim textures from them), never the cache's. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
@@ -46,7 +46,8 @@ typedef struct border_set {
 
 struct sw__fr_border_entry {
     uint32_t face;
-    double tol; /* < 0: the face's parameter box (untrimmed) */
+    double tol;     /* < 0: the rectangle's loop */
+    double rect[4]; /* u0, u1, v0, v1 (tol < 0; else 0) */
     sw_sg_polyline *loops;
     uint32_t n, floored; /* loops, and loops flattened farther than tol somewhere */
     int *left_inside;
@@ -104,14 +105,24 @@ static void entry_free(sw__fr_border_entry *e)
     sw__free(e);
 }
 
-static uint64_t key_hash(uint32_t face, double tol)
+static uint64_t key_hash(uint32_t face, double tol, const double rect[4])
 {
-    uint64_t t;
-    memcpy(&t, &tol, sizeof t);
-    uint64_t h = (uint64_t)face * 0x9E3779B97F4A7C15ull ^ (t + 0x632BE59BD9B4E019ull);
+    uint64_t h = (uint64_t)face * 0x9E3779B97F4A7C15ull;
+    const double parts[5] = {tol, rect[0], rect[1], rect[2], rect[3]};
+    for (int k = 0; k < 5; ++k) {
+        uint64_t b;
+        memcpy(&b, &parts[k], sizeof b);
+        h ^= b + 0x632BE59BD9B4E019ull + (h << 6) + (h >> 2);
+    }
     h ^= h >> 31;
     h *= 0xBF58476D1CE4E5B9ull;
     return h ^ (h >> 29);
+}
+
+static int same_key(const sw__fr_border_entry *e, uint32_t face, double tol, const double rect[4])
+{
+    return e->face == face && e->tol == tol && e->rect[0] == rect[0] && e->rect[1] == rect[1] &&
+           e->rect[2] == rect[2] && e->rect[3] == rect[3];
 }
 
 /* Re-files the entries into n_slots slots (a power of two, at least the entries kept); those
@@ -144,7 +155,7 @@ static void refile(sw__fr_border_cache *c, size_t n_slots, uint64_t since)
     for (size_t k = 0; k < kept; ++k) {
         sw__fr_border_entry *e = atomic_load_explicit(&old[k], memory_order_relaxed);
         atomic_store_explicit(&old[k], NULL, memory_order_relaxed);
-        size_t i = (size_t)key_hash(e->face, e->tol) & (n_slots - 1);
+        size_t i = (size_t)key_hash(e->face, e->tol, e->rect) & (n_slots - 1);
         while (atomic_load_explicit(&fresh[i], memory_order_relaxed))
             i = (i + 1) & (n_slots - 1);
         atomic_store_explicit(&fresh[i], e, memory_order_relaxed);
@@ -202,8 +213,10 @@ void sw__fr_border_cache_end(sw__fr_border_cache *c)
         atomic_store(&c->busy, 0);
 }
 
-/* The face's loops at tol (tol < 0: its parameter box), with their sides, counted as flattened. */
-static sw__fr_border_entry *entry_make(const sw__fr_env *env, uint32_t face, double tol)
+/* The face's loops at tol (tol < 0: the rectangle's, counter-clockwise), with their sides,
+ * counted as flattened. */
+static sw__fr_border_entry *entry_make(const sw__fr_env *env, uint32_t face, double tol,
+                                       const double rect[4])
 {
     const sw_sg_face_rec *rec = &env->sv->faces[face];
     sw__fr_border_entry *e = sw__calloc(1, sizeof *e);
@@ -212,6 +225,7 @@ static sw__fr_border_entry *entry_make(const sw__fr_env *env, uint32_t face, dou
         return NULL;
     e->face = face;
     e->tol = tol;
+    memcpy(e->rect, rect, sizeof e->rect);
     e->loops = sw__calloc(n ? n : 1, sizeof *e->loops);
     e->left_inside = sw__calloc(n ? n : 1, sizeof *e->left_inside);
     if (!e->loops || !e->left_inside) {
@@ -220,8 +234,8 @@ static sw__fr_border_entry *entry_make(const sw__fr_env *env, uint32_t face, dou
     }
     size_t bytes = sizeof *e + n * (sizeof *e->loops + sizeof *e->left_inside);
     if (tol < 0.0) {
-        const double *ub = rec->uv_box;
-        const double box[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
+        const double *b = rect;
+        const double box[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
         if (!(e->loops[0].uv = sw__malloc(sizeof box))) {
             entry_free(e);
             return NULL;
@@ -258,21 +272,22 @@ static void entry_discard(sw__fr_border_cache *c, sw__fr_border_entry *e)
     entry_free(e);
 }
 
-const sw__fr_border_entry *sw__fr_border_entry_get(const sw__fr_env *env, uint32_t face, double tol)
+static const sw__fr_border_entry *entry_get(const sw__fr_env *env, uint32_t face, double tol,
+                                            const double rect[4])
 {
     sw__fr_border_cache *c = env->borders;
     if (!c || c->budget == 0)
         return NULL;
     const int may_add = atomic_load_explicit(&c->bytes, memory_order_relaxed) < c->budget;
     const size_t mask = c->n_slots - 1;
-    size_t i = (size_t)key_hash(face, tol) & mask;
+    size_t i = (size_t)key_hash(face, tol, rect) & mask;
     sw__fr_border_entry *made = NULL;
     for (int probe = 0; probe < MAX_PROBES; ++probe, i = (i + 1) & mask) {
         sw__fr_border_entry *e = atomic_load_explicit(&c->slots[i], memory_order_acquire);
         if (!e) {
             if (!may_add)
                 return NULL; /* over the budget: what the frame finds, no more */
-            if (!made && !(made = entry_make(env, face, tol)))
+            if (!made && !(made = entry_make(env, face, tol, rect)))
                 return NULL;
             if (atomic_compare_exchange_strong_explicit(
                     &c->slots[i], &e, made, memory_order_acq_rel, memory_order_acquire)) {
@@ -281,7 +296,7 @@ const sw__fr_border_entry *sw__fr_border_entry_get(const sw__fr_env *env, uint32
             }
             /* another thread took the slot: e is its entry */
         }
-        if (e->face == face && e->tol == tol) {
+        if (same_key(e, face, tol, rect)) {
             entry_discard(c, made);
             if (atomic_load_explicit(&e->last_used, memory_order_relaxed) != c->frame)
                 atomic_store_explicit(&e->last_used, c->frame, memory_order_relaxed);
@@ -291,6 +306,18 @@ const sw__fr_border_entry *sw__fr_border_entry_get(const sw__fr_env *env, uint32
     atomic_store(&c->full, 1);
     entry_discard(c, made);
     return NULL;
+}
+
+const sw__fr_border_entry *sw__fr_border_entry_get(const sw__fr_env *env, uint32_t face, double tol)
+{
+    static const double none[4] = {0.0, 0.0, 0.0, 0.0};
+    return tol >= 0.0 ? entry_get(env, face, tol, none) : NULL;
+}
+
+const sw__fr_border_entry *sw__fr_border_rect_get(const sw__fr_env *env, uint32_t face,
+                                                  const double rect[4])
+{
+    return entry_get(env, face, -1.0, rect);
 }
 
 static border_set *set_make(const sw__fr_env *env, const sw__fr_border_entry *e,
@@ -371,7 +398,7 @@ static border_set *set_get(const sw__fr_env *env, const sw__fr_border_entry *e,
 
 sw_result sw__fr_border_entry_ribbons(sw__fr_tess *t, const occurrence *o,
                                       const sw__fr_border_entry *e, const double cell[2],
-                                      sw_status *status)
+                                      const double *st_box, size_t share, sw_status *status)
 {
     if (t->env->ctx->crack_fill_off || !(cell[0] > 0.0) || !(cell[1] > 0.0))
         return SW_OK;
@@ -385,14 +412,14 @@ sw_result sw__fr_border_entry_ribbons(sw__fr_tess *t, const occurrence *o,
     sw_result r = SW_OK;
     for (uint32_t k = 0; !s && k < e->n && r == SW_OK; ++k)
         r = sw__fr_fat_border(t, o, e->loops[k].uv, e->loops[k].count, e->left_inside[k], cell,
-                              NULL, 0, status);
+                              st_box, share, status);
     if (s && made_here)
         t->st->border_loops_made += e->n;
     else if (s)
         t->st->border_loops_kept += e->n;
     for (uint32_t k = 0; s && k < e->n && r == SW_OK; ++k)
         if (s->loop[k])
-            r = sw__fr_placed_border(t, o, s->loop[k], cell, NULL, 0, status);
+            r = sw__fr_placed_border(t, o, s->loop[k], cell, st_box, share, status);
     return r;
 }
 

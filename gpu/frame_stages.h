@@ -326,19 +326,28 @@ void sw__fr_border_cache_end(sw__fr_border_cache *c);
 /* Tests and benchmarks, between frames: 0 turns it off. Returns the budget it had. */
 size_t sw__fr_border_cache_set_budget(sw__fr_border_cache *c, size_t bytes);
 size_t sw__fr_border_cache_bytes(const sw__fr_border_cache *c);
-/* The face's loops at tol (tol < 0: its parameter box as one loop), looked up or made; NULL when
- * the frame has no cache, it is over its budget or full, or the loops fail (the caller then
- * flattens them itself, and reports). Any thread of the frame's preparation. */
+/* The face's trim loops flattened at tol, looked up or made; NULL when the frame has no cache,
+ * it is over its budget or full, or the loops fail (the caller then flattens them itself, and
+ * reports). Any thread of the frame's preparation. */
 const sw__fr_border_entry *sw__fr_border_entry_get(const sw__fr_env *env, uint32_t face,
                                                    double tol);
+/* The same for one counter-clockwise loop around rect (u0, u1, v0, v1) in the face's
+ * parameters: an untrimmed face's box, a hierarchy node's rectangle. */
+const sw__fr_border_entry *sw__fr_border_rect_get(const sw__fr_env *env, uint32_t face,
+                                                  const double rect[4]);
 const sw_sg_polyline *sw__fr_border_entry_loops(const sw__fr_border_entry *e, uint32_t *n);
 /* Counts the entry's loops flattened farther than their tolerance, as a flattening does. */
 void sw__fr_border_entry_count(sw__fr_tess *t, const sw__fr_border_entry *e);
-/* The fat borders of the entry's loops under o, sampled at steps cell (§7.1). */
+/* The fat borders of the entry's loops under o, sampled at steps cell (§7.1); st_box and share
+ * as sw__fr_fat_border's. */
 sw_result sw__fr_border_entry_ribbons(sw__fr_tess *t, const occurrence *o,
                                       const sw__fr_border_entry *e, const double cell[2],
-                                      sw_status *status);
-/* The fat border of a face's parameter box (an untrimmed face's), from the cache when it can. */
+                                      const double *st_box, size_t share, sw_status *status);
+/* The fat border along rect (counter-clockwise) as sw__fr_fat_border draws it, from the cache
+ * when it can; box: along the face's parameter box (an untrimmed face's). */
+sw_result sw__fr_rect_border(sw__fr_tess *t, const occurrence *o, const double rect[4],
+                             const double cell[2], const double *st_box, size_t share,
+                             sw_status *status);
 sw_result sw__fr_box_border(sw__fr_tess *t, const occurrence *o, const double cell[2],
                             sw_status *status);
 

@@ -410,7 +410,7 @@ sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops
     const face_loops *fl = &t->geo->loops[loops];
     const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, fl->face, fl->tol);
     if (e)
-        return sw__fr_border_entry_ribbons(t, o, e, cell, status);
+        return sw__fr_border_entry_ribbons(t, o, e, cell, NULL, 0, status);
     sw_result r = SW_OK;
     for (uint32_t k = 0; r == SW_OK && !t->env->ctx->crack_fill_off && k < fl->n; ++k)
         r = sw__fr_fat_border(t, o, fl->loops[k].uv, fl->loops[k].count,
@@ -418,15 +418,22 @@ sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops
     return r;
 }
 
+sw_result sw__fr_rect_border(sw__fr_tess *t, const occurrence *o, const double rect[4],
+                             const double cell[2], const double *st_box, size_t share,
+                             sw_status *status)
+{
+    const sw__fr_border_entry *e = sw__fr_border_rect_get(t->env, o->face, rect);
+    if (e)
+        return sw__fr_border_entry_ribbons(t, o, e, cell, st_box, share, status);
+    const double *b = rect;
+    const double loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
+    return sw__fr_fat_border(t, o, loop, 4, 1, cell, st_box, share, status);
+}
+
 sw_result sw__fr_box_border(sw__fr_tess *t, const occurrence *o, const double cell[2],
                             sw_status *status)
 {
-    const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, o->face, -1.0);
-    if (e)
-        return sw__fr_border_entry_ribbons(t, o, e, cell, status);
-    const double *ub = t->env->sv->faces[o->face].uv_box;
-    const double box_loop[8] = {ub[0], ub[2], ub[1], ub[2], ub[1], ub[3], ub[0], ub[3]};
-    return sw__fr_fat_border(t, o, box_loop, 4, 1, cell, NULL, 0, status);
+    return sw__fr_rect_border(t, o, t->env->sv->faces[o->face].uv_box, cell, NULL, 0, status);
 }
 
 sw_result sw__fr_tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,

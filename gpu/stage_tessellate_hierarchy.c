@@ -193,9 +193,7 @@ static void count_item(hl_face *hf, const sw__gpu_patch *pt, int on_gpu, int tri
 static sw_result item_border(hl_face *hf, const hl_choice *c, const double cell[2],
                              const double *st_box, size_t share, sw_status *status)
 {
-    const double *b = c->rect;
-    const double loop[8] = {b[0], b[2], b[1], b[2], b[1], b[3], b[0], b[3]};
-    return sw__fr_fat_border(hf->f, hf->o, loop, 4, 1, cell, st_box, share, status);
+    return sw__fr_rect_border(hf->f, hf->o, c->rect, cell, st_box, share, status);
 }
 
 /* Per-item trim textures (a face whose one texture would be too large): the item's own draw,

@@ -65,7 +65,7 @@ static sw_result face_borders(sw__fr_tess *t, const occurrence *o, double extent
     const sw__fr_border_entry *e = sw__fr_border_entry_get(t->env, o->face, tol);
     if (e) {
         sw__fr_border_entry_count(t, e);
-        return sw__fr_border_entry_ribbons(t, o, e, cell, status);
+        return sw__fr_border_entry_ribbons(t, o, e, cell, NULL, 0, status);
     }
     int64_t idx = -1;
     sw_result r = sw__fr_face_loops(t, o->face, tol, &idx, status);
