@@ -14,7 +14,7 @@
 
 #define LODS_MAGIC "SWLODS\0"
 #define LODS_VERSION 1u
-#define LODS_MAX_LEVELS 9
+#define LODS_MAX_LEVELS SW_LOD_CACHE_MAX_LEVELS
 
 /* ---- the key ----------------------------------------------------------------------------------
  */
@@ -310,4 +310,80 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
     }
     sw__free(chains);
     return SW_OK;
+}
+
+/* Skips count elements of elem bytes; 0 when they run past the end. */
+static int skip(reader *r, uint64_t count, size_t elem)
+{
+    if (count > (r->n - r->at) / elem)
+        return 0;
+    r->at += (size_t)count * elem;
+    return 1;
+}
+
+/* One level's header into the summary, its arrays skipped. */
+static sw_result summarize_level(reader *r, int32_t k, sw_lod_static_cache_summary *out)
+{
+    uint32_t nv, nt;
+    double d[4];
+    if (!take(r, &nv, 4) || !take(r, &nt, 4) || !take(r, d, sizeof d))
+        return bad(r, "truncated level header", NULL);
+    if (!finite_all(d, 4) || !(d[0] >= 0.0))
+        return bad(r, "a level's ε is not a finite non-negative number", NULL);
+    const size_t per_vertex = 3 * sizeof(double) + 3 * sizeof(float) + 2 * sizeof(double) + 4;
+    if (!skip(r, nv, per_vertex) || !skip(r, nt, 3 * sizeof(uint32_t)))
+        return bad(r, "a level's arrays run past the end", NULL);
+    const int first = out->level_chains[k]++ == 0;
+    out->level_vertices[k] += nv;
+    out->level_triangles[k] += nt;
+    out->level_eps_min[k] = first ? d[0] : fmin(out->level_eps_min[k], d[0]);
+    out->level_eps_max[k] = first ? d[0] : fmax(out->level_eps_max[k], d[0]);
+    return SW_OK;
+}
+
+static sw_result summarize_chain(reader *r, sw_lod_static_cache_summary *out)
+{
+    int32_t n_levels;
+    uint32_t patches;
+    double delta;
+    if (!take(r, &n_levels, 4) || !take(r, &patches, 4) || !take(r, &delta, 8))
+        return bad(r, "truncated chain header", NULL);
+    if (n_levels < 1 || n_levels > LODS_MAX_LEVELS || !(delta > 0.0) || !isfinite(delta))
+        return bad(r, "a chain's level count or δ is out of range", NULL);
+    out->delta_min = out->chains ? fmin(out->delta_min, delta) : delta;
+    out->delta_max = out->chains ? fmax(out->delta_max, delta) : delta;
+    out->chains++;
+    out->max_levels = (uint32_t)n_levels > out->max_levels ? (uint32_t)n_levels : out->max_levels;
+    sw_result res = SW_OK;
+    for (int32_t k = 0; k < n_levels && res == SW_OK; ++k)
+        res = summarize_level(r, k, out);
+    return res;
+}
+
+sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const char *what,
+                                        sw_lod_static_cache_summary *out, sw_status *status)
+{
+    memset(out, 0, sizeof *out);
+    reader r = {data, size, 0, what, status};
+    char magic[8];
+    if (!take(&r, magic, 8) || memcmp(magic, LODS_MAGIC, 8) != 0)
+        return bad(&r, "not a static LOD cache (bad magic)", NULL);
+    if (!take(&r, &out->version, 4) || out->version != LODS_VERSION)
+        return sw__fail(status, SW_ERR_VERSION,
+                        "%s: LODS offset 8: cache version %u, this program "
+                        "reads %u",
+                        what, out->version, LODS_VERSION);
+    if (!take(&r, &out->units, 4) || !take(&r, &out->key, 8))
+        return bad(&r, "truncated header", NULL);
+    sw_result res = SW_OK;
+    for (uint32_t u = 0; u < out->units && res == SW_OK; ++u) {
+        uint32_t has;
+        if (!take(&r, &has, 4) || has > 1)
+            res = bad(&r, "a unit's chain flag is not 0 or 1", NULL);
+        else if (has)
+            res = summarize_chain(&r, out);
+    }
+    if (res == SW_OK && r.at != r.n)
+        res = bad(&r, "bytes after the last chain", NULL);
+    return res;
 }

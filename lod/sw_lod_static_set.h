@@ -174,6 +174,23 @@ sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, 
 sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_t size,
                                  const char *what, uint32_t *adopted, sw_status *status);
 
+/* What a cache holds, read without the scene's clustering (`splinewalk info`): its structure is
+ * checked (header, bounds, counts, finite ε), not whether it fits the scene's super-surfaces,
+ * which the first renderer to use it checks. Per level index k: the chains with a level k and
+ * their vertices, triangles and ε range. */
+enum { SW_LOD_CACHE_MAX_LEVELS = 9 };
+typedef struct sw_lod_static_cache_summary {
+    uint32_t version, units, chains, max_levels;
+    uint64_t key;
+    double delta_min, delta_max; /* level 0's rigorous bound δ over the chains (object units) */
+    uint32_t level_chains[SW_LOD_CACHE_MAX_LEVELS];
+    uint64_t level_vertices[SW_LOD_CACHE_MAX_LEVELS], level_triangles[SW_LOD_CACHE_MAX_LEVELS];
+    double level_eps_min[SW_LOD_CACHE_MAX_LEVELS], level_eps_max[SW_LOD_CACHE_MAX_LEVELS];
+} sw_lod_static_cache_summary;
+/* Errors: SW_ERR_FORMAT (with the offset), SW_ERR_VERSION. */
+sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const char *what,
+                                        sw_lod_static_cache_summary *out, sw_status *status);
+
 #ifdef __cplusplus
 }
 #endif

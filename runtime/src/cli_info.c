@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* splinewalk info SCENE [--json] [--partial] */
 #include "cli.h"
+#include "sw_lod_static_set.h"
+#include "sw_rt.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -11,7 +13,10 @@ static const char k_usage[] =
     "Describes a scene (.sws, or any file `import` reads, imported on the fly): surfaces by kind\n"
     "of their source geometry, trimmed surfaces, trim loops and curves, Bézier patches after\n"
     "extraction, maximum degrees, control points, nodes and instances, face occurrences after\n"
-    "instancing, adjacent face pairs, the bounding box and the memory the loaded scene takes.\n"
+    "instancing, adjacent face pairs, the bounding box and the memory the loaded scene takes,\n"
+    "and the static LOD cache a .sws holds (`build-lod`): its super-surfaces with levels, and per\n"
+    "level their triangles, vertices and error bounds; whether it fits the scene's clustering\n"
+    "is checked when a renderer first uses it.\n"
     "A CAD file's faces skipped or repaired by the import are each named in a warning on stderr\n"
     "and counted (as `import` does); a truncated IGES file is refused unless --partial.\n"
     "\n"
@@ -36,8 +41,10 @@ static void print_json_string(const char *s)
 }
 
 static void print_json_faces(void);
+static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes);
 
-static void print_json(const char *path, const sw_scene_info *in)
+static void print_json(const char *path, const sw_scene_info *in, int got,
+                       const sw_lod_static_cache_summary *lods, size_t lod_bytes)
 {
     printf("{\"file\": ");
     print_json_string(path);
@@ -53,15 +60,17 @@ static void print_json(const char *path, const sw_scene_info *in)
            "\"meshes\": %u, \"mesh_triangles\": %llu, \"mesh_occurrences\": %llu, "
            "\"triangle_occurrences\": %llu, \"faces_skipped\": %u, \"faces_repaired\": %u, "
            "\"partial\": %s, "
-           "\"bbox\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g], \"memory_bytes\": %zu}\n",
+           "\"bbox\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g], \"memory_bytes\": %zu, ",
            in->trimmed_faces, in->loops, in->curves, (unsigned long long)in->bezier_patches,
            in->max_degree_u, in->max_degree_v, in->max_curve_degree,
            (unsigned long long)in->control_points, in->nodes, in->instances,
            (unsigned long long)in->face_occurrences, in->adjacent_face_pairs, in->meshes,
            (unsigned long long)in->mesh_triangles, (unsigned long long)in->mesh_occurrences,
            (unsigned long long)in->triangle_occurrences, in->faces_skipped, in->faces_repaired,
-           in->partial ? "true" : "false", in->bbox_min[0], in->bbox_min[1],
-           in->bbox_min[2], in->bbox_max[0], in->bbox_max[1], in->bbox_max[2], in->memory_bytes);
+           in->partial ? "true" : "false", in->bbox_min[0], in->bbox_min[1], in->bbox_min[2],
+           in->bbox_max[0], in->bbox_max[1], in->bbox_max[2], in->memory_bytes);
+    print_lod_json(got, lods, lod_bytes);
+    printf("}\n");
 }
 
 /* The import's skipped and repaired faces as records: face index (null for a face the reader
@@ -118,6 +127,61 @@ static void print_text(const char *path, const sw_scene_info *in)
                in->faces_repaired, in->partial ? "; truncated file imported in part" : "");
 }
 
+/* The scene's LODS section summarized: 1 when it has one, 0 when none, -1 on a damaged one
+ * (status set). */
+static int lod_cache_of(sw_scene handle, const char *path, sw_lod_static_cache_summary *sum,
+                        size_t *bytes, sw_status *status)
+{
+    sw_rt_scene *scene = NULL;
+    if (sw_rt_scene_acquire(handle, &scene, status) != SW_OK)
+        return -1;
+    const void *data = NULL;
+    sw_status none = {0};
+    int got = 0;
+    if (sw_sg_scene_lods(scene->sg, &data, bytes, &none) == SW_OK)
+        got = sw_lod_static_cache_summarize(data, *bytes, path, sum, status) == SW_OK ? 1 : -1;
+    else if (none.result != SW_ERR_NOT_FOUND) {
+        *status = none;
+        got = -1;
+    }
+    sw_rt_scene_release(scene);
+    return got;
+}
+
+static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t bytes)
+{
+    if (got == 0) {
+        printf("  LOD cache       none (`splinewalk build-lod` makes one; without it static LODs "
+               "are built on first use)\n");
+        return;
+    }
+    printf("  LOD cache       %.1f MiB: %u of %u super-surfaces with levels, up to %u levels, "
+           "level 0 within δ %g-%g\n",
+           (double)bytes / (1024.0 * 1024.0), c->chains, c->units, c->max_levels, c->delta_min,
+           c->delta_max);
+    for (uint32_t k = 0; k < c->max_levels; ++k)
+        printf("    level %u       %u super-surfaces, %llu triangles, %llu vertices, ε %g-%g\n", k,
+               c->level_chains[k], (unsigned long long)c->level_triangles[k],
+               (unsigned long long)c->level_vertices[k], c->level_eps_min[k], c->level_eps_max[k]);
+}
+
+static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes)
+{
+    if (got == 0) {
+        printf("\"lod_cache\": null");
+        return;
+    }
+    printf("\"lod_cache\": {\"bytes\": %zu, \"version\": %u, \"units\": %u, \"chains\": %u, "
+           "\"delta_min\": %.17g, \"delta_max\": %.17g, \"levels\": [",
+           bytes, c->version, c->units, c->chains, c->delta_min, c->delta_max);
+    for (uint32_t k = 0; k < c->max_levels; ++k)
+        printf("%s{\"chains\": %u, \"triangles\": %llu, \"vertices\": %llu, \"eps_min\": "
+               "%.17g, \"eps_max\": %.17g}",
+               k ? ", " : "", c->level_chains[k], (unsigned long long)c->level_triangles[k],
+               (unsigned long long)c->level_vertices[k], c->level_eps_min[k], c->level_eps_max[k]);
+    printf("]}");
+}
+
 int sw_cli_info(int argc, char **argv)
 {
     const char *path = NULL;
@@ -147,13 +211,18 @@ int sw_cli_info(int argc, char **argv)
     if (sw_cli_load_scene(path, flags, &scene, &status) != SW_OK)
         return sw_cli_report_load("info", &status);
     sw_scene_info info;
+    sw_lod_static_cache_summary lods;
+    size_t lod_bytes = 0;
     sw_result r = sw_scene_get_info(scene, &info, &status);
+    const int got = r == SW_OK ? lod_cache_of(scene, path, &lods, &lod_bytes, &status) : -1;
     sw_scene_destroy(scene);
-    if (r != SW_OK)
+    if (r != SW_OK || got < 0)
         return sw_cli_report("info", &status);
     if (json)
-        print_json(path, &info);
+        print_json(path, &info, got, &lods, lod_bytes);
     else
         print_text(path, &info);
+    if (!json)
+        print_lod_text(got, &lods, lod_bytes);
     return 0;
 }

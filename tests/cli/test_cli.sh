@@ -268,5 +268,18 @@ vfaces=$(sed -n 's/.*"faces": \([0-9]*\),.*/\1/p' v1.json)
 [ "$(stat -c %s v1.png 2>/dev/null || echo 0)" -gt 4000 ] || fail "render of the vehicles: blank image"
 pass "generate vehicle: usage errors, missing data, 1000 surfaces ($vfaces unique), BREP read back, rendered"
 
+# info and the static LOD cache of a .sws: "none" before build-lod; after it, per level the
+# triangles build-lod itself reported (catches: info reading the section wrongly, or not at all)
+"$sw" import "$data/occ/Pump_Nut.brep" -o nut.sws >/dev/null 2>&1 || fail "import Pump_Nut"
+"$sw" info nut.sws | grep -q "^  LOD cache       none" || fail "info: a scene without LODs not said"
+"$sw" info nut.sws --json | grep -q '"lod_cache": null}' || fail "info --json: no lod_cache null"
+"$sw" build-lod nut.sws >lods.txt 2>&1 || { fail "build-lod nut.sws"; cat lods.txt; }
+built=$(awk '$1 ~ /^[0-9]$/ && $4 == "%" { printf "%s:%s ", $1, $2 }' lods.txt)
+shown=$("$sw" info nut.sws | awk '$1 == "level" { printf "%s:%s ", $2, $5 }')
+[ -n "$built" ] && [ "$built" = "$shown" ] || fail "info's LOD levels '$shown', build-lod's '$built'"
+"$sw" info nut.sws --json | python3 -c 'import json, sys; c = json.load(sys.stdin)["lod_cache"]; sys.exit(not (c["chains"] > 0 and len(c["levels"]) == 5))' ||
+  fail "info --json: lod_cache"
+pass "info: the LOD cache (none; then levels $shown as build-lod built them)"
+
 echo "$failures failure(s)"
 [ $failures -eq 0 ]

@@ -12,6 +12,10 @@
  *    equal to the original byte for byte;
  *  - every truncation of the cache, a wrong key and a triangle index out of range are refused
  *    as a whole (nothing adopted), with SW_ERR_FORMAT / SW_ERR_INVALID_ARGUMENT;
+ *  - the summary `splinewalk info` prints (sw_lod_static_cache_summarize) equals the set's own
+ *    chains: chains, levels, per level the triangles, vertices and ε range, δ range (catches: a
+ *    summary that skips a level's arrays by the wrong size and reads garbage after the first);
+ *    every truncation it is given is refused with SW_ERR_FORMAT or SW_ERR_VERSION;
  *  - the .sws LODS section: saved, reopened, the same bytes back; the core sections unchanged; a
  *    flipped byte in it gives SW_ERR_CHECKSUM while the scene itself still opens and validates.
  * usage: test_static_cache MODEL WORKDIR
@@ -184,6 +188,58 @@ static void check_cache(const sw_sg_scene *scene, sw_th_pool *pool, const sw_lod
            "refused\n", size, tried);
 }
 
+/* The summary against the chains themselves. */
+static void check_summary(const sw_lod_static_set *a, const unsigned char *blob, size_t size)
+{
+    sw_lod_static_cache_summary sum, want;
+    sw_status st = {0};
+    memset(&want, 0, sizeof want);
+    CHECK(sw_lod_static_cache_summarize(blob, size, "cache", &sum, &st) == SW_OK, "summary: %s",
+          st.message);
+    want.units = sw_lod_static_set_unit_count(a);
+    for (uint32_t u = 0; u < want.units; ++u) {
+        const sw_lod_static_chain *c = sw_lod_static_set_get(a, u);
+        if (!c)
+            continue;
+        want.delta_min = want.chains ? fmin(want.delta_min, c->delta) : c->delta;
+        want.delta_max = want.chains ? fmax(want.delta_max, c->delta) : c->delta;
+        want.chains++;
+        want.max_levels =
+            (uint32_t)c->n_levels > want.max_levels ? (uint32_t)c->n_levels : want.max_levels;
+        for (int32_t k = 0; k < c->n_levels; ++k) {
+            const sw_lod_static_level *l = &c->levels[k];
+            const int first = want.level_chains[k]++ == 0;
+            want.level_vertices[k] += l->n_vertices;
+            want.level_triangles[k] += l->n_triangles;
+            want.level_eps_min[k] = first ? l->eps : fmin(want.level_eps_min[k], l->eps);
+            want.level_eps_max[k] = first ? l->eps : fmax(want.level_eps_max[k], l->eps);
+        }
+    }
+    int same = sum.units == want.units && sum.chains == want.chains &&
+               sum.max_levels == want.max_levels && sum.delta_min == want.delta_min &&
+               sum.delta_max == want.delta_max;
+    for (uint32_t k = 0; k < want.max_levels; ++k)
+        same = same && sum.level_chains[k] == want.level_chains[k] &&
+               sum.level_vertices[k] == want.level_vertices[k] &&
+               sum.level_triangles[k] == want.level_triangles[k] &&
+               sum.level_eps_min[k] == want.level_eps_min[k] &&
+               sum.level_eps_max[k] == want.level_eps_max[k];
+    CHECK(same && want.chains > 0 && want.max_levels > 1,
+          "summary: %u chains, %u levels, level 0 %llu triangles; the chains: %u, %u, %llu",
+          sum.chains, sum.max_levels, (unsigned long long)sum.level_triangles[0], want.chains,
+          want.max_levels, (unsigned long long)want.level_triangles[0]);
+    const size_t step = size / 300 + 1;
+    int refused = 0, tried = 0;
+    for (size_t cut = 0; cut < size; cut += step, ++tried) {
+        const sw_result r = sw_lod_static_cache_summarize(blob, cut, "cache", &sum, &st);
+        refused += r == SW_ERR_FORMAT || r == SW_ERR_VERSION;
+    }
+    CHECK(refused == tried, "summary: %d of %d truncations refused", refused, tried);
+    printf("  summary: %u chains, %u levels, level 0 %llu triangles, as the chains; %d "
+           "truncations refused\n",
+           want.chains, want.max_levels, (unsigned long long)want.level_triangles[0], tried);
+}
+
 static void check_file(sw_sg_scene *scene, const void *blob, size_t size, const char *dir)
 {
     char path[4096];
@@ -263,6 +319,7 @@ int main(int argc, char **argv)
     CHECK(sw_lod_static_set_serialize(a, &blob, &size, &st) == SW_OK, "serialize: %s", st.message);
     if (blob) {
         check_cache(scene, pool, a, blob, size);
+        check_summary(a, blob, size);
         check_file(scene, blob, size, argv[2]);
     }
     free(blob);
