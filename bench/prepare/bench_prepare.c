@@ -109,21 +109,29 @@ static void print_series(const char *name, series *s)
            bench_quantile(s->ms[PROCESS], s->n, 0.5));
 }
 
-/* Alternating passes of two variants set by set(b, 0 or 1), side by side; prints both. */
-static int ab(bench *b, int passes, void (*set)(bench *, int), const char *names[2])
+/* The passes of two variants set by set(b, 0 or 1): alternating (the machine's drift shared),
+ * or each variant's in a row (a cache's state carries over within its own passes only); prints
+ * both. */
+static int variants(bench *b, int passes, int alternate, void (*set)(bench *, int),
+                    const char *names[2])
 {
     static series s[2];
     s[0].n = s[1].n = 0;
-    for (int p = 0; p < passes; ++p)
-        for (int k = 0; k < 2; ++k) {
-            set(b, k);
-            if (!pass(b, &s[k]))
-                return 0;
-        }
+    for (int i = 0; i < 2 * passes; ++i) {
+        const int k = alternate ? i % 2 : i / passes;
+        set(b, k);
+        if (!pass(b, &s[k]))
+            return 0;
+    }
     set(b, 0);
     for (int k = 0; k < 2; ++k)
         print_series(names[k], &s[k]);
     return 1;
+}
+
+static int ab(bench *b, int passes, void (*set)(bench *, int), const char *names[2])
+{
+    return variants(b, passes, 1, set, names);
 }
 
 static void set_affine(bench *b, int k)
@@ -149,23 +157,6 @@ static void set_borders(bench *b, int k)
         budget = sw__fr_border_cache_set_budget(b->ctx->borders, 0);
     else if (budget)
         sw__fr_border_cache_set_budget(b->ctx->borders, budget);
-}
-
-/* The passes of each variant in a row (a cache's state carries over within them only). */
-static int in_turn(bench *b, int passes, void (*set)(bench *, int), const char *names[2])
-{
-    static series s[2];
-    for (int k = 0; k < 2; ++k) {
-        s[k].n = 0;
-        set(b, k);
-        for (int p = 0; p < passes; ++p)
-            if (!pass(b, &s[k]))
-                return 0;
-    }
-    set(b, 0);
-    for (int k = 0; k < 2; ++k)
-        print_series(names[k], &s[k]);
-    return 1;
 }
 
 /* View 0 submitted with a pair's two variants: triangles of each, differing pixels. */
@@ -210,7 +201,7 @@ static int run_mode(bench *b, const char *mode, int passes)
         return 0;
     if (!ab(b, passes, set_density, density) || !compare_images(b, set_density))
         return 0;
-    if (!in_turn(b, passes, set_borders, borders) || !compare_images(b, set_borders))
+    if (!variants(b, passes, 0, set_borders, borders) || !compare_images(b, set_borders))
         return 0;
     return ab(b, passes, set_chunks, chunks);
 }
