@@ -4,6 +4,7 @@
  * k_usage for what is measured and how; the figures and their reading are in bench/peers/README.md.
  */
 #include "bench_peer.h"
+#include "cli.h"
 #include "peer_glu.h"
 #include "peer_mesh.h"
 #include "peer_splinewalk.h"
@@ -61,6 +62,9 @@ static const char k_usage[] =
     "                  in the renderer)\n"
     "  --no-occlusion  splinewalk without occlusion culling (sw_frame_desc.occlusion_culling:\n"
     "                  what the visible planar faces hide is culled; default: on, as in the CLI)\n"
+    "  --glibc-malloc  every peer with glibc's default trim and mmap thresholds; by default\n"
+    "                  they are raised for all peers alike, as `splinewalk` does and\n"
+    "                  docs/embedding.md advises (llvmpipe frees megabytes every frame)\n"
     "  --csv FILE      also write the rows as CSV (written aside, then renamed)\n"
     "  -h, --help      this text\n";
 
@@ -70,7 +74,7 @@ static const bp_peer_fn k_peer_fns[N_PEERS] = {bp_peer_splinewalk, bp_peer_glu, 
 
 typedef struct args {
     int use[N_PEERS];
-    int static_lods, occlusion;
+    int static_lods, occlusion, glibc_malloc;
     uint32_t frames, warmup, passes;
     int32_t w, h;
     double error_px;
@@ -113,6 +117,10 @@ static int parse(int argc, char **argv, args *a)
             return 1;
         if (!strcmp(o, "--static-lods")) {
             a->static_lods = 1;
+            continue;
+        }
+        if (!strcmp(o, "--glibc-malloc")) {
+            a->glibc_malloc = 1;
             continue;
         }
         if (!strcmp(o, "--occlusion") || !strcmp(o, "--no-occlusion")) {
@@ -285,10 +293,13 @@ int main(int argc, char **argv)
         return pr > 0 ? 0 : 2;
     }
     const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
+    if (!a.glibc_malloc)
+        sw_cli_keep_freed_memory(); /* before the peers' children are forked */
     printf("bench_peers: %dx%d, eps_img %g px, LP_NUM_THREADS=%s, EGL_PLATFORM=%s, %ld "
-           "processors online\n",
+           "processors online, malloc %s\n",
            a.w, a.h, a.error_px, lp ? lp : "(unset)", egl ? egl : "(unset)",
-           sysconf(_SC_NPROCESSORS_ONLN));
+           sysconf(_SC_NPROCESSORS_ONLN),
+           a.glibc_malloc ? "glibc's defaults" : "keeping freed memory");
     char tmp[4200];
     FILE *csv = NULL;
     if (a.csv) {

@@ -53,6 +53,12 @@ void sw_cli_print_import_notes(FILE *f, const char *cmd, const sw_scene_info *in
 /* sw_cli_report, with a hint at --partial for a truncated file (commands that take it). */
 int sw_cli_report_load(const char *cmd, const sw_status *status);
 double sw_cli_now_ms(void);
+/* Keeps freed memory in the process's heap (glibc's trim and mmap thresholds raised): llvmpipe
+ * allocates and frees megabytes every frame, and with the defaults the submitting thread faulted
+ * them in again each frame (a quarter of its time on a 10^4-surface building's orbit;
+ * docs/performance.md). Process-wide, so the command line and the benchmarks call it for
+ * themselves; the library leaves its host's malloc alone (docs/embedding.md). */
+void sw_cli_keep_freed_memory(void);
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s);
 
 #endif

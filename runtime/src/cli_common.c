@@ -5,6 +5,7 @@
 
 #include "sw_safe_write.h"
 
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -138,6 +139,12 @@ int sw_cli_report_load(const char *cmd, const sw_status *status)
         fprintf(stderr, "splinewalk %s: --partial imports what is whole of a truncated file\n",
                 cmd);
     return rc;
+}
+
+void sw_cli_keep_freed_memory(void)
+{
+    mallopt(M_MMAP_THRESHOLD, 32 << 20); /* glibc's largest */
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
 }
 
 double sw_cli_now_ms(void)

@@ -2,7 +2,6 @@
 /* splinewalk: the command-line runtime. */
 #include "cli.h"
 
-#include <malloc.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -35,21 +34,9 @@ static void usage(FILE *out)
             SW_VERSION_STRING);
 }
 
-/* llvmpipe allocates and frees megabytes of scene and vertex memory every frame; glibc returned
- * them to the system each time (its heap trimmed above 128 KiB free, larger blocks mapped and
- * unmapped), and the submitting thread paid the page faults again each frame: on a 10^4-surface
- * building's orbit, 18-26 of its 65-91 ms per frame were in the kernel. Kept in the heap, the
- * frame takes 40-50 ms there (docs/performance.md). A process-wide setting, so the command line
- * makes it for itself; docs/embedding.md tells a host that embeds the library. */
-static void keep_freed_memory(void)
-{
-    mallopt(M_MMAP_THRESHOLD, 32 << 20); /* glibc's largest */
-    mallopt(M_TRIM_THRESHOLD, 256 << 20);
-}
-
 int main(int argc, char **argv)
 {
-    keep_freed_memory();
+    sw_cli_keep_freed_memory();
     if (argc < 2) {
         usage(stderr);
         return 2;
