@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Static LODs of a super-surface, Kumar et al. 1997 §4.1-§4.3: the adaptive trimmed tessellation
  * (level 0) and the chain of levels, simplified by lod/static_lod_openmesh.cpp and each declared
- * with its ε_k by the two-sided measurement of static_lod_measure.c. The faces' domains (cells,
- * scalings, flattened loops) are static_lod_domain.c's.
+ * with a certified ε_k (declare_level). The faces' domains (cells, scalings, flattened loops) are
+ * static_lod_domain.c's; static_lod_measure.c samples the distances the tests check ε_k with.
  *
  * Level 0 within δ, and why it holds. δ is split: δ_tri = 3/4 δ for the triangles against the
  * surface over their own (u, v) triangles, δ_trim = 1/4 δ for the trim loops.
@@ -670,39 +670,51 @@ typedef struct build_ctx {
     const sw_lod_static_desc *d;
     sw_result r;
     sw_status *status;
-    double t_measure;
-    sw_lod_mesh_distance *level0; /* built on the first level's measurement, shared by all */
+    double t_certify;
+    sw_lod_mesh_distance *level0; /* built for the first level, shared by all */
 } build_ctx;
 
+/* How tightly a level's distance to level 0 is certified: pieces are accepted at 5 % above the
+ * largest distance found, or below 1e-3 δ (the floor relative to the data), and split at most 12
+ * times (a triangle into 4^12 pieces at worst; the Lipschitz fallback beyond, counted). */
+static const double k_certify_rel = 0.05, k_certify_floor = 1e-3;
+enum { CERTIFY_MAX_DEPTH = 12 };
+
+/* ε_k of a simplified level, certified (Kumar et al. 1997 §4.1 declare "the simplified polygons
+ * lie within δ + ε of the surface" by their offset envelopes; our decimation keeps no envelope,
+ * so the bound is computed after it): for Hausdorff distances H(level, S) <= H(level, level 0) +
+ * H(level 0, S), level 0 is within δ of S both ways (the header comment), and both one-sided
+ * distances between the meshes are bounded by sw_lod_mesh_distance_bound. Level 0 -> level first:
+ * the other side then needs certifying only down to it. */
 static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
 {
     const double t0 = now_seconds();
-    /* a lattice and random points: the random pass catches the sharp peaks near slivers that a
-     * lattice of the same size can step over */
-    sw_lod_static_distance dist, dr;
-    const sw_lod_static_measure_desc random = {1, 0, 0, 1};
     const sw_lod_static_level *l0 = &b->chain->levels[0];
-    const double delta = b->chain->delta;
+    const double delta = b->chain->delta, floor = k_certify_floor * delta;
+    sw_lod_mesh_bound from0, to0;
+    sw_lod_mesh_distance *level = NULL;
     sw_result r = SW_OK;
-    if (!b->level0) /* once per chain: level 0 is the largest mesh the measurement builds */
+    if (!b->level0)
         r = sw_lod_mesh_distance_create(l0->positions, l0->triangles, l0->n_triangles, &b->level0,
                                         b->status);
     if (r == SW_OK)
-        r = sw__sl_measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, NULL, &dist,
-                                b->status);
+        r = sw_lod_mesh_distance_create(l->positions, l->triangles, l->n_triangles, &level,
+                                        b->status);
     if (r == SW_OK)
-        r = sw__sl_measure_with(b->scene, b->ps, l, b->level0, delta, l->eps_target, &random, &dr,
-                                b->status);
-    b->t_measure += now_seconds() - t0;
+        r = sw_lod_mesh_distance_bound(level, l0->positions, l0->triangles, l0->n_triangles,
+                                       k_certify_rel, floor, CERTIFY_MAX_DEPTH, &from0, b->status);
+    if (r == SW_OK)
+        r = sw_lod_mesh_distance_bound(b->level0, l->positions, l->triangles, l->n_triangles,
+                                       k_certify_rel, fmax(floor, from0.upper), CERTIFY_MAX_DEPTH,
+                                       &to0, b->status);
+    sw_lod_mesh_distance_free(level);
+    b->t_certify += now_seconds() - t0;
     if (r != SW_OK)
         return r;
-    dist.surface_to_mesh = fmax(dist.surface_to_mesh, dr.surface_to_mesh);
-    dist.mesh_to_surface = fmax(dist.mesh_to_surface, dr.mesh_to_surface);
-    l->measured[0] = dist.surface_to_mesh;
-    l->measured[1] = dist.mesh_to_surface;
-    /* never below level 0's δ: its vertices are level 0's, and a level measured exact (planes)
-     * would otherwise declare rounding noise */
-    l->eps = fmax(b->chain->delta, b->d->safety * fmax(dist.surface_to_mesh, dist.mesh_to_surface));
+    l->bound[0] = to0.upper;
+    l->bound[1] = from0.upper;
+    l->eps = delta + fmax(to0.upper, from0.upper);
+    b->chain->capped_pieces += to0.capped + from0.capped;
     return SW_OK;
 }
 
@@ -740,17 +752,15 @@ sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static
         d->eps_first = 2.0;
     if (d->eps_growth == 0.0)
         d->eps_growth = 4.0;
-    if (d->safety == 0.0)
-        d->safety = 1.5;
     if (d->max_vertices == 0)
         d->max_vertices = 4000000;
     if (d->max_vertices_per_patch == 0)
         d->max_vertices_per_patch = 4096;
     if (!(d->delta >= 0.0 && isfinite(d->delta)) || d->n_levels < 0 || d->n_levels > 8 ||
-        !(d->eps_first > 1.0) || !(d->eps_growth > 1.0) || !(d->safety >= 1.0))
+        !(d->eps_first > 1.0) || !(d->eps_growth > 1.0))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "static lod: delta %g, %d levels, eps_first %g, growth %g, safety %g",
-                        d->delta, (int)d->n_levels, d->eps_first, d->eps_growth, d->safety);
+                        "static lod: delta %g, %d levels, eps_first %g, growth %g", d->delta,
+                        (int)d->n_levels, d->eps_first, d->eps_growth);
     return SW_OK;
 }
 
@@ -822,19 +832,9 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                 r = b.r;
             sw__free(tol);
             sw_lod_mesh_distance_free(b.level0);
-            chain->seconds[1] = now_seconds() - t0 - b.t_measure;
+            chain->seconds[1] = now_seconds() - t0 - b.t_certify;
+            chain->seconds[2] = b.t_certify;
         }
-        /* level 0's bound is rigorous; its measurement is a check, kept for the report */
-        const double t1 = now_seconds();
-        sw_lod_static_distance dist;
-        if (r == SW_OK)
-            r = sw__sl_measure_set(scene, &ps, &chain->levels[0], NULL, d.delta, d.delta, NULL,
-                                   &dist, status);
-        if (r == SW_OK) {
-            chain->levels[0].measured[0] = dist.surface_to_mesh;
-            chain->levels[0].measured[1] = dist.mesh_to_surface;
-        }
-        chain->seconds[2] = b.t_measure + now_seconds() - t1;
     }
     mesh_buf_free(&m);
     sw__sl_patch_set_free(&ps);

@@ -46,7 +46,8 @@ static uint64_t set_key(const sw_lod_static_set *set, const sw_lod_static_desc *
             h = fnv(h, rec, sizeof rec);
         }
     }
-    const double d[5] = {levels->delta, levels->eps_first, levels->eps_growth, levels->safety,
+    const double d[5] = {levels->delta, levels->eps_first, levels->eps_growth,
+                         SW_LOD_STATIC_EPS_RULE,
                          levels->delta > 0.0 ? 0.0 : SW_LOD_STATIC_DELTA_REL};
     const int32_t i[3] = {levels->n_levels, (int32_t)levels->max_vertices,
                           (int32_t)levels->max_vertices_per_patch};
@@ -92,7 +93,7 @@ static void put_level(writer *w, const sw_lod_static_level *l)
 {
     put_u32(w, l->n_vertices);
     put_u32(w, l->n_triangles);
-    const double d[4] = {l->eps, l->eps_target, l->measured[0], l->measured[1]};
+    const double d[4] = {l->eps, l->eps_target, l->bound[0], l->bound[1]};
     put(w, d, sizeof d);
     put(w, l->positions, (size_t)l->n_vertices * 3 * sizeof *l->positions);
     put(w, l->normals, (size_t)l->n_vertices * 3 * sizeof *l->normals);
@@ -206,7 +207,7 @@ static sw_result read_level(reader *r, const sw_lod_static_set *set, const sw_lo
     double d[4];
     if (!take(r, &l->n_vertices, 4) || !take(r, &l->n_triangles, 4) || !take(r, d, sizeof d))
         return bad(r, "truncated level header", NULL);
-    l->eps = d[0], l->eps_target = d[1], l->measured[0] = d[2], l->measured[1] = d[3];
+    l->eps = d[0], l->eps_target = d[1], l->bound[0] = d[2], l->bound[1] = d[3];
     if (!finite_all(d, 4) || !(l->eps >= 0.0))
         return bad(r, "a level's ε is not a finite non-negative number", NULL);
     const uint64_t nv = l->n_vertices, nt = l->n_triangles;

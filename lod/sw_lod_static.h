@@ -12,8 +12,10 @@
  * triangles are refined until a rigorous bound of their deviation meets δ (see static_lod.c).
  *
  * Levels 1..n, simplification (§4.2): OpenMesh's Decimater (lod/static_lod_openmesh.cpp) with
- * the borders simplified first and then locked. Each level's ε_k is declared from a two-sided
- * measurement against the exact surface (sw_lod_static_measure), times a safety factor.
+ * the borders simplified first and then locked. Each level's ε_k is certified, not sampled:
+ * H(level, S) <= H(level, level 0) + H(level 0, S) <= bound + δ, the distance between the two
+ * meshes bounded both ways by sw_lod_mesh_distance_bound (lod/sw_lod_mesh_distance.h).
+ * sw_lod_static_measure is the independent check: sampled distances to the exact surface.
  *
  * Memory of a chain (sw_lod_static_memory): per level 56 bytes per vertex (position 24, normal
  * 12, (u, v) 16, face 4) and 12 bytes per triangle; the levels after level 0 are small (their
@@ -47,7 +49,6 @@ typedef struct sw_lod_static_desc {
     int32_t n_levels;  /* simplified levels after level 0 (1..8); 0 = 4; -1 = none */
     double eps_first;  /* target ε of level 1 in units of δ (> 1); 0 = 2 */
     double eps_growth; /* ratio of consecutive target ε (> 1); 0 = 4 */
-    double safety;     /* declared ε_k = safety x measured two-sided distance (>= 1); 0 = 1.5 */
     uint32_t max_vertices; /* level 0 limit (SW_ERR_LIMIT beyond it); 0 = 4,000,000 */
     uint32_t max_vertices_per_patch; /* level 0 limit per patch, the same way; 0 = 4,096 (the
                           sample models need 30-1,500; where a patch's rational derivative bounds
@@ -64,10 +65,13 @@ typedef struct sw_lod_static_level {
     uint32_t *face;      /* per vertex: scene face index */
     uint32_t *triangles; /* 3 per triangle, counter-clockwise seen from outside */
     uint32_t n_vertices, n_triangles;
-    double eps;         /* declared ε_k: every point of the level is within eps of the exact
-                           trimmed surface and vice versa (level 0: δ, a rigorous bound) */
-    double eps_target;  /* the ε the simplification aimed at (level 0: δ) */
-    double measured[2]; /* measured surface->mesh, mesh->surface distances */
+    double eps;        /* declared ε_k, a certified bound: every point of the level is within eps
+                          of the exact trimmed surface and vice versa (level 0: δ; level k:
+                          δ + max(bound[0], bound[1])) */
+    double eps_target; /* the ε the simplification aimed at (level 0: δ) */
+    double bound[2];   /* certified upper bounds of the one-sided distances level -> level 0 and
+                          level 0 -> level (sw_lod_mesh_distance_bound; 0 for level 0). The first
+                          is certified only down to the second, which is all ε_k needs. */
 } sw_lod_static_level;
 
 typedef struct sw_lod_static_chain {
@@ -75,7 +79,9 @@ typedef struct sw_lod_static_chain {
     int32_t n_levels;            /* entries of levels[] */
     uint32_t n_patches;
     double delta;
-    double seconds[3]; /* build time: tessellation, decimation, measurement */
+    double seconds[3];      /* build time: tessellation, decimation, certification of the ε_k */
+    uint64_t capped_pieces; /* pieces of the certification at its depth cap (their bound is the
+                               coarser Lipschitz one) */
 } sw_lod_static_chain;
 
 /* Builds the chain of the n >= 1 patches (repeats allowed, order irrelevant). desc may be NULL.
@@ -97,13 +103,18 @@ void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
  * at half the level-0 triangles. */
 #define SW_LOD_STATIC_DELTA_REL 2e-3
 
+/* How the levels' ε_k are declared, hashed into the cache key so that caches declared by another
+ * rule are stale: 2 = certified (sw_lod_mesh_distance_bound); 1.5 was the sampled distance x 1.5.
+ */
+#define SW_LOD_STATIC_EPS_RULE 2.0
+
 /* The δ of level 0 when the desc leaves it 0: SW_LOD_STATIC_DELTA_REL x the diagonal of `box`
  * (the patches' control-point box), 1e-12 for an empty one. */
 double sw_lod_static_default_delta(const double box[6]);
 
 /* *out = *in (NULL: all zero) with every zero field but delta replaced by its default, and the
  * values checked: SW_ERR_INVALID_ARGUMENT for a negative or non-finite δ, n_levels outside
- * -1..8, eps_first or eps_growth <= 1, safety < 1. delta stays 0 when left 0 (per patch set). */
+ * -1..8, eps_first or eps_growth <= 1. delta stays 0 when left 0 (per patch set). */
 sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static_desc *out,
                                      sw_status *status);
 
@@ -135,8 +146,8 @@ typedef struct sw_lod_static_distance {
  * level0 (may be NULL or equal to level) with its rigorous bound delta gives a second upper bound
  * at each mesh sample, the exact distance to level 0 plus delta, which Newton's local foot can
  * exceed where the surface folds back (a thread's next turn).
- * The surface side is a sampled maximum, so it can miss a peak between samples: the builder
- * multiplies by desc->safety and the tests re-measure with other samples. Errors as
+ * The surface side is a sampled maximum, so it can miss a peak between samples: it checks a
+ * declared ε_k from below (the tests), it does not declare one. Errors as
  * sw_lod_static_build. */
 sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
                                 uint32_t n, const sw_lod_static_level *level,

@@ -157,10 +157,11 @@ void sw_lod_static_set_get_stats(const sw_lod_static_set *set, sw_lod_static_set
  * The READY chains as one byte string (the .sws file's LODS section, `splinewalk build-lod`):
  *   "SWLODS\0\0", u32 version 1, u32 unit count, u64 key, then per unit a u32 (0: no chain,
  *   1: a chain follows): i32 levels, u32 patches, f64 δ, and per level u32 vertices, u32
- *   triangles, f64 ε, ε_target, measured[2], then positions (f64 x 3), normals (f32 x 3),
- *   (u, v) (f64 x 2), faces (u32) per vertex and the triangles (u32 x 3); little-endian.
- * The key hashes the units (their faces and patches) and the level settings, so a cache made
- * for another clustering, scene or setting is refused rather than misread. */
+ *   triangles, f64 ε, ε_target, bound[2] (the certified distances to and from level 0), then
+ * positions (f64 x 3), normals (f32 x 3), (u, v) (f64 x 2), faces (u32) per vertex and the
+ * triangles (u32 x 3); little-endian. The key hashes the units (their faces and patches) and the
+ * level settings, so a cache made for another clustering, scene or setting is refused rather than
+ * misread. */
 
 /* *out (malloc, the caller frees) and *size. Errors: SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,

@@ -1,10 +1,11 @@
 /* SPDX-License-Identifier: MIT */
-/* Static LODs (issue 4, Kumar et al. 1997 §4.1-§4.3; lod/sw_lod_static.h): every face of every
- * model given on the command line becomes one super-surface (all its patches), is tessellated
- * within δ and simplified into levels; then an independent measurement — random surface points
- * and random points of the triangles, with a seed and counts different from the lattices that
- * declared ε_k — must find every level within its declared ε_k both ways: surface -> mesh and
- * mesh -> surface. Zero violations, or exit 1.
+/* Static LODs (Kumar et al. 1997 §4.1-§4.3; lod/sw_lod_static.h): every face of every model
+ * given on the command line becomes one super-surface (all its patches), is tessellated within δ
+ * and simplified into levels, each declared with a certified ε_k; then an independent measurement
+ * against the exact surface — random surface points and random points of the triangles, each
+ * projected by Newton's iteration — must find every level within its declared ε_k both ways:
+ * surface -> mesh and mesh -> surface. Zero violations, or exit 1. (A certification that missed
+ * a piece of a level, or level 0's δ, fails here: ε_k would fall below the measured distance.)
  *
  * Usage: test_static_lod [--levels N] [--stride K] [--max-faces N] [--verbose] [--split] model
  * files...
@@ -12,7 +13,7 @@
  * --split takes the lower half of each face's patch grid (a super-surface ending inside a face).
  * Prints per model: patches, triangles of level 0 and each level, reduction against level 0,
  * whether the coarsest level has fewer than 2n triangles for n patches, the worst measured / ε
- * ratio, and the build time split into tessellation, decimation and measurement.
+ * ratio, and the build time split into tessellation, decimation and certification.
  */
 #include "sw_lod_static.h"
 #include "sw_sg_geom.h"
@@ -155,8 +156,8 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
         if (verbose) {
             printf("  face %u: %u patches, delta %.3g:", f, n, c->delta);
             for (int32_t k = 0; k < c->n_levels; ++k)
-                printf(" L%d %u (eps %.3g, measured %.3g %.3g)", (int)k, c->levels[k].n_triangles,
-                       c->levels[k].eps, c->levels[k].measured[0], c->levels[k].measured[1]);
+                printf(" L%d %u (eps %.3g, bound %.3g %.3g)", (int)k, c->levels[k].n_triangles,
+                       c->levels[k].eps, c->levels[k].bound[0], c->levels[k].bound[1]);
             printf(" [%.2f %.2f %.2f s]\n", c->seconds[0], c->seconds[1], c->seconds[2]);
         }
         t.n_levels = c->n_levels;
@@ -185,7 +186,7 @@ static int run_model(const char *path, int32_t levels, uint32_t stride, uint32_t
     printf("\n  coarsest < 2n triangles: %ld of %ld super-surfaces (coarsest %.0f for 2n = %ld)\n",
            t.coarse_below_2n, t.faces, t.n_levels ? t.tri[t.n_levels - 1] : 0.0, 2 * t.patches);
     printf("  checks %ld, violations %ld, worst measured/eps %.3f; build s: tessellation %.2f, "
-           "decimation %.2f, measurement %.2f; memory %.1f MB\n",
+           "decimation %.2f, certification %.2f; memory %.1f MB\n",
            t.checks, t.violations, t.worst_ratio, t.seconds[0], t.seconds[1], t.seconds[2],
            t.memory / 1e6);
     sw_sg_scene_free(scene);
