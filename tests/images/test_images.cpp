@@ -22,7 +22,10 @@
  * closure_at_view), and is printed either way. Failed views leave their frames and an edge diff
  * in OUTDIR.
  *
- * Usage: test_images OUTDIR WIDTHxHEIGHT VIEWS FILE...   VIEWS: comma list of whole,mid,close
+ * Usage: test_images [--hierarchy | --static] OUTDIR WIDTHxHEIGHT VIEWS FILE...
+ * VIEWS: comma list of whole,mid,close. --hierarchy draws through the bicubic hierarchies;
+ * --static also draws super-surfaces from their static LODs where one is fine enough (its
+ * declared ε_k within ε_img at its nearest point), so the same criteria check those levels.
  * Env: SW_IMAGES_MAX_TRIANGLES caps the reference mesh (default 1500000); SW_IMAGES_DEBUG=1
  * prints the depths around the first splinewalk edge pixels farther than 1 px.
  */
@@ -348,7 +351,9 @@ reference_plan plan_reference(const model_ctx &m, const basis &b, const sw_gpu_i
 }
 
 bool g_hierarchy = false;             /* --hierarchy: ours through the bicubic hierarchies */
+bool g_static = false;                /* --static: and super-surfaces from their static LODs */
 struct sw_lod_cache *g_cache = nullptr; /* of the file being tested */
+struct sw_lod_static_set *g_statics = nullptr;
 
 bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d_in, sw_gpu_image &out, double &ms,
                  sw_gpu_frame_stats &fs)
@@ -356,6 +361,7 @@ bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d_in, sw_gpu_image &out,
     sw_status st{};
     sw_gpu_frame_desc d = d_in;
     d.hierarchies = g_cache;
+    d.static_lods = g_statics;
     auto t0 = std::chrono::steady_clock::now();
     sw_result r = sw_gpu_render_scene(m.gpu, m.scene, &d, &out, &fs, &st);
     ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -555,6 +561,10 @@ bool run_view(model_ctx &m, const view &v)
                 (unsigned long long)fs.triangles, (unsigned long long)fs.patches_trimmed,
                 (unsigned long long)fs.patches_untrimmed, (unsigned long long)fs.trim_textures,
                 (double)fs.trim_texels, ms_ours, covered_pixels(ip.ours));
+    if (g_static)
+        std::printf("    static LODs: %llu super-surface instances, %llu faces, %llu triangles\n",
+                    (unsigned long long)fs.static_units_drawn, (unsigned long long)fs.static_faces,
+                    (unsigned long long)fs.static_triangles);
     return compare_edges(m, v, ip, closure_at(m, b, p.z_near));
 }
 
@@ -614,9 +624,11 @@ bool run_file(sw_gpu_context *gpu, const std::string &path, const std::string &o
     }
     sw_test_hierarchies *hier = g_hierarchy ? sw_test_hierarchies_create(scene) : nullptr;
     g_cache = sw_test_hierarchies_cache(hier);
-    ok = ok && (!g_hierarchy || hier) && run_model(m, path, list);
+    g_statics = g_static && hier ? sw_test_hierarchies_statics(hier) : nullptr;
+    ok = ok && (!g_hierarchy || hier) && (!g_static || g_statics) && run_model(m, path, list);
     sw_test_hierarchies_free(hier);
     g_cache = nullptr;
+    g_statics = nullptr;
     sw_sg_scene_free(scene);
     return ok;
 }
@@ -625,11 +637,18 @@ bool run_file(sw_gpu_context *gpu, const std::string &path, const std::string &o
 
 int main(int argc, char **argv)
 {
-    g_hierarchy = argc > 1 && std::strcmp(argv[1], "--hierarchy") == 0;
-    argc -= g_hierarchy;
-    argv += g_hierarchy;
+    for (; argc > 1 && argv[1][0] == '-' && argv[1][1] == '-'; --argc, ++argv) {
+        if (std::strcmp(argv[1], "--static") == 0)
+            g_static = g_hierarchy = true; /* static LODs are drawn beside the hierarchies */
+        else if (std::strcmp(argv[1], "--hierarchy") == 0)
+            g_hierarchy = true;
+        else
+            break;
+    }
     if (argc < 5) {
-        std::fprintf(stderr, "usage: %s [--hierarchy] OUTDIR WIDTHxHEIGHT whole,mid,close FILE...\n",
+        std::fprintf(stderr,
+                     "usage: %s [--hierarchy | --static] OUTDIR WIDTHxHEIGHT whole,mid,close "
+                     "FILE...\n",
                      argv[0]);
         return 2;
     }
