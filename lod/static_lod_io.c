@@ -13,7 +13,7 @@
 #include <string.h>
 
 #define LODS_MAGIC "SWLODS\0"
-#define LODS_VERSION 1u
+#define LODS_VERSION 2u /* 2: the level settings after the key */
 #define LODS_MAX_LEVELS SW_LOD_CACHE_MAX_LEVELS
 
 /* ---- the key ----------------------------------------------------------------------------------
@@ -102,6 +102,18 @@ static void put_level(writer *w, const sw_lod_static_level *l)
     put(w, l->triangles, (size_t)l->n_triangles * 3 * sizeof *l->triangles);
 }
 
+/* The level settings the set was built with (resolved), so that a reader can say how. */
+static void put_settings(writer *w, const sw_lod_static_desc *d)
+{
+    const double f[5] = {d->delta, d->delta > 0.0 ? 0.0 : SW_LOD_STATIC_DELTA_REL, d->eps_first,
+                         d->eps_growth, SW_LOD_STATIC_EPS_RULE};
+    const int32_t n_levels = d->n_levels;
+    put(w, f, sizeof f);
+    put(w, &n_levels, sizeof n_levels);
+    put_u32(w, d->max_vertices);
+    put_u32(w, d->max_vertices_per_patch);
+}
+
 sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,
                                       sw_status *status)
 {
@@ -114,6 +126,7 @@ sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, 
     put_u32(&w, n);
     const uint64_t key = set_key(set, sw__lod_static_set_levels(set));
     put(&w, &key, sizeof key);
+    put_settings(&w, sw__lod_static_set_levels(set));
     for (uint32_t u = 0; u < n; ++u) {
         const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
         put_u32(&w, c ? 1u : 0u);
@@ -201,6 +214,28 @@ static int unit_has_face(const sw_lod_static_set *set, const sw_lod_static_unit 
     return lo < un->n_faces && f[lo] == face;
 }
 
+static sw_result take_settings(reader *r, sw_lod_static_cache_settings *out)
+{
+    double f[5];
+    int32_t n_levels;
+    uint32_t max_v, max_vp;
+    if (!take(r, f, sizeof f) || !take(r, &n_levels, 4) || !take(r, &max_v, 4) ||
+        !take(r, &max_vp, 4))
+        return bad(r, "truncated level settings", NULL);
+    if (!finite_all(f, 5) || !(f[0] >= 0.0) || !(f[0] > 0.0 || f[1] > 0.0) || !(f[2] > 1.0) ||
+        !(f[3] > 1.0) || !(f[4] > 0.0) || n_levels < -1 || n_levels > LODS_MAX_LEVELS - 1)
+        return bad(r, "level settings out of range", NULL);
+    *out = (sw_lod_static_cache_settings){{.delta = f[0],
+                                           .n_levels = n_levels,
+                                           .eps_first = f[2],
+                                           .eps_growth = f[3],
+                                           .max_vertices = max_v,
+                                           .max_vertices_per_patch = max_vp},
+                                          f[1],
+                                          f[4]};
+    return SW_OK;
+}
+
 static sw_result read_level(reader *r, const sw_lod_static_set *set, const sw_lod_static_unit *un,
                             sw_lod_static_level *l)
 {
@@ -275,11 +310,15 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
         return bad(&r, "not a static LOD cache (bad magic)", NULL);
     if (!take(&r, &version, 4) || version != LODS_VERSION)
         return sw__fail(status, SW_ERR_VERSION,
-                        "%s: LODS offset 8: cache version %u, this program "
-                        "reads %u",
+                        "%s: LODS offset 8: cache version %u, this program reads %u: run "
+                        "`splinewalk build-lod` again",
                         what, version, LODS_VERSION);
+    sw_lod_static_cache_settings settings;
     if (!take(&r, &n, 4) || !take(&r, &key, 8))
         return bad(&r, "truncated header", NULL);
+    sw_result head = take_settings(&r, &settings);
+    if (head != SW_OK)
+        return head;
     if (n != sw_lod_static_set_unit_count(set) ||
         key != set_key(set, sw__lod_static_set_levels(set)))
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
@@ -371,12 +410,12 @@ sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const cha
         return bad(&r, "not a static LOD cache (bad magic)", NULL);
     if (!take(&r, &out->version, 4) || out->version != LODS_VERSION)
         return sw__fail(status, SW_ERR_VERSION,
-                        "%s: LODS offset 8: cache version %u, this program "
-                        "reads %u",
+                        "%s: LODS offset 8: cache version %u, this program reads %u: run "
+                        "`splinewalk build-lod` again",
                         what, out->version, LODS_VERSION);
     if (!take(&r, &out->units, 4) || !take(&r, &out->key, 8))
         return bad(&r, "truncated header", NULL);
-    sw_result res = SW_OK;
+    sw_result res = take_settings(&r, &out->settings);
     for (uint32_t u = 0; u < out->units && res == SW_OK; ++u) {
         uint32_t has;
         if (!take(&r, &has, 4) || has > 1)

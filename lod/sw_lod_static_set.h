@@ -155,7 +155,9 @@ void sw_lod_static_set_get_stats(const sw_lod_static_set *set, sw_lod_static_set
 
 /* ---- the LOD cache (static_lod_io.c) ---------------------------------------------------------
  * The READY chains as one byte string (the .sws file's LODS section, `splinewalk build-lod`):
- *   "SWLODS\0\0", u32 version 1, u32 unit count, u64 key, then per unit a u32 (0: no chain,
+ *   "SWLODS\0\0", u32 version 2, u32 unit count, u64 key, the level settings (f64 δ (0: relative),
+ *   f64 δ relative to the diagonal (0 when δ is given), f64 eps_first, eps_growth, the ε rule,
+ *   i32 n_levels, u32 max_vertices, u32 max_vertices_per_patch), then per unit a u32 (0: no chain,
  *   1: a chain follows): i32 levels, u32 patches, f64 δ, and per level u32 vertices, u32
  *   triangles, f64 ε, ε_target, bound[2] (the certified distances to and from level 0), then
  * positions (f64 x 3), normals (f32 x 3), (u, v) (f64 x 2), faces (u32) per vertex and the
@@ -180,9 +182,16 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
  * which the first renderer to use it checks. Per level index k: the chains with a level k and
  * their vertices, triangles and ε range. */
 enum { SW_LOD_CACHE_MAX_LEVELS = 9 };
+/* The level settings a cache was built with: the resolved desc (delta 0: delta_rel x each
+ * super-surface's diagonal) and the rule that declared its ε (SW_LOD_STATIC_EPS_RULE). */
+typedef struct sw_lod_static_cache_settings {
+    sw_lod_static_desc levels;
+    double delta_rel, eps_rule;
+} sw_lod_static_cache_settings;
 typedef struct sw_lod_static_cache_summary {
     uint32_t version, units, chains, max_levels;
     uint64_t key;
+    sw_lod_static_cache_settings settings;
     double delta_min, delta_max; /* level 0's rigorous bound δ over the chains (object units) */
     uint32_t level_chains[SW_LOD_CACHE_MAX_LEVELS];
     uint64_t level_vertices[SW_LOD_CACHE_MAX_LEVELS], level_triangles[SW_LOD_CACHE_MAX_LEVELS];

@@ -22,7 +22,8 @@ static const char k_usage[] =
     "sw_scene_load reads them) along the same camera path at the same frame size and error\n"
     "bound eps_img, each in its own child process (fork), one after the other:\n"
     "  splinewalk  the public API, threaded (sw_renderer_prepare of frame i+1 while\n"
-    "              sw_renderer_submit draws frame i), walkthrough mode, default renderer\n"
+    "              sw_renderer_submit draws frame i), walkthrough mode, default renderer,\n"
+    "              static LODs (the .sws's build-lod cache, else built in the pool)\n"
     "  glu         Mesa's GLU NURBS tessellator (GLU_NURBS_TESSELLATOR, GLU_PARAMETRIC_ERROR =\n"
     "              eps_img px, gluLoadSamplingMatrices per frame, GLU_CULLING on, trim loops as\n"
     "              gluNurbsCurve) re-tessellating every face occurrence every frame; its\n"
@@ -32,10 +33,13 @@ static const char k_usage[] =
     "              one VBO drawn every frame\n"
     "Frame time = the frame's draw calls until glFinish (no readback); for splinewalk the\n"
     "submitting thread's prepare(i+1) + submit(i); for glu tessellation + upload + draw.\n"
-    "Warm-up passes are drawn first and not counted (the first frame is among them). Per peer:\n"
-    "median and p99 frame time, time to first frame (from the child's start: load,\n"
-    "preprocessing - hierarchies are built in the background, GLU's control points, OCCT's mesh -\n"
-    "and the first frame), peak RSS (the child's VmHWM minus its resident memory at the fork),\n"
+    "Warm-up passes are drawn first and not counted (the first frame is among them); for\n"
+    "splinewalk they are converged after its first frame, so that the hierarchies and static\n"
+    "levels the path needs are built before the timed passes (their time is in its note). Per\n"
+    "peer: median and p99 frame time, time to first frame (from the child's start: load,\n"
+    "preprocessing - splinewalk's builds run in the background, GLU's control points, OCCT's\n"
+    "mesh - and the first frame), peak RSS (the child's VmHWM minus its resident memory at the "
+    "fork),\n"
     "triangles per frame (median), and splinewalk / peer ratios of each; for glu and occt the\n"
     "pixels their last frame covered (read back once after the timed frames), to see that both\n"
     "drew the same shape. glu first tessellates every face once in child processes of its own\n"
@@ -57,9 +61,10 @@ static const char k_usage[] =
     "  --brep FILE     the scene's BREP for occt (default: SCENE itself if it is .brep, else\n"
     "                  SCENE with its extension replaced by .brep if that file exists; none:\n"
     "                  occt is skipped with a note). Only with one SCENE.\n"
-    "  --static-lods   splinewalk with its static LODs (sw_frame_desc.static_lods: Kumar et al.\n"
-    "                  1997 super-surface meshes for what the error allows; default: off, as\n"
-    "                  in the renderer)\n"
+    "  --no-static-lods  splinewalk without its static LODs (sw_frame_desc.static_lods: Kumar\n"
+    "                  et al. 1997 super-surface meshes for what the error allows, from the\n"
+    "                  .sws's build-lod cache or built in the pool; default: on, as in the\n"
+    "                  CLI's walkthroughs)\n"
     "  --no-occlusion  splinewalk without occlusion culling (sw_frame_desc.occlusion_culling:\n"
     "                  what the visible planar faces hide is culled; default: on, as in the CLI)\n"
     "  --glibc-malloc  every peer with glibc's default trim and mmap thresholds; by default\n"
@@ -108,6 +113,7 @@ static int parse(int argc, char **argv, args *a)
                 .w = 1280,
                 .h = 720,
                 .error_px = 0.5,
+                .static_lods = 1,
                 .occlusion = 1};
     a->scenes = calloc((size_t)argc, sizeof *a->scenes);
     for (int i = 1; i < argc && a->scenes; ++i) {
@@ -115,8 +121,8 @@ static int parse(int argc, char **argv, args *a)
         int takes = v && o[0] == '-' && strcmp(o, "-h") && strcmp(o, "--help");
         if (!strcmp(o, "-h") || !strcmp(o, "--help"))
             return 1;
-        if (!strcmp(o, "--static-lods")) {
-            a->static_lods = 1;
+        if (!strcmp(o, "--static-lods") || !strcmp(o, "--no-static-lods")) {
+            a->static_lods = !strcmp(o, "--static-lods");
             continue;
         }
         if (!strcmp(o, "--glibc-malloc")) {
@@ -268,7 +274,7 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
     printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s%s\n", scene,
            job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
            a->path_file ? a->path_file : "orbit of the scene box",
-           a->static_lods ? "; splinewalk with static LODs" : "",
+           a->static_lods ? "" : "; splinewalk without static LODs",
            a->occlusion ? "" : "; splinewalk without occlusion culling");
     printf("  peer       |  frame ms: median      p99 | first (ms) | peak RSS MB | triangles | "
            "splinewalk / peer: median p99 first RSS triangles\n");

@@ -475,9 +475,18 @@ static void statics_task(void *ctx)
      * as they are needed instead */
     const void *cache = NULL;
     size_t cache_bytes = 0;
-    if (sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st) == SW_OK)
-        (void)sw_lod_static_set_load(set, cache, cache_bytes,
-                                     sw_sg_scene_path_ptr(r->cache_scene->sg), NULL, &st);
+    const char *path = sw_sg_scene_path_ptr(r->cache_scene->sg);
+    sw_result found = sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st);
+    if (found == SW_OK)
+        found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &st);
+    if (found == SW_ERR_NOT_FOUND)
+        sw__log(SW_LOG_WARN,
+                "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
+                "frames need them (`splinewalk build-lod` stores them in a .sws)",
+                path ? path : "the scene");
+    else if (found != SW_OK)
+        sw__log(SW_LOG_WARN, "static LODs: %s; the levels are built again as frames need them",
+                st.message);
     atomic_store(&r->statics, set);
     atomic_store(&r->statics_state, 2);
 }

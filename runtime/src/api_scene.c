@@ -385,6 +385,10 @@ sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *stat
     out->faces_skipped = scene->faces_skipped;
     out->faces_repaired = scene->faces_repaired;
     out->partial = scene->partial;
+    const void *lods = NULL;
+    size_t lods_bytes = 0;
+    if (sw_sg_scene_lods(scene->sg, &lods, &lods_bytes, NULL) == SW_OK)
+        out->lod_cache_bytes = lods_bytes;
     sw_rt_scene_release(scene);
     return SW_OK;
 }

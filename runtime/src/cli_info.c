@@ -14,9 +14,11 @@ static const char k_usage[] =
     "of their source geometry, trimmed surfaces, trim loops and curves, Bézier patches after\n"
     "extraction, maximum degrees, control points, nodes and instances, face occurrences after\n"
     "instancing, adjacent face pairs, the bounding box and the memory the loaded scene takes,\n"
-    "and the static LOD cache a .sws holds (`build-lod`): its super-surfaces with levels, and per\n"
-    "level their triangles, vertices and error bounds; whether it fits the scene's clustering\n"
-    "is checked when a renderer first uses it.\n"
+    "and the static LOD cache a .sws holds (`build-lod`): the settings it was built with, its\n"
+    "super-surfaces with levels, and per level their triangles, vertices, bytes and error\n"
+    "bounds, or why it cannot be used (an older version, a damaged section: renderers build the\n"
+    "levels again); whether it fits the scene's clustering is checked when a renderer first\n"
+    "uses it.\n"
     "A CAD file's faces skipped or repaired by the import are each named in a warning on stderr\n"
     "and counted (as `import` does); a truncated IGES file is refused unless --partial.\n"
     "\n"
@@ -41,10 +43,12 @@ static void print_json_string(const char *s)
 }
 
 static void print_json_faces(void);
-static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes);
+static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes,
+                           const sw_status *why);
 
 static void print_json(const char *path, const sw_scene_info *in, int got,
-                       const sw_lod_static_cache_summary *lods, size_t lod_bytes)
+                       const sw_lod_static_cache_summary *lods, size_t lod_bytes,
+                       const sw_status *lod_status)
 {
     printf("{\"file\": ");
     print_json_string(path);
@@ -69,7 +73,7 @@ static void print_json(const char *path, const sw_scene_info *in, int got,
            (unsigned long long)in->triangle_occurrences, in->faces_skipped, in->faces_repaired,
            in->partial ? "true" : "false", in->bbox_min[0], in->bbox_min[1], in->bbox_min[2],
            in->bbox_max[0], in->bbox_max[1], in->bbox_max[2], in->memory_bytes);
-    print_lod_json(got, lods, lod_bytes);
+    print_lod_json(got, lods, lod_bytes, lod_status);
     printf("}\n");
 }
 
@@ -148,8 +152,21 @@ static int lod_cache_of(sw_scene handle, const char *path, sw_lod_static_cache_s
     return got;
 }
 
-static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t bytes)
+/* A level's arrays as the cache stores them (sw_lod_static_memory counts the same per vertex and
+ * triangle): position 24, normal 12, (u, v) 16 and face 4 bytes per vertex, 12 per triangle. */
+static double level_bytes(const sw_lod_static_cache_summary *c, uint32_t k)
 {
+    return 56.0 * (double)c->level_vertices[k] + 12.0 * (double)c->level_triangles[k];
+}
+
+static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t bytes,
+                           const sw_status *why)
+{
+    if (got < 0) {
+        printf("  LOD cache       unusable (%s: %s): static LODs are built again on first use\n",
+               sw_result_id_str(why->result), why->message);
+        return;
+    }
     if (got == 0) {
         printf("  LOD cache       none (`splinewalk build-lod` makes one; without it static LODs "
                "are built on first use)\n");
@@ -159,26 +176,53 @@ static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t
            "level 0 within δ %g-%g\n",
            (double)bytes / (1024.0 * 1024.0), c->chains, c->units, c->max_levels, c->delta_min,
            c->delta_max);
+    const sw_lod_static_desc *d = &c->settings.levels;
+    char delta[64];
+    if (d->delta > 0.0)
+        snprintf(delta, sizeof delta, "δ %g", d->delta);
+    else
+        snprintf(delta, sizeof delta, "δ %g x each super-surface's diagonal",
+                 c->settings.delta_rel);
+    printf("    built with    %s, %d simplified levels aiming at ε %g δ x %g^k, ε %s; level 0 at "
+           "most %u vertices per patch, %u in all\n",
+           delta, (int)d->n_levels, d->eps_first, d->eps_growth,
+           c->settings.eps_rule == SW_LOD_STATIC_EPS_RULE ? "certified" : "of another rule",
+           d->max_vertices_per_patch, d->max_vertices);
     for (uint32_t k = 0; k < c->max_levels; ++k)
-        printf("    level %u       %u super-surfaces, %llu triangles, %llu vertices, ε %g-%g\n", k,
-               c->level_chains[k], (unsigned long long)c->level_triangles[k],
-               (unsigned long long)c->level_vertices[k], c->level_eps_min[k], c->level_eps_max[k]);
+        printf("    level %u       %u super-surfaces, %llu triangles, %llu vertices, %.2f MiB, ε "
+               "%g-%g\n",
+               k, c->level_chains[k], (unsigned long long)c->level_triangles[k],
+               (unsigned long long)c->level_vertices[k], level_bytes(c, k) / (1024.0 * 1024.0),
+               c->level_eps_min[k], c->level_eps_max[k]);
 }
 
-static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes)
+static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes,
+                           const sw_status *why)
 {
     if (got == 0) {
         printf("\"lod_cache\": null");
         return;
     }
+    if (got < 0) {
+        printf("\"lod_cache\": {\"unusable\": \"%s\"}", sw_result_id_str(why->result));
+        return;
+    }
+    const sw_lod_static_desc *d = &c->settings.levels;
     printf("\"lod_cache\": {\"bytes\": %zu, \"version\": %u, \"units\": %u, \"chains\": %u, "
-           "\"delta_min\": %.17g, \"delta_max\": %.17g, \"levels\": [",
-           bytes, c->version, c->units, c->chains, c->delta_min, c->delta_max);
+           "\"delta_min\": %.17g, \"delta_max\": %.17g, \"settings\": {\"delta\": %.17g, "
+           "\"delta_relative\": %.17g, \"levels\": %d, \"eps_first\": %.17g, \"eps_growth\": "
+           "%.17g, \"eps_certified\": %s, \"max_vertices\": %u, \"max_vertices_per_patch\": %u}, "
+           "\"levels\": [",
+           bytes, c->version, c->units, c->chains, c->delta_min, c->delta_max, d->delta,
+           c->settings.delta_rel, (int)d->n_levels, d->eps_first, d->eps_growth,
+           c->settings.eps_rule == SW_LOD_STATIC_EPS_RULE ? "true" : "false", d->max_vertices,
+           d->max_vertices_per_patch);
     for (uint32_t k = 0; k < c->max_levels; ++k)
-        printf("%s{\"chains\": %u, \"triangles\": %llu, \"vertices\": %llu, \"eps_min\": "
-               "%.17g, \"eps_max\": %.17g}",
+        printf("%s{\"chains\": %u, \"triangles\": %llu, \"vertices\": %llu, \"bytes\": %.0f, "
+               "\"eps_min\": %.17g, \"eps_max\": %.17g}",
                k ? ", " : "", c->level_chains[k], (unsigned long long)c->level_triangles[k],
-               (unsigned long long)c->level_vertices[k], c->level_eps_min[k], c->level_eps_max[k]);
+               (unsigned long long)c->level_vertices[k], level_bytes(c, k), c->level_eps_min[k],
+               c->level_eps_max[k]);
     printf("]}");
 }
 
@@ -214,15 +258,18 @@ int sw_cli_info(int argc, char **argv)
     sw_lod_static_cache_summary lods;
     size_t lod_bytes = 0;
     sw_result r = sw_scene_get_info(scene, &info, &status);
-    const int got = r == SW_OK ? lod_cache_of(scene, path, &lods, &lod_bytes, &status) : -1;
+    sw_status lod_status = {0};
+    const int got = r == SW_OK ? lod_cache_of(scene, path, &lods, &lod_bytes, &lod_status) : -1;
     sw_scene_destroy(scene);
-    if (r != SW_OK || got < 0)
+    if (r != SW_OK)
         return sw_cli_report("info", &status);
+    /* a cache that cannot be used is the scene's news, not a failure to describe it: renderers
+     * build the levels again */
     if (json)
-        print_json(path, &info, got, &lods, lod_bytes);
+        print_json(path, &info, got, &lods, lod_bytes, &lod_status);
     else
         print_text(path, &info);
     if (!json)
-        print_lod_text(got, &lods, lod_bytes);
+        print_lod_text(got, &lods, lod_bytes, &lod_status);
     return 0;
 }

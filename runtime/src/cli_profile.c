@@ -24,7 +24,7 @@
 static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
-    "                          [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
+    "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--lod-colors]\n"
     "                          [--no-occlusion]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
@@ -61,9 +61,11 @@ static const char k_usage[] =
     "                    that worker and the frame's own thread (the pool cannot be emptied;\n"
     "                    nothing overlaps the frames)\n"
     "  --eval MODE       hierarchy (default), bezier or exact, as for `render`\n"
-    "  --static-lod      static LODs of super-surfaces where fine enough (Kumar et al. 1997),\n"
-    "                    built in the pool on first need: static_drawn, static_faces,\n"
-    "                    static_triangles, static_requests columns\n"
+    "  --no-static-lod   every face by the per-frame path. By default super-surfaces are drawn\n"
+    "                    from static LODs where fine enough (Kumar et al. 1997): read from the\n"
+    "                    scene's `build-lod` cache, else built in the pool on first need (said\n"
+    "                    on stderr); static_drawn, static_faces, static_triangles,\n"
+    "                    static_requests columns\n"
     "  --lod-colors      colour by representation, as for `render`\n"
     "  --no-occlusion    draw what visible planar faces hide too (culled by default, as for\n"
     "                    `render`: occlusion_tests, nodes_occluded, faces_occluded columns; a\n"
@@ -112,8 +114,12 @@ static int parse_args(int argc, char **argv, profile_args *a)
             a->frame.occlusion_culling = !strcmp(arg, "--occlusion");
             continue;
         }
-        if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
-            *(!strcmp(arg, "--static-lod") ? &a->frame.static_lods : &a->frame.lod_colors) = 1;
+        if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--no-static-lod")) {
+            a->frame.static_lods = !strcmp(arg, "--static-lod");
+            continue;
+        }
+        if (!strcmp(arg, "--lod-colors")) {
+            a->frame.lod_colors = 1;
             continue;
         }
         if (!strcmp(arg, "--converged") || !strcmp(arg, "--sequential")) {
@@ -532,6 +538,7 @@ int sw_cli_profile(int argc, char **argv)
         return 0;
     profile_args a = {0};
     a.frame.occlusion_culling = 1;
+    a.frame.static_lods = 1;
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;

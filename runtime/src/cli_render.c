@@ -10,7 +10,7 @@
 static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
-    "                         [--eval hierarchy|bezier|exact] [--static-lod] [--lod-colors]\n"
+    "                         [--eval hierarchy|bezier|exact] [--[no-]static-lod] [--lod-colors]\n"
     "                         [--static-force K] [--no-occlusion] [--partial]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
@@ -43,7 +43,10 @@ static const char k_usage[] =
     "                      points (Krishnamurthy & Yasui), degree <= 15\n"
     "  --static-lod        super-surfaces far enough for one of their static LODs (Kumar et\n"
     "                      al. 1997) are drawn from it; the clustering and the levels are built\n"
-    "                      first (or read from the scene's LOD cache: `build-lod`)\n"
+    "                      first (or read from the scene's LOD cache: `build-lod`). The default\n"
+    "                      when SCENE has a LOD cache; without one it is off (building the\n"
+    "                      levels costs more than they save in one frame)\n"
+    "  --no-static-lod     every face by the per-frame path, LOD cache or not\n"
     "  --lod-colors        colour each surface by how it is drawn: static levels fine to coarse\n"
     "                      blue, teal, green, yellow, orange, pink; per-frame tessellation grey\n"
     "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
@@ -77,8 +80,12 @@ static int parse_args(int argc, char **argv, render_args *a)
             a->frame.occlusion_culling = !strcmp(arg, "--occlusion");
             continue;
         }
-        if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--lod-colors")) {
-            *(!strcmp(arg, "--static-lod") ? &a->frame.static_lods : &a->frame.lod_colors) = 1;
+        if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--no-static-lod")) {
+            a->frame.static_lods = !strcmp(arg, "--static-lod");
+            continue;
+        }
+        if (!strcmp(arg, "--lod-colors")) {
+            a->frame.lod_colors = 1;
             continue;
         }
         if (!strcmp(arg, "--static-force") && val) {
@@ -125,6 +132,7 @@ int sw_cli_render(int argc, char **argv)
     render_args a = {0};
     a.view = SW_VIEW_ISO;
     a.frame.occlusion_culling = 1;
+    a.frame.static_lods = -1; /* not given: from the scene's LOD cache when it has one */
     int rc = parse_args(argc, argv, &a);
     if (rc)
         return rc;
@@ -138,8 +146,13 @@ int sw_cli_render(int argc, char **argv)
         return sw_cli_report_load("render", &status);
     double t1 = sw_cli_now_ms();
     sw_scene_info load_info;
-    if (sw_scene_get_info(scene, &load_info, NULL) == SW_OK)
+    int have_info = sw_scene_get_info(scene, &load_info, NULL) == SW_OK;
+    if (have_info)
         sw_cli_print_import_notes(stdout, "render", &load_info);
+    /* One converged frame: building the levels first would cost more than they save, so by
+     * default they are used only when the file brings them. */
+    if (a.frame.static_lods < 0)
+        a.frame.static_lods = have_info && load_info.lod_cache_bytes > 0;
     sw_renderer renderer = {0};
     sw_frame_stats stats = {0};
     a.frame.scene = scene;

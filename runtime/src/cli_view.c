@@ -63,8 +63,9 @@ static const char k_usage[] =
     "                    F toggles it)\n"
     "  --wireframe       start with the wireframe on (L toggles it)\n"
     "  --no-occlusion    start with occlusion culling off (O toggles it)\n"
-    "  --static-lod      start with static LODs on (T toggles them; built in the pool as\n"
-    "                    needed, or read from the scene's `build-lod` cache)\n"
+    "  --no-static-lod   start with static LODs off (on by default, T toggles them: read\n"
+    "                    from the scene's `build-lod` cache, else built in the pool as\n"
+    "                    needed, which is said on stderr; --static-lod is the default)\n"
     "  --lod-colors      start with LOD colouring on (C toggles it)\n"
     "  --atlas-overlay   start with the trim atlas's first page shown (A cycles the pages)\n"
     "  -h, --help        this text\n";
@@ -72,7 +73,8 @@ static const char k_usage[] =
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot;
     int32_t w, h;
-    int frames, settle, overlay, wireframe, static_lods, lod_colors, atlas_overlay, no_occlusion;
+    int frames, settle, overlay, wireframe, static_lods, no_static_lods, lod_colors, atlas_overlay,
+        no_occlusion;
     double error_px, speed;
 } view_args;
 
@@ -109,6 +111,7 @@ static int parse_args(int argc, char **argv, view_args *a)
                     : !strcmp(arg, "--overlay")       ? &a->overlay
                     : !strcmp(arg, "--wireframe")     ? &a->wireframe
                     : !strcmp(arg, "--static-lod")    ? &a->static_lods
+                    : !strcmp(arg, "--no-static-lod") ? &a->no_static_lods
                     : !strcmp(arg, "--lod-colors")    ? &a->lod_colors
                     : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
                     : !strcmp(arg, "--no-occlusion")  ? &a->no_occlusion
@@ -456,7 +459,7 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
     viewer v = {.args = a,
                 .error_px = a->error_px,
                 .wireframe = a->wireframe,
-                .static_lods = a->static_lods,
+                .static_lods = !a->no_static_lods,
                 .lod_colors = a->lod_colors,
                 .occlusion = !a->no_occlusion};
     if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)

@@ -281,5 +281,22 @@ shown=$("$sw" info nut.sws | awk '$1 == "level" { printf "%s:%s ", $2, $5 }')
   fail "info --json: lod_cache"
 pass "info: the LOD cache (none; then levels $shown as build-lod built them)"
 
+# the settings it was built with; a damaged LODS section is said, not a failure of info (catches:
+# settings not stored or misread; info refusing the whole scene for its cache)
+"$sw" info nut.sws | grep -q "built with    δ 0.002 x each super-surface's diagonal, 4 simplified levels aiming at ε 2 δ x 4^k, ε certified" ||
+  fail "info: the LOD cache's settings"
+python3 - nut.sws bad_lods.sws <<'PY' || fail "a damaged copy of nut.sws"
+import sys
+b = bytearray(open(sys.argv[1], 'rb').read())
+at = b.find(b'SWLODS\0\0')
+b[at + 200] ^= 0x40  # inside the first chain: the section's checksum no longer holds
+open(sys.argv[2], 'wb').write(b)
+PY
+"$sw" info bad_lods.sws >bad_lods.txt 2>&1 || fail "info refused a scene for its damaged LOD cache"
+grep -q "^  LOD cache       unusable (SW_ERR_CHECKSUM" bad_lods.txt || fail "info: a damaged LOD cache not said"
+"$sw" info bad_lods.sws --json | grep -q '"lod_cache": {"unusable": "SW_ERR_CHECKSUM"}' ||
+  fail "info --json: a damaged LOD cache"
+pass "info: the LOD cache's settings; a damaged cache said, the scene described"
+
 echo "$failures failure(s)"
 [ $failures -eq 0 ]

@@ -224,6 +224,18 @@ static void check_summary(const sw_lod_static_set *a, const unsigned char *blob,
                sum.level_triangles[k] == want.level_triangles[k] &&
                sum.level_eps_min[k] == want.level_eps_min[k] &&
                sum.level_eps_max[k] == want.level_eps_max[k];
+    /* the settings it was built with: the set's resolved ones */
+    const sw_lod_static_desc *lv = sw__lod_static_set_levels(a), *got = &sum.settings.levels;
+    CHECK(got->delta == lv->delta && got->n_levels == lv->n_levels &&
+              got->eps_first == lv->eps_first && got->eps_growth == lv->eps_growth &&
+              got->max_vertices == lv->max_vertices &&
+              got->max_vertices_per_patch == lv->max_vertices_per_patch &&
+              sum.settings.delta_rel == (lv->delta > 0.0 ? 0.0 : SW_LOD_STATIC_DELTA_REL) &&
+              sum.settings.eps_rule == SW_LOD_STATIC_EPS_RULE,
+          "summary: settings δ %g (rel %g), %d levels, ε %g x %g^k, rule %g; the set's δ %g, %d, "
+          "%g, %g",
+          got->delta, sum.settings.delta_rel, (int)got->n_levels, got->eps_first, got->eps_growth,
+          sum.settings.eps_rule, lv->delta, (int)lv->n_levels, lv->eps_first, lv->eps_growth);
     CHECK(same && want.chains > 0 && want.max_levels > 1,
           "summary: %u chains, %u levels, level 0 %llu triangles; the chains: %u, %u, %llu",
           sum.chains, sum.max_levels, (unsigned long long)sum.level_triangles[0], want.chains,

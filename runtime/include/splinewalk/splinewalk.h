@@ -160,6 +160,8 @@ typedef struct sw_scene_info {
     uint32_t faces_skipped;  /* not in the scene, each reported to face_problem */
     uint32_t faces_repaired; /* in the scene after an exact repair */
     int32_t partial;         /* 1: a truncated file imported in part (SW_LOAD_PARTIAL) */
+    uint64_t lod_cache_bytes; /* the .sws file's static LOD cache (`splinewalk build-lod`), checked
+                                 against its checksum; 0: none (or damaged) */
 } sw_scene_info;
 
 /* Describes the scene (the first call on a scene verifies it and walks it once). Any thread.
