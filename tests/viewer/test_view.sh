@@ -9,15 +9,17 @@
 #     the converged branch, so 0 held by construction; seen failing with a planted walkthrough
 #     wait for one face's build, "pool waits 1"), the last view is drawn converged (--settle),
 #     the window's back buffer is saved through OpenImageIO, and the viewer closes cleanly
-#     (exit 0). The screenshot must match `splinewalk render --camera` of the camera it printed
-#     (<= 0.1 % of pixels differ): what the window shows is the renderer's frame, presented into
-#     the window's framebuffer.
+#     (exit 0). The screenshot must match `splinewalk render --camera --static-lod` of the camera
+#     it printed (<= 0.1 % of pixels differ; the viewer draws static LODs by default, render only
+#     when asked or when the file has them): what the window shows is the renderer's frame,
+#     presented into the window's framebuffer.
 #     The frame-time, wireframe and trim-atlas overlays change the frame, each only as it should.
 #  4. samples/embed_minimal (a GLFW host of the public API) draws 30 frames into its window and
 #     exits 0.
 #  5. Static LODs and LOD colouring (--static-lod --lod-colors, keys T and C) on STATIC_MODEL: the
 #     settled screenshot equals `render --static-lod --lod-colors` of its camera, and differs from
-#     the plain render (the colours show which representation drew each surface).
+#     the plain render (the colours show which representation drew each surface); with
+#     --no-static-lod it equals the plain render.
 # usage: test_view.sh SPLINEWALK PNG_DIFF MODEL WORKDIR EMBED_MINIMAL STATIC_MODEL
 set -euo pipefail
 sw=$1 diff=$2 model=$3 work=$4 embed=$5 static_model=$6
@@ -51,7 +53,7 @@ grep -q "pool waits 0," "$work/view.out" || fail "walkthrough frames waited for 
 [ -s "$work/shot.png" ] || fail "no screenshot"
 cam=$(sed -n 's/^screenshot camera //p' "$work/view.out")
 [ -n "$cam" ] || fail "no camera printed"
-"$sw" render "$model" -o "$work/render.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
+"$sw" render "$model" -o "$work/render.png" --size 640x360 --camera "$cam" --static-lod >/dev/null 2>&1
 "$diff" "$work/shot.png" "$work/render.png" 0.1 || fail "screenshot differs from render"
 # Negative control: the comparison sees a different view.
 "$sw" render "$model" -o "$work/other.png" --size 640x360 --view front >/dev/null 2>&1
@@ -67,7 +69,7 @@ xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
   --script "$work/orbit.path" --frames 10 --settle --overlay --screenshot "$work/overlay.png" \
   >"$work/overlay.out" 2>"$work/overlay.err" || { cat "$work/overlay.err"; fail "view --overlay"; }
 cam=$(sed -n 's/^screenshot camera //p' "$work/overlay.out")
-"$sw" render "$model" -o "$work/render10.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
+"$sw" render "$model" -o "$work/render10.png" --size 640x360 --camera "$cam" --static-lod >/dev/null 2>&1
 if "$diff" "$work/overlay.png" "$work/render10.png" 0.1 >/dev/null; then
   fail "--overlay: no overlay drawn"
 fi
@@ -116,3 +118,14 @@ if "$diff" "$work/lod.png" "$work/plain.png" 1 >/dev/null; then
   fail "--lod-colors: the frame shows no LOD colours"
 fi
 echo "ok: --static-lod --lod-colors equals render of its camera, coloured by representation"
+
+# --no-static-lod: the viewer draws every face by the per-frame path, as render without a LOD cache
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$static_model" --size 640x360 \
+  --script "$work/static.path" --frames 10 --settle --no-static-lod --lod-colors \
+  --screenshot "$work/nolod.png" >"$work/nolod.out" 2>"$work/nolod.err" ||
+  { cat "$work/nolod.err"; fail "view --no-static-lod"; }
+cam=$(sed -n 's/^screenshot camera //p' "$work/nolod.out")
+"$sw" render "$static_model" -o "$work/nolod_render.png" --size 640x360 --camera "$cam" \
+  --lod-colors >/dev/null 2>&1
+"$diff" "$work/nolod.png" "$work/nolod_render.png" 0.1 || fail "--no-static-lod differs from render"
+echo "ok: --no-static-lod equals render of its camera without static LODs"
