@@ -291,16 +291,16 @@ typedef struct sw__fr_tess {
     sw_sg_surface ex_srf;
 } sw__fr_tess;
 
-/* Everything selected, in order: static levels, per-frame faces, meshes. The per-frame faces
- * in chunks shared with env->pool's workers when there are enough of them
+/* Everything selected, in order: static levels, per-frame faces, meshes. The static levels and
+ * per-frame faces in chunks shared with env->pool's workers when there are enough of them
  * (stage_tessellate_parallel.c). geo: zeroed, or emptied (sw__fr_geometry_empty). */
 sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
                             const sw__fr_selection *sel, sw__fr_geometry *geo,
                             sw_gpu_frame_stats *st, sw_status *status);
 
-/* stage_tessellate_parallel.c: faces [first, end) of sel->faces into t->geo and t->st, split in
- * chunks run by the calling thread and the pool's workers, appended in order. */
-sw_result sw__fr_tess_faces(sw__fr_tess *t, const sw__fr_selection *sel, size_t first, size_t end,
+/* stage_tessellate_parallel.c: sel's static picks, then its face picks, into t->geo and t->st,
+ * split in chunks run by the calling thread and the pool's workers, appended in order. */
+sw_result sw__fr_tess_picks(sw__fr_tess *t, const sw__fr_visible *vis, const sw__fr_selection *sel,
                             sw_status *status);
 /* One face pick into t (the chunk body; stage_tessellate.c). */
 sw_result sw__fr_tess_face(sw__fr_tess *t, const sw__fr_selection *sel, const sw__fr_face_pick *p,

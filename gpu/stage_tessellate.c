@@ -456,11 +456,7 @@ sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
     t.bez = sw__calloc(env->sv->n_faces ? env->sv->n_faces : 1, sizeof *t.bez);
     if (!t.bez)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
-    sw_result r = SW_OK;
-    for (size_t i = 0; i < sel->n_statics && r == SW_OK; ++i)
-        r = sw__fr_tess_static(&t, vis, &sel->statics[i], status);
-    if (r == SW_OK)
-        r = sw__fr_tess_faces(&t, sel, 0, sel->n_faces, status);
+    sw_result r = sw__fr_tess_picks(&t, vis, sel, status);
     if (r == SW_OK)
         r = sw__fr_tess_meshes(&t, vis, status);
     for (uint32_t i = 0; i < env->sv->n_faces; ++i) {

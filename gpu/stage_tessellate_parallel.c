@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* The tessellate stage's per-frame faces in chunks shared by the preparing thread and the pool's
- * workers: Kumar et al. 1997 §5's N_c tessellators working on one frame's visible set. Each chunk
- * (a run of consecutive face picks) is tessellated into geometry of its own, and the chunks are
- * appended in order, every index rebased, so the output is the one thread's byte for byte.
+/* The tessellate stage's picks — unit instances at a static level, then per-frame faces — in
+ * chunks shared by the preparing thread and the pool's workers: Kumar et al. 1997 §5's N_c
+ * tessellators working on one frame's visible set. Each chunk (a run of consecutive picks) is
+ * tessellated into geometry of its own, and the chunks are appended in order, every index
+ * rebased, so the output is the one thread's byte for byte. A static pick is a level's triangles
+ * and its faces' fat borders: with static LODs most of a frame's borders are there.
  *
  * Claiming, not queueing: the chunks are claimed from one atomic counter by the preparing thread
  * and by helper tasks submitted at FRAME priority. The preparing thread claims until none is left,
@@ -12,7 +14,7 @@
  * holds is reference counted, so it outlives the frame's chunks safely.
  *
  * One thread (no pool, the exact path, a patch hook that expects its calls in order, or too few
- * faces to split) runs the faces straight into the frame's geometry. */
+ * picks to split) runs the picks straight into the frame's geometry. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
@@ -22,12 +24,12 @@
 #include <string.h>
 
 enum {
-    MIN_FACES_PER_CHUNK = 16, /* below it a chunk's bookkeeping outweighs its faces */
+    MIN_PICKS_PER_CHUNK = 16, /* below it a chunk's bookkeeping outweighs its picks */
     CHUNKS_PER_THREAD = 4,    /* chunks per participating thread, for the load's balance */
 };
 
 typedef struct chunk {
-    size_t first, end; /* face picks */
+    size_t first, end; /* picks: statics first, then faces (pick_at) */
     sw__fr_geometry geo;
     sw_gpu_frame_stats st;
     sw_status status;
@@ -42,9 +44,20 @@ typedef struct tess_job {
     size_t n_chunks;       /* claimers past it touch nothing but the counters */
     chunk *chunks;         /* owned by the preparing thread, valid until done == n_chunks */
     const sw__fr_tess *t0; /* the frame's tessellation state: env and the Bézier sets */
+    const sw__fr_visible *vis;
     const sw__fr_selection *sel;
     sw_th_pool *pool;
 } tess_job;
+
+/* Pick i of the frame: sel's static picks come first, then its face picks. */
+static sw_result tess_pick(sw__fr_tess *t, const sw__fr_visible *vis, const sw__fr_selection *sel,
+                           size_t i, sw_status *status)
+{
+    sw_result r = i < sel->n_statics
+                      ? sw__fr_tess_static(t, vis, &sel->statics[i], status)
+                      : sw__fr_tess_face(t, sel, &sel->faces[i - sel->n_statics], status);
+    return r == SW_OK ? sw__fr_check_budget(t, status) : r;
+}
 
 static void job_release(tess_job *job)
 {
@@ -61,11 +74,8 @@ static void run_chunk(const tess_job *job, chunk *c)
     t.st = &c->st;
     t.geo = &c->geo;
     c->r = SW_OK;
-    for (size_t i = c->first; i < c->end && c->r == SW_OK; ++i) {
-        c->r = sw__fr_tess_face(&t, job->sel, &job->sel->faces[i], &c->status);
-        if (c->r == SW_OK)
-            c->r = sw__fr_check_budget(&t, &c->status);
-    }
+    for (size_t i = c->first; i < c->end && c->r == SW_OK; ++i)
+        c->r = tess_pick(&t, job->vis, job->sel, i, &c->status);
     c->by_pool = sw_th_pool_current_worker(job->pool) >= 0;
 }
 
@@ -189,30 +199,31 @@ static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
     d->borders_capped += s->borders_capped;
     d->border_loops_kept += s->border_loops_kept;
     d->border_loops_made += s->border_loops_made;
+    d->static_units_drawn += s->static_units_drawn;
+    d->static_faces += s->static_faces;
+    d->static_triangles += s->static_triangles;
+    d->static_levels_used |= s->static_levels_used;
 }
 
 /* ---- the stage's entry --------------------------------------------------------------------- */
-static sw_result faces_in_line(sw__fr_tess *t, const sw__fr_selection *sel, size_t first,
-                               size_t end, sw_status *status)
+static sw_result picks_in_line(sw__fr_tess *t, const sw__fr_visible *vis,
+                               const sw__fr_selection *sel, size_t n, sw_status *status)
 {
     sw_result r = SW_OK;
-    for (size_t i = first; i < end && r == SW_OK; ++i) {
-        r = sw__fr_tess_face(t, sel, &sel->faces[i], status);
-        if (r == SW_OK)
-            r = sw__fr_check_budget(t, status);
-    }
+    for (size_t i = 0; i < n && r == SW_OK; ++i)
+        r = tess_pick(t, vis, sel, i, status);
     return r;
 }
 
-/* Chunks for n faces among `threads` threads; 1: not worth splitting. */
+/* Chunks for n picks among `threads` threads; 1: not worth splitting. */
 static size_t chunk_count(size_t n, size_t threads)
 {
-    size_t by_size = n / MIN_FACES_PER_CHUNK, want = CHUNKS_PER_THREAD * threads;
+    size_t by_size = n / MIN_PICKS_PER_CHUNK, want = CHUNKS_PER_THREAD * threads;
     return by_size < want ? by_size : want;
 }
 
-static tess_job *job_create(sw__fr_tess *t, const sw__fr_selection *sel, size_t first, size_t end,
-                            size_t n_chunks)
+static tess_job *job_create(sw__fr_tess *t, const sw__fr_visible *vis, const sw__fr_selection *sel,
+                            size_t n, size_t n_chunks)
 {
     tess_job *job = sw__calloc(1, sizeof *job);
     chunk *chunks = sw__calloc(n_chunks, sizeof *chunks);
@@ -221,10 +232,9 @@ static tess_job *job_create(sw__fr_tess *t, const sw__fr_selection *sel, size_t 
         sw__free(chunks);
         return NULL;
     }
-    const size_t n = end - first;
     for (size_t c = 0; c < n_chunks; ++c) {
-        chunks[c].first = first + n * c / n_chunks;
-        chunks[c].end = first + n * (c + 1) / n_chunks;
+        chunks[c].first = n * c / n_chunks;
+        chunks[c].end = n * (c + 1) / n_chunks;
         sw__fr_chunk_geometry_take(t->env->ctx, &chunks[c].geo);
     }
     atomic_init(&job->refs, 1);
@@ -233,6 +243,7 @@ static tess_job *job_create(sw__fr_tess *t, const sw__fr_selection *sel, size_t 
     job->n_chunks = n_chunks;
     job->chunks = chunks;
     job->t0 = t;
+    job->vis = vis;
     job->sel = sel;
     job->pool = t->env->pool;
     return job;
@@ -284,15 +295,16 @@ static sw_result merge_chunks(sw__fr_tess *t, tess_job *job, sw_status *status)
     return r == SW_OK ? sw__fr_check_budget(t, status) : r;
 }
 
-sw_result sw__fr_tess_faces(sw__fr_tess *t, const sw__fr_selection *sel, size_t first, size_t end,
+sw_result sw__fr_tess_picks(sw__fr_tess *t, const sw__fr_visible *vis, const sw__fr_selection *sel,
                             sw_status *status)
 {
     const sw__fr_env *env = t->env;
     const size_t threads = env->pool ? 1 + (size_t)sw_th_pool_worker_count(env->pool) : 1;
-    const size_t n_chunks = chunk_count(end - first, threads);
+    const size_t n = sel->n_statics + sel->n_faces;
+    const size_t n_chunks = chunk_count(n, threads);
     if (threads < 2 || n_chunks < 2 || env->exact || env->ctx->patch_hook)
-        return faces_in_line(t, sel, first, end, status);
-    tess_job *job = job_create(t, sel, first, end, n_chunks);
+        return picks_in_line(t, vis, sel, n, status);
+    tess_job *job = job_create(t, vis, sel, n, n_chunks);
     if (!job)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
     submit_helpers(job, (threads - 1 < n_chunks - 1 ? threads - 1 : n_chunks - 1));

@@ -15,6 +15,8 @@
  *  - trim: each texture's class holds its wanted texels (or the atlas maximum), its loops exist
  *    and lie in the face's trim box; after the atlas every trimmed draw has an entry of the
  *    planned size;
+ *  - chunks: the tessellation split among the pool's workers is the one thread's byte for byte,
+ *    for per-frame faces and, with static LODs, for units at a static level with their borders;
  *  - submit: the stages chained by hand give the image sw_gpu_render_scene gives, byte for byte;
  *    and a hand-made geometry (one flat bilinear patch record) covers exactly the pixels its
  *    analytic projection covers.
@@ -25,6 +27,9 @@
 #include "sw_lod_cache.h"
 #include "sw_lod_face_cones.h"
 #include "sw_sg_import.h"
+#ifdef SW_TEST_STATIC
+#include "sw_lod_static_set.h"
+#endif
 
 #include <math.h>
 #include <stdio.h>
@@ -38,6 +43,7 @@ static sw_th_pool *g_pool;
 static int g_bound_counted;  /* narrow views with pieces counted over the bound */
 static int g_partial_views;  /* views that cut a model: the cull check is not vacuous */
 static int g_parallel_split; /* frames tessellated in chunks: the parallel check is not vacuous */
+static int g_static_split;   /* the same with static picks among the chunks */
 
 /* One frame's stage outputs, as sw_gpu_frame_prepare keeps them. */
 typedef struct stages {
@@ -451,6 +457,60 @@ static void check_parallel(sw_gpu_context *ctx, const sw_sg_scene *scene,
     stages_free(&par);
 }
 
+#ifdef SW_TEST_STATIC
+/* Static picks are chunked too (the first model only): with the scene's static LODs (built
+ * converged) and the view 3x farther, so that most units are drawn at a level, the chunked geometry
+ * and the static counters equal the one thread's (a chunk that lost a static pick's borders, or a
+ * counter not merged, differs). */
+static void check_parallel_static(sw_gpu_context *ctx, const sw_sg_scene *scene,
+                                  const sw_gpu_frame_desc *base, const char *name)
+{
+    sw_lod_static_set *set = NULL;
+    sw_status st = {0};
+    if (sw_lod_static_set_create(scene, g_pool, NULL, &set, &st) != SW_OK) {
+        CHECK(0, "%s: static set: %s", name, st.message);
+        return;
+    }
+    sw_gpu_frame_desc d = *base;
+    d.static_lods = set;
+    for (int k = 0; k < 3; ++k)
+        d.camera.eye[k] = d.camera.target[k] + 3.0 * (d.camera.eye[k] - d.camera.target[k]);
+    stages one;
+    if (run_prepare(&one, ctx, scene, &d, &st) != SW_OK) {
+        CHECK(0, "%s: stages with static LODs: %s", name, st.message);
+    } else {
+        char what[256];
+        snprintf(what, sizeof what, "%s (static LODs: %zu static picks, %zu faces)", name,
+                 one.sel.n_statics, one.sel.n_faces);
+        const size_t picks = one.sel.n_statics + one.sel.n_faces;
+        stages par;
+        d.pool = g_pool;
+        if (run_prepare(&par, ctx, scene, &d, &st) != SW_OK) {
+            CHECK(0, "%s: with the pool: %s", what, st.message);
+        } else {
+            const size_t bad = first_mismatch(&par.geo, &one.geo);
+            printf("%s: %llu chunks: %s\n", what, (unsigned long long)par.st.tess_chunks,
+                   bad ? "DIFFERENT" : "the one thread's geometry");
+            CHECK(par.st.tess_chunks > 1 || picks < 32, "%s: not split", what);
+            g_static_split += par.st.tess_chunks > 1 && one.sel.n_statics > 0;
+            CHECK(bad == 0, "%s: chunked tessellation differs from one thread's (%zu)", what, bad);
+            CHECK(par.st.static_units_drawn == one.st.static_units_drawn &&
+                      par.st.static_faces == one.st.static_faces &&
+                      par.st.static_triangles == one.st.static_triangles &&
+                      par.st.static_levels_used == one.st.static_levels_used &&
+                      par.st.border_triangles == one.st.border_triangles,
+                  "%s: chunked static counters differ (units %llu vs %llu, faces %llu vs %llu)",
+                  what, (unsigned long long)par.st.static_units_drawn,
+                  (unsigned long long)one.st.static_units_drawn,
+                  (unsigned long long)par.st.static_faces, (unsigned long long)one.st.static_faces);
+        }
+        stages_free(&par);
+    }
+    stages_free(&one);
+    sw_lod_static_set_destroy(set);
+}
+#endif
+
 /* The stages chained by hand against sw_gpu_render_scene on the same context. From a model's
  * second view on, the reference frame starts from the plan of the frame before, recycled into
  * the context with its arrays (frame_stash.c): an item or count kept from that frame shows here
@@ -572,7 +632,7 @@ static void check_bound_counted(sw_gpu_context *ctx, const sw_sg_scene *scene,
 
 /* ---- driver ------------------------------------------------------------------------------------
  */
-static void run_model(sw_gpu_context *ctx, const char *path)
+static void run_model(sw_gpu_context *ctx, const char *path, int first_model)
 {
     sw_sg_import_desc id = {path, NULL, NULL, NULL, NULL, 0};
     sw_sg_scene *scene = NULL;
@@ -615,6 +675,10 @@ static void run_model(sw_gpu_context *ctx, const char *path)
         check_tessellate(&coned, path);
         check_trim_plan(&coned, path);
         check_parallel(ctx, scene, &desc, &coned, path);
+#ifdef SW_TEST_STATIC
+        if (first_model) /* building the static levels is the slow part under the sanitizers */
+            check_parallel_static(ctx, scene, &desc, path);
+#endif
         check_chain(ctx, scene, &desc, &coned, path);
         CHECK(coned.st.bound_exceeded == 0, "%s: %llu pieces over the error bound", path,
               (unsigned long long)coned.st.bound_exceeded);
@@ -645,11 +709,15 @@ int main(int argc, char **argv)
     }
     check_submit_analytic(ctx);
     for (int a = 1; a < argc; ++a)
-        run_model(ctx, argv[a]);
+        run_model(ctx, argv[a], a == 1);
     CHECK(g_partial_views > 0, "no view left an occurrence outside: the cull check is vacuous");
     CHECK(g_bound_counted > 0, "no narrow view counted a piece over the bound");
     CHECK(g_parallel_split > 0,
           "no frame was tessellated in chunks: the parallel check is vacuous");
+#ifdef SW_TEST_STATIC
+    CHECK(g_static_split > 0,
+          "no frame with static picks was tessellated in chunks: the static check is vacuous");
+#endif
     sw_gpu_context_free(ctx);
     sw_th_pool_destroy(g_pool);
     puts(g_failures ? "FAIL" : "PASS");
