@@ -111,6 +111,21 @@ static sw_lod_mesh_bound bound_of(const sw_lod_mesh_distance *d, const mesh *a, 
     return b;
 }
 
+/* The one-triangle mesh pos[0..8] against d: the bound above the dense lattice's maximum and
+ * within the 5 % it certifies to; *dense gets that maximum. */
+static sw_lod_mesh_bound triangle_against(const sw_lod_mesh_distance *d, double pos[9],
+                                          double *dense)
+{
+    uint32_t tri[3] = {0, 1, 2};
+    mesh a = {pos, tri, 3, 1};
+    *dense = lattice_max(d, &a, 60);
+    const sw_lod_mesh_bound b = bound_of(d, &a, 0.05, 1e-9, 12);
+    print_message("  lattice %.9f\n", *dense);
+    assert_true(b.lower <= *dense * (1.0 + 1e-9) + 1e-12);
+    assert_true(b.upper >= *dense && b.upper <= 1.06 * *dense);
+    return b;
+}
+
 /* A tilted triangle over the plane z = 0: the distance is its height, largest at a corner. */
 static void test_triangle_over_plane(void **state)
 {
@@ -139,14 +154,10 @@ static void test_far_corner(void **state)
     uint32_t btri[6] = {0, 1, 2, 3, 4, 5};
     mesh pair = {bpos, btri, 6, 2};
     double pos[9] = {0.2, 0.2, 0, 0.5, 0.2, 0, 10.2, 0.3, 0};
-    uint32_t tri[3] = {0, 1, 2};
-    mesh a = {pos, tri, 3, 1};
     sw_lod_mesh_distance *d = tree_of(&pair);
-    const double dense = lattice_max(d, &a, 60);
-    const sw_lod_mesh_bound b = bound_of(d, &a, 0.05, 1e-9, 12);
-    print_message("  lattice %.9f\n", dense);
+    double dense;
+    triangle_against(d, pos, &dense);
     assert_true(dense > 4.5);
-    assert_true(b.upper >= dense && b.upper <= 1.06 * dense);
     sw_lod_mesh_distance_free(d);
 }
 
@@ -159,17 +170,13 @@ static void test_interior_maximum(void **state)
     double pos[9] = {-0.75, -0.75, 0, 0.75, -0.5, 0, -0.25, 0.75, 0};
     for (int k = 0; k < 3; ++k)
         pos[3 * k + 2] = paraboloid(pos[3 * k], pos[3 * k + 1]);
+    sw_lod_mesh_distance *d = tree_of(&bowl);
+    double dense;
+    triangle_against(d, pos, &dense);
+    assert_true(dense > 0.1); /* the peak is inside, far above the corners' 0 */
+    /* the same with a cap of one split: the fallback still bounds, and is counted */
     uint32_t tri[3] = {0, 1, 2};
     mesh a = {pos, tri, 3, 1};
-    sw_lod_mesh_distance *d = tree_of(&bowl);
-    const double dense = lattice_max(d, &a, 60);
-    const sw_lod_mesh_bound b = bound_of(d, &a, 0.05, 1e-9, 12);
-    print_message("  lattice %.9f\n", dense);
-    assert_true(dense > 0.1); /* the peak is inside, far above the corners' 0 */
-    assert_true(b.lower <= dense * (1.0 + 1e-9) + 1e-12);
-    assert_true(b.upper >= dense);
-    assert_true(b.upper <= 1.06 * dense);
-    /* the same with a cap of one split: the fallback still bounds, and is counted */
     const sw_lod_mesh_bound c = bound_of(d, &a, 0.0, 1e-9, 1);
     assert_true(c.upper >= dense);
     assert_true(c.capped > 0);
