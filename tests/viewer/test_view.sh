@@ -9,14 +9,14 @@
 #     the converged branch, so 0 held by construction; seen failing with a planted walkthrough
 #     wait for one face's build, "pool waits 1"), the last view is drawn converged (--settle),
 #     the window's back buffer is saved through OpenImageIO, and the viewer closes cleanly
-#     (exit 0). The screenshot must match `splinewalk render --camera --static-lod` of the camera
-#     it printed (<= 0.1 % of pixels differ; the viewer draws static LODs by default, render only
-#     when asked or when the file has them): what the window shows is the renderer's frame,
-#     presented into the window's framebuffer.
+#     (exit 0). The screenshot must match `splinewalk render --camera` of the camera it printed
+#     (<= 0.1 % of pixels differ): what the window shows is the renderer's frame, presented into
+#     the window's framebuffer. These runs are without static LODs (--no-static-lod; render draws
+#     none without a LOD cache); 5. has them, as the viewer draws by default.
 #     The frame-time, wireframe and trim-atlas overlays change the frame, each only as it should.
 #  4. samples/embed_minimal (a GLFW host of the public API) draws 30 frames into its window and
 #     exits 0.
-#  5. Static LODs and LOD colouring (--static-lod --lod-colors, keys T and C) on STATIC_MODEL: the
+#  5. Static LODs (the default) and LOD colouring (--lod-colors, keys T and C) on STATIC_MODEL: the
 #     settled screenshot equals `render --static-lod --lod-colors` of its camera, and differs from
 #     the plain render (the colours show which representation drew each surface); with
 #     --no-static-lod it equals the plain render.
@@ -44,7 +44,7 @@ grep -q "missing.path" <<<"$out" || fail "missing script not named: $out"
 echo "ok: bad arguments -> 2, missing script -> 1 naming it"
 
 "$sw" path orbit "$model" -o "$work/orbit.path" >/dev/null 2>&1
-xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 --no-static-lod \
   --script "$work/orbit.path" --frames 60 --settle --screenshot "$work/shot.png" \
   >"$work/view.out" 2>"$work/view.err" || { cat "$work/view.err"; fail "view exited $?"; }
 cat "$work/view.out"
@@ -53,7 +53,7 @@ grep -q "pool waits 0," "$work/view.out" || fail "walkthrough frames waited for 
 [ -s "$work/shot.png" ] || fail "no screenshot"
 cam=$(sed -n 's/^screenshot camera //p' "$work/view.out")
 [ -n "$cam" ] || fail "no camera printed"
-"$sw" render "$model" -o "$work/render.png" --size 640x360 --camera "$cam" --static-lod >/dev/null 2>&1
+"$sw" render "$model" -o "$work/render.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
 "$diff" "$work/shot.png" "$work/render.png" 0.1 || fail "screenshot differs from render"
 # Negative control: the comparison sees a different view.
 "$sw" render "$model" -o "$work/other.png" --size 640x360 --view front >/dev/null 2>&1
@@ -65,11 +65,11 @@ echo "ok: 60 scripted frames, settled screenshot equals splinewalk render of its
 # The frame-time overlay (the viewer's own GL drawing over the presented frame): the same run with
 # --overlay differs from the render, but only in the overlay's corner (at most 20 % of the pixels:
 # a 360 x 120 box of 640 x 360 is 18.75 %).
-xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 --no-static-lod \
   --script "$work/orbit.path" --frames 10 --settle --overlay --screenshot "$work/overlay.png" \
   >"$work/overlay.out" 2>"$work/overlay.err" || { cat "$work/overlay.err"; fail "view --overlay"; }
 cam=$(sed -n 's/^screenshot camera //p' "$work/overlay.out")
-"$sw" render "$model" -o "$work/render10.png" --size 640x360 --camera "$cam" --static-lod >/dev/null 2>&1
+"$sw" render "$model" -o "$work/render10.png" --size 640x360 --camera "$cam" >/dev/null 2>&1
 if "$diff" "$work/overlay.png" "$work/render10.png" 0.1 >/dev/null; then
   fail "--overlay: no overlay drawn"
 fi
@@ -78,7 +78,7 @@ echo "ok: the overlay is drawn over the frame, in its corner only"
 
 # Wireframe: the same settled view drawn as lines differs from the shaded render in over 1 % of
 # the pixels (the surfaces' interiors turn to background between the lines).
-xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 --no-static-lod \
   --script "$work/orbit.path" --frames 10 --settle --wireframe --screenshot "$work/wire.png" \
   >"$work/wire.out" 2>"$work/wire.err" || { cat "$work/wire.err"; fail "view --wireframe"; }
 if "$diff" "$work/wire.png" "$work/render10.png" 1 >/dev/null; then
@@ -89,7 +89,7 @@ echo "ok: --wireframe draws lines"
 # The trim-atlas overlay: one page of the atlas in the upper right corner (a 180 x 180 box of
 # 640 x 360: 14 % of the pixels); the frame outside it is the render's. Motor-c has trimmed faces,
 # so the page is not empty: the overlay changes more than 1 % of the pixels.
-xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 \
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 640x360 --no-static-lod \
   --script "$work/orbit.path" --frames 10 --settle --atlas-overlay --screenshot "$work/atlas.png" \
   >"$work/atlas.out" 2>"$work/atlas.err" || { cat "$work/atlas.err"; fail "view --atlas-overlay"; }
 if "$diff" "$work/atlas.png" "$work/render10.png" 1 >/dev/null; then
@@ -106,9 +106,9 @@ echo "ok: $(cat "$work/embed.out")"
 
 "$sw" path orbit "$static_model" -o "$work/static.path" >/dev/null 2>&1
 xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$static_model" --size 640x360 \
-  --script "$work/static.path" --frames 10 --settle --static-lod --lod-colors \
+  --script "$work/static.path" --frames 10 --settle --lod-colors \
   --screenshot "$work/lod.png" >"$work/lod.out" 2>"$work/lod.err" ||
-  { cat "$work/lod.err"; fail "view --static-lod --lod-colors"; }
+  { cat "$work/lod.err"; fail "view --lod-colors (static LODs by default)"; }
 cam=$(sed -n 's/^screenshot camera //p' "$work/lod.out")
 "$sw" render "$static_model" -o "$work/lod_render.png" --size 640x360 --camera "$cam" \
   --static-lod --lod-colors >/dev/null 2>&1
@@ -117,7 +117,7 @@ cam=$(sed -n 's/^screenshot camera //p' "$work/lod.out")
 if "$diff" "$work/lod.png" "$work/plain.png" 1 >/dev/null; then
   fail "--lod-colors: the frame shows no LOD colours"
 fi
-echo "ok: --static-lod --lod-colors equals render of its camera, coloured by representation"
+echo "ok: static LODs by default with --lod-colors equal render --static-lod of its camera, coloured by representation"
 
 # --no-static-lod: the viewer draws every face by the per-frame path, as render without a LOD cache
 xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$static_model" --size 640x360 \
