@@ -576,9 +576,8 @@ size_t sw_lod_static_memory(const sw_lod_static_chain *chain)
     size_t b = sizeof *chain + (size_t)chain->n_levels * sizeof *chain->levels;
     for (int32_t k = 0; k < chain->n_levels; ++k) {
         const sw_lod_static_level *l = &chain->levels[k];
-        b += (size_t)l->n_vertices *
-             (3 * sizeof(double) + 3 * sizeof(float) + 2 * sizeof(double) + sizeof(uint32_t));
-        b += (size_t)l->n_triangles * 3 * sizeof(uint32_t);
+        b += (size_t)l->n_vertices * SW_LOD_STATIC_VERTEX_BYTES +
+             (size_t)l->n_triangles * SW_LOD_STATIC_TRIANGLE_BYTES;
     }
     return b;
 }
@@ -663,8 +662,6 @@ static void repair_normals(mesh_buf *m)
 }
 
 typedef struct build_ctx {
-    const sw_sg_scene *scene;
-    patch_set *ps;
     const mesh_buf *m;
     sw_lod_static_chain *chain;
     const sw_lod_static_desc *d;
@@ -816,7 +813,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         chain->delta = d.delta;
         chain->levels[0].eps = chain->levels[0].eps_target = d.delta;
         chain->seconds[0] = now_seconds() - t0;
-        build_ctx b = {scene, &ps, &m, chain, &d, SW_OK, status, 0.0, NULL};
+        build_ctx b = {&m, chain, &d, SW_OK, status, 0.0, NULL};
         if (d.n_levels > 0) {
             double *tol = sw__malloc((size_t)d.n_levels * sizeof *tol);
             if (!tol)

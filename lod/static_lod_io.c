@@ -370,8 +370,7 @@ static sw_result summarize_level(reader *r, int32_t k, sw_lod_static_cache_summa
         return bad(r, "truncated level header", NULL);
     if (!finite_all(d, 4) || !(d[0] >= 0.0))
         return bad(r, "a level's ε is not a finite non-negative number", NULL);
-    const size_t per_vertex = 3 * sizeof(double) + 3 * sizeof(float) + 2 * sizeof(double) + 4;
-    if (!skip(r, nv, per_vertex) || !skip(r, nt, 3 * sizeof(uint32_t)))
+    if (!skip(r, nv, SW_LOD_STATIC_VERTEX_BYTES) || !skip(r, nt, SW_LOD_STATIC_TRIANGLE_BYTES))
         return bad(r, "a level's arrays run past the end", NULL);
     const int first = out->level_chains[k]++ == 0;
     out->level_vertices[k] += nv;

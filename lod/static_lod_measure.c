@@ -1,12 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* The two-sided measurement that declares a static level's ε_k (Kumar et al. 1997 §4.1: the
- * simplified polygons lie within δ + ε of the surface).
- *
- * ε_k of the simplified levels is measured (sw_lod_static_measure): the maximum over lattice and
- * random samples of both distances, times desc.safety. Mesh-to-surface values are upper bounds
- * at each sample (a surface point found by Newton's iteration, or level 0 plus δ); the
+/* The two-sided measurement of a static level against the exact surface (sw_lod_static_measure):
+ * the maximum over lattice or random samples of both distances. Mesh-to-surface values are upper
+ * bounds at each sample (a surface point found by Newton's iteration, or level 0 plus δ); the
  * surface-to-mesh side is exact per sample (CGAL AABB tree). Neither side is a bound between
- * samples: that is what the safety factor and the independent re-measurement in the tests are for.
+ * samples, so it checks a declared ε_k from below (the tests) and declares none: the builder
+ * certifies ε_k (static_lod.c, declare_level).
  */
 #include "sw_lod_static_internal.h"
 #include "sw_hooks.h"
@@ -321,7 +319,9 @@ static void measure_mesh(const patch_set *ps, const mesh_ref *ref, const sw_lod_
 }
 
 /* level0: the tree of level 0 for the mesh -> surface fallback, NULL when lv is level 0 */
-sw_result sw__sl_measure_with(const sw_sg_scene *scene, patch_set *ps,
+/* Both distances of level lv to the surfaces of ps; level0: the tree of level 0 for the mesh ->
+ * surface fallback, NULL when lv is level 0. */
+static sw_result measure_with(const sw_sg_scene *scene, patch_set *ps,
                               const sw_lod_static_level *lv, const sw_lod_mesh_distance *level0,
                               double delta, double eps_hint, const sw_lod_static_measure_desc *din,
                               sw_lod_static_distance *out, sw_status *status)
@@ -359,7 +359,8 @@ sw_result sw__sl_measure_with(const sw_sg_scene *scene, patch_set *ps,
     return SW_OK;
 }
 
-sw_result sw__sl_measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
+/* measure_with with level 0's tree built here (level0 NULL or lv itself: none). */
+static sw_result measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
                              const sw_lod_static_level *level0, double delta, double eps_hint,
                              const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
                              sw_status *status)
@@ -370,7 +371,7 @@ sw_result sw__sl_measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_l
         r = sw_lod_mesh_distance_create(level0->positions, level0->triangles, level0->n_triangles,
                                         &tree, status);
     if (r == SW_OK)
-        r = sw__sl_measure_with(scene, ps, lv, tree, delta, eps_hint, din, out, status);
+        r = measure_with(scene, ps, lv, tree, delta, eps_hint, din, out, status);
     sw_lod_mesh_distance_free(tree);
     return r;
 }
@@ -386,7 +387,7 @@ sw_result sw_lod_static_measure(const sw_sg_scene *scene, const sw_lod_static_pa
     if (r == SW_OK && !(eps_hint > 0.0))
         r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "static lod: eps_hint %g", eps_hint);
     if (r == SW_OK)
-        r = sw__sl_measure_set(scene, &ps, level, level0, delta, eps_hint, desc, out, status);
+        r = measure_set(scene, &ps, level, level0, delta, eps_hint, desc, out, status);
     sw__sl_patch_set_free(&ps);
     return r;
 }

@@ -118,6 +118,10 @@ double sw_lod_static_default_delta(const double box[6]);
 sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static_desc *out,
                                      sw_status *status);
 
+/* A level's bytes per vertex (position 3 f64, normal 3 f32, (u, v) 2 f64, face u32) and per
+ * triangle (3 u32), in memory and in the LODS cache alike. */
+enum { SW_LOD_STATIC_VERTEX_BYTES = 56, SW_LOD_STATIC_TRIANGLE_BYTES = 12 };
+
 /* Bytes the chain owns. */
 size_t sw_lod_static_memory(const sw_lod_static_chain *chain);
 

@@ -85,17 +85,4 @@ sw_result sw__sl_patch_set_init(const sw_sg_scene *scene, const sw_lod_static_pa
 /* The face_dom of `face`, NULL when the set has none. */
 const face_dom *sw__sl_find_face(const patch_set *ps, uint32_t face);
 
-/* ---- static_lod_measure.c ------------------------------------------------------------------- */
-/* Both distances of level lv to the surfaces of ps (see static_lod_measure.c); level0: the tree
- * of level 0 for the mesh -> surface fallback, NULL when lv is level 0. */
-sw_result sw__sl_measure_with(const sw_sg_scene *scene, patch_set *ps,
-                              const sw_lod_static_level *lv, const sw_lod_mesh_distance *level0,
-                              double delta, double eps_hint, const sw_lod_static_measure_desc *din,
-                              sw_lod_static_distance *out, sw_status *status);
-/* sw__sl_measure_with with level 0's tree built here (level0 NULL or lv itself: none). */
-sw_result sw__sl_measure_set(const sw_sg_scene *scene, patch_set *ps, const sw_lod_static_level *lv,
-                             const sw_lod_static_level *level0, double delta, double eps_hint,
-                             const sw_lod_static_measure_desc *din, sw_lod_static_distance *out,
-                             sw_status *status);
-
 #endif

@@ -152,11 +152,11 @@ static int lod_cache_of(sw_scene handle, const char *path, sw_lod_static_cache_s
     return got;
 }
 
-/* A level's arrays as the cache stores them (sw_lod_static_memory counts the same per vertex and
- * triangle): position 24, normal 12, (u, v) 16 and face 4 bytes per vertex, 12 per triangle. */
+/* A level's arrays as the cache stores them. */
 static double level_bytes(const sw_lod_static_cache_summary *c, uint32_t k)
 {
-    return 56.0 * (double)c->level_vertices[k] + 12.0 * (double)c->level_triangles[k];
+    return (double)SW_LOD_STATIC_VERTEX_BYTES * (double)c->level_vertices[k] +
+           (double)SW_LOD_STATIC_TRIANGLE_BYTES * (double)c->level_triangles[k];
 }
 
 static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t bytes,
