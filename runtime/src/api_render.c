@@ -63,6 +63,9 @@ typedef struct rt_job {
     sw_rt_frame_job job; /* first: pipeline pointers are rt_job pointers */
     sw_rt_scene *scene;  /* a reference held until the frame is submitted */
     char *output_path;   /* copy of the desc's, or NULL */
+    /* an immediate frame's surface programs, for its submission only (Guthe §8's special
+     * program); NULL: the library's */
+    const struct sw__gpu_surface_programs *shading;
 } rt_job;
 
 static void job_free(rt_job *j);
@@ -640,34 +643,6 @@ static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
     return res;
 }
 
-/* Renders and writes the frame of a checked desc on the renderer's thread; extra (NULL: none)
- * gives an immediate frame's occurrences and surface programs. */
-static sw_result draw_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame_desc *desc,
-                            const sw_rt_frame_extra *extra, const sw_th_wait_count *w0,
-                            sw_frame_stats *stats, sw_status *status)
-{
-    double t0 = now_ms();
-    sw_gpu_frame_desc frame = {0};
-    sw_result res = gpu_frame(r, scene, desc, &frame, status);
-    if (res != SW_OK)
-        return res;
-    sw_gpu_image image = {0};
-    sw_gpu_frame_stats gstats = {0};
-    const sw__gpu_surface_programs library = r->gpu->surf;
-    if (extra) {
-        frame.occurrences = extra->occurrences;
-        frame.n_occurrences = extra->n_occurrences;
-        if (extra->shading)
-            r->gpu->surf = *extra->shading; /* this frame only (Guthe §8's special program) */
-    }
-    res = sw_gpu_render_scene(r->gpu, scene->sg, &frame, &image, &gstats, status);
-    r->gpu->surf = library;
-    if (res != SW_OK)
-        return res;
-    occlusion_feedback(r, &frame, &gstats);
-    return finish_frame(&image, desc->output_path, &frame, &gstats, t0, w0, 0, stats, status);
-}
-
 static void job_free(rt_job *j)
 {
     sw_gpu_frame_plan_free(j->job.plan);
@@ -677,15 +652,21 @@ static void job_free(rt_job *j)
     sw__free(j);
 }
 
-/* A new job for a checked desc, its scene acquired; NULL with *status set on failure. */
-static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_status *status)
+/* A new job for a checked desc: its scene acquired from the desc's handle, or `scene` (a
+ * reference the caller holds) retained. */
+static sw_result job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_rt_scene *scene,
+                            rt_job **out, sw_status *status)
 {
-    rt_job *j = sw__calloc(1, sizeof *j);
-    if (!j) {
-        sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
-        return NULL;
+    rt_job *j = *out = sw__calloc(1, sizeof *j);
+    if (!j)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "sw_renderer_prepare: out of memory");
+    sw_result res = SW_OK;
+    if (scene) {
+        sw_rt_scene_retain(scene);
+        j->scene = scene;
+    } else {
+        res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &j->scene, status);
     }
-    sw_result res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &j->scene, status);
     if (res == SW_OK && r->in_flight && j->scene != r->cache_scene && j->scene->lineage &&
         j->scene->lineage == r->cache_scene->lineage) {
         /* A node scene published a version since the waiting frames were prepared: this frame
@@ -705,10 +686,81 @@ static rt_job *job_create(sw_rt_renderer *r, const sw_frame_desc *desc, sw_statu
         res = gpu_frame(r, j->scene, desc, &j->job.desc, status);
     if (res != SW_OK) {
         job_free(j);
-        return NULL;
+        *out = NULL;
+        return res;
     }
     j->job.sg = j->scene->sg;
-    return j;
+    return SW_OK;
+}
+
+/* Hands the frame of a checked desc to the visibility thread (started on first use): on the
+ * desc's scene, or on `scene` with `extra` (an immediate frame, whose occurrences V reads: the
+ * caller keeps them until the frame is submitted). Every frame, sw_renderer_draw's too, is
+ * prepared there: one pipeline, whichever call drew it. */
+static sw_result prepare_frame(sw_rt_renderer *r, const sw_frame_desc *desc, sw_rt_scene *scene,
+                               const sw_rt_frame_extra *extra, sw_status *status)
+{
+    sw_result res = r->pipeline ? SW_OK : sw_rt_pipeline_start(r->gpu, &r->pipeline, status);
+    if (res != SW_OK)
+        return res;
+    const uint64_t w0 = sw_th_thread_waits().waits;
+    rt_job *j;
+    res = job_create(r, desc, scene, &j, status);
+    if (res != SW_OK)
+        return res;
+    if (extra) {
+        j->job.desc.occurrences = extra->occurrences;
+        j->job.desc.n_occurrences = extra->n_occurrences;
+        j->shading = extra->shading;
+    }
+    j->job.pool_waits_before = sw_th_thread_waits().waits - w0;
+    j->job.frame = ++r->frames_prepared;
+    j->job.spent = r->spent;
+    r->spent = NULL;
+    r->in_flight++;
+    sw_rt_pipeline_push(r->pipeline, &j->job);
+    return SW_OK;
+}
+
+/* Waits for the oldest prepared frame and draws it on this thread; ms_total counts from t0. */
+static sw_result submit_frame(sw_rt_renderer *r, double t0, sw_frame_stats *stats,
+                              sw_status *status)
+{
+    const double t_wait = now_ms();
+    const sw_th_wait_count w0 = sw_th_thread_waits();
+    rt_job *j = (rt_job *)sw_rt_pipeline_pop(r->pipeline);
+    r->in_flight--;
+    const double t1 = now_ms();
+    sw_result res = j->job.result;
+    if (res != SW_OK) {
+        if (status)
+            *status = j->job.status;
+        job_free(j);
+        return res;
+    }
+    sw_gpu_image image = {0};
+    sw_gpu_frame_stats gstats = {0};
+    const sw__gpu_surface_programs library = r->gpu->surf;
+    if (j->shading)
+        r->gpu->surf = *j->shading; /* this frame only */
+    res = sw_gpu_frame_submit_keep(r->gpu, j->job.plan, &image, &gstats, status);
+    r->gpu->surf = library;
+    if (res == SW_OK)
+        occlusion_feedback(r, &j->job.desc, &gstats);
+    /* freed by V with the next prepare; a spent plan older than that (no prepare in between) is
+     * freed here */
+    sw_gpu_frame_plan_recycle(r->gpu, r->spent);
+    r->spent = j->job.plan;
+    j->job.plan = NULL;
+    if (res == SW_OK)
+        res = finish_frame(&image, j->output_path, &j->job.desc, &gstats, t0, &w0,
+                           j->job.pool_waits + j->job.pool_waits_before, stats, status);
+    if (res == SW_OK && stats) {
+        stats->ms_visibility = j->job.ms_visibility;
+        stats->ms_wait_visibility = t1 - t_wait;
+    }
+    job_free(j);
+    return res;
 }
 
 sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, sw_status *status)
@@ -723,22 +775,11 @@ sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc, s
         res = sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                        "sw_renderer_prepare: %d frames are prepared already; submit one first",
                        SW_RENDERER_MAX_PREPARED);
-    if (res == SW_OK && !r->pipeline)
-        res = sw_rt_pipeline_start(r->gpu, &r->pipeline, status);
-    if (res != SW_OK)
-        return res;
-    const uint64_t w0 = sw_th_thread_waits().waits;
-    rt_job *j = job_create(r, desc, status);
-    if (!j)
-        return status ? status->result : SW_ERR_INVALID_ARGUMENT;
-    j->job.pool_waits_before = sw_th_thread_waits().waits - w0;
-    j->job.frame = ++r->frames_prepared;
-    j->job.spent = r->spent;
-    r->spent = NULL;
-    r->in_flight++;
-    sw_rt_pipeline_push(r->pipeline, &j->job);
-    sw__status_ok(status);
-    return SW_OK;
+    if (res == SW_OK)
+        res = prepare_frame(r, desc, NULL, NULL, status);
+    if (res == SW_OK)
+        sw__status_ok(status);
+    return res;
 }
 
 sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_status *status)
@@ -750,37 +791,7 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     if (!r->in_flight)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "sw_renderer_submit: no prepared frame (call sw_renderer_prepare first)");
-    double t0 = now_ms();
-    const sw_th_wait_count w0 = sw_th_thread_waits();
-    rt_job *j = (rt_job *)sw_rt_pipeline_pop(r->pipeline);
-    r->in_flight--;
-    double t1 = now_ms();
-    res = j->job.result;
-    if (res != SW_OK) {
-        if (status)
-            *status = j->job.status;
-        job_free(j);
-        return res;
-    }
-    sw_gpu_image image = {0};
-    sw_gpu_frame_stats gstats = {0};
-    res = sw_gpu_frame_submit_keep(r->gpu, j->job.plan, &image, &gstats, status);
-    if (res == SW_OK)
-        occlusion_feedback(r, &j->job.desc, &gstats);
-    /* freed by V with the next prepare; a spent plan older than that (no prepare in between) is
-     * freed here */
-    sw_gpu_frame_plan_recycle(r->gpu, r->spent);
-    r->spent = j->job.plan;
-    j->job.plan = NULL;
-    if (res == SW_OK)
-        res = finish_frame(&image, j->output_path, &j->job.desc, &gstats, t0, &w0,
-                           j->job.pool_waits + j->job.pool_waits_before, stats, status);
-    if (res == SW_OK && stats) {
-        stats->ms_visibility = j->job.ms_visibility;
-        stats->ms_wait_visibility = t1 - t0;
-    }
-    job_free(j);
-    return res;
+    return submit_frame(r, now_ms(), stats, status);
 }
 
 sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_frame_stats *stats,
@@ -799,14 +810,9 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
     res = check_frame_desc(desc, status);
     if (res != SW_OK)
         return res;
-    const sw_th_wait_count w0 = sw_th_thread_waits();
-    sw_rt_scene *scene;
-    res = sw_rt_scene_acquire_frame(desc->scene, desc->walkthrough, &scene, status);
-    if (res != SW_OK)
-        return res;
-    res = draw_frame(r, scene, desc, NULL, &w0, stats, status);
-    sw_rt_scene_release(scene);
-    return res;
+    const double t0 = now_ms();
+    res = prepare_frame(r, desc, NULL, NULL, status);
+    return res == SW_OK ? submit_frame(r, t0, stats, status) : res;
 }
 
 sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
@@ -836,9 +842,9 @@ sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_s
     if (r->in_flight)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: %u prepared frames wait; submit them first", fn, r->in_flight);
-    const sw_th_wait_count w0 = sw_th_thread_waits();
+    const double t0 = now_ms();
     res = check_frame_desc(desc, status);
     if (res == SW_OK)
-        res = draw_frame(r, scene, desc, extra, &w0, stats, status);
-    return res;
+        res = prepare_frame(r, desc, scene, extra, status);
+    return res == SW_OK ? submit_frame(r, t0, stats, status) : res;
 }

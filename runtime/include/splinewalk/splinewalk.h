@@ -392,10 +392,11 @@ typedef struct sw_frame_stats {
     double ms_hierarchy;     /* blocked waiting for hierarchy builds and refinements (both
                                 modes; 0 when none was waited for) */
     double ms_tessellate, ms_trim, ms_draw, ms_readback, ms_write, ms_total;
-    /* split frames (sw_renderer_prepare / submit): hierarchy and tessellate ran on the visibility
-     * thread, in ms_visibility there (its whole time for the frame); the rest on the caller's, in
-     * ms_total = ms_wait_visibility (waiting for the visibility thread) + trim + draw + readback
-     * + write + the call's own overhead. Both 0 for sw_renderer_draw. */
+    /* every frame is prepared on the renderer's visibility thread (sw_renderer_draw's too):
+     * hierarchy and tessellate ran there, in ms_visibility (its whole time for the frame); the
+     * rest on the caller's, in ms_total = ms_wait_visibility (waiting for the visibility thread;
+     * in sw_renderer_draw all of ms_visibility) + trim + draw + readback + write + the call's own
+     * overhead (sw_renderer_draw's prepare included) */
     double ms_visibility, ms_wait_visibility;
     double ms_gpu; /* GPU time of the trim textures and the draw, by a GL timer query (on
                       llvmpipe: the rasterizer threads' work; it overlaps ms_trim + ms_draw) */
@@ -431,12 +432,16 @@ typedef struct sw_frame_stats {
     uint64_t occlusion_tests, nodes_occluded, faces_occluded, occluders_drawn;
 } sw_frame_stats;
 
-/* Renders one frame: converged by default (every refinement done before the frame is drawn, so
- * the image is deterministic: the same scene, camera and size give the image `splinewalk render`
- * gives), or walkthrough (desc->walkthrough: never waits for the renderer's worker pool), and
+/* Renders one frame of this call's camera: converged by default (every refinement done before
+ * the frame is drawn, so the image is deterministic: the same scene, camera and size give the
+ * image `splinewalk render` gives), or walkthrough (desc->walkthrough: never waits for the renderer's worker pool), and
  * writes it to desc->output_path when that is not NULL (temporary name, then rename). Owner
  * thread only; the scene may be used by other threads meanwhile. desc is read during the call
  * only. stats may be NULL; it is written on success only.
+ * The frame runs through the same pipeline as split frames (below): sw_renderer_prepare, then
+ * sw_renderer_submit, in one call. There is no look-ahead: the visibility thread prepares this
+ * call's frame while the caller waits, so nothing of it overlaps the caller's own work; a host
+ * that knows its next camera gets the overlap from prepare/submit.
  * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc; a thread other than the renderer's owner; size out
  * of 0..16384; error_px below SW_ERROR_MIN_PX or not finite; fovy out of [SW_FOVY_MIN_DEG, 180);
  * a non-finite or degenerate
