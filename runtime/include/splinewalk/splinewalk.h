@@ -434,20 +434,19 @@ typedef struct sw_frame_stats {
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
  * the frame is drawn, so the image is deterministic: the same scene, camera and size give the
- * image `splinewalk render` gives), or walkthrough (desc->walkthrough: never waits for the renderer's worker pool), and
- * writes it to desc->output_path when that is not NULL (temporary name, then rename). Owner
- * thread only; the scene may be used by other threads meanwhile. desc is read during the call
- * only. stats may be NULL; it is written on success only.
- * The frame runs through the same pipeline as split frames (below): sw_renderer_prepare, then
- * sw_renderer_submit, in one call. There is no look-ahead: the visibility thread prepares this
- * call's frame while the caller waits, so nothing of it overlaps the caller's own work; a host
- * that knows its next camera gets the overlap from prepare/submit.
- * Errors: SW_ERR_INVALID_ARGUMENT (NULL desc; a thread other than the renderer's owner; size out
- * of 0..16384; error_px below SW_ERROR_MIN_PX or not finite; fovy out of [SW_FOVY_MIN_DEG, 180);
- * a non-finite or degenerate
- * camera), SW_ERR_STALE_HANDLE (renderer or desc->scene), SW_ERR_UNSUPPORTED (output extension
- * not .png or .exr), SW_ERR_IO, SW_ERR_GL, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY,
- * SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped scene detected on first use). */
+ * image `splinewalk render` gives), or walkthrough (desc->walkthrough: never waits for the
+ * renderer's worker pool), and writes it to desc->output_path when that is not NULL (temporary
+ * name, then rename). Owner thread only; the scene may be used by other threads meanwhile. desc is
+ * read during the call only. stats may be NULL; it is written on success only. The frame runs
+ * through the same pipeline as split frames (below): sw_renderer_prepare, then sw_renderer_submit,
+ * in one call. There is no look-ahead: the visibility thread prepares this call's frame while the
+ * caller waits, so nothing of it overlaps the caller's own work; a host that knows its next camera
+ * gets the overlap from prepare/submit. Errors: SW_ERR_INVALID_ARGUMENT (NULL desc; a thread other
+ * than the renderer's owner; size out of 0..16384; error_px below SW_ERROR_MIN_PX or not finite;
+ * fovy out of [SW_FOVY_MIN_DEG, 180); a non-finite or degenerate camera), SW_ERR_STALE_HANDLE
+ * (renderer or desc->scene), SW_ERR_UNSUPPORTED (output extension not .png or .exr), SW_ERR_IO,
+ * SW_ERR_GL, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY, SW_ERR_CHECKSUM / SW_ERR_FORMAT (a corrupt mapped
+ * scene detected on first use). */
 SW_API sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc,
                                   sw_frame_stats *stats, sw_status *status);
 
