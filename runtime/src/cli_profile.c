@@ -3,22 +3,17 @@
  * public renderer API, timed stage by stage on the submitting thread and, threaded, on the
  * renderer's visibility thread (issue 5). */
 #include "cli.h"
+#include "cli_profile_out.h"
 
 #include "sw_camera_path.h"
 #include "sw_profile_report.h"
 #include "sw_rt.h"
-#include "sw_safe_write.h"
 #include "sw_status_util.h"
 #include "sw_th_pool.h"
 
-#include <dirent.h>
-#include <errno.h>
-#include <fcntl.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 static const char k_usage[] =
@@ -153,186 +148,7 @@ static int parse_args(int argc, char **argv, profile_args *a)
     return 0;
 }
 
-/* ---- output directory: written aside, renamed in at the end ---------------------------------- */
-typedef struct staging {
-    char dir[4096]; /* DIR/.profile-PID-XXXXXX */
-    char names[8][64];
-    int n_names;
-} staging;
-
-/* Removes the staging folders DIR/.profile-PID-XXXXXX of runs that were killed (their PID no
- * longer runs): they hold only the flat files a run stages. */
-static void remove_stale_staging(const char *out)
-{
-    DIR *d = opendir(out);
-    if (!d)
-        return;
-    const struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        char *end;
-        if (strncmp(e->d_name, ".profile-", 9) != 0)
-            continue;
-        const long pid = strtol(e->d_name + 9, &end, 10);
-        if (end == e->d_name + 9 || *end != '-' || pid <= 0 || pid == (long)getpid() ||
-            kill((pid_t)pid, 0) == 0 || errno != ESRCH)
-            continue;
-        char sub[4200];
-        snprintf(sub, sizeof sub, "%s/%s", out, e->d_name);
-        DIR *s = opendir(sub);
-        const struct dirent *f;
-        while (s && (f = readdir(s)) != NULL) {
-            if (strcmp(f->d_name, ".") != 0 && strcmp(f->d_name, "..") != 0)
-                unlinkat(dirfd(s), f->d_name, 0);
-        }
-        if (s)
-            closedir(s);
-        rmdir(sub);
-    }
-    closedir(d);
-}
-
-static sw_result make_staging(const char *out, staging *st, sw_status *status)
-{
-    struct stat sb;
-    if (stat(out, &sb) != 0) {
-        if (errno != ENOENT || mkdir(out, 0777) != 0)
-            return sw__fail(status, SW_ERR_IO, "%s: %s", out, strerror(errno));
-    } else if (!S_ISDIR(sb.st_mode)) {
-        return sw__fail(status, SW_ERR_IO, "%s: exists and is not a directory", out);
-    }
-    remove_stale_staging(out);
-    if (snprintf(st->dir, sizeof st->dir, "%s/.profile-%ld-XXXXXX", out, (long)getpid()) >=
-        (int)sizeof st->dir)
-        return sw__fail(status, SW_ERR_IO, "%s: path too long", out);
-    if (!mkdtemp(st->dir))
-        return sw__fail(status, SW_ERR_IO, "%s: %s", st->dir, strerror(errno));
-    return SW_OK;
-}
-
-static void staged_path(const staging *st, const char *name, char *buf, size_t size)
-{
-    snprintf(buf, size, "%s/%s", st->dir, name);
-}
-
-static void staging_remember(staging *st, const char *name)
-{
-    if (st->n_names < (int)(sizeof st->names / sizeof st->names[0]))
-        snprintf(st->names[st->n_names++], sizeof st->names[0], "%s", name);
-}
-
-static void staging_abandon(staging *st)
-{
-    char p[4200];
-    for (int i = 0; i < st->n_names; i++) {
-        staged_path(st, st->names[i], p, sizeof p);
-        remove(p);
-    }
-    rmdir(st->dir);
-}
-
-/* Moves every staged file into `out`, then removes the staging directory. */
-static sw_result staging_commit(staging *st, const char *out, sw_status *status)
-{
-    for (int i = 0; i < st->n_names; i++) {
-        char from[4200], to[4200];
-        staged_path(st, st->names[i], from, sizeof from);
-        snprintf(to, sizeof to, "%s/%s", out, st->names[i]);
-        if (rename(from, to) != 0)
-            return sw__fail(status, SW_ERR_IO, "%s: %s", to, strerror(errno));
-    }
-    rmdir(st->dir);
-    const int fd = open(out, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd >= 0) { /* the renames made durable (the files were fsync'd when written) */
-        (void)fsync(fd);
-        close(fd);
-    }
-    return SW_OK;
-}
-
-typedef int (*report_fn)(FILE *f, const sw_rt_profile *p, const char *svg);
-
-static int csv_fn(FILE *f, const sw_rt_profile *p, const char *svg)
-{
-    (void)svg;
-    return sw_rt_profile_write_csv(f, p);
-}
-
-static int json_fn(FILE *f, const sw_rt_profile *p, const char *svg)
-{
-    (void)svg;
-    return sw_rt_profile_write_json(f, p);
-}
-
-static int text_fn(FILE *f, const sw_rt_profile *p, const char *svg)
-{
-    (void)p;
-    return fputs(svg, f) < 0 ? -1 : 0;
-}
-
-static int html_fn(FILE *f, const sw_rt_profile *p, const char *svg)
-{
-    return sw_rt_profile_write_html(f, p, svg);
-}
-
-typedef struct report_job {
-    report_fn fn;
-    const sw_rt_profile *p;
-    const char *svg;
-} report_job;
-
-static int report_fill(FILE *f, const void *ctx)
-{
-    const report_job *job = ctx;
-    return job->fn(f, job->p, job->svg);
-}
-
-/* Each report through the project's one writer (sw_safe_write.h): built in memory, every write
- * and the fsync checked, so a full disk fails the run instead of committing a short file. */
-static sw_result write_staged(staging *st, const char *name, report_fn fn, const sw_rt_profile *p,
-                              const char *svg, sw_status *status)
-{
-    char path[4200];
-    staged_path(st, name, path, sizeof path);
-    staging_remember(st, name);
-    const report_job job = {fn, p, svg};
-    return sw__write_file_printed(path, report_fill, &job, 0, status);
-}
-
-static sw_result write_reports(staging *st, const sw_rt_profile *p, sw_status *status)
-{
-    char *svg = NULL;
-    size_t svg_len = 0;
-    FILE *mem = open_memstream(&svg, &svg_len);
-    if (!mem)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frametime.svg: out of memory");
-    int bad = sw_rt_profile_write_svg(mem, p);
-    bad |= fclose(mem) != 0;
-    sw_result r =
-        bad ? sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frametime.svg: out of memory") : SW_OK;
-    if (r == SW_OK)
-        r = write_staged(st, "profile.csv", csv_fn, p, NULL, status);
-    if (r == SW_OK)
-        r = write_staged(st, "profile.json", json_fn, p, NULL, status);
-    if (r == SW_OK)
-        r = write_staged(st, "frametime.svg", text_fn, p, svg, status);
-    if (r == SW_OK)
-        r = write_staged(st, "report.html", html_fn, p, svg, status);
-    free(svg);
-    return r;
-}
-
 /* ---- the run --------------------------------------------------------------------------------- */
-static double resident_bytes(void)
-{
-    FILE *f = fopen("/proc/self/statm", "r");
-    unsigned long size = 0, resident = 0;
-    if (!f)
-        return 0.0;
-    const int got = fscanf(f, "%lu %lu", &size, &resident);
-    fclose(f);
-    return got == 2 ? (double)resident * (double)sysconf(_SC_PAGESIZE) : 0.0;
-}
-
 static void choose_captures(sw_rt_profile *p, uint32_t n)
 {
     const uint32_t want[3] = {0, n / 2, n - 1};
@@ -359,7 +175,7 @@ static void show_progress(uint32_t done, uint32_t n, double last_ms)
 
 /* Frame i's camera along the path and, when it is captured, its staged PNG in `file` (the
  * renderer copies the path: one buffer serves the frame prepared ahead too). */
-static void set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, staging *st,
+static void set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, sw_cli_staging *st,
                       const sw_rt_profile *p, sw_frame_desc *frame, char file[4200])
 {
     sw_rt_path_eval(path, sw_rt_path_frame_time(path, i, n), &frame->camera);
@@ -367,8 +183,8 @@ static void set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, sta
     if (is_capture(p, i)) {
         char name[64];
         sw_rt_profile_capture_name(i, name, sizeof name);
-        staged_path(st, name, file, 4200);
-        staging_remember(st, name);
+        sw_cli_staging_path(st, name, file, 4200);
+        sw_cli_staging_remember(st, name);
         frame->output_path = file;
     }
 }
@@ -377,7 +193,7 @@ static void set_frame(const sw_rt_camera_path *path, uint32_t i, uint32_t n, sta
  * to the renderer's visibility thread, then frame i (prepared while frame i - 1 was submitted)
  * submitted. */
 static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camera_path *path,
-                           uint32_t i, uint32_t n, sw_frame_desc *frame, staging *st,
+                           uint32_t i, uint32_t n, sw_frame_desc *frame, sw_cli_staging *st,
                            sw_rt_profile *p, sw_frame_stats *stats, double *prepare_ms,
                            sw_status *status)
 {
@@ -397,43 +213,9 @@ static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camer
     return r == SW_OK ? sw_renderer_submit(renderer, stats, status) : r;
 }
 
-/* The pool's counters, queue and injection peak (since the previous read) at one moment; no pool
- * yet (nothing asked for one): zeros. */
-typedef struct pool_sample {
-    sw_th_pool_stats stats;
-    int64_t queued, peak;
-} pool_sample;
-
-static void pool_read(sw_renderer renderer, int with_queues, pool_sample *out)
-{
-    sw_th_pool *pool = sw_rt_renderer_pool_ptr(renderer);
-    memset(out, 0, sizeof *out);
-    if (!pool)
-        return;
-    sw_th_pool_stats_get(pool, &out->stats);
-    if (with_queues) {
-        out->queued = sw_th_pool_queued(pool, NULL);
-        out->peak = sw_th_pool_inject_peak_take(pool);
-    }
-}
-
-/* The pool columns of frame `row`: what the pool did between two reads inside the frame's window
- * (just after its clock starts, just before it stops), so that in walkthrough mode the workers
- * cannot show more than workers x frame_ms however the threads are scheduled between frames;
- * its queue at the frame's end and its injection queue's peak since the previous frame. */
-static void pool_columns(const pool_sample *start, pool_sample *end, sw_rt_prof_row *row)
-{
-    /* a running task's time may read a few ns ahead of what its end then records
-     * (sw_th_pool_stats.ns_by_kind): the totals are kept from going back */
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
-        if (end->stats.ns_by_kind[k] < start->stats.ns_by_kind[k])
-            end->stats.ns_by_kind[k] = start->stats.ns_by_kind[k];
-    sw_rt_profile_row_pool(&start->stats, &end->stats, end->queued, end->peak, row);
-}
-
 /* Draws the n frames; each row's frame_ms is this thread's wall time for its frame. */
 static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_camera_path *path,
-                            uint32_t n, sw_frame_desc *frame, staging *st, sw_rt_profile *p,
+                            uint32_t n, sw_frame_desc *frame, sw_cli_staging *st, sw_rt_profile *p,
                             sw_status *status)
 {
     const int tty = isatty(STDERR_FILENO);
@@ -445,12 +227,12 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
     }
     for (uint32_t i = 0; i < n && r == SW_OK; i++) {
         sw_frame_stats stats = {0};
-        pool_sample pool_start, pool_end;
+        sw_cli_pool_sample pool_start, pool_end;
         double prepare_ms;
         const double t0 = sw_cli_now_ms();
-        pool_read(renderer, 0, &pool_start);
+        sw_cli_pool_read(renderer, 0, &pool_start);
         r = one_frame(renderer, threaded, path, i, n, frame, st, p, &stats, &prepare_ms, status);
-        pool_read(renderer, 1, &pool_end);
+        sw_cli_pool_read(renderer, 1, &pool_end);
         const double ms = sw_cli_now_ms() - t0;
         const double t = sw_rt_path_frame_time(path, i, n);
         if (r != SW_OK) {
@@ -460,8 +242,9 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
             break;
         }
         sw_rt_prof_row row;
-        sw_rt_profile_row(&stats, i, t, ms, prepare_ms, resident_bytes(), is_capture(p, i), &row);
-        pool_columns(&pool_start, &pool_end, &row);
+        sw_rt_profile_row(&stats, i, t, ms, prepare_ms, sw_cli_resident_bytes(), is_capture(p, i),
+                          &row);
+        sw_cli_pool_columns(&pool_start, &pool_end, &row);
         if (sw_rt_profile_push(p, &row) != 0)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
         if (tty)
@@ -480,9 +263,6 @@ static uint32_t requested_workers(const profile_args *a)
 
 static void fill_meta(const profile_args *a, sw_renderer renderer, sw_rt_profile *p)
 {
-    sw_th_pool_desc want = {0}, pool; /* resolves the default as the renderer's pool will */
-    want.worker_count = requested_workers(a);
-    sw_th_pool_desc_defaults(&pool, &want);
     sw_rt_prof_meta *m = &p->meta;
     m->scene = a->scene;
     m->path = a->path;
@@ -493,7 +273,7 @@ static void fill_meta(const profile_args *a, sw_renderer renderer, sw_rt_profile
     m->width = a->frame.width ? a->frame.width : SW_DEFAULT_WIDTH;
     m->height = a->frame.height ? a->frame.height : SW_DEFAULT_HEIGHT;
     m->error_px = a->frame.error_px > 0.0 ? a->frame.error_px : SW_DEFAULT_ERROR_PX;
-    m->worker_threads = pool.worker_count;
+    m->worker_threads = sw_cli_pool_workers(requested_workers(a));
     m->sequential = a->sequential;
 }
 
@@ -510,8 +290,8 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
     /* pool_<kind>_ms: two clock reads per task, nothing next to a hierarchy build's cost */
     sw_rt_renderer_time_pool_tasks(renderer, 1);
     fill_meta(a, renderer, p);
-    staging st = {0};
-    r = make_staging(a->out, &st, status);
+    sw_cli_staging st = {0};
+    r = sw_cli_staging_make(a->out, &st, status);
     if (r == SW_OK) {
         a->frame.scene = scene;
         a->frame.walkthrough = !a->converged;
@@ -522,11 +302,11 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
         if (r == SW_OK && sw_rt_profile_summarize(p) != 0)
             r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
         if (r == SW_OK)
-            r = write_reports(&st, p, status);
+            r = sw_cli_profile_write_reports(&st, p, status);
         if (r == SW_OK)
-            r = staging_commit(&st, a->out, status);
+            r = sw_cli_staging_commit(&st, a->out, status);
         if (r != SW_OK)
-            staging_abandon(&st);
+            sw_cli_staging_abandon(&st);
     }
     sw_renderer_destroy(renderer);
     return r;

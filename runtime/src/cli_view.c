@@ -1,11 +1,15 @@
 /* SPDX-License-Identifier: MIT */
 /* splinewalk view SCENE: the interactive viewer. A GLFW window is the host: its context
  * is current on this thread, a renderer is made on it (sw_renderer_desc.use_current_context), and
- * each frame is drawn in walkthrough mode — the same pipeline as `profile` and the embedding API —
- * then presented into the window (sw_frame_desc.present). --script replays a camera path for a
- * fixed number of frames (tests under xvfb-run, demos), --record writes the keys set with K.
+ * frames run through the renderer's pipeline as `profile` runs them: frame i + 1 is prepared on
+ * the visibility thread (sw_renderer_prepare) while frame i is submitted and presented into the
+ * window (sw_frame_desc.present). Interactively that shows each camera one frame after the input
+ * that made it. --script replays a camera path for a fixed number of frames (tests under
+ * xvfb-run, demos) and --profile records it as `profile` does; --record writes the keys set
+ * with K.
  */
 #include "cli.h"
+#include "cli_profile_out.h"
 #include "cli_view_overlay.h"
 #include "sw_rt.h"
 
@@ -24,11 +28,14 @@
 
 static const char k_usage[] =
     "usage: splinewalk view SCENE [--size WxH] [--error PX] [--speed S] [--record PATH]\n"
-    "                       [--script PATH --frames N [--screenshot OUT.png] [--settle]]\n"
+    "                       [--script PATH --frames N [--screenshot OUT.png] [--settle]\n"
+    "                        [--converged] [--profile DIR]]\n"
     "\n"
     "Opens a window (GLFW; needs a display: under no display use `splinewalk profile`, or run\n"
     "inside xvfb-run) and walks through SCENE in walkthrough mode: frames never wait for the\n"
-    "worker pool; what is not refined yet is drawn coarser and refined for later frames.\n"
+    "worker pool; what is not refined yet is drawn coarser and refined for later frames. As in\n"
+    "`profile`, the renderer's visibility thread prepares the next frame while this one is drawn\n"
+    "and shown, so a view appears one frame after the input that asked for it.\n"
     "\n"
     "keys:\n"
     "  W A S D       forward, left, back, right      Q E   down, up (along +Z)\n"
@@ -61,6 +68,12 @@ static const char k_usage[] =
     "                    refinement done), as `splinewalk render --camera` draws it\n"
     "  --overlay         with --script: draw the frame-time overlay too (interactive: always,\n"
     "                    F toggles it)\n"
+    "  --converged       with --script: every frame waits for the refinements it asks for\n"
+    "                    (as `profile --converged`; the images and counters are then the same\n"
+    "                    on every run)\n"
+    "  --profile DIR     with --script: write DIR/profile.csv, profile.json, frametime.svg and\n"
+    "                    report.html, the columns of `splinewalk profile` (docs/cli.md); frame_ms\n"
+    "                    also holds the overlay and the buffer swap, in other_ms\n"
     "  --wireframe       start with the wireframe on (L toggles it)\n"
     "  --no-occlusion    start with occlusion culling off (O toggles it)\n"
     "  --no-static-lod   start with static LODs off (on by default, T toggles them: read\n"
@@ -71,10 +84,10 @@ static const char k_usage[] =
     "  -h, --help        this text\n";
 
 typedef struct view_args {
-    const char *scene, *record, *script, *screenshot;
+    const char *scene, *record, *script, *screenshot, *profile;
     int32_t w, h;
     int frames, settle, overlay, wireframe, static_lods, no_static_lods, lod_colors, atlas_overlay,
-        no_occlusion;
+        no_occlusion, converged;
     double error_px, speed;
 } view_args;
 
@@ -94,6 +107,8 @@ static int parse_value(view_args *a, const char *arg, const char *val)
         a->script = val;
     else if (!strcmp(arg, "--screenshot"))
         a->screenshot = val;
+    else if (!strcmp(arg, "--profile"))
+        a->profile = val;
     else
         return -1;
     return 0;
@@ -115,6 +130,7 @@ static int parse_args(int argc, char **argv, view_args *a)
                     : !strcmp(arg, "--lod-colors")    ? &a->lod_colors
                     : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
                     : !strcmp(arg, "--no-occlusion")  ? &a->no_occlusion
+                    : !strcmp(arg, "--converged")     ? &a->converged
                                                       : NULL;
         if (flag) {
             *flag = 1;
@@ -138,9 +154,11 @@ static int parse_args(int argc, char **argv, view_args *a)
         fprintf(stderr, "splinewalk view: need SCENE\n%s", k_usage);
         return 2;
     }
-    if ((a->screenshot || a->settle || a->frames || a->overlay) && !a->script) {
+    if ((a->screenshot || a->settle || a->frames || a->overlay || a->converged || a->profile) &&
+        !a->script) {
         fprintf(stderr,
-                "splinewalk view: --frames, --screenshot, --settle and --overlay need --script\n%s",
+                "splinewalk view: --frames, --screenshot, --settle, --overlay, --converged and "
+                "--profile need --script\n%s",
                 k_usage);
         return 2;
     }
@@ -318,8 +336,8 @@ static GLFWwindow *open_window(const view_args *a)
 /* ---- frames -----------------------------------------------------------------------------------
  */
 
-static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int converged,
-                      const char *output, sw_frame_stats *fs, sw_status *st)
+/* The frame of the viewer's camera and settings now. */
+static sw_frame_desc frame_desc(sw_scene scene, const viewer *v, int converged, const char *output)
 {
     sw_frame_desc fd = {0};
     fd.scene = scene;
@@ -334,6 +352,22 @@ static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int conver
     fd.lod_colors = v->lod_colors;
     fd.occlusion_culling = v->occlusion;
     fd.output_path = output;
+    return fd;
+}
+
+/* Hands the frame of the viewer's camera now to the visibility thread. */
+static sw_result prepare(sw_renderer r, sw_scene scene, const viewer *v, int converged,
+                         sw_status *st)
+{
+    const sw_frame_desc fd = frame_desc(scene, v, converged, NULL);
+    return sw_renderer_prepare(r, &fd, st);
+}
+
+/* One frame drawn in one call (the settled view after a script). */
+static sw_result draw(sw_renderer r, sw_scene scene, const viewer *v, int converged,
+                      sw_frame_stats *fs, sw_status *st)
+{
+    const sw_frame_desc fd = frame_desc(scene, v, converged, NULL);
     return sw_renderer_draw(r, &fd, fs, st);
 }
 
@@ -366,38 +400,10 @@ static void print_camera(const char *what, const sw_camera *c)
            c->up[1], c->up[2], c->fovy_deg);
 }
 
-/* The scripted run: the path's cameras for `frames` frames, then optionally a converged frame and
- * a screenshot of what the window shows. */
-static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
-                      const sw_rt_camera_path *path)
+/* What the window shows, saved as --screenshot: its back buffer, read after the present, before
+ * the swap; the camera printed. */
+static int save_screenshot(GLFWwindow *win, const viewer *v)
 {
-    uint32_t n = v->args->frames ? (uint32_t)v->args->frames : path->frames ? path->frames : 120;
-    sw_status st = {0};
-    sw_frame_stats fs = {0};
-    uint64_t waits = 0, fallbacks = 0;
-    double worst = 0.0, t0 = sw_cli_now_ms();
-    for (uint32_t i = 0; i < n && !glfwWindowShouldClose(win); ++i) {
-        sw_rt_path_eval(path, sw_rt_path_frame_time(path, i, n), &v->wk.cam);
-        if (draw(r, scene, v, 0, NULL, &fs, &st) != SW_OK)
-            return sw_cli_report("view", &st);
-        show_overlay(v, &fs);
-        glfwSwapBuffers(win);
-        glfwPollEvents();
-        waits += fs.pool_waits;
-        fallbacks += fs.fallback_draws;
-        worst = fmax(worst, fs.ms_total);
-        show_title(win, v, &fs);
-    }
-    printf("script: %u frames in %.0f ms (slowest %.1f ms), pool waits %llu, fallback draws %llu\n",
-           n, sw_cli_now_ms() - t0, worst, (unsigned long long)waits,
-           (unsigned long long)fallbacks);
-    if (v->args->settle && draw(r, scene, v, 1, NULL, &fs, &st) != SW_OK)
-        return sw_cli_report("view", &st);
-    if (v->args->settle)
-        show_overlay(v, &fs);
-    if (!v->args->screenshot)
-        return 0;
-    /* What the window shows: its back buffer, read after the present, before the swap. */
     sw_gpu_image img = {.width = v->args->w, .height = v->args->h};
     size_t row = (size_t)img.width * 4;
     uint8_t *bottom_up = malloc(row * (size_t)img.height);
@@ -415,6 +421,7 @@ static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
     for (int32_t y = 0; y < img.height; ++y)
         memcpy(img.rgba + (size_t)y * row, bottom_up + (size_t)(img.height - 1 - y) * row, row);
     free(bottom_up);
+    sw_status st = {0};
     sw_result res = sw_gpu_image_write(&img, v->args->screenshot, &st);
     free(img.rgba);
     glfwSwapBuffers(win);
@@ -425,22 +432,147 @@ static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
     return 0;
 }
 
+/* --profile: the run's description, as `profile` writes it. */
+static void profile_meta(const viewer *v, sw_renderer r, sw_rt_profile *p)
+{
+    sw_rt_prof_meta *m = &p->meta;
+    m->scene = v->args->scene;
+    m->path = v->args->script;
+    m->renderer = sw_renderer_description_ptr(r);
+    m->mode = v->args->converged ? "converged" : "walkthrough";
+    m->eval = "hierarchy";
+    m->lp_num_threads = getenv("LP_NUM_THREADS");
+    m->width = v->args->w;
+    m->height = v->args->h;
+    m->error_px = v->error_px;
+    m->worker_threads = sw_cli_pool_workers(0);
+}
+
+/* --profile: the recorded frames summarized and written into DIR (aside, then renamed in). */
+static sw_result profile_write(const char *dir, sw_rt_profile *p, sw_status *st)
+{
+    if (sw_rt_profile_summarize(p) != 0)
+        return sw__fail(st, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
+    sw_cli_staging stage = {0};
+    sw_result res = sw_cli_staging_make(dir, &stage, st);
+    if (res != SW_OK)
+        return res;
+    res = sw_cli_profile_write_reports(&stage, p, st);
+    if (res == SW_OK)
+        res = sw_cli_staging_commit(&stage, dir, st);
+    if (res != SW_OK)
+        sw_cli_staging_abandon(&stage);
+    return res;
+}
+
+/* Frame i of the script: frame i + 1 prepared (its camera set), frame i submitted, presented with
+ * the overlay and swapped; with --profile its row, timed over all of that as `profile` times its
+ * frames (frame_ms; the overlay and the swap fall in other_ms). */
+static sw_result script_frame(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
+                              const sw_rt_camera_path *path, uint32_t i, uint32_t n,
+                              sw_rt_profile *prof, sw_frame_stats *fs, sw_status *st)
+{
+    sw_cli_pool_sample pool_start, pool_end;
+    const double t0 = sw_cli_now_ms();
+    sw_cli_pool_read(r, 0, &pool_start);
+    double prepare_ms = 0.0;
+    sw_result res = SW_OK;
+    if (i + 1 < n) {
+        sw_rt_path_eval(path, sw_rt_path_frame_time(path, i + 1, n), &v->wk.cam);
+        res = prepare(r, scene, v, v->args->converged, st);
+        prepare_ms = sw_cli_now_ms() - t0;
+    }
+    if (res == SW_OK)
+        res = sw_renderer_submit(r, fs, st);
+    if (res != SW_OK)
+        return res;
+    show_overlay(v, fs);
+    glfwSwapBuffers(win);
+    glfwPollEvents();
+    show_title(win, v, fs);
+    if (!v->args->profile)
+        return SW_OK;
+    sw_cli_pool_read(r, 1, &pool_end);
+    sw_rt_prof_row row;
+    sw_rt_profile_row(fs, i, sw_rt_path_frame_time(path, i, n), sw_cli_now_ms() - t0, prepare_ms,
+                      sw_cli_resident_bytes(), 0, &row);
+    sw_cli_pool_columns(&pool_start, &pool_end, &row);
+    return sw_rt_profile_push(prof, &row) == 0
+               ? SW_OK
+               : sw__fail(st, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
+}
+
+/* The scripted run: the path's cameras for `frames` frames, pipelined as `profile` runs them,
+ * then optionally a converged frame and a screenshot of what the window shows. */
+static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
+                      const sw_rt_camera_path *path)
+{
+    uint32_t n = v->args->frames ? (uint32_t)v->args->frames : path->frames ? path->frames : 120;
+    sw_status st = {0};
+    sw_frame_stats fs = {0};
+    sw_rt_profile prof = {0};
+    uint64_t waits = 0, fallbacks = 0;
+    double worst = 0.0, t0 = sw_cli_now_ms();
+    if (v->args->profile) {
+        sw_rt_renderer_time_pool_tasks(r, 1); /* the pool_<kind>_ms columns */
+        profile_meta(v, r, &prof);
+    }
+    sw_rt_path_eval(path, sw_rt_path_frame_time(path, 0, n), &v->wk.cam);
+    sw_result res = prepare(r, scene, v, v->args->converged, &st);
+    uint32_t i = 0;
+    for (; i < n && res == SW_OK; ++i) {
+        res = script_frame(win, r, scene, v, path, i, n, &prof, &fs, &st);
+        waits += fs.pool_waits;
+        fallbacks += fs.fallback_draws;
+        worst = fmax(worst, fs.ms_total);
+        if (res == SW_OK && i + 1 < n && glfwWindowShouldClose(win)) {
+            res = sw_renderer_submit(r, &fs, &st); /* the frame prepared ahead, not shown */
+            n = i + 1;
+        }
+    }
+    prof.meta.wall_s = (sw_cli_now_ms() - t0) / 1e3;
+    if (res == SW_OK && v->args->profile)
+        res = profile_write(v->args->profile, &prof, &st);
+    sw_rt_profile_free(&prof);
+    if (res != SW_OK)
+        return sw_cli_report("view", &st);
+    printf("script: %u frames in %.0f ms (slowest %.1f ms), pool waits %llu, fallback draws %llu\n",
+           n, sw_cli_now_ms() - t0, worst, (unsigned long long)waits,
+           (unsigned long long)fallbacks);
+    if (v->args->profile)
+        printf("wrote %s/profile.csv, profile.json, frametime.svg and report.html\n",
+               v->args->profile);
+    if (v->args->settle && draw(r, scene, v, 1, &fs, &st) != SW_OK)
+        return sw_cli_report("view", &st);
+    if (v->args->settle)
+        show_overlay(v, &fs);
+    if (!v->args->screenshot)
+        return 0;
+    return save_screenshot(win, v);
+}
+
 static int run_interactive(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v)
 {
     sw_status st = {0};
     sw_frame_stats fs = {0};
     double last = glfwGetTime();
-    while (!glfwWindowShouldClose(win)) {
+    sw_result res = prepare(r, scene, v, 0, &st);
+    while (res == SW_OK && !glfwWindowShouldClose(win)) {
         glfwPollEvents();
         double now = glfwGetTime();
         walker_step(&v->wk, win, fmin(now - last, 0.25));
         last = now;
-        if (draw(r, scene, v, 0, NULL, &fs, &st) != SW_OK)
-            return sw_cli_report("view", &st);
+        res = prepare(r, scene, v, 0, &st); /* the next frame, while this one is drawn */
+        if (res == SW_OK)
+            res = sw_renderer_submit(r, &fs, &st);
+        if (res != SW_OK)
+            break;
         show_overlay(v, &fs);
         show_title(win, v, &fs);
         glfwSwapBuffers(win);
     }
+    if (res != SW_OK)
+        return sw_cli_report("view", &st);
     if (v->args->record && v->recording.n_keys > 0) {
         if (sw_rt_path_save(&v->recording, v->args->record, 0, &st) != SW_OK)
             return sw_cli_report("view", &st);

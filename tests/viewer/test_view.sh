@@ -129,3 +129,32 @@ cam=$(sed -n 's/^screenshot camera //p' "$work/nolod.out")
   --lod-colors >/dev/null 2>&1
 "$diff" "$work/nolod.png" "$work/nolod_render.png" 0.1 || fail "--no-static-lod differs from render"
 echo "ok: --no-static-lod equals render of its camera without static LODs"
+
+# One pipeline for the viewer and `profile`: the same scripted path, converged, recorded by
+# `view --profile` and by `profile`, gives the same columns and, frame by frame, the same
+# counters (faces, patches, hierarchy nodes, triangles, fat borders and the samples kept for them,
+# trim textures and those kept, occlusion tests...). Times differ, and so do the pool's own
+# columns and the pool waits (when a build ends is the scheduler's). A viewer that set up its frames
+# differently (planted: occlusion culling off in view's frame) fails here on occlusion_tests.
+"$sw" profile "$model" --path "$work/orbit.path" --frames 12 --size 320x180 --converged \
+  --no-static-lod --out "$work/prof" >"$work/prof.out" 2>&1 || { cat "$work/prof.out"; fail "profile"; }
+xvfb-run -a -s "-screen 0 1280x1024x24" "$sw" view "$model" --size 320x180 --no-static-lod \
+  --script "$work/orbit.path" --frames 12 --converged --profile "$work/vprof" \
+  >"$work/vprof.out" 2>"$work/vprof.err" || { cat "$work/vprof.err"; fail "view --profile"; }
+grep -q "^wrote $work/vprof/profile.csv" "$work/vprof.out" || fail "view --profile: $(cat "$work/vprof.out")"
+for f in profile.json frametime.svg report.html; do
+  [ -s "$work/vprof/$f" ] || fail "view --profile: no $f"
+done
+[ "$(head -1 "$work/prof/profile.csv")" = "$(head -1 "$work/vprof/profile.csv")" ] ||
+  fail "view --profile: other columns than profile's"
+counters() {
+  awk -F, 'NR == 1 { for (i = 1; i <= NF; i++)
+                       if ($i !~ /(_ms|_s|^pool_.*|^resident_bytes|^captured)$/) keep[i] = 1 }
+           { line = ""; for (i = 1; i <= NF; i++) if (i in keep) line = line $i ","; print line }' "$1"
+}
+counters "$work/prof/profile.csv" >"$work/prof_counts.csv"
+counters "$work/vprof/profile.csv" >"$work/view_counts.csv"
+[ "$(wc -l <"$work/view_counts.csv")" -eq 13 ] || fail "view --profile: not 12 frames"
+diff "$work/prof_counts.csv" "$work/view_counts.csv" >"$work/counts.diff" ||
+  { cat "$work/counts.diff"; fail "view --profile: counters differ from profile's on the same path"; }
+echo "ok: view --profile and profile on the same path: the same columns, $(head -1 "$work/view_counts.csv" | tr , '\n' | grep -c .) counters equal on 12 frames"
