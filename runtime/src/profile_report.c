@@ -20,11 +20,12 @@ static const col_info k_cols[SW_RT_COL_COUNT] = {
 #undef SW_RT__COL_INFO
 };
 
-/* Stage colours, in stacking order (hierarchy at the bottom, other on top). */
-static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#76b7b2", "#59a14f",
-                                             "#f28e2b", "#e15759", "#b07aa1", "#a0a0a0"};
-#define FIRST_STAGE SW_RT_COL_HIERARCHY_MS
-#define N_STAGES (SW_RT_COL_OTHER_MS - SW_RT_COL_HIERARCHY_MS + 1)
+/* Stage colours, in stacking order (waiting for the visibility thread at the bottom, other on
+ * top). */
+static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#76b7b2",
+                                             "#59a14f", "#f28e2b", "#a0a0a0"};
+#define FIRST_STAGE SW_RT_COL_WAIT_VISIBILITY_MS
+#define N_STAGES (SW_RT_COL_OTHER_MS - FIRST_STAGE + 1)
 /* The pool's columns come from one table of task kinds: one ms and one tasks column per kind, in
  * the kinds' order. */
 #define SW_RT_COL_POOL_FIRST_MS SW_RT_COL_POOL_OTHER_MS
@@ -65,9 +66,8 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_FRAME] = index;
     v[SW_RT_COL_T] = t;
     v[SW_RT_COL_FRAME_MS] = frame_ms;
-    const int split = st->ms_visibility > 0.0;
-    v[split ? SW_RT_COL_VIS_HIERARCHY_MS : SW_RT_COL_HIERARCHY_MS] = st->ms_hierarchy;
-    v[split ? SW_RT_COL_VIS_TESSELLATE_MS : SW_RT_COL_TESSELLATE_MS] = st->ms_tessellate;
+    v[SW_RT_COL_VIS_HIERARCHY_MS] = st->ms_hierarchy;
+    v[SW_RT_COL_VIS_TESSELLATE_MS] = st->ms_tessellate;
     v[SW_RT_COL_VIS_MS] = st->ms_visibility;
     v[SW_RT_COL_VIS_JOIN_MS] = st->ms_join;
     v[SW_RT_COL_WAIT_VISIBILITY_MS] = st->ms_wait_visibility;

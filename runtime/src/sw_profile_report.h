@@ -38,12 +38,8 @@
     X(T, "t_s", SECONDS, "path time of the frame (s)")                                             \
     X(FRAME_MS, "frame_ms", FRAME,                                                                 \
       "the submitting thread's time for the frame (sw_renderer_draw, or prepare + submit)")        \
-    X(HIERARCHY_MS, "hierarchy_ms", STAGE,                                                         \
-      "waiting for hierarchy builds and refinements (0 when on the visibility thread)")            \
-    X(TESSELLATE_MS, "tessellate_ms", STAGE,                                                       \
-      "culling, traversal, bounds, CPU grids, requests (0 when on the visibility thread)")         \
     X(WAIT_VISIBILITY_MS, "wait_visibility_ms", STAGE,                                             \
-      "threaded: waiting for the visibility thread to finish the frame")                           \
+      "waiting for the visibility thread to finish the frame")                                     \
     X(PREPARE_MS, "prepare_ms", STAGE,                                                             \
       "threaded: handing the next frame to the visibility thread (sw_renderer_prepare)")           \
     X(TRIM_MS, "trim_ms", STAGE, "trim-texture generation into the atlas")                         \
@@ -51,11 +47,11 @@
     X(READBACK_MS, "readback_ms", STAGE, "glReadPixels of the frame")                              \
     X(WRITE_MS, "write_ms", STAGE, "PNG write (captured frames only)")                             \
     X(OTHER_MS, "other_ms", STAGE, "frame_ms minus the stages above")                              \
-    X(VIS_MS, "vis_ms", VSTAGE, "threaded: the visibility thread's time for the frame")            \
+    X(VIS_MS, "vis_ms", VSTAGE, "the visibility thread's time for the frame")                      \
     X(VIS_HIERARCHY_MS, "vis_hierarchy_ms", VSTAGE,                                                \
-      "threaded: of vis_ms, waiting for hierarchy builds and refinements")                         \
+      "of vis_ms, waiting for hierarchy builds and refinements")                                   \
     X(VIS_TESSELLATE_MS, "vis_tessellate_ms", VSTAGE,                                              \
-      "threaded: of vis_ms, culling, traversal, bounds, CPU grids, requests")                      \
+      "of vis_ms, culling, traversal, bounds, CPU grids, requests")                                \
     X(VIS_JOIN_MS, "vis_join_ms", VSTAGE,                                                          \
       "of the tessellation, waiting at its join for chunks the pool's workers still ran")          \
     X(PATCHES, "patches", COUNT, "patches drawn (trimmed + untrimmed)")                            \
@@ -151,9 +147,8 @@ typedef struct sw_rt_profile {
 
 /* A frame's row from the renderer's stats, the submitting thread's wall time for it, the part of
  * that time it spent preparing the next frame (threaded; 0 otherwise) and resident memory; OTHER_MS
- * is frame_ms minus the measured stages. A split frame (prepared on the visibility thread:
- * st->ms_visibility > 0) has its hierarchy and tessellate times in the VIS_ columns, a frame drawn
- * in one call in the stage columns. */
+ * is frame_ms minus the measured stages. Every frame is prepared on the visibility thread: its
+ * hierarchy and tessellate times are in the VIS_ columns. */
 void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, double frame_ms,
                        double prepare_ms, double resident_bytes, int captured, sw_rt_prof_row *out);
 /* The pool columns of a row: per kind, `now` minus `before` (two samples of the pool's
