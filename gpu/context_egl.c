@@ -292,6 +292,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
     if (ctx->gl_ready) {
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);
+        sw__gpu_resident_free(ctx);
         sw__gpu_grids_free(ctx);
         glDeleteVertexArrays(1, &ctx->vao);
         glDeleteFramebuffers(1, &ctx->trim_fbo);

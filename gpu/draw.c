@@ -56,6 +56,15 @@ static void stream_to(GLenum target, GLuint buf, size_t *capacity, size_t bytes,
         glBufferSubData(target, 0, (GLsizeiptr)bytes, data);
 }
 
+/* stream_to, counted in the frame's uploads. */
+static void send(sw_gpu_context *ctx, GLenum target, GLuint buf, size_t *capacity, size_t bytes,
+                 const void *data)
+{
+    stream_to(target, buf, capacity, bytes, data);
+    if (data)
+        ctx->upload_bytes += bytes;
+}
+
 static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
 {
     if (!ctx->mesh_vbo) {
@@ -63,10 +72,10 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
         glGenBuffers(1, &ctx->mesh_ibo);
     }
     glBindVertexArray(ctx->vao);
-    stream_to(GL_ARRAY_BUFFER, ctx->mesh_vbo, &ctx->mesh_vbo_cap, mesh->n_v * sizeof *mesh->v,
-              mesh->v);
-    stream_to(GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo, &ctx->mesh_ibo_cap,
-              mesh->n_idx * sizeof *mesh->idx, mesh->idx);
+    send(ctx, GL_ARRAY_BUFFER, ctx->mesh_vbo, &ctx->mesh_vbo_cap, mesh->n_v * sizeof *mesh->v,
+         mesh->v);
+    send(ctx, GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo, &ctx->mesh_ibo_cap,
+         mesh->n_idx * sizeof *mesh->idx, mesh->idx);
     GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
@@ -80,20 +89,20 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
 }
 
 /* Exact path: pieces, knots and double control points into storage buffers 2, 3, 4. */
-static void upload_ssbo(GLuint buf, size_t *capacity, GLuint binding, size_t bytes,
-                        const void *data)
+static void upload_ssbo(sw_gpu_context *ctx, GLuint buf, size_t *capacity, GLuint binding,
+                        size_t bytes, const void *data)
 {
-    stream_to(GL_SHADER_STORAGE_BUFFER, buf, capacity, bytes, bytes ? data : NULL);
+    send(ctx, GL_SHADER_STORAGE_BUFFER, buf, capacity, bytes, bytes ? data : NULL);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buf);
 }
 
 static void upload_exact(sw_gpu_context *ctx, const sw__gpu_patch_batch *batch)
 {
-    upload_ssbo(ctx->piece_ssbo, &ctx->piece_ssbo_cap, 2, batch->n_pieces * sizeof *batch->pieces,
-                batch->pieces);
-    upload_ssbo(ctx->knot_ssbo, &ctx->knot_ssbo_cap, 3, batch->n_knots * sizeof *batch->knots,
+    upload_ssbo(ctx, ctx->piece_ssbo, &ctx->piece_ssbo_cap, 2,
+                batch->n_pieces * sizeof *batch->pieces, batch->pieces);
+    upload_ssbo(ctx, ctx->knot_ssbo, &ctx->knot_ssbo_cap, 3, batch->n_knots * sizeof *batch->knots,
                 batch->knots);
-    upload_ssbo(ctx->dcp_ssbo, &ctx->dcp_ssbo_cap, 4, batch->n_dcps * 4 * sizeof *batch->dcps,
+    upload_ssbo(ctx, ctx->dcp_ssbo, &ctx->dcp_ssbo_cap, 4, batch->n_dcps * 4 * sizeof *batch->dcps,
                 batch->dcps);
 }
 
@@ -164,9 +173,9 @@ sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out
 static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                          const sw__gpu_patch_batch *batch)
 {
-    upload_ssbo(ctx->patch_ssbo, &ctx->patch_ssbo_cap, 0, batch->n_recs * sizeof *batch->recs,
+    upload_ssbo(ctx, ctx->patch_ssbo, &ctx->patch_ssbo_cap, 0, batch->n_recs * sizeof *batch->recs,
                 batch->recs);
-    upload_ssbo(ctx->cp_ssbo, &ctx->cp_ssbo_cap, 1, batch->n_cps * 4 * sizeof *batch->cps,
+    upload_ssbo(ctx, ctx->cp_ssbo, &ctx->cp_ssbo_cap, 1, batch->n_cps * 4 * sizeof *batch->cps,
                 batch->cps);
     if (batch->exact)
         upload_exact(ctx, batch);
@@ -204,6 +213,20 @@ static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
     }
 }
 
+/* The mesh program of a trim variant in use, its eye-relative placement set. */
+static const sw__gpu_surface_program *use_mesh_program(sw_gpu_context *ctx,
+                                                       const sw__gpu_view *view, int variant)
+{
+    static const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[3] = {0, 0, 0};
+    const sw__gpu_surface_program *prog = &ctx->surf.mesh[variant];
+    glUseProgram(prog->prog);
+    glUniformMatrix4fv(prog->loc_view_proj, 1, GL_FALSE, view->view_proj);
+    glUniform1i(prog->loc_trim, 0);
+    glUniformMatrix3fv(prog->loc_model_rot, 1, GL_TRUE, identity);
+    glUniform3fv(prog->loc_model_off, 1, zero);
+    return prog;
+}
+
 /* The mesh's draws of one trim variant, with that variant's mesh program. */
 static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
                               const sw__gpu_draw *draws, size_t n_draws, int variant)
@@ -214,11 +237,8 @@ static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
         const int trimmed = draws[d].trim_entry >= 0;
         if (draws[d].n_idx == 0 || trimmed != (variant == SW__GPU_TRIMMED))
             continue;
-        if (!used++) {
-            glUseProgram(prog->prog);
-            glUniformMatrix4fv(prog->loc_view_proj, 1, GL_FALSE, view->view_proj);
-            glUniform1i(prog->loc_trim, 0);
-        }
+        if (!used++)
+            use_mesh_program(ctx, view, variant);
         glUniform4fv(prog->loc_color, 1, draws[d].color);
         glUniform4fv(prog->loc_uv_map, 1, draws[d].uv_map);
         /* set for untrimmed draws too (w = 0: the lookup accepts all): a host's shading draws
@@ -236,8 +256,10 @@ static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
                              const sw__gpu_draw *draws, size_t n_draws,
-                             const sw__gpu_patch_batch *batch, sw_status *status)
+                             const sw__gpu_patch_batch *batch,
+                             const sw__gpu_resident_list *resident, sw_status *status)
 {
+    ctx->upload_bytes = 0;
     const float *bg = desc->background;
     sw_result r = sw__gpu_target_ensure(ctx, view->width, view->height, status);
     if (r != SW_OK)
@@ -262,11 +284,15 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
         draw_patches(ctx, view, batch);
     bind_mesh(ctx, mesh);
     draw_mesh_variant(ctx, view, draws, n_draws, SW__GPU_UNTRIMMED);
+    r = resident && resident->n
+            ? sw__gpu_resident_draw_all(ctx, use_mesh_program(ctx, view, SW__GPU_UNTRIMMED),
+                                        resident, status)
+            : SW_OK;
     draw_mesh_variant(ctx, view, draws, n_draws, SW__GPU_TRIMMED);
     if (desc->wireframe)
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
     glFinish();
-    return sw__gpu_check(status, "frame draw");
+    return r == SW_OK ? sw__gpu_check(status, "frame draw") : r;
 }
 
 /* The fullscreen pass of a depth-compositing present, in the host's state as the host-state
@@ -440,7 +466,7 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
         r = triangles_to_mesh(positions, n_vertices, indices, n_indices, view.eye, &mesh, status);
     sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1, {0.0f, 0.0f, 0.0f, 0.0f}};
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &view, &desc, &mesh, &draw, 1, NULL, status);
+        r = sw__gpu_draw_frame(ctx, &view, &desc, &mesh, &draw, 1, NULL, NULL, status);
     sw__gpu_mesh_free(&mesh);
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &view, desc.want_depth, out, status);

@@ -29,6 +29,11 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on)
     ctx->crack_fill_off = !on;
 }
 
+void sw__gpu_set_resident(sw_gpu_context *ctx, int on)
+{
+    ctx->resident_off = !on;
+}
+
 void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on)
 {
     ctx->border_affine_off = !on;
@@ -123,6 +128,11 @@ void sw_gpu_frame_plan_recycle(sw_gpu_context *ctx, sw_gpu_frame_plan *plan)
 double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan)
 {
     return plan->ms_prepare;
+}
+
+const sw_gpu_frame_stats *sw_gpu_frame_plan_stats(const sw_gpu_frame_plan *plan)
+{
+    return &plan->st;
 }
 
 sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scene *scene,
@@ -278,7 +288,9 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
         sw__gpu_host_state_restore(&host);
     double t4 = sw__gpu_now_ms();
 
-    st->triangles += geo->mesh.n_idx / 3 - geo->border_triangles;
+    st->triangles += geo->mesh.n_idx / 3 - geo->border_triangles + geo->resident_triangles;
+    st->resident_triangles = geo->resident_triangles;
+    st->upload_bytes = ctx->upload_bytes;
     st->border_triangles = geo->border_triangles;
     st->ms_trim = t2 - t1;
     st->ms_draw = t3 - t2;

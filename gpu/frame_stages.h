@@ -270,6 +270,11 @@ typedef struct sw__fr_geometry {
     size_t n_knots, cap_knots, n_dcps, cap_dcps;
     double gpu_vertices;       /* grid vertices the vertex shader will evaluate */
     uint64_t border_triangles; /* fat-border triangles (in stats.triangles already) */
+    /* static levels drawn from the context's GPU buffers (gpu/resident.c), with their
+     * triangles */
+    sw__gpu_resident_draw *resident;
+    size_t n_resident, cap_resident;
+    uint64_t resident_triangles;
 } sw__fr_geometry;
 void sw__fr_geometry_free(sw__fr_geometry *g);
 /* Zeroes every count, keeping the arrays (the per-face trim loops owned are freed). */

@@ -102,6 +102,8 @@ static void locate_uniforms(sw__gpu_surface_program *p)
     p->loc_trim_rect = glGetUniformLocation(p->prog, "u_trim_rect");
     p->loc_trim_layer = glGetUniformLocation(p->prog, "u_trim_layer");
     p->loc_uv_map = glGetUniformLocation(p->prog, "u_uv_map");
+    p->loc_model_rot = glGetUniformLocation(p->prog, "u_model_rot");
+    p->loc_model_off = glGetUniformLocation(p->prog, "u_model_off");
     p->loc_grid = glGetUniformLocation(p->prog, "u_grid");
     p->loc_base = glGetUniformLocation(p->prog, "u_base");
     p->loc_capture = glGetUniformLocation(p->prog, "u_capture");

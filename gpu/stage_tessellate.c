@@ -29,6 +29,7 @@ void sw__fr_geometry_free(sw__fr_geometry *g)
     sw__free(g->pieces);
     sw__free(g->knots);
     sw__free(g->dcps);
+    sw__free(g->resident);
     sw__gpu_mesh_free(&g->mesh);
     memset(g, 0, sizeof *g);
 }
@@ -46,6 +47,8 @@ void sw__fr_geometry_empty(sw__fr_geometry *g)
     g->n_recs = g->n_cps = g->n_pieces = g->n_knots = g->n_dcps = 0;
     g->gpu_vertices = 0.0;
     g->border_triangles = 0;
+    g->n_resident = 0;
+    g->resident_triangles = 0;
 }
 
 void sw__fr_chunk_geometry_take(sw_gpu_context *ctx, sw__fr_geometry *dst)

@@ -133,7 +133,9 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
               sizeof *dst->shares) ||
         !grow((void **)&dst->loops, &dst->cap_loops, loops0 + src->n_loops, sizeof *dst->loops) ||
         !grow((void **)&dst->recs, &dst->cap_recs, dst->n_recs + src->n_recs, sizeof *dst->recs) ||
-        !grow((void **)&dst->cps, &dst->cap_cps, 4 * (cps0 + src->n_cps), sizeof *dst->cps))
+        !grow((void **)&dst->cps, &dst->cap_cps, 4 * (cps0 + src->n_cps), sizeof *dst->cps) ||
+        !grow((void **)&dst->resident, &dst->cap_resident, dst->n_resident + src->n_resident,
+              sizeof *dst->resident))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame geometry: out of memory");
     sw_result r = append_mesh(&dst->mesh, &src->mesh, status);
     if (r != SW_OK)
@@ -168,6 +170,11 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
     dst->n_cps += src->n_cps;
     dst->gpu_vertices += src->gpu_vertices;
     dst->border_triangles += src->border_triangles;
+    if (src->n_resident > 0)
+        memcpy(dst->resident + dst->n_resident, src->resident,
+               src->n_resident * sizeof *src->resident);
+    dst->n_resident += src->n_resident;
+    dst->resident_triangles += src->resident_triangles;
     return SW_OK;
 }
 
@@ -178,7 +185,7 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 488,
+        sizeof(sw_gpu_frame_stats) == 504,
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;

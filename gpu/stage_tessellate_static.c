@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* The tessellate stage for unit instances drawn at a static level (Kumar et al. 1997 §4; the
- * level is chosen by stage_select.c): the level's triangles under the instance's transform, and
- * the fat borders of its shown faces.
+ * level is chosen by stage_select.c): the level's triangles under the instance's transform — a
+ * draw of the GPU copy the context keeps of the level (gpu/resident.c), or with residency off
+ * the triangles moved into the frame's mesh — and the fat borders of its shown faces.
  *
  * Cracks. A unit drawn at level k meets its neighbours — other units at other levels, faces of
  * the per-frame path, and its own faces (level 0 triangulates face by face) — along borders that
@@ -27,7 +28,38 @@
 enum { STATIC_BORDER_MIN_CELLS = 2, STATIC_BORDER_MAX_CELLS = 32 };
 static const double k_border_px = 4.0;
 
-/* Appends the level's triangles, transformed to eye-relative world space, as one draw. */
+/* The level as a draw of the context's GPU copy (gpu/resident.c): its placement composed in
+ * double, the unit's box centre moved to eye-relative world space. */
+static sw_result resident_level(sw__fr_tess *t, const occurrence *o, uint32_t unit,
+                                const sw_lod_static_level *lv, int32_t level, sw_status *status)
+{
+    sw__fr_geometry *g = t->geo;
+    if (g->n_resident == g->cap_resident && !sw__gpu_grow((void **)&g->resident, &g->cap_resident,
+                                                          g->n_resident + 1, sizeof *g->resident))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static levels: out of memory");
+    const double *box = sw_lod_static_set_unit(t->env->statics, unit)->box, *m = o->world;
+    sw__gpu_resident_draw *d = &g->resident[g->n_resident++];
+    d->level = lv;
+    d->unit = unit;
+    d->index = level;
+    for (int r = 0; r < 3; ++r) {
+        d->centre[r] = 0.5 * (box[r] + box[3 + r]);
+        for (int c = 0; c < 3; ++c)
+            d->rot[3 * r + c] = (float)m[4 * r + c];
+    }
+    for (int r = 0; r < 3; ++r)
+        d->off[r] = (float)(m[4 * r] * d->centre[0] + m[4 * r + 1] * d->centre[1] +
+                            m[4 * r + 2] * d->centre[2] + (m[4 * r + 3] - t->env->view.eye[r]));
+    memcpy(d->color, o->color, sizeof d->color);
+    if (t->env->lod_colors)
+        sw__fr_lod_color(level, d->color);
+    g->resident_triangles += lv->n_triangles;
+    t->st->static_triangles += lv->n_triangles;
+    return SW_OK;
+}
+
+/* Appends the level's triangles, transformed to eye-relative world space, as one draw of the
+ * frame's mesh. */
 static sw_result append_level(sw__fr_tess *t, const occurrence *o, const sw_lod_static_level *lv,
                               int32_t level, sw_status *status)
 {
@@ -81,7 +113,11 @@ sw_result sw__fr_tess_static(sw__fr_tess *t, const sw__fr_visible *vis,
     const sw_lod_static_occ *oc0 = &ins->occs[ins->instances[it->face].first_occ];
     occurrence first;
     sw__fr_occurrence_init(&first, oc0->face, it->world, oc0->color);
-    sw_result r = append_level(t, &first, &pick->chain->levels[pick->level], pick->level, status);
+    const sw_lod_static_level *lv = &pick->chain->levels[pick->level];
+    const uint32_t unit = ins->instances[it->face].unit;
+    sw_result r = !t->env->ctx->resident_off && pick->level < SW__GPU_RESIDENT_LEVELS
+                      ? resident_level(t, &first, unit, lv, pick->level, status)
+                      : append_level(t, &first, lv, pick->level, status);
     t->st->static_units_drawn++;
     t->st->static_levels_used |= 1u << (pick->level < 31 ? pick->level : 31);
     for (size_t k = vi->first_face; k < vi->first_face + vi->n_faces && r == SW_OK; ++k) {

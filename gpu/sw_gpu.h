@@ -221,6 +221,10 @@ typedef struct sw_gpu_frame_stats {
      * face occurrences found hidden (of faces_culled: the occurrences under those nodes too),
      * planar faces drawn into the map */
     uint64_t occlusion_tests, nodes_occluded, faces_occluded, occluders_drawn;
+    /* the submit stage's: triangles drawn from GPU buffers kept between frames (static levels,
+     * gpu/resident.c; of triangles), and the bytes sent to the GPU for the draw (the frame's
+     * vertices, indices and patch data, and the resident levels uploaded this frame) */
+    uint64_t resident_triangles, upload_bytes;
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {
@@ -267,6 +271,9 @@ void sw_gpu_frame_plan_free(sw_gpu_frame_plan *plan);
  * when ctx keeps enough already); any thread, while ctx lives. */
 void sw_gpu_frame_plan_recycle(sw_gpu_context *ctx, sw_gpu_frame_plan *plan);
 double sw_gpu_frame_plan_ms(const sw_gpu_frame_plan *plan); /* prepare's wall time */
+/* What the prepare counted and timed (tessellation chunks, the join, culling...); the submit adds
+ * the rest. */
+const sw_gpu_frame_stats *sw_gpu_frame_plan_stats(const sw_gpu_frame_plan *plan);
 
 /* Renders plain triangles (world-space double positions, 3 per vertex) through the same camera,
  * projection, depth and shading path as sw_gpu_render_scene — the path an independent reference

@@ -104,6 +104,7 @@ typedef struct sw__gpu_surface_program {
     GLuint prog;
     GLint loc_view_proj, loc_trim;
     GLint loc_color, loc_trim_rect, loc_trim_layer, loc_uv_map; /* the mesh program's */
+    GLint loc_model_rot, loc_model_off; /* the mesh program's: resident geometry's placement */
     GLint loc_grid, loc_base;                                   /* the evaluation programs' */
     GLint loc_capture;                                          /* Bézier evaluation only */
 } sw__gpu_surface_program;
@@ -175,6 +176,10 @@ struct sw_gpu_context {
     uint32_t capture_max; /* vertices; 0 = off */
     uint32_t *rec_source; /* sorted record -> record in append (patch hook) order */
     size_t cap_rec_source;
+    /* static levels kept in GPU buffers between frames (resident.c); the frame's uploads */
+    struct sw__gpu_resident *resident;
+    int32_t resident_off;  /* 1: static levels sent with the frame's mesh (tests' A/B) */
+    uint64_t upload_bytes; /* the last draw's: vertices, indices and patch data sent */
 };
 
 /* Last GL error as SW_ERR_GL naming `what`, or SW_OK. */
@@ -339,6 +344,9 @@ sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
                                 const double *st_box, sw__gpu_mesh *mesh, sw_status *status);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
+/* Static levels drawn from the GPU copies the context keeps (default), or sent with each frame's
+ * mesh: the A/B of the tests and benchmarks. Between frames. */
+void sw__gpu_set_resident(sw_gpu_context *ctx, int on);
 /* Fat borders of affine faces by their loop's vertices (default) or sampled as curved ones: the
  * A/B of bench_prepare and the test that both cover alike. */
 void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on);
@@ -470,10 +478,46 @@ double sw__gpu_near_plane(const double eye[3], const double world_box[6]);
  * mesh's fat borders lie behind them (crack_fill.c), so most of their fragments fail the depth
  * test before they are shaded. Waits for the GPU (glFinish) so that the caller's timing is the
  * real draw time. */
+struct sw__gpu_resident_list; /* below */
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
                              const sw__gpu_draw *draws, size_t n_draws,
-                             const sw__gpu_patch_batch *batch, sw_status *status);
+                             const sw__gpu_patch_batch *batch,
+                             const struct sw__gpu_resident_list *resident, sw_status *status);
+
+/* ---- resident static levels (resident.c) -------------------------------------------------------
+ * A static level (Kumar et al. 1997 §4) does not change with the view, so its vertices and
+ * triangles go to a GPU buffer once, in the object space of its unit around the unit's box
+ * centre, and every later frame draws them with a camera-relative placement composed in double on
+ * the CPU (ARCHITECTURE.md's precision rule): rot, and off = world(centre) - eye, both in float. */
+typedef struct sw__gpu_resident_draw {
+    const struct sw_lod_static_level *level; /* the set's (it outlives the frame) */
+    uint32_t unit;                           /* of the static set */
+    int32_t index;                           /* of the level in its chain */
+    double centre[3]; /* object space: the origin its buffer's positions are relative to */
+    float rot[9];     /* row-major: the instance transform's 3 x 3 (normals too: similarities) */
+    float off[3];     /* eye-relative world position of the centre */
+    float color[4];
+} sw__gpu_resident_draw;
+typedef struct sw__gpu_resident_list {
+    const sw__gpu_resident_draw *draws;
+    size_t n;
+    uint64_t set; /* sw_lod_static_set_serial of their set */
+} sw__gpu_resident_list;
+/* Levels whose index reaches this are drawn from the frame's mesh instead. */
+enum { SW__GPU_RESIDENT_LEVELS = 8 };
+/* Draws the list with the mesh program (untrimmed, in use with its view set), uploading the
+ * levels it does not hold yet; adds the uploaded bytes to ctx->upload_bytes. Errors:
+ * SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__gpu_resident_draw_all(sw_gpu_context *ctx, const sw__gpu_surface_program *prog,
+                                    const sw__gpu_resident_list *list, sw_status *status);
+/* Between frames: the levels of another set are dropped, and over the budget those the last
+ * frame did not draw. */
+void sw__gpu_resident_begin(sw_gpu_context *ctx, uint64_t set);
+void sw__gpu_resident_free(sw_gpu_context *ctx);
+/* Bytes of GPU buffers held, and the budget (tests; 0 keeps only the last frame's levels). */
+size_t sw__gpu_resident_bytes(const sw_gpu_context *ctx);
+size_t sw__gpu_resident_set_budget(sw_gpu_context *ctx, size_t bytes);
 /* The host's GL state (host_state.c says which), saved and set to GL's defaults when the
  * renderer starts working in an adopted context or on a presenting frame (desc.present), and
  * restored when it ends. */

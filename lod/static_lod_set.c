@@ -44,7 +44,10 @@ struct sw_lod_static_set {
     _Atomic uint64_t n_builds, n_adopted;
     _Atomic uint64_t build_ns;
     _Atomic int cancelled; /* builds not started yet return at once (the set is going away) */
+    uint64_t serial;       /* sw_lod_static_set_serial */
 };
+
+static _Atomic uint64_t g_set_serial; /* sets made by this process */
 
 typedef struct build_job {
     sw_lod_static_set *set;
@@ -437,6 +440,7 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     s->scene = scene;
     s->pool = pool;
+    s->serial = atomic_fetch_add(&g_set_serial, 1) + 1;
     s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     /* resolved now: the cache key (lod/static_lod_io.c) hashes the values the chains get */
     sw_result r = sw_lod_static_desc_resolve(desc ? &desc->levels : NULL, &s->levels, status);
@@ -503,6 +507,11 @@ void sw_lod_static_set_destroy(sw_lod_static_set *s)
 uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *s)
 {
     return s->n_units;
+}
+
+uint64_t sw_lod_static_set_serial(const sw_lod_static_set *s)
+{
+    return s->serial;
 }
 
 const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *s)

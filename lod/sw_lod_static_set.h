@@ -123,6 +123,9 @@ void sw_lod_static_set_cancel(sw_lod_static_set *set);
 void sw_lod_static_set_destroy(sw_lod_static_set *set);
 
 uint32_t sw_lod_static_set_unit_count(const sw_lod_static_set *set);
+/* A number no other set of this process has had (1, 2, ...): what keys a set's chains where the
+ * set's address could be a freed set's (GPU copies of its levels). */
+uint64_t sw_lod_static_set_serial(const sw_lod_static_set *set);
 const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *set);
 /* The level settings the set builds with (its desc's, zero fields as given). */
 const sw_lod_static_desc *sw__lod_static_set_levels(const sw_lod_static_set *set);

@@ -13,16 +13,25 @@
  *              submitted frame per variant gives the triangles and the pixels they differ in;
  *   chunks     the faces tessellated by the preparing thread alone, or in chunks shared with a
  *              pool of --workers workers (desc.pool);
+ *   workers    the chunks shared with a pool of 1 worker, or of 2 (the parallel visibility stage
+ *              on one and two more threads), with the join's wait (ms_join) beside the times;
  *   density    planes' patches given the coarsest grid by the affine test (fast, the default) or
  *              by the full screen-space bound (lod/sampling.c sw_lod_screen_affine_fast), on one
  *              thread, with the triangles and differing pixels of view 0 as for affine;
  *   borders    the border cache (gpu/border_cache.c: loops and samples kept between frames) on,
  *              the default, or off, on one thread; each variant's passes one after another, so
  *              that the cache keeps what its own passes made (its first pass starts empty).
- * Each variant prints the median of the prepare's wall time, of the preparing thread's CPU time
- * and of the process's CPU time (every thread: the pool's share of the work included, so the
- * split's extra work shows).
- * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--workers W] FILE...
+ * Each variant prints the median of the prepare's wall time, of the preparing thread's CPU time,
+ * of the process's CPU time (every thread: the pool's share of the work included, so the split's
+ * extra work shows) and of the wait at the tessellation's join.
+ *
+ * --callgrind W: only the measured prepares of each mode (after its warm-up), with the chunks
+ * shared with a pool of W workers (0: the preparing thread alone), between callgrind's collect
+ * toggles, so that the instructions of every thread that worked on them are counted:
+ *   valgrind --tool=callgrind --collect-atstart=no --callgrind-out-file=cg.W \
+ *     build/bin/bench_prepare --callgrind W --views 4 --passes 1 FILE
+ * ("summary:" in cg.W is the total). The split's extra work is the ratio of two such totals.
+ * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--workers W] [--callgrind W] FILE...
  *        (.brep/.step/.igs imported, .sws opened)
  */
 #include "sw_lod_sampling.h"
@@ -38,6 +47,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <valgrind/callgrind.h>
 
 enum { MAX_VIEWS = 256, MAX_PASSES = 16 };
 
@@ -63,16 +73,19 @@ static sw_gpu_camera orbit_camera(const double box[6], int i, int n)
 
 typedef struct bench {
     sw_gpu_context *ctx;
-    sw_th_pool *pool;
+    sw_th_pool *pool;       /* --workers workers: the chunks pair */
+    sw_th_pool *workers[2]; /* 1 and 2 workers: the workers pair */
     const sw_sg_scene *scene;
     sw_gpu_frame_desc desc;
     double box[6];
     int views;
+    int callgrind; /* -1: off; else the workers of the counted prepares */
 } bench;
 
-/* Times of one variant, per clock, over its passes. */
+/* Times of one variant, per clock, over its passes, and the waits at the join. */
 typedef struct series {
     double ms[N_CLOCKS][MAX_PASSES * MAX_VIEWS];
+    double join[MAX_PASSES * MAX_VIEWS];
     int n;
 } series;
 
@@ -92,11 +105,13 @@ static int pass(bench *b, series *s)
         }
         for (int k = 0; k < N_CLOCKS; ++k)
             t1[k] = clock_ms(k_clocks[k]);
+        const double join = sw_gpu_frame_plan_stats(plan)->ms_join;
         sw_gpu_frame_plan_recycle(b->ctx, plan); /* as the renderer's visibility thread does */
         if (!s)
             continue;
         for (int k = 0; k < N_CLOCKS; ++k)
             s->ms[k][s->n] = t1[k] - t0[k];
+        s->join[s->n] = join;
         s->n++;
     }
     return 1;
@@ -104,9 +119,9 @@ static int pass(bench *b, series *s)
 
 static void print_series(const char *name, series *s)
 {
-    printf("    %-24s wall %8.2f  thread CPU %8.2f  process CPU %8.2f ms\n", name,
+    printf("    %-24s wall %8.2f  thread CPU %8.2f  process CPU %8.2f  join %7.2f ms\n", name,
            bench_quantile(s->ms[WALL], s->n, 0.5), bench_quantile(s->ms[THREAD], s->n, 0.5),
-           bench_quantile(s->ms[PROCESS], s->n, 0.5));
+           bench_quantile(s->ms[PROCESS], s->n, 0.5), bench_quantile(s->join, s->n, 0.5));
 }
 
 /* The passes of two variants set by set(b, 0 or 1): alternating (the machine's drift shared),
@@ -142,6 +157,11 @@ static void set_affine(bench *b, int k)
 static void set_chunks(bench *b, int k)
 {
     b->desc.pool = k ? b->pool : NULL;
+}
+
+static void set_workers(bench *b, int k)
+{
+    b->desc.pool = b->workers[k];
 }
 
 static void set_density(bench *b, int k)
@@ -188,26 +208,45 @@ static int compare_images(bench *b, void (*set)(bench *, int))
     return 1;
 }
 
+/* --callgrind: the mode's measured prepares alone between the collect toggles, the chunks shared
+ * with b->workers[callgrind - 1] (0: none). */
+static int counted_passes(bench *b, const char *mode, int passes)
+{
+    b->desc.pool = b->callgrind > 0 ? b->workers[b->callgrind - 1] : NULL;
+    CALLGRIND_TOGGLE_COLLECT;
+    int ok = 1;
+    for (int i = 0; i < passes && ok; ++i)
+        ok = pass(b, NULL);
+    CALLGRIND_TOGGLE_COLLECT;
+    b->desc.pool = NULL;
+    printf("  %s: %d prepares counted, chunks with %d pool workers\n", mode, passes * b->views,
+           b->callgrind);
+    return ok;
+}
+
 static int run_mode(bench *b, const char *mode, int passes)
 {
     static const char *affine[2] = {"affine borders on", "affine borders off"};
     static const char *chunks[2] = {"one thread", "chunks with the pool"};
     static const char *density[2] = {"affine densities fast", "affine densities bounded"};
     static const char *borders[2] = {"border cache on", "border cache off"};
-    printf("  %s, medians of %d prepares per variant:\n", mode, passes * b->views);
+    static const char *workers[2] = {"chunks, 1 worker", "chunks, 2 workers"};
     if (!pass(b, NULL)) /* warm-up: hierarchies built and refined, buffers grown */
         return 0;
+    if (b->callgrind >= 0)
+        return counted_passes(b, mode, passes);
+    printf("  %s, medians of %d prepares per variant:\n", mode, passes * b->views);
     if (!ab(b, passes, set_affine, affine) || !compare_images(b, set_affine))
         return 0;
     if (!ab(b, passes, set_density, density) || !compare_images(b, set_density))
         return 0;
     if (!variants(b, passes, 0, set_borders, borders) || !compare_images(b, set_borders))
         return 0;
-    return ab(b, passes, set_chunks, chunks);
+    return ab(b, passes, set_chunks, chunks) && ab(b, passes, set_workers, workers);
 }
 
-static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, int w, int h,
-                       int views, int passes)
+/* One file through both modes; tmpl gives the context, the pools and the options. */
+static int bench_scene(const bench *tmpl, const char *path, int w, int h, int passes)
 {
     /* the hierarchies' builds use a pool of their own, so that the chunks' pool is idle */
     sw_status st = {0};
@@ -226,7 +265,8 @@ static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, 
     }
     sw_sg_scene_stats ss;
     sw_sg_scene_compute_stats(scene, &ss);
-    bench b = {ctx, pool, scene, {0}, {0}, views};
+    bench b = *tmpl;
+    b.scene = scene;
     memcpy(b.box, ss.bbox, sizeof b.box);
     b.desc.width = w;
     b.desc.height = h;
@@ -255,9 +295,17 @@ static int bench_scene(sw_gpu_context *ctx, sw_th_pool *pool, const char *path, 
     return ok;
 }
 
+static sw_th_pool *make_pool(int workers)
+{
+    sw_th_pool_desc pd = {0};
+    pd.worker_count = (uint32_t)workers;
+    sw_th_pool *pool = NULL;
+    return sw_th_pool_create(&pd, &pool) == SW_OK ? pool : NULL;
+}
+
 int main(int argc, char **argv)
 {
-    int views = 24, passes = 2, w = 1280, h = 720, workers = 1, first = 1;
+    int views = 24, passes = 2, w = 1280, h = 720, workers = 1, callgrind = -1, first = 1;
     for (; first < argc && strncmp(argv[first], "--", 2) == 0; first += 2) {
         if (first + 1 >= argc)
             break;
@@ -265,6 +313,8 @@ int main(int argc, char **argv)
             views = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--workers") == 0)
             workers = atoi(argv[first + 1]);
+        else if (strcmp(argv[first], "--callgrind") == 0)
+            callgrind = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--passes") == 0)
             passes = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--size") == 0 &&
@@ -274,32 +324,33 @@ int main(int argc, char **argv)
             break;
     }
     if (first >= argc || views < 1 || views > MAX_VIEWS || passes < 1 || passes > MAX_PASSES ||
-        w < 1 || h < 1 || workers < 1 || workers > 64) {
+        w < 1 || h < 1 || workers < 1 || workers > 64 || callgrind < -1 || callgrind > 2) {
         fprintf(stderr,
-                "usage: %s [--views N<=%d] [--passes P<=%d] [--size WxH] [--workers W] FILE...\n",
+                "usage: %s [--views N<=%d] [--passes P<=%d] [--size WxH] [--workers W] "
+                "[--callgrind 0|1|2] FILE...\n",
                 argv[0], MAX_VIEWS, MAX_PASSES);
         return 2;
     }
     sw_status st = {0};
-    sw_gpu_context *ctx = NULL;
-    if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK) {
+    bench b = {.views = views, .callgrind = callgrind};
+    if (sw_gpu_context_create_headless(&b.ctx, &st) != SW_OK) {
         fprintf(stderr, "%s\n", st.message);
         return 1;
     }
-    sw_th_pool_desc pd = {0};
-    pd.worker_count = (uint32_t)workers;
-    sw_th_pool *pool = NULL;
-    if (sw_th_pool_create(&pd, &pool) != SW_OK) {
+    b.pool = make_pool(workers);
+    b.workers[0] = make_pool(1);
+    b.workers[1] = make_pool(2);
+    int ok = b.pool && b.workers[0] && b.workers[1];
+    if (!ok)
         fprintf(stderr, "pool: cannot start\n");
-        sw_gpu_context_free(ctx);
-        return 1;
-    }
-    printf("%s, %dx%d, ε_img default, %d views, %d passes per variant, %d pool workers\n",
-           sw_gpu_context_description_ptr(ctx), w, h, views, passes, workers);
-    int ok = 1;
+    else
+        printf("%s, %dx%d, ε_img default, %d views, %d passes per variant, %d pool workers\n",
+               sw_gpu_context_description_ptr(b.ctx), w, h, views, passes, workers);
     for (int a = first; a < argc && ok; ++a)
-        ok = bench_scene(ctx, pool, argv[a], w, h, views, passes);
-    sw_th_pool_destroy(pool);
-    sw_gpu_context_free(ctx);
+        ok = bench_scene(&b, argv[a], w, h, passes);
+    sw_th_pool_destroy(b.pool);
+    sw_th_pool_destroy(b.workers[0]);
+    sw_th_pool_destroy(b.workers[1]);
+    sw_gpu_context_free(b.ctx);
     return ok ? 0 : 1;
 }

@@ -390,6 +390,8 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->nodes_occluded = g->nodes_occluded;
     out->faces_occluded = g->faces_occluded;
     out->occluders_drawn = g->occluders_drawn;
+    out->resident_triangles = g->resident_triangles;
+    out->upload_bytes = g->upload_bytes;
 }
 
 static int camera_is_zero(const sw_camera *c)

@@ -170,17 +170,19 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
         printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
                (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);
     if (s->static_drawn > 0 || s->static_requests > 0)
-        printf("%*s  static LODs: %llu super-surface instances drawn (%llu faces, %llu triangles), "
-               "%llu builds queued\n",
+        printf("%*s  static LODs: %llu super-surface instances drawn (%llu faces, %llu triangles, "
+               "%llu from GPU buffers kept between frames), %llu builds queued\n",
                (int)strlen(label), "", (unsigned long long)s->static_drawn,
                (unsigned long long)s->static_faces, (unsigned long long)s->static_triangles,
-               (unsigned long long)s->static_requests);
+               (unsigned long long)s->resident_triangles, (unsigned long long)s->static_requests);
     if (s->bound_exceeded > 0 && s->bound_excess_px > 0.0)
         printf("%*s  error bound: %llu pieces drawn over it (worst known excess %.3g px)\n",
                (int)strlen(label), "", (unsigned long long)s->bound_exceeded, s->bound_excess_px);
     else if (s->bound_exceeded > 0)
         printf("%*s  error bound: %llu pieces drawn over it (grids capped at the segment limit)\n",
                (int)strlen(label), "", (unsigned long long)s->bound_exceeded);
+    printf("%*s  upload: %.2f MiB of vertices, indices and patch data sent for the draw\n",
+           (int)strlen(label), "", (double)s->upload_bytes / (1024.0 * 1024.0));
     printf("%*s  time: hierarchy builds %.1f ms, tessellate %.1f ms, trim textures %.1f ms, draw "
            "%.1f ms, readback %.1f ms, write %.1f ms, total %.1f ms\n",
            (int)strlen(label), "", s->ms_hierarchy, s->ms_tessellate, s->ms_trim, s->ms_draw,

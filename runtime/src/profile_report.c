@@ -107,6 +107,8 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_OCCLUSION_TESTS] = (double)st->occlusion_tests;
     v[SW_RT_COL_NODES_OCCLUDED] = (double)st->nodes_occluded;
     v[SW_RT_COL_FACES_OCCLUDED] = (double)st->faces_occluded;
+    v[SW_RT_COL_RESIDENT_TRIANGLES] = (double)st->resident_triangles;
+    v[SW_RT_COL_UPLOAD_BYTES] = (double)st->upload_bytes;
     v[SW_RT_COL_RESIDENT_BYTES] = resident_bytes;
     v[SW_RT_COL_CAPTURED] = captured ? 1.0 : 0.0;
 }

@@ -85,6 +85,10 @@
     X(NODES_OCCLUDED, "nodes_occluded", COUNT, "--occlusion: hierarchy (BVH) nodes found hidden")  \
     X(FACES_OCCLUDED, "faces_occluded", COUNT,                                                     \
       "--occlusion: face occurrences culled as hidden (of faces_culled)")                          \
+    X(RESIDENT_TRIANGLES, "resident_triangles", COUNT,                                             \
+      "of triangles: drawn from GPU buffers kept between frames (static levels)")                  \
+    X(UPLOAD_BYTES, "upload_bytes", COUNT,                                                         \
+      "bytes sent to the GPU for the draw (vertices, indices, patch data, new resident levels)")   \
     SW_TH_TASK_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \
     SW_TH_TASK_KINDS(SW_RT__POOL_TASKS_COLUMN, X)                                                  \
     X(POOL_QUEUED, "pool_queued", COUNT,                                                           \

@@ -421,15 +421,20 @@ static size_t first_mismatch(const sw__fr_geometry *a, const sw__fr_geometry *b)
         return 7;
     if (a->n_cps != b->n_cps || !same_bytes(a->cps, b->cps, 4 * a->n_cps * sizeof *a->cps))
         return 8;
-    return a->gpu_vertices != b->gpu_vertices || a->border_triangles != b->border_triangles ? 9 : 0;
+    if (a->gpu_vertices != b->gpu_vertices || a->border_triangles != b->border_triangles)
+        return 9;
+    if (a->n_resident != b->n_resident || a->resident_triangles != b->resident_triangles ||
+        !same_bytes(a->resident, b->resident, a->n_resident * sizeof *a->resident))
+        return 10;
+    return 0;
 }
 
 static void check_parallel(sw_gpu_context *ctx, const sw_sg_scene *scene,
                            const sw_gpu_frame_desc *desc, const stages *one, const char *name)
 {
     static const char *const what[] = {
-        "",       "vertices", "indices", "draws",          "trims",
-        "shares", "loops",    "records", "control points", "vertex counts"};
+        "",      "vertices", "indices",        "draws",         "trims",         "shares",
+        "loops", "records",  "control points", "vertex counts", "resident draws"};
     sw_gpu_frame_desc d = *desc;
     d.pool = g_pool;
     stages par;
@@ -494,6 +499,12 @@ static void check_parallel_static(sw_gpu_context *ctx, const sw_sg_scene *scene,
             CHECK(par.st.tess_chunks > 1 || picks < 32, "%s: not split", what);
             g_static_split += par.st.tess_chunks > 1 && one.sel.n_statics > 0;
             CHECK(bad == 0, "%s: chunked tessellation differs from one thread's (%zu)", what, bad);
+            /* every static pick a draw of the context's GPU copy of its level (gpu/resident.c) */
+            CHECK(one.geo.n_resident == one.sel.n_statics &&
+                      one.geo.resident_triangles == one.st.static_triangles,
+                  "%s: %zu resident draws (%llu triangles) for %zu static picks (%llu)", what,
+                  one.geo.n_resident, (unsigned long long)one.geo.resident_triangles,
+                  one.sel.n_statics, (unsigned long long)one.st.static_triangles);
             CHECK(par.st.static_units_drawn == one.st.static_units_drawn &&
                       par.st.static_faces == one.st.static_faces &&
                       par.st.static_triangles == one.st.static_triangles &&

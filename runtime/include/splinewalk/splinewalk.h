@@ -430,6 +430,10 @@ typedef struct sw_frame_stats {
      * map, hierarchy nodes and face occurrences found hidden (of faces_culled, the occurrences
      * under those nodes included), planar faces drawn into the map */
     uint64_t occlusion_tests, nodes_occluded, faces_occluded, occluders_drawn;
+    /* of triangles: those drawn from GPU buffers the renderer keeps between frames (static LODs'
+     * levels, sent once); and the bytes sent to the GPU for the frame's draw (the vertices,
+     * indices and patch data made for it, and the levels sent for the first time) */
+    uint64_t resident_triangles, upload_bytes;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
