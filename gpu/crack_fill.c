@@ -158,10 +158,23 @@ static int screen_of(const sw__gpu_view *v, const double p[3], double out[2])
     return 1;
 }
 
-static double dist2_to_segment(const double p[2], const double a[2], const double b[2])
+/* A segment from a to b on screen, its direction and squared length made once for the many
+ * samples tested against it. */
+typedef struct screen_chord {
+    double a[2], d[2], l2;
+} screen_chord;
+
+static screen_chord chord_of(const double a[2], const double b[2])
 {
-    double d[2] = {b[0] - a[0], b[1] - a[1]}, l2 = d[0] * d[0] + d[1] * d[1];
-    double t = l2 > 0.0 ? ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2 : 0.0;
+    screen_chord c = {{a[0], a[1]}, {b[0] - a[0], b[1] - a[1]}, 0.0};
+    c.l2 = c.d[0] * c.d[0] + c.d[1] * c.d[1];
+    return c;
+}
+
+static double dist2_to_chord(const double p[2], const screen_chord *c)
+{
+    const double *a = c->a, *d = c->d;
+    double t = c->l2 > 0.0 ? ((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / c->l2 : 0.0;
     t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
     double x = p[0] - a[0] - t * d[0], y = p[1] - a[1] - t * d[1];
     return x * x + y * y;
@@ -181,10 +194,10 @@ static size_t thin_samples(const sw__gpu_view *v, border_point *bp, size_t n, do
         if (bp[kept - 1].in_front) {
             const double *a = bp[kept - 1].scr;
             while (end + 1 < n && end + 1 - (i - 1) <= MAX_RUN && bp[end + 1].in_front) {
-                const double *b = bp[end + 1].scr;
+                const screen_chord c = chord_of(a, bp[end + 1].scr);
                 int fits = 1;
                 for (size_t k = i; k <= end && fits; ++k)
-                    fits = bp[k].in_front && dist2_to_segment(bp[k].scr, a, b) <= tol_px * tol_px;
+                    fits = bp[k].in_front && dist2_to_chord(bp[k].scr, &c) <= tol_px * tol_px;
                 if (!fits)
                     break;
                 ++end;
