@@ -66,6 +66,7 @@ typedef struct rt_job {
     /* an immediate frame's surface programs, for its submission only (Guthe §8's special
      * program); NULL: the library's */
     const struct sw__gpu_surface_programs *shading;
+    double t_pushed; /* when it was handed to the visibility thread (ms) */
 } rt_job;
 
 static void job_free(rt_job *j);
@@ -720,15 +721,19 @@ static sw_result prepare_frame(sw_rt_renderer *r, const sw_frame_desc *desc, sw_
     j->job.spent = r->spent;
     r->spent = NULL;
     r->in_flight++;
+    j->t_pushed = now_ms();
     sw_rt_pipeline_push(r->pipeline, &j->job);
     return SW_OK;
 }
 
-/* Waits for the oldest prepared frame and draws it on this thread; ms_total counts from t0. */
-static sw_result submit_frame(sw_rt_renderer *r, double t0, sw_frame_stats *stats,
+/* Waits for the oldest prepared frame and draws it on this thread; ms_total counts from t0, the
+ * wait for the visibility thread from this call (since_push: from the frame's hand-over, for a
+ * caller that did nothing in between, so that the wait covers the visibility thread's time
+ * however the threads were scheduled). */
+static sw_result submit_frame(sw_rt_renderer *r, double t0, int since_push, sw_frame_stats *stats,
                               sw_status *status)
 {
-    const double t_wait = now_ms();
+    const double t_call = now_ms();
     const sw_th_wait_count w0 = sw_th_thread_waits();
     rt_job *j = (rt_job *)sw_rt_pipeline_pop(r->pipeline);
     r->in_flight--;
@@ -759,7 +764,7 @@ static sw_result submit_frame(sw_rt_renderer *r, double t0, sw_frame_stats *stat
                            j->job.pool_waits + j->job.pool_waits_before, stats, status);
     if (res == SW_OK && stats) {
         stats->ms_visibility = j->job.ms_visibility;
-        stats->ms_wait_visibility = t1 - t_wait;
+        stats->ms_wait_visibility = t1 - (since_push ? j->t_pushed : t_call);
     }
     job_free(j);
     return res;
@@ -793,7 +798,7 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     if (!r->in_flight)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "sw_renderer_submit: no prepared frame (call sw_renderer_prepare first)");
-    return submit_frame(r, now_ms(), stats, status);
+    return submit_frame(r, now_ms(), 0, stats, status);
 }
 
 sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_frame_stats *stats,
@@ -814,7 +819,7 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
         return res;
     const double t0 = now_ms();
     res = prepare_frame(r, desc, NULL, NULL, status);
-    return res == SW_OK ? submit_frame(r, t0, stats, status) : res;
+    return res == SW_OK ? submit_frame(r, t0, 1, stats, status) : res;
 }
 
 sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
@@ -848,5 +853,5 @@ sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_s
     res = check_frame_desc(desc, status);
     if (res == SW_OK)
         res = prepare_frame(r, desc, scene, extra, status);
-    return res == SW_OK ? submit_frame(r, t0, stats, status) : res;
+    return res == SW_OK ? submit_frame(r, t0, 1, stats, status) : res;
 }
