@@ -76,7 +76,12 @@ static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
          mesh->v);
     send(ctx, GL_ELEMENT_ARRAY_BUFFER, ctx->mesh_ibo, &ctx->mesh_ibo_cap,
          mesh->n_idx * sizeof *mesh->idx, mesh->idx);
-    GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
+    sw__gpu_vertex_layout();
+}
+
+void sw__gpu_vertex_layout(void)
+{
+    const GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
                           (const void *)offsetof(sw__gpu_vertex, pos));

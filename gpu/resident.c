@@ -14,7 +14,6 @@
 #include "sw_lod_static.h"
 #include "sw_status_util.h"
 
-#include <stddef.h>
 #include <string.h>
 
 /* Bytes of GPU buffers the table may keep past a frame (entries unused in the last frame are
@@ -161,16 +160,7 @@ static sw_result upload(sw_gpu_context *ctx, struct sw__gpu_resident *t, residen
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)ibytes, lv->triangles, GL_STATIC_DRAW);
     sw__free(v);
-    const GLsizei stride = (GLsizei)sizeof(sw__gpu_vertex);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, stride,
-                          (const void *)offsetof(sw__gpu_vertex, pos));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, stride,
-                          (const void *)offsetof(sw__gpu_vertex, nrm));
-    glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 2, GL_FLOAT, GL_FALSE, stride,
-                          (const void *)offsetof(sw__gpu_vertex, st));
+    sw__gpu_vertex_layout();
     e->n_idx = (GLsizei)(3 * lv->n_triangles);
     e->bytes = vbytes + ibytes;
     t->bytes += e->bytes;

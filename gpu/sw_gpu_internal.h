@@ -254,6 +254,10 @@ typedef struct sw__gpu_vertex {
     float st[2];  /* face parameter mapped to [0,1]^2 over the face's uv_box (trim lookup) */
 } sw__gpu_vertex;
 
+/* The attributes of sw__gpu_vertex (0 position, 1 normal, 2 st) from the bound array buffer into
+ * the bound vertex array (draw.c). */
+void sw__gpu_vertex_layout(void);
+
 typedef struct sw__gpu_mesh {
     sw__gpu_vertex *v;
     uint32_t *idx;

@@ -20,6 +20,15 @@ static inline sw_gpu_camera sw_test_view_camera(const double b[6], int iso)
     return c;
 }
 
+/* The same preset with its eye moved to `scale` times the fitted distance from the target. */
+static inline sw_gpu_camera sw_test_view_camera_at(const double b[6], int iso, double scale)
+{
+    sw_gpu_camera c = sw_test_view_camera(b, iso);
+    for (int k = 0; k < 3; ++k)
+        c.eye[k] = c.target[k] + scale * (c.eye[k] - c.target[k]);
+    return c;
+}
+
 typedef struct sw_test_image_diff {
     long covered;      /* pixels covered by either image */
     long differ;       /* coverage or a channel beyond the tolerance */
