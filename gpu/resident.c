@@ -176,8 +176,8 @@ sw_result sw__gpu_resident_draw_all(sw_gpu_context *ctx, const sw__gpu_surface_p
     struct sw__gpu_resident *t = table(ctx);
     if (!t)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "resident static levels: out of memory");
-    if (t->set != list->set)
-        sw__gpu_resident_begin(ctx, list->set); /* a frame drawn without a begin (tests) */
+    if (t->set != list->set) /* the table's first frame: made just now, after the begin */
+        sw__gpu_resident_begin(ctx, list->set);
     static const float no_trim[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glUniform4fv(prog->loc_uv_map, 1, no_trim);
     glUniform4fv(prog->loc_trim_rect, 1, no_trim);
