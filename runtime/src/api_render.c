@@ -489,7 +489,7 @@ static void statics_task(void *ctx)
         sw__log(SW_LOG_WARN,
                 "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
                 "frames need them (`splinewalk build-lod` stores them in a .sws)",
-                path ? path : "the scene");
+                path && *path ? path : "the scene");
     else if (found != SW_OK)
         sw__log(SW_LOG_WARN, "static LODs: %s; the levels are built again as frames need them",
                 st.message);
