@@ -6,9 +6,8 @@
 #   profile.json agrees with the CSV (its median recomputed here); other_ms = frame_ms - stages;
 # - converged: on the median frame the stages add up to frame_ms within 5 % (other <= 5 %);
 #   walkthrough: no frame waits for the pool (pool_waits 0 and vis_hierarchy_ms 0.0000: both
-#   count where a frame's threads block on the pool, in both modes, issue 19; before,
-#   only the converged branch counted them, so these checks held by construction; seen failing
-#   with a planted walkthrough wait for one face's build in gpu/stage_hierarchy.c
+#   count where a frame's threads block on the pool, in both modes, so the checks can fail; seen
+#   failing with a planted walkthrough wait for one face's build in gpu/stage_hierarchy.c
 #   request_walkthrough: pool_waits and vis_hierarchy_ms both fail); converged: no fallback draws;
 # - frametime.svg and report.html are well-formed XML; 3 frames captured, nothing left staged;
 # - bad path files: the malformed corpus (tests/malformed) holds them; here a failed run leaves an
