@@ -42,14 +42,16 @@ static sw_result resident_level(sw__fr_tess *t, const occurrence *o, uint32_t un
     d->level = lv;
     d->unit = unit;
     d->index = level;
+    const double centre[4] = {0.5 * (box[0] + box[3]), 0.5 * (box[1] + box[4]),
+                              0.5 * (box[2] + box[5]), 1.0};
+    double off[4];
+    sw__fr_xform_h(m, t->env->view.eye, centre, off);
     for (int r = 0; r < 3; ++r) {
-        d->centre[r] = 0.5 * (box[r] + box[3 + r]);
+        d->centre[r] = centre[r];
+        d->off[r] = (float)off[r];
         for (int c = 0; c < 3; ++c)
             d->rot[3 * r + c] = (float)m[4 * r + c];
     }
-    for (int r = 0; r < 3; ++r)
-        d->off[r] = (float)(m[4 * r] * d->centre[0] + m[4 * r + 1] * d->centre[1] +
-                            m[4 * r + 2] * d->centre[2] + (m[4 * r + 3] - t->env->view.eye[r]));
     memcpy(d->color, o->color, sizeof d->color);
     if (t->env->lod_colors)
         sw__fr_lod_color(level, d->color);
