@@ -79,7 +79,7 @@ static void rows_free(struct sw__gpu_resident *t)
 
 void sw__gpu_resident_begin(sw_gpu_context *ctx, uint64_t set)
 {
-    struct sw__gpu_resident *t = ctx->resident;
+    struct sw__gpu_resident *t = set ? table(ctx) : ctx->resident; /* made by a set's frame */
     if (!t)
         return;
     if (t->set != set && t->n_rows)
@@ -173,11 +173,9 @@ sw_result sw__gpu_resident_draw_all(sw_gpu_context *ctx, const sw__gpu_surface_p
 {
     if (!list || list->n == 0)
         return SW_OK;
-    struct sw__gpu_resident *t = table(ctx);
-    if (!t)
+    struct sw__gpu_resident *t = ctx->resident;
+    if (!t || t->set != list->set) /* the frame's begin could not make the table */
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "resident static levels: out of memory");
-    if (t->set != list->set) /* the table's first frame: made just now, after the begin */
-        sw__gpu_resident_begin(ctx, list->set);
     static const float no_trim[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     glUniform4fv(prog->loc_uv_map, 1, no_trim);
     glUniform4fv(prog->loc_trim_rect, 1, no_trim);

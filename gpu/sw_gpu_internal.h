@@ -511,12 +511,13 @@ typedef struct sw__gpu_resident_list {
 /* Levels whose index reaches this are drawn from the frame's mesh instead. */
 enum { SW__GPU_RESIDENT_LEVELS = 8 };
 /* Draws the list with the mesh program (untrimmed, in use with its view set), uploading the
- * levels it does not hold yet; adds the uploaded bytes to ctx->upload_bytes. Errors:
- * SW_ERR_OUT_OF_MEMORY. */
+ * levels it does not hold yet; adds the uploaded bytes to ctx->upload_bytes. After the frame's
+ * sw__gpu_resident_begin with the list's set. Errors: SW_ERR_OUT_OF_MEMORY. */
 sw_result sw__gpu_resident_draw_all(sw_gpu_context *ctx, const sw__gpu_surface_program *prog,
                                     const sw__gpu_resident_list *list, sw_status *status);
-/* Between frames: the levels of another set are dropped, and over the budget those the last
- * frame did not draw. */
+/* Before each frame's draw (set 0: the frame has no static set): the levels of another set are
+ * dropped, and over the budget those the last frame did not draw; a set's first frame makes the
+ * table. */
 void sw__gpu_resident_begin(sw_gpu_context *ctx, uint64_t set);
 void sw__gpu_resident_free(sw_gpu_context *ctx);
 /* Bytes of GPU buffers held, and the budget (tests; 0 keeps only the last frame's levels). */
