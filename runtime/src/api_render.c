@@ -806,20 +806,8 @@ sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_f
 {
     if (!desc)
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_draw: NULL desc");
-    sw_rt_renderer *r;
-    sw_result res = owned_renderer(renderer, "sw_renderer_draw", &r, status);
-    if (res != SW_OK)
-        return res;
-    if (r->in_flight)
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "sw_renderer_draw: %u prepared frames wait; submit them first",
-                        r->in_flight);
-    res = check_frame_desc(desc, status);
-    if (res != SW_OK)
-        return res;
-    const double t0 = now_ms();
-    res = prepare_frame(r, desc, NULL, NULL, status);
-    return res == SW_OK ? submit_frame(r, t0, 1, stats, status) : res;
+    return sw__rt_renderer_draw_scene(renderer, "sw_renderer_draw", NULL, desc, NULL, stats,
+                                      status);
 }
 
 sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,

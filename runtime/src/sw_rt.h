@@ -137,8 +137,9 @@ typedef struct sw_rt_frame_extra {
 sw_result sw__rt_renderer_immediate(sw_renderer handle, const char *fn, int drawing,
                                     struct sw_rt_immediate ***slot, sw_gpu_context **gpu,
                                     sw_status *status);
-/* Draws `scene` (a reference the caller holds; not behind a handle) as sw_renderer_draw draws a
- * scene's frame, with `extra`. Errors: those of sw_renderer_draw. */
+/* A frame in one call, prepared on the visibility thread and submitted (sw_renderer_draw's, named
+ * fn in errors): of `scene` (a reference the caller holds; not behind a handle) with `extra`, or
+ * with scene NULL of desc->scene's handle (extra NULL). Errors: those of sw_renderer_draw. */
 sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_scene *scene,
                                      const sw_frame_desc *desc, const sw_rt_frame_extra *extra,
                                      sw_frame_stats *stats, sw_status *status);
