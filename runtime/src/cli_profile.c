@@ -299,14 +299,7 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
         const double t0 = sw_cli_now_ms();
         r = run_frames(renderer, !a->sequential, path, n, &a->frame, &st, p, status);
         p->meta.wall_s = (sw_cli_now_ms() - t0) / 1e3;
-        if (r == SW_OK && sw_rt_profile_summarize(p) != 0)
-            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
-        if (r == SW_OK)
-            r = sw_cli_profile_write_reports(&st, p, status);
-        if (r == SW_OK)
-            r = sw_cli_staging_commit(&st, a->out, status);
-        if (r != SW_OK)
-            sw_cli_staging_abandon(&st);
+        r = sw_cli_profile_finish(&st, a->out, p, r, status);
     }
     sw_renderer_destroy(renderer);
     return r;

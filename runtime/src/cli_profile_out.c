@@ -155,8 +155,7 @@ static sw_result write_staged(sw_cli_staging *st, const char *name, report_fn fn
     return sw__write_file_printed(path, report_fill, &job, 0, status);
 }
 
-sw_result sw_cli_profile_write_reports(sw_cli_staging *st, const sw_rt_profile *p,
-                                       sw_status *status)
+static sw_result write_reports(sw_cli_staging *st, const sw_rt_profile *p, sw_status *status)
 {
     char *svg = NULL;
     size_t svg_len = 0;
@@ -176,6 +175,21 @@ sw_result sw_cli_profile_write_reports(sw_cli_staging *st, const sw_rt_profile *
     if (r == SW_OK)
         r = write_staged(st, "report.html", html_fn, p, svg, status);
     free(svg);
+    return r;
+}
+
+sw_result sw_cli_profile_finish(sw_cli_staging *st, const char *out, sw_rt_profile *p,
+                                sw_result run, sw_status *status)
+{
+    sw_result r = run;
+    if (r == SW_OK && sw_rt_profile_summarize(p) != 0)
+        r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
+    if (r == SW_OK)
+        r = write_reports(st, p, status);
+    if (r == SW_OK)
+        r = sw_cli_staging_commit(st, out, status);
+    if (r != SW_OK)
+        sw_cli_staging_abandon(st);
     return r;
 }
 

@@ -32,9 +32,12 @@ void sw_cli_staging_remember(sw_cli_staging *st, const char *name);
 void sw_cli_staging_abandon(sw_cli_staging *st);
 /* Moves every staged file into `out`, then removes the staging directory. */
 sw_result sw_cli_staging_commit(sw_cli_staging *st, const char *out, sw_status *status);
-/* profile.csv, profile.json, frametime.svg and report.html of a summarized profile, staged. */
-sw_result sw_cli_profile_write_reports(sw_cli_staging *st, const sw_rt_profile *p,
-                                       sw_status *status);
+/* The end of a run whose frames ended with `run`: on SW_OK the profile summarized and its
+ * profile.csv, profile.json, frametime.svg and report.html staged, then everything staged moved
+ * into `out`; on any failure the staged files removed, `out` as it was. Returns the first
+ * failure. */
+sw_result sw_cli_profile_finish(sw_cli_staging *st, const char *out, sw_rt_profile *p,
+                                sw_result run, sw_status *status);
 
 /* ---- per-frame samples ---------------------------------------------------------------------- */
 /* Resident memory now (/proc/self/statm), in bytes; 0 when unknown. */

@@ -451,18 +451,9 @@ static void profile_meta(const viewer *v, sw_renderer r, sw_rt_profile *p)
 /* --profile: the recorded frames summarized and written into DIR (aside, then renamed in). */
 static sw_result profile_write(const char *dir, sw_rt_profile *p, sw_status *st)
 {
-    if (sw_rt_profile_summarize(p) != 0)
-        return sw__fail(st, SW_ERR_OUT_OF_MEMORY, "profile: out of memory");
     sw_cli_staging stage = {0};
     sw_result res = sw_cli_staging_make(dir, &stage, st);
-    if (res != SW_OK)
-        return res;
-    res = sw_cli_profile_write_reports(&stage, p, st);
-    if (res == SW_OK)
-        res = sw_cli_staging_commit(&stage, dir, st);
-    if (res != SW_OK)
-        sw_cli_staging_abandon(&stage);
-    return res;
+    return res == SW_OK ? sw_cli_profile_finish(&stage, dir, p, SW_OK, st) : res;
 }
 
 /* Frame i of the script: frame i + 1 prepared (its camera set), frame i submitted, presented with
@@ -479,8 +470,9 @@ static sw_result script_frame(GLFWwindow *win, sw_renderer r, sw_scene scene, vi
     sw_result res = SW_OK;
     if (i + 1 < n) {
         sw_rt_path_eval(path, sw_rt_path_frame_time(path, i + 1, n), &v->wk.cam);
+        const double p0 = sw_cli_now_ms(); /* the prepare call alone, as `profile` times it */
         res = prepare(r, scene, v, v->args->converged, st);
-        prepare_ms = sw_cli_now_ms() - t0;
+        prepare_ms = sw_cli_now_ms() - p0;
     }
     if (res == SW_OK)
         res = sw_renderer_submit(r, fs, st);
