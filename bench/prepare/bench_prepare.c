@@ -11,10 +11,9 @@
  *   affine     fat borders of affine faces (planes) by their loop's vertices (on, the default)
  *              or sampled at the grid's cells as curved faces are (off), on one thread; one
  *              submitted frame per variant gives the triangles and the pixels they differ in;
- *   chunks     the faces tessellated by the preparing thread alone, or in chunks shared with a
- *              pool of --workers workers (desc.pool);
- *   workers    the chunks shared with a pool of 1 worker, or of 2 (the parallel visibility stage
- *              on one and two more threads), with the join's wait (ms_join) beside the times;
+ *   chunks     three variants: the faces tessellated by the preparing thread alone, or in
+ *              chunks shared with a pool (desc.pool) of 1 worker, or of 2 (the parallel
+ *              visibility stage on one and two more threads), with the join's wait (ms_join);
  *   density    planes' patches given the coarsest grid by the affine test (fast, the default) or
  *              by the full screen-space bound (lod/sampling.c sw_lod_screen_affine_fast), on one
  *              thread, with the triangles and differing pixels of view 0 as for affine;
@@ -33,7 +32,7 @@
  *   valgrind --tool=callgrind --instr-atstart=no --callgrind-out-file=cg.W \
  *     build/bin/bench_prepare --callgrind W --views 4 --passes 1 FILE
  * ("summary:" in cg.W is the total). The split's extra work is the ratio of two such totals.
- * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--workers W] [--callgrind W] FILE...
+ * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--callgrind W] FILE...
  *        (.brep/.step/.igs imported, .sws opened)
  */
 #include "sw_lod_sampling.h"
@@ -75,8 +74,7 @@ static sw_gpu_camera orbit_camera(const double box[6], int i, int n)
 
 typedef struct bench {
     sw_gpu_context *ctx;
-    sw_th_pool *pool;       /* --workers workers: the chunks pair */
-    sw_th_pool *workers[2]; /* 1 and 2 workers: the workers pair */
+    sw_th_pool *workers[2]; /* pools of 1 and 2 workers for the chunks */
     const sw_sg_scene *scene;
     sw_gpu_frame_desc desc;
     double box[6];
@@ -126,29 +124,30 @@ static void print_series(const char *name, series *s)
            bench_quantile(s->ms[PROCESS], s->n, 0.5), bench_quantile(s->join, s->n, 0.5));
 }
 
-/* The passes of two variants set by set(b, 0 or 1): alternating (the machine's drift shared),
- * or each variant's in a row (a cache's state carries over within its own passes only); prints
- * both. */
+/* The passes of n (at most 3) variants set by set(b, 0 .. n - 1): alternating (the machine's
+ * drift shared), or each variant's in a row (a cache's state carries over within its own passes
+ * only); prints them all. */
 static int variants(bench *b, int passes, int alternate, void (*set)(bench *, int),
-                    const char *names[2])
+                    const char *const *names, int n)
 {
-    static series s[2];
-    s[0].n = s[1].n = 0;
-    for (int i = 0; i < 2 * passes; ++i) {
-        const int k = alternate ? i % 2 : i / passes;
+    static series s[3];
+    for (int k = 0; k < n; ++k)
+        s[k].n = 0;
+    for (int i = 0; i < n * passes; ++i) {
+        const int k = alternate ? i % n : i / passes;
         set(b, k);
         if (!pass(b, &s[k]))
             return 0;
     }
     set(b, 0);
-    for (int k = 0; k < 2; ++k)
+    for (int k = 0; k < n; ++k)
         print_series(names[k], &s[k]);
     return 1;
 }
 
-static int ab(bench *b, int passes, void (*set)(bench *, int), const char *names[2])
+static int ab(bench *b, int passes, void (*set)(bench *, int), const char *const names[2])
 {
-    return variants(b, passes, 1, set, names);
+    return variants(b, passes, 1, set, names, 2);
 }
 
 static void set_affine(bench *b, int k)
@@ -156,14 +155,10 @@ static void set_affine(bench *b, int k)
     sw__gpu_set_border_affine(b->ctx, k == 0);
 }
 
+/* 0: the preparing thread alone; 1, 2: chunks shared with a pool of that many workers. */
 static void set_chunks(bench *b, int k)
 {
-    b->desc.pool = k ? b->pool : NULL;
-}
-
-static void set_workers(bench *b, int k)
-{
-    b->desc.pool = b->workers[k];
+    b->desc.pool = k ? b->workers[k - 1] : NULL;
 }
 
 static void set_density(bench *b, int k)
@@ -214,7 +209,7 @@ static int compare_images(bench *b, void (*set)(bench *, int))
  * b->workers[callgrind - 1] (0: none). */
 static int counted_passes(bench *b, const char *mode, int passes)
 {
-    b->desc.pool = b->callgrind > 0 ? b->workers[b->callgrind - 1] : NULL;
+    set_chunks(b, b->callgrind);
     CALLGRIND_START_INSTRUMENTATION; /* every thread's (collection state is per thread) */
     int ok = 1;
     for (int i = 0; i < passes && ok; ++i)
@@ -228,11 +223,10 @@ static int counted_passes(bench *b, const char *mode, int passes)
 
 static int run_mode(bench *b, const char *mode, int passes)
 {
-    static const char *affine[2] = {"affine borders on", "affine borders off"};
-    static const char *chunks[2] = {"one thread", "chunks with the pool"};
-    static const char *density[2] = {"affine densities fast", "affine densities bounded"};
-    static const char *borders[2] = {"border cache on", "border cache off"};
-    static const char *workers[2] = {"chunks, 1 worker", "chunks, 2 workers"};
+    static const char *const affine[2] = {"affine borders on", "affine borders off"};
+    static const char *const chunks[3] = {"one thread", "chunks, 1 worker", "chunks, 2 workers"};
+    static const char *const density[2] = {"affine densities fast", "affine densities bounded"};
+    static const char *const borders[2] = {"border cache on", "border cache off"};
     if (!pass(b, NULL)) /* warm-up: hierarchies built and refined, buffers grown */
         return 0;
     if (b->callgrind >= 0) /* the direct mode's cut is the same on every run: the hierarchy's
@@ -243,9 +237,9 @@ static int run_mode(bench *b, const char *mode, int passes)
         return 0;
     if (!ab(b, passes, set_density, density) || !compare_images(b, set_density))
         return 0;
-    if (!variants(b, passes, 0, set_borders, borders) || !compare_images(b, set_borders))
+    if (!variants(b, passes, 0, set_borders, borders, 2) || !compare_images(b, set_borders))
         return 0;
-    return ab(b, passes, set_chunks, chunks) && ab(b, passes, set_workers, workers);
+    return variants(b, passes, 1, set_chunks, chunks, 3);
 }
 
 /* One file through both modes; tmpl gives the context, the pools and the options. */
@@ -308,14 +302,12 @@ static sw_th_pool *make_pool(int workers)
 
 int main(int argc, char **argv)
 {
-    int views = 24, passes = 2, w = 1280, h = 720, workers = 1, callgrind = -1, first = 1;
+    int views = 24, passes = 2, w = 1280, h = 720, callgrind = -1, first = 1;
     for (; first < argc && strncmp(argv[first], "--", 2) == 0; first += 2) {
         if (first + 1 >= argc)
             break;
         if (strcmp(argv[first], "--views") == 0)
             views = atoi(argv[first + 1]);
-        else if (strcmp(argv[first], "--workers") == 0)
-            workers = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--callgrind") == 0)
             callgrind = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--passes") == 0)
@@ -327,10 +319,10 @@ int main(int argc, char **argv)
             break;
     }
     if (first >= argc || views < 1 || views > MAX_VIEWS || passes < 1 || passes > MAX_PASSES ||
-        w < 1 || h < 1 || workers < 1 || workers > 64 || callgrind < -1 || callgrind > 2) {
+        w < 1 || h < 1 || callgrind < -1 || callgrind > 2) {
         fprintf(stderr,
-                "usage: %s [--views N<=%d] [--passes P<=%d] [--size WxH] [--workers W] "
-                "[--callgrind 0|1|2] FILE...\n",
+                "usage: %s [--views N<=%d] [--passes P<=%d] [--size WxH] [--callgrind 0|1|2] "
+                "FILE...\n",
                 argv[0], MAX_VIEWS, MAX_PASSES);
         return 2;
     }
@@ -340,18 +332,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "%s\n", st.message);
         return 1;
     }
-    b.pool = make_pool(workers);
     b.workers[0] = make_pool(1);
     b.workers[1] = make_pool(2);
-    int ok = b.pool && b.workers[0] && b.workers[1];
+    int ok = b.workers[0] && b.workers[1];
     if (!ok)
         fprintf(stderr, "pool: cannot start\n");
     else
-        printf("%s, %dx%d, ε_img default, %d views, %d passes per variant, %d pool workers\n",
-               sw_gpu_context_description_ptr(b.ctx), w, h, views, passes, workers);
+        printf("%s, %dx%d, ε_img default, %d views, %d passes per variant\n",
+               sw_gpu_context_description_ptr(b.ctx), w, h, views, passes);
     for (int a = first; a < argc && ok; ++a)
         ok = bench_scene(&b, argv[a], w, h, passes);
-    sw_th_pool_destroy(b.pool);
     sw_th_pool_destroy(b.workers[0]);
     sw_th_pool_destroy(b.workers[1]);
     sw_gpu_context_free(b.ctx);
