@@ -14,6 +14,8 @@
 #ifndef SW_GPU_H
 #define SW_GPU_H
 
+#include "sw_module_abi.h"
+
 #include "sw_sg_scene.h"
 
 #include <splinewalk/sw_result.h>
@@ -299,6 +301,20 @@ void sw_gpu_trim_atlas_info(const sw_gpu_context *ctx, uint32_t *texture, int32_
  * time, or SOURCE_DATE_EPOCH (seconds since 1970, UTC) when that is set, so that one frame
  * gives the same bytes on every run. */
 sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *path, sw_status *status);
+
+/* PNG is encoded by the core (gpu/png_stb.c); other types by an encoder the image module
+ * installs (OpenImageIO: .exr). Without one, sw_gpu_image_write refuses them with
+ * SW_ERR_UNSUPPORTED saying which module writes them. An encoder puts the whole file in *bytes
+ * (sw__malloc; the caller frees it with sw__free) and touches no file. ext: lower case, without
+ * the dot. Installing may race with writers (an atomic pointer); NULL uninstalls. */
+typedef sw_result (*sw_gpu_image_encode_fn)(const sw_gpu_image *img, const char *path,
+                                            const char *ext, void **bytes, size_t *size,
+                                            sw_status *status);
+SW_MODULE_ABI void sw_gpu_image_encoder_install(sw_gpu_image_encode_fn encode);
+/* The image module's encoder (gpu/image_oiio.cpp): .exr, half RGBA plus a float Z channel when
+ * depth exists. */
+sw_result sw_gpu_image_encode_oiio(const sw_gpu_image *img, const char *path, const char *ext,
+                                   void **bytes, size_t *size, sw_status *status);
 
 #ifdef __cplusplus
 }

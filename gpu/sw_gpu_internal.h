@@ -572,6 +572,11 @@ sw_result sw__gpu_present(sw_gpu_context *ctx, const sw__gpu_view *view, int dep
 sw_result sw__gpu_readback(sw_gpu_context *ctx, const sw__gpu_view *view, int want_depth,
                            sw_gpu_image *out, sw_status *status);
 
+/* An RGBA8 image (top row first) as a PNG file's bytes in *bytes (sw__malloc) and *size; 0 when
+ * out of memory or the size is out of range. */
+int sw__gpu_png_encode(const uint8_t *rgba, int32_t width, int32_t height, void **bytes,
+                       size_t *size);
+
 #ifdef __cplusplus
 }
 #endif

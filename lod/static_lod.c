@@ -552,36 +552,6 @@ done:
 /* ---- the chain --------------------------------------------------------------------------------
  */
 
-static void level_free(sw_lod_static_level *l)
-{
-    sw__free(l->positions), sw__free(l->normals), sw__free(l->uv), sw__free(l->face),
-        sw__free(l->triangles);
-    memset(l, 0, sizeof *l);
-}
-
-void sw_lod_static_free(sw_lod_static_chain *chain)
-{
-    if (!chain)
-        return;
-    for (int32_t k = 0; k < chain->n_levels; ++k)
-        level_free(&chain->levels[k]);
-    sw__free(chain->levels);
-    sw__free(chain);
-}
-
-size_t sw_lod_static_memory(const sw_lod_static_chain *chain)
-{
-    if (!chain)
-        return 0;
-    size_t b = sizeof *chain + (size_t)chain->n_levels * sizeof *chain->levels;
-    for (int32_t k = 0; k < chain->n_levels; ++k) {
-        const sw_lod_static_level *l = &chain->levels[k];
-        b += (size_t)l->n_vertices * SW_LOD_STATIC_VERTEX_BYTES +
-             (size_t)l->n_triangles * SW_LOD_STATIC_TRIANGLE_BYTES;
-    }
-    return b;
-}
-
 /* A level from the level-0 mesh restricted to triangles tri[] (indices of level 0). */
 static int level_from(const mesh_buf *m, const uint32_t *tri, uint32_t n_tri,
                       sw_lod_static_level *l)
@@ -603,7 +573,7 @@ static int level_from(const mesh_buf *m, const uint32_t *tri, uint32_t n_tri,
     l->triangles = sw__malloc(((size_t)n_tri ? n_tri : 1) * 3 * sizeof(uint32_t));
     if (!l->positions || !l->normals || !l->uv || !l->face || !l->triangles) {
         sw__free(map);
-        level_free(l);
+        sw__sl_level_free(l);
         return 0;
     }
     for (uint32_t v = 0; v < m->n_v; ++v) {
@@ -727,38 +697,6 @@ static int on_level(void *ctx, int32_t level, const uint32_t *tri, uint32_t n_tr
     l->eps_target = b->chain->delta * b->d->eps_first * pow(b->d->eps_growth, level);
     b->r = declare_level(b, l);
     return b->r != SW_OK;
-}
-
-double sw_lod_static_default_delta(const double box[6])
-{
-    const double d = SW_LOD_STATIC_DELTA_REL * sqrt((box[3] - box[0]) * (box[3] - box[0]) +
-                                                    (box[4] - box[1]) * (box[4] - box[1]) +
-                                                    (box[5] - box[2]) * (box[5] - box[2]));
-    return d > 0.0 ? d : 1e-12; /* a super-surface collapsed to a point */
-}
-
-sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static_desc *d,
-                                     sw_status *status)
-{
-    *d = in ? *in : (sw_lod_static_desc){0};
-    if (d->n_levels == 0)
-        d->n_levels = 4;
-    else if (d->n_levels == -1)
-        d->n_levels = 0;
-    if (d->eps_first == 0.0)
-        d->eps_first = 2.0;
-    if (d->eps_growth == 0.0)
-        d->eps_growth = 4.0;
-    if (d->max_vertices == 0)
-        d->max_vertices = 4000000;
-    if (d->max_vertices_per_patch == 0)
-        d->max_vertices_per_patch = 4096;
-    if (!(d->delta >= 0.0 && isfinite(d->delta)) || d->n_levels < 0 || d->n_levels > 8 ||
-        !(d->eps_first > 1.0) || !(d->eps_growth > 1.0))
-        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                        "static lod: delta %g, %d levels, eps_first %g, growth %g", d->delta,
-                        (int)d->n_levels, d->eps_first, d->eps_growth);
-    return SW_OK;
 }
 
 /* The level-0 vertex limit of n patches: the smaller of the two limits. */

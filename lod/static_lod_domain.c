@@ -391,16 +391,6 @@ void sw__sl_patch_set_free(patch_set *ps)
     memset(ps, 0, sizeof *ps);
 }
 
-int sw__sl_patch_cmp(const void *a, const void *b)
-{
-    const sw_lod_static_patch *x = a, *y = b;
-    if (x->face != y->face)
-        return x->face < y->face ? -1 : 1;
-    if (x->iv != y->iv)
-        return x->iv < y->iv ? -1 : 1;
-    return (x->iu > y->iu) - (x->iu < y->iu);
-}
-
 sw_result sw__sl_patch_set_init(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
                                 uint32_t n, patch_set *ps, sw_status *status)
 {

@@ -598,16 +598,23 @@ static void build_task(void *ctx)
 {
     build_job *job = ctx;
     sw_lod_static_set *s = job->set;
-    const sw_lod_static_unit *un = &s->units[job->unit];
-    slot *sl = &s->slots[job->unit];
+    const uint32_t unit = job->unit;
+    const sw_lod_static_unit *un = &s->units[unit];
+    slot *sl = &s->slots[unit];
     sw__free(job);
     if (atomic_load_explicit(&s->cancelled, memory_order_acquire))
         return; /* the slot stays QUEUED: nobody reads it any more */
     const uint64_t t0 = now_ns();
     sw_lod_static_chain *chain = NULL;
     sw_status st = {0};
-    const sw_result r = sw_lod_static_build(s->scene, s->patches + un->first_patch, un->n_patches,
-                                            &s->levels, &chain, &st);
+    const sw_lod_static_build_fn build = sw_lod_static_builder();
+    const sw_result r =
+        build
+            ? build(s->scene, s->patches + un->first_patch, un->n_patches, &s->levels, &chain, &st)
+            : sw__fail(&st, SW_ERR_UNSUPPORTED,
+                       "static LODs: no LOD builder is installed (the LOD-building module, "
+                       "sw_lod_build_install); unit %u is drawn per frame",
+                       unit);
     atomic_fetch_add(&s->build_ns, now_ns() - t0);
     atomic_fetch_add(&s->n_builds, 1);
     if (r == SW_OK) {

@@ -16,6 +16,8 @@
 #ifndef SW_LOD_BEZIER_H
 #define SW_LOD_BEZIER_H
 
+#include "sw_module_abi.h"
+
 #include <stddef.h>
 #include <stdint.h>
 
@@ -45,8 +47,8 @@ void sw_lod_bez_subdivide(int32_t deg_u, int32_t deg_v, int32_t dim, const doubl
 
 /* The net restricted to the sub-rectangle rect = {s0, s1, t0, t1} of [0,1]^2 (s0 <= s1, t0 <= t1),
  * reparameterized to [0,1]^2. out may equal cpw (in place); otherwise they must not overlap. */
-void sw_lod_bez_restrict(int32_t deg_u, int32_t deg_v, int32_t dim, const double *cpw,
-                         const double rect[4], double *out);
+SW_MODULE_ABI void sw_lod_bez_restrict(int32_t deg_u, int32_t deg_v, int32_t dim, const double *cpw,
+                                       const double rect[4], double *out);
 
 /* Exact degree elevation to (new_u, new_v) >= (deg_u, deg_v). out must not overlap cpw. */
 void sw_lod_bez_elevate(int32_t deg_u, int32_t deg_v, int32_t dim, const double *cpw, int32_t new_u,

@@ -11,6 +11,8 @@
 #ifndef SW_LOD_SAMPLING_H
 #define SW_LOD_SAMPLING_H
 
+#include "sw_module_abi.h"
+
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -27,8 +29,8 @@ typedef struct sw_lod_patch_bounds {
 /* Bounds the derivatives of the rational Bézier patch of degrees (deg_u, deg_v) >= 1 whose
  * homogeneous control points (w*x, w*y, w*z, w), u fastest, are cpw[(j*(deg_u+1)+i)*4].
  * Precondition: every weight > 0 and finite (validated geometry). */
-void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *cpw,
-                                   sw_lod_patch_bounds *out);
+SW_MODULE_ABI void sw_lod_rational_bezier_bounds(int32_t deg_u, int32_t deg_v, const double *cpw,
+                                                 sw_lod_patch_bounds *out);
 
 /* Segments needed along one direction of a patch's local domain so that the Filip bound of that
  * direction stays within eps/2 (Guthe §5.2): ceil(len * sqrt((M_dir + M_mixed) / (4 eps))),

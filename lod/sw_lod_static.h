@@ -25,6 +25,8 @@
 #ifndef SW_LOD_STATIC_H
 #define SW_LOD_STATIC_H
 
+#include "sw_module_abi.h"
+
 #include "sw_sg_scene.h"
 
 #include <splinewalk/sw_result.h>
@@ -93,7 +95,21 @@ typedef struct sw_lod_static_chain {
 sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
                               uint32_t n, const sw_lod_static_desc *desc, sw_lod_static_chain **out,
                               sw_status *status);
-void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
+SW_MODULE_ABI void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
+
+/* The builder the static set's pool tasks call: sw_lod_static_build, which needs CGAL and
+ * OpenMesh, lives in the LOD-building module (sw_lod_build, libsplinewalk_lodbuild) above the
+ * core; the module installs it. Without one, a unit's build fails at once with
+ * SW_ERR_UNSUPPORTED (it is drawn by the per-frame path) and only levels read from a LOD cache
+ * are drawn. Installing is idempotent and may race with readers (an atomic pointer); NULL
+ * uninstalls. */
+typedef sw_result (*sw_lod_static_build_fn)(const sw_sg_scene *scene,
+                                            const sw_lod_static_patch *patches, uint32_t n,
+                                            const sw_lod_static_desc *desc,
+                                            sw_lod_static_chain **out, sw_status *status);
+SW_MODULE_ABI void sw_lod_static_builder_install(sw_lod_static_build_fn build);
+/* The installed builder, NULL when none. */
+sw_lod_static_build_fn sw_lod_static_builder(void);
 
 /* The default δ of level 0 relative to the super-surface's diagonal. Level 0 is never drawn
  * (the frame draws a level only at <= 24 triangles per patch; a rigorous tessellation has
@@ -110,13 +126,13 @@ void sw_lod_static_free(sw_lod_static_chain *chain); /* NULL allowed */
 
 /* The δ of level 0 when the desc leaves it 0: SW_LOD_STATIC_DELTA_REL x the diagonal of `box`
  * (the patches' control-point box), 1e-12 for an empty one. */
-double sw_lod_static_default_delta(const double box[6]);
+SW_MODULE_ABI double sw_lod_static_default_delta(const double box[6]);
 
 /* *out = *in (NULL: all zero) with every zero field but delta replaced by its default, and the
  * values checked: SW_ERR_INVALID_ARGUMENT for a negative or non-finite δ, n_levels outside
  * -1..8, eps_first or eps_growth <= 1. delta stays 0 when left 0 (per patch set). */
-sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in, sw_lod_static_desc *out,
-                                     sw_status *status);
+SW_MODULE_ABI sw_result sw_lod_static_desc_resolve(const sw_lod_static_desc *in,
+                                                   sw_lod_static_desc *out, sw_status *status);
 
 /* A level's bytes per vertex (position 3 f64, normal 3 f32, (u, v) 2 f64, face u32) and per
  * triangle (3 u32), in memory and in the LODS cache alike. */

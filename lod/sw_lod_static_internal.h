@@ -5,6 +5,8 @@
 #ifndef SW_LOD_STATIC_INTERNAL_H
 #define SW_LOD_STATIC_INTERNAL_H
 
+#include "sw_module_abi.h"
+
 #include "sw_lod_mesh_distance.h"
 #include "sw_lod_static.h"
 #include "sw_sg_geom.h"
@@ -78,7 +80,9 @@ sw_result sw__sl_face_dom_flatten(const sw_sg_scene *scene, face_dom *fd, double
                                   sw_status *status);
 void sw__sl_patch_set_free(patch_set *ps);
 /* qsort order of sw_lod_static_patch: by face, then iv, then iu. */
-int sw__sl_patch_cmp(const void *a, const void *b);
+SW_MODULE_ABI int sw__sl_patch_cmp(const void *a, const void *b);
+/* Frees a level's arrays and zeroes it. */
+SW_MODULE_ABI void sw__sl_level_free(sw_lod_static_level *l);
 /* The faces of a patch list, each with its selected patches and its cell grid. */
 sw_result sw__sl_patch_set_init(const sw_sg_scene *scene, const sw_lod_static_patch *patches,
                                 uint32_t n, patch_set *ps, sw_status *status);

@@ -30,6 +30,8 @@
 #ifndef SW_LOD_SUPERSURFACE_H
 #define SW_LOD_SUPERSURFACE_H
 
+#include "sw_module_abi.h"
+
 #include "sw_sg_scene.h"
 
 #include <splinewalk/sw_result.h>
@@ -108,8 +110,8 @@ void sw_lod_cone_set_angle(sw_lod_cone *c, double half_angle);
  * rectangle intersected with uv_box; the patch's u0, u1, v0, v1 are set to that cut rectangle.
  * Free with sw_sg_bezier_set_free. Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_INVALID_ARGUMENT (a uv_box
  * that misses the domain). Precondition: SW_SG_SEC_FACES and SW_SG_SEC_POOL required. */
-sw_result sw_lod_face_patches(const sw_sg_scene *scene, uint32_t face, sw_sg_bezier_set *out,
-                              sw_status *status);
+SW_MODULE_ABI sw_result sw_lod_face_patches(const sw_sg_scene *scene, uint32_t face,
+                                            sw_sg_bezier_set *out, sw_status *status);
 
 /* ---- super-surfaces (supersurface.c) --------------------------------------------------------- */
 

@@ -2,14 +2,18 @@
 /* embed_headless: the smallest program that embeds splinewalk without a window. It loads a scene
  * (a .sws file, anything `splinewalk import` reads, or the built-in default scene), fits the iso
  * camera preset to it, renders one converged frame headlessly (EGL; Mesa's llvmpipe when there
- * is no GPU) and writes it as PNG. Written only against the installed public API:
+ * is no GPU) and writes it as PNG. Written only against the installed public API: the core
+ * (.sws and .tsm files, PNG frames) and the import module, which it installs so that it also reads
+ * STEP, IGES and BREP files and builds the default scene:
  *
- *   cc embed_headless.c $(pkg-config --cflags --libs splinewalk)
+ *   cc embed_headless.c $(pkg-config --cflags --libs splinewalk splinewalk-import)
  *
- * or, with CMake, find_package(splinewalk) and link splinewalk::splinewalk.
+ * or, with CMake, find_package(splinewalk COMPONENTS import) and link splinewalk::splinewalk and
+ * splinewalk::import.
  * The image equals `splinewalk render SCENE --view iso --size WxH` (tests/consumer checks it).
  * Exit status: 0 success, 1 a failure (reported on stderr), 2 a usage error. */
 #include <splinewalk/splinewalk.h>
+#include <splinewalk/sw_import.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -119,6 +123,7 @@ int main(int argc, char **argv)
     if (rc >= 0)
         return rc;
     sw_status status = {0};
+    (void)sw_import_install(); /* CAD files and the default scene */
     sw_scene_load_desc load = {a.scene, progress, warning, NULL, NULL, 0};
     sw_scene scene;
     sw_result r = a.scene ? sw_scene_load(&load, &scene, &status)

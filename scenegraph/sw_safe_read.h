@@ -10,6 +10,8 @@
 #ifndef SW_SAFE_READ_H
 #define SW_SAFE_READ_H
 
+#include "sw_module_abi.h"
+
 #include <splinewalk/sw_result.h>
 
 #include <stddef.h>
@@ -26,13 +28,14 @@ sw_result sw__in_open(const char *path, uint64_t max_bytes, const char *what, in
                       uint64_t *size, sw_status *status);
 
 /* sw__in_open, then close: for paths handed to a library that opens them itself (OCCT). */
-sw_result sw__in_check(const char *path, uint64_t max_bytes, const char *what, sw_status *status);
+SW_MODULE_ABI sw_result sw__in_check(const char *path, uint64_t max_bytes, const char *what,
+                                     sw_status *status);
 
 /* Reads a whole regular file of at most max_bytes (nonzero) into *text (sw__malloc'd, one NUL
  * byte after the *len bytes; the caller sw__free's it). A file that grows past max_bytes while it
  * is read is refused too. */
-sw_result sw__in_read_all(const char *path, uint64_t max_bytes, const char *what, char **text,
-                          size_t *len, sw_status *status);
+SW_MODULE_ABI sw_result sw__in_read_all(const char *path, uint64_t max_bytes, const char *what,
+                                        char **text, size_t *len, sw_status *status);
 
 #ifdef __cplusplus
 }

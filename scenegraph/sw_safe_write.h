@@ -23,6 +23,8 @@
 #ifndef SW_SAFE_WRITE_H
 #define SW_SAFE_WRITE_H
 
+#include "sw_module_abi.h"
+
 #include <splinewalk/sw_result.h>
 
 #include <stddef.h>
@@ -63,8 +65,8 @@ sw_result sw__out_commit(sw__out *out, sw_status *status);
 void sw__out_abandon(sw__out *out);
 
 /* open + write + commit of one buffer. */
-sw_result sw__write_file(const char *path, const void *data, size_t n, unsigned flags,
-                         sw_status *status);
+SW_MODULE_ABI sw_result sw__write_file(const char *path, const void *data, size_t n, unsigned flags,
+                                       sw_status *status);
 
 /* Writes what `fill` prints into a FILE (an in-memory stream: fill returns nonzero or leaves
  * the stream in error on failure) to `path` with sw__write_file. For the text writers (camera

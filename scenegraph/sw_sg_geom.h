@@ -22,6 +22,8 @@
 #ifndef SW_SG_GEOM_H
 #define SW_SG_GEOM_H
 
+#include "sw_module_abi.h"
+
 #include <splinewalk/sw_result.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -77,8 +79,10 @@ typedef struct sw_sg_surface_d2 {
  * domain, no interior knot of multiplicity > degree + 1, finite control points and strictly
  * positive finite weights. Returns SW_OK or SW_ERR_INVALID_GEOMETRY with the offending index in
  * `status` (may be NULL); `what` names the object in the message (e.g. "face 12"). */
-sw_result sw_sg_curve_validate(const sw_sg_curve *c, const char *what, sw_status *status);
-sw_result sw_sg_surface_validate(const sw_sg_surface *s, const char *what, sw_status *status);
+SW_MODULE_ABI sw_result sw_sg_curve_validate(const sw_sg_curve *c, const char *what,
+                                             sw_status *status);
+SW_MODULE_ABI sw_result sw_sg_surface_validate(const sw_sg_surface *s, const char *what,
+                                               sw_status *status);
 
 /* ---- knot vectors ---------------------------------------------------------------------------- */
 /* Parameter domain [knots[degree], knots[n]]. */
@@ -97,9 +101,10 @@ void sw_sg_curve_eval_h(const sw_sg_curve *c, double t, int32_t nd, double *out)
 /* Euclidean point of a rational curve (dim-1 coordinates). */
 void sw_sg_curve_eval(const sw_sg_curve *c, double t, double *out);
 /* Euclidean surface point only. */
-void sw_sg_surface_eval(const sw_sg_surface *s, double u, double v, double p[3]);
+SW_MODULE_ABI void sw_sg_surface_eval(const sw_sg_surface *s, double u, double v, double p[3]);
 /* Euclidean point, first and second partial derivatives (quotient rule on the homogeneous form). */
-void sw_sg_surface_eval_d2(const sw_sg_surface *s, double u, double v, sw_sg_surface_d2 *out);
+SW_MODULE_ABI void sw_sg_surface_eval_d2(const sw_sg_surface *s, double u, double v,
+                                         sw_sg_surface_d2 *out);
 /* Homogeneous point and first derivatives: h[0..3] = S^w, h[4..7] = dS^w/du, h[8..11] = dS^w/dv. */
 void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[12]);
 /* 1 when the surface is an affine map of its parameters, S(u, v) = origin + u du + v dv, to
@@ -142,7 +147,7 @@ sw_result sw_sg_surface_extract_bezier(const sw_sg_surface *s, sw_sg_bezier_set 
  * region's box): patches entirely outside are never produced. */
 sw_result sw_sg_surface_extract_bezier_in(const sw_sg_surface *s, double u0, double u1, double v0,
                                           double v1, sw_sg_bezier_set *out, sw_status *status);
-void sw_sg_bezier_set_free(sw_sg_bezier_set *set);
+SW_MODULE_ABI void sw_sg_bezier_set_free(sw_sg_bezier_set *set);
 
 /* Evaluates a rational Bézier patch (Euclidean) at local parameters (s, t) in [0,1]^2. */
 void sw_sg_bezier_patch_eval(const sw_sg_bezier_patch *p, double s, double t, double out[3]);

@@ -16,6 +16,8 @@
 #ifndef SW_SG_IGES_H
 #define SW_SG_IGES_H
 
+#include "sw_module_abi.h"
+
 #include <splinewalk/sw_result.h>
 
 #include <stddef.h>
@@ -39,9 +41,9 @@ typedef struct sw_sg_iges_scan {
  * a truncated file is SW_OK with out->truncated = 1. Errors: SW_ERR_UNSUPPORTED (not fixed-format
  * ASCII IGES — compressed or binary form, records not in 80-column lines — about which nothing is
  * said; *out is zero), SW_ERR_OUT_OF_MEMORY. `text` need not be NUL-terminated. Any thread. */
-sw_result sw_sg_iges_scan_text(const char *text, size_t len, sw_sg_iges_scan *out,
-                               sw_status *status);
-void sw_sg_iges_scan_free(sw_sg_iges_scan *scan);
+SW_MODULE_ABI sw_result sw_sg_iges_scan_text(const char *text, size_t len, sw_sg_iges_scan *out,
+                                             sw_status *status);
+SW_MODULE_ABI void sw_sg_iges_scan_free(sw_sg_iges_scan *scan);
 
 #ifdef __cplusplus
 }

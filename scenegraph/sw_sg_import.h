@@ -1,11 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /* Importing STEP / IGES / BREP through OpenCASCADE (import_occt.cpp, a C++ shim that lets no
- * exception through). Every face becomes a NURBS surface with its wires' pcurves as 2D rational
- * B-spline trim loops (snapped closed), its orientation, the assembly tree with instances and
- * transforms (XCAF for STEP), colours where present, and face adjacency through shared edges.
+ * exception through, in the import module; the core calls it through an installed importer). Every
+ * face becomes a NURBS surface with its wires' pcurves as 2D rational B-spline trim loops (snapped
+ * closed), its orientation, the assembly tree with instances and transforms (XCAF for STEP),
+ * colours where present, and face adjacency through shared edges.
  */
 #ifndef SW_SG_IMPORT_H
 #define SW_SG_IMPORT_H
+
+#include "sw_module_abi.h"
 
 #include "sw_sg_scene.h"
 
@@ -74,6 +77,27 @@ sw_result sw_sg_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
 sw_result sw_sg_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
                             const sw_sg_import_desc *desc, sw_sg_import_report *report,
                             sw_status *status);
+
+/* ---- the installed importer (cad_import.c) ---------------------------------------------------
+ * sw_sg_import_file and sw_sg_import_into live in the import module (import_occt.cpp, OpenCASCADE)
+ * above the core. The core reads CAD files through the importer the module installs
+ * (sw_import_install); without one, sw_sg_cad_import_file and sw_sg_cad_import_into return
+ * SW_ERR_UNSUPPORTED saying so. */
+typedef struct sw_sg_importer {
+    sw_result (*import_file)(const sw_sg_import_desc *desc, sw_sg_scene **out,
+                             sw_sg_import_report *report, sw_status *status);
+    sw_result (*import_into)(sw_sg_builder *b, uint32_t parent, const double xform[12],
+                             const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                             sw_status *status);
+} sw_sg_importer;
+/* `importer` must outlive its use (static storage); NULL uninstalls. Any thread. */
+SW_MODULE_ABI void sw_sg_importer_install(const sw_sg_importer *importer);
+/* sw_sg_import_file and sw_sg_import_into through the installed importer. */
+sw_result sw_sg_cad_import_file(const sw_sg_import_desc *desc, sw_sg_scene **out,
+                                sw_sg_import_report *report, sw_status *status);
+sw_result sw_sg_cad_import_into(sw_sg_builder *b, uint32_t parent, const double xform[12],
+                                const sw_sg_import_desc *desc, sw_sg_import_report *report,
+                                sw_status *status);
 
 #ifdef __cplusplus
 }

@@ -15,6 +15,8 @@
 #ifndef SW_SG_SCENE_H
 #define SW_SG_SCENE_H
 
+#include "sw_module_abi.h"
+
 #include "sw_sg_geom.h"
 
 #include <splinewalk/sw_result.h>
@@ -160,7 +162,7 @@ typedef struct sw_sg_scene_view {
     uint64_t n_indices;
 } sw_sg_scene_view;
 
-const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene);
+SW_MODULE_ABI const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene);
 /* Path of the file the scene was loaded from, or "" for one built in memory. */
 const char *sw_sg_scene_path_ptr(const sw_sg_scene *scene);
 /* A number no other scene of the process has had (1, 2, ...): what caches keyed by a scene hold
@@ -177,8 +179,9 @@ sw_result sw_sg_scene_require(sw_sg_scene *scene, uint32_t sections, sw_status *
 sw_result sw_sg_scene_validate(const sw_sg_scene_view *view, const char *what, sw_status *status);
 
 /* Borrowed geometry views of face `face` and curve `curve` (indices must be valid). */
-void sw_sg_scene_face_surface(const sw_sg_scene *scene, uint32_t face, sw_sg_surface *out);
-void sw_sg_scene_curve(const sw_sg_scene *scene, uint32_t curve, sw_sg_curve *out);
+SW_MODULE_ABI void sw_sg_scene_face_surface(const sw_sg_scene *scene, uint32_t face,
+                                            sw_sg_surface *out);
+SW_MODULE_ABI void sw_sg_scene_curve(const sw_sg_scene *scene, uint32_t curve, sw_sg_curve *out);
 
 /* Bytes the scene occupies (arrays, pool, strings, bookkeeping; mapped bytes counted). */
 size_t sw_sg_scene_memory(const sw_sg_scene *scene);
@@ -210,17 +213,19 @@ void sw_sg_scene_mesh(const sw_sg_scene *scene, uint32_t mesh, const double **po
 /* ---- building -------------------------------------------------------------------------------- */
 typedef struct sw_sg_builder sw_sg_builder;
 
-sw_sg_builder *sw_sg_builder_create(void); /* NULL when out of memory */
-void sw_sg_builder_free(sw_sg_builder *b); /* NULL allowed */
+SW_MODULE_ABI sw_sg_builder *sw_sg_builder_create(void); /* NULL when out of memory */
+SW_MODULE_ABI void sw_sg_builder_free(sw_sg_builder *b); /* NULL allowed */
 /* Appends doubles to the pool; returns their offset, or UINT64_MAX when out of memory. */
-uint64_t sw_sg_builder_push_doubles(sw_sg_builder *b, const double *values, size_t count);
+SW_MODULE_ABI uint64_t sw_sg_builder_push_doubles(sw_sg_builder *b, const double *values,
+                                                  size_t count);
 /* Appends a NUL-terminated string; returns its byte offset, or SW_SG_NONE on failure. */
 uint32_t sw_sg_builder_push_string(sw_sg_builder *b, const char *s);
 /* Append records; each returns the new index, or SW_SG_NONE when out of memory. */
-uint32_t sw_sg_builder_add_face(sw_sg_builder *b, const sw_sg_face_rec *face);
-uint32_t sw_sg_builder_add_loop(sw_sg_builder *b, const sw_sg_loop_rec *loop);
-uint32_t sw_sg_builder_add_curve(sw_sg_builder *b, const sw_sg_curve_rec *curve);
-uint32_t sw_sg_builder_add_adjacency(sw_sg_builder *b, uint32_t face_a, uint32_t face_b);
+SW_MODULE_ABI uint32_t sw_sg_builder_add_face(sw_sg_builder *b, const sw_sg_face_rec *face);
+SW_MODULE_ABI uint32_t sw_sg_builder_add_loop(sw_sg_builder *b, const sw_sg_loop_rec *loop);
+SW_MODULE_ABI uint32_t sw_sg_builder_add_curve(sw_sg_builder *b, const sw_sg_curve_rec *curve);
+SW_MODULE_ABI uint32_t sw_sg_builder_add_adjacency(sw_sg_builder *b, uint32_t face_a,
+                                                   uint32_t face_b);
 /* Appends vertex indices to the INDICES section; returns their offset, or UINT64_MAX. */
 uint64_t sw_sg_builder_push_indices(sw_sg_builder *b, const uint32_t *indices, size_t count);
 /* A mesh whose arrays were pushed: its box is computed here from the positions (rec->box is
@@ -229,18 +234,19 @@ uint64_t sw_sg_builder_push_indices(sw_sg_builder *b, const uint32_t *indices, s
 uint32_t sw_sg_builder_add_mesh(sw_sg_builder *b, const sw_sg_mesh_rec *mesh);
 /* Adds a node as the last child of `parent` (SW_SG_NONE: a detached node, e.g. a prototype);
  * links parent/first_child/next_sibling itself. xform NULL = identity, color NULL = inherit. */
-uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind, uint32_t parent,
-                                uint32_t ref, const double xform[12], const float color[4],
-                                const char *name);
+SW_MODULE_ABI uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind,
+                                              uint32_t parent, uint32_t ref, const double xform[12],
+                                              const float color[4], const char *name);
 /* Mutable access while building (valid until the next add/push call). */
 double *sw_sg_builder_pool_ptr(sw_sg_builder *b);
-sw_sg_face_rec *sw_sg_builder_face_ptr(sw_sg_builder *b, uint32_t face);
+SW_MODULE_ABI sw_sg_face_rec *sw_sg_builder_face_ptr(sw_sg_builder *b, uint32_t face);
 uint32_t sw_sg_builder_face_count(const sw_sg_builder *b);
 /* Sets the root node (default: node 0, created by sw_sg_builder_create as a group). */
 void sw_sg_builder_set_root(sw_sg_builder *b, uint32_t node);
 /* Validates and turns the builder into an immutable scene; the builder is consumed (freed) in all
  * cases. Errors: SW_ERR_INVALID_GEOMETRY / SW_ERR_FORMAT with the offending record. */
-sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *status);
+SW_MODULE_ABI sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out,
+                                             sw_status *status);
 
 /* ---- .sws files (sws_file.c) ----------------------------------------------------------------- */
 /* Writes PATH through the project's one writer (sw_safe_write.h): replaced whole or left as it

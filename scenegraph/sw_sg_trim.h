@@ -6,6 +6,8 @@
 #ifndef SW_SG_TRIM_H
 #define SW_SG_TRIM_H
 
+#include "sw_module_abi.h"
+
 #include "sw_sg_scene.h"
 
 #ifdef __cplusplus
@@ -17,8 +19,8 @@ extern "C" {
  * midpoint), stored with each curve's own weight. Gaps larger than `max_gap` (parameter units) are
  * reported as SW_ERR_INVALID_GEOMETRY, `what` naming the face. cpw[k] points at curve k's
  * homogeneous control points (n[k] * 3 doubles), mutable. */
-sw_result sw_sg_trim_snap_loop(int32_t n_curves, double *const *cpw, const int32_t *n,
-                               double max_gap, const char *what, sw_status *status);
+SW_MODULE_ABI sw_result sw_sg_trim_snap_loop(int32_t n_curves, double *const *cpw, const int32_t *n,
+                                             double max_gap, const char *what, sw_status *status);
 
 /* A loop flattened to a closed polyline in (u, v): vertex 0 is the loop's first join point; the
  * closing vertex is not repeated. Every join point is the Euclidean image of the curve's first
@@ -43,9 +45,10 @@ typedef struct sw_sg_polyline {
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than `max_vertices`), SW_ERR_INVALID_GEOMETRY
  * (a curve that is not a clamped 2D curve: its first vertex would not be its first control point).
  */
-sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, double tol,
-                                  uint32_t max_vertices, sw_sg_polyline *out, sw_status *status);
-void sw_sg_polyline_free(sw_sg_polyline *p);
+SW_MODULE_ABI sw_result sw_sg_trim_flatten_loop(const sw_sg_scene *scene, uint32_t loop, double tol,
+                                                uint32_t max_vertices, sw_sg_polyline *out,
+                                                sw_status *status);
+SW_MODULE_ABI void sw_sg_polyline_free(sw_sg_polyline *p);
 
 /* Even-odd classification of (u, v) against a set of closed polylines: 1 inside, 0 outside. */
 int sw_sg_trim_classify(const sw_sg_polyline *loops, uint32_t n_loops, double u, double v);

@@ -11,6 +11,8 @@
 #ifndef SW_HOOKS_H
 #define SW_HOOKS_H
 
+#include "sw_module_abi.h"
+
 #include <splinewalk/sw_setup.h>
 
 #include <stddef.h>
@@ -19,10 +21,10 @@
 extern "C" {
 #endif
 
-void *sw__malloc(size_t size);
-void *sw__calloc(size_t count, size_t size); /* NULL when count * size overflows */
-void *sw__realloc(void *ptr, size_t size);   /* as C's realloc; ptr NULL: sw__malloc */
-void sw__free(void *ptr);                    /* NULL: nothing */
+SW_MODULE_ABI void *sw__malloc(size_t size);
+SW_MODULE_ABI void *sw__calloc(size_t count, size_t size); /* NULL when count * size overflows */
+SW_MODULE_ABI void *sw__realloc(void *ptr, size_t size); /* as C's realloc; ptr NULL: sw__malloc */
+SW_MODULE_ABI void sw__free(void *ptr);                  /* NULL: nothing */
 char *sw__strdup(const char *text);
 /* align: a power of two, at most 4096; size need not be a multiple of it. */
 void *sw__aligned_alloc(size_t align, size_t size);
@@ -30,9 +32,10 @@ void sw__aligned_free(void *ptr);
 
 /* One log line (printf format, no trailing newline) at `level`; not formatted below the
  * logger's min_level. Any thread. */
-void sw__log(sw_log_level level, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+SW_MODULE_ABI void sw__log(sw_log_level level, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
 /* Whether a line at `level` would be written (to skip building an expensive message). */
-int sw__log_enabled(sw_log_level level);
+SW_MODULE_ABI int sw__log_enabled(sw_log_level level);
 
 /* sw_setup's work: installs desc's hooks unless the library has already allocated or been set
  * up. Returns 0 on success, -1 when refused (see sw_setup); `why` says which. */

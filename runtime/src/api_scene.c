@@ -114,7 +114,7 @@ sw_result sw_rt_scene_read(const sw_scene_load_desc *desc, sw_sg_scene **out,
                                 (void *)desc,
                                 desc->face_problem ? relay_face_problem : NULL,
                                 (desc->flags & SW_LOAD_PARTIAL) ? SW_SG_IMPORT_PARTIAL : 0u};
-    return sw_sg_import_file(&import, out, report, status);
+    return sw_sg_cad_import_file(&import, out, report, status);
 }
 
 sw_result sw_scene_load(const sw_scene_load_desc *desc, sw_scene *out, sw_status *status)
@@ -178,7 +178,7 @@ static sw_result import_part(sw_sg_builder *b, uint32_t parent, const double *xf
                                 (void *)desc,
                                 desc && desc->face_problem ? relay_face_problem : NULL,
                                 0};
-    return sw_sg_import_into(b, parent, xform, &import, NULL, status);
+    return sw_sg_cad_import_into(b, parent, xform, &import, NULL, status);
 }
 
 static sw_result build_default(sw_sg_builder *b, const char *data_dir,

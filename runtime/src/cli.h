@@ -21,6 +21,11 @@ int sw_cli_view(int argc, char **argv);
 int sw_cli_generate(int argc, char **argv);
 int sw_cli_build_lod(int argc, char **argv);
 
+/* Installs the import, image and LOD-building modules into the core (cli_modules.c): the tool,
+ * the benchmarks and in-tree tests that read CAD files, write .exr or build static LODs through
+ * the runtime call it first. */
+void sw_cli_install_modules(void);
+
 /* ---- shared helpers (cli_common.c) ---------------------------------------------------------- */
 int sw_cli_is_help(const char *arg);
 /* When any argument asks for help: prints usage on stdout and returns 1 (the command exits 0). */

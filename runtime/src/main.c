@@ -37,6 +37,7 @@ static void usage(FILE *out)
 int main(int argc, char **argv)
 {
     sw_cli_keep_freed_memory();
+    sw_cli_install_modules();
     if (argc < 2) {
         usage(stderr);
         return 2;

@@ -12,6 +12,8 @@
  *                                         a scene destroyed while its owner draws it, and
  *                                         BIG_SCENE destroyed after a walkthrough frame (EGL) */
 #include <splinewalk/splinewalk.h>
+#include <splinewalk/sw_import.h>
+#include <splinewalk/sw_lod_build.h>
 
 #include "api_test_expect.h"
 
@@ -489,10 +491,30 @@ static void test_renderer(void)
     EXPECT_RESULT(sw_scene_destroy(scene), SW_OK);
 }
 
+/* The core alone (no module installed in this mode) reads no CAD file: a clear refusal naming the
+ * module, not a crash or "not found". A core that still linked an importer would load it. */
+static void test_core_without_modules(void)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/no_importer.brep", g_work);
+    FILE *f = fopen(path, "w");
+    EXPECT(f != NULL);
+    if (f)
+        fclose(f);
+    sw_scene_load_desc ld = {path, NULL, NULL, NULL, NULL, 0};
+    sw_scene scene = {0};
+    sw_status st = {0};
+    EXPECT_RESULT(sw_scene_load(&ld, &scene, &st), SW_ERR_UNSUPPORTED);
+    EXPECT(strstr(st.message, "import module") != NULL);
+    EXPECT(scene.id == 0);
+}
+
 int main(int argc, char **argv)
 {
     int handles = argc == 4 && !strcmp(argv[1], "handles");
     int renderer = argc == 5 && !strcmp(argv[1], "renderer");
+    if (renderer)
+        (void)sw_import_install(), (void)sw_lod_build_install();
     if (!handles && !renderer) {
         fprintf(stderr, "usage: test_api handles SCENE WORKDIR\n"
                         "       test_api renderer SCENE WORKDIR BIG_SCENE\n");
@@ -502,6 +524,7 @@ int main(int argc, char **argv)
     g_work = argv[3];
     g_big_scene_path = renderer ? argv[4] : NULL;
     if (!strcmp(argv[1], "handles")) {
+        test_core_without_modules();
         test_null_arguments();
         test_stale_and_double_destroy();
         test_strings();

@@ -37,6 +37,8 @@
  *   waits 285" of 300 frames, 7 with another thread editing.
  */
 #include <splinewalk/splinewalk.h>
+#include <splinewalk/sw_import.h>
+#include <splinewalk/sw_lod_build.h>
 
 #include "test_check.h"
 
@@ -745,6 +747,7 @@ static void test_live(void)
 
 int main(int argc, char **argv)
 {
+    (void)sw_import_install(), (void)sw_lod_build_install(); /* .brep scenes, static LODs */
     if (argc >= 4 && strcmp(argv[1], "nodes") == 0) {
         g_tsm = argv[2], g_work = argv[3];
         built b = build_scene();

@@ -31,6 +31,8 @@
  * usage: test_api_pipeline SCENE WORKDIR [FRAMES [STATIC_SCENE]]
  */
 #include <splinewalk/splinewalk.h>
+#include <splinewalk/sw_import.h>
+#include <splinewalk/sw_lod_build.h>
 
 #include "api_test_expect.h"
 
@@ -291,6 +293,7 @@ static void test_static_walkthrough(const char *scene_path, int frames)
 
 int main(int argc, char **argv)
 {
+    (void)sw_import_install(), (void)sw_lod_build_install(); /* .brep scenes, static LODs */
     if (argc < 3 || argc > 5) {
         fprintf(stderr, "usage: %s SCENE WORKDIR [FRAMES [STATIC_SCENE]]\n", argv[0]);
         return 2;

@@ -19,6 +19,8 @@
  * .ci/run's manner and at length by hand (docs/reliability.md).
  */
 #include <splinewalk/splinewalk.h>
+#include <splinewalk/sw_import.h>
+#include <splinewalk/sw_lod_build.h>
 #include <splinewalk/sw_nodes.h>
 
 #include <math.h>
@@ -160,6 +162,7 @@ static sw_camera orbit_camera(int frame)
 
 int main(int argc, char **argv)
 {
+    (void)sw_import_install(), (void)sw_lod_build_install(); /* .brep scenes, static LODs */
     if (argc < 4) {
         fprintf(stderr, "usage: test_api_soak WORKDIR MODEL.brep FRAMES [--rss-flat PERCENT]\n");
         return 2;

@@ -33,16 +33,26 @@ if [ "${SW_CONSUMER_FROM:-install}" = debs ]; then
   (cd "$build" && cpack -B "$work/debs" >/dev/null) || fail "cpack failed"
   runtime=$(ls "$work"/debs/libsplinewalk[0-9]*_*.deb) dev=$(ls "$work"/debs/libsplinewalk-dev_*.deb)
   tools=$(ls "$work"/debs/splinewalk-tools_*.deb)
-  for deb in "$runtime" "$dev" "$tools"; do
+  modules=()
+  for m in import image lodbuild; do
+    modules+=("$(ls "$work"/debs/libsplinewalk-"$m"[0-9]*_*.deb)") || fail "no package of the $m module"
+  done
+  for deb in "$runtime" "$dev" "$tools" "${modules[@]}"; do
     dpkg-deb -x "$deb" "$work/root"
     echo "$(dpkg-deb -f "$deb" Package): $(dpkg-deb -f "$deb" Depends | cut -c1-160)"
   done
   version=$(dpkg-deb -f "$runtime" Version)
-  dpkg-deb -f "$dev" Depends | grep -q "$(dpkg-deb -f "$runtime" Package) (= $version)" ||
-    fail "libsplinewalk-dev does not depend on its library's exact version"
+  for deb in "$dev" "${modules[@]}"; do
+    dpkg-deb -f "$deb" Depends | grep -q "$(dpkg-deb -f "$runtime" Package) (= $version)" ||
+      fail "$(dpkg-deb -f "$deb" Package) does not depend on its library's exact version"
+  done
   for lib in libc6 libegl1 libopengl0; do
     dpkg-deb -f "$runtime" Depends | grep -q -w "$lib" || fail "the library's package does not depend on $lib"
   done
+  # the core's package: libc, EGL and OpenGL only (dpkg-shlibdeps reads them off the binary)
+  extra=$(dpkg-deb -f "$runtime" Depends | tr ',' '\n' | sed 's/^ *//; s/ .*//' |
+          grep -v -x -E 'libc6|libegl1|libopengl0' || true)
+  [ -z "$extra" ] || fail "the core's package depends on more than libc, EGL and OpenGL: $extra"
   dpkg-deb -c "$runtime" | awk '{print $6}' | grep -q -x './usr/lib/libsplinewalk.so' &&
     fail "the unversioned link name is in the runtime package, not in -dev"
   prefix=$work/root/usr
@@ -55,15 +65,48 @@ for f in lib/libsplinewalk.so include/splinewalk/splinewalk.h include/splinewalk
          lib/pkgconfig/splinewalk.pc bin/splinewalk; do
   [ -e "$prefix/$f" ] || fail "$f not installed"
 done
+for m in import image lodbuild; do
+  for f in lib/libsplinewalk_$m.so lib/pkgconfig/splinewalk-$m.pc; do
+    [ -e "$prefix/$f" ] || fail "$f not installed"
+  done
+done
+[ -e "$prefix/include/splinewalk/sw_import.h" ] && [ -e "$prefix/include/splinewalk/sw_image.h" ] &&
+  [ -e "$prefix/include/splinewalk/sw_lod_build.h" ] || fail "a module's header is not installed"
+
+step "the core is lean: libc, pthreads, EGL and OpenGL; no OCCT, OIIO, CGAL, OpenMesh or C++"
+core=$prefix/lib/libsplinewalk.so
+deps=$(ldd "$core")
+echo "$deps"
+[ "$(echo "$deps" | wc -l)" -le 12 ] || fail "ldd of the core lists more than 12 lines"
+if grep -i -E 'TK[A-Z]|OpenImageIO|opencv|CGAL|gmp|OpenMesh|osd|stdc\+\+' <<<"$deps"; then
+  fail "the core loads a library that belongs to a module"
+fi
+# no C++ symbol (mangled _Z...) and no third-party name, defined or needed
+if nm -D "$core" | grep -E ' _Z|OpenImageIO|TopoDS|Standard_|CGAL|OpenMesh|OpenSubdiv'; then
+  fail "the core holds or needs a module's symbols"
+fi
+echo "core: $(stat -L -c %s "$core") bytes"
+for m in import image lodbuild; do
+  lib=$prefix/lib/libsplinewalk_$m.so
+  echo "module $m: $(stat -L -c %s "$lib") bytes, ldd $(ldd "$lib" | wc -l) lines"
+  entry=$(nm -D --defined-only "$lib" | awk '$2 == "T" {print $3}')
+  [ "$entry" = "sw_${m/lodbuild/lod_build}_install" ] || fail "libsplinewalk_$m exports '$entry'"
+done
 
 step "the library exports exactly the functions the installed headers declare"
-exported=$(nm -D --defined-only "$prefix/lib/libsplinewalk.so" | awk '$2 ~ /^[TDBRVW]$/ {print $3}' |
-           grep -v -E '^(_edata|_end|__bss_start)$' | sort)
+# public: version SPLINEWALK_<major>; the modules' ABI: SPLINEWALK_PRIVATE_<version>
+exported=$(nm -D --defined-only "$core" | awk '$2 ~ /^[TDBRVW]$/ {print $3}' |
+           grep -v -E '^(_edata|_end|__bss_start)$' | grep -v '@@SPLINEWALK_PRIVATE_' |
+           sed 's/@@SPLINEWALK_[0-9]*$//' | sort)
 declared=$(grep -h -o -E '^SW_API [^(]*\(' "$prefix"/include/splinewalk/*.h |
            sed -E 's/.*[ *]([A-Za-z_0-9]+)\($/\1/' | sort)
 [ -n "$declared" ] || fail "no SW_API declarations found"
 diff <(echo "$exported") <(echo "$declared") || fail "exported symbols differ from the public API"
 echo "$(echo "$exported" | wc -l) functions"
+private=$(nm -D --defined-only "$core" | awk '$3 ~ /@@SPLINEWALK_PRIVATE_/ {print $3}' | sed 's/@@.*//')
+if grep -v -E '^sw_|^sw__' <<<"$private"; then fail "a private export outside the sw_ names"; fi
+if grep -x -F -f <(echo "$declared") <<<"$private"; then fail "a public function is also private"; fi
+echo "$(echo "$private" | wc -l) functions for the modules (SPLINEWALK_PRIVATE)"
 
 cp "$src/samples/embed_headless.c" "$work/embed_headless.c"
 cp "$src/samples/embed_custom_shader.c" "$work/embed_custom_shader.c"
@@ -80,7 +123,7 @@ step "build through pkg-config"
 export PKG_CONFIG_LIBDIR=$prefix/lib/pkgconfig   # this prefix only, never a system copy
 libdir=$(pkg-config --variable=libdir splinewalk)
 # shellcheck disable=SC2046  # pkg-config's output is a list of words
-cc "${flags[@]}" "$work/embed_headless.c" $(pkg-config --cflags --libs splinewalk) \
+cc "${flags[@]}" "$work/embed_headless.c" $(pkg-config --cflags --libs splinewalk splinewalk-import) \
    -Wl,-rpath,"$libdir" -o "$work/embed_pc"
 bin_pc=$work/embed_pc
 

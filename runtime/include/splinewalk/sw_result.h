@@ -19,6 +19,9 @@ extern "C" {
 #else
 #define SW_API __attribute__((visibility("default")))
 #endif
+/* The modules' entry points (sw_import.h, sw_image.h, sw_lod_build.h): exported by their own
+ * libraries, not by libsplinewalk. */
+#define SW_MODULE_API SW_API
 
 /* One table generates the enum and its names (like sokol's _SG_LOGITEM_XMACRO). New ids go at
  * the end: the numbers of the others stay stable for a program built against an older library. */

@@ -1,16 +1,18 @@
 /* SPDX-License-Identifier: MIT */
-// Frame images out through OpenImageIO: PNG (RGBA8) or OpenEXR (half RGBA plus a float Z channel
-// when the frame has depth). Encoded to memory (an OIIO IOVecOutput proxy), then handed to the
-// project's one writer (sw_safe_write.h), which replaces the target whole or not at all: OIIO's
-// own file writes do not report a full disk. A thin C++ shim: no exception leaves it.
+// The image module's encoder (sw_gpu.h, sw_gpu_image_encode_oiio): OpenEXR through OpenImageIO,
+// half RGBA plus a float Z channel when the frame has depth, encoded to memory (an OIIO
+// IOVecOutput proxy); sw_gpu_image_write hands the bytes to the project's one writer
+// (sw_safe_write.h), since OIIO's own file writes do not report a full disk. A thin C++ shim: no
+// exception leaves it.
 #include "sw_gpu.h"
-#include "sw_safe_write.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 #include <cerrno>
+#include <cstring>
 #include <cstdlib>
 #include <ctime>
 #include <string>
@@ -22,18 +24,6 @@ namespace
 using OIIO::ImageOutput;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
-
-std::string lower_extension(const std::string &path)
-{
-    size_t dot = path.find_last_of('.');
-    size_t slash = path.find_last_of('/');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
-        return "";
-    std::string e = path.substr(dot + 1);
-    for (char &c : e)
-        c = (char)((c >= 'A' && c <= 'Z') ? c - 'A' + 'a' : c);
-    return e;
-}
 
 // Encodes the image into `bytes` (nothing touches the disk here).
 sw_result write_spec(const std::string &format, std::vector<unsigned char> &bytes,
@@ -61,14 +51,6 @@ sw_result write_spec(const std::string &format, std::vector<unsigned char> &byte
     if (!ok)
         return sw__fail(status, SW_ERR_IO, "%s: encoding failed: %s", path, err.c_str());
     return SW_OK;
-}
-
-sw_result write_png(const sw_gpu_image *img, std::vector<unsigned char> &bytes, const char *path,
-                    sw_status *status)
-{
-    ImageSpec spec(img->width, img->height, 4, TypeDesc::UINT8);
-    spec.attribute("png:compressionLevel", 1);
-    return write_spec("png", bytes, spec, TypeDesc::UINT8, img->rgba, path, status);
 }
 
 // OpenEXR files carry a capture date (capDate), which OpenImageIO sets to the current second
@@ -119,33 +101,30 @@ sw_result write_exr(const sw_gpu_image *img, std::vector<unsigned char> &bytes, 
 
 } // namespace
 
-extern "C" sw_result sw_gpu_image_write(const sw_gpu_image *img, const char *path,
-                                        sw_status *status)
+extern "C" sw_result sw_gpu_image_encode_oiio(const sw_gpu_image *img, const char *path,
+                                              const char *ext, void **bytes, size_t *size,
+                                              sw_status *status)
 {
+    *bytes = nullptr;
+    *size = 0;
     try {
-        std::string p(path), ext = lower_extension(p);
-        bool png = ext == "png", exr = ext == "exr";
-        if (ext.empty())
-            return sw__fail(status, SW_ERR_UNSUPPORTED,
-                            "%s: the image file name has no extension: end it in .png or .exr",
-                            path);
-        if (!png && !exr)
-            return sw__fail(status, SW_ERR_UNSUPPORTED,
-                            "%s: unsupported image type '.%s' (use .png or .exr)", path,
-                            ext.c_str());
-        if (!img->rgba || img->width < 1 || img->height < 1)
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: empty image", path);
-        std::vector<unsigned char> bytes;
-        sw_result r =
-            png ? write_png(img, bytes, path, status) : write_exr(img, bytes, path, status);
-        if (r == SW_OK)
-            r = sw__write_file(path, bytes.data(), bytes.size(), 0, status);
-        if (r == SW_OK)
-            sw__status_ok(status);
-        return r;
+        if (std::string(ext) != "exr")
+            return sw__fail(status, SW_ERR_UNSUPPORTED, "%s: the image module writes .exr, not .%s",
+                            path, ext);
+        std::vector<unsigned char> encoded;
+        sw_result r = write_exr(img, encoded, path, status);
+        if (r != SW_OK)
+            return r;
+        void *out = sw__malloc(encoded.empty() ? 1 : encoded.size());
+        if (!out)
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+        std::memcpy(out, encoded.data(), encoded.size());
+        *bytes = out;
+        *size = encoded.size();
+        return SW_OK;
     } catch (const std::exception &e) {
         return sw__fail(status, SW_ERR_IO, "%s: %s", path, e.what());
     } catch (...) {
-        return sw__fail(status, SW_ERR_IO, "%s: unknown error writing the image", path);
+        return sw__fail(status, SW_ERR_IO, "%s: unknown error encoding the image", path);
     }
 }
