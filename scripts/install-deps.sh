@@ -7,6 +7,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libglfw3-dev libosd-dev libopenmesh-dev libopenimageio-dev openimageio-tools
+  libstb-dev  # the core's PNG writer (stb_image_write.h, compiled in)
   libegl-dev libgl-dev libopengl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri libgbm-dev
   libglu1-mesa-dev
   libocct-data-exchange-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev

@@ -291,6 +291,7 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
 
 int main(int argc, char **argv)
 {
+    sw_cli_install_modules(); /* CAD files, .exr, static LOD builds */
     args a;
     int pr = parse(argc, argv, &a);
     if (pr != 0) {

@@ -20,6 +20,7 @@
  */
 #include <splinewalk/splinewalk.h>
 
+#include "cli.h"
 #include "bench_stats.h"
 #include "bench_scene.h"
 
@@ -164,6 +165,7 @@ static int parse(int argc, char **argv, bench *b, const char **scene)
 
 int main(int argc, char **argv)
 {
+    sw_cli_install_modules(); /* CAD files, .exr, static LOD builds */
     bench b;
     const char *scene_path = NULL;
     if (parse(argc, argv, &b, &scene_path) != 0) {

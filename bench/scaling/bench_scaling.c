@@ -7,6 +7,7 @@
  * the required detail, not with the model's size. See k_usage.
  */
 #define _GNU_SOURCE
+#include "cli.h"
 #include "bench_peer.h"
 #include "peer_splinewalk.h"
 #include "scaling_svg.h"
@@ -226,6 +227,7 @@ static int write_svg(const char *path, const uint64_t *ns, const bp_result *r, u
 
 int main(int argc, char **argv)
 {
+    sw_cli_install_modules(); /* CAD files, .exr, static LOD builds */
     args a;
     int pr = parse(argc, argv, &a);
     if (pr != 0) {

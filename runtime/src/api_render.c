@@ -467,8 +467,28 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
 static void statics_task(void *ctx)
 {
     sw_rt_renderer *r = ctx;
-    sw_lod_static_set *set = NULL;
     sw_status st = {0};
+    /* the scene file's LOD cache (build-lod), when it has one made for these super-surfaces; a
+     * stale or damaged cache is refused as a whole (nothing adopted) and the units are built as
+     * they are needed instead, when a LOD builder is installed (the LOD-building module) */
+    const void *cache = NULL;
+    size_t cache_bytes = 0;
+    const char *path = sw_sg_scene_path_ptr(r->cache_scene->sg);
+    const char *name = path && *path ? path : "the scene";
+    const int can_build = sw_lod_static_builder() != NULL;
+    sw_result found = sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st);
+    if (found != SW_OK && !can_build) {
+        /* nothing to draw from: no set, so no clustering either */
+        sw__log(SW_LOG_WARN,
+                "static LODs: %s%s and no LOD builder is installed (the LOD-building module: "
+                "sw_lod_build_install): every face is drawn per frame",
+                found == SW_ERR_NOT_FOUND ? name : st.message,
+                found == SW_ERR_NOT_FOUND ? " has no LOD cache" : "");
+        atomic_store(&r->statics, NULL);
+        atomic_store(&r->statics_state, 2);
+        return;
+    }
+    sw_lod_static_set *set = NULL;
     sw_result res = sw_lod_static_set_create(r->cache_scene->sg, r->pool, NULL, &set, &st);
     if (res != SW_OK) {
         r->statics_failure = st;
@@ -476,23 +496,17 @@ static void statics_task(void *ctx)
         atomic_store(&r->statics_state, 3);
         return;
     }
-    /* the scene file's LOD cache (build-lod), when it has one made for these super-surfaces; a
-     * stale or damaged cache is refused as a whole (nothing adopted) and the units are built
-     * as they are needed instead */
-    const void *cache = NULL;
-    size_t cache_bytes = 0;
-    const char *path = sw_sg_scene_path_ptr(r->cache_scene->sg);
-    sw_result found = sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st);
     if (found == SW_OK)
         found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &st);
     if (found == SW_ERR_NOT_FOUND)
         sw__log(SW_LOG_WARN,
                 "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
                 "frames need them (`splinewalk build-lod` stores them in a .sws)",
-                path && *path ? path : "the scene");
+                name);
     else if (found != SW_OK)
-        sw__log(SW_LOG_WARN, "static LODs: %s; the levels are built again as frames need them",
-                st.message);
+        sw__log(SW_LOG_WARN, "static LODs: %s; %s", st.message,
+                can_build ? "the levels are built again as frames need them"
+                          : "no LOD builder is installed: every face is drawn per frame");
     atomic_store(&r->statics, set);
     atomic_store(&r->statics_state, 2);
 }

@@ -509,16 +509,65 @@ static void test_core_without_modules(void)
     EXPECT(scene.id == 0);
 }
 
+/* ---- the core without the LOD builder ---------------------------------------------------------
+ * Only the levels a .sws stores are drawn: the scene with a LOD cache (`splinewalk build-lod`)
+ * draws super-surfaces from it, the same scene without one draws every face per frame. A core
+ * that still built levels itself would draw static levels for the second; one that ignored the
+ * cache would draw none for the first. */
+static uint64_t static_draws_of(const char *path)
+{
+    sw_scene_load_desc ld = {path, NULL, NULL, NULL, NULL, 0};
+    sw_scene scene = {0};
+    sw_renderer r = {0};
+    sw_camera c;
+    sw_status st = {0};
+    sw_frame_stats fs = {0};
+    EXPECT_RESULT(sw_scene_load(&ld, &scene, &st), SW_OK);
+    EXPECT_RESULT(sw_camera_fit(scene, SW_VIEW_ISO, &c, NULL), SW_OK);
+    for (int k = 0; k < 3; ++k) /* far out: whole super-surfaces at coarse levels */
+        c.eye[k] = c.target[k] + 8.0 * (c.eye[k] - c.target[k]);
+    EXPECT_RESULT(sw_renderer_create(NULL, &r, &st), SW_OK);
+    sw_frame_desc f = {0};
+    f.scene = scene;
+    f.camera = c;
+    f.width = 320;
+    f.height = 240;
+    f.static_lods = 1; /* converged: waits for the clustering and any build it asks for */
+    EXPECT_RESULT(sw_renderer_draw(r, &f, &fs, &st), SW_OK);
+    EXPECT(fs.triangles > 0);
+    EXPECT_RESULT(sw_renderer_destroy(r), SW_OK);
+    EXPECT_RESULT(sw_scene_destroy(scene), SW_OK);
+    return fs.static_drawn;
+}
+
+static void test_core_lods(const char *cached, const char *bare)
+{
+    const uint64_t with_cache = static_draws_of(cached), without = static_draws_of(bare);
+    printf("core without the LOD builder: %llu super-surfaces drawn from the LOD cache, %llu "
+           "without one\n",
+           (unsigned long long)with_cache, (unsigned long long)without);
+    EXPECT(with_cache > 0);
+    EXPECT(without == 0);
+}
+
 int main(int argc, char **argv)
 {
     int handles = argc == 4 && !strcmp(argv[1], "handles");
     int renderer = argc == 5 && !strcmp(argv[1], "renderer");
-    if (renderer)
+    int core_lods = argc == 4 && !strcmp(argv[1], "core_lods");
+    if (renderer) /* the other modes run the core alone */
         (void)sw_import_install(), (void)sw_lod_build_install();
-    if (!handles && !renderer) {
+    if (!handles && !renderer && !core_lods) {
         fprintf(stderr, "usage: test_api handles SCENE WORKDIR\n"
-                        "       test_api renderer SCENE WORKDIR BIG_SCENE\n");
+                        "       test_api renderer SCENE WORKDIR BIG_SCENE\n"
+                        "       test_api core_lods SCENE_WITH_LOD_CACHE.sws SCENE_WITHOUT.sws\n");
         return 2;
+    }
+    if (core_lods) {
+        test_core_lods(argv[2], argv[3]);
+        if (g_failures)
+            fprintf(stderr, "%d failures\n", g_failures);
+        return g_failures != 0;
     }
     g_scene_path = argv[2];
     g_work = argv[3];

@@ -17,6 +17,8 @@
  * (allocations / 60)-th: each call fails with SW_ERR_OUT_OF_MEMORY or succeeds, the renderer draws
  * again once memory is back, and its destruction frees everything.
  */
+#include <splinewalk/sw_import.h>
+#include <splinewalk/sw_lod_build.h>
 #include <splinewalk/splinewalk.h>
 
 #include "api_test_expect.h"
@@ -386,6 +388,7 @@ static int run_oom_render(void)
 
 int main(int argc, char **argv)
 {
+    (void)sw_import_install(), (void)sw_lod_build_install(); /* CAD files, static LODs */
     if (argc != 4) {
         fprintf(stderr, "usage: %s count|oom|oom_render SCENE.tsm WORKDIR\n", argv[0]);
         return 2;

@@ -15,6 +15,8 @@
  * restored fails, by name. The frame presented under the host's odd state (scissor, colour mask,
  * pixel store, depth range, polygon mode, clip control, sampler, ...) must equal, pixel for pixel,
  * the one presented under GL's defaults, and must not be empty. */
+#include <splinewalk/sw_import.h>
+#include <splinewalk/sw_lod_build.h>
 #include <splinewalk/splinewalk.h>
 
 #define SW_API_TEST_HOST_CONTEXT
@@ -447,6 +449,7 @@ static void clear_host_framebuffer(const host_objects *o)
 
 int main(int argc, char **argv)
 {
+    (void)sw_import_install(), (void)sw_lod_build_install(); /* CAD files, static LODs */
     if (argc != 3) {
         fprintf(stderr, "usage: %s SCENE WORKDIR\n", argv[0]);
         return 2;

@@ -29,6 +29,7 @@
  *    bound_holds() for why the second is a guard and not a theorem.
  * Usage: test_bvh_cull TERRAIN.brep CRANKARM.brep
  */
+#include <splinewalk/sw_lod_build.h>
 #include "sw_lod_static_set.h"
 #include "sw_sg_bvh.h"
 #include "sw_sg_generate.h"
@@ -665,6 +666,7 @@ static sw_sg_scene *grid_of(const sw_sg_scene *model, uint32_t count, int32_t di
 
 int main(int argc, char **argv)
 {
+    (void)sw_lod_build_install(); /* static LODs are built by the LOD-building module */
     if (argc != 3) {
         fprintf(stderr, "usage: %s TERRAIN.brep CRANKARM.brep\n", argv[0]);
         return 2;

@@ -7,6 +7,7 @@
  *
  * Usage: test_gpu_analytic OUTDIR
  */
+#include <splinewalk/sw_image.h>
 #include "sw_gpu.h"
 #include "sw_sg_scene.h"
 
@@ -214,6 +215,7 @@ static int check_writes(const sw_gpu_image *img, const char *dir)
 
 int main(int argc, char **argv)
 {
+    (void)sw_image_install(); /* .exr frames */
     const char *dir = argc > 1 ? argv[1] : ".";
     sw_status st = {0};
     sw_sg_scene *scene = NULL;

@@ -17,6 +17,7 @@
  *    another static set (here none) drops them all (catches: a table that never evicts, planted;
  *    copies of a freed set's levels found by a new set's units).
  * Usage: test_gpu_resident MODEL */
+#include <splinewalk/sw_lod_build.h>
 #include "frame_stages.h"
 #include "gpu_test_compare.h"
 #include "sw_lod_cache.h"
@@ -160,6 +161,7 @@ static void budget(sw_gpu_context *ctx, const model *m)
 
 int main(int argc, char **argv)
 {
+    (void)sw_lod_build_install(); /* static LODs are built by the LOD-building module */
     if (argc != 2) {
         fprintf(stderr, "usage: %s MODEL\n", argv[0]);
         return 2;

@@ -21,6 +21,7 @@
  *    and a hand-made geometry (one flat bilinear patch record) covers exactly the pixels its
  *    analytic projection covers.
  * Usage: test_gpu_stages MODEL... */
+#include <splinewalk/sw_lod_build.h>
 #include "frame_stages.h"
 #include "gpu_test_compare.h"
 #include "sw_hooks.h"
@@ -706,6 +707,7 @@ done:
 
 int main(int argc, char **argv)
 {
+    (void)sw_lod_build_install(); /* static LODs are built by the LOD-building module */
     if (argc < 2) {
         fprintf(stderr, "usage: %s MODEL...\n", argv[0]);
         return 2;

@@ -27,6 +27,7 @@
  * writes); with it malformed, the real date stays.
  * usage: test_io WORKDIR */
 #define _GNU_SOURCE
+#include <splinewalk/sw_image.h>
 #include "cli.h"
 #include "sw_camera_path.h"
 #include "sw_gpu.h"
@@ -567,6 +568,7 @@ static void reproducible_exr(void)
 
 int main(int argc, char **argv)
 {
+    (void)sw_image_install(); /* .exr frames */
     if (argc != 2) {
         fprintf(stderr, "usage: test_io WORKDIR\n");
         return 2;

@@ -20,6 +20,7 @@
  *    flipped byte in it gives SW_ERR_CHECKSUM while the scene itself still opens and validates.
  * usage: test_static_cache MODEL WORKDIR
  */
+#include <splinewalk/sw_lod_build.h>
 #include "model_import.h"
 #include "sw_lod_static_set.h"
 #include "sw_sg_scene.h"
@@ -302,6 +303,7 @@ static void check_file(sw_sg_scene *scene, const void *blob, size_t size, const 
 
 int main(int argc, char **argv)
 {
+    (void)sw_lod_build_install(); /* static LODs are built by the LOD-building module */
     if (argc != 3) {
         fprintf(stderr, "usage: %s MODEL WORKDIR\n", argv[0]);
         return 2;

@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: MIT */
+#include <splinewalk/sw_lod_build.h>
 #include "hierarchy_support.h"
 
 #include "sw_lod_cache.h"
@@ -41,6 +42,7 @@ struct sw_lod_cache *sw_test_hierarchies_cache(sw_test_hierarchies *h)
 struct sw_lod_static_set *sw_test_hierarchies_statics(sw_test_hierarchies *h)
 {
     sw_status st = {0};
+    (void)sw_lod_build_install(); /* the levels are built by the LOD-building module */
     if (h && !h->statics &&
         sw_lod_static_set_create(h->scene, h->pool, NULL, &h->statics, &st) != SW_OK)
         fprintf(stderr, "static LODs: %s\n", st.message);

@@ -323,7 +323,9 @@ typedef struct sw_frame_desc {
                                 the tessellation the error bound chose */
     int32_t static_lods;     /* 1: Kumar et al. 1997 static LODs: the scene's super-surfaces
                                 (whole faces grouped under a normal-cone bound) get simplified
-                                meshes with declared errors, built in the worker pool on first
+                                meshes with declared errors, read from the .sws file's LOD
+                                cache (`splinewalk build-lod`) or, with the LOD-building module
+                                installed (sw_lod_build.h), built in the worker pool on first
                                 need (their clustering too); a visible one is drawn at the
                                 coarsest level within ε_img at its nearest point, else by the
                                 per-frame path. Walkthrough frames never wait for the builds;
