@@ -6,6 +6,7 @@
 #include "sw_hooks.h"
 
 #include <limits.h>
+#include <pthread.h>
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_STATIC
@@ -24,6 +25,18 @@
 #include <stb/stb_image_write.h>
 #pragma GCC diagnostic pop
 
+/* stb's defaults (deflate level 8, each row's filter chosen among five) took 52 ms for a
+ * 1280 x 720 frame here; level 5 (stb's lowest) with the "up" filter on every row takes 29 ms for
+ * 1 % more bytes (rendered frames change little from row to row). Set once, before any encode
+ * reads them. */
+static pthread_once_t g_settings_once = PTHREAD_ONCE_INIT;
+
+static void set_speed(void)
+{
+    stbi_write_png_compression_level = 5;
+    stbi_write_force_png_filter = 2;
+}
+
 int sw__gpu_png_encode(const uint8_t *rgba, int32_t width, int32_t height, void **bytes,
                        size_t *size)
 {
@@ -31,6 +44,7 @@ int sw__gpu_png_encode(const uint8_t *rgba, int32_t width, int32_t height, void 
     *size = 0;
     if (width < 1 || height < 1 || width > INT_MAX / 4)
         return 0;
+    pthread_once(&g_settings_once, set_speed);
     int len = 0;
     unsigned char *png = stbi_write_png_to_mem(rgba, width * 4, width, height, 4, &len);
     if (!png || len <= 0) {
