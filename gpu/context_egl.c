@@ -90,6 +90,16 @@ static EGLDisplay open_device_display(void)
     return EGL_NO_DISPLAY;
 }
 
+/* SW_EGL_PLATFORM=surfaceless|device|default tries that platform alone: the device platform
+ * (EGL_EXT_device_enumeration, what NVIDIA's driver offers without a display server) is only
+ * reached here when Mesa's surfaceless platform is missing, so tests force it on Mesa's software
+ * device; a host whose first choice misbehaves can pick another. NULL: all, in order. */
+static int platform_wanted(const char *name)
+{
+    const char *forced = getenv("SW_EGL_PLATFORM");
+    return !forced || !*forced || strcmp(forced, name) == 0;
+}
+
 /* Opens the process's display once. Caller holds g_display_lock. */
 static EGLDisplay acquire_display(void)
 {
@@ -97,16 +107,17 @@ static EGLDisplay acquire_display(void)
         return g_display;
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     EGLDisplay d = EGL_NO_DISPLAY;
-    if (has_extension(client, "EGL_MESA_platform_surfaceless")) {
+    if (platform_wanted("surfaceless") && has_extension(client, "EGL_MESA_platform_surfaceless")) {
         d = try_initialize(
             eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL));
         snprintf(g_display_platform, sizeof g_display_platform, "surfaceless");
     }
-    if (d == EGL_NO_DISPLAY && has_extension(client, "EGL_EXT_platform_device")) {
+    if (d == EGL_NO_DISPLAY && platform_wanted("device") &&
+        has_extension(client, "EGL_EXT_platform_device")) {
         d = open_device_display();
         snprintf(g_display_platform, sizeof g_display_platform, "device");
     }
-    if (d == EGL_NO_DISPLAY) {
+    if (d == EGL_NO_DISPLAY && platform_wanted("default")) {
         d = try_initialize(eglGetDisplay(EGL_DEFAULT_DISPLAY));
         snprintf(g_display_platform, sizeof g_display_platform, "default");
     }
@@ -173,9 +184,12 @@ static sw_result make_context(sw_gpu_context *ctx, sw_status *status)
     pthread_mutex_unlock(&g_display_lock);
     if (dpy == EGL_NO_DISPLAY)
         return sw__fail(status, SW_ERR_NO_CONTEXT,
-                        "no EGL display (tried the Mesa surfaceless platform, the EGL device "
-                        "platform and EGL_DEFAULT_DISPLAY; EGL error 0x%04x): install "
+                        "no EGL display (tried %s; EGL error 0x%04x): install "
                         "libegl-mesa0 and libgl1-mesa-dri, or set EGL_PLATFORM=surfaceless",
+                        getenv("SW_EGL_PLATFORM") && *getenv("SW_EGL_PLATFORM")
+                            ? "only the platform SW_EGL_PLATFORM names"
+                            : "the Mesa surfaceless platform, the EGL device platform and "
+                              "EGL_DEFAULT_DISPLAY",
                         (unsigned)eglGetError());
     ctx->egl_display = dpy;
     /* Each thread binds the API itself, or context creation fails with EGL_BAD_MATCH. */
@@ -197,7 +211,11 @@ static sw_result make_context(sw_gpu_context *ctx, sw_status *status)
                         "eglMakeCurrent without a surface failed (EGL error 0x%04x): the driver "
                         "lacks EGL_KHR_surfaceless_context",
                         (unsigned)eglGetError());
-    return check_gl_version(ctx, status);
+    sw_result r = check_gl_version(ctx, status);
+    size_t used = strlen(ctx->description);
+    snprintf(ctx->description + used, sizeof ctx->description - used, " (EGL %s platform)",
+             g_display_platform);
+    return r;
 }
 
 /* The objects every frame uses, in the current context. Reversed-Z needs zero-to-one clip depth:

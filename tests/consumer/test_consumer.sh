@@ -173,6 +173,14 @@ step "Motor-c: both builds against splinewalk render --view iso at $size"
 "$png_diff" "$work/motor_ref.png" "$work/motor_cmake.png" 0.1 || fail "find_package build differs"
 "$png_diff" "$work/motor_ref.png" "$work/motor_pc.png" 0.1 || fail "pkg-config build differs"
 
+step "the EGL device platform (EGL_EXT_device_enumeration, what NVIDIA offers without a display) on Mesa's software device"
+grep -q "EGL surfaceless platform" "$work/motor_pc.log" || fail "the default run did not use the surfaceless platform"
+SW_EGL_PLATFORM=device "$bin_pc" "$work/motor.sws" -o "$work/motor_device.png" --size $size \
+  > "$work/motor_device.log" || fail "no frame through the EGL device platform"
+grep "^GL:" "$work/motor_device.log"
+grep -q "EGL device platform" "$work/motor_device.log" || fail "SW_EGL_PLATFORM=device was not used"
+"$png_diff" "$work/motor_pc.png" "$work/motor_device.png" 0 || fail "the device platform draws another frame"
+
 step "negative controls: another camera must be seen as different"
 expect_different() {
   set +e
