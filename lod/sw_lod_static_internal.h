@@ -7,7 +7,6 @@
 
 #include "sw_module_abi.h"
 
-#include "sw_lod_mesh_distance.h"
 #include "sw_lod_static.h"
 #include "sw_sg_geom.h"
 #include "sw_sg_trim.h"

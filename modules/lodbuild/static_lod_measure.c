@@ -8,6 +8,7 @@
  */
 #include "sw_lod_static_internal.h"
 #include "sw_hooks.h"
+#include "sw_lod_mesh_distance.h"
 #include "sw_lod_sampling.h"
 #include "sw_status_util.h"
 
