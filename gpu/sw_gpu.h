@@ -3,7 +3,8 @@
  * display or GPU), and one converged frame of a scene: every face's Bézier patches drawn as grids
  * (evaluated on the CPU in this slice, at densities from the Filip bound, Guthe et al. 2005 §5.2),
  * trimmed faces through a trim texture made on the GPU by triangle-fan parity (§4) and a
- * fragment-discarding lookup. Frame images go out through OpenImageIO (capture_oiio.cpp).
+ * fragment-discarding lookup. Frame images go out as PNG (png_stb.c, image_write.c), .exr through
+ * the image module (modules/image/image_oiio.cpp).
  *
  * Threads: only the thread that created a context may call the functions taking it
  * (ARCHITECTURE.md: only the GL owner touches GL). A thread may own several headless contexts:
@@ -311,8 +312,8 @@ typedef sw_result (*sw_gpu_image_encode_fn)(const sw_gpu_image *img, const char 
                                             const char *ext, void **bytes, size_t *size,
                                             sw_status *status);
 SW_MODULE_ABI void sw_gpu_image_encoder_install(sw_gpu_image_encode_fn encode);
-/* The image module's encoder (gpu/image_oiio.cpp): .exr, half RGBA plus a float Z channel when
- * depth exists. */
+/* The image module's encoder (modules/image/image_oiio.cpp): .exr, half RGBA plus a float Z channel
+ * when depth exists. */
 sw_result sw_gpu_image_encode_oiio(const sw_gpu_image *img, const char *path, const char *ext,
                                    void **bytes, size_t *size, sw_status *status);
 

@@ -6,16 +6,18 @@
  * knot rectangle intersected with uv_box — the patches lod/hierarchy.c builds its trees from.
  *
  * Level 0, the adaptive tessellation within δ (§4.1, §4.3): per face, a constrained Delaunay
- * triangulation (CGAL, lod/trim_mesh_cgal.cpp) of the part of the face's (u, v) domain covered by
- * the selected patches and inside its trim loops. The loops and the selected patches' knot lines
- * are constraints, so the mesh follows the trim curves and no triangle straddles two patches;
- * triangles are refined until a rigorous bound of their deviation meets δ (see static_lod.c).
+ * triangulation (CGAL, modules/lodbuild/trim_mesh_cgal.cpp) of the part of the face's (u, v) domain
+ * covered by the selected patches and inside its trim loops. The loops and the selected patches'
+ * knot lines are constraints, so the mesh follows the trim curves and no triangle straddles two
+ * patches; triangles are refined until a rigorous bound of their deviation meets δ (see
+ * static_lod.c).
  *
- * Levels 1..n, simplification (§4.2): OpenMesh's Decimater (lod/static_lod_openmesh.cpp) with
- * the borders simplified first and then locked. Each level's ε_k is certified, not sampled:
- * H(level, S) <= H(level, level 0) + H(level 0, S) <= bound + δ, the distance between the two
- * meshes bounded both ways by sw_lod_mesh_distance_bound (lod/sw_lod_mesh_distance.h).
- * sw_lod_static_measure is the independent check: sampled distances to the exact surface.
+ * Levels 1..n, simplification (§4.2): OpenMesh's Decimater
+ * (modules/lodbuild/static_lod_openmesh.cpp) with the borders simplified first and then locked.
+ * Each level's ε_k is certified, not sampled: H(level, S) <= H(level, level 0) + H(level 0, S) <=
+ * bound + δ, the distance between the two meshes bounded both ways by sw_lod_mesh_distance_bound
+ * (modules/lodbuild/sw_lod_mesh_distance.h). sw_lod_static_measure is the independent check:
+ * sampled distances to the exact surface.
  *
  * Memory of a chain (sw_lod_static_memory): per level 56 bytes per vertex (position 24, normal
  * 12, (u, v) 16, face 4) and 12 bytes per triangle; the levels after level 0 are small (their

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The image module's entry point: OpenImageIO's .exr encoder (gpu/image_oiio.cpp) installed into
- * the core's image writer (sw_gpu.h). */
+/* The image module's entry point: OpenImageIO's .exr encoder (modules/image/image_oiio.cpp)
+ * installed into the core's image writer (sw_gpu.h). */
 #include "sw_gpu.h"
 
 #include <splinewalk/sw_image.h>

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The import module's entry point: OCCT's importer (scenegraph/import_occt.cpp) installed into
+/* The import module's entry point: OCCT's importer (modules/import/import_occt.cpp) installed into
  * the core (sw_sg_import.h). */
 #include "sw_sg_import.h"
 

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The LOD-building module's entry point: the static-LOD builder (lod/static_lod.c with its CGAL
- * and OpenMesh shims) installed into the core's static sets (sw_lod_static.h). */
+/* The LOD-building module's entry point: the static-LOD builder (modules/lodbuild/static_lod.c with
+ * its CGAL and OpenMesh shims) installed into the core's static sets (sw_lod_static.h). */
 #include "sw_lod_static.h"
 
 #include <splinewalk/sw_lod_build.h>

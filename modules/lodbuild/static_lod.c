@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* Static LODs of a super-surface, Kumar et al. 1997 §4.1-§4.3: the adaptive trimmed tessellation
- * (level 0) and the chain of levels, simplified by lod/static_lod_openmesh.cpp and each declared
- * with a certified ε_k (declare_level). The faces' domains (cells, scalings, flattened loops) are
- * static_lod_domain.c's; static_lod_measure.c samples the distances the tests check ε_k with.
+ * (level 0) and the chain of levels, simplified by modules/lodbuild/static_lod_openmesh.cpp and
+ * each declared with a certified ε_k (declare_level). The faces' domains (cells, scalings,
+ * flattened loops) are static_lod_domain.c's; static_lod_measure.c samples the distances the tests
+ * check ε_k with.
  *
  * Level 0 within δ, and why it holds. δ is split: δ_tri = 3/4 δ for the triangles against the
  * surface over their own (u, v) triangles, δ_trim = 1/4 δ for the trim loops.

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* Exact point-to-triangle-mesh distance queries behind a C interface (lod/mesh_distance_cgal.cpp,
- * CGAL's AABB tree over the triangles in double precision). The static LOD builder
- * (lod/static_lod.c) measures the surface-to-mesh side of the two-sided distance with it.
+/* Exact point-to-triangle-mesh distance queries behind a C interface
+ * (modules/lodbuild/mesh_distance_cgal.cpp, CGAL's AABB tree over the triangles in double
+ * precision). The static LOD builder (modules/lodbuild/static_lod.c) measures the surface-to-mesh
+ * side of the two-sided distance with it.
  *
  * A built tree is immutable: queries may run from several threads at once.
  */

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Simplification of a static LOD's level-0 mesh into coarser levels, behind a C interface
- * (lod/static_lod_openmesh.cpp: OpenMesh's Decimater, Kumar et al. 1997 §4.2).
+ * (modules/lodbuild/static_lod_openmesh.cpp: OpenMesh's Decimater, Kumar et al. 1997 §4.2).
  *
  * Borders first (§4.2): every boundary loop of the mesh is cut at its corner vertices into
  * polylines, and each polyline is simplified on its own (Douglas-Peucker in 3D against the level-0

@@ -1,13 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /* 2D constrained Delaunay triangulation in a face's parameter domain, behind a C interface
- * (lod/trim_mesh_cgal.cpp, CGAL's Constrained_Delaunay_triangulation_2 with exact predicates).
+ * (modules/lodbuild/trim_mesh_cgal.cpp, CGAL's Constrained_Delaunay_triangulation_2 with exact
+ * predicates).
  *
  * Kumar et al. 1997 §4.3 meshes a trimmed patch with its trimming curves as borders: the static
- * LOD builder (lod/static_lod.c) inserts the flattened trim loops, the knot lines of the selected
- * Bézier patches and interior sample points, reads the triangles back, and inserts refinement
- * points until every triangle meets its deviation bound (§4.1). Constraints that cross (a trim
- * loop over a knot line) are split at their intersection, which CGAL inserts as a new vertex
- * (tag SW_LOD_CDT_NO_TAG). No C++ exception crosses this interface.
+ * LOD builder (modules/lodbuild/static_lod.c) inserts the flattened trim loops, the knot lines of
+ * the selected Bézier patches and interior sample points, reads the triangles back, and inserts
+ * refinement points until every triangle meets its deviation bound (§4.1). Constraints that cross
+ * (a trim loop over a knot line) are split at their intersection, which CGAL inserts as a new
+ * vertex (tag SW_LOD_CDT_NO_TAG). No C++ exception crosses this interface.
  *
  * One triangulation is used by one thread at a time.
  */

@@ -66,7 +66,7 @@ pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 # white background; <= 0.5 % of them may disagree, at antialiased edges), at least 5 % of the
 # image; and every finite Z must lie within the depth range of the part's bounding box seen by
 # the iso preset (centre at diag / (2 tan 20 deg) x 1.1, +- diag / 2), as info --json gives it.
-# Caught when planted: rows written bottom-up (gpu/capture_oiio.cpp write_exr), a Z channel of 0.
+# Caught when planted: rows written bottom-up (modules/image/image_oiio.cpp write_exr), a Z channel of 0.
 "$sw" render "$model" -o motor_exr_ref.png --size 160x120 >/dev/null 2>&1 || fail "render PNG beside the EXR"
 if oiiotool --dumpdata motor.exr >exr.txt && oiiotool --dumpdata motor_exr_ref.png >png.txt; then
   exr_check=$(python3 - info_brep.json exr.txt png.txt <<'PY'

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// libFuzzer harness for the OCCT importer's conversion layer (scenegraph/import_occt.cpp,
+// libFuzzer harness for the OCCT importer's conversion layer (modules/import/import_occt.cpp,
 // face_occt.cpp): the input is read as the parameters of OCCT shapes — B-spline, plane,
 // cylinder, sphere, torus, cone, extrusion and revolution surfaces, their parameter bounds and
 // an optional trimming wire of 2D lines, circles or B-splines — drawn from moderate

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The certified one-sided Hausdorff distance between triangle meshes (sw_lod_mesh_distance_bound,
- * lod/sw_lod_mesh_distance.h), which declares the static levels' ε_k, against references that do
- * not use it:
+ * modules/lodbuild/sw_lod_mesh_distance.h), which declares the static levels' ε_k, against
+ * references that do not use it:
  *  - analytic: a triangle above a plane (the maximum at a corner), a triangle reaching from one
  *    small triangle to another 10 away (the maximum halfway), a flat triangle whose corners
  *    lie on a finely triangulated paraboloid (the maximum inside, where no corner or midpoint of
