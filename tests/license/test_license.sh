@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # The project's license is stated: LICENSE exists at the source root, and every library source
-# file (*.c *.h *.cpp *.hpp *.glsl under threads/ scenegraph/ lod/ gpu/ runtime/) names its license
+# file (*.c *.h *.cpp *.hpp *.glsl under threads/ scenegraph/ lod/ gpu/ runtime/ modules/) names its license
 # with an SPDX-License-Identifier line among its first 3 lines. Lists every offending file.
 # In a git checkout the files are git's (tracked, plus untracked ones not ignored); elsewhere find's.
 # usage: test_license.sh SOURCE_DIR
 set -u
 root=${1:?usage: test_license.sh SOURCE_DIR}
 cd "$root" || { echo "FAIL: no source directory $root"; exit 1; }
-dirs="threads scenegraph lod gpu runtime"
+dirs="threads scenegraph lod gpu runtime modules"
 
 # Prints the files among its arguments that lack the line in their first 3 lines (one awk for
 # all of them; an empty file has no first line, so it is caught apart).
