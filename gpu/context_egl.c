@@ -25,13 +25,6 @@ static pthread_mutex_t g_display_lock = PTHREAD_MUTEX_INITIALIZER;
 static EGLDisplay g_display = EGL_NO_DISPLAY;
 static char g_display_platform[64];
 
-double sw__gpu_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
 void sw__gpu_waits_since(const sw_th_wait_count *since, sw_gpu_frame_stats *st)
 {
     const sw_th_wait_count now = sw_th_thread_waits();

@@ -212,7 +212,7 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
                                sw_status *status)
 {
     *out = NULL;
-    double t0 = sw__gpu_now_ms();
+    double t0 = sw__clock_ms();
     const sw_th_wait_count w0 = sw_th_thread_waits(); /* every wait of the frame */
     sw_gpu_frame_plan *p = sw__gpu_stash_take(ctx, SW__GPU_STASH_PLAN);
     if (!p)
@@ -237,7 +237,7 @@ sw_result sw_gpu_frame_prepare(sw_gpu_context *ctx, const sw_sg_scene *scene,
     /* the selection is consumed by the tessellation: only the geometry travels to submit (its
      * arrays stay, for the frame this plan is recycled into) */
     sw__fr_selection_empty(&p->sel);
-    p->ms_prepare = sw__gpu_now_ms() - t0;
+    p->ms_prepare = sw__clock_ms() - t0;
     p->st.ms_tessellate = p->ms_prepare - p->st.ms_hierarchy; /* the waits are counted apart */
     sw__gpu_waits_since(&w0, &p->st);
     *out = p;
@@ -261,7 +261,7 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     const int host_state = desc->present || sw__gpu_context_adopted(ctx);
     if (host_state)
         sw__gpu_host_state_save(&host);
-    double t1 = sw__gpu_now_ms();
+    double t1 = sw__clock_ms();
     /* GPU time of the trim textures and the draw, by two GL_TIMESTAMP queries (the second one
      * is after the draw's glFinish, so its result is there without a wait of its own). A
      * GL_TIME_ELAPSED query gave 7.5e6 ms for the first frame of a context on llvmpipe. */
@@ -270,7 +270,7 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     glQueryCounter(query[0], GL_TIMESTAMP);
     if (r == SW_OK)
         r = sw__fr_trim_atlas(ctx, plan->env.scene, geo, st, status);
-    double t2 = sw__gpu_now_ms();
+    double t2 = sw__clock_ms();
     if (r == SW_OK)
         r = sw__fr_submit(ctx, &plan->env.view, desc, geo, status);
     glQueryCounter(query[1], GL_TIMESTAMP);
@@ -279,14 +279,14 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     glGetQueryObjectui64v(query[1], GL_QUERY_RESULT, &ns[1]);
     glDeleteQueries(2, query);
     st->ms_gpu = ns[1] > ns[0] ? 1e-6 * (double)(ns[1] - ns[0]) : 0.0;
-    double t3 = sw__gpu_now_ms();
+    double t3 = sw__clock_ms();
     if (r == SW_OK && desc->present)
         r = sw__gpu_present(ctx, &plan->env.view, desc->present_depth, &host, status);
     if (r == SW_OK && !desc->no_readback)
         r = sw__gpu_readback(ctx, &plan->env.view, desc->want_depth, out, status);
     if (host_state)
         sw__gpu_host_state_restore(&host);
-    double t4 = sw__gpu_now_ms();
+    double t4 = sw__clock_ms();
 
     st->triangles += geo->mesh.n_idx / 3 - geo->border_triangles + geo->resident_triangles;
     st->resident_triangles = geo->resident_triangles;

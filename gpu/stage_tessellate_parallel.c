@@ -316,9 +316,9 @@ sw_result sw__fr_tess_picks(sw__fr_tess *t, const sw__fr_visible *vis, const sw_
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
     submit_helpers(job, (threads - 1 < n_chunks - 1 ? threads - 1 : n_chunks - 1));
     claim_chunks(job);
-    const double t0 = sw__gpu_now_ms();
+    const double t0 = sw__clock_ms();
     join_chunks(job);
-    t->st->ms_join += sw__gpu_now_ms() - t0;
+    t->st->ms_join += sw__clock_ms() - t0;
     sw_result r = merge_chunks(t, job, status);
     sw__free(job->chunks);
     job->chunks = NULL;

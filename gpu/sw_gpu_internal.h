@@ -7,6 +7,7 @@
 #ifndef SW_GPU_INTERNAL_H
 #define SW_GPU_INTERNAL_H
 
+#include "sw_clock.h"
 #include "sw_gpu.h"
 #include "sw_sg_trim.h"
 
@@ -209,7 +210,6 @@ enum { SW__GPU_GLSL_KINDS = 6 };
 /* (Re)allocates the RGBA8 + 32F depth render target, two textures (context_egl.c); leaves
  * unit 0's GL_TEXTURE_2D binding at 0. */
 sw_result sw__gpu_target_ensure(sw_gpu_context *ctx, int32_t w, int32_t h, sw_status *status);
-double sw__gpu_now_ms(void);
 /* Adds the calling thread's pool waits since `since` (sw_th_thread_waits) to st's pool_waits and
  * ms_pool_wait: prepare and submit each take their own thread's share (context_egl.c). */
 struct sw_th_wait_count; /* sw_th_pool.h (C only: this header is included by C++ tests) */

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
  * units are formed and how slots are published). */
+#include "sw_clock.h"
 #include "sw_lod_static_set.h"
 #include "sw_lod_static_internal.h"
 #include "sw_hooks.h"
@@ -581,13 +582,6 @@ sw_result sw_lod_static_set_failure(const sw_lod_static_set *s, uint32_t unit, c
 /* ---- builds -----------------------------------------------------------------------------------
  */
 
-static uint64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-}
-
 static void publish(slot *sl, sw_lod_static_chain *chain)
 {
     atomic_store_explicit(&sl->chain, chain, memory_order_release);
@@ -604,7 +598,7 @@ static void build_task(void *ctx)
     sw__free(job);
     if (atomic_load_explicit(&s->cancelled, memory_order_acquire))
         return; /* the slot stays QUEUED: nobody reads it any more */
-    const uint64_t t0 = now_ns();
+    const uint64_t t0 = sw__clock_ns();
     sw_lod_static_chain *chain = NULL;
     sw_status st = {0};
     const sw_lod_static_build_fn build = sw_lod_static_builder();
@@ -615,7 +609,7 @@ static void build_task(void *ctx)
                        "static LODs: no LOD builder is installed (the LOD-building module, "
                        "sw_lod_build_install); unit %u is drawn per frame",
                        unit);
-    atomic_fetch_add(&s->build_ns, now_ns() - t0);
+    atomic_fetch_add(&s->build_ns, sw__clock_ns() - t0);
     atomic_fetch_add(&s->n_builds, 1);
     if (r == SW_OK) {
         publish(sl, chain);

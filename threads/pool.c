@@ -22,6 +22,7 @@
  * test-then-wait on `wake_cond`. It is never held while taking another lock, and push, pop and
  * steal never take it.
  */
+#include "sw_clock.h"
 #include "sw_th_pool.h"
 #include "sw_hooks.h"
 #include "sw_th_deque.h"
@@ -432,13 +433,6 @@ static void group_release(sw_th_pool *pool, sw_th_group *g)
     pthread_mutex_unlock(&pool->lock);
 }
 
-static uint64_t now_ns(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec;
-}
-
 /* Ends the calling thread's running segment (its time goes to the segment's kind) and starts one
  * of kind `to` (SW_TH_TASK_KIND_COUNT: none). A worker publishes both under its seqlock; a thread
  * outside the pool (waiting on a group) adds the ended segment to the pool's shared totals.
@@ -450,7 +444,7 @@ static void switch_segment(sw_th_pool *pool, worker *w, uint32_t to)
 {
     const uint32_t from = tls_seg_kind;
     if (!w) {
-        const uint64_t now = now_ns();
+        const uint64_t now = sw__clock_ns();
         if (from < SW_TH_TASK_KIND_COUNT)
             atomic_fetch_add_explicit(&pool->ext_kind_ns[from], now - tls_seg_start,
                                       memory_order_relaxed);
@@ -460,7 +454,7 @@ static void switch_segment(sw_th_pool *pool, worker *w, uint32_t to)
     }
     const uint64_t seq = atomic_load_explicit(&w->seg_seq, memory_order_relaxed);
     atomic_store_explicit(&w->seg_seq, seq + 1, memory_order_relaxed);
-    const uint64_t now = now_ns();
+    const uint64_t now = sw__clock_ns();
     if (from < SW_TH_TASK_KIND_COUNT)
         atomic_store_explicit(&w->kind_ns[from],
                               atomic_load_explicit(&w->kind_ns[from], memory_order_relaxed) + now -
@@ -798,7 +792,7 @@ void sw_th_wait_begin(void)
 {
     if (tls_wait_depth++ == 0) {
         tls_waits++;
-        tls_wait_start = now_ns();
+        tls_wait_start = sw__clock_ns();
     }
 }
 
@@ -806,7 +800,7 @@ void sw_th_wait_end(void)
 {
     assert(tls_wait_depth > 0);
     if (--tls_wait_depth == 0)
-        tls_wait_ns += now_ns() - tls_wait_start;
+        tls_wait_ns += sw__clock_ns() - tls_wait_start;
 }
 
 sw_th_wait_count sw_th_thread_waits(void)
@@ -897,7 +891,7 @@ static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_COUNT])
         if (atomic_load_explicit(&w->seg_seq, memory_order_relaxed) == seq)
             break;
     }
-    const uint64_t now = now_ns();
+    const uint64_t now = sw__clock_ns();
     if (kind < SW_TH_TASK_KIND_COUNT && now > start)
         total[kind] += now - start;
     for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)

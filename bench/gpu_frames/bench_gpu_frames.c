@@ -136,14 +136,14 @@ int main(int argc, char **argv)
             print("cpu", &s, frames);
         sw__gpu_set_eval_mode(ctx, SW__GPU_EVAL_AUTO);
         sw_lod_face_cones *fc = NULL;
-        const double t0 = sw__gpu_now_ms();
+        const double t0 = sw__clock_ms();
         if (ok && sw_lod_face_cones_build(scene, &fc, &st) != SW_OK) {
             fprintf(stderr, "%s: face cones: %s\n", argv[a], st.message);
             ok = 0;
         }
         if (ok) {
             printf("  cones: %u of %u faces bounded, built in %.1f ms\n", fc->n_bounded,
-                   fc->n_faces, sw__gpu_now_ms() - t0);
+                   fc->n_faces, sw__clock_ms() - t0);
             desc.face_cones = fc;
             if (run(ctx, scene, &desc, frames, 0, &s))
                 print("cull", &s, frames);

@@ -295,10 +295,10 @@ static int glu_frame(bench *b, glu_input *in, const sw__gpu_view *v, double *ms_
     static const float identity[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
     int32_t vp[4] = {0, 0, v->width, v->height};
     bt_glu_mesh *m = &b->glu_mesh;
-    double t0 = sw__gpu_now_ms();
+    double t0 = sw__clock_ms();
     eye_relative(b->shape, v->eye, in->cpw);
     int rc = bt_glu_tessellate(b->glu, &in->surf, identity, v->view_proj, vp, m);
-    double t1 = sw__gpu_now_ms();
+    double t1 = sw__clock_ms();
     if (rc != 0) {
         fprintf(stderr, "GLU: %s\n", bt_glu_error_str(rc));
         return 0;
@@ -306,7 +306,7 @@ static int glu_frame(bench *b, glu_input *in, const sw__gpu_view *v, double *ms_
     b->glu_gl_errors = bt_draw_drain_errors();
     unsigned e =
         bt_draw_mesh(b->draw, v->view_proj, m->v, m->n_v, BT_GLU_VERTEX_FLOATS, m->idx, m->n_idx);
-    double t2 = sw__gpu_now_ms();
+    double t2 = sw__clock_ms();
     if (e != 0) {
         fprintf(stderr, "GLU draw: GL error 0x%04x\n", e);
         return 0;

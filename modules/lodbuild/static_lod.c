@@ -35,6 +35,7 @@
  * §4.3 says trimming curves "are treated like boundary curves" without saying how finely they are
  * sampled; ours are sampled for δ_trim in object space.
  */
+#include "sw_clock.h"
 #include "sw_lod_static_internal.h"
 #include "sw_hooks.h"
 #include "sw_lod_supersurface.h"
@@ -63,13 +64,6 @@ enum {
 };
 
 #define STATIC_MAX_ROUNDS 48 /* refinement passes */
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ---- level 0: the adaptive tessellation ------------------------------------------------------ */
 
@@ -656,7 +650,7 @@ enum { CERTIFY_MAX_DEPTH = 12 };
  * the other side then needs certifying only down to it. */
 static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
 {
-    const double t0 = now_seconds();
+    const double t0 = (sw__clock_ms() * 1e-3);
     const sw_lod_static_level *l0 = &b->chain->levels[0];
     const double delta = b->chain->delta, floor = k_certify_floor * delta;
     sw_lod_mesh_bound from0, to0;
@@ -676,7 +670,7 @@ static sw_result declare_level(build_ctx *b, sw_lod_static_level *l)
                                        k_certify_rel, fmax(floor, from0.upper), CERTIFY_MAX_DEPTH,
                                        &to0, b->status);
     sw_lod_mesh_distance_free(level);
-    b->t_certify += now_seconds() - t0;
+    b->t_certify += (sw__clock_ms() * 1e-3) - t0;
     if (r != SW_OK)
         return r;
     l->bound[0] = to0.upper;
@@ -712,7 +706,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                               sw_status *status)
 {
     *out = NULL;
-    double t0 = now_seconds();
+    double t0 = (sw__clock_ms() * 1e-3);
     patch_set ps;
     mesh_buf m = {0};
     sw_lod_static_desc d;
@@ -751,7 +745,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
         chain->n_patches = ps.n;
         chain->delta = d.delta;
         chain->levels[0].eps = chain->levels[0].eps_target = d.delta;
-        chain->seconds[0] = now_seconds() - t0;
+        chain->seconds[0] = (sw__clock_ms() * 1e-3) - t0;
         build_ctx b = {&m, chain, &d, SW_OK, status, 0.0, NULL};
         if (d.n_levels > 0) {
             double *tol = sw__malloc((size_t)d.n_levels * sizeof *tol);
@@ -759,7 +753,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                 r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static lod: levels");
             for (int32_t k = 0; r == SW_OK && k < d.n_levels; ++k) /* against level 0 */
                 tol[k] = d.delta * (d.eps_first * pow(d.eps_growth, k) - 1.0);
-            t0 = now_seconds();
+            t0 = (sw__clock_ms() * 1e-3);
             const sw_lod_decimate_input in = {m.pos,    m.n_v, m.tri,     m.n_t,
                                               m.corner, tol,   d.n_levels};
             if (r == SW_OK)
@@ -768,7 +762,7 @@ sw_result sw_lod_static_build(const sw_sg_scene *scene, const sw_lod_static_patc
                 r = b.r;
             sw__free(tol);
             sw_lod_mesh_distance_free(b.level0);
-            chain->seconds[1] = now_seconds() - t0 - b.t_certify;
+            chain->seconds[1] = (sw__clock_ms() * 1e-3) - t0 - b.t_certify;
             chain->seconds[2] = b.t_certify;
         }
     }

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Public rendering API: a headless renderer owns a GL context on its creating thread and draws
  * converged frames (ARCHITECTURE.md: only the GL owner touches GL). */
+#include "sw_clock.h"
 #include "sw_rt.h"
 #include "sw_hooks.h"
 #include "sw_rt_pipeline.h"
@@ -72,13 +73,6 @@ typedef struct rt_job {
 static void job_free(rt_job *j);
 
 static sw_rt_pool g_renderers = SW_RT_POOL_INIT;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_status *status)
 {
@@ -642,9 +636,9 @@ static sw_result finish_frame(sw_gpu_image *image, const char *output_path,
                               double t0, const sw_th_wait_count *w0, uint64_t other_waits,
                               sw_frame_stats *stats, sw_status *status)
 {
-    double t1 = now_ms();
+    double t1 = sw__clock_ms();
     sw_result res = output_path ? sw_gpu_image_write(image, output_path, status) : SW_OK;
-    double t2 = now_ms();
+    double t2 = sw__clock_ms();
     sw_gpu_image_free(image);
     if (res == SW_OK && stats) {
         memset(stats, 0, sizeof *stats);
@@ -735,7 +729,7 @@ static sw_result prepare_frame(sw_rt_renderer *r, const sw_frame_desc *desc, sw_
     j->job.spent = r->spent;
     r->spent = NULL;
     r->in_flight++;
-    j->t_pushed = now_ms();
+    j->t_pushed = sw__clock_ms();
     sw_rt_pipeline_push(r->pipeline, &j->job);
     return SW_OK;
 }
@@ -747,11 +741,11 @@ static sw_result prepare_frame(sw_rt_renderer *r, const sw_frame_desc *desc, sw_
 static sw_result submit_frame(sw_rt_renderer *r, double t0, int since_push, sw_frame_stats *stats,
                               sw_status *status)
 {
-    const double t_call = now_ms();
+    const double t_call = sw__clock_ms();
     const sw_th_wait_count w0 = sw_th_thread_waits();
     rt_job *j = (rt_job *)sw_rt_pipeline_pop(r->pipeline);
     r->in_flight--;
-    const double t1 = now_ms();
+    const double t1 = sw__clock_ms();
     sw_result res = j->job.result;
     if (res != SW_OK) {
         if (status)
@@ -812,7 +806,7 @@ sw_result sw_renderer_submit(sw_renderer renderer, sw_frame_stats *stats, sw_sta
     if (!r->in_flight)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "sw_renderer_submit: no prepared frame (call sw_renderer_prepare first)");
-    return submit_frame(r, now_ms(), 0, stats, status);
+    return submit_frame(r, sw__clock_ms(), 0, stats, status);
 }
 
 sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *desc, sw_frame_stats *stats,
@@ -851,7 +845,7 @@ sw_result sw__rt_renderer_draw_scene(sw_renderer handle, const char *fn, sw_rt_s
     if (r->in_flight)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
                         "%s: %u prepared frames wait; submit them first", fn, r->in_flight);
-    const double t0 = now_ms();
+    const double t0 = sw__clock_ms();
     res = check_frame_desc(desc, status);
     if (res == SW_OK)
         res = prepare_frame(r, desc, scene, extra, status);

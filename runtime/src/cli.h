@@ -6,6 +6,7 @@
 
 #include <splinewalk/splinewalk.h>
 
+#include "sw_clock.h"
 #include "cli_numbers.h"
 
 #include <stdio.h>
@@ -57,7 +58,6 @@ size_t sw_cli_face_notes(const sw_cli_face_note **out);
 void sw_cli_print_import_notes(FILE *f, const char *cmd, const sw_scene_info *info);
 /* sw_cli_report, with a hint at --partial for a truncated file (commands that take it). */
 int sw_cli_report_load(const char *cmd, const sw_status *status);
-double sw_cli_now_ms(void);
 /* Keeps freed memory in the process's heap (glibc's trim and mmap thresholds raised): llvmpipe
  * allocates and frees megabytes every frame, and with the defaults the submitting thread faulted
  * them in again each frame (a quarter of its time on a 10^4-surface building's orbit;

@@ -147,7 +147,7 @@ int sw_cli_build_lod(int argc, char **argv)
         return 1;
     sw_status status = {0};
     sw_scene handle;
-    const double t0 = sw_cli_now_ms();
+    const double t0 = sw__clock_ms();
     if (sw_cli_load_scene(a.scene, 0, &handle, &status) != SW_OK)
         return sw_cli_report("build-lod", &status);
     sw_rt_scene *scene = NULL;
@@ -160,17 +160,17 @@ int sw_cli_build_lod(int argc, char **argv)
         r = sw_sg_scene_require(scene->sg, SW_SG_SEC_ALL, &status);
     if (r == SW_OK && sw_th_pool_create(&pd, &pool) != SW_OK)
         r = sw__fail(&status, SW_ERR_OUT_OF_MEMORY, "worker pool: could not start");
-    const double t1 = sw_cli_now_ms();
+    const double t1 = sw__clock_ms();
     if (r == SW_OK)
         r = sw_lod_static_set_create(scene->sg, pool, NULL, &set, &status);
-    const double t2 = sw_cli_now_ms();
+    const double t2 = sw__clock_ms();
     size_t bytes = 0;
     if (r == SW_OK) {
         build_all(set);
         const sw_lod_supersurfaces *ss = sw_lod_static_set_supersurfaces(set);
         print_summary(set, ss->n_patches);
     }
-    const double t3 = sw_cli_now_ms();
+    const double t3 = sw__clock_ms();
     if (r == SW_OK)
         r = write_cache(scene->sg, set, a.out, &bytes, &status);
     sw_lod_static_set_destroy(set);
@@ -182,7 +182,7 @@ int sw_cli_build_lod(int argc, char **argv)
         return sw_cli_report("build-lod", &status);
     printf("%s -> %s: LOD cache %.1f MiB; load %.0f ms, clustering %.0f ms, levels %.1f s, "
            "write %.0f ms\n",
-           a.scene, a.out, (double)bytes / (1024.0 * 1024.0), t1 - t0, t2 - t1,
-           1e-3 * (t3 - t2), sw_cli_now_ms() - t3);
+           a.scene, a.out, (double)bytes / (1024.0 * 1024.0), t1 - t0, t2 - t1, 1e-3 * (t3 - t2),
+           sw__clock_ms() - t3);
     return 0;
 }

@@ -147,13 +147,6 @@ void sw_cli_keep_freed_memory(void)
     mallopt(M_TRIM_THRESHOLD, 256 << 20);
 }
 
-double sw_cli_now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
 {
     printf("%s: patches drawn trimmed by trim textures %llu, untrimmed %llu, culled %llu "

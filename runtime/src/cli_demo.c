@@ -70,11 +70,11 @@ static int render_views(sw_scene scene, const demo_args *a)
 {
     sw_status status = {0};
     sw_renderer renderer;
-    double t0 = sw_cli_now_ms();
+    double t0 = sw__clock_ms();
     if (sw_renderer_create(NULL, &renderer, &status) != SW_OK)
         return sw_cli_report("demo", &status);
     printf("GL context: %s (%.0f ms)\n", sw_renderer_description_ptr(renderer),
-           sw_cli_now_ms() - t0);
+           sw__clock_ms() - t0);
     int rc = 0;
     for (size_t i = 0; i < sizeof k_views / sizeof k_views[0] && !rc; i++) {
         char path[4096];
@@ -122,28 +122,28 @@ int sw_cli_demo(int argc, char **argv)
 
     sw_status status = {0};
     sw_scene built;
-    double t0 = sw_cli_now_ms();
+    double t0 = sw__clock_ms();
     printf("building the default scene from %s\n", a.data ? a.data : "/usr/share/opencascade/data");
     sw_scene_load_desc desc = {NULL, sw_cli_progress, sw_cli_warning, NULL, NULL, 0};
     sw_result r = sw_scene_load_default(a.data, &desc, &built, &status);
     sw_cli_progress_end();
     if (r != SW_OK)
         return sw_cli_report("demo", &status);
-    double t1 = sw_cli_now_ms();
+    double t1 = sw__clock_ms();
     char sws[4096];
     snprintf(sws, sizeof sws, "%s/default.sws", a.dir);
     r = sw_scene_save(built, sws, &status);
     sw_scene_destroy(built);
     if (r != SW_OK)
         return sw_cli_report("demo", &status);
-    double t2 = sw_cli_now_ms();
+    double t2 = sw__clock_ms();
 
     sw_scene scene;
     sw_scene_info info;
     if (sw_cli_load_scene(sws, 0, &scene, &status) != SW_OK ||
         sw_scene_get_info(scene, &info, &status) != SW_OK)
         return sw_cli_report("demo", &status);
-    double t3 = sw_cli_now_ms();
+    double t3 = sw__clock_ms();
     printf("import %.0f ms, write %s %.0f ms, map + verify %.0f ms\n", t1 - t0, sws, t2 - t1,
            t3 - t2);
     printf("scene: %u surfaces (%u trimmed, %u trim loops), %llu Bézier patches, %u instances, "
@@ -154,6 +154,6 @@ int sw_cli_demo(int argc, char **argv)
     rc = render_views(scene, &a);
     sw_scene_destroy(scene);
     if (!rc)
-        printf("frames in %s/ (total %.1f s)\n", a.dir, (sw_cli_now_ms() - t0) / 1e3);
+        printf("frames in %s/ (total %.1f s)\n", a.dir, (sw__clock_ms() - t0) / 1e3);
     return rc;
 }

@@ -194,7 +194,7 @@ enum { SLOW_WRITE_BYTES = 256 << 20, SLOW_BREP_BYTES = 16 << 20 };
 static void progress(void *user_data, double fraction, const char *stage)
 {
     quiet_progress *q = user_data;
-    q->on = q->on || sw_cli_now_ms() - q->t0 > 1000.0;
+    q->on = q->on || sw__clock_ms() - q->t0 > 1000.0;
     if (q->on)
         sw_cli_progress(NULL, fraction, stage);
 }
@@ -203,11 +203,11 @@ static void progress(void *user_data, double fraction, const char *stage)
 static sw_result write_grid(const gen_args *a, const sw_rt_scene *model, sw_sg_grid_report *rep,
                             double ms[2], sw_status *status)
 {
-    quiet_progress q = {sw_cli_now_ms(), 0};
+    quiet_progress q = {sw__clock_ms(), 0};
     sw_sg_grid_desc d = {(uint32_t)a->count, a->dims, a->spacing, progress, &q};
     sw_sg_scene *grid = NULL;
     sw_result r = sw_sg_generate_grid(model->sg, &d, &grid, rep, status);
-    const double t1 = sw_cli_now_ms();
+    const double t1 = sw__clock_ms();
     if (r == SW_OK) {
         q.on = q.on || sw_sg_scene_memory(grid) >= SLOW_WRITE_BYTES;
         progress(&q, 1.0, "writing");
@@ -216,7 +216,7 @@ static sw_result write_grid(const gen_args *a, const sw_rt_scene *model, sw_sg_g
     sw_cli_progress_end();
     sw_sg_scene_free(grid);
     ms[0] = t1 - q.t0;
-    ms[1] = sw_cli_now_ms() - t1;
+    ms[1] = sw__clock_ms() - t1;
     return r;
 }
 
@@ -248,7 +248,7 @@ static sw_result load_models(const char *data, const char *const *files, int n,
 static sw_result write_building(const gen_args *a, sw_sg_scene *scene, double *ms_write,
                                 sw_sg_export_report *er, sw_status *status)
 {
-    const double t0 = sw_cli_now_ms();
+    const double t0 = sw__clock_ms();
     char *brep = NULL;
     size_t brep_len = 0;
     sw_result r = a->brep ? sw_sg_export_brep_text(scene, &brep, &brep_len, er, status) : SW_OK;
@@ -257,7 +257,7 @@ static sw_result write_building(const gen_args *a, sw_sg_scene *scene, double *m
     if (r == SW_OK && a->brep)
         r = sw__write_file(a->brep, brep, brep_len, 0, status);
     sw__free(brep);
-    *ms_write = sw_cli_now_ms() - t0;
+    *ms_write = sw__clock_ms() - t0;
     return r;
 }
 
@@ -291,11 +291,11 @@ static int generate_scene(const gen_args *a)
     const int n = vehicle ? SW_SG_VEHICLE_N_MODELS : SW_SG_BUILDING_N_MODELS;
     sw_status status = {0};
     sw_sg_scene *models[SW_SG_BUILDING_N_MODELS] = {0};
-    const double t0 = sw_cli_now_ms();
+    const double t0 = sw__clock_ms();
     sw_result r = load_models(a->data ? a->data : DEFAULT_DATA,
                               vehicle ? sw_sg_vehicle_model_files : sw_sg_building_model_files, n,
                               models, &status);
-    const double t1 = sw_cli_now_ms();
+    const double t1 = sw__clock_ms();
     quiet_progress q = {t1, 0};
     sw_sg_building_report brep;
     sw_sg_vehicle_report vrep;
@@ -311,7 +311,7 @@ static int generate_scene(const gen_args *a)
                                  progress, &q};
         r = sw_sg_generate_building(&d, &scene, &brep, &status);
     }
-    const double t2 = sw_cli_now_ms();
+    const double t2 = sw__clock_ms();
     if (r == SW_OK) {
         /* the BREP writer runs at ~11 MB of scene a second here */
         q.on = q.on || sw_sg_scene_memory(scene) >= (a->brep ? SLOW_BREP_BYTES : SLOW_WRITE_BYTES);

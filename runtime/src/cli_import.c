@@ -53,15 +53,15 @@ int sw_cli_import(int argc, char **argv)
         return 1;
     sw_status status = {0};
     sw_scene scene;
-    double t0 = sw_cli_now_ms();
+    double t0 = sw__clock_ms();
     if (sw_cli_load_scene(in, flags, &scene, &status) != SW_OK)
         return sw_cli_report_load("import", &status);
-    double t1 = sw_cli_now_ms();
+    double t1 = sw__clock_ms();
     sw_scene_info info;
     sw_result r = sw_scene_get_info(scene, &info, &status);
     if (r == SW_OK)
         r = sw_scene_save(scene, out, &status);
-    double t2 = sw_cli_now_ms();
+    double t2 = sw__clock_ms();
     sw_scene_destroy(scene);
     if (r != SW_OK)
         return sw_cli_report("import", &status);

@@ -206,9 +206,9 @@ static sw_result one_frame(sw_renderer renderer, int threaded, const sw_rt_camer
     sw_result r = SW_OK;
     if (i + 1 < n) {
         set_frame(path, i + 1, n, st, p, frame, file);
-        const double t0 = sw_cli_now_ms();
+        const double t0 = sw__clock_ms();
         r = sw_renderer_prepare(renderer, frame, status);
-        *prepare_ms = sw_cli_now_ms() - t0;
+        *prepare_ms = sw__clock_ms() - t0;
     }
     return r == SW_OK ? sw_renderer_submit(renderer, stats, status) : r;
 }
@@ -229,11 +229,11 @@ static sw_result run_frames(sw_renderer renderer, int threaded, const sw_rt_came
         sw_frame_stats stats = {0};
         sw_cli_pool_sample pool_start, pool_end;
         double prepare_ms;
-        const double t0 = sw_cli_now_ms();
+        const double t0 = sw__clock_ms();
         sw_cli_pool_read(renderer, 0, &pool_start);
         r = one_frame(renderer, threaded, path, i, n, frame, st, p, &stats, &prepare_ms, status);
         sw_cli_pool_read(renderer, 1, &pool_end);
-        const double ms = sw_cli_now_ms() - t0;
+        const double ms = sw__clock_ms() - t0;
         const double t = sw_rt_path_frame_time(path, i, n);
         if (r != SW_OK) {
             char msg[sizeof status->message];
@@ -296,9 +296,9 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
         a->frame.scene = scene;
         a->frame.walkthrough = !a->converged;
         choose_captures(p, n);
-        const double t0 = sw_cli_now_ms();
+        const double t0 = sw__clock_ms();
         r = run_frames(renderer, !a->sequential, path, n, &a->frame, &st, p, status);
-        p->meta.wall_s = (sw_cli_now_ms() - t0) / 1e3;
+        p->meta.wall_s = (sw__clock_ms() - t0) / 1e3;
         r = sw_cli_profile_finish(&st, a->out, p, r, status);
     }
     sw_renderer_destroy(renderer);

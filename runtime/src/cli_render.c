@@ -140,11 +140,11 @@ int sw_cli_render(int argc, char **argv)
     if (sw_cli_check_output("render", a.out, 0))
         return 1;
     sw_status status = {0};
-    double t0 = sw_cli_now_ms();
+    double t0 = sw__clock_ms();
     sw_scene scene;
     if (sw_cli_load_scene(a.scene, a.load_flags, &scene, &status) != SW_OK)
         return sw_cli_report_load("render", &status);
-    double t1 = sw_cli_now_ms();
+    double t1 = sw__clock_ms();
     sw_scene_info load_info;
     int have_info = sw_scene_get_info(scene, &load_info, NULL) == SW_OK;
     if (have_info)
@@ -162,7 +162,7 @@ int sw_cli_render(int argc, char **argv)
         r = sw_camera_fit(scene, a.view, &a.frame.camera, &status);
     if (r == SW_OK)
         r = sw_renderer_create(NULL, &renderer, &status);
-    double t2 = sw_cli_now_ms();
+    double t2 = sw__clock_ms();
     if (r == SW_OK)
         r = sw_renderer_draw(renderer, &a.frame, &stats, &status);
     if (renderer.id)

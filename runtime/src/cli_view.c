@@ -464,15 +464,15 @@ static sw_result script_frame(GLFWwindow *win, sw_renderer r, sw_scene scene, vi
                               sw_rt_profile *prof, sw_frame_stats *fs, sw_status *st)
 {
     sw_cli_pool_sample pool_start, pool_end;
-    const double t0 = sw_cli_now_ms();
+    const double t0 = sw__clock_ms();
     sw_cli_pool_read(r, 0, &pool_start);
     double prepare_ms = 0.0;
     sw_result res = SW_OK;
     if (i + 1 < n) {
         sw_rt_path_eval(path, sw_rt_path_frame_time(path, i + 1, n), &v->wk.cam);
-        const double p0 = sw_cli_now_ms(); /* the prepare call alone, as `profile` times it */
+        const double p0 = sw__clock_ms(); /* the prepare call alone, as `profile` times it */
         res = prepare(r, scene, v, v->args->converged, st);
-        prepare_ms = sw_cli_now_ms() - p0;
+        prepare_ms = sw__clock_ms() - p0;
     }
     if (res == SW_OK)
         res = sw_renderer_submit(r, fs, st);
@@ -486,7 +486,7 @@ static sw_result script_frame(GLFWwindow *win, sw_renderer r, sw_scene scene, vi
         return SW_OK;
     sw_cli_pool_read(r, 1, &pool_end);
     sw_rt_prof_row row;
-    sw_rt_profile_row(fs, i, sw_rt_path_frame_time(path, i, n), sw_cli_now_ms() - t0, prepare_ms,
+    sw_rt_profile_row(fs, i, sw_rt_path_frame_time(path, i, n), sw__clock_ms() - t0, prepare_ms,
                       sw_cli_resident_bytes(), 0, &row);
     sw_cli_pool_columns(&pool_start, &pool_end, &row);
     return sw_rt_profile_push(prof, &row) == 0
@@ -504,7 +504,7 @@ static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
     sw_frame_stats fs = {0};
     sw_rt_profile prof = {0};
     uint64_t waits = 0, fallbacks = 0;
-    double worst = 0.0, t0 = sw_cli_now_ms();
+    double worst = 0.0, t0 = sw__clock_ms();
     if (v->args->profile) {
         sw_rt_renderer_time_pool_tasks(r, 1); /* the pool_<kind>_ms columns */
         profile_meta(v, r, &prof);
@@ -522,15 +522,14 @@ static int run_script(GLFWwindow *win, sw_renderer r, sw_scene scene, viewer *v,
             n = i + 1;
         }
     }
-    prof.meta.wall_s = (sw_cli_now_ms() - t0) / 1e3;
+    prof.meta.wall_s = (sw__clock_ms() - t0) / 1e3;
     if (res == SW_OK && v->args->profile)
         res = profile_write(v->args->profile, &prof, &st);
     sw_rt_profile_free(&prof);
     if (res != SW_OK)
         return sw_cli_report("view", &st);
     printf("script: %u frames in %.0f ms (slowest %.1f ms), pool waits %llu, fallback draws %llu\n",
-           n, sw_cli_now_ms() - t0, worst, (unsigned long long)waits,
-           (unsigned long long)fallbacks);
+           n, sw__clock_ms() - t0, worst, (unsigned long long)waits, (unsigned long long)fallbacks);
     if (v->args->profile)
         printf("wrote %s/profile.csv, profile.json, frametime.svg and report.html\n",
                v->args->profile);
