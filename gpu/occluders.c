@@ -27,8 +27,7 @@ static int push_point(builder *b, const double o[3], const double du[3], const d
                       double u, double v)
 {
     sw_gpu_occluders *oc = b->oc;
-    if (!sw__gpu_grow((void **)&oc->points, &b->cap_points, 3 * (oc->n_points + 1),
-                      sizeof *oc->points))
+    if (!sw__grow((void **)&oc->points, &b->cap_points, 3 * (oc->n_points + 1), sizeof *oc->points))
         return 0;
     double *p = oc->points + 3 * oc->n_points++;
     for (int k = 0; k < 3; ++k)
@@ -39,10 +38,9 @@ static int push_point(builder *b, const double o[3], const double du[3], const d
 static int push_loop(builder *b, uint32_t first, uint32_t count)
 {
     sw_gpu_occluders *oc = b->oc;
-    if (!sw__gpu_grow((void **)&oc->loop_first, &b->cap_first, oc->n_loops + 1,
-                      sizeof *oc->loop_first) ||
-        !sw__gpu_grow((void **)&oc->loop_count, &b->cap_count, oc->n_loops + 1,
-                      sizeof *oc->loop_count))
+    if (!sw__grow((void **)&oc->loop_first, &b->cap_first, oc->n_loops + 1,
+                  sizeof *oc->loop_first) ||
+        !sw__grow((void **)&oc->loop_count, &b->cap_count, oc->n_loops + 1, sizeof *oc->loop_count))
         return 0;
     oc->loop_first[oc->n_loops] = first;
     oc->loop_count[oc->n_loops++] = count;

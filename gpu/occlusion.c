@@ -71,7 +71,7 @@ static void to_view(const sw__occ_map *m, const double p[3], double out[3])
 
 static int push_pt(sw__occ_map *m, size_t *n, const double q[3])
 {
-    if (!sw__gpu_grow((void **)&m->pts, &m->cap_pts, 3 * (*n + 1), sizeof *m->pts))
+    if (!sw__grow((void **)&m->pts, &m->cap_pts, 3 * (*n + 1), sizeof *m->pts))
         return 0;
     memcpy(m->pts + 3 * (*n)++, q, 3 * sizeof *q);
     return 1;
@@ -160,7 +160,7 @@ static long row_crossings(sw__occ_map *m, uint32_t n_loops, double yc)
                          *b = m->pts + 3 * (first + (i + 1) % m->counts[l]);
             if ((a[1] <= yc) == (b[1] <= yc))
                 continue;
-            if (!sw__gpu_grow((void **)&m->xs, &m->cap_xs, n + 1, sizeof *m->xs))
+            if (!sw__grow((void **)&m->xs, &m->cap_xs, n + 1, sizeof *m->xs))
                 return -1;
             m->xs[n++] = a[0] + (yc - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
         }
@@ -235,7 +235,7 @@ static long view_loops(sw__occ_map *m, const sw_gpu_occluders *oc, const sw__occ
     for (uint32_t l = 0; l < of->n_loops; ++l) {
         const uint32_t first = oc->loop_first[of->first_loop + l],
                        count = oc->loop_count[of->first_loop + l];
-        if (!sw__gpu_grow((void **)&m->vp, &m->cap_vp, 3 * (size_t)count, sizeof *m->vp))
+        if (!sw__grow((void **)&m->vp, &m->cap_vp, 3 * (size_t)count, sizeof *m->vp))
             return -1;
         for (uint32_t i = 0; i < count; ++i) {
             const double *p = oc->points + 3 * (size_t)(first + i);
@@ -251,7 +251,7 @@ static long view_loops(sw__occ_map *m, const sw_gpu_occluders *oc, const sw__occ
             return -1;
         if (c == 0)
             continue;
-        if (!sw__gpu_grow((void **)&m->counts, &m->cap_counts, (size_t)kept + 1, sizeof *m->counts))
+        if (!sw__grow((void **)&m->counts, &m->cap_counts, (size_t)kept + 1, sizeof *m->counts))
             return -1;
         m->counts[kept++] = (uint32_t)c;
     }
@@ -295,7 +295,7 @@ int sw__occ_map_add_face(sw__occ_map *m, const sw_gpu_occluders *oc, uint32_t fa
     if (r.x1 - r.x0 + 1 < m->min_extent || r.y1 - r.y0 + 1 < m->min_extent)
         return 0;
     const size_t area = (size_t)(r.x1 - r.x0 + 1) * (size_t)(r.y1 - r.y0 + 1);
-    if (!sw__gpu_grow((void **)&m->band, &m->cap_band, area, 1))
+    if (!sw__grow((void **)&m->band, &m->cap_band, area, 1))
         return -1;
     memset(m->band, 0, area);
     size_t first = 0;

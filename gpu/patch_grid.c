@@ -21,27 +21,12 @@ void sw__gpu_mesh_free(sw__gpu_mesh *m)
     memset(m, 0, sizeof *m);
 }
 
-int sw__gpu_grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? *cap * 2 : 64;
-    while (c < need)
-        c *= 2;
-    void *q = sw__realloc(*p, c * elem);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
-
 sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, sw_status *status)
 {
     if (m->n_v + more_v > UINT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "frame needs more than 2^32 grid vertices");
-    if (!sw__gpu_grow((void **)&m->v, &m->cap_v, m->n_v + more_v, sizeof *m->v) ||
-        !sw__gpu_grow((void **)&m->idx, &m->cap_idx, m->n_idx + more_idx, sizeof *m->idx))
+    if (!sw__grow((void **)&m->v, &m->cap_v, m->n_v + more_v, sizeof *m->v) ||
+        !sw__grow((void **)&m->idx, &m->cap_idx, m->n_idx + more_idx, sizeof *m->idx))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "grid buffers: out of memory");
     return SW_OK;
 }

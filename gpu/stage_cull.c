@@ -34,8 +34,8 @@
 
 int sw__fr_faces_push(sw__fr_faces *l, const occurrence *o, const double eye_box[6])
 {
-    if (!sw__gpu_grow((void **)&l->occ, &l->cap_occ, l->n + 1, sizeof *l->occ) ||
-        !sw__gpu_grow((void **)&l->boxes, &l->cap_boxes, 6 * (l->n + 1), sizeof *l->boxes))
+    if (!sw__grow((void **)&l->occ, &l->cap_occ, l->n + 1, sizeof *l->occ) ||
+        !sw__grow((void **)&l->boxes, &l->cap_boxes, 6 * (l->n + 1), sizeof *l->boxes))
         return 0;
     l->occ[l->n] = *o;
     memcpy(l->boxes + 6 * l->n, eye_box, 6 * sizeof *l->boxes);
@@ -141,8 +141,8 @@ static int take_mesh(void *ctx, uint32_t mesh, uint32_t node, const double world
     (void)node;
     mesh_taker *c = ctx;
     sw__fr_visible *vis = c->vis;
-    if (!sw__gpu_grow((void **)&vis->meshes, &vis->cap_meshes, vis->n_meshes + 1,
-                      sizeof *vis->meshes)) {
+    if (!sw__grow((void **)&vis->meshes, &vis->cap_meshes, vis->n_meshes + 1,
+                  sizeof *vis->meshes)) {
         c->oom = 1;
         return 1;
     }
@@ -333,7 +333,7 @@ static void occ_item(occ_walk *w, uint32_t item, int inside)
             return;
         }
     }
-    if (!sw__gpu_grow((void **)&w->kept, &w->cap_kept, w->n_kept + 1, sizeof *w->kept) ||
+    if (!sw__grow((void **)&w->kept, &w->cap_kept, w->n_kept + 1, sizeof *w->kept) ||
         sw__occ_map_add_face(&w->map, w->oc, it->face, it->world, w->env->view.eye) < 0) {
         w->oom = 1;
         return;
@@ -544,8 +544,8 @@ static int push_instance(sw__fr_visible *vis, uint32_t item, size_t first)
     const size_t n = vis->unit_faces.n - first;
     if (n == 0)
         return 1;
-    if (!sw__gpu_grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
-                      sizeof *vis->instances))
+    if (!sw__grow((void **)&vis->instances, &vis->cap_instances, vis->n_instances + 1,
+                  sizeof *vis->instances))
         return 0;
     vis->instances[vis->n_instances++] = (sw__fr_instance){item, first, n};
     return 1;

@@ -79,7 +79,7 @@ static void item_net(const hl_face *hf, const sw_lod_hnode *n, const double rang
 
 static int push(hl_face *hf, int32_t node, const double range[4], int32_t part_depth)
 {
-    if (!sw__gpu_grow((void **)&hf->stack, &hf->cap_stack, hf->n_stack + 1, sizeof *hf->stack)) {
+    if (!sw__grow((void **)&hf->stack, &hf->cap_stack, hf->n_stack + 1, sizeof *hf->stack)) {
         hf->oom = 1;
         return 0;
     }
@@ -117,8 +117,8 @@ static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double 
     sw__fr_selection *sel = hf->sel;
     if (!sel)
         return;
-    if (hf->n_chosen >= MAX_ITEMS_PER_FACE || !sw__gpu_grow((void **)&sel->items, &sel->cap_items,
-                                                            sel->n_items + 1, sizeof *sel->items)) {
+    if (hf->n_chosen >= MAX_ITEMS_PER_FACE ||
+        !sw__grow((void **)&sel->items, &sel->cap_items, sel->n_items + 1, sizeof *sel->items)) {
         hf->oom = 1;
         return;
     }
@@ -141,10 +141,10 @@ static void ask_refine(hl_face *hf, int32_t node, double eps_obj)
     double tol = 0.5 * eps_obj / hf->scale;
     if (!(tol > 0.0) || !isfinite(tol))
         return;
-    if (!sw__gpu_grow((void **)&hf->refine_nodes, &hf->cap_refine, hf->n_refine + 1,
-                      sizeof *hf->refine_nodes) ||
-        !sw__gpu_grow((void **)&hf->refine_tol, &hf->cap_refine_tol, hf->n_refine + 1,
-                      sizeof *hf->refine_tol)) {
+    if (!sw__grow((void **)&hf->refine_nodes, &hf->cap_refine, hf->n_refine + 1,
+                  sizeof *hf->refine_nodes) ||
+        !sw__grow((void **)&hf->refine_tol, &hf->cap_refine_tol, hf->n_refine + 1,
+                  sizeof *hf->refine_tol)) {
         hf->oom = 1;
         return;
     }

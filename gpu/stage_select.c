@@ -153,8 +153,8 @@ static sw_result select_instances(const sw__fr_env *env, const sw__fr_visible *v
         if (in->unit != SW_LOD_STATIC_NO_UNIT)
             pick.level = choose_level(env, in->unit, it->world, &pick.chain, &pick.extent_px, st);
         if (pick.level >= 0) {
-            if (!sw__gpu_grow((void **)&sel->statics, &sel->cap_statics, sel->n_statics + 1,
-                              sizeof *sel->statics))
+            if (!sw__grow((void **)&sel->statics, &sel->cap_statics, sel->n_statics + 1,
+                          sizeof *sel->statics))
                 return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static picks: out of memory");
             sel->statics[sel->n_statics++] = pick;
             continue;
@@ -188,7 +188,7 @@ static sw_result visible_faces(const sw__fr_env *env, const sw__fr_faces *in, sw
 static sw_result pick_face(const sw__fr_env *env, sw__fr_hierarchy *hy, const occurrence *o,
                            sw__fr_selection *sel, sw_gpu_frame_stats *st, sw_status *status)
 {
-    if (!sw__gpu_grow((void **)&sel->faces, &sel->cap_faces, sel->n_faces + 1, sizeof *sel->faces))
+    if (!sw__grow((void **)&sel->faces, &sel->cap_faces, sel->n_faces + 1, sizeof *sel->faces))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face picks: out of memory");
     sw__fr_face_pick *p = &sel->faces[sel->n_faces];
     memset(p, 0, sizeof *p);

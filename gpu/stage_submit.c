@@ -24,8 +24,8 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_pa
     memset(b, 0, sizeof *b);
     if (g->n_recs == 0)
         return SW_OK;
-    if (!sw__gpu_grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, g->n_recs,
-                      sizeof *ctx->recs_sorted))
+    if (!sw__grow((void **)&ctx->recs_sorted, &ctx->cap_recs_sorted, g->n_recs,
+                  sizeof *ctx->recs_sorted))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < g->n_recs; ++i) {
         sw__gpu_patch_rec *rec = &g->recs[i];
@@ -52,8 +52,8 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_pa
                 at += b->count[t][v][u];
             }
     int keep = ctx->capture_max > 0;
-    if (keep && !sw__gpu_grow((void **)&ctx->rec_source, &ctx->cap_rec_source, g->n_recs,
-                              sizeof *ctx->rec_source))
+    if (keep && !sw__grow((void **)&ctx->rec_source, &ctx->cap_rec_source, g->n_recs,
+                          sizeof *ctx->rec_source))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < g->n_recs; ++i) {
         const sw__gpu_patch_rec *rec = &g->recs[i];

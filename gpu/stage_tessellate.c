@@ -103,9 +103,8 @@ sw_result sw__fr_add_draw(sw__fr_tess *t, const occurrence *o, size_t first_idx,
                           const trim_need *need, const double cell[2], sw_status *status)
 {
     sw__fr_geometry *g = t->geo;
-    if (!sw__gpu_grow((void **)&g->draws, &g->cap_draws, g->n_draws + 1, sizeof *g->draws) ||
-        (trimmed &&
-         !sw__gpu_grow((void **)&g->trims, &g->cap_trims, g->n_trims + 1, sizeof *g->trims)))
+    if (!sw__grow((void **)&g->draws, &g->cap_draws, g->n_draws + 1, sizeof *g->draws) ||
+        (trimmed && !sw__grow((void **)&g->trims, &g->cap_trims, g->n_trims + 1, sizeof *g->trims)))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame draws: out of memory");
     sw__gpu_draw *d = &g->draws[g->n_draws];
     d->first_idx = first_idx;
@@ -186,9 +185,8 @@ static sw_result exact_net(sw__fr_tess *t, const occurrence *o, sw_status *statu
     if (g->n_knots + nku + nkv > UINT32_MAX || g->n_dcps + ncp > UINT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "face %u: exact evaluation buffers over 2^32",
                         o->face);
-    if (!sw__gpu_grow((void **)&g->knots, &g->cap_knots, g->n_knots + nku + nkv,
-                      sizeof *g->knots) ||
-        !sw__gpu_grow((void **)&g->dcps, &g->cap_dcps, 4 * (g->n_dcps + ncp), sizeof *g->dcps))
+    if (!sw__grow((void **)&g->knots, &g->cap_knots, g->n_knots + nku + nkv, sizeof *g->knots) ||
+        !sw__grow((void **)&g->dcps, &g->cap_dcps, 4 * (g->n_dcps + ncp), sizeof *g->dcps))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     sw__gpu_exact_piece *b = &t->ex_base;
     memset(b, 0, sizeof *b);
@@ -218,7 +216,7 @@ static sw_result exact_piece(sw__fr_tess *t, const occurrence *o, const sw__gpu_
     if (r != SW_OK)
         return r;
     sw__fr_geometry *g = t->geo;
-    if (!sw__gpu_grow((void **)&g->pieces, &g->cap_pieces, g->n_pieces + 1, sizeof *g->pieces))
+    if (!sw__grow((void **)&g->pieces, &g->cap_pieces, g->n_pieces + 1, sizeof *g->pieces))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     const sw_sg_surface *s = &t->ex_srf;
     sw__gpu_exact_piece *q = &g->pieces[g->n_pieces];
@@ -253,8 +251,8 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
     split_class(pt->nu, &ku, &lu);
     split_class(pt->nv, &kv, &lv);
     size_t n_rec = (size_t)ku * (size_t)kv;
-    if (!sw__gpu_grow((void **)&g->cps, &g->cap_cps, 4 * (g->n_cps + n_cp), sizeof *g->cps) ||
-        !sw__gpu_grow((void **)&g->recs, &g->cap_recs, g->n_recs + n_rec, sizeof *g->recs))
+    if (!sw__grow((void **)&g->cps, &g->cap_cps, 4 * (g->n_cps + n_cp), sizeof *g->cps) ||
+        !sw__grow((void **)&g->recs, &g->cap_recs, g->n_recs + n_rec, sizeof *g->recs))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < 4 * n_cp; ++i)
         g->cps[4 * g->n_cps + i] = (float)pt->cpw[i];
@@ -316,8 +314,8 @@ static sw_result ribbon_draw(sw__fr_tess *t, const occurrence *o, size_t first, 
     t->st->triangles += (g->mesh.n_idx - first) / 3;
     g->border_triangles += (g->mesh.n_idx - first) / 3;
     if (r == SW_OK && st_box) {
-        if (!sw__gpu_grow((void **)&g->shares, &g->cap_shares, 2 * (g->n_shares + 1),
-                          sizeof *g->shares))
+        if (!sw__grow((void **)&g->shares, &g->cap_shares, 2 * (g->n_shares + 1),
+                      sizeof *g->shares))
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame draws: out of memory");
         g->shares[2 * g->n_shares] = draw;
         g->shares[2 * g->n_shares + 1] = share;
@@ -380,7 +378,7 @@ sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *
 {
     sw__fr_geometry *g = t->geo;
     const sw_sg_face_rec *rec = &t->env->sv->faces[face];
-    if (!sw__gpu_grow((void **)&g->loops, &g->cap_loops, g->n_loops + 1, sizeof *g->loops))
+    if (!sw__grow((void **)&g->loops, &g->cap_loops, g->n_loops + 1, sizeof *g->loops))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u trim: out of memory", face);
     face_loops *fl = &g->loops[g->n_loops];
     fl->n = 0;

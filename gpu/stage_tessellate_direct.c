@@ -286,7 +286,7 @@ static int find_tiles(tiling *t, int32_t i0, int32_t i1, int32_t j0, int32_t j1)
         return find_tiles(t, i0, i1, j0, (j0 + j1) / 2) && find_tiles(t, i0, i1, (j0 + j1) / 2, j1);
     }
     if (t->n_tiles >= MAX_TILES_PER_FACE ||
-        !sw__gpu_grow((void **)&t->tiles, &t->cap_tiles, t->n_tiles + 1, sizeof *t->tiles))
+        !sw__grow((void **)&t->tiles, &t->cap_tiles, t->n_tiles + 1, sizeof *t->tiles))
         return 0;
     tile *tl = &t->tiles[t->n_tiles++];
     memset(tl, 0, sizeof *tl);
@@ -303,7 +303,7 @@ static int tile_cells(tiling *t, tile *tl)
     patch_span(t->set, 0, tl->rect[0], tl->rect[1], &tl->a0, &tl->a1);
     patch_span(t->set, 1, tl->rect[2], tl->rect[3], &tl->b0, &tl->b1);
     size_t n = (size_t)(tl->a1 - tl->a0 + 1) * (size_t)(tl->b1 - tl->b0 + 1);
-    if (!sw__gpu_grow((void **)&t->cells, &t->cap_cells, t->n_cells + n, sizeof *t->cells))
+    if (!sw__grow((void **)&t->cells, &t->cap_cells, t->n_cells + n, sizeof *t->cells))
         return 0;
     tl->first_cell = t->n_cells;
     tl->need = (trim_need){1.0, 1.0};

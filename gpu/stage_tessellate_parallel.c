@@ -100,11 +100,6 @@ static void helper_task(void *ctx)
 
 /* ---- appending a chunk's geometry, every index rebased ----------------------------------------
  */
-static int grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    return need <= *cap || sw__gpu_grow(p, cap, need, elem);
-}
-
 static sw_result append_mesh(sw__gpu_mesh *dst, const sw__gpu_mesh *src, sw_status *status)
 {
     const size_t v0 = dst->n_v;
@@ -126,16 +121,19 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 {
     const size_t idx0 = dst->mesh.n_idx, draw0 = dst->n_draws, loops0 = dst->n_loops;
     const size_t cps0 = dst->n_cps;
-    if (!grow((void **)&dst->draws, &dst->cap_draws, draw0 + src->n_draws, sizeof *dst->draws) ||
-        !grow((void **)&dst->trims, &dst->cap_trims, dst->n_trims + src->n_trims,
-              sizeof *dst->trims) ||
-        !grow((void **)&dst->shares, &dst->cap_shares, 2 * (dst->n_shares + src->n_shares),
-              sizeof *dst->shares) ||
-        !grow((void **)&dst->loops, &dst->cap_loops, loops0 + src->n_loops, sizeof *dst->loops) ||
-        !grow((void **)&dst->recs, &dst->cap_recs, dst->n_recs + src->n_recs, sizeof *dst->recs) ||
-        !grow((void **)&dst->cps, &dst->cap_cps, 4 * (cps0 + src->n_cps), sizeof *dst->cps) ||
-        !grow((void **)&dst->resident, &dst->cap_resident, dst->n_resident + src->n_resident,
-              sizeof *dst->resident))
+    if (!sw__grow((void **)&dst->draws, &dst->cap_draws, draw0 + src->n_draws,
+                  sizeof *dst->draws) ||
+        !sw__grow((void **)&dst->trims, &dst->cap_trims, dst->n_trims + src->n_trims,
+                  sizeof *dst->trims) ||
+        !sw__grow((void **)&dst->shares, &dst->cap_shares, 2 * (dst->n_shares + src->n_shares),
+                  sizeof *dst->shares) ||
+        !sw__grow((void **)&dst->loops, &dst->cap_loops, loops0 + src->n_loops,
+                  sizeof *dst->loops) ||
+        !sw__grow((void **)&dst->recs, &dst->cap_recs, dst->n_recs + src->n_recs,
+                  sizeof *dst->recs) ||
+        !sw__grow((void **)&dst->cps, &dst->cap_cps, 4 * (cps0 + src->n_cps), sizeof *dst->cps) ||
+        !sw__grow((void **)&dst->resident, &dst->cap_resident, dst->n_resident + src->n_resident,
+                  sizeof *dst->resident))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame geometry: out of memory");
     sw_result r = append_mesh(&dst->mesh, &src->mesh, status);
     if (r != SW_OK)

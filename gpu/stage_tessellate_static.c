@@ -15,6 +15,7 @@
  * between two sides each within ε_img (gpu/crack_fill.c argues the width). The overlap is sized
  * from both sides' errors because both are bounded by the same ε_img. */
 #include "frame_stages.h"
+#include "sw_hooks.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -34,8 +35,8 @@ static sw_result resident_level(sw__fr_tess *t, const occurrence *o, uint32_t un
                                 const sw_lod_static_level *lv, int32_t level, sw_status *status)
 {
     sw__fr_geometry *g = t->geo;
-    if (g->n_resident == g->cap_resident && !sw__gpu_grow((void **)&g->resident, &g->cap_resident,
-                                                          g->n_resident + 1, sizeof *g->resident))
+    if (g->n_resident == g->cap_resident &&
+        !sw__grow((void **)&g->resident, &g->cap_resident, g->n_resident + 1, sizeof *g->resident))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static levels: out of memory");
     const double *box = sw_lod_static_set_unit(t->env->statics, unit)->box, *m = o->world;
     sw__gpu_resident_draw *d = &g->resident[g->n_resident++];

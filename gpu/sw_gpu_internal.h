@@ -280,9 +280,6 @@ void sw__gpu_stash_free(struct sw__gpu_stash *s); /* NULL allowed; frees what it
 void *sw__gpu_stash_take(sw_gpu_context *ctx, sw__gpu_stash_role role);
 int sw__gpu_stash_put(sw_gpu_context *ctx, sw__gpu_stash_role role, void *item);
 
-/* Grows *p (capacity *cap elements of elem bytes) to hold `need`, doubling; 0 when out of memory
- * (*p and *cap unchanged). */
-int sw__gpu_grow(void **p, size_t *cap, size_t need, size_t elem);
 /* Liang–Barsky: 1 when segment ab meets the closed rectangle r = {x0, x1, y0, y1} (infinite
  * sides allowed), with t the parameter range of ab inside it; 0 when it misses (t untouched).
  * trim_tiles.c. */

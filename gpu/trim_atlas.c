@@ -98,7 +98,7 @@ static void evict_idle(struct sw__gpu_atlas *a);
 static int grow32(void **p, int32_t *cap, size_t need, size_t elem)
 {
     size_t c = (size_t)*cap;
-    int ok = sw__gpu_grow(p, &c, need, elem);
+    int ok = sw__grow(p, &c, need, elem);
     *cap = (int32_t)c;
     return ok;
 }
@@ -556,13 +556,13 @@ static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int
 static sw_result scratch_for_page(struct sw__gpu_atlas *a, size_t n_xy, size_t n_loops,
                                   sw_status *status)
 {
-    if (!sw__gpu_grow((void **)&a->clip, &a->cap_clip, 2 * n_xy + 2, sizeof *a->clip))
+    if (!sw__grow((void **)&a->clip, &a->cap_clip, 2 * n_xy + 2, sizeof *a->clip))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     size_t cap = a->cap_loops;
-    if (!sw__gpu_grow((void **)&a->first, &cap, n_loops + 1, sizeof *a->first))
+    if (!sw__grow((void **)&a->first, &cap, n_loops + 1, sizeof *a->first))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     cap = a->cap_loops;
-    if (!sw__gpu_grow((void **)&a->count, &cap, n_loops + 1, sizeof *a->count))
+    if (!sw__grow((void **)&a->count, &cap, n_loops + 1, sizeof *a->count))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "trim atlas: out of memory");
     a->cap_loops = cap;
     return SW_OK;

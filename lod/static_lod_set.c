@@ -248,21 +248,6 @@ typedef struct inst_build {
     int failed; /* 1: out of memory, 2: over the limit */
 } inst_build;
 
-static int grow(void **p, size_t *cap, size_t need, size_t size)
-{
-    if (need <= *cap)
-        return 1;
-    size_t c = *cap ? 2 * *cap : 256;
-    while (c < need)
-        c *= 2;
-    void *q = sw__realloc(*p, c * size);
-    if (!q)
-        return 0;
-    *p = q;
-    *cap = c;
-    return 1;
-}
-
 static uint64_t instance_hash(uint32_t unit, const double m[12])
 {
     uint64_t h = 1469598103934665603ull ^ unit;
@@ -296,8 +281,8 @@ static int grow_map(inst_build *b)
 static int new_instance(inst_build *b, uint32_t unit, const double world[12], size_t *out)
 {
     if (b->n_items >= INT32_MAX ||
-        !grow((void **)&b->items, &b->cap_items, b->n_items + 1, sizeof *b->items) ||
-        !grow((void **)&b->inst, &b->cap_inst, b->n_items + 1, sizeof *b->inst))
+        !sw__grow((void **)&b->items, &b->cap_items, b->n_items + 1, sizeof *b->items) ||
+        !sw__grow((void **)&b->inst, &b->cap_inst, b->n_items + 1, sizeof *b->inst))
         return 0;
     sw_sg_bvh_item *it = &b->items[b->n_items];
     memset(it, 0, sizeof *it);
@@ -340,7 +325,7 @@ static int visit_occurrence(void *ctx, uint32_t face, const double world[12], co
         b->failed = 2;
         return 1;
     }
-    if (!grow((void **)&b->occ, &b->cap_occ, b->n_occ + 1, sizeof *b->occ) ||
+    if (!sw__grow((void **)&b->occ, &b->cap_occ, b->n_occ + 1, sizeof *b->occ) ||
         !instance_of(b, sw_lod_static_set_unit_of(b->s, face), world, &i)) {
         b->failed = b->n_items >= INT32_MAX ? 2 : 1;
         return 1;

@@ -110,6 +110,23 @@ void *sw__realloc(void *ptr, size_t size)
     return fresh;
 }
 
+int sw__grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+    if (need <= *cap)
+        return 1;
+    size_t c = *cap ? *cap : 64;
+    while (c < need)
+        c = c > SIZE_MAX / 2 ? need : 2 * c;
+    if (elem && c > SIZE_MAX / elem)
+        return 0;
+    void *q = sw__realloc(*p, c * elem);
+    if (!q)
+        return 0;
+    *p = q;
+    *cap = c;
+    return 1;
+}
+
 char *sw__strdup(const char *text)
 {
     size_t n = strlen(text) + 1;

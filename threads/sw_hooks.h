@@ -24,6 +24,10 @@ extern "C" {
 SW_MODULE_ABI void *sw__malloc(size_t size);
 SW_MODULE_ABI void *sw__calloc(size_t count, size_t size); /* NULL when count * size overflows */
 SW_MODULE_ABI void *sw__realloc(void *ptr, size_t size); /* as C's realloc; ptr NULL: sw__malloc */
+/* The one growable array: makes *p (sw__realloc'd, *cap elements of elem bytes) hold at least
+ * `need`, doubling from 64; 1 on success, 0 when out of memory or the size overflows (*p and *cap
+ * unchanged then). */
+SW_MODULE_ABI int sw__grow(void **p, size_t *cap, size_t need, size_t elem);
 SW_MODULE_ABI void sw__free(void *ptr);                  /* NULL: nothing */
 char *sw__strdup(const char *text);
 /* align: a power of two, at most 4096; size need not be a multiple of it. */

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* bench/peers: the GLU peer (see peer_glu.h). */
 #include "peer_glu.h"
+#include "sw_hooks.h"
 
 #include "../tessellation/glu_nurbs.h"
 #include "../tessellation/vbo_draw.h"
@@ -148,8 +149,8 @@ static int visit(void *ctx, uint32_t face, const double m[12], const float color
     sw_sg_surface s;
     sw_sg_scene_face_surface(r->sg, face, &s);
     size_t n = (size_t)s.n_u * (size_t)s.n_v;
-    if (!sw__gpu_grow((void **)&r->occ, &r->cap_occ, r->n_occ + 1, sizeof *r->occ) ||
-        !sw__gpu_grow((void **)&r->world_cpw, &r->cap_world, r->n_world + 4 * n, sizeof(double))) {
+    if (!sw__grow((void **)&r->occ, &r->cap_occ, r->n_occ + 1, sizeof *r->occ) ||
+        !sw__grow((void **)&r->world_cpw, &r->cap_world, r->n_world + 4 * n, sizeof(double))) {
         r->oom = 1;
         return 1;
     }
@@ -169,9 +170,9 @@ static int visit(void *ctx, uint32_t face, const double m[12], const float color
 static int append_face(bt_glu_mesh *dst, const bt_glu_mesh *src)
 {
     size_t base = dst->n_v;
-    if (!sw__gpu_grow((void **)&dst->v, &dst->cap_v, (dst->n_v + src->n_v) * BT_GLU_VERTEX_FLOATS,
-              sizeof(float)) ||
-        !sw__gpu_grow((void **)&dst->idx, &dst->cap_idx, dst->n_idx + src->n_idx, sizeof(uint32_t)))
+    if (!sw__grow((void **)&dst->v, &dst->cap_v, (dst->n_v + src->n_v) * BT_GLU_VERTEX_FLOATS,
+                  sizeof(float)) ||
+        !sw__grow((void **)&dst->idx, &dst->cap_idx, dst->n_idx + src->n_idx, sizeof(uint32_t)))
         return -1;
     memcpy(dst->v + base * BT_GLU_VERTEX_FLOATS, src->v,
            src->n_v * BT_GLU_VERTEX_FLOATS * sizeof(float));
@@ -193,7 +194,7 @@ static int append_face(bt_glu_mesh *dst, const bt_glu_mesh *src)
 static int fitted_points(glu_run *r, const sw_sg_surface *s)
 {
     size_t n = (size_t)s->n_u * (size_t)s->n_v;
-    if (!sw__gpu_grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
+    if (!sw__grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
         return -1;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t i = 0; i < n; ++i)
@@ -385,7 +386,7 @@ static int tessellate_occurrence(glu_run *r, size_t k, const sw__gpu_view *view)
     sw_sg_surface s;
     sw_sg_scene_face_surface(r->sg, o->face, &s);
     size_t n = (size_t)s.n_u * (size_t)s.n_v;
-    if (!sw__gpu_grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
+    if (!sw__grow((void **)&r->scratch, &r->cap_scratch, 4 * n, sizeof(float)))
         return -1;
     const double *w = r->world_cpw + o->cpw;
     for (size_t i = 0; i < n; ++i) { /* eye-relative: w * (x - eye) */

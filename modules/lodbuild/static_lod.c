@@ -85,18 +85,13 @@ static void mesh_buf_free(mesh_buf *m)
     memset(m, 0, sizeof *m);
 }
 
+/* sw__grow for the builder's 32-bit counts (a capacity past 2^32 - 1 is noted as 2^32 - 1). */
 static int grow(void **p, uint32_t *cap, uint32_t need, size_t elem)
 {
-    if (need <= *cap)
-        return 1;
-    uint32_t c = *cap ? *cap : 1024;
-    while (c < need)
-        c = c > UINT32_MAX / 2 ? need : 2 * c;
-    void *q = sw__realloc(*p, (size_t)c * elem);
-    if (!q)
+    size_t c = *cap;
+    if (!sw__grow(p, &c, need, elem))
         return 0;
-    *p = q;
-    *cap = c;
+    *cap = c > UINT32_MAX ? UINT32_MAX : (uint32_t)c;
     return 1;
 }
 

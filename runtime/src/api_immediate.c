@@ -302,7 +302,7 @@ static sw_result make_occurrences(struct sw_rt_immediate *im, const sw_immediate
         uint32_t k = s->object_of[i];
         n += im->first_face[k + 1] - im->first_face[k];
     }
-    if (!sw__gpu_grow((void **)&im->occ, &im->cap_occ, n ? n : 1, sizeof *im->occ))
+    if (!sw__grow((void **)&im->occ, &im->cap_occ, n ? n : 1, sizeof *im->occ))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     size_t at = 0;
     for (uint32_t i = 0; i < d->draw_count; i++) {

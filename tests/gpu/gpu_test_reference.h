@@ -165,7 +165,7 @@ static inline int sw__ref_row(sw_test_ref_mesh *m, const sw_sg_polyline *loops, 
             const double ui = p[2 * i], vi = p[2 * i + 1], uj = p[2 * j], vj = p[2 * j + 1];
             if ((vi > v) == (vj > v))
                 continue;
-            if (!sw__gpu_grow((void **)&m->xs, &m->cap_xs, nx + 1, sizeof *m->xs))
+            if (!sw__grow((void **)&m->xs, &m->cap_xs, nx + 1, sizeof *m->xs))
                 return 0;
             m->xs[nx++] = ui + (v - vi) * (uj - ui) / (vj - vi);
         }
@@ -197,9 +197,9 @@ static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12]
     int32_t nu, nv;
     sw__ref_cells(m, &s, world, b, &nu, &nv);
     const size_t base = m->n_pos / 3, nvert = (size_t)(nu + 1) * (size_t)(nv + 1);
-    if (!sw__gpu_grow((void **)&m->pos, &m->cap_pos, m->n_pos + 3 * nvert, sizeof *m->pos) ||
-        !sw__gpu_grow((void **)&m->idx, &m->cap_idx, m->n_idx + 6 * (size_t)nu * (size_t)nv,
-                      sizeof *m->idx)) {
+    if (!sw__grow((void **)&m->pos, &m->cap_pos, m->n_pos + 3 * nvert, sizeof *m->pos) ||
+        !sw__grow((void **)&m->idx, &m->cap_idx, m->n_idx + 6 * (size_t)nu * (size_t)nv,
+                  sizeof *m->idx)) {
         m->failed = 1;
         return 1;
     }
@@ -212,7 +212,7 @@ static inline int sw__ref_visit(void *ctx, uint32_t face, const double world[12]
             m->n_pos += 3;
         }
     const double du = (b[1] - b[0]) / nu, dv = (b[3] - b[2]) / nv;
-    if (!sw__gpu_grow((void **)&m->keep, &m->cap_keep, 2 * (size_t)nu, 1)) {
+    if (!sw__grow((void **)&m->keep, &m->cap_keep, 2 * (size_t)nu, 1)) {
         m->failed = 1;
         return 1;
     }
