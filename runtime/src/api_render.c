@@ -461,7 +461,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
 static void statics_task(void *ctx)
 {
     sw_rt_renderer *r = ctx;
-    sw_status st = {0};
+    sw_status st = {0}, cst = {0}; /* the set's, the cache's (both reported) */
     /* the scene file's LOD cache (build-lod), when it has one made for these super-surfaces; a
      * stale or damaged cache is refused as a whole (nothing adopted) and the units are built as
      * they are needed instead, when a LOD builder is installed (the LOD-building module) */
@@ -470,13 +470,13 @@ static void statics_task(void *ctx)
     const char *path = sw_sg_scene_path_ptr(r->cache_scene->sg);
     const char *name = path && *path ? path : "the scene";
     const int can_build = sw_lod_static_builder() != NULL;
-    sw_result found = sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &st);
+    sw_result found = sw_sg_scene_lods(r->cache_scene->sg, &cache, &cache_bytes, &cst);
     if (found != SW_OK && !can_build) {
         /* nothing to draw from: no set, so no clustering either */
         sw__log(SW_LOG_WARN,
                 "static LODs: %s%s and no LOD builder is installed (the LOD-building module: "
                 "sw_lod_build_install): every face is drawn per frame",
-                found == SW_ERR_NOT_FOUND ? name : st.message,
+                found == SW_ERR_NOT_FOUND ? name : cst.message,
                 found == SW_ERR_NOT_FOUND ? " has no LOD cache" : "");
         atomic_store(&r->statics, NULL);
         atomic_store(&r->statics_state, 2);
@@ -491,14 +491,14 @@ static void statics_task(void *ctx)
         return;
     }
     if (found == SW_OK)
-        found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &st);
+        found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &cst);
     if (found == SW_ERR_NOT_FOUND)
         sw__log(SW_LOG_WARN,
                 "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
                 "frames need them (`splinewalk build-lod` stores them in a .sws)",
                 name);
     else if (found != SW_OK)
-        sw__log(SW_LOG_WARN, "static LODs: %s; %s", st.message,
+        sw__log(SW_LOG_WARN, "static LODs: %s; %s", cst.message,
                 can_build ? "the levels are built again as frames need them"
                           : "no LOD builder is installed: every face is drawn per frame");
     atomic_store(&r->statics, set);
