@@ -145,6 +145,12 @@ int sw_cli_build_lod(int argc, char **argv)
         return rc;
     if (sw_cli_check_output("build-lod", a.out, 0))
         return 1;
+    if (!sw_lod_static_builder()) {
+        /* else every super-surface fails and an empty cache would replace the file's */
+        fprintf(stderr, "splinewalk build-lod: this build has no LOD-building module "
+                        "(libsplinewalk_lodbuild, CGAL and OpenMesh): nothing written\n");
+        return 1;
+    }
     sw_status status = {0};
     sw_scene handle;
     const double t0 = sw__clock_ms();

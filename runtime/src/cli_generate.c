@@ -7,8 +7,10 @@
 #include "sw_safe_write.h"
 #include "sw_sg_export.h"
 #include "sw_sg_generate.h"
+#include "sw_sg_import.h"
 #include "sw_status_util.h"
 
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -74,8 +76,10 @@ static const char k_usage[] =
     "  --brep FILE         also write the scene as an OCCT BREP compound (instances share their\n"
     "                      TShape), which `splinewalk import` and OCCT-based programs read\n"
     "  --data DIR          the OCCT sample-data folder holding occ/MODERN_Chair_1.brep,\n"
-    "                      occ/Motor-c.brep and the other models (default\n"
-    "                      " DEFAULT_DATA ", Debian's occt-misc)\n"
+    "                      occ/Motor-c.brep and the other models, or each as a .sws of the\n"
+    "                      same name (occ/Motor-c.sws; a build without the import module reads\n"
+    "                      only these) (default " DEFAULT_DATA ",\n"
+    "                      Debian's occt-misc, else a bundle's share/splinewalk/data)\n"
     "  -h, --help          this text\n";
 
 typedef struct gen_args {
@@ -143,6 +147,13 @@ static int check_args(const gen_args *a)
                 a->kind, k_usage);
         return 2;
     }
+#if !SW_CLI_IMPORT
+    if (a->brep) {
+        fprintf(stderr, "splinewalk generate: --brep writes through OpenCASCADE, and this build has "
+                        "no import module\n");
+        return 2;
+    }
+#endif
     return 0;
 }
 
@@ -222,25 +233,62 @@ static sw_result write_grid(const gen_args *a, const sw_rt_scene *model, sw_sg_g
 
 /* ---- building ------------------------------------------------------------------------------ */
 
-/* Imports the models from the sample-data folder, each once. */
+/* A sample model: the OCCT file itself when the folder holds it (through the installed
+ * importer), else a .sws of the same name beside where it would be (occ/Motor-c.sws for
+ * occ/Motor-c.brep; scripts/bundle ships the parts so, for a build without the import module). A
+ * .sws written by `splinewalk import` holds the imported scene itself, so either way the
+ * generated scene is the same, byte for byte. */
+static sw_result load_model(const char *data, const char *file, sw_sg_scene **model,
+                            sw_status *status)
+{
+    char path[4096], sws[4096];
+    struct stat sb;
+    const int n = snprintf(path, sizeof path, "%s/%s", data, file);
+    if (n < 0 || (size_t)n >= sizeof path)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: the folder's name is too long", data);
+    if (stat(path, &sb) == 0 && S_ISREG(sb.st_mode)) {
+        sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL, NULL, 0};
+        return sw_sg_cad_import_file(&d, model, NULL, status);
+    }
+    const char *dot = strrchr(path, '.');
+    const int m = snprintf(sws, sizeof sws, "%.*s.sws",
+                           (int)(dot ? dot - path : (ptrdiff_t)strlen(path)), path);
+    if (m > 0 && (size_t)m < sizeof sws && stat(sws, &sb) == 0 && S_ISREG(sb.st_mode))
+        return sw_sg_scene_open(sws, model, status);
+    return sw__fail(status, SW_ERR_NOT_FOUND,
+                    "%s: no such file (nor %s): the models come from the OCCT sample data "
+                    "(Debian's occt-misc); give its folder with --data DIR",
+                    path, sws);
+}
+
+/* Loads the models, each once. */
 static sw_result load_models(const char *data, const char *const *files, int n,
                              sw_sg_scene **models, sw_status *status)
 {
     for (int m = 0; m < n; ++m) {
-        char path[4096];
-        snprintf(path, sizeof path, "%s/%s", data, files[m]);
-        struct stat sb;
-        if (stat(path, &sb) != 0 || !S_ISREG(sb.st_mode))
-            return sw__fail(status, SW_ERR_NOT_FOUND,
-                            "%s: no such file: the models come from the OCCT sample "
-                            "data (Debian's occt-misc); give its folder with --data DIR",
-                            path);
-        sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL, NULL, 0};
-        sw_result r = sw_sg_import_file(&d, &models[m], NULL, status);
+        sw_result r = load_model(data, files[m], &models[m], status);
         if (r != SW_OK)
             return r;
     }
     return SW_OK;
+}
+
+/* The sample-data folder when --data is not given: Debian's, else the one a bundle ships beside
+ * its bin/ (share/splinewalk/data, see scripts/bundle). */
+static const char *default_data(char *buf, size_t size)
+{
+    struct stat sb;
+    if (stat(DEFAULT_DATA, &sb) == 0 && S_ISDIR(sb.st_mode))
+        return DEFAULT_DATA;
+    char exe[4096];
+    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    char *slash = n > 0 ? (exe[n] = '\0', strrchr(exe, '/')) : NULL;
+    if (!slash)
+        return DEFAULT_DATA;
+    *slash = '\0';
+    const int k = snprintf(buf, size, "%s/../share/splinewalk/data", exe);
+    return k > 0 && (size_t)k < size && stat(buf, &sb) == 0 && S_ISDIR(sb.st_mode) ? buf
+                                                                                 : DEFAULT_DATA;
 }
 
 /* The BREP is built in memory first (an OCCT refusal leaves both outputs untouched) and written
@@ -251,7 +299,12 @@ static sw_result write_building(const gen_args *a, sw_sg_scene *scene, double *m
     const double t0 = sw__clock_ms();
     char *brep = NULL;
     size_t brep_len = 0;
+#if SW_CLI_IMPORT
     sw_result r = a->brep ? sw_sg_export_brep_text(scene, &brep, &brep_len, er, status) : SW_OK;
+#else
+    (void)er; /* check_args refused --brep */
+    sw_result r = SW_OK;
+#endif
     if (r == SW_OK)
         r = sw_sg_scene_save(scene, a->out, status);
     if (r == SW_OK && a->brep)
@@ -292,7 +345,8 @@ static int generate_scene(const gen_args *a)
     sw_status status = {0};
     sw_sg_scene *models[SW_SG_BUILDING_N_MODELS] = {0};
     const double t0 = sw__clock_ms();
-    sw_result r = load_models(a->data ? a->data : DEFAULT_DATA,
+    char bundled[4096];
+    sw_result r = load_models(a->data ? a->data : default_data(bundled, sizeof bundled),
                               vehicle ? sw_sg_vehicle_model_files : sw_sg_building_model_files, n,
                               models, &status);
     const double t1 = sw__clock_ms();
