@@ -4,7 +4,7 @@ JOBS ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 DEMO_OUT ?= demo-out
 
-.PHONY: all deps configure build demo test conformance clean
+.PHONY: all deps configure build demo test bundle conformance clean
 
 all: build
 
@@ -23,6 +23,10 @@ demo: build
 test: build
 	cd $(BUILD) && EGL_PLATFORM=surfaceless ctest --output-on-failure -j $(JOBS) $(CTEST_FLAGS)
 
+# One folder that runs on another x86-64 Linux with a GL/EGL driver (scripts/bundle, docs/bundle.md).
+bundle: build
+	scripts/bundle --full $(BUILD)
+
 # The full conformance sweep (tests/conformance/run_conformance.sh; about two hours on 2 cores):
 # every sample model, its IGES export and scaled copies, three views, against BRepMesh.
 conformance: build
@@ -31,4 +35,4 @@ conformance: build
 	  $(BUILD)/conformance full
 
 clean:
-	rm -rf $(BUILD) $(DEMO_OUT)
+	rm -rf $(BUILD) $(DEMO_OUT) build-bundle

@@ -76,10 +76,11 @@ static const char k_usage[] =
     "  --brep FILE         also write the scene as an OCCT BREP compound (instances share their\n"
     "                      TShape), which `splinewalk import` and OCCT-based programs read\n"
     "  --data DIR          the OCCT sample-data folder holding occ/MODERN_Chair_1.brep,\n"
-    "                      occ/Motor-c.brep and the other models, or each as a .sws of the\n"
-    "                      same name (occ/Motor-c.sws; a build without the import module reads\n"
-    "                      only these) (default " DEFAULT_DATA ",\n"
-    "                      Debian's occt-misc, else a bundle's share/splinewalk/data)\n"
+    "                      occ/Motor-c.brep and the other models; a .sws of the same name\n"
+    "                      (occ/Motor-c.sws, the imported file) is read instead where present,\n"
+    "                      and is all a build without the import module reads (default: a\n"
+    "                      bundle's share/splinewalk/data beside its bin/, else\n"
+    "                      " DEFAULT_DATA ", Debian's occt-misc)\n"
     "  -h, --help          this text\n";
 
 typedef struct gen_args {
@@ -233,11 +234,11 @@ static sw_result write_grid(const gen_args *a, const sw_rt_scene *model, sw_sg_g
 
 /* ---- building ------------------------------------------------------------------------------ */
 
-/* A sample model: the OCCT file itself when the folder holds it (through the installed
- * importer), else a .sws of the same name beside where it would be (occ/Motor-c.sws for
- * occ/Motor-c.brep; scripts/bundle ships the parts so, for a build without the import module). A
- * .sws written by `splinewalk import` holds the imported scene itself, so either way the
- * generated scene is the same, byte for byte. */
+/* A sample model: a .sws of the same name beside where the OCCT file would be (occ/Motor-c.sws
+ * for occ/Motor-c.brep; scripts/bundle ships the parts so, for a build without the import
+ * module), else the OCCT file itself through the installed importer. A .sws written by
+ * `splinewalk import` holds the imported scene itself, so either way the generated scene is the
+ * same, byte for byte. */
 static sw_result load_model(const char *data, const char *file, sw_sg_scene **model,
                             sw_status *status)
 {
@@ -246,15 +247,15 @@ static sw_result load_model(const char *data, const char *file, sw_sg_scene **mo
     const int n = snprintf(path, sizeof path, "%s/%s", data, file);
     if (n < 0 || (size_t)n >= sizeof path)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: the folder's name is too long", data);
-    if (stat(path, &sb) == 0 && S_ISREG(sb.st_mode)) {
-        sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL, NULL, 0};
-        return sw_sg_cad_import_file(&d, model, NULL, status);
-    }
     const char *dot = strrchr(path, '.');
     const int m = snprintf(sws, sizeof sws, "%.*s.sws",
                            (int)(dot ? dot - path : (ptrdiff_t)strlen(path)), path);
     if (m > 0 && (size_t)m < sizeof sws && stat(sws, &sb) == 0 && S_ISREG(sb.st_mode))
         return sw_sg_scene_open(sws, model, status);
+    if (stat(path, &sb) == 0 && S_ISREG(sb.st_mode)) {
+        sw_sg_import_desc d = {path, NULL, sw_cli_warning, NULL, NULL, 0};
+        return sw_sg_cad_import_file(&d, model, NULL, status);
+    }
     return sw__fail(status, SW_ERR_NOT_FOUND,
                     "%s: no such file (nor %s): the models come from the OCCT sample data "
                     "(Debian's occt-misc); give its folder with --data DIR",
@@ -273,13 +274,11 @@ static sw_result load_models(const char *data, const char *const *files, int n,
     return SW_OK;
 }
 
-/* The sample-data folder when --data is not given: Debian's, else the one a bundle ships beside
- * its bin/ (share/splinewalk/data, see scripts/bundle). */
+/* The sample-data folder when --data is not given: the one a bundle ships beside its bin/
+ * (share/splinewalk/data: the parts as .sws, see scripts/bundle), else Debian's. */
 static const char *default_data(char *buf, size_t size)
 {
     struct stat sb;
-    if (stat(DEFAULT_DATA, &sb) == 0 && S_ISDIR(sb.st_mode))
-        return DEFAULT_DATA;
     char exe[4096];
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
     char *slash = n > 0 ? (exe[n] = '\0', strrchr(exe, '/')) : NULL;

@@ -165,6 +165,10 @@ int sw_cli_render(int argc, char **argv)
     double t2 = sw__clock_ms();
     if (r == SW_OK)
         r = sw_renderer_draw(renderer, &a.frame, &stats, &status);
+    /* which GL and EGL platform drew it: llvmpipe, or which GPU */
+    char gl[256] = "";
+    if (renderer.id)
+        snprintf(gl, sizeof gl, "%s", sw_renderer_description_ptr(renderer));
     if (renderer.id)
         sw_renderer_destroy(renderer);
     sw_scene_destroy(scene);
@@ -174,7 +178,7 @@ int sw_cli_render(int argc, char **argv)
            a.frame.width ? a.frame.width : SW_DEFAULT_WIDTH,
            a.frame.height ? a.frame.height : SW_DEFAULT_HEIGHT,
            a.frame.error_px > 0 ? a.frame.error_px : SW_DEFAULT_ERROR_PX);
-    printf("load %.0f ms, GL context %.0f ms\n", t1 - t0, t2 - t1);
+    printf("load %.0f ms, GL context %.0f ms (%s)\n", t1 - t0, t2 - t1, gl);
     sw_cli_print_frame_stats("frame", &stats);
     return 0;
 }
