@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The select stage's traversal of the faces' bicubic hierarchies (Guthe et al. 2005 §7 over the
- * §6 hierarchies of lod/hierarchy_cache.c): the cut of each per-frame face occurrence.
+ * §6 hierarchies of lod/hierarchy/hierarchy_cache.c): the cut of each per-frame face occurrence.
  *
  * Per face occurrence, from the root down: a node whose box (grown by its error) misses the
  * frustum is culled; a node is chosen when its approximation error, in world units, is at most

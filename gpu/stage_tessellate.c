@@ -8,7 +8,7 @@
  * Order: static levels (stage_tessellate_static.c), then the per-frame faces by their hierarchy
  * cut (stage_tessellate_hierarchy.c) or their own Bézier patches (stage_tessellate_direct.c),
  * then meshes (stage_tessellate_mesh.c). Grid densities come from one rigorous bound
- * (lod/sampling.c's sw_lod_screen_segments) over the grid classes' segment counts. */
+ * (lod/bezier/sampling.c's sw_lod_screen_segments) over the grid classes' segment counts. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"

@@ -36,7 +36,7 @@ extern "C" {
 
 /* The range validation admits, so that no product the evaluation and the bounds form
  * overflows or underflows. The largest of them is a coordinate times the square of the net's
- * weight ratio (the rational second-derivative bounds of lod/sampling.c, error_bound.c's wratio),
+ * weight ratio (the rational second-derivative bounds of lod/bezier/sampling.c, error_bound.c's wratio),
  * times a transform's scale and a focal length in pixels (< 1e6), and then squared (distances,
  * segment counts): with every factor within these limits that is at most
  * (1e30 x 1e30 x 1e30 x 1e6)^2 = 1e192, finite; homogeneous products w x and 1 / w stay normal

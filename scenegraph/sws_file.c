@@ -20,7 +20,7 @@
  *   section table entry (40 bytes):
  *   0  u32 id (0 FACES, 1 LOOPS, 2 CURVES, 3 NODES, 4 ADJACENCY, 5 POOL, 6 STRINGS, 7 META,
  *            8 LODS: optional, the static-LOD cache, opaque bytes with their own format owned by
- *            lod/static_lod_io.c; only when the count is 9 or 11, and may be empty with 11;
+ *            lod/static/static_lod_io.c; only when the count is 9 or 11, and may be empty with 11;
  *            9 MESHES, 10 INDICES: triangle meshes, only when the count is 11)
  *   4  u32 reserved, zero
  *   8  u64 offset of the section (16-byte aligned, after the table, sections do not overlap)

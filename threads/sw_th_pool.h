@@ -67,7 +67,7 @@ typedef void (*sw_th_task_fn)(void *ctx);
  * profile's columns). The first, OTHER, is the zero default. */
 #define SW_TH_TASK_KINDS(X, A)                                                                     \
     X(A, OTHER, "other", "tasks of no other kind")                                                 \
-    X(A, HIERARCHY, "hierarchy", "bicubic hierarchy builds (lod/hierarchy_cache.c)")               \
+    X(A, HIERARCHY, "hierarchy", "bicubic hierarchy builds (lod/hierarchy/hierarchy_cache.c)")               \
     X(A, HIERARCHY_WAIT, "hierarchy_wait",                                                         \
       "converged frames' tasks waiting for a hierarchy build (their own time, waits included)")    \
     X(A, REFINE, "refine", "refinements below a hierarchy's leaves")                               \

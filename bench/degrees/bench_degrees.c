@@ -6,7 +6,7 @@
  * (animated.c). The surface changes every frame, so every frame redoes the whole chain:
  *
  *   approximation  the rational cubic approximation of the trim loop (timed here), and the
- *                  bicubic hierarchy over the trim region's box (lod/hierarchy.c: extraction, G1
+ *                  bicubic hierarchy over the trim region's box (lod/hierarchy/hierarchy.c: extraction, G1
  *                  reduction, leaf subdivision, median-cut simplification, rigorous bounds,
  *                  derivative constants), built in the worker pool by the frame itself from a
  *                  fresh sw_lod_cache of the frame's scene, with any refinement below its leaves

@@ -15,7 +15,7 @@
  *              chunks shared with a pool (desc.pool) of 1 worker, or of 2 (the parallel
  *              visibility stage on one and two more threads), with the join's wait (ms_join);
  *   density    planes' patches given the coarsest grid by the affine test (fast, the default) or
- *              by the full screen-space bound (lod/sampling.c sw_lod_screen_affine_fast), on one
+ *              by the full screen-space bound (lod/bezier/sampling.c sw_lod_screen_affine_fast), on one
  *              thread, with the triangles and differing pixels of view 0 as for affine;
  *   borders    the border cache (gpu/border_cache.c: loops and samples kept between frames) on,
  *              the default, or off, on one thread; each variant's passes one after another, so

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* bench/supersurface: clustering time per model (lod/sw_lod_supersurface.h).
+/* bench/supersurface: clustering time per model (lod/static/sw_lod_supersurface.h).
  *
  * Usage: bench_supersurface [--runs N] [--alpha DEG] MODEL...
  * Prints per model: faces, patches, clusters, patches per cluster, and the median and minimum

@@ -3,7 +3,7 @@
  * promise (Guthe et al. 2005 §5.2, §7). For every patch piece a frame draws (the frame's debug
  * hook), each link of the chain ε_img -> object tolerance -> Filip bound -> segments -> grid class
  * is measured against dense evaluation:
- *   (a) derivative bounds (lod/sampling.c) vs the sampled sup of |S_ss|, |S_st|, |S_tt| over the
+ *   (a) derivative bounds (lod/bezier/sampling.c) vs the sampled sup of |S_ss|, |S_st|, |S_tt| over the
  *       drawn part of the patch;
  *   (b) Filip's bound at the drawn grid vs the largest object-space deviation of its triangles;
  *   (c) the object tolerance vs the screen error it turns into (px per object unit);

@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: MIT
-# Embeds GLSL sources in a C header at build time: for every DIR/NAME.STAGE.glsl a
+# Embeds GLSL sources in a C header at build time: for every NAME.STAGE.glsl of FILES a
 # `static const char sw_glsl_NAME_STAGE[]` holding its bytes and a terminating NUL.
-# Usage: cmake -DOUT=header.h -DDIR=glsl_dir -P embed_glsl.cmake
-file(GLOB files ${DIR}/*.glsl)
+# Usage: cmake -DOUT=header.h -DFILES=a.glsl,b.glsl -P embed_glsl.cmake (gpu/CMakeLists.txt lists
+# them)
+string(REPLACE "," ";" files "${FILES}")
 list(SORT files)
 string(REPEAT "0x[0-9a-f][0-9a-f]," 16 row) # CMake's regular expressions have no {n}
 set(text "/* Generated from gpu/glsl/NAME.glsl by gpu/glsl/embed_glsl.cmake: do not edit. */\n")

@@ -31,7 +31,7 @@
  * metric.
  *
  * Where the paper is loose: §4.1 obtains M1..M3 by solving polynomial systems (elimination
- * theory); we use the rigorous but coarser control-net bounds of lod/sampling.c over each patch.
+ * theory); we use the rigorous but coarser control-net bounds of lod/bezier/sampling.c over each patch.
  * §4.3 says trimming curves "are treated like boundary curves" without saying how finely they are
  * sampled; ours are sampled for δ_trim in object space.
  */

@@ -7,7 +7,7 @@
  *    (sw_sg_bvh_build_boxes);
  *  - grids of >= 10,000 terrain instances made by sw_sg_generate_grid (the library behind
  *    `splinewalk generate grid`), 3D and 2D: a BVH over instance occurrences;
- *  - with static LODs (lod/sw_lod_static_set.h), the static set's BVH whose leaves are
+ *  - with static LODs (lod/static/sw_lod_static_set.h), the static set's BVH whose leaves are
  *    super-surface (unit) instances, on terrain.brep, on a grid of 10,000 terrain instances and on
  *    a grid of 400 CrankArms (25 units each: 10,000 unit instances). First the instances
  *    themselves: every face occurrence of the scene's traversal in exactly one instance, of its

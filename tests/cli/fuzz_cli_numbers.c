@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* libFuzzer harness for the command line's numbers (runtime/src/cli_numbers.c) and the decimal
+/* libFuzzer harness for the command line's numbers (tools/splinewalk/cli_numbers.c) and the decimal
  * reader under them (scenegraph/decimal.c). The first byte picks the parser, the rest is its text.
  * Each accepted text must be what an independent reading says it is:
  * - the decimal reader consumes exactly the longest prefix a POSIX regular expression of its

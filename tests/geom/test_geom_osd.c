@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The uniform bicubic B-spline evaluator against OpenSubdiv, linked for real through the
- * lod/uniform_bicubic_osd.cpp shim: random regular control grids (random heights and jittered
+ * lod/osd/uniform_bicubic_osd.cpp shim: random regular control grids (random heights and jittered
  * x, y), every interior face whose 4x4 neighbourhood lies in the grid, random (s, t) plus the
  * corners. Compared directly, in Bézier form (sw_sg_uniform_bicubic_to_bezier + Bézier patch
  * evaluation), and as a uniform unclamped B-spline surface through the NURBS evaluator and its

@@ -7,7 +7,7 @@
  * double from the face's exact NURBS (sw_sg_surface_eval: knot vectors and control points, no
  * Bézier extraction), over a uniform grid of its trim box whose cells project to at most
  * k_ref_cell_px pixels (measured on a 33 x 33 sampling of the face in the frame's view, not by
- * lod/sampling.c's bounds), each cell's two triangles kept when their centroid is inside the
+ * lod/bezier/sampling.c's bounds), each cell's two triangles kept when their centroid is inside the
  * face's trim loops by exact even-odd classification (sw_sg_trim_classify's rule, by scanlines, on
  * loops flattened to 1e-7 of the trim box; no trim texture). It is drawn by
  * sw_gpu_render_triangles (the same camera, projection and depth convention, nothing else of the

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Back-patch culling (Kumar et al. 1997 §4.4; lod/sw_lod_face_cones.h, desc.face_cones):
+/* Back-patch culling (Kumar et al. 1997 §4.4; lod/static/sw_lod_face_cones.h, desc.face_cones):
  *  - on closed models, frames with culling equal frames without it from views all around the
  *    model up to silhouette slivers of the back faces' tessellation (see `slivers`: culling must
  *    never remove anything visible), while some occurrences are culled (printed per view) — a test

@@ -8,7 +8,7 @@
  * of the vertices, positions evaluated in double from the frame's Bézier control points) against
  * the exact surface at the same (u, v) — sw_sg_surface_eval of the face's NURBS, through the
  * occurrence transform — both projected through the frame's camera in double. This is independent
- * of the frame's Bézier extraction and of its bounds (lod/sampling.c).
+ * of the frame's Bézier extraction and of its bounds (lod/bezier/sampling.c).
  * Skipped: points whose (u, v) is outside the face's trim loops (exact even-odd classification on
  * loops flattened to 1e-7 of the parameter box; the trim texture discards them), and points not
  * on screen (behind the near plane or outside the viewport by more than 1 px).

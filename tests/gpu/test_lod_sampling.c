@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* lod/sampling.c against independent references (no GL):
+/* lod/bezier/sampling.c against independent references (no GL):
  *  - the derivative bounds of random rational Bézier patches (degrees 1..5, weights 0.2..5, far
  *    from the origin) are >= the derivatives the scenegraph's NURBS evaluator
  * (sw_sg_surface_eval_d2) finds on a dense grid, equal for a polynomial quadratic (tight), and

@@ -8,7 +8,7 @@
  * the model files given on the command line.
  *
  * Usage: test_lod_bounds [--random N] [--stride K] [model files...]
- * Also builds every face's hierarchy (lod/hierarchy.c) and checks its nodes' accumulated bounds
+ * Also builds every face's hierarchy (lod/hierarchy/hierarchy.c) and checks its nodes' accumulated bounds
  * against the exact NURBS surface.
  * Prints, per kind: items checked, violations (measured > bound), exact cases (bound at rounding
  * level, left out of the ratio), median and minimum of measured / bound. Fails (exit 1) on any

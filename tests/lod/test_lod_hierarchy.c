@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The per-surface bicubic hierarchy (lod/sw_lod_hierarchy.h, Guthe et al. 2005 §6):
+/* The per-surface bicubic hierarchy (lod/hierarchy/sw_lod_hierarchy.h, Guthe et al. 2005 §6):
  *  - structure: children split their parent's rectangle exactly, leaves tile the domain (or the
  *    requested uv box), leaves meet the tolerance, errors never decrease towards the root;
  *  - every representable node's error bounds the distance between the exact NURBS surface

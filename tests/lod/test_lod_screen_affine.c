@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The affine fast path of the screen-space grid density (lod/sampling.c affine_segments): planes'
+/* The affine fast path of the screen-space grid density (lod/bezier/sampling.c affine_segments): planes'
  * patches take the coarsest allowed grid without the full bound, and must stay within ε_img.
  * Random views of random patches, degrees 1-5 in each direction, eye-relative as the frame gives
  * them, over random ranges of their local domain:

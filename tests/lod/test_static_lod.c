@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Static LODs (Kumar et al. 1997 §4.1-§4.3; lod/sw_lod_static.h): every face of every model
+/* Static LODs (Kumar et al. 1997 §4.1-§4.3; lod/static/sw_lod_static.h): every face of every model
  * given on the command line becomes one super-surface (all its patches), is tessellated within δ
  * and simplified into levels, each declared with a certified ε_k; then an independent measurement
  * against the exact surface — random surface points and random points of the triangles, each
@@ -40,7 +40,7 @@ typedef struct totals {
     size_t memory;
 } totals;
 
-/* The patches of one face: its whole Bézier grid over the uv_box (as lod/hierarchy.c builds). */
+/* The patches of one face: its whole Bézier grid over the uv_box (as lod/hierarchy/hierarchy.c builds). */
 static uint32_t face_patches(const sw_sg_scene *scene, uint32_t face, sw_lod_static_patch **out)
 {
     const sw_sg_face_rec *fr = &sw_sg_scene_view_ptr(scene)->faces[face];

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* libFuzzer harness for camera paths (runtime/src/camera_path.c): every input is parsed and
+/* libFuzzer harness for camera paths (tools/splinewalk/camera_path.c): every input is parsed and
  * validated; a failure must leave no path and name the input with a line; an accepted path must
  * evaluate to cameras the renderer accepts (finite, fovy in (0, 180)) at every frame time when its
  * numbers are moderate. */

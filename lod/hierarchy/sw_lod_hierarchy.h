@@ -13,7 +13,7 @@
  * where eps_s is the object-space tolerance given to sampling (the paper splits ε equally between
  * approximation and sampling, §7) and eps_t the one given to trimming. With the node's bicubic S
  * over its local [0,1]^2 and M_ss, M_st, M_tt, G_s, G_t bounds of |S_ss|, |S_st|, |S_tt|, |S_s|,
- * |S_t| (sw_lod_rational_bezier_bounds, lod/sampling.c): seg_c[0] = sqrt(M_ss + M_st) / 2,
+ * |S_t| (sw_lod_rational_bezier_bounds, lod/bezier/sampling.c): seg_c[0] = sqrt(M_ss + M_st) / 2,
  * seg_c[1] = sqrt(M_tt + M_st) / 2 (from n = ceil(sqrt((M_dir + M_st) / (4 eps_s))), i.e.
  * (ds^2 (M_ss + M_st) + dt^2 (M_tt + M_st)) / 8 <= eps_s), tex_c = (G_s, G_t) for a texture
  * spanning the node's whole rectangle (scale by the covered fraction otherwise).

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* A scene's static LODs built lazily in the worker pool (lod/sw_lod_static_set.h says how the
+/* A scene's static LODs built lazily in the worker pool (lod/static/sw_lod_static_set.h says how the
  * units are formed and how slots are published). */
 #include "sw_clock.h"
 #include "sw_lod_static_set.h"
@@ -428,7 +428,7 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     s->pool = pool;
     s->serial = atomic_fetch_add(&g_set_serial, 1) + 1;
     s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    /* resolved now: the cache key (lod/static_lod_io.c) hashes the values the chains get */
+    /* resolved now: the cache key (lod/static/static_lod_io.c) hashes the values the chains get */
     sw_result r = sw_lod_static_desc_resolve(desc ? &desc->levels : NULL, &s->levels, status);
     if (r == SW_OK)
         r = sw_lod_supersurfaces_build(scene, desc ? &desc->clustering : NULL, &s->ss, status);

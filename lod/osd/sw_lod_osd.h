@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* OpenSubdiv limit-surface evaluation behind a C interface (lod/uniform_bicubic_osd.cpp).
+/* OpenSubdiv limit-surface evaluation behind a C interface (lod/osd/uniform_bicubic_osd.cpp).
  *
  * The independent reference for the project's uniform bicubic B-spline evaluator (the patch type
  * of Guthe et al. 2005 §6's bi-cubic hierarchy and of OpenSubdiv's regular Catmull-Clark faces):

@@ -3,7 +3,7 @@
  *
  * Input: a set of trimmed rational Bézier patches (a super-surface, §3), each named by its face and
  * its (iu, iv) in the face's Bézier grid extracted over the face's uv_box, every net cut to its
- * knot rectangle intersected with uv_box — the patches lod/hierarchy.c builds its trees from.
+ * knot rectangle intersected with uv_box — the patches lod/hierarchy/hierarchy.c builds its trees from.
  *
  * Level 0, the adaptive tessellation within δ (§4.1, §4.3): per face, a constrained Delaunay
  * triangulation (CGAL, modules/lodbuild/trim_mesh_cgal.cpp) of the part of the face's (u, v) domain
@@ -40,7 +40,7 @@ extern "C" {
 #endif
 
 /* One Bézier patch of a super-surface. Same layout as sw_lod_ss_patch of the super-surface
- * clustering (lod/sw_lod_supersurface.h), so a cluster's patch range can be passed as it is. */
+ * clustering (lod/static/sw_lod_supersurface.h), so a cluster's patch range can be passed as it is. */
 typedef struct sw_lod_static_patch {
     uint32_t face;
     uint16_t iu, iv;
