@@ -23,6 +23,10 @@
 #include <stdatomic.h>
 #include <string.h>
 
+/* The pool's task kind of the chunks. */
+static sw_th_task_kind_slot k_chunk =
+    SW_TH_TASK_KIND_SLOT("frame_stage", "chunks of a frame's tessellation taken by workers");
+
 enum {
     MIN_PICKS_PER_CHUNK = 16, /* below it a chunk's bookkeeping outweighs its picks */
     CHUNKS_PER_THREAD = 4,    /* chunks per participating thread, for the load's balance */
@@ -261,7 +265,7 @@ static size_t submit_helpers(tess_job *job, size_t helpers)
     for (; k < helpers; ++k) {
         atomic_fetch_add_explicit(&job->refs, 1, memory_order_relaxed);
         sw_th_task task = {helper_task, job,  SW_TH_PRIORITY_FRAME,  NULL,
-                           0,           NULL, SW_TH_TASK_FRAME_STAGE};
+                           0,           NULL, sw_th_task_kind_of(&k_chunk)};
         if (sw_th_pool_submit(job->pool, &task) != SW_OK) {
             atomic_fetch_sub_explicit(&job->refs, 1, memory_order_relaxed);
             break; /* the chunks left are claimed by the preparing thread */

@@ -76,12 +76,12 @@ typedef struct worker {
     /* Written by the owner only (load + store), read by sw_th_pool_stats_get. */
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t executed;
     _Atomic uint64_t cancelled, steals, stolen, sleeps;
-    _Atomic uint64_t kind_executed[SW_TH_TASK_KIND_COUNT];
+    _Atomic uint64_t kind_executed[SW_TH_TASK_KIND_MAX];
     /* Timed tasks' own time: kind_ns (ended segments) and the segment running now (seg_kind,
-     * SW_TH_TASK_KIND_COUNT for none, since seg_start), under the seqlock seg_seq (odd while the
+     * SW_TH_TASK_KIND_MAX for none, since seg_start), under the seqlock seg_seq (odd while the
      * owner updates them) so that a reader adds the running segment to a consistent total. */
     _Atomic uint64_t seg_seq;
-    _Atomic uint64_t kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic uint64_t kind_ns[SW_TH_TASK_KIND_MAX];
     _Atomic uint32_t seg_kind;
     _Atomic uint64_t seg_start;
 } worker;
@@ -99,7 +99,7 @@ struct sw_th_pool {
     alignas(SW_TH_CACHE_LINE) _Atomic(node *) spare[SPARE_SLOTS];
     alignas(SW_TH_CACHE_LINE) _Atomic uint64_t ext_executed;
     _Atomic uint64_t ext_cancelled, ext_steals;
-    _Atomic uint64_t ext_kind_executed[SW_TH_TASK_KIND_COUNT], ext_kind_ns[SW_TH_TASK_KIND_COUNT];
+    _Atomic uint64_t ext_kind_executed[SW_TH_TASK_KIND_MAX], ext_kind_ns[SW_TH_TASK_KIND_MAX];
     _Atomic int time_tasks;      /* read per task (relaxed): a switch, it orders nothing */
     _Atomic int64_t inject_peak; /* longest injection queue a submission made since the last
                                     sw_th_pool_inject_peak_take */
@@ -111,8 +111,8 @@ struct sw_th_pool {
 static _Thread_local worker *tls_worker;
 static _Thread_local uint64_t tls_rng;
 /* The calling thread's running segment of timed task time: the kind of its innermost timed task
- * (SW_TH_TASK_KIND_COUNT: none) and since when it runs uninterrupted by a nested task. */
-static _Thread_local uint32_t tls_seg_kind = SW_TH_TASK_KIND_COUNT;
+ * (SW_TH_TASK_KIND_MAX: none) and since when it runs uninterrupted by a nested task. */
+static _Thread_local uint32_t tls_seg_kind = SW_TH_TASK_KIND_MAX;
 static _Thread_local uint64_t tls_seg_start;
 /* The calling thread's waits (sw_th_thread_waits): outermost waits counted, their time summed. */
 static _Thread_local uint32_t tls_wait_depth;
@@ -434,7 +434,7 @@ static void group_release(sw_th_pool *pool, sw_th_group *g)
 }
 
 /* Ends the calling thread's running segment (its time goes to the segment's kind) and starts one
- * of kind `to` (SW_TH_TASK_KIND_COUNT: none). A worker publishes both under its seqlock; a thread
+ * of kind `to` (SW_TH_TASK_KIND_MAX: none). A worker publishes both under its seqlock; a thread
  * outside the pool (waiting on a group) adds the ended segment to the pool's shared totals.
  * Writer side of the seqlock: the odd store, then release stores of the data (a reader that
  * acquires any of them also sees the odd count), then the even store (release). The clock is
@@ -445,7 +445,7 @@ static void switch_segment(sw_th_pool *pool, worker *w, uint32_t to)
     const uint32_t from = tls_seg_kind;
     if (!w) {
         const uint64_t now = sw__clock_ns();
-        if (from < SW_TH_TASK_KIND_COUNT)
+        if (from < SW_TH_TASK_KIND_MAX)
             atomic_fetch_add_explicit(&pool->ext_kind_ns[from], now - tls_seg_start,
                                       memory_order_relaxed);
         tls_seg_kind = to;
@@ -455,7 +455,7 @@ static void switch_segment(sw_th_pool *pool, worker *w, uint32_t to)
     const uint64_t seq = atomic_load_explicit(&w->seg_seq, memory_order_relaxed);
     atomic_store_explicit(&w->seg_seq, seq + 1, memory_order_relaxed);
     const uint64_t now = sw__clock_ns();
-    if (from < SW_TH_TASK_KIND_COUNT)
+    if (from < SW_TH_TASK_KIND_MAX)
         atomic_store_explicit(&w->kind_ns[from],
                               atomic_load_explicit(&w->kind_ns[from], memory_order_relaxed) + now -
                                   tls_seg_start,
@@ -690,7 +690,7 @@ static sw_result pool_init_workers(sw_th_pool *pool, const sw_th_pool_desc *d)
         worker *w = &pool->workers[i];
         w->pool = pool;
         w->index = i;
-        atomic_store_explicit(&w->seg_kind, SW_TH_TASK_KIND_COUNT, memory_order_relaxed);
+        atomic_store_explicit(&w->seg_kind, SW_TH_TASK_KIND_MAX, memory_order_relaxed);
         w->rng = (uint64_t)d->seed * 0x9e3779b97f4a7c15u + i + 1;
         for (int p = 0; p < SW_TH_PRIORITY_COUNT; p++)
             if (sw_th_deque_init_owner(&w->deques[p], d->deque_capacity) != SW_OK)
@@ -761,7 +761,7 @@ sw_result sw_th_pool_submit(sw_th_pool *pool, const sw_th_task *task)
 {
     assert(pool && task && task->fn);
     assert((unsigned)task->priority < SW_TH_PRIORITY_COUNT);
-    assert((unsigned)task->kind < SW_TH_TASK_KIND_COUNT);
+    assert((unsigned)task->kind < SW_TH_TASK_KIND_MAX);
     worker *w = own_worker(pool);
     node *n = node_alloc(pool, w);
     if (!n)
@@ -874,9 +874,9 @@ int sw_th_pool_current_worker(const sw_th_pool *pool)
 /* Adds worker w's timed task time to ns[]: its ended segments and the one running now. Reader
  * side of the seqlock (switch_segment): an even count, acquire loads of the data, the count
  * again (the acquire loads keep it after them); retried only while the owner is mid-update. */
-static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_COUNT])
+static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_MAX])
 {
-    uint64_t total[SW_TH_TASK_KIND_COUNT], start, seq;
+    uint64_t total[SW_TH_TASK_KIND_MAX], start, seq;
     uint32_t kind;
     for (;;) {
         seq = atomic_load_explicit(&w->seg_seq, memory_order_acquire);
@@ -884,7 +884,7 @@ static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_COUNT])
             cpu_relax();
             continue;
         }
-        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+        for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++)
             total[k] = atomic_load_explicit(&w->kind_ns[k], memory_order_acquire);
         kind = atomic_load_explicit(&w->seg_kind, memory_order_acquire);
         start = atomic_load_explicit(&w->seg_start, memory_order_acquire);
@@ -892,9 +892,9 @@ static void add_task_time(worker *w, uint64_t ns[SW_TH_TASK_KIND_COUNT])
             break;
     }
     const uint64_t now = sw__clock_ns();
-    if (kind < SW_TH_TASK_KIND_COUNT && now > start)
+    if (kind < SW_TH_TASK_KIND_MAX && now > start)
         total[kind] += now - start;
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+    for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++)
         ns[k] += total[k];
 }
 
@@ -908,12 +908,12 @@ void sw_th_pool_stats_get(sw_th_pool *pool, sw_th_pool_stats *out)
         out->steals += atomic_load_explicit(&w->steals, memory_order_relaxed);
         out->stolen_tasks += atomic_load_explicit(&w->stolen, memory_order_relaxed);
         out->sleeps += atomic_load_explicit(&w->sleeps, memory_order_relaxed);
-        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+        for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++)
             out->executed_by_kind[k] +=
                 atomic_load_explicit(&w->kind_executed[k], memory_order_relaxed);
         add_task_time(w, out->ns_by_kind);
     }
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+    for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++) {
         out->executed_by_kind[k] +=
             atomic_load_explicit(&pool->ext_kind_executed[k], memory_order_relaxed);
         out->ns_by_kind[k] += atomic_load_explicit(&pool->ext_kind_ns[k], memory_order_relaxed);
@@ -950,14 +950,4 @@ int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool)
 {
     /* relaxed: a statistic; a submission racing with the reset counts in one period or the next */
     return atomic_exchange_explicit(&pool->inject_peak, 0, memory_order_relaxed);
-}
-
-const char *sw_th_task_kind_name(sw_th_task_kind kind)
-{
-    static const char *const names[SW_TH_TASK_KIND_COUNT] = {
-#define SW_TH__KIND_NAME(a, id, name, what) name,
-        SW_TH_TASK_KINDS(SW_TH__KIND_NAME, ~)
-#undef SW_TH__KIND_NAME
-    };
-    return (unsigned)kind < SW_TH_TASK_KIND_COUNT ? names[kind] : "?";
 }

@@ -62,27 +62,12 @@ typedef struct sw_th_group {
 
 typedef void (*sw_th_task_fn)(void *ctx);
 
-/* What a task does, for the pool's per-kind accounting only (scheduling ignores it). The table
- * calls X(A, id, name, what) per kind, A passed through (a table nested in another's, like the
- * profile's columns). The first, OTHER, is the zero default. */
-#define SW_TH_TASK_KINDS(X, A)                                                                     \
-    X(A, OTHER, "other", "tasks of no other kind")                                                 \
-    X(A, HIERARCHY, "hierarchy", "bicubic hierarchy builds (lod/hierarchy/hierarchy_cache.c)")               \
-    X(A, HIERARCHY_WAIT, "hierarchy_wait",                                                         \
-      "converged frames' tasks waiting for a hierarchy build (their own time, waits included)")    \
-    X(A, REFINE, "refine", "refinements below a hierarchy's leaves")                               \
-    X(A, STATIC_CLUSTER, "static_cluster", "super-surface clustering of a scene (static LODs)")    \
-    X(A, STATIC_BUILD, "static_build", "static LOD builds of one super-surface")                   \
-    X(A, STATIC_RETIRE, "static_retire", "freeing a retired set of static LODs")                   \
-    X(A, COMPILE, "compile", "node scenes' compile tasks")                                         \
-    X(A, FRAME_STAGE, "frame_stage", "chunks of a frame's tessellation taken by workers")
-
-typedef enum sw_th_task_kind {
-#define SW_TH__KIND_ENUM(a, id, name, what) SW_TH_TASK_##id,
-    SW_TH_TASK_KINDS(SW_TH__KIND_ENUM, ~)
-#undef SW_TH__KIND_ENUM
-        SW_TH_TASK_KIND_COUNT
-} sw_th_task_kind;
+/* What a task does, for the pool's per-kind accounting only (scheduling ignores it). The layers
+ * that submit tasks register their kinds by name (sw_th_task_kind_register: the hierarchy cache
+ * its builds and refinements, the static set its builds, the frame its chunks...); the pool
+ * knows none of them. 0, "other", is the default. */
+typedef uint32_t sw_th_task_kind;
+enum { SW_TH_TASK_OTHER = 0, SW_TH_TASK_KIND_MAX = 16 };
 
 /* Copied at submission. Zero means default for every field but fn. */
 typedef struct sw_th_task {
@@ -110,13 +95,13 @@ typedef struct sw_th_pool_stats {
     uint64_t steals;       /* successful steal operations (one or a batch) */
     uint64_t stolen_tasks; /* tasks moved by them */
     uint64_t sleeps;       /* times a worker blocked for lack of work */
-    uint64_t executed_by_kind[SW_TH_TASK_KIND_COUNT]; /* of executed, by sw_th_task.kind */
+    uint64_t executed_by_kind[SW_TH_TASK_KIND_MAX]; /* of executed, by sw_th_task.kind */
     /* Time in the tasks of each kind while timing was on, ns: a task's own time, without that of
      * the tasks it ran nested (in sw_th_group_wait), so the kinds add up to the busy time. A
      * worker's running task counts up to the call (each sample is, up to a store buffer's delay,
      * at least the one before); a thread outside the pool that runs tasks while waiting on a
      * group adds its time when each of its task segments ends. */
-    uint64_t ns_by_kind[SW_TH_TASK_KIND_COUNT];
+    uint64_t ns_by_kind[SW_TH_TASK_KIND_MAX];
 } sw_th_pool_stats;
 
 /* Token. cancel makes every task of the older generations stale; returns the new generation. */
@@ -181,8 +166,27 @@ SW_API int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRI
  * it. A backlog the end-of-frame snapshot of sw_th_pool_queued misses when the workers catch up
  * within the frame. */
 SW_API int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool);
-/* "hierarchy", ...; "?" for a value out of range. */
+/* Registers a task kind under `name` (and a line saying what its tasks do), both strings of
+ * static lifetime; returns its value. A name registered before gets its value again; when all
+ * SW_TH_TASK_KIND_MAX values are taken, SW_TH_TASK_OTHER. Any thread; takes a lock: register once
+ * (e.g. under pthread_once), not per task. */
+SW_API sw_th_task_kind sw_th_task_kind_register(const char *name, const char *what);
+/* A kind registered on its first use, for a layer's static table:
+ *   static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("static_build", "...");
+ *   task.kind = sw_th_task_kind_of(&k_build);
+ * The first call registers (a lock, once: two threads racing register the same name and get the
+ * same value); later calls are one atomic load. */
+typedef struct sw_th_task_kind_slot {
+    const char *name, *what;
+    _Atomic uint32_t value; /* the kind + 1; 0 until registered */
+} sw_th_task_kind_slot;
+#define SW_TH_TASK_KIND_SLOT(name, what) {(name), (what), 0}
+SW_API sw_th_task_kind sw_th_task_kind_of(sw_th_task_kind_slot *slot);
+/* Kinds registered so far (values 0 .. count - 1; "other" is always there). */
+SW_API uint32_t sw_th_task_kind_count(void);
+/* The registered name and line of a kind; "?" and "" for a value not registered. */
 SW_API const char *sw_th_task_kind_name(sw_th_task_kind kind);
+SW_API const char *sw_th_task_kind_what(sw_th_task_kind kind);
 
 #ifdef __cplusplus
 }

@@ -34,6 +34,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The pool's task kinds of this cache (profile columns pool_<name>_ms, pool_<name>_tasks). */
+static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("hierarchy", "bicubic hierarchy builds");
+static sw_th_task_kind_slot k_wait = SW_TH_TASK_KIND_SLOT(
+    "hierarchy_wait",
+    "converged frames' tasks waiting for a hierarchy build (their own time, waits included)");
+static sw_th_task_kind_slot k_refine =
+    SW_TH_TASK_KIND_SLOT("refine", "refinements below a hierarchy's leaves");
+
 enum { STATE_BITS = 3, STATE_MASK = (1 << STATE_BITS) - 1, MAX_READERS = 65536 };
 
 typedef struct slot {
@@ -208,7 +216,7 @@ static sw_result claim(sw_lod_cache *c, slot *s, uint64_t w, const sw_lod_cache_
     atomic_store_explicit(&s->q_prio, (uint32_t)r->priority, memory_order_release);
     atomic_store_explicit(&s->q_ticket, t, memory_order_release); /* last: stamps the record */
     const sw_th_task task = {build_task,    s,         r->priority,         r->token,
-                             r->generation, &s->group, SW_TH_TASK_HIERARCHY};
+                             r->generation, &s->group, sw_th_task_kind_of(&k_build)};
     if (sw_th_pool_submit(c->pool, &task) != SW_OK) {
         uint64_t mine = make_word(SW_LOD_CACHE_QUEUED, t);
         atomic_compare_exchange_strong_explicit(&s->word, &mine, make_word(SW_LOD_CACHE_EMPTY, t),
@@ -301,7 +309,7 @@ sw_result sw_lod_cache_request_group(sw_lod_cache *c, uint32_t face, const sw_lo
         return SW_ERR_OUT_OF_MEMORY;
     *f = (follow){c, face, *r};
     const sw_th_task task = {
-        follow_task, f, r->priority, NULL, 0, group, SW_TH_TASK_HIERARCHY_WAIT};
+        follow_task, f, r->priority, NULL, 0, group, sw_th_task_kind_of(&k_wait)};
     if (sw_th_pool_submit(c->pool, &task) != SW_OK) {
         sw__free(f);
         return SW_ERR_OUT_OF_MEMORY;
@@ -719,7 +727,7 @@ sw_result sw_lod_cache_refine_leaves(sw_lod_cache *c, uint32_t face, const int32
         /* no token for the pool: the task must run to release the flag; it checks itself */
         const sw_th_task task = {
             refine_task,      j, r->priority, NULL, 0, group ? group : &c->refine_group,
-            SW_TH_TASK_REFINE};
+            sw_th_task_kind_of(&k_refine)};
         res = sw_th_pool_submit(c->pool, &task);
         if (res != SW_OK)
             sw__free(j);

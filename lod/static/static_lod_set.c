@@ -17,6 +17,10 @@
 #include <string.h>
 #include <time.h>
 
+/* The pool's task kind of the set's builds. */
+static sw_th_task_kind_slot k_build =
+    SW_TH_TASK_KIND_SLOT("static_build", "static LOD builds of one super-surface");
+
 typedef struct slot {
     _Atomic int state;                    /* sw_lod_static_state */
     _Atomic(sw_lod_static_chain *) chain; /* READY: the chain */
@@ -619,7 +623,7 @@ sw_result sw_lod_static_set_request(sw_lod_static_set *s, uint32_t unit, sw_th_p
         *job = (build_job){s, unit};
         /* in the slot's group: converged frames and destroy wait on it */
         const sw_th_task task = {
-            build_task, job, priority, NULL, 0, &sl->group, SW_TH_TASK_STATIC_BUILD};
+            build_task, job, priority, NULL, 0, &sl->group, sw_th_task_kind_of(&k_build)};
         if (sw_th_pool_submit(s->pool, &task) == SW_OK)
             return SW_OK;
         sw__free(job);

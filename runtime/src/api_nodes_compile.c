@@ -18,6 +18,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* The pool's task kind of node scenes' compiles. */
+static sw_th_task_kind_slot k_compile =
+    SW_TH_TASK_KIND_SLOT("compile", "node scenes' compile tasks");
+
 /* ---- compiling ---------------------------------------------------------------------------------
  */
 
@@ -339,7 +343,7 @@ static void compile_task(void *ctx)
         sw_th_task t = {.fn = compile_task,
                         .ctx = m,
                         .priority = SW_TH_PRIORITY_BACKGROUND,
-                        .kind = SW_TH_TASK_COMPILE};
+                        .kind = sw_th_task_kind_of(&k_compile)};
         again = sw_th_pool_submit(m->pool, &t) == SW_OK;
     }
     m->compile_queued = again;
@@ -356,7 +360,7 @@ static void schedule_compile(sw_rt_model *m)
     sw_th_task t = {.fn = compile_task,
                     .ctx = m,
                     .priority = SW_TH_PRIORITY_BACKGROUND,
-                    .kind = SW_TH_TASK_COMPILE};
+                    .kind = sw_th_task_kind_of(&k_compile)};
     m->compile_queued = sw_th_pool_submit(m->pool, &t) == SW_OK;
 }
 

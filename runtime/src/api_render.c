@@ -22,6 +22,12 @@
 #include <strings.h>
 #include <time.h>
 
+/* The pool's task kinds of the renderer's static LODs. */
+static sw_th_task_kind_slot k_cluster =
+    SW_TH_TASK_KIND_SLOT("static_cluster", "super-surface clustering of a scene (static LODs)");
+static sw_th_task_kind_slot k_retire =
+    SW_TH_TASK_KIND_SLOT("static_retire", "freeing a retired set of static LODs");
+
 /* The hierarchies live with the renderer, for the scene it last drew: a walkthrough keeps drawing
  * one scene, and the pool's workers then stay busy with that scene only. The renderer holds a
  * reference to that scene: its workers may still build hierarchies from it after a walkthrough
@@ -161,7 +167,7 @@ static void retire_statics(sw_rt_renderer *r)
         sw_rt_scene_retain(r->cache_scene);
         const sw_th_task task = {
             retire_statics_task,     rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL,
-            SW_TH_TASK_STATIC_RETIRE};
+            sw_th_task_kind_of(&k_retire)};
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;
         sw_rt_scene_release(r->cache_scene);
@@ -518,7 +524,7 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
                                  NULL,
                                  0,
                                  &r->statics_group,
-                                 SW_TH_TASK_STATIC_CLUSTER};
+                                 sw_th_task_kind_of(&k_cluster)};
         if (sw_th_pool_submit(r->pool, &task) != SW_OK) {
             atomic_store(&r->statics_state, 0);
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: could not submit");

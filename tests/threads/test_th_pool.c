@@ -5,6 +5,7 @@
  * nested tasks, time of running tasks, queue lengths, the injection peak). */
 #include "sw_th_pool.h"
 
+#include <pthread.h>
 #include <sched.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +15,20 @@
 #include <sys/resource.h>
 #include <time.h>
 #include <cmocka.h>
+
+/* The test's task kinds, registered in main as a layer registers its own. */
+static struct {
+    sw_th_task_kind compile, hierarchy, wait, refine, build;
+} g_kind;
+
+static void register_test_kinds(void)
+{
+    g_kind.compile = sw_th_task_kind_register("t_compile", "test");
+    g_kind.hierarchy = sw_th_task_kind_register("t_hierarchy", "test");
+    g_kind.wait = sw_th_task_kind_register("t_wait", "test");
+    g_kind.refine = sw_th_task_kind_register("t_refine", "test");
+    g_kind.build = sw_th_task_kind_register("t_build", "test");
+}
 
 static void sleep_ms(int ms)
 {
@@ -506,7 +521,7 @@ static void hold_after_spawning_fn(void *ctx)
     kind_spawner *sp = ctx;
     for (int i = 0; i < 4; i++) {
         sw_th_task t = {
-            .fn = child_fn, .ctx = sp, .group = sp->group, .kind = SW_TH_TASK_HIERARCHY};
+            .fn = child_fn, .ctx = sp, .group = sp->group, .kind = g_kind.hierarchy};
         assert_int_equal(sw_th_pool_submit(sp->pool, &t), SW_OK);
     }
     gate_fn(sp->g);
@@ -525,7 +540,7 @@ static void test_kinds_and_queue(void **state)
     gate g = {0};
     kind_spawner sp = {.pool = pool, .group = &grp, .g = &g};
     sw_th_task hold = {
-        .fn = hold_after_spawning_fn, .ctx = &sp, .group = &grp, .kind = SW_TH_TASK_COMPILE};
+        .fn = hold_after_spawning_fn, .ctx = &sp, .group = &grp, .kind = g_kind.compile};
     assert_int_equal(sw_th_pool_submit(pool, &hold), SW_OK);
     while (!atomic_load(&g.running))
         sched_yield();
@@ -535,7 +550,7 @@ static void test_kinds_and_queue(void **state)
                         .ctx = &sp,
                         .group = &grp,
                         .priority = i < 5 ? SW_TH_PRIORITY_FRAME : SW_TH_PRIORITY_BACKGROUND,
-                        .kind = i < 5 ? SW_TH_TASK_REFINE : SW_TH_TASK_STATIC_BUILD};
+                        .kind = i < 5 ? g_kind.refine : g_kind.build};
         assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
     }
     int64_t by[SW_TH_PRIORITY_COUNT] = {0};
@@ -550,18 +565,18 @@ static void test_kinds_and_queue(void **state)
     assert_int_equal(sw_th_pool_queued(pool, NULL), 0);
     sw_th_pool_stats st;
     sw_th_pool_stats_get(pool, &st);
-    const uint64_t want[SW_TH_TASK_KIND_COUNT] = {[SW_TH_TASK_COMPILE] = 1,
-                                                  [SW_TH_TASK_HIERARCHY] = 4,
-                                                  [SW_TH_TASK_REFINE] = 5,
-                                                  [SW_TH_TASK_STATIC_BUILD] = 3};
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+    uint64_t want[SW_TH_TASK_KIND_MAX] = {0};
+    want[g_kind.compile] = 1;
+    want[g_kind.hierarchy] = 4;
+    want[g_kind.refine] = 5;
+    want[g_kind.build] = 3;
+    for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++) {
         assert_int_equal(st.executed_by_kind[k], want[k]);
         assert_int_equal(st.ns_by_kind[k], 0); /* timing is off by default */
     }
     assert_int_equal(st.executed, 13);
     sw_th_pool_destroy(pool);
-    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_STATIC_BUILD), "static_build");
-    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_KIND_COUNT), "?");
+    assert_string_equal(sw_th_task_kind_name(g_kind.build), "t_build");
 }
 
 enum { NAP_MS = 30 };
@@ -584,7 +599,7 @@ static void wait_for_naps_fn(void *ctx)
     sw_th_group naps;
     sw_th_group_init(&naps);
     for (int i = 0; i < 2; i++) {
-        sw_th_task t = {.fn = nap_fn, .group = &naps, .kind = SW_TH_TASK_HIERARCHY};
+        sw_th_task t = {.fn = nap_fn, .group = &naps, .kind = g_kind.hierarchy};
         assert_int_equal(sw_th_pool_submit(w->pool, &t), SW_OK);
     }
     sw_th_group_wait(w->pool, &naps);
@@ -603,28 +618,28 @@ static void test_kind_timing_nested(void **state)
     sw_th_group grp;
     sw_th_group_init(&grp);
     sw_th_task t = {
-        .fn = wait_for_naps_fn, .ctx = &w, .group = &grp, .kind = SW_TH_TASK_HIERARCHY_WAIT};
+        .fn = wait_for_naps_fn, .ctx = &w, .group = &grp, .kind = g_kind.wait};
     assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
     while (sw_th_group_pending(&grp) > 0) /* polls: a helping caller could take a nap itself */
         sleep_ms(1);
     sw_th_pool_stats st;
     sw_th_pool_stats_get(pool, &st);
     print_message("naps %.3f ms, their waiter's own time %.3f ms\n",
-                  1e-6 * (double)st.ns_by_kind[SW_TH_TASK_HIERARCHY],
-                  1e-6 * (double)st.ns_by_kind[SW_TH_TASK_HIERARCHY_WAIT]);
-    assert_int_equal(st.executed_by_kind[SW_TH_TASK_HIERARCHY], 2);
-    assert_int_equal(st.executed_by_kind[SW_TH_TASK_HIERARCHY_WAIT], 1);
-    assert_true(st.ns_by_kind[SW_TH_TASK_HIERARCHY] >= 2u * NAP_MS * 1000000u);
-    assert_true(st.ns_by_kind[SW_TH_TASK_HIERARCHY_WAIT] < NAP_MS * 1000000u);
+                  1e-6 * (double)st.ns_by_kind[g_kind.hierarchy],
+                  1e-6 * (double)st.ns_by_kind[g_kind.wait]);
+    assert_int_equal(st.executed_by_kind[g_kind.hierarchy], 2);
+    assert_int_equal(st.executed_by_kind[g_kind.wait], 1);
+    assert_true(st.ns_by_kind[g_kind.hierarchy] >= 2u * NAP_MS * 1000000u);
+    assert_true(st.ns_by_kind[g_kind.wait] < NAP_MS * 1000000u);
     sw_th_pool_set_task_timing(pool, 0);
-    sw_th_task nap = {.fn = nap_fn, .group = &grp, .kind = SW_TH_TASK_HIERARCHY};
+    sw_th_task nap = {.fn = nap_fn, .group = &grp, .kind = g_kind.hierarchy};
     assert_int_equal(sw_th_pool_submit(pool, &nap), SW_OK);
     while (sw_th_group_pending(&grp) > 0)
         sleep_ms(1);
     sw_th_pool_stats st2;
     sw_th_pool_stats_get(pool, &st2);
-    assert_int_equal(st2.executed_by_kind[SW_TH_TASK_HIERARCHY], 3);
-    assert_int_equal(st2.ns_by_kind[SW_TH_TASK_HIERARCHY], st.ns_by_kind[SW_TH_TASK_HIERARCHY]);
+    assert_int_equal(st2.executed_by_kind[g_kind.hierarchy], 3);
+    assert_int_equal(st2.ns_by_kind[g_kind.hierarchy], st.ns_by_kind[g_kind.hierarchy]);
     sw_th_pool_destroy(pool);
 }
 
@@ -639,24 +654,24 @@ static void test_kind_time_while_running(void **state)
     sw_th_group grp;
     sw_th_group_init(&grp);
     gate g = {0};
-    sw_th_task hold = {.fn = gate_fn, .ctx = &g, .group = &grp, .kind = SW_TH_TASK_STATIC_BUILD};
+    sw_th_task hold = {.fn = gate_fn, .ctx = &g, .group = &grp, .kind = g_kind.build};
     assert_int_equal(sw_th_pool_submit(pool, &hold), SW_OK);
     while (!atomic_load(&g.running))
         sched_yield();
     sleep_ms(100);
     sw_th_pool_stats st;
     sw_th_pool_stats_get(pool, &st);
-    const double half = 1e-6 * (double)st.ns_by_kind[SW_TH_TASK_STATIC_BUILD];
-    assert_int_equal(st.executed_by_kind[SW_TH_TASK_STATIC_BUILD], 0);
+    const double half = 1e-6 * (double)st.ns_by_kind[g_kind.build];
+    assert_int_equal(st.executed_by_kind[g_kind.build], 0);
     assert_true(half >= 90.0);
     sleep_ms(100);
     atomic_store(&g.open, 1);
     while (sw_th_group_pending(&grp) > 0)
         sleep_ms(1);
     sw_th_pool_stats_get(pool, &st);
-    const double whole = 1e-6 * (double)st.ns_by_kind[SW_TH_TASK_STATIC_BUILD];
+    const double whole = 1e-6 * (double)st.ns_by_kind[g_kind.build];
     print_message("a 200 ms task: %.1f ms half way, %.1f ms at its end\n", half, whole);
-    assert_int_equal(st.executed_by_kind[SW_TH_TASK_STATIC_BUILD], 1);
+    assert_int_equal(st.executed_by_kind[g_kind.build], 1);
     assert_true(whole >= 200.0 && whole >= half);
     sw_th_pool_destroy(pool);
 }
@@ -696,11 +711,11 @@ static void test_kind_counts_concurrent(void **state)
     sw_th_group grp;
     sw_th_group_init(&grp);
     kind_level levels[TREE_DEPTH + 1];
-    uint64_t want[SW_TH_TASK_KIND_COUNT] = {0};
+    uint64_t want[SW_TH_TASK_KIND_MAX] = {0};
     for (int depth = 0; depth <= TREE_DEPTH; depth++) {
-        levels[depth] = (kind_level){pool, &grp, (sw_th_task_kind)(depth % SW_TH_TASK_KIND_COUNT),
+        levels[depth] = (kind_level){pool, &grp, (sw_th_task_kind)(depth % SW_TH_TASK_KIND_MAX),
                                      depth ? &levels[depth - 1] : NULL};
-        want[depth % SW_TH_TASK_KIND_COUNT] += (uint64_t)TREE_ROOTS << (TREE_DEPTH - depth);
+        want[depth % SW_TH_TASK_KIND_MAX] += (uint64_t)TREE_ROOTS << (TREE_DEPTH - depth);
     }
     for (int r = 0; r < TREE_ROOTS; r++) {
         sw_th_task t = {.fn = kind_tree_fn,
@@ -714,7 +729,7 @@ static void test_kind_counts_concurrent(void **state)
     while (sw_th_group_pending(&grp) > 0) { /* polls: stats only, no helping */
         sw_th_pool_stats st;
         sw_th_pool_stats_get(pool, &st);
-        for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+        for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++) {
             assert_true(st.executed_by_kind[k] >= prev.executed_by_kind[k]);
             /* a running task's time so far may run ahead of its end by a store buffer's delay
              * (sw_th_pool_stats.ns_by_kind): 100 us is thousands of times that */
@@ -728,19 +743,69 @@ static void test_kind_counts_concurrent(void **state)
     sw_th_pool_stats st;
     sw_th_pool_stats_get(pool, &st);
     uint64_t all = 0;
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+    for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++) {
         assert_int_equal(st.executed_by_kind[k], want[k]);
         all += want[k];
     }
     assert_int_equal(st.executed, all);
     assert_int_equal(sw_th_pool_queued(pool, NULL), 0);
     print_message("%d samples while %llu tasks of %d kinds ran\n", samples, (unsigned long long)all,
-                  (int)SW_TH_TASK_KIND_COUNT);
+                  (int)SW_TH_TASK_KIND_MAX);
     sw_th_pool_destroy(pool);
+}
+
+/* Registering: one value per name, distinct names distinct values, "other" at 0, the table's
+ * end gives "other" and leaves the names as they were; slots register once, from any thread, with
+ * the same value as a direct registration. Would catch a registry that hands out a second value
+ * for a name (a profile column split in two), overruns its table, or a slot racing to two values. */
+static void *slot_thread(void *arg)
+{
+    return (void *)(uintptr_t)sw_th_task_kind_of(arg);
+}
+
+static void test_kind_registry(void **state)
+{
+    (void)state;
+    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_OTHER), "other");
+    assert_int_equal(sw_th_task_kind_register("t_hierarchy", "again"), g_kind.hierarchy);
+    assert_string_equal(sw_th_task_kind_what(g_kind.hierarchy), "test");
+    assert_true(g_kind.hierarchy != g_kind.compile && g_kind.hierarchy != SW_TH_TASK_OTHER);
+    static sw_th_task_kind_slot slot = SW_TH_TASK_KIND_SLOT("t_slot", "a slot's kind");
+    pthread_t th[4];
+    for (int i = 0; i < 4; i++)
+        assert_int_equal(pthread_create(&th[i], NULL, slot_thread, &slot), 0);
+    uintptr_t got[4];
+    for (int i = 0; i < 4; i++) {
+        void *v;
+        pthread_join(th[i], &v);
+        got[i] = (uintptr_t)v;
+    }
+    for (int i = 1; i < 4; i++)
+        assert_int_equal(got[i], got[0]);
+    assert_int_equal(sw_th_task_kind_register("t_slot", NULL), got[0]);
+    assert_string_equal(sw_th_task_kind_name((sw_th_task_kind)got[0]), "t_slot");
+    /* fill the table: the rest get values up to the end, then "other" */
+    static const char *const extra[SW_TH_TASK_KIND_MAX] = {
+        "x0", "x1", "x2", "x3", "x4", "x5", "x6", "x7",
+        "x8", "x9", "x10", "x11", "x12", "x13", "x14", "x15"};
+    for (int i = 0; i < SW_TH_TASK_KIND_MAX; i++) {
+        const uint32_t before = sw_th_task_kind_count();
+        const sw_th_task_kind k = sw_th_task_kind_register(extra[i], "filler");
+        if (before < SW_TH_TASK_KIND_MAX) {
+            assert_int_equal(k, before);
+            assert_string_equal(sw_th_task_kind_name(k), extra[i]);
+        } else {
+            assert_int_equal(k, SW_TH_TASK_OTHER);
+        }
+    }
+    assert_int_equal(sw_th_task_kind_count(), SW_TH_TASK_KIND_MAX);
+    assert_string_equal(sw_th_task_kind_name(g_kind.hierarchy), "t_hierarchy");
+    assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_KIND_MAX), "?");
 }
 
 int main(void)
 {
+    register_test_kinds();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cancel_external),
         cmocka_unit_test(test_cancel_from_task),
@@ -756,6 +821,7 @@ int main(void)
         cmocka_unit_test(test_kind_timing_nested),
         cmocka_unit_test(test_kind_counts_concurrent),
         cmocka_unit_test(test_kind_time_while_running),
+        cmocka_unit_test(test_kind_registry), /* last: it fills the table */
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -229,7 +229,7 @@ void sw_cli_pool_columns(const sw_cli_pool_sample *start, sw_cli_pool_sample *en
 {
     /* a running task's time may read a few ns ahead of what its end then records
      * (sw_th_pool_stats.ns_by_kind): the totals are kept from going back */
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++)
+    for (int k = 0; k < SW_TH_TASK_KIND_MAX; k++)
         if (end->stats.ns_by_kind[k] < start->stats.ns_by_kind[k])
             end->stats.ns_by_kind[k] = start->stats.ns_by_kind[k];
     sw_rt_profile_row_pool(&start->stats, &end->stats, end->queued, end->peak, row);

@@ -30,13 +30,13 @@ static const char *const k_stage_colour[] = {"#8e6bbf", "#4c8bd6", "#edc948", "#
  * the kinds' order. */
 #define SW_RT_COL_POOL_FIRST_MS SW_RT_COL_POOL_OTHER_MS
 #define SW_RT_COL_POOL_FIRST_TASKS SW_RT_COL_POOL_OTHER_TASKS
-_Static_assert(SW_RT_COL_POOL_FIRST_TASKS - SW_RT_COL_POOL_FIRST_MS == SW_TH_TASK_KIND_COUNT &&
-                   SW_RT_COL_POOL_QUEUED - SW_RT_COL_POOL_FIRST_TASKS == SW_TH_TASK_KIND_COUNT,
+_Static_assert(SW_RT_COL_POOL_FIRST_TASKS - SW_RT_COL_POOL_FIRST_MS == SW_RT_POOL_KIND_COUNT &&
+                   SW_RT_COL_POOL_QUEUED - SW_RT_COL_POOL_FIRST_TASKS == SW_RT_POOL_KIND_COUNT,
                "one ms and one tasks column per pool task kind, in order");
 /* Pool kinds' colours (same order as the kinds). */
 static const char *const k_pool_colour[] = {"#a0a0a0", "#4c8bd6", "#9ecae9", "#8e6bbf", "#59a14f",
                                             "#edc948", "#f28e2b", "#e15759", "#76b7b2"};
-_Static_assert(sizeof k_pool_colour / sizeof k_pool_colour[0] == SW_TH_TASK_KIND_COUNT,
+_Static_assert(sizeof k_pool_colour / sizeof k_pool_colour[0] == SW_RT_POOL_KIND_COUNT,
                "one colour per pool task kind");
 
 _Static_assert(sizeof k_stage_colour / sizeof k_stage_colour[0] == N_STAGES,
@@ -113,13 +113,37 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_CAPTURED] = captured ? 1.0 : 0.0;
 }
 
+const char *sw_rt_pool_kind_name(int kind)
+{
+    static const char *const names[SW_RT_POOL_KIND_COUNT] = {
+#define SW_RT__POOL_KIND_NAME(a, id, name, what) name,
+        SW_RT_POOL_KINDS(SW_RT__POOL_KIND_NAME, ~)
+#undef SW_RT__POOL_KIND_NAME
+    };
+    return kind >= 0 && kind < SW_RT_POOL_KIND_COUNT ? names[kind] : "?";
+}
+
+/* The profile column of a registered pool kind: the one of its name, else "other". */
+static int pool_column(sw_th_task_kind kind)
+{
+    const char *name = sw_th_task_kind_name(kind);
+    for (int c = 0; c < SW_RT_POOL_KIND_COUNT; c++)
+        if (!strcmp(name, sw_rt_pool_kind_name(c)))
+            return c;
+    return SW_RT_POOL_KIND_OTHER;
+}
+
 void sw_rt_profile_row_pool(const sw_th_pool_stats *before, const sw_th_pool_stats *now,
                             int64_t queued, int64_t inject_peak, sw_rt_prof_row *row)
 {
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
-        row->v[SW_RT_COL_POOL_FIRST_MS + k] =
+    for (int c = 0; c < SW_RT_POOL_KIND_COUNT; c++)
+        row->v[SW_RT_COL_POOL_FIRST_MS + c] = row->v[SW_RT_COL_POOL_FIRST_TASKS + c] = 0.0;
+    const uint32_t n = sw_th_task_kind_count();
+    for (uint32_t k = 0; k < n && k < SW_TH_TASK_KIND_MAX; k++) {
+        const int c = pool_column(k);
+        row->v[SW_RT_COL_POOL_FIRST_MS + c] +=
             1e-6 * (double)(now->ns_by_kind[k] - before->ns_by_kind[k]);
-        row->v[SW_RT_COL_POOL_FIRST_TASKS + k] =
+        row->v[SW_RT_COL_POOL_FIRST_TASKS + c] +=
             (double)(now->executed_by_kind[k] - before->executed_by_kind[k]);
     }
     row->v[SW_RT_COL_POOL_QUEUED] = (double)queued;
@@ -413,7 +437,7 @@ typedef struct stack {
 } stack;
 
 static const stack k_stages = {FIRST_STAGE, N_STAGES, k_stage_colour};
-static const stack k_pool = {SW_RT_COL_POOL_FIRST_MS, SW_TH_TASK_KIND_COUNT, k_pool_colour};
+static const stack k_pool = {SW_RT_COL_POOL_FIRST_MS, SW_RT_POOL_KIND_COUNT, k_pool_colour};
 
 /* Cumulative top of a stack up to its layer s (inclusive) at frame i; negative values (a clock's
  * rounding in "other") count as 0. */
@@ -555,12 +579,12 @@ static void svg_pool_legend(FILE *f, const sw_rt_profile *p, const plot *pl)
     svg_line_key(f, x, pl->top + 40, "stroke=\"#d62728\" stroke-dasharray=\"1,2\"");
     fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">inject peak, max %.0f</text>\n", x + 20, pl->top + 44,
             p->summary[SW_RT_COL_POOL_INJECT_PEAK].max);
-    for (int k = SW_TH_TASK_KIND_COUNT; k-- > 0;) {
-        const double y = pl->top + 60 + 14 * (SW_TH_TASK_KIND_COUNT - 1 - k);
+    for (int k = SW_RT_POOL_KIND_COUNT; k-- > 0;) {
+        const double y = pl->top + 60 + 14 * (SW_RT_POOL_KIND_COUNT - 1 - k);
         const sw_rt_prof_col c = (sw_rt_prof_col)(SW_RT_COL_POOL_FIRST_MS + k);
         svg_swatch(f, x, y, k_pool_colour[k]);
         fprintf(f, "<text x=\"%.1f\" y=\"%.1f\">%s %.1f</text>\n", x + 20, y + 4,
-                sw_th_task_kind_name((sw_th_task_kind)k), p->summary[c].mean * p->n_rows);
+                sw_rt_pool_kind_name(k), p->summary[c].mean * p->n_rows);
     }
     fputs("</g>\n", f);
 }
@@ -714,13 +738,13 @@ int sw_rt_profile_write_html(FILE *f, const sw_rt_profile *p, const char *svg)
 static void print_pool_summary(FILE *f, const sw_rt_profile *p)
 {
     fputs("pool, all threads (beside frame_ms):\n", f);
-    for (int k = 0; k < SW_TH_TASK_KIND_COUNT; k++) {
+    for (int k = 0; k < SW_RT_POOL_KIND_COUNT; k++) {
         const sw_rt_prof_stat *s = &p->summary[SW_RT_COL_POOL_FIRST_MS + k];
         const double tasks = p->summary[SW_RT_COL_POOL_FIRST_TASKS + k].mean * p->n_rows;
         if (!(tasks > 0.0))
             continue;
         fprintf(f, "  %-14s %9.2f %9.2f %9.2f %9.2f %9.2f  %.0f tasks, %.1f ms in all\n",
-                sw_th_task_kind_name((sw_th_task_kind)k), s->median, s->p90, s->p99, s->max,
+                sw_rt_pool_kind_name(k), s->median, s->p90, s->p99, s->max,
                 s->mean, tasks, s->mean * p->n_rows);
     }
     const sw_rt_prof_stat *q = &p->summary[SW_RT_COL_POOL_QUEUED];

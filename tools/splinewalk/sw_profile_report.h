@@ -27,6 +27,31 @@
 
 /* Per task kind of the pool (sw_th_pool.h's table): the time the pool's threads spent in the
  * kind's tasks during the frame and how many ran. */
+/* The pool's task kinds the profile has columns for, by the names their layers register them
+ * under (sw_th_task_kind_register: lod/hierarchy/hierarchy_cache.c, lod/static/static_lod_set.c,
+ * gpu/stage_tessellate_parallel.c, runtime/src/api_render.c, api_nodes_compile.c). A kind
+ * registered under another name counts as "other" (sw_rt_profile_row_pool), so the kinds' times
+ * still add up to the pool's busy time. */
+#define SW_RT_POOL_KINDS(X, A)                                                                     \
+    X(A, OTHER, "other", "tasks of no other kind")                                                 \
+    X(A, HIERARCHY, "hierarchy", "bicubic hierarchy builds")                                       \
+    X(A, HIERARCHY_WAIT, "hierarchy_wait",                                                         \
+      "converged frames' tasks waiting for a hierarchy build (their own time, waits included)")    \
+    X(A, REFINE, "refine", "refinements below a hierarchy's leaves")                               \
+    X(A, STATIC_CLUSTER, "static_cluster", "super-surface clustering of a scene (static LODs)")    \
+    X(A, STATIC_BUILD, "static_build", "static LOD builds of one super-surface")                   \
+    X(A, STATIC_RETIRE, "static_retire", "freeing a retired set of static LODs")                   \
+    X(A, COMPILE, "compile", "node scenes' compile tasks")                                         \
+    X(A, FRAME_STAGE, "frame_stage", "chunks of a frame's tessellation taken by workers")
+enum {
+#define SW_RT__POOL_KIND_ENUM(a, id, name, what) SW_RT_POOL_KIND_##id,
+    SW_RT_POOL_KINDS(SW_RT__POOL_KIND_ENUM, ~)
+#undef SW_RT__POOL_KIND_ENUM
+        SW_RT_POOL_KIND_COUNT
+};
+/* A profile pool kind's name ("hierarchy", ...); "?" out of range. */
+const char *sw_rt_pool_kind_name(int kind);
+
 #define SW_RT__POOL_MS_COLUMN(X, id, name, what)                                                   \
     X(POOL_##id##_MS, "pool_" name "_ms", POOL, "pool threads' ms in " what)
 #define SW_RT__POOL_TASKS_COLUMN(X, id, name, what)                                                \
@@ -89,8 +114,8 @@
       "of triangles: drawn from GPU buffers kept between frames (static levels)")                  \
     X(UPLOAD_BYTES, "upload_bytes", COUNT,                                                         \
       "bytes sent to the GPU for the draw (vertices, indices, patch data, new resident levels)")   \
-    SW_TH_TASK_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \
-    SW_TH_TASK_KINDS(SW_RT__POOL_TASKS_COLUMN, X)                                                  \
+    SW_RT_POOL_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \
+    SW_RT_POOL_KINDS(SW_RT__POOL_TASKS_COLUMN, X)                                                  \
     X(POOL_QUEUED, "pool_queued", COUNT,                                                           \
       "pool tasks waiting at the frame's end (injection queues and workers' deques)")              \
     X(POOL_INJECT_PEAK, "pool_inject_peak", COUNT,                                                 \
