@@ -36,6 +36,7 @@
  * LP_NUM_THREADS (llvmpipe's threads) is set to 2 unless already set, and printed; the worker pool
  * has its default worker count (one per online processor), printed.
  */
+#include "cli_numbers.h"
 #include "animated.h"
 #include "source_scene.h"
 #include "sw_gpu.h"
@@ -384,10 +385,12 @@ static int parse(bench *b, int argc, char **argv)
         if (strcmp(argv[a], "--frames") == 0)
             b->frames = atoi(v);
         else if (strcmp(argv[a], "--size") == 0) {
-            if (sscanf(v, "%dx%d", &b->width, &b->height) != 2)
+            if (sw_cli_parse_size(v, &b->width, &b->height))
                 return 0;
-        } else if (strcmp(argv[a], "--error") == 0)
-            b->error_px = atof(v);
+        } else if (strcmp(argv[a], "--error") == 0) {
+            if (sw_cli_parse_error_px(v, &b->error_px))
+                return 0;
+        }
         else if (strcmp(argv[a], "--leaf") == 0) {
             if (strcmp(v, "view") != 0 && strcmp(v, "frame") != 0)
                 return 0;

@@ -9,6 +9,7 @@
  *          et al. 1997 §4.4; the cones' one-off build time is printed apart)
  * Usage: bench_gpu_frames [--frames N] [--size WxH] FILE...   (set LP_NUM_THREADS and say so)
  */
+#include "cli_numbers.h"
 #include "sw_gpu_internal.h"
 #include "sw_lod_face_cones.h"
 #include "sw_sg_import.h"
@@ -92,8 +93,8 @@ int main(int argc, char **argv)
             return 2;
         if (strcmp(argv[first], "--frames") == 0)
             frames = atoi(argv[first + 1]);
-        else if (strcmp(argv[first], "--size") == 0)
-            sscanf(argv[first + 1], "%dx%d", &w, &h);
+        else if (strcmp(argv[first], "--size") == 0 && sw_cli_parse_size(argv[first + 1], &w, &h))
+            w = 0; /* refused below */
     }
     if (frames < 1 || frames > MAX_FRAMES || first >= argc) {
         fprintf(stderr, "usage: %s [--frames 1..%d] [--size WxH] FILE...\n", argv[0], MAX_FRAMES);

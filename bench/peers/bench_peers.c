@@ -3,6 +3,7 @@
  * on the same scene, camera path, frame size and ε_img; each peer in its own child process. See
  * k_usage for what is measured and how; the figures and their reading are in bench/peers/README.md.
  */
+#include "cli_numbers.h"
 #include "bench_peer.h"
 #include "cli.h"
 #include "peer_glu.h"
@@ -148,10 +149,10 @@ static int parse(int argc, char **argv, args *a)
             a->warmup = (uint32_t)strtoul(v, NULL, 10);
         else if (!strcmp(o, "--passes"))
             a->passes = (uint32_t)strtoul(v, NULL, 10);
-        else if (!strcmp(o, "--size") && sscanf(v, "%dx%d", &a->w, &a->h) == 2)
+        else if (!strcmp(o, "--size") && !sw_cli_parse_size(v, &a->w, &a->h))
             continue;
-        else if (!strcmp(o, "--error"))
-            a->error_px = strtod(v, NULL);
+        else if (!strcmp(o, "--error") && !sw_cli_parse_error_px(v, &a->error_px))
+            continue;
         else if (!strcmp(o, "--path"))
             a->path_file = v;
         else if (!strcmp(o, "--brep"))

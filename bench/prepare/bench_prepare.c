@@ -35,6 +35,7 @@
  * Usage: bench_prepare [--views N] [--passes P] [--size WxH] [--callgrind W] FILE...
  *        (.brep/.step/.igs imported, .sws opened)
  */
+#include "cli_numbers.h"
 #include "sw_lod_sampling.h"
 #include "bench_stats.h"
 #include "frame_stages.h"
@@ -312,8 +313,7 @@ int main(int argc, char **argv)
             callgrind = atoi(argv[first + 1]);
         else if (strcmp(argv[first], "--passes") == 0)
             passes = atoi(argv[first + 1]);
-        else if (strcmp(argv[first], "--size") == 0 &&
-                 sscanf(argv[first + 1], "%dx%d", &w, &h) == 2)
+        else if (strcmp(argv[first], "--size") == 0 && !sw_cli_parse_size(argv[first + 1], &w, &h))
             continue;
         else
             break;

@@ -7,6 +7,7 @@
  * the required detail, not with the model's size. See k_usage.
  */
 #define _GNU_SOURCE
+#include "cli_numbers.h"
 #include "cli.h"
 #include "bench_peer.h"
 #include "peer_splinewalk.h"
@@ -100,10 +101,10 @@ static int parse(int argc, char **argv, args *a)
             a->warmup = (uint32_t)strtoul(v, NULL, 10);
         else if (!strcmp(o, "--passes"))
             a->passes = (uint32_t)strtoul(v, NULL, 10);
-        else if (!strcmp(o, "--size") && sscanf(v, "%dx%d", &a->w, &a->h) == 2)
+        else if (!strcmp(o, "--size") && !sw_cli_parse_size(v, &a->w, &a->h))
             continue;
-        else if (!strcmp(o, "--error"))
-            a->error_px = strtod(v, NULL);
+        else if (!strcmp(o, "--error") && !sw_cli_parse_error_px(v, &a->error_px))
+            continue;
         else if (!strcmp(o, "--dir"))
             a->dir = v;
         else if (!strcmp(o, "--splinewalk"))

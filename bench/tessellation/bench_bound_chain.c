@@ -17,6 +17,7 @@
  * 256 and 1024 px in 1280 x 1024; FILEs: iso view fitted to the box, 1280 x 720). A benchmark,
  * not a test.
  */
+#include "cli_numbers.h"
 #include "sw_gpu_internal.h"
 #include "sw_lod_sampling.h"
 #include "wavy_patch.h"
@@ -311,7 +312,8 @@ int main(int argc, char **argv)
     double eps_px = 0.5;
     int first_file = 1;
     if (argc > 2 && strcmp(argv[1], "--error") == 0) {
-        eps_px = atof(argv[2]);
+        if (sw_cli_parse_error_px(argv[2], &eps_px))
+            return sw_cli_bad_value("bench_bound_chain", argv[1], argv[2], NULL);
         first_file = 3;
     }
     if (!getenv("LP_NUM_THREADS"))

@@ -13,6 +13,7 @@
  * the surface at the same (u, v) (the issue's numerical screen-space criterion), and the pixels
  * each renderer covered.
  */
+#include "cli_numbers.h"
 #include "glu_nurbs.h"
 #include "vbo_draw.h"
 #include "wavy_patch.h"
@@ -558,12 +559,14 @@ static int parse_args(int argc, char **argv, bench *b)
             b->keep_trims = 1;
         } else if (strcmp(a, "--frames") == 0 && i + 1 < argc) {
             b->frames = atoi(argv[++i]);
-        } else if (strcmp(a, "--error") == 0 && i + 1 < argc) {
-            b->error_px = atof(argv[++i]);
+        } else if (strcmp(a, "--error") == 0 && i + 1 < argc &&
+                   !sw_cli_parse_error_px(argv[i + 1], &b->error_px)) {
+            i++;
         } else if (strcmp(a, "--glu-trim-split") == 0 && i + 1 < argc) {
             b->glu_trim_split = atoi(argv[++i]);
-        } else if (strcmp(a, "--glu-error") == 0 && i + 1 < argc) {
-            b->glu_error_px = atof(argv[++i]);
+        } else if (strcmp(a, "--glu-error") == 0 && i + 1 < argc &&
+                   !sw_cli_parse_positive(argv[i + 1], &b->glu_error_px)) {
+            i++;
         } else {
             fprintf(stderr, "unknown or incomplete argument '%s'\n", a);
             return -1;
