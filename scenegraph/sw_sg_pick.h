@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* splinewalk scenegraph/: picking — the nearest point where a ray meets the scene's trimmed
- * surfaces (issue 7: "picking by ray through the BVH, returning node, surface and (u,v)").
+ * surfaces ("picking by ray through the BVH, returning node, surface and (u,v)").
  *
  * The BVH (sw_sg_bvh.h) gives the face occurrences whose boxes the ray crosses, nearest box
  * first; each occurrence's face is intersected in its own frame (the ray mapped by the inverse

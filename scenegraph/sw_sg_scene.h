@@ -89,7 +89,7 @@ typedef struct sw_sg_curve_rec {
     uint64_t knots, cpw; /* pool offsets: n+degree+1 and n*3 doubles */
 } sw_sg_curve_rec;
 
-/* A triangle mesh given as such (issue 7's mesh nodes): drawn as it is, not tessellated, so it has
+/* A triangle mesh given as such (the mesh nodes): drawn as it is, not tessellated, so it has
  * no error bound of its own. Offsets: positions and normals in the double pool, indices in the
  * INDICES section (u32 each). */
 #define SW_SG_NO_NORMALS UINT64_MAX

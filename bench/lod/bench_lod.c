@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* bench/lod (issue 4; Kumar et al. 1997 §6: "40-50 % better" with static LODs): frame times along
+/* bench/lod (Kumar et al. 1997 §6: "40-50 % better" with static LODs): frame times along
  * one camera path at ε_img = 0.5 px with the static LODs of super-surfaces on and off, threaded
  * walkthrough frames (sw_renderer_prepare / submit), in alternating passes over the same path in
  * one process, each mode on its own renderer. Both are warmed up first: one converged pass with

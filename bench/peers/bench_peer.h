@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* bench/peers and bench/scaling (issue 6): what every peer of a side-by-side run shares — a
+/* bench/peers and bench/scaling: what every peer of a side-by-side run shares — a
  * result record, running one peer in its own child process (fork) so that its peak resident
  * memory is its own (VmHWM of the child minus the resident memory it inherited at the fork), the
  * frame-time summary (median, p99: bench/common's bench_quantile), the camera of

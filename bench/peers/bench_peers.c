@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* bench_peers (issue 6): splinewalk beside Mesa's GLU NURBS tessellator and OpenCASCADE's mesher
+/* bench_peers: splinewalk beside Mesa's GLU NURBS tessellator and OpenCASCADE's mesher
  * on the same scene, camera path, frame size and ε_img; each peer in its own child process. See
  * k_usage for what is measured and how; the figures and their reading are in bench/peers/README.md.
  */

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* bench/pipeline (issue 5; Kumar et al. 1997 Fig. 9): frame times along one camera path with the
+/* bench/pipeline (Kumar et al. 1997 Fig. 9): frame times along one camera path with the
  * renderer's visibility thread preparing frame i+1 while the submitting thread draws frame i
  * (sw_renderer_prepare / sw_renderer_submit, "threaded"), against each frame in one call
  * (sw_renderer_draw, "sequential": prepared on the visibility thread while the caller waits, so

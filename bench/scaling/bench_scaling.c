@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* bench_scaling (issue 6): how splinewalk's frame time and memory grow with the scene — generated
+/* bench_scaling: how splinewalk's frame time and memory grow with the scene — generated
  * buildings of N = 10^3, 10^4, 10^5 (10^6 with --max) surfaces, each drawn along the orbit of its
  * own box (the same relative path: the view composition stays, the detail grows; --fly: the low
  * fly-through instead), each in its own

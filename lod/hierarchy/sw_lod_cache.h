@@ -100,7 +100,7 @@ typedef struct sw_lod_cache_stats {
     uint64_t refine_cancelled;
     uint64_t versions_retired, versions_freed;
     size_t memory_bytes;    /* sw_lod_cache_memory */
-    uint64_t refine_capped; /* refinements of leaves above their tolerance refused (issue 19): at
+    uint64_t refine_capped; /* refinements of leaves above their tolerance refused: at
                                the depth cap, a parameter rectangle at the rounding floor, or a
                                hierarchy at its node cap (hierarchy_cache.c, refine_leaf) */
 } sw_lod_cache_stats;

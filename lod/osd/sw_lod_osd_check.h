@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The OpenSubdiv cross-check (issue 3; `splinewalk check-osd`): every uniform, non-rational bicubic
+/* The OpenSubdiv cross-check (`splinewalk check-osd`): every uniform, non-rational bicubic
  * B-spline region of a scene — a knot span whose six surrounding knots are equally spaced in both
  * directions, on a face whose weights are all equal — is evaluated by the project's NURBS
  * evaluator, by de Casteljau on its extracted Bézier patch, and by OpenSubdiv's limit evaluation of

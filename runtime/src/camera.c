@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Camera presets that fit a bounding box (issue 2: fovy 40°, target = box centre, distance =
+/* Camera presets that fit a bounding box (fovy 40°, target = box centre, distance =
  * diagonal / (2 tan(fovy/2)) × 1.1). */
 #include "sw_rt.h"
 

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Misuse of the public API (never installed): a caller's programming mistake — a NULL desc or
  * out pointer, a stale handle (also a second destroy), a call from a thread that does not own the
- * renderer. CONVENTIONS.md (Errors) makes such a mistake an assert; issue 7 asks for the
+ * renderer. CONVENTIONS.md (Errors) makes such a mistake an assert; the API asks for the
  * documented sw_result in release builds (never memory corruption) and an abort with the message
  * in debug builds. SW__MISUSE does both: it fills the status, writes the message to the log hook
  * at SW_LOG_ERROR and returns `result`, and where the library was built with SW_MISUSE_ASSERT=1

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/api: misuse of the public API (issue 7) → the sw_result each function documents in
+/* tests/api: misuse of the public API → the sw_result each function documents in
  * runtime/include/splinewalk/splinewalk.h, never a crash or a memory error (CI runs this under
  * ASan + UBSan). Linked against libsplinewalk.so through the public headers only.
  *

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/api: depth compositing of the renderer's surfaces with a host's own 3D drawing (issue 7:
- * sw_frame_desc.present_depth, sw_camera_matrices, sw_frame_stats.view / proj / near_plane).
+/* tests/api: depth compositing of the renderer's surfaces with a host's own 3D drawing
+ * (sw_frame_desc.present_depth, sw_camera_matrices, sw_frame_stats.view / proj / near_plane).
  *
  *   test_api_compose [SCENE]
  *

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/api: the host's allocator and log hooks (sw_setup.h, issue 7), through the public API of
+/* tests/api: the host's allocator and log hooks (sw_setup.h), through the public API of
  * libsplinewalk.so only. Each mode is its own process (sw_setup comes once per process).
  *
  *   test_api_hooks count SCENE.tsm WORKDIR

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* tests/api: drawing into the host's GL context (sw_renderer_desc.use_current_context,
- * sw_frame_desc.present) leaves every piece of the host's GL state as it was (issue 7).
+ * sw_frame_desc.present) leaves every piece of the host's GL state as it was.
  *
  *   test_api_host_state SCENE WORKDIR
  *

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/api: triangle-mesh nodes (sw_nodes.h MESH, issue 7), against the shared library.
+/* tests/api: triangle-mesh nodes (sw_nodes.h MESH), against the shared library.
  *
  * usage: test_api_meshes meshes WORKDIR   (no GL)
  *        test_api_meshes render WORKDIR   (EGL)

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/api: misuse of the public API (issue 7) in both kinds of build, from one source.
+/* tests/api: misuse of the public API in both kinds of build, from one source.
  *
  *   test_api_misuse SCENE.tsm [CASE]
  *

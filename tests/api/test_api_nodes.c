@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/api: scenes built from nodes (sw_nodes.h, issue 7), against the shared library.
+/* tests/api: scenes built from nodes (sw_nodes.h), against the shared library.
  *
  * usage: test_api_nodes nodes TSM WORKDIR          (no GL)
  *        test_api_nodes render TSM BREP WORKDIR    (EGL)
@@ -28,7 +28,7 @@
  *   between each, all submitted without pool waits; another thread adding, hiding, removing
  *   nodes and editing the surface while this one draws walkthrough frames and picks (run under
  *   TSan too); a draw with the destroyed scene's handle is SW_ERR_STALE_HANDLE.
- *   Pool waits are counted wherever the frame's threads block on the pool (issue 19; before,
+ *   Pool waits are counted wherever the frame's threads block on the pool (before,
  *   only the converged hierarchy stage counted them, so 0 held by construction). Counted
  *   honestly they showed a real wait: a frame drawing a new version destroyed the old version's
  *   hierarchy cache in place, waiting for its builds (25-98 of 300 frames); the cache is now

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* tests/api: split frames — sw_renderer_prepare on the visibility thread, sw_renderer_submit on
- * the owner's (issue 5's frame overlap, issue 7's split calls), against the shared library.
+ * the owner's (the frame overlap, the split calls), against the shared library.
  *
  *  1. Converged split frames equal sw_renderer_draw's: three cameras drawn in one call each, then
  *     prepared two ahead and submitted; the PNG files are byte-identical (the same pixels through
@@ -14,7 +14,7 @@
  *     no frame waits for the pool, every prepared frame is submitted once, and the visibility
  *     thread's work is reported (ms_visibility) apart from the submitting thread's (its stages,
  *     ms_wait_visibility included, are parts of ms_total; how large a part is for profiles).
- *     Pool waits are counted wherever the frame's threads block on the pool (issue 19: group
+ *     Pool waits are counted wherever the frame's threads block on the pool (group
  *     waits that find tasks pending and bracketed waits on tasks' results, on the visibility
  *     thread and on the submitting one; before, only the converged hierarchy stage counted, so
  *     0 held by construction). Seen failing with a planted walkthrough wait for one face's build

@@ -60,7 +60,7 @@ exact=$(sed -n 's/.*, \([0-9]*\) by the exact path.*/\1/p' exact.txt)
 [ -s motor.exr ] || fail "no EXR written"
 pass "import / info / render on Motor-c.brep ($trimmed trim-textured patches)"
 
-# The EXR's content (issue 19: a non-empty file passed before, a blank or wrong image too): its
+# The EXR's content (a non-empty file passed before, a blank or wrong image too): its
 # RGB must be the PNG render of the same view to within one level (the EXR holds RGBA8 / 255 in
 # half); its Z must cover exactly the pixels the PNG shows the part on (finite there, +inf on the
 # white background; <= 0.5 % of them may disagree, at antialiased edges), at least 5 % of the

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 19, item 1: runaways replayed through the CLI, each with a time limit, each ending with a
+# Runaways replayed through the CLI, each with a time limit, each ending with a
 # valid image or a clear refusal.
 #  quick (make test, ~20 s):
 #   - a real part written as IGES (IGESControl_Writer's trimmed surfaces) and uniformly scaled to

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# The consumer test of issue 7: install splinewalk to a temporary prefix, build
+# The consumer test: install splinewalk to a temporary prefix, build
 # samples/embed_headless.c (and samples/embed_custom_shader.c, run once per build: the immediate
 # API with a host shading function) against the installed package through find_package and through
 # pkg-config (a copy of the sample, so nothing but the installed headers can be seen), run both

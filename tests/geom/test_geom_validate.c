@@ -184,7 +184,7 @@ static void test_validate_curves(void **state)
            "dim 1 rejected\n");
 }
 
-/* Issue 19: finite values whose products overflow the evaluation's range (the rule of
+/* Finite values whose products overflow the evaluation's range (the rule of
  * sw_sg_geom.h). A weight of 1e-300 or a coordinate of 1e308 passed validation and then refined
  * forever; each is now refused with SW_ERR_INVALID_GEOMETRY, the object and the control point.
  * Planted fault (the range checks dropped from bad_point): every case here passes validation. */

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* tests/gpu: what the "same scene, two render paths" tests share — the iso / front camera preset
- * of `splinewalk render` (issue 2: fovy 40°, distance = diagonal / (2 tan 20°) × 1.1) and the pixel
+ * of `splinewalk render` (fovy 40°, distance = diagonal / (2 tan 20°) × 1.1) and the pixel
  * comparison: a pixel differs when its coverage differs or a colour channel differs by more than
  * `color_tol` levels. */
 #ifndef SW_TESTS_GPU_COMPARE_H

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/gpu: an independent reference frame for the render-path tests (issue 19: test_gpu_eval
+/* tests/gpu: an independent reference frame for the render-path tests (test_gpu_eval
  * and test_gpu_exact compared two of the renderer's own paths, which share the Filip densities,
  * the trim-texture atlas and the Bézier extraction, so a bug in any of those passed both).
  *

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Rendering, analytic (issue 2): a planar NURBS square with a circular hole (an exact rational
+/* Rendering, analytic: a planar NURBS square with a circular hole (an exact rational
  * quadratic circle as trim curve) and a star-shaped hole (a degree-1 loop), rendered at 512x512
  * looking straight at it. Every pixel whose centre is more than 1 pixel from a boundary (computed
  * here by projecting the analytic shape) must be covered exactly when the analytic shape says so,

@@ -1,4 +1,4 @@
-/* The fat border's sampling is bounded by the view (issue 19 item 1): a loop whose grid cells are
+/* The fat border's sampling is bounded by the view: a loop whose grid cells are
  * tiny (a face refined deep under a narrow field of view: fovy 1e-9 grew memory at ~600 MB/s in
  * sw__gpu_fat_border) takes at most max(2 n, 64 (width + height)) samples, the fallback counted
  * in mesh.border_capped; a loop at ordinary cells is sampled as before, uncounted.

@@ -13,7 +13,7 @@
  * (gpu_test_reference.h: a dense mesh of the exact NURBS with exact trims, drawn as plain
  * triangles): at most 4 + 0.1 % of the covered pixels may have a coverage found nowhere within
  * 1 px in the reference, or a depth off the reference's on its smooth interiors. What it catches
- * (issue 19, each planted and seen failing while the two paths still agreed, 0.0000 % differ):
+ * (each planted and seen failing while the two paths still agreed, 0.0000 % differ):
  * densities a quarter of what the bound asks (lod/bezier/sampling.c sw_lod_screen_segments) — all 6
  * views fail, 169-1696 depth errors and up to 98 coverage errors (limits 8-11); the trim atlas
  * read 2 texel rows off (gpu/glsl/surface_trim.frag.glsl) — 4 of 6 views fail, 13-38 depth errors.

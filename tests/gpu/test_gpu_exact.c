@@ -13,7 +13,7 @@
  * (gpu_test_reference.h: a dense mesh of the exact NURBS with exact trims, drawn as plain
  * triangles): at most 4 + 0.1 % of the covered pixels may have a coverage found nowhere within
  * 1 px in the reference, or a depth off the reference's on its smooth interiors. What it catches
- * (issue 19, each planted and seen failing): densities a quarter of what the bound asks
+ * (each planted and seen failing): densities a quarter of what the bound asks
  * (lod/bezier/sampling.c sw_lod_screen_segments) — all 6 views fail against the reference, while the
  * two paths disagreed on 2 of them only; the trim atlas read 2 texel rows off
  * (gpu/glsl/surface_trim.frag.glsl) — 4 of 6 views fail, while the two paths agreed on all.

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Rendering, real (issue 2): imported CAD models rendered by sw_gpu_render_scene (trim textures,
+/* Rendering, real: imported CAD models rendered by sw_gpu_render_scene (trim textures,
  * Filip grids) against an independent reference — OCCT's BRepMesh_IncrementalMesh of the same
  * file at a deflection of 1e-4 x the box diagonal, drawn through sw_gpu_render_triangles with the
  * same camera. From the iso and front views: coverage masks differ in <= 0.1 % of the covered

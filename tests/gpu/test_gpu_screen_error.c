@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Screen-space error, numerically (issue 3; ARCHITECTURE.md "Numbers that define works"): every
+/* Screen-space error, numerically (ARCHITECTURE.md "Numbers that define works"): every
  * drawn triangle of a frame stays within ε_img = 0.5 px of the exact surface. The frame's patch
  * pieces are taken from gpu/frame.c's debug hook (the same records, grid classes and parameters
  * the vertex shader or the CPU grid uses; grid parameters of shader records recomputed in float

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* T-spline GPU agreement (issue 3): samples/tsplines/t_junctions.tsm is imported as one bicubic
+/* T-spline GPU agreement: samples/tsplines/t_junctions.tsm is imported as one bicubic
  * rational Bézier face per Krishnamurthy–Yasui region (face (u, v) = T-spline (u, v)), rendered
  * through the vertex-shader path (Guthe et al. 2005 §4.2) with the shader's debug capture on, and
  * every evaluated vertex (its float (s, t) and eye-relative float position) is compared with the

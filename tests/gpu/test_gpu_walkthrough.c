@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: MIT */
-/* Walkthrough mode (ARCHITECTURE.md "two modes of the same pipeline"; issue 5's walkthrough
+/* Walkthrough mode (ARCHITECTURE.md "two modes of the same pipeline"; the walkthrough
  * behaviour at the frame level): frames drawn through the hierarchy cache with desc.walkthrough
  * never wait for the worker pool, whatever is missing.
  *  1. A fast orbit (FRAMES_MOVING frames, 11° apart, distance swinging between 0.35 and 1.1 of
  *     the fitted distance) starting with an empty cache: every frame must report 0 pool waits and
  *     0 ms blocked (sw_gpu_frame_stats.pool_waits / ms_pool_wait / ms_hierarchy, counted wherever
  *     the frame's threads block on the pool: group waits that find tasks pending, bracketed waits
- *     on tasks' results — issue 19; the old hlod_waits was counted on the converged branch only,
+ *     on tasks' results; the old hlod_waits was counted on the converged branch only,
  *     so this test passed by construction). It catches a walkthrough frame that waits for a
  *     build: planted as a converged-style wait for one face's hierarchy in the walkthrough
  *     requests (stage_hierarchy.c request_walkthrough), it fails with "waits 1". And the
@@ -20,7 +20,7 @@
  *     waits for the fresh cache's builds (pool_waits > 0, ms_hierarchy > 0): the counter is alive.
  *
  * Usage: test_gpu_walkthrough OUTDIR MODEL [FRAMES_MOVING [WxH]]
- * (default 40 frames at 480x270; .ci/run's ThreadSanitizer build runs 2,000 at 320x240, issue 5's
+ * (default 40 frames at 480x270; .ci/run's ThreadSanitizer build runs 2,000 at 320x240, its
  * "pipeline under ThreadSanitizer").
  */
 #include "gpu_test_compare.h"

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Close-up zoom (issue 3): from the whole model down to a view 1/10,000 of its size, every frame
+/* Close-up zoom: from the whole model down to a view 1/10,000 of its size, every frame
  * renders (no SW_ERR_LIMIT: the trim-texture hierarchy of Guthe et al. 2005 §5.3 splits a face's
  * trim box into tiles instead of asking for one texture above the maximum size), the atlas pages
  * stay within GL_MAX_TEXTURE_SIZE, and the drawn trim edges stay within 1 px of the exact curves.

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Screen-space error in images (issue 3): real models rendered by sw_gpu_render_scene at
+/* Screen-space error in images: real models rendered by sw_gpu_render_scene at
  * ε_img = 0.5 px against an independent reference, OCCT's BRepMesh at a deflection chosen per view
  * so that its own error is <= 0.1 px there (0.1 px x the object size of a pixel at the nearest
  * visible depth; meshing only the faces whose boxes meet the view frustum; capped at a triangle

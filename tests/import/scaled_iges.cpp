@@ -2,8 +2,8 @@
  *
  * Writes a copy of a part as IGES, uniformly scaled about its bounding-box centre so that the box
  * diagonal becomes DIAGONAL, the way a unit conversion does it (BRepBuilderAPI_Transform with a
- * gp_Trsf scale, copy = true; IGESControl_Writer turns the trims into B-spline pcurves). Issue 19:
- * such copies of real parts made the first frame's trim flattening recurse at a tolerance of
+ * gp_Trsf scale, copy = true; IGESControl_Writer turns the trims into B-spline pcurves).
+ * Such copies of real parts made the first frame's trim flattening recurse at a tolerance of
  * 1e-17; tests/cli/test_scaled_iges.sh renders them. A fifth argument `brep` writes the faces as
  * an IGES B-rep (write.iges.brep.mode 1) instead of trimmed surfaces. DIAGONAL 0 keeps the
  * part's size (a plain IGES export). OUT.brep writes the scaled

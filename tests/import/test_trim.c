@@ -277,11 +277,11 @@ static sw_sg_scene *make_bulge_scene(double bulge, double scale)
     return scene;
 }
 
-/* Issue 19, the scaled-IGES hang: a tolerance below the rounding of the loop's own coordinates
+/* The scaled-IGES hang: a tolerance below the rounding of the loop's own coordinates
  * (1e-20 of a loop at 0.7, or 1e-26 of the same loop scaled by 1e-6) is met only where rounding
  * happens to cancel, so the walk splits rounding noise down to the depth cap. With the floor the
  * arc is flattened at 64 ulps of its largest coordinate in a few vertices and the fallback is
- * counted. Planted fault (the floor removed in flatten_curve; the code before issue 19 too): 295
+ * counted. Planted fault (the floor removed in flatten_curve, as the code first had it): 295
  * vertices instead of 17, and this fails. */
 static void test_flatten_below_rounding(void **state)
 {
@@ -320,7 +320,7 @@ static void test_flatten_below_rounding(void **state)
 
 /* A loop the vertex budget cannot hold at such a tolerance (the circle: ~1e7 vertices even at the
  * floor) ends with SW_ERR_LIMIT as soon as the budget is spent. Planted fault (the code before
- * issue 19: no floor, and the walk going on after the budget was spent): 2^40 pieces per arc, and
+ * no floor, and the walk going on after the budget was spent): 2^40 pieces per arc, and
  * this test runs into its timeout. */
 static void test_flatten_budget_stops(void **state)
 {

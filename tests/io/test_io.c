@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: MIT */
-/* The project's one writer and its guarded inputs (issue 22 items 1 and 2; scenegraph/
+/* The project's one writer and its guarded inputs (scenegraph/
  * sw_safe_write.h, sw_safe_read.h), format by format.
  *
  * Full disk, simulated: the writer's failure-injection hook makes the k-th write(2) fail with
  * ENOSPC, for every k a clean write of that format makes, and then the fsync; each time the call
  * must return an error, the pre-existing target must be byte-identical and no temporary may be
  * left (catches: a writer that ignores a failed write or fsync, renames a partial temporary over
- * the target — issue 22's 0-byte old.png — or forgets to remove its temporary). The formats:
+ * the target — the 0-byte old.png — or forgets to remove its temporary). The formats:
  * PNG, EXR, .sws, LOD cache (the .sws LODS section), camera path, BREP, and profile reports
  * (a whole `splinewalk profile` run, in process).
  * Full disk, real: a 64 KiB tmpfs filled to ENOSPC, where mount(2) is permitted (root with
@@ -357,7 +357,7 @@ static void full_disk_real(void)
 static void targets(void)
 {
     sw_status st = {0};
-    /* /dev/null: written in place, still a character device (issue 22: root turned it into a
+    /* /dev/null: written in place, still a character device (root turned it into a
      * regular file) */
     CHECK(write_sws("/dev/null", &st) == SW_OK, "/dev/null: %s", st.message);
     CHECK(write_path("/dev/null", &st) == SW_OK, "/dev/null: %s", st.message);

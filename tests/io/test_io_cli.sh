@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# The project's one writer and its guarded inputs through the CLI (issue 22 items 1 and 2). Each
+# The project's one writer and its guarded inputs through the CLI. Each
 # check names the fault it catches:
 # - `import -o /dev/null` succeeds and /dev/null stays a character device (a writer that renames
 #   a temporary over any non-directory turns it into a regular file when run as root);

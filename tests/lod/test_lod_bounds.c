@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* "Every bound holds and is tight" (issue 3): the rigorous error bounds of lod/ (error_bound.c)
+/* "Every bound holds and is tight": the rigorous error bounds of lod/ (error_bound.c)
  * for degree reduction to bicubic leaves (§6.1), pairwise simplification (§6.2) and trim curves
  * approximated by rational cubics (§4.1), checked against the distance measured independently:
  * both surfaces evaluated with the scenegraph kernel (sw_sg_bezier_patch_eval, sw_sg_curve_eval),

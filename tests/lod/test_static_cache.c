@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The static-LOD set and its cache (lod/static/sw_lod_static_set.h, lod/static/static_lod_io.c; issue 4:
+/* The static-LOD set and its cache (lod/static/sw_lod_static_set.h, lod/static/static_lod_io.c:
  * "cached in the .sws file by splinewalk build-lod"):
  *  - units partition the faces: every face with patches in exactly one unit, each unit's patches
  *    exactly its faces' patches of the clustering, its box holding every vertex of its chain, its

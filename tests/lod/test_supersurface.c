@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Super-surfaces (issue 4, Kumar et al. 1997 §3; lod/static/sw_lod_supersurface.h):
+/* Super-surfaces (Kumar et al. 1997 §3; lod/static/sw_lod_supersurface.h):
  *
  *  1. The Gauss-map cone bounds the true normals: S_u x S_v from the scenegraph's NURBS evaluator
  *     (sw_sg_surface_eval_d2, an independent code path) on a dense grid of every Bézier patch of

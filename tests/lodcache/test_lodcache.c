@@ -853,7 +853,7 @@ static void test_failure(void)
     sw_sg_scene_free(m.scene);
 }
 
-/* Issue 19: refinement bounded at its root. Asking again and again for a tolerance the bounds
+/* Refinement bounded at its root. Asking again and again for a tolerance the bounds
  * cannot meet (1e-300: what a weight of 1e-300 or a coordinate of 1e308 asked for, memory growing
  * 8-20 MB/s in refine_leaf / merge_subtree) ends: every round refines the deepest worst leaf, until
  * the depth cap, the parameter floor or the node cap refuses it, and the refusal is counted in

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# splinewalk path and profile, end to end on the default scene (issue 5, first slice):
+# splinewalk path and profile, end to end on the default scene:
 # - `path orbit|fly` write paths that `profile` reads back;
 # - `profile` writes profile.csv with the documented columns and one row per frame, all numbers;
 #   profile.json agrees with the CSV (its median recomputed here); other_ms = frame_ms - stages;

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* scale_setup: what a renderer builds for a scene before its first frame, stage by stage, with the
- * time and the resident memory each stage adds (issue 6, large-model readiness). Not a test: it
+ * time and the resident memory each stage adds (large-model readiness). Not a test: it
  * prints figures for the README's memory table and for deciding what must be lazy.
  *
  * The stages are those of runtime/src/api_render.c (renderer_cache) after the public API's load:

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# scale_walk_1e5 (issue 6, large-model readiness; label heavy): a generated 10^5-surface building
+# scale_walk_1e5 (large-model readiness; label heavy): a generated 10^5-surface building
 # is loaded and walked by a walkthrough profile run along a fly-through, and
 # - generate, path and profile exit 0; the building has 10^5 surfaces drawn;
 # - profile.csv has the documented header and one numeric row per frame, frame indices in order;
 #   profile.json holds the same number of frames;
 # - every frame draws faces and triangles (a walk that loads nothing or draws nothing fails);
-# - no frame waits for the worker pool (walkthrough mode, issue 5). pool_waits counts wherever
-#   the frame's threads block on the pool (issue 19; before, only the converged branch counted,
+# - no frame waits for the worker pool (walkthrough mode). pool_waits counts wherever
+#   the frame's threads block on the pool (before, only the converged branch counted,
 #   so 0 held by construction); seen failing with a planted walkthrough wait for one face's
 #   build (gpu/stage_hierarchy.c request_walkthrough): frames 9, 11, 12, 14, 16 "1 pool waits";
 # - the peak resident set of the profile process stays under MAX_RSS_MIB (from the measured peak,

@@ -810,7 +810,7 @@ static void test_cycles(void **state)
 }
 
 /* Every padding byte between sections (no checksum covers them) flipped in turn: open refuses
- * it (issue 22: such a flip went undetected). Catches a reader that skips the padding check. */
+ * it (such a flip went undetected). Catches a reader that skips the padding check. */
 static void test_padding_flipped(void **state)
 {
     (void)state;

@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# tests/viewer: `splinewalk view` (issue 5) as a user meets it.
+# tests/viewer: `splinewalk view` as a user meets it.
 #  1. No display: exit 1 with a message that points to `splinewalk profile` (before any import).
 #  2. Bad arguments: --screenshot without --script is a usage error (2); a missing script file
 #     is named in the error (1).
 #  3. Under xvfb-run: the window opens, 60 frames of a scripted orbit are drawn in walkthrough mode
-#     (0 pool waits: counted wherever the frame blocks on the pool, issue 19 — before, only on
+#     (0 pool waits: counted wherever the frame blocks on the pool — before, only on
 #     the converged branch, so 0 held by construction; seen failing with a planted walkthrough
 #     wait for one face's build, "pool waits 1"), the last view is drawn converged (--settle),
 #     the window's back buffer is saved through OpenImageIO, and the viewer closes cleanly

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* splinewalk profile SCENE --path PATH --out DIR [...]: frames along a camera path through the
  * public renderer API, timed stage by stage on the submitting thread and, threaded, on the
- * renderer's visibility thread (issue 5). */
+ * renderer's visibility thread. */
 #include "cli.h"
 #include "cli_profile_out.h"
 

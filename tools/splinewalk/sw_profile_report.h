@@ -6,7 +6,7 @@
  * The stages are the renderer's own timers (sw_frame_stats) plus "other" = frame_ms - sum of the
  * measured stages: whatever the frame call spent outside them (setup, bookkeeping, the first
  * frame's pool and cache creation). Keeping "other" small is what shows that the stages account
- * for the frame (issue 5).
+ * for the frame.
  *
  * The worker pool's share of a frame is beside them, like the visibility thread's and the GPU's:
  * pool_<kind>_ms and pool_<kind>_tasks per task kind (sw_th_pool.h), the differences of the
