@@ -14,8 +14,8 @@
  * from inside a solid's material its back faces are what one sees.
  *
  * The unit-instance BVH. With static LODs the frame culls the set's BVH whose leaves are unit
- * instances (lod/static/sw_lod_static_set.h: the face occurrences grouped by (unit, transform) once,
- * when the set was made), not the faces' BVH: an instance is what gets a level, so its
+ * instances (lod/static/sw_lod_static_set.h: the face occurrences grouped by (unit, transform)
+ * once, when the set was made), not the faces' BVH: an instance is what gets a level, so its
  * classification and back-patch test are decided once, at its leaf. Partly visible, each of its
  * faces is classified against the frustum by its own box (the box and test of the faces' BVH, so
  * the per-frame path gets the faces it got from that BVH and asks no hierarchy for the others).

@@ -1,11 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /* The select stage: the representation of everything the cull stage kept — the LOD cut.
  *
- * Per visible unit instance (a super-surface of whole faces, lod/static/sw_lod_static_set.h) the static
- * LOD level whose declared ε_k meets the object-space tolerance its nearest point needs (Kumar
- * et al. 1997 §4), else its shown faces go to the per-frame path. Per per-frame face occurrence
- * its hierarchy cut (Guthe et al. 2005 §7, stage_hierarchy.c), or its own Bézier patches when it
- * has no hierarchy (yet).
+ * Per visible unit instance (a super-surface of whole faces, lod/static/sw_lod_static_set.h) the
+ * static LOD level whose declared ε_k meets the object-space tolerance its nearest point needs
+ * (Kumar et al. 1997 §4), else its shown faces go to the per-frame path. Per per-frame face
+ * occurrence its hierarchy cut (Guthe et al. 2005 §7, stage_hierarchy.c), or its own Bézier patches
+ * when it has no hierarchy (yet).
  *
  * The tolerance. A displacement d of a point at depth z (along the view axis) and off-axis
  * tangents (t_x, t_y) moves its image by at most focal_px |d| sqrt(1 + t_x^2 + t_y^2) / z pixels

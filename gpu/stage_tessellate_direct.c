@@ -2,11 +2,11 @@
 /* The tessellate stage's direct path: a face occurrence by its own rational Bézier patches
  * (Guthe et al. 2005 §4.2, without the bicubic hierarchy): each patch culled by its control-net
  * box, its grid density chosen so that its triangles stay within ε_img on screen (§5.2 and §7 in
- * one rigorous bound, lod/bezier/sampling.c's sw_lod_screen_segments, over the grid classes' segment
- * counts), densities unified per patch column and row so that grids meet vertex to vertex; drawn
- * as vertex-shader records (degree <= 3 x 3), as CPU grids (higher degrees), or, with eval_exact,
- * evaluated from the face's knot vectors. A trimmed face whose trim texture would be too large
- * has its trim box cut into tiles, each with its own texture. */
+ * one rigorous bound, lod/bezier/sampling.c's sw_lod_screen_segments, over the grid classes'
+ * segment counts), densities unified per patch column and row so that grids meet vertex to vertex;
+ * drawn as vertex-shader records (degree <= 3 x 3), as CPU grids (higher degrees), or, with
+ * eval_exact, evaluated from the face's knot vectors. A trimmed face whose trim texture would be
+ * too large has its trim box cut into tiles, each with its own texture. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
 #include "sw_lod_bezier.h"

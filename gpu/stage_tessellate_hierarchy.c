@@ -3,15 +3,15 @@
  * stage_hierarchy.c).
  *
  * The error budget of a drawn node is rigorous, not the paper's 50/50 guess: the node's bound e
- * (distance between the exact surface and the bicubic at the same parameters, lod/bezier/error_bound.c)
- * projects to at most e_px = ε_img e / ε_obj(z_min) pixels, and the grid density is chosen for the
- * rest, ε_img - e_px (sw_lod_screen_segments, which bounds the grid against the bicubic on
- * screen). Each drawn node gets its own trim texture over its rectangle when the face's one
- * texture would be too large (nodes wholly inside the trimmed region need none; nodes outside it
- * are not drawn) and, when the face is drawn as more than one node, a fat border along its
- * rectangle, since neighbouring nodes are different bicubics sampled at different densities
- * (§7.1); the border carries the node's trim lookup, so that it does not show in trimmed-away
- * parts. */
+ * (distance between the exact surface and the bicubic at the same parameters,
+ * lod/bezier/error_bound.c) projects to at most e_px = ε_img e / ε_obj(z_min) pixels, and the grid
+ * density is chosen for the rest, ε_img - e_px (sw_lod_screen_segments, which bounds the grid
+ * against the bicubic on screen). Each drawn node gets its own trim texture over its rectangle when
+ * the face's one texture would be too large (nodes wholly inside the trimmed region need none;
+ * nodes outside it are not drawn) and, when the face is drawn as more than one node, a fat border
+ * along its rectangle, since neighbouring nodes are different bicubics sampled at different
+ * densities (§7.1); the border carries the node's trim lookup, so that it does not show in
+ * trimmed-away parts. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
@@ -31,8 +31,8 @@ typedef struct hl_face {
 
 /* ---- exact degree of a node's bicubic ----------------------------------------------------------
  * Planes, cylinders and cones reach the hierarchy as degree-elevated bicubics. Their derivative
- * bounds (lod/bezier/sampling.c, products of degree 3p x 3q) cost ~6x more at degree 3 than at the true
- * degree, and the bound is the same surface's: so the density is computed at the lowest degree
+ * bounds (lod/bezier/sampling.c, products of degree 3p x 3q) cost ~6x more at degree 3 than at the
+ * true degree, and the bound is the same surface's: so the density is computed at the lowest degree
  * that reproduces the net exactly (up to rounding). */
 static int near(const double *a, const double *b, double tol)
 {

@@ -264,7 +264,7 @@ static size_t submit_helpers(tess_job *job, size_t helpers)
     size_t k = 0;
     for (; k < helpers; ++k) {
         atomic_fetch_add_explicit(&job->refs, 1, memory_order_relaxed);
-        sw_th_task task = {helper_task, job,  SW_TH_PRIORITY_FRAME,  NULL,
+        sw_th_task task = {helper_task, job,  SW_TH_PRIORITY_FRAME,        NULL,
                            0,           NULL, sw_th_task_kind_of(&k_chunk)};
         if (sw_th_pool_submit(job->pool, &task) != SW_OK) {
             atomic_fetch_sub_explicit(&job->refs, 1, memory_order_relaxed);

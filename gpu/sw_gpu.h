@@ -99,8 +99,8 @@ typedef struct sw_gpu_frame_desc {
                          away from the eye over its whole box is culled (Kumar §4.4); with
                          static_lods, whole super-surface instances by their units' cones too */
     struct sw_lod_static_set *static_lods; /* NULL: no static LODs; else the scene's set
-                              (lod/static/sw_lod_static_set.h), whose BVH of unit instances then culls
-                              instead of desc.bvh: a visible unit is drawn at the coarsest
+                              (lod/static/sw_lod_static_set.h), whose BVH of unit instances then
+                              culls instead of desc.bvh: a visible unit is drawn at the coarsest
                               level within the view's tolerance at its nearest point, built in
                               the pool on first need (walkthrough: queued, drawn per frame
                               meanwhile; converged: waited for). Ignored with eval_exact */

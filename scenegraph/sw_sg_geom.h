@@ -36,13 +36,13 @@ extern "C" {
 
 /* The range validation admits, so that no product the evaluation and the bounds form
  * overflows or underflows. The largest of them is a coordinate times the square of the net's
- * weight ratio (the rational second-derivative bounds of lod/bezier/sampling.c, error_bound.c's wratio),
- * times a transform's scale and a focal length in pixels (< 1e6), and then squared (distances,
- * segment counts): with every factor within these limits that is at most
- * (1e30 x 1e30 x 1e30 x 1e6)^2 = 1e192, finite; homogeneous products w x and 1 / w stay normal
- * doubles (1e130, 1e100). Each is far beyond real data (the universe is ~1e30 mm across; OCCT's
- * weights lie within a factor 10 of each other); a weight of 1e-300 or a coordinate or transform
- * entry of 1e308, which passed before and then refined forever, is rejected with its position. */
+ * weight ratio (the rational second-derivative bounds of lod/bezier/sampling.c, error_bound.c's
+ * wratio), times a transform's scale and a focal length in pixels (< 1e6), and then squared
+ * (distances, segment counts): with every factor within these limits that is at most (1e30 x 1e30 x
+ * 1e30 x 1e6)^2 = 1e192, finite; homogeneous products w x and 1 / w stay normal doubles (1e130,
+ * 1e100). Each is far beyond real data (the universe is ~1e30 mm across; OCCT's weights lie within
+ * a factor 10 of each other); a weight of 1e-300 or a coordinate or transform entry of 1e308, which
+ * passed before and then refined forever, is rejected with its position. */
 #define SW_SG_COORD_MAX 1e30    /* |Euclidean coordinate| and |knot| of curves and surfaces */
 #define SW_SG_WEIGHT_MIN 1e-100 /* each weight in [SW_SG_WEIGHT_MIN, SW_SG_WEIGHT_MAX] */
 #define SW_SG_WEIGHT_MAX 1e100

@@ -256,8 +256,8 @@ SW_MODULE_ABI sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out
  * SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_sg_scene_save(sw_sg_scene *scene, const char *path, sw_status *status);
 /* As sw_sg_scene_save, with lods_size bytes at lods as the file's optional LODS section (the
- * static-LOD cache, lod/static/static_lod_io.c); lods NULL or lods_size 0 writes none. sw_sg_scene_save
- * keeps a mapped scene's LODS section (verified first). Same errors. */
+ * static-LOD cache, lod/static/static_lod_io.c); lods NULL or lods_size 0 writes none.
+ * sw_sg_scene_save keeps a mapped scene's LODS section (verified first). Same errors. */
 sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void *lods,
                                 size_t lods_size, sw_status *status);
 /* The LODS section of a mapped scene, checked against its checksum on every call (it is read

@@ -180,7 +180,10 @@ typedef struct sw_th_task_kind_slot {
     const char *name, *what;
     _Atomic uint32_t value; /* the kind + 1; 0 until registered */
 } sw_th_task_kind_slot;
-#define SW_TH_TASK_KIND_SLOT(name, what) {(name), (what), 0}
+#define SW_TH_TASK_KIND_SLOT(name, what)                                                           \
+    {                                                                                              \
+        (name), (what), 0                                                                          \
+    }
 SW_API sw_th_task_kind sw_th_task_kind_of(sw_th_task_kind_slot *slot);
 /* Kinds registered so far (values 0 .. count - 1; "other" is always there). */
 SW_API uint32_t sw_th_task_kind_count(void);

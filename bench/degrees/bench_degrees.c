@@ -6,8 +6,8 @@
  * (animated.c). The surface changes every frame, so every frame redoes the whole chain:
  *
  *   approximation  the rational cubic approximation of the trim loop (timed here), and the
- *                  bicubic hierarchy over the trim region's box (lod/hierarchy/hierarchy.c: extraction, G1
- *                  reduction, leaf subdivision, median-cut simplification, rigorous bounds,
+ *                  bicubic hierarchy over the trim region's box (lod/hierarchy/hierarchy.c:
+ * extraction, G1 reduction, leaf subdivision, median-cut simplification, rigorous bounds,
  *                  derivative constants), built in the worker pool by the frame itself from a
  *                  fresh sw_lod_cache of the frame's scene, with any refinement below its leaves
  *                  the view asks for: the frame stats' ms_hierarchy, which runs from the build
@@ -390,8 +390,7 @@ static int parse(bench *b, int argc, char **argv)
         } else if (strcmp(argv[a], "--error") == 0) {
             if (sw_cli_parse_error_px(v, &b->error_px))
                 return 0;
-        }
-        else if (strcmp(argv[a], "--leaf") == 0) {
+        } else if (strcmp(argv[a], "--leaf") == 0) {
             if (strcmp(v, "view") != 0 && strcmp(v, "frame") != 0)
                 return 0;
             b->leaf_frame = strcmp(v, "frame") == 0;

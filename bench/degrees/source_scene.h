@@ -18,8 +18,8 @@ sw_result bd_source_scene(const sw_sg_surface *s, const sw_lod_cubic_set *loop,
 
 /* An upper bound of the surface's parametric speed over uv_box: a move of the parameters by
  * (du, dv) moves the surface point by at most the result times |(du, dv)| (Cauchy-Schwarz over
- * sup |S_u|, sup |S_v| of the Bézier patches meeting the box, lod/bezier/sampling.c's rigorous bounds).
- * Returns 0 when out of memory. */
+ * sup |S_u|, sup |S_v| of the Bézier patches meeting the box, lod/bezier/sampling.c's rigorous
+ * bounds). Returns 0 when out of memory. */
 double bd_parametric_speed(const sw_sg_surface *s, const double uv_box[4]);
 
 #endif

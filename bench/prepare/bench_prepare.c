@@ -15,14 +15,14 @@
  *              chunks shared with a pool (desc.pool) of 1 worker, or of 2 (the parallel
  *              visibility stage on one and two more threads), with the join's wait (ms_join);
  *   density    planes' patches given the coarsest grid by the affine test (fast, the default) or
- *              by the full screen-space bound (lod/bezier/sampling.c sw_lod_screen_affine_fast), on one
- *              thread, with the triangles and differing pixels of view 0 as for affine;
- *   borders    the border cache (gpu/border_cache.c: loops and samples kept between frames) on,
- *              the default, or off, on one thread; each variant's passes one after another, so
- *              that the cache keeps what its own passes made (its first pass starts empty).
- * Each variant prints the median of the prepare's wall time, of the preparing thread's CPU time,
- * of the process's CPU time (every thread: the pool's share of the work included, so the split's
- * extra work shows) and of the wait at the tessellation's join.
+ *              by the full screen-space bound (lod/bezier/sampling.c sw_lod_screen_affine_fast), on
+ * one thread, with the triangles and differing pixels of view 0 as for affine; borders    the
+ * border cache (gpu/border_cache.c: loops and samples kept between frames) on, the default, or off,
+ * on one thread; each variant's passes one after another, so that the cache keeps what its own
+ * passes made (its first pass starts empty). Each variant prints the median of the prepare's wall
+ * time, of the preparing thread's CPU time, of the process's CPU time (every thread: the pool's
+ * share of the work included, so the split's extra work shows) and of the wait at the
+ * tessellation's join.
  *
  * --callgrind W: only the measured prepares of the direct mode (after its warm-up; the hierarchy
  * mode's cut depends on when its builds end), with the chunks shared with a pool of W workers

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* bench/scaling: the plot of a scaling run, hand-written SVG — two panels over a logarithmic
  * x axis of surfaces N: frame time (median and p99, ms) and memory (peak RSS and the scene's own
- * bytes, MB). tools/splinewalk/profile_report.c's SVG is a per-frame stacked chart over a linear frame
- * axis, which does not fit.
+ * bytes, MB). tools/splinewalk/profile_report.c's SVG is a per-frame stacked chart over a linear
+ * frame axis, which does not fit.
  */
 #ifndef BS_SCALING_SVG_H
 #define BS_SCALING_SVG_H

@@ -3,15 +3,14 @@
  * promise (Guthe et al. 2005 §5.2, §7). For every patch piece a frame draws (the frame's debug
  * hook), each link of the chain ε_img -> object tolerance -> Filip bound -> segments -> grid class
  * is measured against dense evaluation:
- *   (a) derivative bounds (lod/bezier/sampling.c) vs the sampled sup of |S_ss|, |S_st|, |S_tt| over the
- *       drawn part of the patch;
- *   (b) Filip's bound at the drawn grid vs the largest object-space deviation of its triangles;
- *   (c) the object tolerance vs the screen error it turns into (px per object unit);
- *   (d) Filip's segments (unrounded) vs the drawn grid (class rounding, row / column unification);
- * and the drawn error in pixels. Triangle totals: drawn; the §5.2 formula (whole-patch bounds,
- * ε/2 per direction, at the frame's isotropic object tolerance) before rounding; the same with
- * the sampled M; the smallest uniform grid of the drawn grid's aspect that meets ε_img when
- * measured.
+ *   (a) derivative bounds (lod/bezier/sampling.c) vs the sampled sup of |S_ss|, |S_st|, |S_tt| over
+ * the drawn part of the patch; (b) Filip's bound at the drawn grid vs the largest object-space
+ * deviation of its triangles; (c) the object tolerance vs the screen error it turns into (px per
+ * object unit); (d) Filip's segments (unrounded) vs the drawn grid (class rounding, row / column
+ * unification); and the drawn error in pixels. Triangle totals: drawn; the §5.2 formula
+ * (whole-patch bounds, ε/2 per direction, at the frame's isotropic object tolerance) before
+ * rounding; the same with the sampled M; the smallest uniform grid of the drawn grid's aspect that
+ * meets ε_img when measured.
  *
  * Usage: bench_bound_chain [--error PX] [FILE...]   (no FILE: the benchmark's wavy patch at 32,
  * 256 and 1024 px in 1280 x 1024; FILEs: iso view fitted to the box, 1280 x 720). A benchmark,

@@ -159,7 +159,8 @@ static uint32_t largest_loop(const sw_sg_polyline *loops, uint32_t n)
     for (uint32_t l = 0; l < n; l++) {
         double a = 0.0;
         for (uint32_t i = 0; i < loops[l].count; i++) {
-            const double *p = loops[l].uv + 2 * i, *q = loops[l].uv + 2 * ((i + 1) % loops[l].count);
+            const double *p = loops[l].uv + 2 * i,
+                         *q = loops[l].uv + 2 * ((i + 1) % loops[l].count);
             a += p[0] * q[1] - q[0] * p[1];
         }
         if (fabs(a) > best_area) {
@@ -205,8 +206,8 @@ static void bench_face(GEOSContextHandle_t g, const sw_sg_scene *scene, uint32_t
         double t0 = sw__clock_ms();
         const long nc = cgal_triangulate(loops, fr->n_loops, &ca);
         double t1 = sw__clock_ms();
-        const long ng = geos_triangulate(g, loops, fr->n_loops, largest_loop(loops, fr->n_loops),
-                                         &ga);
+        const long ng =
+            geos_triangulate(g, loops, fr->n_loops, largest_loop(loops, fr->n_loops), &ga);
         double t2 = sw__clock_ms();
         t->cgal_failed += nc < 0;
         t->geos_failed += ng < 0;
@@ -252,9 +253,9 @@ int main(int argc, char **argv)
     printf("CGAL 2D CDT (GPL-3) vs GEOS %s polygon CDT (LGPL-2.1); loops flattened within %g of "
            "each face's domain\n",
            GEOSversion(), rel);
-    printf("%-24s %6s %9s %9s %7s %8s %8s %9s %9s %7s %7s %6s %6s\n", "model", "faces",
-           "needs_pts", "affine1", "both", "cgal_ms", "geos_ms", "cgal_tri", "geos_tri",
-           "cgal_a", "geos_a", "c_fail", "g_fail");
+    printf("%-24s %6s %9s %9s %7s %8s %8s %9s %9s %7s %7s %6s %6s\n", "model", "faces", "needs_pts",
+           "affine1", "both", "cgal_ms", "geos_ms", "cgal_tri", "geos_tri", "cgal_a", "geos_a",
+           "c_fail", "g_fail");
     tally all = {.cgal_min_angle = 180.0, .geos_min_angle = 180.0};
     for (int i = first; i < argc; i++) {
         sw_status st = {0};
@@ -268,8 +269,8 @@ int main(int argc, char **argv)
         for (uint32_t f = 0; f < n; f++)
             bench_face(g, scene, f, rel, &t);
         const char *name = strrchr(argv[i], '/') ? strrchr(argv[i], '/') + 1 : argv[i];
-        printf("%-24s %6u %9u %9u %7u %8.2f %8.2f %9llu %9llu %7.2f %7.2f %6u %6u\n", name,
-               t.faces, t.needs_points, t.affine_single, t.both_ok, t.cgal_ms, t.geos_ms,
+        printf("%-24s %6u %9u %9u %7u %8.2f %8.2f %9llu %9llu %7.2f %7.2f %6u %6u\n", name, t.faces,
+               t.needs_points, t.affine_single, t.both_ok, t.cgal_ms, t.geos_ms,
                (unsigned long long)t.cgal_triangles, (unsigned long long)t.geos_triangles,
                t.cgal_min_angle, t.geos_min_angle, t.cgal_failed, t.geos_failed);
         all.faces += t.faces;

@@ -215,8 +215,13 @@ static sw_result claim(sw_lod_cache *c, slot *s, uint64_t w, const sw_lod_cache_
     atomic_store_explicit(&s->q_gen, r->generation, memory_order_release);
     atomic_store_explicit(&s->q_prio, (uint32_t)r->priority, memory_order_release);
     atomic_store_explicit(&s->q_ticket, t, memory_order_release); /* last: stamps the record */
-    const sw_th_task task = {build_task,    s,         r->priority,         r->token,
-                             r->generation, &s->group, sw_th_task_kind_of(&k_build)};
+    const sw_th_task task = {build_task,
+                             s,
+                             r->priority,
+                             r->token,
+                             r->generation,
+                             &s->group,
+                             sw_th_task_kind_of(&k_build)};
     if (sw_th_pool_submit(c->pool, &task) != SW_OK) {
         uint64_t mine = make_word(SW_LOD_CACHE_QUEUED, t);
         atomic_compare_exchange_strong_explicit(&s->word, &mine, make_word(SW_LOD_CACHE_EMPTY, t),
@@ -725,9 +730,13 @@ sw_result sw_lod_cache_refine_leaves(sw_lod_cache *c, uint32_t face, const int32
     }
     if (j) {
         /* no token for the pool: the task must run to release the flag; it checks itself */
-        const sw_th_task task = {
-            refine_task,      j, r->priority, NULL, 0, group ? group : &c->refine_group,
-            sw_th_task_kind_of(&k_refine)};
+        const sw_th_task task = {refine_task,
+                                 j,
+                                 r->priority,
+                                 NULL,
+                                 0,
+                                 group ? group : &c->refine_group,
+                                 sw_th_task_kind_of(&k_refine)};
         res = sw_th_pool_submit(c->pool, &task);
         if (res != SW_OK)
             sw__free(j);

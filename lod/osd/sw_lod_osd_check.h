@@ -15,11 +15,11 @@ extern "C" {
 #endif
 
 typedef struct sw_lod_osd_report {
-    uint64_t faces_checked;   /* faces with at least one uniform region */
-    uint64_t regions;         /* uniform regions evaluated */
+    uint64_t faces_checked; /* faces with at least one uniform region */
+    uint64_t regions;       /* uniform regions evaluated */
     uint64_t samples;
-    double max_rel_nurbs;     /* max |ours - OSD| / diagonal of the region's control net */
-    double max_rel_bezier;    /* the same for the extracted Bézier patch */
+    double max_rel_nurbs;  /* max |ours - OSD| / diagonal of the region's control net */
+    double max_rel_bezier; /* the same for the extracted Bézier patch */
 } sw_lod_osd_report;
 
 /* Checks face `face` of a scene (SW_SG_SEC_ALL required) at `samples_per_region` points of each
@@ -30,8 +30,8 @@ sw_result sw_lod_osd_check_face(const sw_sg_scene *scene, uint32_t face, int sam
 
 /* Checks a generated uniform test net: an nx x ny grid of random heights (seeded) as a uniform
  * unclamped bicubic B-spline surface, every interior region. */
-sw_result sw_lod_osd_check_generated(int32_t nx, int32_t ny, int samples_per_region,
-                                     uint64_t seed, sw_lod_osd_report *report, sw_status *status);
+sw_result sw_lod_osd_check_generated(int32_t nx, int32_t ny, int samples_per_region, uint64_t seed,
+                                     sw_lod_osd_report *report, sw_status *status);
 
 #ifdef __cplusplus
 }

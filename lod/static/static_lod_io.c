@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* The static-LOD cache: a set's READY chains as one byte string and back (the layout is in
- * lod/static/sw_lod_static_set.h). Reading trusts nothing: every count is checked against the bytes left
- * before anything is allocated, every value against what a chain may hold, and the whole string
- * is parsed into new chains before the first one is adopted. */
+ * lod/static/sw_lod_static_set.h). Reading trusts nothing: every count is checked against the bytes
+ * left before anything is allocated, every value against what a chain may hold, and the whole
+ * string is parsed into new chains before the first one is adopted. */
 #include "sw_lod_static_set.h"
 #include "sw_hooks.h"
 

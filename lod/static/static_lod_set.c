@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* A scene's static LODs built lazily in the worker pool (lod/static/sw_lod_static_set.h says how the
- * units are formed and how slots are published). */
+/* A scene's static LODs built lazily in the worker pool (lod/static/sw_lod_static_set.h says how
+ * the units are formed and how slots are published). */
 #include "sw_clock.h"
 #include "sw_lod_static_set.h"
 #include "sw_lod_static_internal.h"

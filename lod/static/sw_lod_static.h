@@ -3,7 +3,8 @@
  *
  * Input: a set of trimmed rational Bézier patches (a super-surface, §3), each named by its face and
  * its (iu, iv) in the face's Bézier grid extracted over the face's uv_box, every net cut to its
- * knot rectangle intersected with uv_box — the patches lod/hierarchy/hierarchy.c builds its trees from.
+ * knot rectangle intersected with uv_box — the patches lod/hierarchy/hierarchy.c builds its trees
+ * from.
  *
  * Level 0, the adaptive tessellation within δ (§4.1, §4.3): per face, a constrained Delaunay
  * triangulation (CGAL, modules/lodbuild/trim_mesh_cgal.cpp) of the part of the face's (u, v) domain
@@ -40,7 +41,8 @@ extern "C" {
 #endif
 
 /* One Bézier patch of a super-surface. Same layout as sw_lod_ss_patch of the super-surface
- * clustering (lod/static/sw_lod_supersurface.h), so a cluster's patch range can be passed as it is. */
+ * clustering (lod/static/sw_lod_supersurface.h), so a cluster's patch range can be passed as it is.
+ */
 typedef struct sw_lod_static_patch {
     uint32_t face;
     uint16_t iu, iv;
@@ -53,7 +55,7 @@ typedef struct sw_lod_static_desc {
     int32_t n_levels;  /* simplified levels after level 0 (1..8); 0 = 4; -1 = none */
     double eps_first;  /* target ε of level 1 in units of δ (> 1); 0 = 2 */
     double eps_growth; /* ratio of consecutive target ε (> 1); 0 = 4 */
-    uint32_t max_vertices; /* level 0 limit (SW_ERR_LIMIT beyond it); 0 = 4,000,000 */
+    uint32_t max_vertices;           /* level 0 limit (SW_ERR_LIMIT beyond it); 0 = 4,000,000 */
     uint32_t max_vertices_per_patch; /* level 0 limit per patch, the same way; 0 = 4,096 (the
                           sample models need 30-1,500; where a patch's rational derivative bounds
                           are far too loose, tens of thousands: such a super-surface is refused in

@@ -19,8 +19,8 @@
  * Patches. Face f's patches are those of sw_lod_face_patches(): sw_sg_surface_extract_bezier_in()
  * over the face's uv_box, each net then cut (exactly, by de Casteljau) to the intersection of its
  * knot rectangle with uv_box; patch (iu, iv) is set.patches[iv * set.n_u + iu] of that set. These
- * are the patches lod/hierarchy/hierarchy.c builds its trees from (use_box = 1), so a static LOD built from
- * a cluster covers exactly the patches the dynamic path draws for the same faces.
+ * are the patches lod/hierarchy/hierarchy.c builds its trees from (use_box = 1), so a static LOD
+ * built from a cluster covers exactly the patches the dynamic path draws for the same faces.
  *
  * Orientation. Cones are of the B-rep's outward normal: S_u x S_v, negated for faces with
  * SW_SG_FACE_REVERSED. Boxes and cones are in the face's object space (the frame of its control

@@ -31,9 +31,9 @@
  * metric.
  *
  * Where the paper is loose: §4.1 obtains M1..M3 by solving polynomial systems (elimination
- * theory); we use the rigorous but coarser control-net bounds of lod/bezier/sampling.c over each patch.
- * §4.3 says trimming curves "are treated like boundary curves" without saying how finely they are
- * sampled; ours are sampled for δ_trim in object space.
+ * theory); we use the rigorous but coarser control-net bounds of lod/bezier/sampling.c over each
+ * patch. §4.3 says trimming curves "are treated like boundary curves" without saying how finely
+ * they are sampled; ours are sampled for δ_trim in object space.
  */
 #include "sw_clock.h"
 #include "sw_lod_static_internal.h"

@@ -166,7 +166,7 @@ static void retire_statics(sw_rt_renderer *r)
         *rs = (retired_statics){set, r->cache_scene};
         sw_rt_scene_retain(r->cache_scene);
         const sw_th_task task = {
-            retire_statics_task,     rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL,
+            retire_statics_task,          rs, SW_TH_PRIORITY_BACKGROUND, NULL, 0, NULL,
             sw_th_task_kind_of(&k_retire)};
         if (sw_th_pool_submit(r->pool, &task) == SW_OK)
             return;

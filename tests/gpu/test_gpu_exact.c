@@ -14,8 +14,8 @@
  * triangles): at most 4 + 0.1 % of the covered pixels may have a coverage found nowhere within
  * 1 px in the reference, or a depth off the reference's on its smooth interiors. What it catches
  * (each planted and seen failing): densities a quarter of what the bound asks
- * (lod/bezier/sampling.c sw_lod_screen_segments) — all 6 views fail against the reference, while the
- * two paths disagreed on 2 of them only; the trim atlas read 2 texel rows off
+ * (lod/bezier/sampling.c sw_lod_screen_segments) — all 6 views fail against the reference, while
+ * the two paths disagreed on 2 of them only; the trim atlas read 2 texel rows off
  * (gpu/glsl/surface_trim.frag.glsl) — 4 of 6 views fail, while the two paths agreed on all.
  *
  * Usage: test_gpu_exact OUTDIR WIDTHxHEIGHT FILE...

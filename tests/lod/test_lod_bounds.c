@@ -8,11 +8,10 @@
  * the model files given on the command line.
  *
  * Usage: test_lod_bounds [--random N] [--stride K] [model files...]
- * Also builds every face's hierarchy (lod/hierarchy/hierarchy.c) and checks its nodes' accumulated bounds
- * against the exact NURBS surface.
- * Prints, per kind: items checked, violations (measured > bound), exact cases (bound at rounding
- * level, left out of the ratio), median and minimum of measured / bound. Fails (exit 1) on any
- * violation or a median ratio below 0.1.
+ * Also builds every face's hierarchy (lod/hierarchy/hierarchy.c) and checks its nodes' accumulated
+ * bounds against the exact NURBS surface. Prints, per kind: items checked, violations (measured >
+ * bound), exact cases (bound at rounding level, left out of the ratio), median and minimum of
+ * measured / bound. Fails (exit 1) on any violation or a median ratio below 0.1.
  */
 #include "sw_lod_bezier.h"
 #include "sw_lod_hierarchy.h"

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* The affine fast path of the screen-space grid density (lod/bezier/sampling.c affine_segments): planes'
- * patches take the coarsest allowed grid without the full bound, and must stay within ε_img.
- * Random views of random patches, degrees 1-5 in each direction, eye-relative as the frame gives
- * them, over random ranges of their local domain:
+/* The affine fast path of the screen-space grid density (lod/bezier/sampling.c affine_segments):
+ * planes' patches take the coarsest allowed grid without the full bound, and must stay within
+ * ε_img. Random views of random patches, degrees 1-5 in each direction, eye-relative as the frame
+ * gives them, over random ranges of their local domain:
  *  - exact planes (an affine map of the parameters, equal weights): the fast path's grid is the
  *    coarsest allowed and equals the full bound's choice; its eps_obj equals the full bound's; its
  *    d1 is at least the largest derivative sampled densely;

@@ -40,7 +40,8 @@ typedef struct totals {
     size_t memory;
 } totals;
 
-/* The patches of one face: its whole Bézier grid over the uv_box (as lod/hierarchy/hierarchy.c builds). */
+/* The patches of one face: its whole Bézier grid over the uv_box (as lod/hierarchy/hierarchy.c
+ * builds). */
 static uint32_t face_patches(const sw_sg_scene *scene, uint32_t face, sw_lod_static_patch **out)
 {
     const sw_sg_face_rec *fr = &sw_sg_scene_view_ptr(scene)->faces[face];

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* tests/lodcache: the per-scene cache of face hierarchies (lod/hierarchy/sw_lod_cache.h) on a real model.
+/* tests/lodcache: the per-scene cache of face hierarchies (lod/hierarchy/sw_lod_cache.h) on a real
+ * model.
  *
  *   once      4 threads request every face of the model concurrently in random order (FRAME and
  *             BACKGROUND, plain and converged): every face is built exactly once (builds ==

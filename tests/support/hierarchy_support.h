@@ -20,8 +20,8 @@ typedef struct sw_test_hierarchies sw_test_hierarchies;
 sw_test_hierarchies *sw_test_hierarchies_create(const sw_sg_scene *scene);
 /* The cache, for sw_gpu_frame_desc.hierarchies. */
 struct sw_lod_cache *sw_test_hierarchies_cache(sw_test_hierarchies *h);
-/* The scene's static LODs on the same pool (lod/static/sw_lod_static_set.h), made on the first call;
- * NULL (message on stderr) when the clustering fails. */
+/* The scene's static LODs on the same pool (lod/static/sw_lod_static_set.h), made on the first
+ * call; NULL (message on stderr) when the clustering fails. */
 struct sw_lod_static_set *sw_test_hierarchies_statics(sw_test_hierarchies *h);
 void sw_test_hierarchies_free(sw_test_hierarchies *h); /* NULL allowed */
 

@@ -520,8 +520,7 @@ static void hold_after_spawning_fn(void *ctx)
 {
     kind_spawner *sp = ctx;
     for (int i = 0; i < 4; i++) {
-        sw_th_task t = {
-            .fn = child_fn, .ctx = sp, .group = sp->group, .kind = g_kind.hierarchy};
+        sw_th_task t = {.fn = child_fn, .ctx = sp, .group = sp->group, .kind = g_kind.hierarchy};
         assert_int_equal(sw_th_pool_submit(sp->pool, &t), SW_OK);
     }
     gate_fn(sp->g);
@@ -617,8 +616,7 @@ static void test_kind_timing_nested(void **state)
     waiter w = {pool};
     sw_th_group grp;
     sw_th_group_init(&grp);
-    sw_th_task t = {
-        .fn = wait_for_naps_fn, .ctx = &w, .group = &grp, .kind = g_kind.wait};
+    sw_th_task t = {.fn = wait_for_naps_fn, .ctx = &w, .group = &grp, .kind = g_kind.wait};
     assert_int_equal(sw_th_pool_submit(pool, &t), SW_OK);
     while (sw_th_group_pending(&grp) > 0) /* polls: a helping caller could take a nap itself */
         sleep_ms(1);
@@ -757,7 +755,8 @@ static void test_kind_counts_concurrent(void **state)
 /* Registering: one value per name, distinct names distinct values, "other" at 0, the table's
  * end gives "other" and leaves the names as they were; slots register once, from any thread, with
  * the same value as a direct registration. Would catch a registry that hands out a second value
- * for a name (a profile column split in two), overruns its table, or a slot racing to two values. */
+ * for a name (a profile column split in two), overruns its table, or a slot racing to two values.
+ */
 static void *slot_thread(void *arg)
 {
     return (void *)(uintptr_t)sw_th_task_kind_of(arg);
@@ -785,9 +784,9 @@ static void test_kind_registry(void **state)
     assert_int_equal(sw_th_task_kind_register("t_slot", NULL), got[0]);
     assert_string_equal(sw_th_task_kind_name((sw_th_task_kind)got[0]), "t_slot");
     /* fill the table: the rest get values up to the end, then "other" */
-    static const char *const extra[SW_TH_TASK_KIND_MAX] = {
-        "x0", "x1", "x2", "x3", "x4", "x5", "x6", "x7",
-        "x8", "x9", "x10", "x11", "x12", "x13", "x14", "x15"};
+    static const char *const extra[SW_TH_TASK_KIND_MAX] = {"x0",  "x1",  "x2",  "x3", "x4",  "x5",
+                                                           "x6",  "x7",  "x8",  "x9", "x10", "x11",
+                                                           "x12", "x13", "x14", "x15"};
     for (int i = 0; i < SW_TH_TASK_KIND_MAX; i++) {
         const uint32_t before = sw_th_task_kind_count();
         const sw_th_task_kind k = sw_th_task_kind_register(extra[i], "filler");

@@ -103,8 +103,8 @@ static void print_summary(const sw_lod_static_set *set, uint64_t patches)
             const char *msg = NULL;
             sw_lod_static_set_failure(set, u, &msg);
             if (failed++ < 5)
-                fprintf(stderr, "splinewalk build-lod: super-surface %u: %s (drawn per frame)\n",
-                        u, msg ? msg : "not built");
+                fprintf(stderr, "splinewalk build-lod: super-surface %u: %s (drawn per frame)\n", u,
+                        msg ? msg : "not built");
             continue;
         }
         for (int32_t k = 0; k < c->n_levels && k < 9; ++k) {
@@ -118,8 +118,7 @@ static void print_summary(const sw_lod_static_set *set, uint64_t patches)
            (unsigned long long)patches, n - failed, failed);
     printf("level  triangles   vs level 0   per patch   largest declared ε / δ\n");
     for (int k = 0; k < 9 && sum[k].chains; ++k)
-        printf("%5d  %9llu   %9.1f %%   %9.2f   %8.1f\n", k,
-               (unsigned long long)sum[k].triangles,
+        printf("%5d  %9llu   %9.1f %%   %9.2f   %8.1f\n", k, (unsigned long long)sum[k].triangles,
                100.0 * (double)sum[k].triangles / (double)(sum[0].triangles ? sum[0].triangles : 1),
                (double)sum[k].triangles / (double)(patches ? patches : 1), sum[k].eps_rel_max);
 }

@@ -15,8 +15,10 @@ static const char k_usage[] =
     "\n"
     "Cross-checks the project's B-spline evaluation against OpenSubdiv. Every uniform,\n"
     "non-rational bicubic B-spline region (a knot span whose six surrounding knots are equally\n"
-    "spaced in u and in v, on a face with equal weights) of each SCENE, and of N generated uniform\n"
-    "test nets, is evaluated by the NURBS evaluator, by its Bézier form, and by OpenSubdiv's limit\n"
+    "spaced in u and in v, on a face with equal weights) of each SCENE, and of N generated "
+    "uniform\n"
+    "test nets, is evaluated by the NURBS evaluator, by its Bézier form, and by OpenSubdiv's "
+    "limit\n"
     "evaluation of the same control net (its regular patches are uniform bicubic B-splines).\n"
     "Prints the regions checked and the largest difference relative to each region's control-net\n"
     "diagonal; exits 1 when a difference exceeds the tolerance.\n"
@@ -88,9 +90,11 @@ int sw_cli_check_osd(int argc, char **argv)
         if (sw_cli_is_help(argv[i])) {
             fputs(k_usage, stdout);
             return 0;
-        } else if (!strcmp(argv[i], "--generated") && val && sw_cli_parse_count(val, 0, 1000, &a.generated) == 0) {
+        } else if (!strcmp(argv[i], "--generated") && val &&
+                   sw_cli_parse_count(val, 0, 1000, &a.generated) == 0) {
             i++;
-        } else if (!strcmp(argv[i], "--samples") && val && sw_cli_parse_count(val, 1, 4096, &a.samples) == 0) {
+        } else if (!strcmp(argv[i], "--samples") && val &&
+                   sw_cli_parse_count(val, 1, 4096, &a.samples) == 0) {
             i++;
         } else if (!strcmp(argv[i], "--tolerance") && val && sw_cli_parse_positive(val, &d) == 0) {
             a.tolerance = d;

@@ -150,8 +150,9 @@ static int check_args(const gen_args *a)
     }
 #if !SW_CLI_IMPORT
     if (a->brep) {
-        fprintf(stderr, "splinewalk generate: --brep writes through OpenCASCADE, and this build has "
-                        "no import module\n");
+        fprintf(stderr,
+                "splinewalk generate: --brep writes through OpenCASCADE, and this build has "
+                "no import module\n");
         return 2;
     }
 #endif
@@ -287,7 +288,7 @@ static const char *default_data(char *buf, size_t size)
     *slash = '\0';
     const int k = snprintf(buf, size, "%s/../share/splinewalk/data", exe);
     return k > 0 && (size_t)k < size && stat(buf, &sb) == 0 && S_ISDIR(sb.st_mode) ? buf
-                                                                                 : DEFAULT_DATA;
+                                                                                   : DEFAULT_DATA;
 }
 
 /* The BREP is built in memory first (an OCCT refusal leaves both outputs untouched) and written

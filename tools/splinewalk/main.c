@@ -21,7 +21,8 @@ static const command k_commands[] = {
     {"view", sw_cli_view, "walk through a scene in a window (WASD, mouse; needs a display)"},
 #endif
     {"generate", sw_cli_generate, "write a test scene: a grid of instances, or a building"},
-    {"build-lod", sw_cli_build_lod, "build the static LODs of a scene's super-surfaces into its .sws"},
+    {"build-lod", sw_cli_build_lod,
+     "build the static LODs of a scene's super-surfaces into its .sws"},
     {"demo", sw_cli_demo, "build and render the built-in default scene"},
 #if SW_CLI_CHECK_OSD
     {"check-osd", sw_cli_check_osd, "cross-check uniform bicubic regions against OpenSubdiv"},

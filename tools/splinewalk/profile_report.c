@@ -744,8 +744,8 @@ static void print_pool_summary(FILE *f, const sw_rt_profile *p)
         if (!(tasks > 0.0))
             continue;
         fprintf(f, "  %-14s %9.2f %9.2f %9.2f %9.2f %9.2f  %.0f tasks, %.1f ms in all\n",
-                sw_rt_pool_kind_name(k), s->median, s->p90, s->p99, s->max,
-                s->mean, tasks, s->mean * p->n_rows);
+                sw_rt_pool_kind_name(k), s->median, s->p90, s->p99, s->max, s->mean, tasks,
+                s->mean * p->n_rows);
     }
     const sw_rt_prof_stat *q = &p->summary[SW_RT_COL_POOL_QUEUED];
     fprintf(f,

@@ -78,7 +78,7 @@ sw_result sw_rt_path_orbit(const double bbox[6], double seconds, uint32_t frames
                            sw_rt_camera_path *out, sw_status *status);
 sw_result sw_rt_path_fly(const double bbox[6], double seconds, uint32_t frames,
                          sw_rt_camera_path *out, sw_status *status);
-sw_result sw_rt_path_walk(const double bbox[6], double eye_height, double seconds,
-                          uint32_t frames, sw_rt_camera_path *out, sw_status *status);
+sw_result sw_rt_path_walk(const double bbox[6], double eye_height, double seconds, uint32_t frames,
+                          sw_rt_camera_path *out, sw_status *status);
 
 #endif
