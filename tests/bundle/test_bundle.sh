@@ -8,6 +8,7 @@
 #   left out, fails here);
 # - the default scene rendered by the bundle (Mesa's surfaceless platform, then the EGL device
 #   platform as on NVIDIA) is byte for byte the full build's frame, so 0 pixels differ;
+# - `demo` renders the default scene the bundle ships: its four views are the full build's;
 # - `generate building` from the bundle's .sws parts is byte for byte the full build's from
 #   OCCT's files; build-lod (CGAL, OpenMesh from the bundle's lib/) and profile run;
 # - a program compiled against the bundle's headers and core library draws a node scene.
@@ -60,6 +61,16 @@ scrubbed SW_EGL_PLATFORM=device "$b/bin/splinewalk" render "$scene" -o "$work/de
     --view iso | grep -q "EGL device platform" || fail "not drawn through the EGL device platform"
 cmp "$work/full.png" "$work/device.png" || fail "the EGL device platform's frame differs"
 echo "default scene: the bundle's frames (surfaceless, device) = the full build's"
+
+# `demo`: the bundle renders the copy it ships; its four views = the full build's `make demo`.
+"$full/bin/splinewalk" demo -o "$work/demo_full" --size 320x180 >/dev/null 2>&1 ||
+  fail "the full build's demo"
+scrubbed "$b/bin/splinewalk" demo -o "$work/demo_bundle" --size 320x180 >/dev/null ||
+  fail "the bundle's demo"
+for view in iso front top inside; do
+  cmp "$work/demo_full/$view.png" "$work/demo_bundle/$view.png" || fail "demo's $view view differs"
+done
+echo "demo: the bundle's four views = the full build's"
 
 # generate from the shipped parts = generate from OCCT's files.
 "$full/bin/splinewalk" generate building --surfaces 10000 -o "$work/full_b.sws" >/dev/null

@@ -65,5 +65,8 @@ int sw_cli_report_load(const char *cmd, const sw_status *status);
  * themselves; the library leaves its host's malloc alone (docs/embedding.md). */
 void sw_cli_keep_freed_memory(void);
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s);
+/* What a bundle ships beside its bin/ (share/splinewalk/REL; scripts/bundle): its path in buf, or
+ * NULL when this program is not in a bundle that has it. */
+const char *sw_cli_bundle_path(const char *rel, char *buf, size_t size);
 
 #endif

@@ -181,3 +181,15 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
            (int)strlen(label), "", s->ms_hierarchy, s->ms_tessellate, s->ms_trim, s->ms_draw,
            s->ms_readback, s->ms_write, s->ms_total);
 }
+
+const char *sw_cli_bundle_path(const char *rel, char *buf, size_t size)
+{
+    char exe[4096];
+    const ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    char *slash = n > 0 ? (exe[n] = '\0', strrchr(exe, '/')) : NULL;
+    if (!slash)
+        return NULL;
+    *slash = '\0'; /* bin/ */
+    const int k = snprintf(buf, size, "%s/../share/splinewalk/%s", exe, rel);
+    return k > 0 && (size_t)k < size && access(buf, F_OK) == 0 ? buf : NULL;
+}

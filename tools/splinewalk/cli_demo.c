@@ -15,7 +15,8 @@ static const char k_usage[] =
     "furniture in Room.brep, a chair instanced twice, Motor-c.brep on the table), writes it as\n"
     "DIR/default.sws, maps it back, and renders four converged frames headlessly (iso, front, top\n"
     "and a view from inside the room) into DIR/*.png, printing what was drawn and how long each\n"
-    "step took.\n"
+    "step took. A build without the import module (a bundle, scripts/bundle) renders the copy\n"
+    "its bundle ships (share/splinewalk/default.sws, with its static LODs) instead.\n"
     "\n"
     "options:\n"
     "  -o, --output DIR   where the scene and frames go (default demo-out)\n"
@@ -111,6 +112,29 @@ static int make_dir(const char *dir)
     return 1;
 }
 
+/* Maps the scene file, prints what it holds and renders the views. */
+static int show(const char *sws, const demo_args *a, double t0)
+{
+    sw_status status = {0};
+    sw_scene scene;
+    sw_scene_info info;
+    const double t2 = sw__clock_ms();
+    if (sw_cli_load_scene(sws, 0, &scene, &status) != SW_OK ||
+        sw_scene_get_info(scene, &info, &status) != SW_OK)
+        return sw_cli_report("demo", &status);
+    printf("map + verify %s %.0f ms\n", sws, sw__clock_ms() - t2);
+    printf("scene: %u surfaces (%u trimmed, %u trim loops), %llu Bézier patches, %u instances, "
+           "%llu surfaces drawn, %.1f MiB\n",
+           info.faces, info.trimmed_faces, info.loops, (unsigned long long)info.bezier_patches,
+           info.instances, (unsigned long long)info.face_occurrences,
+           (double)info.memory_bytes / (1024.0 * 1024.0));
+    const int rc = render_views(scene, a);
+    sw_scene_destroy(scene);
+    if (!rc)
+        printf("frames in %s/ (total %.1f s)\n", a->dir, (sw__clock_ms() - t0) / 1e3);
+    return rc;
+}
+
 int sw_cli_demo(int argc, char **argv)
 {
     if (sw_cli_print_help(argc, argv, k_usage))
@@ -119,41 +143,30 @@ int sw_cli_demo(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc || make_dir(a.dir))
         return rc ? rc : 1;
-
+    const double t0 = sw__clock_ms();
+#if !SW_CLI_IMPORT
+    /* No importer to build it with: a bundle's prebuilt copy (with its LOD cache) */
+    char bundled[4096];
+    if (!a.data && sw_cli_bundle_path("default.sws", bundled, sizeof bundled)) {
+        printf("the default scene as the bundle ships it\n");
+        return show(bundled, &a, t0);
+    }
+#endif
     sw_status status = {0};
     sw_scene built;
-    double t0 = sw__clock_ms();
     printf("building the default scene from %s\n", a.data ? a.data : "/usr/share/opencascade/data");
     sw_scene_load_desc desc = {NULL, sw_cli_progress, sw_cli_warning, NULL, NULL, 0};
     sw_result r = sw_scene_load_default(a.data, &desc, &built, &status);
     sw_cli_progress_end();
     if (r != SW_OK)
         return sw_cli_report("demo", &status);
-    double t1 = sw__clock_ms();
+    const double t1 = sw__clock_ms();
     char sws[4096];
     snprintf(sws, sizeof sws, "%s/default.sws", a.dir);
     r = sw_scene_save(built, sws, &status);
     sw_scene_destroy(built);
     if (r != SW_OK)
         return sw_cli_report("demo", &status);
-    double t2 = sw__clock_ms();
-
-    sw_scene scene;
-    sw_scene_info info;
-    if (sw_cli_load_scene(sws, 0, &scene, &status) != SW_OK ||
-        sw_scene_get_info(scene, &info, &status) != SW_OK)
-        return sw_cli_report("demo", &status);
-    double t3 = sw__clock_ms();
-    printf("import %.0f ms, write %s %.0f ms, map + verify %.0f ms\n", t1 - t0, sws, t2 - t1,
-           t3 - t2);
-    printf("scene: %u surfaces (%u trimmed, %u trim loops), %llu Bézier patches, %u instances, "
-           "%llu surfaces drawn, %.1f MiB\n",
-           info.faces, info.trimmed_faces, info.loops, (unsigned long long)info.bezier_patches,
-           info.instances, (unsigned long long)info.face_occurrences,
-           (double)info.memory_bytes / (1024.0 * 1024.0));
-    rc = render_views(scene, &a);
-    sw_scene_destroy(scene);
-    if (!rc)
-        printf("frames in %s/ (total %.1f s)\n", a.dir, (sw__clock_ms() - t0) / 1e3);
-    return rc;
+    printf("import %.0f ms, write %s %.0f ms\n", t1 - t0, sws, sw__clock_ms() - t1);
+    return show(sws, &a, t0);
 }

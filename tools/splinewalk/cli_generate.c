@@ -275,20 +275,12 @@ static sw_result load_models(const char *data, const char *const *files, int n,
     return SW_OK;
 }
 
-/* The sample-data folder when --data is not given: the one a bundle ships beside its bin/
- * (share/splinewalk/data: the parts as .sws, see scripts/bundle), else Debian's. */
+/* The sample-data folder when --data is not given: the one a bundle ships (share/splinewalk/data:
+ * the parts as .sws, see scripts/bundle), else Debian's. */
 static const char *default_data(char *buf, size_t size)
 {
-    struct stat sb;
-    char exe[4096];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    char *slash = n > 0 ? (exe[n] = '\0', strrchr(exe, '/')) : NULL;
-    if (!slash)
-        return DEFAULT_DATA;
-    *slash = '\0';
-    const int k = snprintf(buf, size, "%s/../share/splinewalk/data", exe);
-    return k > 0 && (size_t)k < size && stat(buf, &sb) == 0 && S_ISDIR(sb.st_mode) ? buf
-                                                                                   : DEFAULT_DATA;
+    const char *bundled = sw_cli_bundle_path("data", buf, size);
+    return bundled ? bundled : DEFAULT_DATA;
 }
 
 /* The BREP is built in memory first (an OCCT refusal leaves both outputs untouched) and written
