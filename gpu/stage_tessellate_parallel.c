@@ -24,8 +24,7 @@
 #include <string.h>
 
 /* The pool's task kind of the chunks. */
-static sw_th_task_kind_slot k_chunk =
-    SW_TH_TASK_KIND_SLOT("frame_stage", "chunks of a frame's tessellation taken by workers");
+static sw_th_task_kind_slot k_chunk = SW_TH_TASK_KIND_SLOT("frame_stage");
 
 enum {
     MIN_PICKS_PER_CHUNK = 16, /* below it a chunk's bookkeeping outweighs its picks */

@@ -166,30 +166,29 @@ SW_API int64_t sw_th_pool_queued(sw_th_pool *pool, int64_t by_priority[SW_TH_PRI
  * it. A backlog the end-of-frame snapshot of sw_th_pool_queued misses when the workers catch up
  * within the frame. */
 SW_API int64_t sw_th_pool_inject_peak_take(sw_th_pool *pool);
-/* Registers a task kind under `name` (and a line saying what its tasks do), both strings of
- * static lifetime; returns its value. A name registered before gets its value again; when all
- * SW_TH_TASK_KIND_MAX values are taken, SW_TH_TASK_OTHER. Any thread; takes a lock: register once
- * (e.g. under pthread_once), not per task. */
-SW_API sw_th_task_kind sw_th_task_kind_register(const char *name, const char *what);
+/* Registers a task kind under `name` (a string of static lifetime; what the kind's tasks do is
+ * said where the name is shown, e.g. the profile's columns); returns its value. A name registered
+ * before gets its value again; when all SW_TH_TASK_KIND_MAX values are taken, SW_TH_TASK_OTHER.
+ * Any thread; takes a lock: register once (e.g. through a slot below), not per task. */
+SW_API sw_th_task_kind sw_th_task_kind_register(const char *name);
 /* A kind registered on its first use, for a layer's static table:
- *   static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("static_build", "...");
+ *   static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("static_build");
  *   task.kind = sw_th_task_kind_of(&k_build);
  * The first call registers (a lock, once: two threads racing register the same name and get the
  * same value); later calls are one atomic load. */
 typedef struct sw_th_task_kind_slot {
-    const char *name, *what;
+    const char *name;
     _Atomic uint32_t value; /* the kind + 1; 0 until registered */
 } sw_th_task_kind_slot;
-#define SW_TH_TASK_KIND_SLOT(name, what)                                                           \
+#define SW_TH_TASK_KIND_SLOT(name)                                                                 \
     {                                                                                              \
-        (name), (what), 0                                                                          \
+        (name), 0                                                                                  \
     }
 SW_API sw_th_task_kind sw_th_task_kind_of(sw_th_task_kind_slot *slot);
 /* Kinds registered so far (values 0 .. count - 1; "other" is always there). */
 SW_API uint32_t sw_th_task_kind_count(void);
-/* The registered name and line of a kind; "?" and "" for a value not registered. */
+/* The registered name of a kind; "?" for a value not registered. */
 SW_API const char *sw_th_task_kind_name(sw_th_task_kind kind);
-SW_API const char *sw_th_task_kind_what(sw_th_task_kind kind);
 
 #ifdef __cplusplus
 }

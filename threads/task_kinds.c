@@ -7,16 +7,12 @@
 #include <stdatomic.h>
 #include <string.h>
 
-typedef struct kind_entry {
-    const char *name, *what;
-} kind_entry;
-
 static pthread_mutex_t g_lock = PTHREAD_MUTEX_INITIALIZER;
-static kind_entry g_kinds[SW_TH_TASK_KIND_MAX] = {{"other", "tasks of no registered kind"}};
+static const char *g_kinds[SW_TH_TASK_KIND_MAX] = {"other"};
 /* Entries below g_count are complete: published with release after they are written. */
 static _Atomic uint32_t g_count = 1;
 
-sw_th_task_kind sw_th_task_kind_register(const char *name, const char *what)
+sw_th_task_kind sw_th_task_kind_register(const char *name)
 {
     if (!name)
         return SW_TH_TASK_OTHER;
@@ -24,12 +20,12 @@ sw_th_task_kind sw_th_task_kind_register(const char *name, const char *what)
     const uint32_t n = atomic_load_explicit(&g_count, memory_order_relaxed);
     sw_th_task_kind kind = SW_TH_TASK_OTHER;
     uint32_t k = 0;
-    while (k < n && strcmp(g_kinds[k].name, name) != 0)
+    while (k < n && strcmp(g_kinds[k], name) != 0)
         k++;
     if (k < n) {
         kind = k;
     } else if (n < SW_TH_TASK_KIND_MAX) {
-        g_kinds[n] = (kind_entry){name, what ? what : ""};
+        g_kinds[n] = name;
         atomic_store_explicit(&g_count, n + 1, memory_order_release);
         kind = n;
     }
@@ -41,7 +37,7 @@ sw_th_task_kind sw_th_task_kind_of(sw_th_task_kind_slot *slot)
 {
     uint32_t v = atomic_load_explicit(&slot->value, memory_order_acquire);
     if (!v) {
-        v = sw_th_task_kind_register(slot->name, slot->what) + 1;
+        v = sw_th_task_kind_register(slot->name) + 1;
         atomic_store_explicit(&slot->value, v, memory_order_release);
     }
     return v - 1;
@@ -54,10 +50,5 @@ uint32_t sw_th_task_kind_count(void)
 
 const char *sw_th_task_kind_name(sw_th_task_kind kind)
 {
-    return kind < sw_th_task_kind_count() ? g_kinds[kind].name : "?";
-}
-
-const char *sw_th_task_kind_what(sw_th_task_kind kind)
-{
-    return kind < sw_th_task_kind_count() ? g_kinds[kind].what : "";
+    return kind < sw_th_task_kind_count() ? g_kinds[kind] : "?";
 }

@@ -35,12 +35,9 @@
 #include <string.h>
 
 /* The pool's task kinds of this cache (profile columns pool_<name>_ms, pool_<name>_tasks). */
-static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("hierarchy", "bicubic hierarchy builds");
-static sw_th_task_kind_slot k_wait = SW_TH_TASK_KIND_SLOT(
-    "hierarchy_wait",
-    "converged frames' tasks waiting for a hierarchy build (their own time, waits included)");
-static sw_th_task_kind_slot k_refine =
-    SW_TH_TASK_KIND_SLOT("refine", "refinements below a hierarchy's leaves");
+static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("hierarchy");
+static sw_th_task_kind_slot k_wait = SW_TH_TASK_KIND_SLOT("hierarchy_wait");
+static sw_th_task_kind_slot k_refine = SW_TH_TASK_KIND_SLOT("refine");
 
 enum { STATE_BITS = 3, STATE_MASK = (1 << STATE_BITS) - 1, MAX_READERS = 65536 };
 

@@ -18,8 +18,7 @@
 #include <time.h>
 
 /* The pool's task kind of the set's builds. */
-static sw_th_task_kind_slot k_build =
-    SW_TH_TASK_KIND_SLOT("static_build", "static LOD builds of one super-surface");
+static sw_th_task_kind_slot k_build = SW_TH_TASK_KIND_SLOT("static_build");
 
 typedef struct slot {
     _Atomic int state;                    /* sw_lod_static_state */

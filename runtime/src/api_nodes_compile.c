@@ -19,8 +19,7 @@
 #include <string.h>
 
 /* The pool's task kind of node scenes' compiles. */
-static sw_th_task_kind_slot k_compile =
-    SW_TH_TASK_KIND_SLOT("compile", "node scenes' compile tasks");
+static sw_th_task_kind_slot k_compile = SW_TH_TASK_KIND_SLOT("compile");
 
 /* ---- compiling ---------------------------------------------------------------------------------
  */

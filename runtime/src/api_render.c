@@ -23,10 +23,8 @@
 #include <time.h>
 
 /* The pool's task kinds of the renderer's static LODs. */
-static sw_th_task_kind_slot k_cluster =
-    SW_TH_TASK_KIND_SLOT("static_cluster", "super-surface clustering of a scene (static LODs)");
-static sw_th_task_kind_slot k_retire =
-    SW_TH_TASK_KIND_SLOT("static_retire", "freeing a retired set of static LODs");
+static sw_th_task_kind_slot k_cluster = SW_TH_TASK_KIND_SLOT("static_cluster");
+static sw_th_task_kind_slot k_retire = SW_TH_TASK_KIND_SLOT("static_retire");
 
 /* The hierarchies live with the renderer, for the scene it last drew: a walkthrough keeps drawing
  * one scene, and the pool's workers then stay busy with that scene only. The renderer holds a

@@ -23,11 +23,11 @@ static struct {
 
 static void register_test_kinds(void)
 {
-    g_kind.compile = sw_th_task_kind_register("t_compile", "test");
-    g_kind.hierarchy = sw_th_task_kind_register("t_hierarchy", "test");
-    g_kind.wait = sw_th_task_kind_register("t_wait", "test");
-    g_kind.refine = sw_th_task_kind_register("t_refine", "test");
-    g_kind.build = sw_th_task_kind_register("t_build", "test");
+    g_kind.compile = sw_th_task_kind_register("t_compile");
+    g_kind.hierarchy = sw_th_task_kind_register("t_hierarchy");
+    g_kind.wait = sw_th_task_kind_register("t_wait");
+    g_kind.refine = sw_th_task_kind_register("t_refine");
+    g_kind.build = sw_th_task_kind_register("t_build");
 }
 
 static void sleep_ms(int ms)
@@ -766,10 +766,9 @@ static void test_kind_registry(void **state)
 {
     (void)state;
     assert_string_equal(sw_th_task_kind_name(SW_TH_TASK_OTHER), "other");
-    assert_int_equal(sw_th_task_kind_register("t_hierarchy", "again"), g_kind.hierarchy);
-    assert_string_equal(sw_th_task_kind_what(g_kind.hierarchy), "test");
+    assert_int_equal(sw_th_task_kind_register("t_hierarchy"), g_kind.hierarchy);
     assert_true(g_kind.hierarchy != g_kind.compile && g_kind.hierarchy != SW_TH_TASK_OTHER);
-    static sw_th_task_kind_slot slot = SW_TH_TASK_KIND_SLOT("t_slot", "a slot's kind");
+    static sw_th_task_kind_slot slot = SW_TH_TASK_KIND_SLOT("t_slot");
     pthread_t th[4];
     for (int i = 0; i < 4; i++)
         assert_int_equal(pthread_create(&th[i], NULL, slot_thread, &slot), 0);
@@ -781,7 +780,7 @@ static void test_kind_registry(void **state)
     }
     for (int i = 1; i < 4; i++)
         assert_int_equal(got[i], got[0]);
-    assert_int_equal(sw_th_task_kind_register("t_slot", NULL), got[0]);
+    assert_int_equal(sw_th_task_kind_register("t_slot"), got[0]);
     assert_string_equal(sw_th_task_kind_name((sw_th_task_kind)got[0]), "t_slot");
     /* fill the table: the rest get values up to the end, then "other" */
     static const char *const extra[SW_TH_TASK_KIND_MAX] = {"x0",  "x1",  "x2",  "x3", "x4",  "x5",
@@ -789,7 +788,7 @@ static void test_kind_registry(void **state)
                                                            "x12", "x13", "x14", "x15"};
     for (int i = 0; i < SW_TH_TASK_KIND_MAX; i++) {
         const uint32_t before = sw_th_task_kind_count();
-        const sw_th_task_kind k = sw_th_task_kind_register(extra[i], "filler");
+        const sw_th_task_kind k = sw_th_task_kind_register(extra[i]);
         if (before < SW_TH_TASK_KIND_MAX) {
             assert_int_equal(k, before);
             assert_string_equal(sw_th_task_kind_name(k), extra[i]);
