@@ -17,6 +17,7 @@
  * usage: bench_triangulate [--tol REL] MODEL... (.brep/.step/.iges or .sws)
  *   --tol REL   loops flattened within REL x the face's domain size (default 1e-3)
  */
+#include "cli_numbers.h"
 #include "sw_lod_trim_mesh.h"
 #include "sw_sg_geom.h"
 #include "sw_sg_import.h"
@@ -240,7 +241,8 @@ int main(int argc, char **argv)
     double rel = 1e-3;
     int first = 1;
     if (argc > 2 && !strcmp(argv[1], "--tol")) {
-        rel = atof(argv[2]);
+        if (sw_cli_parse_positive(argv[2], &rel))
+            return sw_cli_bad_value("bench_triangulate", argv[1], argv[2], NULL);
         first = 3;
     }
     if (first >= argc || !(rel > 0.0 && rel < 1.0)) {

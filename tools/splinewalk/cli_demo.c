@@ -16,7 +16,7 @@ static const char k_usage[] =
     "DIR/default.sws, maps it back, and renders four converged frames headlessly (iso, front, top\n"
     "and a view from inside the room) into DIR/*.png, printing what was drawn and how long each\n"
     "step took. A build without the import module (a bundle, scripts/bundle) renders the copy\n"
-    "its bundle ships (share/splinewalk/default.sws, with its static LODs) instead.\n"
+    "its bundle ships (share/splinewalk/default.sws) instead: the same frames.\n"
     "\n"
     "options:\n"
     "  -o, --output DIR   where the scene and frames go (default demo-out)\n"
