@@ -150,6 +150,20 @@ static int gl_extension(const char *name)
     return 0;
 }
 
+/* The GPU memory the driver reports, in bytes; 0 where it reports none (Mesa's llvmpipe). */
+static uint64_t reported_memory(void)
+{
+    enum { DEDICATED_VIDMEM_NVX = 0x9047, TEXTURE_FREE_MEMORY_ATI = 0x87FC };
+    GLint kib[4] = {0, 0, 0, 0};
+    if (gl_extension("GL_NVX_gpu_memory_info"))
+        glGetIntegerv(DEDICATED_VIDMEM_NVX, kib);
+    else if (gl_extension("GL_ATI_meminfo"))
+        glGetIntegerv(TEXTURE_FREE_MEMORY_ATI, kib); /* total free, largest block, ... */
+    while (glGetError() != GL_NO_ERROR) {
+    }
+    return kib[0] > 0 ? (uint64_t)kib[0] << 10 : 0;
+}
+
 static sw_result check_gl_version(sw_gpu_context *ctx, sw_status *status)
 {
     GLint major = 0, minor = 0;
@@ -167,6 +181,7 @@ static sw_result check_gl_version(sw_gpu_context *ctx, sw_status *status)
                         "try Mesa llvmpipe (EGL_PLATFORM=surfaceless, LIBGL_ALWAYS_SOFTWARE=1)",
                         ctx->description);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &ctx->max_texture_size);
+    ctx->gpu_reported_bytes = reported_memory();
     return SW_OK;
 }
 
@@ -263,6 +278,7 @@ static sw_result context_create(sw_result (*make)(sw_gpu_context *, sw_status *)
         sw_gpu_context_free(ctx);
         return r;
     }
+    sw_gpu_set_memory_budget(ctx, 0, 0);
     *out = ctx;
     sw__status_ok(status);
     return SW_OK;

@@ -46,6 +46,12 @@ typedef struct hl_face {
     int oom;
 } hl_face;
 
+/* The hierarchies hold their share of the memory budget (memory_budget.c): no more refinement. */
+static int hierarchy_budget_spent(const hl_face *hf)
+{
+    return sw_lod_cache_memory(hf->hy->cache) >= hf->env->ctx->hierarchy_bytes;
+}
+
 static void item_rect(const sw_lod_hnode *n, const double range[4], double out[4])
 {
     double du = n->rect[1] - n->rect[0], dv = n->rect[3] - n->rect[2];
@@ -130,14 +136,22 @@ static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double 
     c->err_w = err_w;
     c->eps_obj = eps_obj;
     c->need = *need;
-    if (!(err_w <= 0.5 * eps_obj))
+    if (!(err_w <= 0.5 * eps_obj)) {
         hf->st->hlod_over_budget++;
+        if (hierarchy_budget_spent(hf)) { /* left unrefined for the budget's sake */
+            hf->st->budget_coarsened++;
+            hf->st->bound_exceeded++;
+        }
+    }
 }
 
 /* In planning rounds and walkthrough frames: a leaf to refine below, to a tolerance in the
- * surface's units (asked for together after the traversal, submit_refines). */
+ * surface's units (asked for together after the traversal, submit_refines); none once the
+ * hierarchies hold their share of the memory budget: the leaf is drawn as it is. */
 static void ask_refine(hl_face *hf, int32_t node, double eps_obj)
 {
+    if (hierarchy_budget_spent(hf))
+        return;
     double tol = 0.5 * eps_obj / hf->scale;
     if (!(tol > 0.0) || !isfinite(tol))
         return;

@@ -186,7 +186,7 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 504,
+        sizeof(sw_gpu_frame_stats) == 512,
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;
@@ -202,6 +202,7 @@ static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
     d->bound_excess_px =
         d->bound_excess_px > s->bound_excess_px ? d->bound_excess_px : s->bound_excess_px;
     d->hlod_over_budget += s->hlod_over_budget;
+    d->budget_coarsened += s->budget_coarsened;
     d->faces_backculled += s->faces_backculled;
     d->trim_loops_floored += s->trim_loops_floored;
     d->borders_capped += s->borders_capped;

@@ -18,8 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const double k_max_frame_texels = 256e6; /* R8 trim texels per frame */
-
 /* Footprints (texture plus gutters) are powers of two, so that a class changes only when the
  * wanted resolution doubles or halves, and pages pack them tightly. */
 int32_t sw__fr_class_texels(double want, int32_t max_entry)
@@ -68,22 +66,23 @@ static double trim_footprint(const sw__fr_geometry *g, int32_t max_entry, double
 }
 
 /* The common scale of the wanted trim resolutions that keeps the frame's atlas footprints within
- * k_max_frame_texels. The wanted texels alone are no bound: rounding up to classes and the gutters
- * make the footprints up to ~4x larger (a 10^6-surface building wanted 3.4e8 texels, scaled to the
- * budget, and still needed 5.7e8, more than the atlas holds). Each step shrinks the scale by at
- * least 10 %; when every trim is at the smallest class the footprints cannot shrink further and the
- * atlas reports the overflow. */
-static double trim_scale(const sw__fr_geometry *g, int32_t max_entry)
+ * `budget` texels (the trim textures' share of the memory budget, memory_budget.c). The wanted
+ * texels alone are no bound: rounding up to classes and the gutters make the footprints up to ~4x
+ * larger (a 10^6-surface building wanted 3.4e8 texels, scaled to the budget, and still
+ * needed 5.7e8, more than the atlas holds). Each step shrinks the scale by at least 10 %; when
+ * every trim is at the smallest class the footprints cannot shrink further and the atlas reports
+ * the overflow. */
+static double trim_scale(const sw__fr_geometry *g, int32_t max_entry, double budget)
 {
     double total = 0.0;
     for (size_t i = 0; i < g->n_trims; ++i)
         total += g->trims[i].width * g->trims[i].height;
-    double scale = total > k_max_frame_texels ? sqrt(k_max_frame_texels / total) : 1.0;
+    double scale = total > budget ? sqrt(budget / total) : 1.0;
     for (int step = 0; step < 64; ++step) {
         const double foot = trim_footprint(g, max_entry, scale);
-        if (foot <= k_max_frame_texels)
+        if (foot <= budget)
             break;
-        scale *= fmin(0.9, sqrt(k_max_frame_texels / foot));
+        scale *= fmin(0.9, sqrt(budget / foot));
     }
     return scale;
 }
@@ -111,7 +110,7 @@ sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_f
     t.st = st;
     t.geo = geo;
     const int32_t max_entry = sw__gpu_atlas_max_entry(env->ctx);
-    const double scale = trim_scale(geo, max_entry);
+    const double scale = trim_scale(geo, max_entry, env->ctx->atlas_frame_texels);
     sw_result r = SW_OK;
     for (size_t i = 0; i < geo->n_trims && r == SW_OK; ++i) {
         pending_trim *p = &geo->trims[i];
@@ -119,8 +118,10 @@ sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_f
         p->h = sw__fr_class_texels(p->height * scale, max_entry);
         /* coarser than its need (the budget's scale, an entry's size limit): its edge may move by
          * more than the object tolerance, which the error bound and occlusion culling assume */
-        if (p->w < p->width || p->h < p->height)
+        if (p->w < p->width || p->h < p->height) {
             st->bound_exceeded++;
+            st->budget_coarsened += scale < 1.0;
+        }
         if (!p->clip)
             r = plan_whole_box(&t, i, status);
     }

@@ -43,6 +43,17 @@ void sw_gpu_context_free(sw_gpu_context *ctx); /* NULL allowed */
 /* "GL_RENDERER / GL_VERSION" of the context (borrowed). */
 const char *sw_gpu_context_description_ptr(const sw_gpu_context *ctx);
 
+/* The memory budget (memory_budget.c): host and GPU bytes the caches kept between frames may
+ * take, divided among them in fixed shares; 0 = the default (host: half of physical memory; GPU:
+ * half of what the driver reports, 1 GiB where it reports nothing, as llvmpipe). A context starts
+ * with the defaults. Between frames only. */
+void sw_gpu_set_memory_budget(sw_gpu_context *ctx, uint64_t host, uint64_t gpu);
+/* The budget in force and the GPU memory the driver reports (GL_NVX_gpu_memory_info's dedicated
+ * memory, GL_ATI_meminfo's free texture memory; 0: none). */
+void sw_gpu_memory_budget(const sw_gpu_context *ctx, uint64_t *host, uint64_t *gpu,
+                          uint64_t *gpu_reported);
+uint64_t sw_gpu_default_host_budget(void);
+
 typedef struct sw_gpu_camera {
     double eye[3], target[3], up[3];
     double fovy_deg; /* vertical field of view, in [SW_FOVY_MIN_DEG, 180) */
@@ -177,6 +188,10 @@ typedef struct sw_gpu_frame_stats {
      * over ε_img, in pixels (0 when none is known) */
     uint64_t bound_exceeded;
     double bound_excess_px;
+    uint64_t budget_coarsened;     /* pieces drawn coarser than the view asks because a share
+                                      of the memory budget is spent (memory_budget.c): trim
+                                      textures scaled down, hierarchy leaves left unrefined;
+                                      counted in bound_exceeded too */
     uint64_t hlod_over_budget;     /* nodes drawn although their error exceeds their share of
                                       ε_img (refinement stopped at its depth limit) */
     uint64_t hlod_waits;           /* converged: the hierarchy stage's group waits */

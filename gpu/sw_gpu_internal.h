@@ -157,6 +157,11 @@ struct sw_gpu_context {
     size_t piece_ssbo_cap, knot_ssbo_cap, dcp_ssbo_cap;
     struct sw__gpu_atlas *atlas; /* trim-texture atlas kept across frames (trim_atlas.c) */
     int32_t atlas_max_side;      /* page side limit (tests); 0 = the default; set between frames */
+    /* the memory budget and its shares (memory_budget.c); set between frames */
+    uint64_t budget_host, budget_gpu;
+    uint64_t gpu_reported_bytes; /* what the driver reports (context set-up); 0: nothing */
+    double atlas_frame_texels;   /* the frame's trim textures, at most */
+    size_t hierarchy_bytes;      /* the hierarchies refine no further above it */
     /* predefined grids of the Bézier evaluation (§4.2; grid_set.c) */
     GLuint grid_ibo; /* every grid class's triangles, one after another */
     uint32_t grid_first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* [level v][level u] */

@@ -97,6 +97,8 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
         sw__free(r);
         return res;
     }
+    sw_gpu_set_memory_budget(r->gpu, desc ? desc->memory_budget_host : 0,
+                             desc ? desc->memory_budget_gpu : 0);
     r->owner = pthread_self();
     out->id = sw_rt_pool_add(&g_renderers, r);
     if (!out->id) {
@@ -106,6 +108,11 @@ sw_result sw_renderer_create(const sw_renderer_desc *desc, sw_renderer *out, sw_
     }
     sw__log(SW_LOG_INFO, "renderer %#x: %s%s", out->id, sw_gpu_context_description_ptr(r->gpu),
             desc && desc->use_current_context ? " (the host's context)" : "");
+    uint64_t host, gpu, reported;
+    sw_gpu_memory_budget(r->gpu, &host, &gpu, &reported);
+    sw__log(SW_LOG_INFO,
+            "renderer %#x: memory budget host %.0f MiB, GPU %.0f MiB (driver reports %.0f MiB)",
+            out->id, host / 1048576.0, gpu / 1048576.0, reported / 1048576.0);
     return SW_OK;
 }
 
@@ -326,6 +333,20 @@ const char *sw_renderer_description_ptr(sw_renderer renderer)
     return sw_gpu_context_description_ptr(r->gpu);
 }
 
+sw_result sw_renderer_memory_budget(sw_renderer renderer, sw_memory_budget *out, sw_status *status)
+{
+    if (!out)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_renderer_memory_budget: NULL out");
+    memset(out, 0, sizeof *out);
+    sw_rt_renderer *r;
+    sw_result res = owned_renderer(renderer, "sw_renderer_memory_budget", &r, status);
+    if (res != SW_OK)
+        return res;
+    sw_gpu_memory_budget(r->gpu, &out->host_bytes, &out->gpu_bytes, &out->gpu_reported_bytes);
+    sw__status_ok(status);
+    return SW_OK;
+}
+
 static sw_result check_frame_desc(const sw_frame_desc *desc, sw_status *status)
 {
     if (desc->width < 0 || desc->height < 0 || desc->width > 16384 || desc->height > 16384)
@@ -378,6 +399,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->mesh_triangles = g->mesh_triangles;
     out->static_requests = g->static_requests;
     out->bound_exceeded = g->bound_exceeded;
+    out->budget_coarsened = g->budget_coarsened;
     out->bound_excess_px = g->bound_excess_px;
     out->tess_chunks = g->tess_chunks;
     out->tess_chunks_by_pool = g->tess_chunks_by_pool;

@@ -65,6 +65,18 @@ int sw_cli_report_load(const char *cmd, const sw_status *status);
  * themselves; the library leaves its host's malloc alone (docs/embedding.md). */
 void sw_cli_keep_freed_memory(void);
 void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s);
+/* "memory budget: host X GiB, GPU Y GiB (what the driver reports)\n" into buf ("" for a renderer
+ * the caller does not own). */
+void sw_cli_memory_budget_line(sw_renderer renderer, char *buf, size_t size);
+/* The help line of --memory-budget, shared by render, profile and view. */
+#define SW_CLI_MEMORY_BUDGET_HELP                                                                  \
+    "  --memory-budget HOST[,GPU]\n"                                                               \
+    "                      bytes the renderer may keep between frames (suffix K, M, G or T):\n"    \
+    "                      hierarchies and fat borders in host memory, resident levels and\n"      \
+    "                      trim textures on the GPU; over it the picture coarsens and says\n"      \
+    "                      so. Default: half of physical memory, half of the GPU's (1 GiB\n"       \
+    "                      where the driver reports none, as llvmpipe)\n"
+
 /* What a bundle ships beside its bin/ (share/splinewalk/REL; scripts/bundle): its path in buf, or
  * NULL when this program is not in a bundle that has it. */
 const char *sw_cli_bundle_path(const char *rel, char *buf, size_t size);

@@ -172,8 +172,12 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
         printf("%*s  error bound: %llu pieces drawn over it (worst known excess %.3g px)\n",
                (int)strlen(label), "", (unsigned long long)s->bound_exceeded, s->bound_excess_px);
     else if (s->bound_exceeded > 0)
-        printf("%*s  error bound: %llu pieces drawn over it (grids capped at the segment limit)\n",
+        printf("%*s  error bound: %llu pieces drawn over it (their excess is not known)\n",
                (int)strlen(label), "", (unsigned long long)s->bound_exceeded);
+    if (s->budget_coarsened > 0)
+        printf("%*s  memory budget: %llu pieces drawn coarser than the view asks (a share of "
+               "the budget is spent; --memory-budget)\n",
+               (int)strlen(label), "", (unsigned long long)s->budget_coarsened);
     printf("%*s  upload: %.2f MiB of vertices, indices and patch data sent for the draw\n",
            (int)strlen(label), "", (double)s->upload_bytes / (1024.0 * 1024.0));
     printf("%*s  time: hierarchy builds %.1f ms, tessellate %.1f ms, trim textures %.1f ms, draw "
@@ -192,4 +196,32 @@ const char *sw_cli_bundle_path(const char *rel, char *buf, size_t size)
     *slash = '\0'; /* bin/ */
     const int k = snprintf(buf, size, "%s/../share/splinewalk/%s", exe, rel);
     return k > 0 && (size_t)k < size && access(buf, F_OK) == 0 ? buf : NULL;
+}
+
+/* "1.50 GiB", "12.0 MiB", "512 KiB": a budget as a person reads it. */
+static void human_bytes(uint64_t b, char *buf, size_t size)
+{
+    if (b >= (uint64_t)1 << 30)
+        snprintf(buf, size, "%.2f GiB", (double)b / (double)(1 << 30));
+    else if (b >= (uint64_t)1 << 20)
+        snprintf(buf, size, "%.1f MiB", (double)b / (double)(1 << 20));
+    else
+        snprintf(buf, size, "%.0f KiB", (double)b / 1024.0);
+}
+
+void sw_cli_memory_budget_line(sw_renderer renderer, char *buf, size_t size)
+{
+    sw_memory_budget b;
+    buf[0] = '\0';
+    if (sw_renderer_memory_budget(renderer, &b, NULL) != SW_OK)
+        return;
+    char host[32], gpu[32], reported[64] = "the driver reports no GPU memory";
+    human_bytes(b.host_bytes, host, sizeof host);
+    human_bytes(b.gpu_bytes, gpu, sizeof gpu);
+    if (b.gpu_reported_bytes) {
+        char r[32];
+        human_bytes(b.gpu_reported_bytes, r, sizeof r);
+        snprintf(reported, sizeof reported, "the driver reports %s", r);
+    }
+    snprintf(buf, size, "memory budget: host %s, GPU %s (%s)\n", host, gpu, reported);
 }

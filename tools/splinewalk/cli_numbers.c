@@ -129,3 +129,56 @@ int sw_cli_parse_seed(const char *text, unsigned long long *out)
     *out = v;
     return 0;
 }
+
+/* One byte count: digits with an optional binary suffix K, M, G or T (case-insensitive). */
+static int parse_bytes(const char *text, const char **end, uint64_t *out)
+{
+    unsigned long long v;
+    if (parse_digits(text, end, ULLONG_MAX, &v) != 0)
+        return -1;
+    int shift = 0;
+    switch (**end) {
+    case 'k':
+    case 'K':
+        shift = 10;
+        break;
+    case 'm':
+    case 'M':
+        shift = 20;
+        break;
+    case 'g':
+    case 'G':
+        shift = 30;
+        break;
+    case 't':
+    case 'T':
+        shift = 40;
+        break;
+    default:
+        break;
+    }
+    if (shift) {
+        if (v > (ULLONG_MAX >> shift))
+            return refuse("more bytes than 2^64");
+        v <<= shift;
+        ++*end;
+    }
+    *out = v;
+    return 0;
+}
+
+int sw_cli_parse_memory_budget(const char *text, uint64_t *host, uint64_t *gpu)
+{
+    g_parse_reason[0] = '\0';
+    const char *end;
+    uint64_t h, g = 0;
+    if (parse_bytes(text, &end, &h) != 0)
+        return -1;
+    if (*end == ',' && parse_bytes(end + 1, &end, &g) != 0)
+        return -1;
+    if (*end != '\0')
+        return -1;
+    *host = h;
+    *gpu = g;
+    return 0;
+}

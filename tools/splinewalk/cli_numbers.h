@@ -26,6 +26,9 @@ int sw_cli_parse_positive(const char *text, double *out);
 /* A screen-space error in pixels: a decimal number of at least SW_ERROR_MIN_PX (what every frame
  * accepts), so that a run refuses it before it creates any output. Returns 0 on success. */
 int sw_cli_parse_error_px(const char *text, double *out);
+/* "HOST[,GPU]": the renderer's memory budget in bytes, each digits with an optional binary suffix
+ * K, M, G or T ("8G,512M"); 0 or an absent GPU part = the default. Returns 0 on success. */
+int sw_cli_parse_memory_budget(const char *text, uint64_t *host, uint64_t *gpu);
 /* A random seed: decimal digits only (no sign, no space), at most 2^64 - 1. Returns 0 on success.
  */
 int sw_cli_parse_seed(const char *text, unsigned long long *out);

@@ -20,7 +20,7 @@ static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
     "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--lod-colors]\n"
-    "                          [--no-occlusion]\n"
+    "                          [--no-occlusion] [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
     "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
@@ -64,7 +64,8 @@ static const char k_usage[] =
     "  --lod-colors      colour by representation, as for `render`\n"
     "  --no-occlusion    draw what visible planar faces hide too (culled by default, as for\n"
     "                    `render`: occlusion_tests, nodes_occluded, faces_occluded columns; a\n"
-    "                    frame that hides nothing makes the next 1, 3, 7 or 15 go without it)\n"
+    "                    frame that hides nothing makes the next 1, 3, 7 or 15 go without "
+    "it)\n" SW_CLI_MEMORY_BUDGET_HELP "                    (budget_coarsened column)\n"
     "  -h, --help        this text\n";
 
 typedef struct profile_args {
@@ -73,6 +74,7 @@ typedef struct profile_args {
     int threads;
     int converged, sequential;
     sw_frame_desc frame;
+    uint64_t budget_host, budget_gpu; /* --memory-budget; 0 = the default */
 } profile_args;
 
 static int parse_option(profile_args *a, const char *arg, const char *val)
@@ -89,6 +91,8 @@ static int parse_option(profile_args *a, const char *arg, const char *val)
         return sw_cli_parse_error_px(val, &a->frame.error_px);
     else if (!strcmp(arg, "--threads"))
         return sw_cli_parse_count(val, 1, 1024, &a->threads);
+    else if (!strcmp(arg, "--memory-budget"))
+        return sw_cli_parse_memory_budget(val, &a->budget_host, &a->budget_gpu);
     else if (!strcmp(arg, "--eval")) {
         a->eval = val;
         a->frame.eval_exact = strcmp(val, "exact") == 0;
@@ -283,10 +287,15 @@ static sw_result profile_run(profile_args *a, sw_scene scene, const sw_rt_camera
 {
     sw_renderer_desc rd = {0};
     rd.worker_threads = requested_workers(a);
+    rd.memory_budget_host = a->budget_host;
+    rd.memory_budget_gpu = a->budget_gpu;
     sw_renderer renderer = {0};
     sw_result r = sw_renderer_create(&rd, &renderer, status);
     if (r != SW_OK)
         return r;
+    char budget[256];
+    sw_cli_memory_budget_line(renderer, budget, sizeof budget);
+    printf("profile: %s", budget);
     /* pool_<kind>_ms: two clock reads per task, nothing next to a hierarchy build's cost */
     sw_rt_renderer_time_pool_tasks(renderer, 1);
     fill_meta(a, renderer, p);

@@ -12,6 +12,7 @@ static const char k_usage[] =
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--[no-]static-lod] [--lod-colors]\n"
     "                         [--static-force K] [--no-occlusion] [--partial]\n"
+    "                         [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as "
@@ -55,8 +56,8 @@ static const char k_usage[] =
     "  --no-occlusion      draw what the visible planar faces hide too (by default it is culled\n"
     "                      before it is tessellated, by a depth map of those faces on the\n"
     "                      visibility thread; the image is the same)\n"
-    "  --partial           import what is whole of a truncated file (see `import --help`)\n"
-    "  -h, --help          this text\n";
+    "  --partial           import what is whole of a truncated file (see `import "
+    "--help`)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help          this text\n";
 
 typedef struct render_args {
     const char *scene, *out;
@@ -64,6 +65,7 @@ typedef struct render_args {
     sw_view_preset view;
     int has_camera;
     uint32_t load_flags;
+    sw_renderer_desc renderer;
 } render_args;
 
 static int parse_args(int argc, char **argv, render_args *a)
@@ -90,6 +92,9 @@ static int parse_args(int argc, char **argv, render_args *a)
         }
         if (!strcmp(arg, "--static-force") && val) {
             bad = sw_cli_parse_count(val, 1, 1 << 20, &a->frame.static_force);
+        } else if (!strcmp(arg, "--memory-budget") && val) {
+            bad = sw_cli_parse_memory_budget(val, &a->renderer.memory_budget_host,
+                                             &a->renderer.memory_budget_gpu);
         } else if ((!strcmp(arg, "-o") || !strcmp(arg, "--output")) && val) {
             a->out = val;
         } else if (!strcmp(arg, "--size") && val) {
@@ -161,14 +166,17 @@ int sw_cli_render(int argc, char **argv)
     if (!a.has_camera)
         r = sw_camera_fit(scene, a.view, &a.frame.camera, &status);
     if (r == SW_OK)
-        r = sw_renderer_create(NULL, &renderer, &status);
+        r = sw_renderer_create(&a.renderer, &renderer, &status);
     double t2 = sw__clock_ms();
     if (r == SW_OK)
         r = sw_renderer_draw(renderer, &a.frame, &stats, &status);
     /* which GL and EGL platform drew it: llvmpipe, or which GPU */
     char gl[256] = "";
-    if (renderer.id)
+    char budget[256] = "";
+    if (renderer.id) {
         snprintf(gl, sizeof gl, "%s", sw_renderer_description_ptr(renderer));
+        sw_cli_memory_budget_line(renderer, budget, sizeof budget);
+    }
     if (renderer.id)
         sw_renderer_destroy(renderer);
     sw_scene_destroy(scene);
@@ -179,6 +187,7 @@ int sw_cli_render(int argc, char **argv)
            a.frame.height ? a.frame.height : SW_DEFAULT_HEIGHT,
            a.frame.error_px > 0 ? a.frame.error_px : SW_DEFAULT_ERROR_PX);
     printf("load %.0f ms, GL context %.0f ms (%s)\n", t1 - t0, t2 - t1, gl);
+    printf("%s", budget);
     sw_cli_print_frame_stats("frame", &stats);
     return 0;
 }

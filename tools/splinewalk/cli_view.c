@@ -29,7 +29,7 @@
 static const char k_usage[] =
     "usage: splinewalk view SCENE [--size WxH] [--error PX] [--speed S] [--record PATH]\n"
     "                       [--script PATH --frames N [--screenshot OUT.png] [--settle]\n"
-    "                        [--converged] [--profile DIR]]\n"
+    "                        [--converged] [--profile DIR]] [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Opens a window (GLFW; needs a display: under no display use `splinewalk profile`, or run\n"
     "inside xvfb-run) and walks through SCENE in walkthrough mode: frames never wait for the\n"
@@ -80,8 +80,8 @@ static const char k_usage[] =
     "                    from the scene's `build-lod` cache, else built in the pool as\n"
     "                    needed, which is said on stderr; --static-lod is the default)\n"
     "  --lod-colors      start with LOD colouring on (C toggles it)\n"
-    "  --atlas-overlay   start with the trim atlas's first page shown (A cycles the pages)\n"
-    "  -h, --help        this text\n";
+    "  --atlas-overlay   start with the trim atlas's first page shown (A cycles the "
+    "pages)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help        this text\n";
 
 typedef struct view_args {
     const char *scene, *record, *script, *screenshot, *profile;
@@ -89,6 +89,7 @@ typedef struct view_args {
     int frames, settle, overlay, wireframe, static_lods, no_static_lods, lod_colors, atlas_overlay,
         no_occlusion, converged;
     double error_px, speed;
+    uint64_t budget_host, budget_gpu; /* --memory-budget; 0 = the default */
 } view_args;
 
 static int parse_value(view_args *a, const char *arg, const char *val)
@@ -97,6 +98,8 @@ static int parse_value(view_args *a, const char *arg, const char *val)
         return sw_cli_parse_size(val, &a->w, &a->h);
     if (!strcmp(arg, "--error"))
         return sw_cli_parse_error_px(val, &a->error_px);
+    if (!strcmp(arg, "--memory-budget"))
+        return sw_cli_parse_memory_budget(val, &a->budget_host, &a->budget_gpu);
     if (!strcmp(arg, "--speed"))
         return sw_cli_parse_positive(val, &a->speed);
     if (!strcmp(arg, "--frames"))
@@ -597,8 +600,15 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
     glfwSetScrollCallback(win, on_scroll);
     glfwSetCursorPosCallback(win, on_mouse);
     sw_renderer r = {0};
-    sw_renderer_desc rd = {.use_current_context = 1};
+    sw_renderer_desc rd = {.use_current_context = 1,
+                           .memory_budget_host = a->budget_host,
+                           .memory_budget_gpu = a->budget_gpu};
     int rc = sw_renderer_create(&rd, &r, &st) != SW_OK ? sw_cli_report("view", &st) : 0;
+    if (rc == 0) {
+        char budget[256];
+        sw_cli_memory_budget_line(r, budget, sizeof budget);
+        printf("view: %s", budget);
+    }
     if (rc == 0 && sw_cli_overlay_init(&v.overlay) != 0)
         fprintf(stderr, "splinewalk view: the frame-time overlay's shaders do not build here\n");
     if (rc == 0 && sw_cli_atlas_view_init(&v.atlas) != 0)

@@ -103,6 +103,7 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_STATIC_TRIANGLES] = (double)st->static_triangles;
     v[SW_RT_COL_STATIC_REQUESTS] = (double)st->static_requests;
     v[SW_RT_COL_BOUND_EXCEEDED] = (double)st->bound_exceeded;
+    v[SW_RT_COL_BUDGET_COARSENED] = (double)st->budget_coarsened;
     v[SW_RT_COL_BOUND_EXCESS_PX] = st->bound_excess_px;
     v[SW_RT_COL_OCCLUSION_TESTS] = (double)st->occlusion_tests;
     v[SW_RT_COL_NODES_OCCLUDED] = (double)st->nodes_occluded;

@@ -105,6 +105,8 @@ const char *sw_rt_pool_kind_name(int kind);
       "pieces drawn whose error bound exceeds the screen-space error (capped grids, floors)")      \
     X(BOUND_EXCESS_PX, "bound_excess_px", PIXELS,                                                  \
       "the worst known bound over the screen-space error, in pixels")                              \
+    X(BUDGET_COARSENED, "budget_coarsened", COUNT,                                                 \
+      "pieces drawn coarser because a share of the memory budget is spent (of bound_exceeded)")    \
     X(OCCLUSION_TESTS, "occlusion_tests", COUNT,                                                   \
       "--occlusion: boxes tested against the occlusion map")                                       \
     X(NODES_OCCLUDED, "nodes_occluded", COUNT, "--occlusion: hierarchy (BVH) nodes found hidden")  \

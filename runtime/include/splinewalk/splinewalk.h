@@ -274,6 +274,16 @@ typedef struct sw_renderer_desc {
                                 meanwhile (zero-to-one clip depth, reversed-Z). Not
                                 restored: texture units other than 0, image units,
                                 transform feedback, queries, GL errors. */
+    /* The memory budget of what the renderer keeps between frames, in bytes; 0 = the default.
+     * Host: half to the bicubic hierarchies (over it they refine no further), a sixteenth (at most
+     * 64 MiB) to the fat borders' cache; default half of physical memory. GPU: half to static
+     * levels resident in buffers, a quarter (at most 256 MiB) to a frame's trim textures; default
+     * half of what the driver reports, 1 GiB where it reports nothing (llvmpipe). Over a share a
+     * cache keeps only what the last frame used, and the picture coarsens instead of failing:
+     * sw_frame_stats.budget_coarsened counts what was drawn coarser (in bound_exceeded too). The
+     * scene, the BVH and the per-frame buffers, which follow the scene and the screen, are not
+     * budgeted. sw_renderer_memory_budget says what is in force. */
+    uint64_t memory_budget_host, memory_budget_gpu;
 } sw_renderer_desc;
 
 /* Creates a renderer owned by the calling thread: headless (EGL; llvmpipe when there is no GPU),
@@ -292,6 +302,16 @@ SW_API sw_result sw_renderer_destroy(sw_renderer renderer);
 /* "renderer / GL version" of the renderer's context, borrowed until the renderer is destroyed;
  * "" for a stale handle or a call from a thread other than the owner. Never NULL. */
 SW_API const char *sw_renderer_description_ptr(sw_renderer renderer);
+
+typedef struct sw_memory_budget {
+    uint64_t host_bytes, gpu_bytes; /* the budget in force (sw_renderer_desc's, or the default) */
+    uint64_t gpu_reported_bytes;    /* the GPU memory the driver reports (GL_NVX_gpu_memory_info,
+                                       GL_ATI_meminfo); 0: it reports none (llvmpipe) */
+} sw_memory_budget;
+/* The renderer's memory budget. Owner thread only. Errors: SW_ERR_STALE_HANDLE,
+ * SW_ERR_INVALID_ARGUMENT (NULL out, another thread). */
+SW_API sw_result sw_renderer_memory_budget(sw_renderer renderer, sw_memory_budget *out,
+                                           sw_status *status);
 
 typedef struct sw_frame_desc {
     sw_scene scene;
@@ -389,7 +409,7 @@ typedef struct sw_frame_stats {
                                 segment limit, hierarchy nodes at the sampling floor, trim loops
                                 flattened at their floor, fat borders sampled coarser than their
                                 cells, trim textures coarser than their need (the frame's atlas
-                                budget) */
+                                budget), hierarchy leaves left unrefined under the memory budget */
     double bound_excess_px;  /* the worst known bound over ε_img of those, in pixels */
     double ms_hierarchy;     /* blocked waiting for hierarchy builds and refinements (both
                                 modes; 0 when none was waited for) */
@@ -436,6 +456,10 @@ typedef struct sw_frame_stats {
      * levels, sent once); and the bytes sent to the GPU for the frame's draw (the vertices,
      * indices and patch data made for it, and the levels sent for the first time) */
     uint64_t resident_triangles, upload_bytes;
+    /* pieces drawn coarser than the view asks because a share of the renderer's memory budget is
+     * spent (sw_renderer_desc.memory_budget_*): trim textures scaled down to the frame's share,
+     * hierarchy leaves left unrefined; each is in bound_exceeded too */
+    uint64_t budget_coarsened;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
