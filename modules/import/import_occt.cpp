@@ -5,7 +5,7 @@
  * rational B-spline trim loops, snapped closed (sw_sg_trim.h) as Guthe et al. 2005 §4's
  * parity-based trim textures require. Shapes shared with different locations become one prototype
  * subtree drawn by INSTANCE nodes. Faces sharing an edge are recorded as adjacent (for Kumar et al.
- * 1997's super-surfaces). The readers of STEP, IGES and BREP files are import_occt_read.cpp.
+ * 1997's super-surfaces). The readers of STEP, IGES and BREP files are read_occt.cpp.
  *
  * This is a C++ shim: no exception leaves it. A face that cannot be converted becomes a warning
  * and a count, anything else SW_ERR_INTERNAL.

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The OCCT importer's state, shared by the conversion of a shape into an sw_sg_builder
  * (import_occt.cpp) and the file and document readers that produce the shape
- * (import_occt_read.cpp). Private to the import module. */
+ * (read_occt.cpp). Private to the import module. */
 #pragma once
 
 #include "import_occt_face.hpp"
