@@ -68,7 +68,7 @@ check_run() {
   [ "$(($(wc -l <"$dir/profile.csv") - 1))" -eq "$n" ] || fail "$dir: CSV rows $(($(wc -l <"$dir/profile.csv") - 1)), expected $n"
   # border_triangles: some in every run (every face drawn gets its fat borders), never more than
   # the triangles they are counted in (a field left unset or counted apart fails here)
-  awk -F, -v n=65 -v n_other="$(col other_ms)" -v n_tri="$(col triangles)" \
+  awk -F, -v n="$(echo "$columns" | tr , "\n" | wc -l)" -v n_other="$(col other_ms)" -v n_tri="$(col triangles)" \
       -v n_border="$(col border_triangles)" 'NR > 1 {
       if ($n_border > $n_tri) { print "row " NR ": " $n_border " border triangles of " $n_tri; bad = 1 }
       borders += $n_border
