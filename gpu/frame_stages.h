@@ -166,6 +166,7 @@ typedef struct hl_choice {
     double err_w;   /* its error bound in world units */
     double eps_obj; /* ε_obj at its nearest depth */
     trim_need need; /* trim texels over rect */
+    int32_t grid_splits; /* times it was halved because its grid reached the segment limit */
 } hl_choice;
 
 /* A unit instance drawn at a static level. */

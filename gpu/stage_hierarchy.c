@@ -136,6 +136,7 @@ static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double 
     c->err_w = err_w;
     c->eps_obj = eps_obj;
     c->need = *need;
+    c->grid_splits = 0;
     if (!(err_w <= 0.5 * eps_obj)) {
         hf->st->hlod_over_budget++;
         if (hierarchy_budget_spent(hf)) { /* left unrefined for the budget's sake */

@@ -14,6 +14,7 @@
  * trimmed-away parts. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
+#include "sw_lod_bezier.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -24,8 +25,9 @@
 typedef struct hl_face {
     sw__fr_tess *f;
     const occurrence *o;
-    hl_choice *chosen; /* the cut (a copy: the trim needs are tightened per item) */
-    size_t n_chosen;
+    hl_choice *chosen; /* the cut (a copy: the trim needs are tightened per item, and an item
+                          whose grid the segment limit caps is replaced by its halves) */
+    size_t n_chosen, cap_chosen;
     int trimmed;
 } hl_face;
 
@@ -113,8 +115,9 @@ static void lowest_degree(const double cpw[64], double low[64], int32_t *du, int
 /* ---- drawing the chosen items ------------------------------------------------------------------
  */
 /* The item as a patch of the direct path: clipped to the face's trim box, density for what its
- * approximation error leaves of ε_img. */
-static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
+ * approximation error leaves of ε_img. Returns the directions (bit 0: u, bit 1: v) whose density
+ * the segment limit capped, 0 when the grid keeps the bound. */
+static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
 {
     sw__fr_tess *f = hf->f;
     const double *ub = f->env->sv->faces[hf->o->face].uv_box;
@@ -132,7 +135,7 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     pt->t1 = fmin(1.0, (ub[3] - pt->v0) / dv);
     pt->nu = pt->nv = 1;
     if (!(pt->s1 > pt->s0) || !(pt->t1 > pt->t0))
-        return;
+        return 0;
     pt->visible = 1;
     sw_lod_screen_view scr = f->env->screen;
     double approx_px = f->env->eps_px * c->err_w / c->eps_obj;
@@ -149,9 +152,9 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     int32_t deg_u, deg_v;
     lowest_degree(c->cpw, low, &deg_u, &deg_v);
     sw_lod_screen_density d;
-    if (!sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->env->gpu_segments.n,
-                                f->env->gpu_segments.count, MAX_BOUND_SUBDIVISION, &d))
-        f->st->bound_exceeded++; /* capped at the largest grid: the bound is not kept */
+    const int kept = sw_lod_screen_segments(deg_u, deg_v, low, range, &scr, f->env->gpu_segments.n,
+                                            f->env->gpu_segments.count, MAX_BOUND_SUBDIVISION, &d);
+    const int32_t most = f->env->gpu_segments.n[f->env->gpu_segments.count - 1];
     pt->eps = d.eps_obj;
     pt->nu = d.nu;
     pt->nv = d.nv;
@@ -160,6 +163,92 @@ static void item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
         c->need.u = sw_lod_trim_texels(1.0, d.d1[0], 1.0, eps_t); /* over the item */
         c->need.v = sw_lod_trim_texels(1.0, d.d1[1], 1.0, eps_t);
     }
+    if (kept)
+        return 0;
+    const int dirs = (d.nu >= most ? 1 : 0) | (d.nv >= most ? 2 : 0);
+    return dirs ? dirs : 3; /* not kept below the limit (the derivative bounds): both */
+}
+
+/* Halvings of an item whose grid reaches the segment limit: 2^8 x the limit per direction. */
+enum { MAX_GRID_SPLITS = 8 };
+
+/* The item halved in the capped directions (bit 0: u, bit 1: v): the same bicubic restricted to
+ * each piece, with the same error bound and tolerance (its nearest depth is no nearer than the
+ * whole item's). The pieces are drawn as items of their own, joined by fat borders as nodes are
+ * (§7.1), each grid within the limit where the whole one was capped. Writes 2 or 4 pieces. */
+static int halve_item(const hl_choice *c, int dirs, hl_choice out[4])
+{
+    const int nu = dirs & 1 ? 2 : 1, nv = dirs & 2 ? 2 : 1;
+    for (int b = 0; b < nv; ++b)
+        for (int a = 0; a < nu; ++a) {
+            const double r[4] = {(double)a / nu, (double)(a + 1) / nu, (double)b / nv,
+                                 (double)(b + 1) / nv};
+            hl_choice *p = &out[b * nu + a];
+            *p = *c;
+            sw_lod_bez_restrict(3, 3, 4, c->cpw, r, p->cpw);
+            const double du = c->rect[1] - c->rect[0], dv = c->rect[3] - c->rect[2];
+            const double iu = c->it.range[1] - c->it.range[0], iv = c->it.range[3] - c->it.range[2];
+            p->rect[0] = c->rect[0] + du * r[0];
+            p->rect[1] = a + 1 == nu ? c->rect[1] : c->rect[0] + du * r[1];
+            p->rect[2] = c->rect[2] + dv * r[2];
+            p->rect[3] = b + 1 == nv ? c->rect[3] : c->rect[2] + dv * r[3];
+            p->it.range[0] = c->it.range[0] + iu * r[0];
+            p->it.range[1] = a + 1 == nu ? c->it.range[1] : c->it.range[0] + iu * r[1];
+            p->it.range[2] = c->it.range[2] + iv * r[2];
+            p->it.range[3] = b + 1 == nv ? c->it.range[3] : c->it.range[2] + iv * r[3];
+            p->grid_splits = c->grid_splits + 1;
+        }
+    return nu * nv;
+}
+
+/* Whether a piece of an item is in view, by the selection's rule (stage_hierarchy.c): the box of
+ * its control points grown by its error bound. A piece behind the eye is not drawn (nor its fat
+ * border, whose screen-space ribbon would be meaningless there). */
+static int piece_visible(const sw__fr_env *env, const hl_choice *c)
+{
+    double box[6];
+    sw__fr_box_empty(box);
+    for (int i = 0; i < 16; ++i)
+        sw__fr_box_add(box, c->cpw + 4 * i);
+    for (int k = 0; k < 3; ++k) {
+        box[k] -= c->err_w;
+        box[3 + k] += c->err_w;
+    }
+    return sw__gpu_view_box_visible(&env->view, box);
+}
+
+/* The items' patches; an item whose grid the segment limit caps is replaced by its halves in view
+ * (up to MAX_GRID_SPLITS times; at that depth it is drawn capped and counted: the bound is not
+ * kept). */
+static sw_result item_patches(hl_face *hf, sw__gpu_patch **pts, size_t *cap_pts, size_t *cap_chosen,
+                              sw_status *status)
+{
+    for (size_t i = 0; i < hf->n_chosen;) {
+        if (!sw__grow((void **)pts, cap_pts, hf->n_chosen, sizeof **pts))
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", hf->o->face);
+        const int capped = item_patch(hf, &hf->chosen[i], &(*pts)[i]);
+        if (!capped) {
+            i++;
+            continue;
+        }
+        if (hf->chosen[i].grid_splits >= MAX_GRID_SPLITS) {
+            hf->f->st->bound_exceeded++; /* capped at the largest grid: the bound is not kept */
+            i++;
+            continue;
+        }
+        if (!sw__grow((void **)&hf->chosen, cap_chosen, hf->n_chosen + 3, sizeof *hf->chosen))
+            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", hf->o->face);
+        hl_choice pieces[4];
+        const int n = halve_item(&hf->chosen[i], capped, pieces);
+        hf->chosen[i] = hf->chosen[--hf->n_chosen]; /* i is looked at again */
+        for (int k = 0; k < n; ++k) {
+            if (piece_visible(hf->f->env, &pieces[k]))
+                hf->chosen[hf->n_chosen++] = pieces[k];
+            else
+                hf->f->st->patches_culled++;
+        }
+    }
+    return SW_OK;
 }
 
 static void item_cell(const sw__gpu_patch *pt, double cell[2])
@@ -315,12 +404,15 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
     const occurrence *o = hf->o;
     const double sign = sw__fr_normal_sign(f->env, o);
     int on_gpu = f->env->ctx->eval_mode == SW__GPU_EVAL_AUTO;
-    sw__gpu_patch *pts = sw__malloc((hf->n_chosen ? hf->n_chosen : 1) * sizeof *pts);
-    if (!pts)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
+    sw__gpu_patch *pts = NULL;
+    size_t cap_pts = 0;
+    sw_result r = item_patches(hf, &pts, &cap_pts, &hf->cap_chosen, status);
+    if (r != SW_OK) {
+        sw__free(pts);
+        return r;
+    }
     double cell[2] = {INFINITY, INFINITY};
     for (size_t i = 0; i < hf->n_chosen; ++i) {
-        item_patch(hf, &hf->chosen[i], &pts[i]);
         double c[2];
         item_cell(&pts[i], c);
         if (pts[i].visible) {
@@ -328,7 +420,6 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
             cell[1] = fmin(cell[1], c[1]);
         }
     }
-    sw_result r = SW_OK;
     if (cell[0] < INFINITY) {
         trim_need need = face_need(hf, pts);
         r = hf->trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)
@@ -345,8 +436,8 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
 sw_result sw__fr_tess_hierarchy(sw__fr_tess *f, const occurrence *o, const hl_choice *items,
                                 size_t n, sw_status *status)
 {
-    hl_face hf = {f, o, sw__malloc((n ? n : 1) * sizeof *items), n,
-                  sw__fr_face_trimmed(f->env, o->face)};
+    hl_face hf = {f, o,         sw__malloc((n ? n : 1) * sizeof *items),
+                  n, n ? n : 1, sw__fr_face_trimmed(f->env, o->face)};
     if (!hf.chosen)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "face %u: out of memory", o->face);
     memcpy(hf.chosen, items, n * sizeof *items);

@@ -557,10 +557,11 @@ bool run_view(model_ctx &m, const view &v)
                 p.deflection, p.ref_px, p.capped ? " CAPPED by the triangle budget" : "",
                 ref.faces_meshed, ref.n_triangles(), p.est_triangles, ref.ms, covered_pixels(ip.ref));
     std::printf("    splinewalk: %llu triangles, %llu trimmed + %llu untrimmed patches, %llu trim "
-                "textures of %.3g texels, %.0f ms; covers %ld px\n",
+                "textures of %.3g texels, %.0f ms; covers %ld px; bound exceeded %llu\n",
                 (unsigned long long)fs.triangles, (unsigned long long)fs.patches_trimmed,
                 (unsigned long long)fs.patches_untrimmed, (unsigned long long)fs.trim_textures,
-                (double)fs.trim_texels, ms_ours, covered_pixels(ip.ours));
+                (double)fs.trim_texels, ms_ours, covered_pixels(ip.ours),
+                (unsigned long long)fs.bound_exceeded);
     if (g_static)
         std::printf("    static LODs: %llu super-surface instances, %llu faces, %llu triangles\n",
                     (unsigned long long)fs.static_units_drawn, (unsigned long long)fs.static_faces,
