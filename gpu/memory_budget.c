@@ -5,12 +5,14 @@
  * stage_hierarchy.c; the frame's trim textures are scaled down, stage_trim.c): the picture
  * coarsens, it does not fail, and each coarsening is counted (budget_coarsened, bound_exceeded).
  *
- * GPU: half to static levels resident in buffers, a quarter to the frame's trim textures (R8: a
- * byte per texel, capped at 256 M texels, what one frame's atlas takes at most), the rest to the
- * per-frame streams and render targets, which follow the screen. Host: half to the bicubic
+ * GPU: three eighths to static levels resident in buffers, half to the trim atlas (R8: a byte per
+ * texel, at most 512 M texels; one frame's textures are scaled to half of it, so that the atlas
+ * can keep the last frames' textures beside them and pack them), the last eighth to the per-frame
+ * streams and render targets, which follow the screen. Host: half to the bicubic
  * hierarchies, a sixteenth (at most 64 MiB) to the fat borders' cache; the rest is the scene, the
- * BVH and per-frame lists, which follow the scene and the screen. At the defaults (llvmpipe:
- * 1 GiB GPU) these are the sizes the caches had before they were shares of one budget. */
+ * BVH and per-frame lists, which follow the scene and the screen. At the default (llvmpipe: 1 GiB
+ * GPU) the atlas and the fat borders keep the sizes they had before they were shares of one
+ * budget; resident levels had 512 MiB. */
 #include "frame_stages.h"
 #include "sw_gpu_internal.h"
 
@@ -18,7 +20,7 @@
 #include <unistd.h>
 
 enum { k_gpu_default = 1 << 30 };
-static const double k_atlas_texels_max = 256e6;
+static const double k_atlas_texels_max = 512e6;
 static const size_t k_border_cache_max = (size_t)64 << 20;
 
 uint64_t sw_gpu_default_host_budget(void)
@@ -37,9 +39,10 @@ void sw_gpu_set_memory_budget(sw_gpu_context *ctx, uint64_t host, uint64_t gpu)
         gpu = ctx->gpu_reported_bytes ? ctx->gpu_reported_bytes / 2 : (uint64_t)k_gpu_default;
     ctx->budget_host = host;
     ctx->budget_gpu = gpu;
-    ctx->atlas_frame_texels = fmin(k_atlas_texels_max, (double)gpu / 4.0);
+    ctx->atlas_max_texels = fmin(k_atlas_texels_max, (double)gpu / 2.0);
+    ctx->atlas_frame_texels = ctx->atlas_max_texels / 2.0;
     ctx->hierarchy_bytes = (size_t)(host / 2);
-    sw__gpu_resident_set_budget(ctx, (size_t)(gpu / 2));
+    sw__gpu_resident_set_budget(ctx, (size_t)(gpu / 8 * 3));
     sw__fr_border_cache_set_budget(ctx->borders,
                                    (size_t)fmin((double)k_border_cache_max, (double)(host / 16)));
 }

@@ -160,7 +160,8 @@ struct sw_gpu_context {
     /* the memory budget and its shares (memory_budget.c); set between frames */
     uint64_t budget_host, budget_gpu;
     uint64_t gpu_reported_bytes; /* what the driver reports (context set-up); 0: nothing */
-    double atlas_frame_texels;   /* the frame's trim textures, at most */
+    double atlas_max_texels;     /* texels the trim atlas keeps, at most */
+    double atlas_frame_texels;   /* the frame's trim textures, at most (half the atlas's) */
     size_t hierarchy_bytes;      /* the hierarchies refine no further above it */
     /* predefined grids of the Bézier evaluation (§4.2; grid_set.c) */
     GLuint grid_ibo; /* every grid class's triangles, one after another */

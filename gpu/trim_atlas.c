@@ -39,7 +39,6 @@
 #include <string.h>
 
 enum { MIN_SIDE = 256, DEFAULT_MAX_SIDE = 4096, MAX_PAGES = 64 };
-static const double k_max_atlas_texels = 512e6; /* R8 texels kept by the atlas at most */
 /* Frames an entry may go unused before begin drops it: a walkthrough coming back to a view within
  * about a second (at 60 Hz) finds its textures. */
 static const uint64_t k_max_idle_frames = 64;
@@ -441,10 +440,12 @@ static void reset_pages(struct sw__gpu_atlas *a)
     a->n_pages = 0;
 }
 
-static int32_t page_limit(const struct sw__gpu_atlas *a)
+/* Pages the atlas may hold: its share of the memory budget (R8: a byte per texel, twice what one
+ * frame's textures may take, memory_budget.c), at least one. */
+static int32_t page_limit(const sw_gpu_context *ctx, const struct sw__gpu_atlas *a)
 {
     double per = (double)a->side * (double)a->side;
-    int32_t n = (int32_t)(k_max_atlas_texels / per);
+    int32_t n = (int32_t)(ctx->atlas_max_texels / per);
     return n < 1 ? 1 : (n > MAX_PAGES ? MAX_PAGES : n);
 }
 
@@ -467,7 +468,7 @@ static sw_result repack(sw_gpu_context *ctx, struct sw__gpu_atlas *a, sw_status 
         return r;
     a->side = choose_side(a, n, max_side(ctx));
     reset_pages(a);
-    int32_t limit = page_limit(a);
+    int32_t limit = page_limit(ctx, a);
     for (int32_t i = 0; i < n; ++i)
         if (!place(a, &a->entries[a->order[i].id], limit))
             return sw__fail(status, SW_ERR_LIMIT,
@@ -541,7 +542,7 @@ static sw_result place_pending(sw_gpu_context *ctx, struct sw__gpu_atlas *a, int
         *fits = 0;
         return SW_OK;
     }
-    int32_t limit = page_limit(a);
+    int32_t limit = page_limit(ctx, a);
     if (place_all(a, n, a->cap_layers < limit ? a->cap_layers : limit))
         return SW_OK;
     if (dead_exceeds_live(a) || !place_all(a, n, limit)) {

@@ -276,9 +276,10 @@ typedef struct sw_renderer_desc {
                                 transform feedback, queries, GL errors. */
     /* The memory budget of what the renderer keeps between frames, in bytes; 0 = the default.
      * Host: half to the bicubic hierarchies (over it they refine no further), a sixteenth (at most
-     * 64 MiB) to the fat borders' cache; default half of physical memory. GPU: half to static
-     * levels resident in buffers, a quarter (at most 256 MiB) to a frame's trim textures; default
-     * half of what the driver reports, 1 GiB where it reports nothing (llvmpipe). Over a share a
+     * 64 MiB) to the fat borders' cache; default half of physical memory. GPU: three eighths to
+     * static levels resident in buffers, half (at most 512 M texels, one byte each) to the trim
+     * atlas, a frame's trim textures taking at most half of that; default half of what the driver
+     * reports, 1 GiB where it reports nothing (llvmpipe). Over a share a
      * cache keeps only what the last frame used, and the picture coarsens instead of failing:
      * sw_frame_stats.budget_coarsened counts what was drawn coarser (in bound_exceeded too). The
      * scene, the BVH and the per-frame buffers, which follow the scene and the screen, are not
