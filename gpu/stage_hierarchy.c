@@ -299,12 +299,44 @@ sw_result sw__fr_hierarchy_cut(const sw__fr_env *env, sw__fr_hierarchy *hy, cons
 
 /* ---- converged mode: build and refine before the cut ------------------------------------------
  */
-static sw_result request_builds(sw__fr_hierarchy *hy, const sw__fr_faces *faces)
+/* Whether face's hierarchy is to be asked for: once the hierarchies hold their share of the memory
+ * budget, only those already built are used; the others are drawn by their Bézier patches (the
+ * bound kept, the work done every frame, nothing kept). */
+static int may_build(const sw__fr_env *env, const sw__fr_hierarchy *hy, uint32_t face)
 {
-    for (size_t i = 0; i < faces->n; ++i) {
-        sw_result r = sw_lod_cache_request_group(hy->cache, faces->occ[i].face, NULL, &hy->group);
-        if (r == SW_ERR_OUT_OF_MEMORY)
-            return r; /* a FAILED face is drawn by its Bézier patches */
+    return sw_lod_cache_memory(hy->cache) < env->ctx->hierarchy_bytes ||
+           sw_lod_cache_state_get(hy->cache, face) != SW_LOD_CACHE_EMPTY;
+}
+
+/* Whether requesting `n` more builds could take the hierarchies past their share: at a bound of
+ * what a face's hierarchy takes (~2.4 KiB measured, docs/memory.md; 4 KiB with margin). */
+static int share_tight(const sw__fr_env *env, const sw__fr_hierarchy *hy, size_t n)
+{
+    return (double)sw_lod_cache_memory(hy->cache) + 4096.0 * (double)n >=
+           (double)env->ctx->hierarchy_bytes;
+}
+
+static void wait_group(sw__fr_hierarchy *hy, sw_th_pool *pool, sw_gpu_frame_stats *st);
+
+/* The faces' builds, waited for. Where the hierarchies' share of the memory budget could be spent
+ * by them, in batches, looking at the memory between batches (may_build). */
+static sw_result request_builds(const sw__fr_env *env, sw__fr_hierarchy *hy,
+                                const sw__fr_faces *faces, sw_gpu_frame_stats *st)
+{
+    enum { BATCH = 32 };
+    sw_th_pool *pool = sw_lod_cache_pool(hy->cache);
+    for (size_t i = 0; i < faces->n;) {
+        const size_t end =
+            share_tight(env, hy, faces->n - i) && faces->n - i > BATCH ? i + BATCH : faces->n;
+        for (; i < end; ++i) {
+            if (!may_build(env, hy, faces->occ[i].face))
+                continue;
+            sw_result r =
+                sw_lod_cache_request_group(hy->cache, faces->occ[i].face, NULL, &hy->group);
+            if (r == SW_ERR_OUT_OF_MEMORY)
+                return r; /* a FAILED face is drawn by its Bézier patches */
+        }
+        wait_group(hy, pool, st);
     }
     return SW_OK;
 }
@@ -335,7 +367,8 @@ static sw_result request_walkthrough(const sw__fr_env *env, sw__fr_hierarchy *hy
     hy->req.token = env->ctx->walk_token;
     hy->req.generation = sw_th_token_cancel(env->ctx->walk_token);
     for (size_t i = 0; i < faces->n; ++i)
-        if (sw_lod_cache_request(hy->cache, faces->occ[i].face, &hy->req) == SW_ERR_OUT_OF_MEMORY)
+        if (may_build(env, hy, faces->occ[i].face) &&
+            sw_lod_cache_request(hy->cache, faces->occ[i].face, &hy->req) == SW_ERR_OUT_OF_MEMORY)
             return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "hierarchy requests: out of memory");
     return SW_OK;
 }
@@ -351,11 +384,10 @@ static sw_result converge(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw_
 {
     sw_th_pool *pool = sw_lod_cache_pool(hy->cache);
     sw_th_group_init(&hy->group);
-    if (request_builds(hy, faces) != SW_OK) {
+    if (request_builds(env, hy, faces, st) != SW_OK) {
         wait_group(hy, pool, st);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "hierarchy builds: out of memory");
     }
-    wait_group(hy, pool, st);
     hy->planning = 1;
     sw_result r = SW_OK;
     for (int round = 0; round < MAX_REFINE_ROUNDS; ++round) {

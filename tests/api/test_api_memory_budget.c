@@ -5,7 +5,10 @@
  * - a frame under a budget far below the scene's need still draws: the image is a valid, coarser
  *   one (covered pixels within a few percent of the full-budget frame's, and most of them the
  *   same), and the frame says so: budget_coarsened > 0, within bound_exceeded;
- * - with the default budget the same frame coarsens nothing.
+ * - with the default budget the same frame coarsens nothing;
+ * - once the hierarchies hold their host share, faces not yet built are drawn by their Bézier
+ *   patches: fewer hierarchy nodes drawn than with the default budget (planted: the build requests
+ *   not gated → as many nodes → FAIL).
  * It would catch a budget that is ignored (no coarsening counted; planted: the trim textures'
  * share not taken from the context → budget_coarsened 0 → FAIL), a budget that breaks the frame
  * (an error, or an empty or garbage image), and coarsening counted where nothing was spent.
@@ -134,6 +137,11 @@ int main(int argc, char **argv)
     CHECK(small.trim_texels * 4 <= full.trim_texels && small.trim_texels > 0,
           "small budget: %llu trim texels against %llu", (unsigned long long)small.trim_texels,
           (unsigned long long)full.trim_texels);
+    printf("hierarchy nodes drawn: %llu default, %llu small budget\n",
+           (unsigned long long)full.hierarchy_nodes, (unsigned long long)small.hierarchy_nodes);
+    CHECK(small.hierarchy_nodes < full.hierarchy_nodes,
+          "small budget: %llu hierarchy nodes drawn, as many as the default's %llu",
+          (unsigned long long)small.hierarchy_nodes, (unsigned long long)full.hierarchy_nodes);
     CHECK(small.faces_drawn == full.faces_drawn, "faces drawn %llu against %llu",
           (unsigned long long)small.faces_drawn, (unsigned long long)full.faces_drawn);
 

@@ -275,7 +275,8 @@ typedef struct sw_renderer_desc {
                                 restored: texture units other than 0, image units,
                                 transform feedback, queries, GL errors. */
     /* The memory budget of what the renderer keeps between frames, in bytes; 0 = the default.
-     * Host: half to the bicubic hierarchies (over it they refine no further), a sixteenth (at most
+     * Host: half to the bicubic hierarchies (over it they refine no further and faces not yet
+     * built are drawn by their Bézier patches), a sixteenth (at most
      * 64 MiB) to the fat borders' cache; default half of physical memory. GPU: three eighths to
      * static levels resident in buffers, half (at most 512 M texels, one byte each) to the trim
      * atlas, a frame's trim textures taking at most half of that; default half of what the driver
