@@ -7,13 +7,13 @@
  * "(not written)" or read back as written ("path never writes a key it would refuse to read").
  * The round trips go through a scratch file (SW_FUZZ_SCRATCH, else one per process in /dev/shm or
  * /tmp). Planted: the writer printing %.15g → the round trip aborts on the committed seeds. */
+#include "../support/fuzz_scratch.h"
 #include "sw_camera_path.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 static int moderate(const sw_rt_camera_path *p)
 {
@@ -44,26 +44,9 @@ static void exercise(const sw_rt_camera_path *p)
     }
 }
 
-static char scratch_name[512];
-
-static void remove_scratch(void)
-{
-    unlink(scratch_name);
-}
-
 static const char *scratch_file(void)
 {
-    char *name = scratch_name;
-    if (!name[0]) {
-        const char *env = getenv("SW_FUZZ_SCRATCH");
-        if (env && *env)
-            snprintf(name, sizeof scratch_name, "%s", env);
-        else
-            snprintf(name, sizeof scratch_name, "%s/sw_fuzz_path_%ld.path",
-                     access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp", (long)getpid());
-        atexit(remove_scratch);
-    }
-    return name;
+    return sw_fuzz_scratch("sw_fuzz_path.path");
 }
 
 static int same_key(const sw_rt_path_key *a, const sw_rt_path_key *b)

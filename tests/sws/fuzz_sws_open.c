@@ -9,13 +9,13 @@
  * LOD cache must come back byte for byte (the writer loses nothing the reader accepted), through
  * the file open the in-memory one stands for. Planted: the writer dropping the last adjacency
  * record → the round trip aborts on the committed corpus. */
+#include "../support/fuzz_scratch.h"
 #include "sw_crc32c.h"
 #include "sw_sg_scene.h"
 
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 enum { HDR_TABLE = 32, HDR_CRC = 60, ENTRY = 40, N_SEC = 8, TABLE_BYTES = ENTRY * N_SEC };
 
@@ -27,25 +27,9 @@ static int count_visit(void *ctx, uint32_t face, const double world[12], const f
     return ++*(uint64_t *)ctx > 100000; /* instances can multiply occurrences exponentially */
 }
 
-static char scratch_name[512];
-
-static void remove_scratch(void)
-{
-    unlink(scratch_name);
-}
-
 static const char *scratch_file(void)
 {
-    if (!scratch_name[0]) {
-        const char *env = getenv("SW_FUZZ_SCRATCH");
-        if (env && *env)
-            snprintf(scratch_name, sizeof scratch_name, "%s", env);
-        else
-            snprintf(scratch_name, sizeof scratch_name, "%s/sw_fuzz_sws_%ld.sws",
-                     access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp", (long)getpid());
-        atexit(remove_scratch);
-    }
-    return scratch_name;
+    return sw_fuzz_scratch("sw_fuzz_sws.sws");
 }
 
 static int same_bytes(const void *a, const void *b, size_t n)
