@@ -379,6 +379,13 @@ int sw__fr_face_trimmed(const sw__fr_env *env, uint32_t face);
 /* Effective segments of a direction of n segments drawn by predefined grid classes (pieces of
  * the largest class when n exceeds it). */
 int32_t sw__fr_class_segments(int32_t n);
+/* A bound of the float error of a patch's vertices (the vertex shader evaluates the eye-relative
+ * control points in float, then projects), in pixels at the nearest depth of `box` (its
+ * eye-relative box): 16 FLT_EPSILON R, R the largest control point over its weight (the bound
+ * test_gpu_tspline_capture checks against double evaluation, with |P| <= R for positive weights).
+ * The grid density is chosen for what it leaves of ε_img. */
+double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
+                             const double box[6]);
 /* The limit of grid vertices per frame (SW_ERR_LIMIT past it). */
 sw_result sw__fr_check_budget(const sw__fr_tess *t, sw_status *status);
 

@@ -13,6 +13,7 @@
 #include "sw_hooks.h"
 #include "sw_status_util.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -162,6 +163,19 @@ static void split_class(int32_t n, int32_t *pieces, int32_t *level)
 {
     *pieces = (n + SW__GPU_GRID_MAX - 1) / SW__GPU_GRID_MAX;
     *level = class_for((n + *pieces - 1) / *pieces);
+}
+
+double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
+                             const double box[6])
+{
+    double r = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double *p = cpw + 4 * i;
+        r = fmax(r, sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / fabs(p[3]));
+    }
+    const double z = fmax(sw__gpu_view_box_depth(&env->view, box), env->view.near_plane);
+    const double px = 16.0 * FLT_EPSILON * r * env->view.focal_px / z;
+    return isfinite(px) ? px : INFINITY;
 }
 
 int32_t sw__fr_class_segments(int32_t n)

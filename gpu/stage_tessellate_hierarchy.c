@@ -112,11 +112,24 @@ static void lowest_degree(const double cpw[64], double low[64], int32_t *du, int
     *dv = e;
 }
 
+/* Halvings of an item whose grid reaches the segment limit (2^8 x the limit per direction), or
+ * whose float evaluation error takes more than a quarter of ε_img. */
+enum { MAX_GRID_SPLITS = 8 };
+
+/* The eye-relative box of an item's control points (its surface's, for positive weights). */
+static void item_box(const hl_choice *c, double box[6])
+{
+    sw__fr_box_empty(box);
+    for (int i = 0; i < 16; ++i)
+        sw__fr_box_add(box, c->cpw + 4 * i);
+}
+
 /* ---- drawing the chosen items ------------------------------------------------------------------
  */
 /* The item as a patch of the direct path: clipped to the face's trim box, density for what its
- * approximation error leaves of ε_img. Returns the directions (bit 0: u, bit 1: v) whose density
- * the segment limit capped, 0 when the grid keeps the bound. */
+ * approximation and float errors leave of ε_img. Returns the directions (bit 0: u, bit 1: v) in
+ * which to halve it (its density capped by the segment limit, or its float error too large), 0
+ * when the grid keeps the bound. */
 static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
 {
     sw__fr_tess *f = hf->f;
@@ -138,11 +151,19 @@ static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
         return 0;
     pt->visible = 1;
     sw_lod_screen_view scr = f->env->screen;
-    double approx_px = f->env->eps_px * c->err_w / c->eps_obj;
-    scr.eps_px = fmax(f->env->eps_px - approx_px, 0.25 * f->env->eps_px);
-    /* the sampling floor: a node whose approximation error leaves less than a quarter of ε_img
-     * is drawn at that quarter, over ε_img in all (counted: refinement stopped at its limit) */
-    const double excess_px = approx_px + scr.eps_px - f->env->eps_px;
+    double box[6];
+    item_box(c, box);
+    /* ε_img less the approximation's error and the float evaluation's */
+    const double approx_px = f->env->eps_px * c->err_w / c->eps_obj;
+    const double float_px = sw__fr_float_error_px(f->env, c->cpw, 16, box);
+    scr.eps_px = fmax(f->env->eps_px - approx_px - float_px, 0.25 * f->env->eps_px);
+    /* the sampling floor: a node whose errors leave less than a quarter of ε_img is drawn at that
+     * quarter, over ε_img in all (counted: refinement stopped at its limit). The float error
+     * shrinks with the item (it follows its control points' distance from the eye): an item
+     * where it takes more than a quarter is halved instead, as a capped grid is. */
+    const double excess_px = approx_px + float_px + scr.eps_px - f->env->eps_px;
+    if (excess_px > 0.0 && float_px > 0.25 * f->env->eps_px && c->grid_splits < MAX_GRID_SPLITS)
+        return 3;
     if (excess_px > 0.0) {
         f->st->bound_exceeded++;
         f->st->bound_excess_px = fmax(f->st->bound_excess_px, excess_px);
@@ -168,9 +189,6 @@ static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     const int dirs = (d.nu >= most ? 1 : 0) | (d.nv >= most ? 2 : 0);
     return dirs ? dirs : 3; /* not kept below the limit (the derivative bounds): both */
 }
-
-/* Halvings of an item whose grid reaches the segment limit: 2^8 x the limit per direction. */
-enum { MAX_GRID_SPLITS = 8 };
 
 /* The item halved in the capped directions (bit 0: u, bit 1: v): the same bicubic restricted to
  * each piece, with the same error bound and tolerance (its nearest depth is no nearer than the
@@ -207,9 +225,7 @@ static int halve_item(const hl_choice *c, int dirs, hl_choice out[4])
 static int piece_visible(const sw__fr_env *env, const hl_choice *c)
 {
     double box[6];
-    sw__fr_box_empty(box);
-    for (int i = 0; i < 16; ++i)
-        sw__fr_box_add(box, c->cpw + 4 * i);
+    item_box(c, box);
     for (int k = 0; k < 3; ++k) {
         box[k] -= c->err_w;
         box[3 + k] += c->err_w;
