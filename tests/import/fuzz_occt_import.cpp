@@ -5,7 +5,9 @@
 // an optional trimming wire of 2D lines, circles or B-splines — drawn from moderate
 // values and from hostile ones (NaN, ±inf, ±1e308, 1e-300, zero and negative weights, repeated
 // knots). The faces are assembled with BRep_Builder, as OCCT's BREP reader assembles a file's
-// (no algorithm runs on them on the way), and go through sw__occt_import_shape, then the scene
+// (no algorithm runs on them on the way) into a shell that a compound holds twice (once moved:
+// the closed-shell vote and the prototype-and-instances walk of an assembly), and go through
+// sw__occt_import_shape, then the scene
 // builder. Offset surfaces are left out: OCCT's own face construction on a fuzzed offset spends
 // seconds in exceptions thrown at its singular points before the importer sees the face. It must
 // never crash, hang or leak, and what it accepts must be drawable:
@@ -46,7 +48,9 @@
 #include <TColgp_Array1OfPnt2d.hxx>
 #include <TColgp_Array2OfPnt.hxx>
 #include <TopoDS.hxx>
+#include <TopLoc_Location.hxx>
 #include <TopoDS_Compound.hxx>
+#include <TopoDS_Shell.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Vertex.hxx>
@@ -55,6 +59,8 @@
 #include <gp_Ax2.hxx>
 #include <gp_Ax2d.hxx>
 #include <gp_Ax3.hxx>
+#include <gp_Trsf.hxx>
+#include <gp_Vec.hxx>
 #include <gp_Vec2d.hxx>
 
 #include <cfloat>
@@ -449,14 +455,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     reader r(data, size);
     BRep_Builder bb;
-    TopoDS_Compound all;
-    bb.MakeCompound(all);
+    TopoDS_Shell shell;
+    bb.MakeShell(shell);
     const int faces = r.pick(1, 4);
     for (int i = 0; i < faces; i++) {
         try {
             TopoDS_Face f = face(r);
             if (!f.IsNull())
-                bb.Add(all, f);
+                bb.Add(shell, f);
         } catch (const Standard_Failure &e) {
             /* OCCT refused the parameters (a zero direction, decreasing knots, ...): no face */
             if (std::getenv("SW_FUZZ_VERBOSE"))
@@ -464,6 +470,14 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                              e.GetMessageString());
         }
     }
+    /* The faces as a shell (the closed-shell vote), placed twice: once as it is and once moved,
+     * as an assembly uses a part twice (one prototype drawn by two instances). */
+    TopoDS_Compound all;
+    bb.MakeCompound(all);
+    bb.Add(all, shell);
+    gp_Trsf moved;
+    moved.SetTranslation(gp_Vec(1.0, 2.0, 3.0));
+    bb.Add(all, shell.Moved(TopLoc_Location(moved)));
     if (const char *out = std::getenv("SW_FUZZ_WRITE_BREP")) /* the input as a BREP file */
         BRepTools::Write(all, out);
     import_and_check(all);
