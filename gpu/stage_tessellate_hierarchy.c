@@ -113,8 +113,10 @@ static void lowest_degree(const double cpw[64], double low[64], int32_t *du, int
 }
 
 /* Halvings of an item whose grid reaches the segment limit (2^8 x the limit per direction), or
- * whose float evaluation error takes more than a quarter of ε_img. */
-enum { MAX_GRID_SPLITS = 8 };
+ * whose float evaluation error takes more than a quarter of ε_img; and the items a face may be
+ * drawn as once halved (the selection's own cap, stage_hierarchy.c): past either, an item is drawn
+ * as it is and counted. */
+enum { MAX_GRID_SPLITS = 8, MAX_HALVED_ITEMS = 16384 };
 
 /* The eye-relative box of an item's control points (its surface's, for positive weights). */
 static void item_box(const hl_choice *c, double box[6])
@@ -162,7 +164,8 @@ static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
      * shrinks with the item (it follows its control points' distance from the eye): an item
      * where it takes more than a quarter is halved instead, as a capped grid is. */
     const double excess_px = approx_px + float_px + scr.eps_px - f->env->eps_px;
-    if (excess_px > 0.0 && float_px > 0.25 * f->env->eps_px && c->grid_splits < MAX_GRID_SPLITS)
+    if (excess_px > 0.0 && float_px > 0.25 * f->env->eps_px && c->grid_splits < MAX_GRID_SPLITS &&
+        hf->n_chosen + 3 <= MAX_HALVED_ITEMS)
         return 3;
     if (excess_px > 0.0) {
         f->st->bound_exceeded++;
@@ -247,7 +250,7 @@ static sw_result item_patches(hl_face *hf, sw__gpu_patch **pts, size_t *cap_pts,
             i++;
             continue;
         }
-        if (hf->chosen[i].grid_splits >= MAX_GRID_SPLITS) {
+        if (hf->chosen[i].grid_splits >= MAX_GRID_SPLITS || hf->n_chosen + 3 > MAX_HALVED_ITEMS) {
             hf->f->st->bound_exceeded++; /* capped at the largest grid: the bound is not kept */
             i++;
             continue;
