@@ -386,6 +386,9 @@ int32_t sw__fr_class_segments(int32_t n);
  * The grid density is chosen for what it leaves of ε_img. */
 double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
                              const double box[6]);
+/* The screen a grid density is chosen on: ε_img less what other errors spend (`spent_px`), at
+ * least a quarter of ε_img (the sampling floor: over ε_img in all, counted in bound_exceeded). */
+void sw__fr_screen_less(sw__fr_tess *t, double spent_px, sw_lod_screen_view *scr);
 /* The limit of grid vertices per frame (SW_ERR_LIMIT past it). */
 sw_result sw__fr_check_budget(const sw__fr_tess *t, sw_status *status);
 

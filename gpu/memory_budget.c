@@ -23,7 +23,8 @@ enum { k_gpu_default = 1 << 30 };
 static const double k_atlas_texels_max = 512e6;
 static const size_t k_border_cache_max = (size_t)64 << 20;
 
-uint64_t sw_gpu_default_host_budget(void)
+/* Half of physical memory. */
+static uint64_t default_host_budget(void)
 {
     const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
     if (pages <= 0 || page <= 0)
@@ -34,7 +35,7 @@ uint64_t sw_gpu_default_host_budget(void)
 void sw_gpu_set_memory_budget(sw_gpu_context *ctx, uint64_t host, uint64_t gpu)
 {
     if (host == 0)
-        host = sw_gpu_default_host_budget();
+        host = default_host_budget();
     if (gpu == 0)
         gpu = ctx->gpu_reported_bytes ? ctx->gpu_reported_bytes / 2 : (uint64_t)k_gpu_default;
     ctx->budget_host = host;

@@ -178,6 +178,18 @@ double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
     return isfinite(px) ? px : INFINITY;
 }
 
+void sw__fr_screen_less(sw__fr_tess *t, double spent_px, sw_lod_screen_view *scr)
+{
+    const double eps = t->env->eps_px;
+    *scr = t->env->screen;
+    scr->eps_px = fmax(eps - spent_px, 0.25 * eps);
+    const double excess_px = spent_px + scr->eps_px - eps;
+    if (excess_px > 0.0) {
+        t->st->bound_exceeded++;
+        t->st->bound_excess_px = fmax(t->st->bound_excess_px, excess_px);
+    }
+}
+
 int32_t sw__fr_class_segments(int32_t n)
 {
     int32_t pieces, level;

@@ -50,21 +50,6 @@ static sw_result face_bezier(sw__fr_tess *f, uint32_t face, const sw_sg_bezier_s
     return SW_OK;
 }
 
-/* The screen for a patch's density: ε_img less its float evaluation error
- * (sw__fr_float_error_px), at least a quarter of ε_img (over it in all: counted). */
-static void budget_less_float(sw__fr_tess *f, const double *cpw, size_t n, const double box[6],
-                              sw_lod_screen_view *scr)
-{
-    *scr = f->env->screen;
-    const double float_px = sw__fr_float_error_px(f->env, cpw, n, box);
-    scr->eps_px = fmax(f->env->eps_px - float_px, 0.25 * f->env->eps_px);
-    const double excess_px = float_px + scr->eps_px - f->env->eps_px;
-    if (excess_px > 0.0) {
-        f->st->bound_exceeded++;
-        f->st->bound_excess_px = fmax(f->st->bound_excess_px, excess_px);
-    }
-}
-
 /* Sets up one patch: eye-relative control points, clipping to the uv box, culling, density. */
 static void patch_setup(sw__fr_tess *f, const occurrence *o, const sw_sg_bezier_patch *bp,
                         const double ub[4], int class_grids, double *cpw, sw__gpu_patch *pt,
@@ -97,7 +82,7 @@ static void patch_setup(sw__fr_tess *f, const occurrence *o, const sw_sg_bezier_
     const double range[4] = {pt->s0, pt->s1, pt->t0, pt->t1};
     const segment_set *set = class_grids ? &f->env->gpu_segments : &f->env->cpu_segments;
     sw_lod_screen_view scr;
-    budget_less_float(f, cpw, n, box, &scr);
+    sw__fr_screen_less(f, sw__fr_float_error_px(f->env, cpw, n, box), &scr);
     sw_lod_screen_density d;
     if (!sw_lod_screen_segments(bp->deg_u, bp->deg_v, cpw, range, &scr, set->n, set->count,
                                 MAX_BOUND_SUBDIVISION, &d))
@@ -340,7 +325,7 @@ static int tile_cells(tiling *t, tile *tl)
             for (size_t i = 0; i < n_cp; ++i)
                 sw__fr_box_add(box, c->cpw + 4 * i);
             sw_lod_screen_view scr;
-            budget_less_float(f, c->cpw, n_cp, box, &scr);
+            sw__fr_screen_less(f, sw__fr_float_error_px(f->env, c->cpw, n_cp, box), &scr);
             sw_lod_screen_density d;
             if (!sw_lod_screen_segments(c->deg_u, c->deg_v, c->cpw, range, &scr, set->n, set->count,
                                         MAX_BOUND_SUBDIVISION, &d))

@@ -152,25 +152,19 @@ static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     if (!(pt->s1 > pt->s0) || !(pt->t1 > pt->t0))
         return 0;
     pt->visible = 1;
-    sw_lod_screen_view scr = f->env->screen;
     double box[6];
     item_box(c, box);
-    /* ε_img less the approximation's error and the float evaluation's */
+    /* ε_img less the approximation's error and the float evaluation's; the float error shrinks
+     * with the item (it follows its control points' distance from the eye): an item where it
+     * takes more than a quarter of ε_img and leaves less than a quarter is halved instead, as a
+     * capped grid is */
     const double approx_px = f->env->eps_px * c->err_w / c->eps_obj;
     const double float_px = sw__fr_float_error_px(f->env, c->cpw, 16, box);
-    scr.eps_px = fmax(f->env->eps_px - approx_px - float_px, 0.25 * f->env->eps_px);
-    /* the sampling floor: a node whose errors leave less than a quarter of ε_img is drawn at that
-     * quarter, over ε_img in all (counted: refinement stopped at its limit). The float error
-     * shrinks with the item (it follows its control points' distance from the eye): an item
-     * where it takes more than a quarter is halved instead, as a capped grid is. */
-    const double excess_px = approx_px + float_px + scr.eps_px - f->env->eps_px;
-    if (excess_px > 0.0 && float_px > 0.25 * f->env->eps_px && c->grid_splits < MAX_GRID_SPLITS &&
-        hf->n_chosen + 3 <= MAX_HALVED_ITEMS)
+    if (approx_px + float_px > 0.75 * f->env->eps_px && float_px > 0.25 * f->env->eps_px &&
+        c->grid_splits < MAX_GRID_SPLITS && hf->n_chosen + 3 <= MAX_HALVED_ITEMS)
         return 3;
-    if (excess_px > 0.0) {
-        f->st->bound_exceeded++;
-        f->st->bound_excess_px = fmax(f->st->bound_excess_px, excess_px);
-    }
+    sw_lod_screen_view scr;
+    sw__fr_screen_less(f, approx_px + float_px, &scr);
     const double range[4] = {pt->s0, pt->s1, pt->t0, pt->t1};
     double low[64];
     int32_t deg_u, deg_v;

@@ -52,7 +52,6 @@ void sw_gpu_set_memory_budget(sw_gpu_context *ctx, uint64_t host, uint64_t gpu);
  * memory, GL_ATI_meminfo's free texture memory; 0: none). */
 void sw_gpu_memory_budget(const sw_gpu_context *ctx, uint64_t *host, uint64_t *gpu,
                           uint64_t *gpu_reported);
-uint64_t sw_gpu_default_host_budget(void);
 
 typedef struct sw_gpu_camera {
     double eye[3], target[3], up[3];
