@@ -261,6 +261,9 @@ static sw_result item_patches(hl_face *hf, sw__gpu_patch **pts, size_t *cap_pts,
                 hf->f->st->patches_culled++;
         }
     }
+    /* a patch points at its item's control points, which growing the items may have moved */
+    for (size_t i = 0; i < hf->n_chosen; ++i)
+        (*pts)[i].cpw = hf->chosen[i].cpw;
     return SW_OK;
 }
 
