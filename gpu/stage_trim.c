@@ -29,13 +29,22 @@ int32_t sw__fr_class_texels(double want, int32_t max_entry)
     return n < max_entry ? n : max_entry;
 }
 
-/* Classified just left of the middle of the loop's longest edge (loops are simple, so one point
- * decides for the whole loop). */
+/* Whether the face lies left of loop k (the side its fat border covers), by parity: the left of a
+ * counter-clockwise loop is its interior, and a point there is inside the face when the loops
+ * around it, k included, are odd in number (the even-odd rule of sw_sg_trim_classify and of the
+ * trim textures). The loops around k are counted at the middle of its longest edge (loops are
+ * simple and do not cross, so one point decides). A probe point a fixed fraction of the longest
+ * edge off the loop is no test: a band 2π long in u and 0.002 wide in v (a cone's face around its
+ * seam, screw.step scaled to a diagonal of 0.03) was probed beyond its far side, and its ribbons
+ * were drawn on the outer side, over the silhouette. */
 int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k)
 {
     const sw_sg_polyline *l = &loops[k];
+    if (l->count < 3)
+        return 1;
     uint32_t best = 0;
-    double best_len = -1.0;
+    double best_len = -1.0, area2 = 0.0;
+    const double *o = l->uv; /* the shoelace sum about a vertex: no cancellation far from 0 */
     for (uint32_t i = 0; i < l->count; ++i) {
         const double *a = l->uv + 2 * i, *b = l->uv + 2 * ((i + 1) % l->count);
         double len = hypot(b[0] - a[0], b[1] - a[1]);
@@ -43,13 +52,17 @@ int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_
             best_len = len;
             best = i;
         }
+        area2 += (a[0] - o[0]) * (b[1] - o[1]) - (b[0] - o[0]) * (a[1] - o[1]);
     }
-    if (l->count < 2 || !(best_len > 0.0))
+    if (!(area2 != 0.0))
         return 1;
     const double *a = l->uv + 2 * best, *b = l->uv + 2 * ((best + 1) % l->count);
-    double t[2] = {(b[0] - a[0]) / best_len, (b[1] - a[1]) / best_len}, step = 1e-3 * best_len;
-    double u = 0.5 * (a[0] + b[0]) - t[1] * step, v = 0.5 * (a[1] + b[1]) + t[0] * step;
-    return sw_sg_trim_classify(loops, n_loops, u, v);
+    const double u = 0.5 * (a[0] + b[0]), v = 0.5 * (a[1] + b[1]);
+    int around = area2 > 0.0; /* k itself, when its left is its interior */
+    for (uint32_t j = 0; j < n_loops; ++j)
+        if (j != k)
+            around ^= sw_sg_trim_classify(&loops[j], 1, u, v);
+    return around;
 }
 
 /* ---- the plan ---------------------------------------------------------------------------------

@@ -14,7 +14,9 @@
  *    count is the records' grids plus the borders (a bookkeeping slip shows);
  *  - trim: each texture's class holds its wanted texels (or the atlas maximum), its loops exist
  *    and lie in the face's trim box; after the atlas every trimmed draw has an entry of the
- *    planned size;
+ *    planned size; the side of a loop its fat border covers is the face's for thin bands, holes
+ *    and islands in either orientation (a probe a fixed fraction of the longest edge off the loop
+ *    lands beyond a band 2π long and 0.002 wide: the ribbon then covers the outside);
  *  - chunks: the tessellation split among the pool's workers is the one thread's byte for byte,
  *    for per-frame faces and, with static LODs, for units at a static level with their borders;
  *  - submit: the stages chained by hand give the image sw_gpu_render_scene gives, byte for byte;
@@ -705,6 +707,40 @@ done:
     sw_sg_scene_free(scene);
 }
 
+/* sw__fr_left_is_inside on hand-made loops whose answer is known: a band 2π x 0.002 (a cone's
+ * face around its seam in a small unit), with a thin slot in it and an island in the slot, each
+ * loop in both orientations. */
+static void check_left_is_inside(void)
+{
+    enum { N_CASES = 8 };
+    const double two_pi = 6.283185307179586, w = 0.002;
+    double band[8] = {0, 0, two_pi, 0, two_pi, w, 0, w};
+    double slot[8] = {1, 0.25 * w, 1, 0.75 * w, 4, 0.75 * w, 4, 0.25 * w};
+    double island[8] = {2, 0.4 * w, 3, 0.4 * w, 3, 0.6 * w, 2, 0.6 * w};
+    size_t wrong = 0;
+    for (int c = 0; c < N_CASES; ++c) {
+        double *pts[3] = {band, slot, island};
+        double rev[3][8];
+        sw_sg_polyline loops[3];
+        for (int k = 0; k < 3; ++k) {
+            const int flip = (c >> k) & 1; /* loop k reversed */
+            for (int i = 0; i < 4; ++i) {
+                rev[k][2 * i] = pts[k][2 * (flip ? 3 - i : i)];
+                rev[k][2 * i + 1] = pts[k][2 * (flip ? 3 - i : i) + 1];
+            }
+            loops[k] = (sw_sg_polyline){.uv = rev[k], .count = 4};
+        }
+        for (uint32_t k = 0; k < 3; ++k) {
+            /* as written the band and the island run counter-clockwise, the slot clockwise:
+             * each has the face on its left */
+            const int want = !((c >> k) & 1);
+            wrong += sw__fr_left_is_inside(loops, 3, k) != want;
+        }
+    }
+    CHECK(wrong == 0, "%zu of %d loops: the fat border's side is not the face's", wrong,
+          3 * N_CASES);
+}
+
 int main(int argc, char **argv)
 {
     (void)sw_lod_build_install(); /* static LODs are built by the LOD-building module */
@@ -721,6 +757,7 @@ int main(int argc, char **argv)
         return 1;
     }
     check_submit_analytic(ctx);
+    check_left_is_inside();
     for (int a = 1; a < argc; ++a)
         run_model(ctx, argv[a], a == 1);
     CHECK(g_partial_views > 0, "no view left an occurrence outside: the cull check is vacuous");
