@@ -331,16 +331,37 @@ struct reference_plan {
  * reference, less its deflection), unless the triangle estimate (coarse triangles of the kept
  * faces x the deflection ratio: BRepMesh's count on curved faces grows as 1/deflection) exceeds
  * the budget; then the deflection grows to meet it, and the view says so. */
+/* Coarse triangles with a vertex or their centroid in the clip box (at least 1). */
+double coarse_triangles_in(const sw_test::occt_triangles &coarse, const sw_test::occt_clip_box &c)
+{
+    double n = 0;
+    for (size_t t = 0; t + 2 < coarse.idx.size(); t += 3) {
+        double centroid[3] = {0, 0, 0};
+        bool in = false;
+        for (int k = 0; k < 3; ++k) {
+            const double *q = &coarse.pos[3 * (size_t)coarse.idx[t + k]];
+            in = in || c.contains(q);
+            for (int a = 0; a < 3; ++a)
+                centroid[a] += q[a] / 3.0;
+        }
+        n += in || c.contains(centroid);
+    }
+    return std::fmax(n, 1.0);
+}
+
 reference_plan plan_reference(const model_ctx &m, const basis &b, const sw_gpu_image &coarse,
-                              const sw_test::occt_face_filter &keep)
+                              const sw_test::occt_face_filter &keep,
+                              const sw_test::occt_clip_box *clip)
 {
     reference_plan p;
     double z = min_depth(coarse);
     p.z_near = std::fmax(z - m.coarse_deflection, 0.5 * z);
     p.deflection = k_ref_px * p.z_near / b.focal_px;
     double n_sel = 0;
-    for (size_t i = 0; i < m.occt->n_faces(); ++i)
+    for (size_t i = 0; i < m.occt->n_faces() && !clip; ++i)
         n_sel += keep(m.occt->face_boxes()[i]) ? m.coarse.triangles_per_face[i] : 0;
+    if (clip)
+        n_sel = coarse_triangles_in(m.coarse, *clip);
     p.est_triangles = n_sel * std::fmax(1.0, m.coarse_deflection / p.deflection);
     if (p.est_triangles > (double)m.max_triangles) {
         p.capped = true;
@@ -522,6 +543,31 @@ long covered_pixels(const sw_gpu_image &img)
     return n;
 }
 
+/* The part of the view's frustum in front of the farthest depth the coarse reference shows (with
+ * view_cull's margin, and 5 % beyond the sides), as a box the reference is cut to before meshing:
+ * a close view shows a small part of its faces, and meshing them whole at its deflection took
+ * minutes (screw.step's close view: over 300 s). False for a box not much smaller than the model
+ * (the whole views, which gain nothing). */
+bool view_clip(const model_ctx &m, const basis &b, const sw_gpu_image &coarse,
+               sw_test::occt_clip_box &clip)
+{
+    double zmax = 0.0;
+    for (size_t i = 0; i < (size_t)coarse.width * coarse.height; ++i)
+        if (std::isfinite(coarse.depth[i]))
+            zmax = std::fmax(zmax, (double)coarse.depth[i]);
+    const double far = zmax * 1.05 + 4.0 * m.coarse_deflection;
+    const double hx = 1.05 * far * b.tan_x, hy = 1.05 * far * b.tan_y;
+    if (!(zmax > 0.0) ||
+        2.0 * std::sqrt(hx * hx + hy * hy + 0.25 * far * far) > 0.5 * diagonal(m.box))
+        return false;
+    const vec3 centre = axpy(b.eye, 0.5 * far, b.fwd);
+    clip.centre = {centre[0], centre[1], centre[2]};
+    clip.x_axis = {b.right[0], b.right[1], b.right[2]};
+    clip.z_axis = {b.fwd[0], b.fwd[1], b.fwd[2]};
+    clip.half = {hx, hy, 0.5 * far};
+    return true;
+}
+
 bool run_view(model_ctx &m, const view &v)
 {
     basis b = make_basis(v.cam, m.w, m.h);
@@ -531,9 +577,12 @@ bool run_view(model_ctx &m, const view &v)
         return false;
     view_cull cull{b, coarse.depth, m.w, m.h, m.coarse_deflection};
     sw_test::occt_face_filter keep = [&cull](const box6 &fb) { return cull(fb); };
-    reference_plan p = plan_reference(m, b, coarse, keep);
+    sw_test::occt_clip_box clip;
+    const bool clipping = view_clip(m, b, coarse, clip);
+    reference_plan p = plan_reference(m, b, coarse, keep, clipping ? &clip : nullptr);
     sw_test::occt_triangles ref;
-    bool meshed = m.occt->mesh(p.deflection, ref, keep);
+    bool clipped = false;
+    bool meshed = m.occt->mesh(p.deflection, ref, keep, 0.5, clipping ? &clip : nullptr, &clipped);
     sw_gpu_image_free(&coarse);
     if (!meshed) {
         std::printf("%s %s: no face of the reference in view\n", m.prefix.c_str(), v.name.c_str());
@@ -553,9 +602,13 @@ bool run_view(model_ctx &m, const view &v)
     std::printf("    camera: eye %.9g %.9g %.9g, target %.9g %.9g %.9g\n", v.cam.eye[0],
                 v.cam.eye[1], v.cam.eye[2], v.cam.target[0], v.cam.target[1], v.cam.target[2]);
     std::printf("    reference: deflection %.3g (%.3f px at the nearest depth)%s, %zu faces, %zu "
-                "triangles (%.3g estimated) in %.0f ms; covers %ld px\n",
+                "triangles (%.3g estimated) in %.0f ms%s; covers %ld px\n",
                 p.deflection, p.ref_px, p.capped ? " CAPPED by the triangle budget" : "",
-                ref.faces_meshed, ref.n_triangles(), p.est_triangles, ref.ms, covered_pixels(ip.ref));
+                ref.faces_meshed, ref.n_triangles(), p.est_triangles, ref.ms,
+                clipped    ? ", cut to the view's box"
+                : clipping ? ", whole faces (the cut failed)"
+                           : "",
+                covered_pixels(ip.ref));
     std::printf("    splinewalk: %llu triangles, %llu trimmed + %llu untrimmed patches, %llu trim "
                 "textures of %.3g texels, %.0f ms; covers %ld px; bound exceeded %llu\n",
                 (unsigned long long)fs.triangles, (unsigned long long)fs.patches_trimmed,

@@ -6,16 +6,20 @@
  */
 #include "occt_reference.hpp"
 
+#include <BRepAlgoAPI_Common.hxx>
 #include <BRepBndLib.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Reader.hxx>
 #include <IMeshTools_Parameters.hxx>
 #include <Poly_Triangulation.hxx>
+#include <Precision.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <TopExp.hxx>
@@ -32,6 +36,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 namespace sw_test
 {
@@ -99,7 +104,10 @@ std::array<double, 6> zero_if_empty(const std::array<double, 6> &b)
 }
 
 /* Appends one meshed face occurrence, its location applied. */
-void append_face(const TopoDS_Face &f, occt_triangles &out)
+/* The face's triangulation; its nodes mapped by p -> centre + (p - centre) / up (a face of a
+ * copy meshed scaled up by `up` about `centre`: see meshed_copy). */
+void append_face(const TopoDS_Face &f, occt_triangles &out, const gp_Pnt &centre = gp_Pnt(),
+                 double up = 1.0)
 {
     TopLoc_Location loc;
     Handle(Poly_Triangulation) tri = BRep_Tool::Triangulation(f, loc);
@@ -108,6 +116,8 @@ void append_face(const TopoDS_Face &f, occt_triangles &out)
     uint32_t base = (uint32_t)out.n_vertices();
     for (Standard_Integer i = 1; i <= tri->NbNodes(); ++i) {
         gp_Pnt p = tri->Node(i).Transformed(loc.Transformation());
+        if (up != 1.0)
+            p = gp_Pnt(centre.XYZ() + (p.XYZ() - centre.XYZ()) / up);
         out.pos.insert(out.pos.end(), {p.X(), p.Y(), p.Z()});
     }
     for (Standard_Integer i = 1; i <= tri->NbTriangles(); ++i) {
@@ -119,7 +129,37 @@ void append_face(const TopoDS_Face &f, occt_triangles &out)
     ++out.faces_meshed;
 }
 
+/* The selection cut to the box: the faces' parts inside it. Empty when the cut fails or leaves
+ * no face. */
+TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_box &c)
+{
+    const gp_Dir x(c.x_axis[0], c.x_axis[1], c.x_axis[2]), z(c.z_axis[0], c.z_axis[1], c.z_axis[2]);
+    const gp_Dir y = z.Crossed(x);
+    gp_XYZ corner(c.centre[0], c.centre[1], c.centre[2]);
+    corner -= x.XYZ() * c.half[0] + y.XYZ() * c.half[1] + z.XYZ() * c.half[2];
+    BRepPrimAPI_MakeBox box(gp_Ax2(gp_Pnt(corner), z, x), 2.0 * c.half[0], 2.0 * c.half[1],
+                            2.0 * c.half[2]);
+    BRepAlgoAPI_Common common(sel, box.Solid());
+    if (!common.IsDone() || common.HasErrors())
+        return TopoDS_Shape();
+    TopExp_Explorer any(common.Shape(), TopAbs_FACE);
+    return any.More() ? common.Shape() : TopoDS_Shape();
+}
+
 } // namespace
+
+bool occt_clip_box::contains(const double p[3]) const
+{
+    const double d[3] = {p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]};
+    const double y_axis[3] = {z_axis[1] * x_axis[2] - z_axis[2] * x_axis[1],
+                              z_axis[2] * x_axis[0] - z_axis[0] * x_axis[2],
+                              z_axis[0] * x_axis[1] - z_axis[1] * x_axis[0]};
+    const double *axes[3] = {x_axis.data(), y_axis, z_axis.data()};
+    for (int k = 0; k < 3; ++k)
+        if (std::fabs(d[0] * axes[k][0] + d[1] * axes[k][1] + d[2] * axes[k][2]) > half[k])
+            return false;
+    return true;
+}
 
 std::array<double, 6> occt_triangles::box() const
 {
@@ -203,9 +243,11 @@ std::array<double, 6> occt_model::box() const
 }
 
 bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_filter &keep,
-                      double angle_rad)
+                      double angle_rad, const occt_clip_box *clip, bool *clipped)
 {
     out = occt_triangles{};
+    if (clipped)
+        *clipped = false;
     if (!(deflection > 0.0) || p_->faces.empty())
         return false;
     try {
@@ -222,24 +264,59 @@ bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_fi
             }
         if (chosen.empty())
             return false;
+        /* A close view shows a small part of its faces; meshed whole at its deflection they
+         * took minutes (screw.step's close view: over 300 s). */
+        TopoDS_Shape cut = clip ? cut_to(sel, *clip) : TopoDS_Shape();
+        const TopoDS_Shape selection = cut.IsNull() ? TopoDS_Shape(sel) : cut;
+        /* BRepMesh meshes nothing finer than OCCT's confusion tolerance (1e-7, absolute): a close
+         * view of a part converted to a small unit (a diagonal of 0.01) asks for 3.5e-9 and got no
+         * triangle. Below k_finest the selection is meshed as a copy scaled up about its box
+         * centre at the deflection scaled alike, and its nodes are mapped back in double: the same
+         * surfaces at the deflection asked for. */
+        const double k_finest = 100.0 * Precision::Confusion();
+        const double up = deflection < k_finest ? k_finest / deflection : 1.0;
+        gp_Pnt centre;
+        TopoDS_Shape target = selection;
+        std::unique_ptr<BRepBuilderAPI_Transform> scaled;
+        if (up > 1.0) {
+            Bnd_Box bb;
+            BRepBndLib::Add(selection, bb);
+            double x0, y0, z0, x1, y1, z1;
+            bb.Get(x0, y0, z0, x1, y1, z1);
+            centre = gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1));
+            gp_Trsf t;
+            t.SetScale(centre, up);
+            scaled = std::make_unique<BRepBuilderAPI_Transform>(selection, t, Standard_True);
+            target = scaled->Shape();
+        }
         auto t0 = std::chrono::steady_clock::now();
         /* ForceFaceDeflection: BRepMesh otherwise meshes a face no finer than twice its largest
          * edge or vertex tolerance (BRepMesh_Deflection), which on a loosely toleranced face can
          * be many pixels at a close view (linkrods.step: 8.3e-4, 2.7 px at its close-up's
          * silhouette, where its facets showed a depth edge 3 px from the exact one). */
         IMeshTools_Parameters prm;
-        prm.Deflection = prm.DeflectionInterior = deflection;
+        prm.Deflection = prm.DeflectionInterior = deflection * up;
         prm.Angle = prm.AngleInterior = angle_rad;
         prm.Relative = Standard_False;
         prm.InParallel = Standard_True;
         prm.ForceFaceDeflection = Standard_True;
-        BRepMesh_IncrementalMesh mesher(sel, prm);
+        BRepMesh_IncrementalMesh mesher(target, prm);
         out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
                      .count();
         out.triangles_per_face.assign(p_->faces.size(), 0);
+        if (!cut.IsNull()) {
+            for (TopExp_Explorer e(target, TopAbs_FACE); e.More(); e.Next())
+                append_face(TopoDS::Face(e.Current()), out, centre, up);
+            if (clipped)
+                *clipped = true;
+            chosen.clear();
+        }
         for (size_t i : chosen) {
             size_t before = out.n_triangles();
-            append_face(p_->faces[i], out);
+            if (up > 1.0)
+                append_face(TopoDS::Face(scaled->ModifiedShape(p_->faces[i])), out, centre, up);
+            else
+                append_face(p_->faces[i], out);
             out.triangles_per_face[i] = (uint32_t)(out.n_triangles() - before);
         }
     } catch (const Standard_Failure &) {

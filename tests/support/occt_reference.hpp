@@ -4,7 +4,8 @@
  * positions + uint32 indices) ready for sw_gpu_render_triangles. The model is read once; each
  * mesh() call discards the previous triangulation, so a test can mesh the same model at a
  * different deflection per view, and can restrict meshing to the faces a view can see (by their
- * world-space bounding boxes). OCCT types stay inside occt_reference.cpp.
+ * world-space bounding boxes) and cut them to the part of the view's frustum it shows. OCCT types
+ * stay inside occt_reference.cpp.
  */
 #ifndef SW_TEST_OCCT_REFERENCE_HPP
 #define SW_TEST_OCCT_REFERENCE_HPP
@@ -43,6 +44,14 @@ struct occt_closure {
     double max_tolerance = 0.0;
 };
 
+/* An oriented box, centre and half extents along orthonormal axes x and z (y = z x x): the part
+ * of a view's frustum in front of what it shows, which a reference of a close view is cut to. */
+struct occt_clip_box {
+    std::array<double, 3> centre, x_axis, z_axis, half;
+    /* Whether world point p lies inside. */
+    bool contains(const double p[3]) const;
+};
+
 /* Selects a face by its world-space bounding box (min xyz, max xyz). */
 using occt_face_filter = std::function<bool(const std::array<double, 6> &box)>;
 
@@ -67,10 +76,12 @@ class occt_model
     /* Meshes the selected faces (all when `keep` is empty) with BRepMesh_IncrementalMesh at an
      * absolute linear `deflection` and angular deflection `angle_rad`, in parallel, after
      * dropping any earlier triangulation, and appends nothing else: `out` is replaced. Faces
-     * sharing an edge are meshed together, so their triangulations meet without cracks. False
-     * when nothing could be meshed. */
+     * sharing an edge are meshed together, so their triangulations meet without cracks. With
+     * `clip`, the selected faces are first cut to the box (BRepAlgoAPI_Common; uncut when the
+     * cut fails or leaves nothing, and `clipped` says which) and triangles_per_face stays 0.
+     * False when nothing could be meshed. */
     bool mesh(double deflection, occt_triangles &out, const occt_face_filter &keep = {},
-              double angle_rad = 0.5);
+              double angle_rad = 0.5, const occt_clip_box *clip = nullptr, bool *clipped = nullptr);
 
   private:
     struct impl;
