@@ -262,6 +262,7 @@ typedef struct loop_grid {
     size_t n;
     double lo[2], cell[2];
     int32_t g[2];
+    double box_lo[2], box_hi[2];                      /* the loop's (u, v) box */
     uint32_t *start;                                  /* g[0] g[1] + 1 offsets into items */
     uint32_t *items;                                  /* segment indices, cell by cell */
     uint32_t small_start[2], small_items[SMALL_LOOP]; /* a small loop's, in place */
@@ -300,18 +301,20 @@ static int loop_grid_build(loop_grid *gr, const double *uv, size_t n)
     memset(gr, 0, sizeof *gr);
     gr->uv = uv;
     gr->n = n;
+    for (int k = 0; k < 2; ++k)
+        gr->box_lo[k] = gr->box_hi[k] = n ? uv[k] : 0.0;
+    for (size_t i = 1; i < n; ++i)
+        for (int k = 0; k < 2; ++k) {
+            gr->box_lo[k] = fmin(gr->box_lo[k], uv[2 * i + k]);
+            gr->box_hi[k] = fmax(gr->box_hi[k], uv[2 * i + k]);
+        }
     if (n <= SMALL_LOOP) {
         loop_grid_small(gr);
         return 1;
     }
-    double hi[2] = {uv[0], uv[1]};
-    gr->lo[0] = uv[0];
-    gr->lo[1] = uv[1];
-    for (size_t i = 1; i < n; ++i)
-        for (int k = 0; k < 2; ++k) {
-            gr->lo[k] = fmin(gr->lo[k], uv[2 * i + k]);
-            hi[k] = fmax(hi[k], uv[2 * i + k]);
-        }
+    const double *hi = gr->box_hi;
+    gr->lo[0] = gr->box_lo[0];
+    gr->lo[1] = gr->box_lo[1];
     int32_t side = (int32_t)ceil(sqrt((double)n));
     side = side < 1 ? 1 : (side > 256 ? 256 : side);
     for (int k = 0; k < 2; ++k) {
@@ -355,6 +358,23 @@ static void loop_grid_free(loop_grid *gr)
         return;
     sw__free(gr->start);
     sw__free(gr->items);
+}
+
+/* Largest s in [0, s_max] with p + s r inside the loop's (u, v) box. A step beyond it leaves the
+ * face whatever ray_exit finds (a ray from a corner that leaves the face at once meets no
+ * segment), and the surface is extrapolated there: along a degree-1 direction it extends
+ * straight, passes inner_point's bulge test, and an inner point lay hundreds of pixels away
+ * (Bottom.brep scaled to a diagonal of 10: a sample on a degenerate edge, S_u = 0, whose
+ * first-order step was 3e8 in u). */
+static double box_exit(const loop_grid *gr, const double p[2], const double r[2], double s_max)
+{
+    for (int k = 0; k < 2; ++k) {
+        if (r[k] > 0.0)
+            s_max = fmin(s_max, (gr->box_hi[k] - p[k]) / r[k]);
+        else if (r[k] < 0.0)
+            s_max = fmin(s_max, (gr->box_lo[k] - p[k]) / r[k]);
+    }
+    return fmax(s_max, 0.0);
 }
 
 /* Smallest s in (0, s_max] at which p + s r crosses a loop segment; s_max if none. Crossings at
@@ -477,7 +497,8 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const doub
     memcpy(out, e->p, 3 * sizeof *out);
     if (!(h > 0.0) || !starts_inside(e, r_uv, c->side))
         return 0.0;
-    double s = ray_exit(c->grid, e->uv, r_uv, h), tol = 0.25 * c->width_px;
+    double s = ray_exit(c->grid, e->uv, r_uv, box_exit(c->grid, e->uv, r_uv, h));
+    const double tol = 0.25 * c->width_px;
     if (c->affine)
         return inner_point_affine(c, e, r_uv, s, out);
     for (int k = 0; k < MAX_HALVINGS; ++k, s *= 0.5) {

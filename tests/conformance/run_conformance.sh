@@ -13,7 +13,9 @@
 # (stage_tessellate_hierarchy.c MAX_GRID_SPLITS 0) → Pump_Nut's mid views fail (3 each); the
 # side of a trim loop its fat border covers probed 1e-3 of the longest edge off the loop
 # (stage_trim.c) → screw and bottle at diagonal 0.01 fail (the ribbons of thin faces drawn
-# outside them: max 2.24 and 1.41 px). Variants: the file itself; an IGES copy at its own size
+# outside them: max 2.24 and 1.41 px); a fat border's inner point not kept in its loop's (u, v)
+# box (crack_fill.c box_exit) → Bottom at diagonal 10 fails (a sample on a degenerate edge stepped
+# 3e8 in u, onto the surface extrapolated: a spike of 276 px). Variants: the file itself; an IGES copy at its own size
 # (IGESControl_Writer: trims become B-spline pcurves); BREP copies uniformly scaled to bounding
 # diagonals of 0.01, 10 and 10,000 (a unit conversion: scaled_iges). Views: whole, mid, close.
 #  - full: every .brep under DATA/occ and .step under DATA/step (or the FILEs given), every
@@ -95,6 +97,7 @@ if [ "$mode" = quick ]; then
   one_model "$data/step/screw.step" "orig d0.01 d10000" whole
   one_model "$data/occ/bottle.brep" "iges" whole,mid
   one_model "$data/occ/bottle.brep" "d0.01" whole
+  one_model "$data/occ/Bottom.brep" "d10" whole
   one_model "$data/occ/Pump_Nut.brep" "orig d10" whole,mid
   one_model "$data/occ/Motor-c.brep" "orig" whole
   one_model "$data/occ/shell1.brep" "d10000" whole

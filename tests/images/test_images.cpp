@@ -581,8 +581,10 @@ bool run_view(model_ctx &m, const view &v)
     const bool clipping = view_clip(m, b, coarse, clip);
     reference_plan p = plan_reference(m, b, coarse, keep, clipping ? &clip : nullptr);
     sw_test::occt_triangles ref;
-    bool clipped = false;
-    bool meshed = m.occt->mesh(p.deflection, ref, keep, 0.5, clipping ? &clip : nullptr, &clipped);
+    const bool clipped = clipping && m.occt->mesh(p.deflection, ref, keep, 0.5, &clip);
+    if (!clipped && clipping)
+        p = plan_reference(m, b, coarse, keep, nullptr);
+    const bool meshed = clipped || m.occt->mesh(p.deflection, ref, keep);
     sw_gpu_image_free(&coarse);
     if (!meshed) {
         std::printf("%s %s: no face of the reference in view\n", m.prefix.c_str(), v.name.c_str());

@@ -9,6 +9,7 @@
 #include <BRepAlgoAPI_Common.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepBuilderAPI_Transform.hxx>
+#include <BRepExtrema_DistShapeShape.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
@@ -129,8 +130,8 @@ void append_face(const TopoDS_Face &f, occt_triangles &out, const gp_Pnt &centre
     ++out.faces_meshed;
 }
 
-/* The selection cut to the box: the faces' parts inside it. Empty when the cut fails or leaves
- * no face. */
+/* The selection cut to the box: the faces' parts inside it. Empty when the cut fails, loses a
+ * face or leaves none. */
 TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_box &c)
 {
     const gp_Dir x(c.x_axis[0], c.x_axis[1], c.x_axis[2]), z(c.z_axis[0], c.z_axis[1], c.z_axis[2]);
@@ -142,6 +143,15 @@ TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_box &c)
     BRepAlgoAPI_Common common(sel, box.Solid());
     if (!common.IsDone() || common.HasErrors())
         return TopoDS_Shape();
+    /* The boolean may drop a face that reaches into the box (the unsewn faces of an IGES export:
+     * Axis_of_bearing's close view lost 8 of 32, a third of the frame): then no cut. */
+    for (TopExp_Explorer e(sel, TopAbs_FACE); e.More(); e.Next()) {
+        if (!common.IsDeleted(e.Current()))
+            continue;
+        BRepExtrema_DistShapeShape dist(e.Current(), box.Solid());
+        if (!dist.IsDone() || dist.InnerSolution() || dist.Value() <= Precision::Confusion())
+            return TopoDS_Shape();
+    }
     TopExp_Explorer any(common.Shape(), TopAbs_FACE);
     return any.More() ? common.Shape() : TopoDS_Shape();
 }
@@ -242,12 +252,74 @@ std::array<double, 6> occt_model::box() const
     return zero_if_empty(b);
 }
 
+namespace
+{
+
+/* A shape meshed by BRepMesh: the shape the triangulations are on, and the map back to world
+ * space (append_face's centre and up). */
+struct meshed_shape {
+    TopoDS_Shape target;
+    std::unique_ptr<BRepBuilderAPI_Transform> scaled; /* when up > 1 */
+    gp_Pnt centre;
+    double up = 1.0, ms = 0.0;
+
+    TopoDS_Face face(const TopoDS_Shape &f) const
+    {
+        return TopoDS::Face(scaled ? scaled->ModifiedShape(f) : f);
+    }
+};
+
+/* BRepMesh meshes nothing finer than OCCT's confusion tolerance (1e-7, absolute): a close view of
+ * a part converted to a small unit (a diagonal of 0.01) asks for 3.5e-9 and got no triangle.
+ * Below k_finest the shape is meshed as a copy scaled up about its box centre at the deflection
+ * scaled alike, and its nodes are mapped back in double: the same surfaces at the deflection
+ * asked for. ForceFaceDeflection: BRepMesh otherwise meshes a face no finer than twice its
+ * largest edge or vertex tolerance (BRepMesh_Deflection), which on a loosely toleranced face can
+ * be many pixels at a close view (linkrods.step: 8.3e-4, 2.7 px at its close-up's silhouette,
+ * where its facets showed a depth edge 3 px from the exact one). */
+void mesh_shape(const TopoDS_Shape &shape, double deflection, double angle_rad, meshed_shape &m)
+{
+    const double k_finest = 100.0 * Precision::Confusion();
+    m.up = deflection < k_finest ? k_finest / deflection : 1.0;
+    m.target = shape;
+    if (m.up > 1.0) {
+        Bnd_Box bb;
+        BRepBndLib::Add(shape, bb);
+        double x0, y0, z0, x1, y1, z1;
+        bb.Get(x0, y0, z0, x1, y1, z1);
+        m.centre = gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1));
+        gp_Trsf t;
+        t.SetScale(m.centre, m.up);
+        m.scaled = std::make_unique<BRepBuilderAPI_Transform>(shape, t, Standard_True);
+        m.target = m.scaled->Shape();
+    }
+    auto t0 = std::chrono::steady_clock::now();
+    IMeshTools_Parameters prm;
+    prm.Deflection = prm.DeflectionInterior = deflection * m.up;
+    prm.Angle = prm.AngleInterior = angle_rad;
+    prm.Relative = Standard_False;
+    prm.InParallel = Standard_True;
+    prm.ForceFaceDeflection = Standard_True;
+    BRepMesh_IncrementalMesh mesher(m.target, prm);
+    m.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/* Whether every face of the shape got a triangulation. */
+bool every_face_meshed(const TopoDS_Shape &shape)
+{
+    TopLoc_Location loc;
+    for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next())
+        if (BRep_Tool::Triangulation(TopoDS::Face(e.Current()), loc).IsNull())
+            return false;
+    return true;
+}
+
+} // namespace
+
 bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_filter &keep,
-                      double angle_rad, const occt_clip_box *clip, bool *clipped)
+                      double angle_rad, const occt_clip_box *clip)
 {
     out = occt_triangles{};
-    if (clipped)
-        *clipped = false;
     if (!(deflection > 0.0) || p_->faces.empty())
         return false;
     try {
@@ -264,59 +336,31 @@ bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_fi
             }
         if (chosen.empty())
             return false;
-        /* A close view shows a small part of its faces; meshed whole at its deflection they
-         * took minutes (screw.step's close view: over 300 s). */
-        TopoDS_Shape cut = clip ? cut_to(sel, *clip) : TopoDS_Shape();
-        const TopoDS_Shape selection = cut.IsNull() ? TopoDS_Shape(sel) : cut;
-        /* BRepMesh meshes nothing finer than OCCT's confusion tolerance (1e-7, absolute): a close
-         * view of a part converted to a small unit (a diagonal of 0.01) asks for 3.5e-9 and got no
-         * triangle. Below k_finest the selection is meshed as a copy scaled up about its box
-         * centre at the deflection scaled alike, and its nodes are mapped back in double: the same
-         * surfaces at the deflection asked for. */
-        const double k_finest = 100.0 * Precision::Confusion();
-        const double up = deflection < k_finest ? k_finest / deflection : 1.0;
-        gp_Pnt centre;
-        TopoDS_Shape target = selection;
-        std::unique_ptr<BRepBuilderAPI_Transform> scaled;
-        if (up > 1.0) {
-            Bnd_Box bb;
-            BRepBndLib::Add(selection, bb);
-            double x0, y0, z0, x1, y1, z1;
-            bb.Get(x0, y0, z0, x1, y1, z1);
-            centre = gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1));
-            gp_Trsf t;
-            t.SetScale(centre, up);
-            scaled = std::make_unique<BRepBuilderAPI_Transform>(selection, t, Standard_True);
-            target = scaled->Shape();
-        }
-        auto t0 = std::chrono::steady_clock::now();
-        /* ForceFaceDeflection: BRepMesh otherwise meshes a face no finer than twice its largest
-         * edge or vertex tolerance (BRepMesh_Deflection), which on a loosely toleranced face can
-         * be many pixels at a close view (linkrods.step: 8.3e-4, 2.7 px at its close-up's
-         * silhouette, where its facets showed a depth edge 3 px from the exact one). */
-        IMeshTools_Parameters prm;
-        prm.Deflection = prm.DeflectionInterior = deflection * up;
-        prm.Angle = prm.AngleInterior = angle_rad;
-        prm.Relative = Standard_False;
-        prm.InParallel = Standard_True;
-        prm.ForceFaceDeflection = Standard_True;
-        BRepMesh_IncrementalMesh mesher(target, prm);
-        out.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                     .count();
         out.triangles_per_face.assign(p_->faces.size(), 0);
+        /* A close view shows a small part of its faces; meshed whole at its deflection they took
+         * minutes (screw.step's close view: over 300 s). A face the cut leaves unmeshable (the
+         * unsewn faces of an IGES export: 8 of Axis_of_bearing's 32 at its close view, a third
+         * of the frame) fails the call: the caller meshes whole faces, at a deflection planned
+         * for them. */
+        TopoDS_Shape cut = clip ? cut_to(sel, *clip) : TopoDS_Shape();
         if (!cut.IsNull()) {
-            for (TopExp_Explorer e(target, TopAbs_FACE); e.More(); e.Next())
-                append_face(TopoDS::Face(e.Current()), out, centre, up);
-            if (clipped)
-                *clipped = true;
-            chosen.clear();
+            meshed_shape m;
+            mesh_shape(cut, deflection, angle_rad, m);
+            if (!every_face_meshed(m.target))
+                return false;
+            for (TopExp_Explorer e(m.target, TopAbs_FACE); e.More(); e.Next())
+                append_face(TopoDS::Face(e.Current()), out, m.centre, m.up);
+            out.ms = m.ms;
+            return !out.idx.empty();
         }
+        if (clip)
+            return false;
+        meshed_shape m;
+        mesh_shape(sel, deflection, angle_rad, m);
+        out.ms = m.ms;
         for (size_t i : chosen) {
             size_t before = out.n_triangles();
-            if (up > 1.0)
-                append_face(TopoDS::Face(scaled->ModifiedShape(p_->faces[i])), out, centre, up);
-            else
-                append_face(p_->faces[i], out);
+            append_face(m.face(p_->faces[i]), out, m.centre, m.up);
             out.triangles_per_face[i] = (uint32_t)(out.n_triangles() - before);
         }
     } catch (const Standard_Failure &) {

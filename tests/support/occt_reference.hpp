@@ -77,11 +77,11 @@ class occt_model
      * absolute linear `deflection` and angular deflection `angle_rad`, in parallel, after
      * dropping any earlier triangulation, and appends nothing else: `out` is replaced. Faces
      * sharing an edge are meshed together, so their triangulations meet without cracks. With
-     * `clip`, the selected faces are first cut to the box (BRepAlgoAPI_Common; uncut when the
-     * cut fails or leaves nothing, and `clipped` says which) and triangles_per_face stays 0.
-     * False when nothing could be meshed. */
+     * `clip`, the selected faces' parts in the box (BRepAlgoAPI_Common), and triangles_per_face
+     * stays 0. False when nothing could be meshed, or with `clip` when the cut fails, leaves no
+     * face or leaves one BRepMesh cannot mesh (mesh the faces whole then). */
     bool mesh(double deflection, occt_triangles &out, const occt_face_filter &keep = {},
-              double angle_rad = 0.5, const occt_clip_box *clip = nullptr, bool *clipped = nullptr);
+              double angle_rad = 0.5, const occt_clip_box *clip = nullptr);
 
   private:
     struct impl;
