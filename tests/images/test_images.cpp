@@ -331,8 +331,9 @@ struct reference_plan {
  * reference, less its deflection), unless the triangle estimate (coarse triangles of the kept
  * faces x the deflection ratio: BRepMesh's count on curved faces grows as 1/deflection) exceeds
  * the budget; then the deflection grows to meet it, and the view says so. */
-/* Coarse triangles with a vertex or their centroid in the clip box (at least 1). */
-double coarse_triangles_in(const sw_test::occt_triangles &coarse, const sw_test::occt_clip_box &c)
+/* Coarse triangles with a vertex or their centroid in the clip frustum (at least 1). */
+double coarse_triangles_in(const sw_test::occt_triangles &coarse,
+                           const sw_test::occt_clip_frustum &c)
 {
     double n = 0;
     for (size_t t = 0; t + 2 < coarse.idx.size(); t += 3) {
@@ -351,7 +352,7 @@ double coarse_triangles_in(const sw_test::occt_triangles &coarse, const sw_test:
 
 reference_plan plan_reference(const model_ctx &m, const basis &b, const sw_gpu_image &coarse,
                               const sw_test::occt_face_filter &keep,
-                              const sw_test::occt_clip_box *clip)
+                              const sw_test::occt_clip_frustum *clip)
 {
     reference_plan p;
     double z = min_depth(coarse);
@@ -543,28 +544,33 @@ long covered_pixels(const sw_gpu_image &img)
     return n;
 }
 
-/* The part of the view's frustum in front of the farthest depth the coarse reference shows (with
- * view_cull's margin, and 5 % beyond the sides), as a box the reference is cut to before meshing:
- * a close view shows a small part of its faces, and meshing them whole at its deflection took
- * minutes (screw.step's close view: over 300 s). False for a box not much smaller than the model
- * (the whole views, which gain nothing). */
+/* The part of the view's frustum where it can show something: from half the nearest depth the
+ * coarse reference shows to the farthest (with view_cull's margin), 5 % wider than the view; the
+ * reference is cut to it before meshing. A close view shows a small part of its faces, and
+ * meshing them whole at its deflection took minutes (screw.step's close view: over 300 s, cut:
+ * 52 ms). False where the frustum at the nearest depth is not much smaller than the model (the
+ * whole views, which gain nothing), and for a B-rep with free edges: the cut of an IGES export's
+ * unsewn faces lost a face in view (Axis_of_bearing's close view, a third of the frame), whether
+ * cut all at once or face by face, with no failure reported. */
 bool view_clip(const model_ctx &m, const basis &b, const sw_gpu_image &coarse,
-               sw_test::occt_clip_box &clip)
+               sw_test::occt_clip_frustum &clip)
 {
-    double zmax = 0.0;
+    double zmin = INFINITY, zmax = 0.0;
     for (size_t i = 0; i < (size_t)coarse.width * coarse.height; ++i)
-        if (std::isfinite(coarse.depth[i]))
+        if (std::isfinite(coarse.depth[i])) {
+            zmin = std::fmin(zmin, (double)coarse.depth[i]);
             zmax = std::fmax(zmax, (double)coarse.depth[i]);
-    const double far = zmax * 1.05 + 4.0 * m.coarse_deflection;
-    const double hx = 1.05 * far * b.tan_x, hy = 1.05 * far * b.tan_y;
-    if (!(zmax > 0.0) ||
-        2.0 * std::sqrt(hx * hx + hy * hy + 0.25 * far * far) > 0.5 * diagonal(m.box))
+        }
+    if (!(zmax > 0.0) || 2.0 * zmin * b.tan_y > 0.5 * diagonal(m.box) || m.closure.free_edges > 0)
         return false;
-    const vec3 centre = axpy(b.eye, 0.5 * far, b.fwd);
-    clip.centre = {centre[0], centre[1], centre[2]};
-    clip.x_axis = {b.right[0], b.right[1], b.right[2]};
-    clip.z_axis = {b.fwd[0], b.fwd[1], b.fwd[2]};
-    clip.half = {hx, hy, 0.5 * far};
+    clip.eye = {b.eye[0], b.eye[1], b.eye[2]};
+    clip.fwd = {b.fwd[0], b.fwd[1], b.fwd[2]};
+    clip.right = {b.right[0], b.right[1], b.right[2]};
+    clip.up = {b.up[0], b.up[1], b.up[2]};
+    clip.tan_x = 1.05 * b.tan_x;
+    clip.tan_y = 1.05 * b.tan_y;
+    clip.z_far = zmax * 1.05 + 4.0 * m.coarse_deflection;
+    clip.z_near = std::fmax(0.5 * (zmin - m.coarse_deflection), 1e-3 * clip.z_far);
     return true;
 }
 
@@ -577,7 +583,7 @@ bool run_view(model_ctx &m, const view &v)
         return false;
     view_cull cull{b, coarse.depth, m.w, m.h, m.coarse_deflection};
     sw_test::occt_face_filter keep = [&cull](const box6 &fb) { return cull(fb); };
-    sw_test::occt_clip_box clip;
+    sw_test::occt_clip_frustum clip;
     const bool clipping = view_clip(m, b, coarse, clip);
     reference_plan p = plan_reference(m, b, coarse, keep, clipping ? &clip : nullptr);
     sw_test::occt_triangles ref;
@@ -607,7 +613,7 @@ bool run_view(model_ctx &m, const view &v)
                 "triangles (%.3g estimated) in %.0f ms%s; covers %ld px\n",
                 p.deflection, p.ref_px, p.capped ? " CAPPED by the triangle budget" : "",
                 ref.faces_meshed, ref.n_triangles(), p.est_triangles, ref.ms,
-                clipped    ? ", cut to the view's box"
+                clipped    ? ", cut to the view's frustum"
                 : clipping ? ", whole faces (the cut failed)"
                            : "",
                 covered_pixels(ip.ref));

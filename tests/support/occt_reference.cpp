@@ -13,7 +13,7 @@
 #include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
-#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeWedge.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <IFSelect_ReturnStatus.hxx>
@@ -32,6 +32,7 @@
 #include <TopoDS_Compound.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <TopoDS_Solid.hxx>
 
 #include <algorithm>
 #include <cctype>
@@ -130,25 +131,34 @@ void append_face(const TopoDS_Face &f, occt_triangles &out, const gp_Pnt &centre
     ++out.faces_meshed;
 }
 
-/* The selection cut to the box: the faces' parts inside it. Empty when the cut fails, loses a
- * face or leaves none. */
-TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_box &c)
+/* The frustum as a solid: a wedge (BRepPrimAPI_MakeWedge) whose base is the far rectangle and
+ * whose top, z_far - z_near towards the eye, the near one. Local axes: x = right, z = -up, so
+ * that y = z x x = -fwd. */
+TopoDS_Solid frustum_solid(const occt_clip_frustum &c)
 {
-    const gp_Dir x(c.x_axis[0], c.x_axis[1], c.x_axis[2]), z(c.z_axis[0], c.z_axis[1], c.z_axis[2]);
-    const gp_Dir y = z.Crossed(x);
-    gp_XYZ corner(c.centre[0], c.centre[1], c.centre[2]);
-    corner -= x.XYZ() * c.half[0] + y.XYZ() * c.half[1] + z.XYZ() * c.half[2];
-    BRepPrimAPI_MakeBox box(gp_Ax2(gp_Pnt(corner), z, x), 2.0 * c.half[0], 2.0 * c.half[1],
-                            2.0 * c.half[2]);
-    BRepAlgoAPI_Common common(sel, box.Solid());
+    const gp_XYZ eye(c.eye[0], c.eye[1], c.eye[2]), fwd(c.fwd[0], c.fwd[1], c.fwd[2]),
+        right(c.right[0], c.right[1], c.right[2]), up(c.up[0], c.up[1], c.up[2]);
+    const double hx1 = c.tan_x * c.z_far, hy1 = c.tan_y * c.z_far;
+    const double hx0 = c.tan_x * c.z_near, hy0 = c.tan_y * c.z_near;
+    const gp_XYZ corner = eye + fwd * c.z_far - right * hx1 + up * hy1;
+    BRepPrimAPI_MakeWedge wedge(gp_Ax2(gp_Pnt(corner), gp_Dir(up * -1.0), gp_Dir(right)), 2.0 * hx1,
+                                c.z_far - c.z_near, 2.0 * hy1, hx1 - hx0, hy1 - hy0, hx1 + hx0,
+                                hy1 + hy0);
+    return wedge.Solid();
+}
+
+/* The selection cut to the frustum: its faces' parts inside it (their shared edges cut alike),
+ * or nothing when the cut fails, drops a face that reaches into the frustum, or leaves no face. */
+TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_frustum &c)
+{
+    const TopoDS_Solid frustum = frustum_solid(c);
+    BRepAlgoAPI_Common common(sel, frustum);
     if (!common.IsDone() || common.HasErrors())
         return TopoDS_Shape();
-    /* The boolean may drop a face that reaches into the box (the unsewn faces of an IGES export:
-     * Axis_of_bearing's close view lost 8 of 32, a third of the frame): then no cut. */
     for (TopExp_Explorer e(sel, TopAbs_FACE); e.More(); e.Next()) {
         if (!common.IsDeleted(e.Current()))
             continue;
-        BRepExtrema_DistShapeShape dist(e.Current(), box.Solid());
+        BRepExtrema_DistShapeShape dist(e.Current(), frustum);
         if (!dist.IsDone() || dist.InnerSolution() || dist.Value() <= Precision::Confusion())
             return TopoDS_Shape();
     }
@@ -158,17 +168,13 @@ TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_box &c)
 
 } // namespace
 
-bool occt_clip_box::contains(const double p[3]) const
+bool occt_clip_frustum::contains(const double p[3]) const
 {
-    const double d[3] = {p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]};
-    const double y_axis[3] = {z_axis[1] * x_axis[2] - z_axis[2] * x_axis[1],
-                              z_axis[2] * x_axis[0] - z_axis[0] * x_axis[2],
-                              z_axis[0] * x_axis[1] - z_axis[1] * x_axis[0]};
-    const double *axes[3] = {x_axis.data(), y_axis, z_axis.data()};
-    for (int k = 0; k < 3; ++k)
-        if (std::fabs(d[0] * axes[k][0] + d[1] * axes[k][1] + d[2] * axes[k][2]) > half[k])
-            return false;
-    return true;
+    const double d[3] = {p[0] - eye[0], p[1] - eye[1], p[2] - eye[2]};
+    const double z = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2];
+    const double x = d[0] * right[0] + d[1] * right[1] + d[2] * right[2];
+    const double y = d[0] * up[0] + d[1] * up[1] + d[2] * up[2];
+    return z >= z_near && z <= z_far && std::fabs(x) <= tan_x * z && std::fabs(y) <= tan_y * z;
 }
 
 std::array<double, 6> occt_triangles::box() const
@@ -317,7 +323,7 @@ bool every_face_meshed(const TopoDS_Shape &shape)
 } // namespace
 
 bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_filter &keep,
-                      double angle_rad, const occt_clip_box *clip)
+                      double angle_rad, const occt_clip_frustum *clip)
 {
     out = occt_triangles{};
     if (!(deflection > 0.0) || p_->faces.empty())

@@ -44,10 +44,12 @@ struct occt_closure {
     double max_tolerance = 0.0;
 };
 
-/* An oriented box, centre and half extents along orthonormal axes x and z (y = z x x): the part
- * of a view's frustum in front of what it shows, which a reference of a close view is cut to. */
-struct occt_clip_box {
-    std::array<double, 3> centre, x_axis, z_axis, half;
+/* The part of a view's frustum a reference is cut to: depths (along fwd from the eye) in
+ * [z_near, z_far], and |right offset| <= tan_x depth, |up offset| <= tan_y depth (the view's
+ * half-angles, with any margin). fwd, right, up: orthonormal, right = fwd x up. */
+struct occt_clip_frustum {
+    std::array<double, 3> eye, fwd, right, up;
+    double tan_x, tan_y, z_near, z_far;
     /* Whether world point p lies inside. */
     bool contains(const double p[3]) const;
 };
@@ -77,11 +79,11 @@ class occt_model
      * absolute linear `deflection` and angular deflection `angle_rad`, in parallel, after
      * dropping any earlier triangulation, and appends nothing else: `out` is replaced. Faces
      * sharing an edge are meshed together, so their triangulations meet without cracks. With
-     * `clip`, the selected faces' parts in the box (BRepAlgoAPI_Common), and triangles_per_face
+     * `clip`, the selected faces' parts inside it (BRepAlgoAPI_Common), and triangles_per_face
      * stays 0. False when nothing could be meshed, or with `clip` when the cut fails, leaves no
      * face or leaves one BRepMesh cannot mesh (mesh the faces whole then). */
     bool mesh(double deflection, occt_triangles &out, const occt_face_filter &keep = {},
-              double angle_rad = 0.5, const occt_clip_box *clip = nullptr);
+              double angle_rad = 0.5, const occt_clip_frustum *clip = nullptr);
 
   private:
     struct impl;
