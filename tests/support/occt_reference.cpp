@@ -147,11 +147,13 @@ TopoDS_Solid frustum_solid(const occt_clip_frustum &c)
     return wedge.Solid();
 }
 
-/* The selection cut to the frustum: its faces' parts inside it (their shared edges cut alike),
- * or nothing when the cut fails, drops a face that reaches into the frustum, or leaves no face. */
-TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_frustum &c)
+/* The selection cut to the frustum placed by t (the selection's own scaling, see scale_up): its
+ * faces' parts inside it (their shared edges cut alike), or nothing when the cut fails, drops a
+ * face that reaches into the frustum, or leaves no face. */
+TopoDS_Shape cut_to(const TopoDS_Shape &sel, const occt_clip_frustum &c, const gp_Trsf &t)
 {
-    const TopoDS_Solid frustum = frustum_solid(c);
+    const TopoDS_Solid frustum =
+        TopoDS::Solid(BRepBuilderAPI_Transform(frustum_solid(c), t, Standard_True).Shape());
     BRepAlgoAPI_Common common(sel, frustum);
     if (!common.IsDone() || common.HasErrors())
         return TopoDS_Shape();
@@ -261,53 +263,59 @@ std::array<double, 6> occt_model::box() const
 namespace
 {
 
-/* A shape meshed by BRepMesh: the shape the triangulations are on, and the map back to world
- * space (append_face's centre and up). */
-struct meshed_shape {
-    TopoDS_Shape target;
-    std::unique_ptr<BRepBuilderAPI_Transform> scaled; /* when up > 1 */
+/* The selection as BRepMesh and the cut see it: itself, or a copy scaled up by `up` about its box
+ * centre. BRepMesh meshes nothing finer than OCCT's confusion tolerance (1e-7, absolute): a close
+ * view of a part converted to a small unit (a diagonal of 0.01) asks for 3.5e-9 and got no
+ * triangle, and a boolean cut at that size loses precision too (Axis_of_bearing at 0.01, mid view:
+ * 87 % of edge pixels within 1 px, 6.3 px at most, where cut after scaling: 100 %). Below k_finest
+ * the copy is meshed at the deflection scaled alike and its nodes mapped back in double
+ * (append_face): the same surfaces at the deflection asked for. */
+struct scaled_selection {
+    TopoDS_Shape shape;
+    std::unique_ptr<BRepBuilderAPI_Transform> xf; /* when up > 1 */
+    gp_Trsf t;
     gp_Pnt centre;
-    double up = 1.0, ms = 0.0;
+    double up = 1.0;
 
     TopoDS_Face face(const TopoDS_Shape &f) const
     {
-        return TopoDS::Face(scaled ? scaled->ModifiedShape(f) : f);
+        return TopoDS::Face(xf ? xf->ModifiedShape(f) : f);
     }
 };
 
-/* BRepMesh meshes nothing finer than OCCT's confusion tolerance (1e-7, absolute): a close view of
- * a part converted to a small unit (a diagonal of 0.01) asks for 3.5e-9 and got no triangle.
- * Below k_finest the shape is meshed as a copy scaled up about its box centre at the deflection
- * scaled alike, and its nodes are mapped back in double: the same surfaces at the deflection
- * asked for. ForceFaceDeflection: BRepMesh otherwise meshes a face no finer than twice its
- * largest edge or vertex tolerance (BRepMesh_Deflection), which on a loosely toleranced face can
- * be many pixels at a close view (linkrods.step: 8.3e-4, 2.7 px at its close-up's silhouette,
- * where its facets showed a depth edge 3 px from the exact one). */
-void mesh_shape(const TopoDS_Shape &shape, double deflection, double angle_rad, meshed_shape &m)
+void scale_up(const TopoDS_Shape &sel, double deflection, scaled_selection &s)
 {
     const double k_finest = 100.0 * Precision::Confusion();
-    m.up = deflection < k_finest ? k_finest / deflection : 1.0;
-    m.target = shape;
-    if (m.up > 1.0) {
-        Bnd_Box bb;
-        BRepBndLib::Add(shape, bb);
-        double x0, y0, z0, x1, y1, z1;
-        bb.Get(x0, y0, z0, x1, y1, z1);
-        m.centre = gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1));
-        gp_Trsf t;
-        t.SetScale(m.centre, m.up);
-        m.scaled = std::make_unique<BRepBuilderAPI_Transform>(shape, t, Standard_True);
-        m.target = m.scaled->Shape();
-    }
+    s.up = deflection < k_finest ? k_finest / deflection : 1.0;
+    s.shape = sel;
+    if (!(s.up > 1.0))
+        return;
+    Bnd_Box bb;
+    BRepBndLib::Add(sel, bb);
+    double x0, y0, z0, x1, y1, z1;
+    bb.Get(x0, y0, z0, x1, y1, z1);
+    s.centre = gp_Pnt(0.5 * (x0 + x1), 0.5 * (y0 + y1), 0.5 * (z0 + z1));
+    s.t.SetScale(s.centre, s.up);
+    s.xf = std::make_unique<BRepBuilderAPI_Transform>(sel, s.t, Standard_True);
+    s.shape = s.xf->Shape();
+}
+
+/* BRepMesh of the shape at an absolute deflection; its time in ms. ForceFaceDeflection: BRepMesh
+ * otherwise meshes a face no finer than twice its largest edge or vertex tolerance
+ * (BRepMesh_Deflection), which on a loosely toleranced face can be many pixels at a close view
+ * (linkrods.step: 8.3e-4, 2.7 px at its close-up's silhouette, where its facets showed a depth
+ * edge 3 px from the exact one). */
+double mesh_shape(const TopoDS_Shape &shape, double deflection, double angle_rad)
+{
     auto t0 = std::chrono::steady_clock::now();
     IMeshTools_Parameters prm;
-    prm.Deflection = prm.DeflectionInterior = deflection * m.up;
+    prm.Deflection = prm.DeflectionInterior = deflection;
     prm.Angle = prm.AngleInterior = angle_rad;
     prm.Relative = Standard_False;
     prm.InParallel = Standard_True;
     prm.ForceFaceDeflection = Standard_True;
-    BRepMesh_IncrementalMesh mesher(m.target, prm);
-    m.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    BRepMesh_IncrementalMesh mesher(shape, prm);
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
 /* Whether every face of the shape got a triangulation. */
@@ -348,25 +356,23 @@ bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_fi
          * unsewn faces of an IGES export: 8 of Axis_of_bearing's 32 at its close view, a third
          * of the frame) fails the call: the caller meshes whole faces, at a deflection planned
          * for them. */
-        TopoDS_Shape cut = clip ? cut_to(sel, *clip) : TopoDS_Shape();
+        scaled_selection sc;
+        scale_up(sel, deflection, sc);
+        TopoDS_Shape cut = clip ? cut_to(sc.shape, *clip, sc.t) : TopoDS_Shape();
         if (!cut.IsNull()) {
-            meshed_shape m;
-            mesh_shape(cut, deflection, angle_rad, m);
-            if (!every_face_meshed(m.target))
+            out.ms = mesh_shape(cut, deflection * sc.up, angle_rad);
+            if (!every_face_meshed(cut))
                 return false;
-            for (TopExp_Explorer e(m.target, TopAbs_FACE); e.More(); e.Next())
-                append_face(TopoDS::Face(e.Current()), out, m.centre, m.up);
-            out.ms = m.ms;
+            for (TopExp_Explorer e(cut, TopAbs_FACE); e.More(); e.Next())
+                append_face(TopoDS::Face(e.Current()), out, sc.centre, sc.up);
             return !out.idx.empty();
         }
         if (clip)
             return false;
-        meshed_shape m;
-        mesh_shape(sel, deflection, angle_rad, m);
-        out.ms = m.ms;
+        out.ms = mesh_shape(sc.shape, deflection * sc.up, angle_rad);
         for (size_t i : chosen) {
             size_t before = out.n_triangles();
-            append_face(m.face(p_->faces[i]), out, m.centre, m.up);
+            append_face(sc.face(p_->faces[i]), out, sc.centre, sc.up);
             out.triangles_per_face[i] = (uint32_t)(out.n_triangles() - before);
         }
     } catch (const Standard_Failure &) {
