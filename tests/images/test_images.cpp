@@ -358,11 +358,9 @@ reference_plan plan_reference(const model_ctx &m, const basis &b, const sw_gpu_i
     double z = min_depth(coarse);
     p.z_near = std::fmax(z - m.coarse_deflection, 0.5 * z);
     p.deflection = k_ref_px * p.z_near / b.focal_px;
-    double n_sel = 0;
+    double n_sel = clip ? coarse_triangles_in(m.coarse, *clip) : 0.0;
     for (size_t i = 0; i < m.occt->n_faces() && !clip; ++i)
         n_sel += keep(m.occt->face_boxes()[i]) ? m.coarse.triangles_per_face[i] : 0;
-    if (clip)
-        n_sel = coarse_triangles_in(m.coarse, *clip);
     p.est_triangles = n_sel * std::fmax(1.0, m.coarse_deflection / p.deflection);
     if (p.est_triangles > (double)m.max_triangles) {
         p.capped = true;

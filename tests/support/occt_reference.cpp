@@ -107,7 +107,7 @@ std::array<double, 6> zero_if_empty(const std::array<double, 6> &b)
 
 /* Appends one meshed face occurrence, its location applied. */
 /* The face's triangulation; its nodes mapped by p -> centre + (p - centre) / up (a face of a
- * copy meshed scaled up by `up` about `centre`: see meshed_copy). */
+ * copy meshed scaled up by `up` about `centre`: see scale_up). */
 void append_face(const TopoDS_Face &f, occt_triangles &out, const gp_Pnt &centre = gp_Pnt(),
                  double up = 1.0)
 {
@@ -352,10 +352,9 @@ bool occt_model::mesh(double deflection, occt_triangles &out, const occt_face_fi
             return false;
         out.triangles_per_face.assign(p_->faces.size(), 0);
         /* A close view shows a small part of its faces; meshed whole at its deflection they took
-         * minutes (screw.step's close view: over 300 s). A face the cut leaves unmeshable (the
-         * unsewn faces of an IGES export: 8 of Axis_of_bearing's 32 at its close view, a third
-         * of the frame) fails the call: the caller meshes whole faces, at a deflection planned
-         * for them. */
+         * minutes (screw.step's close view: over 300 s). A cut that fails, or leaves a face
+         * BRepMesh cannot mesh, fails the call: the caller meshes whole faces, at a deflection
+         * planned for them. */
         scaled_selection sc;
         scale_up(sel, deflection, sc);
         TopoDS_Shape cut = clip ? cut_to(sc.shape, *clip, sc.t) : TopoDS_Shape();
