@@ -125,6 +125,18 @@ static void surface_point(const sw_sg_surface *srf, const double world[12], cons
                  world[4 * r + 3] - eye[r];
 }
 
+/* Length of a closed uv polyline in cells (du, dv), each segment measured along its longer
+ * side in cells: the samples count_samples makes, before rounding up and the per-segment cap. */
+static double length_in_cells(const double *uv, size_t n, double du, double dv)
+{
+    double total = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double *a = uv + 2 * i, *b = uv + 2 * ((i + 1) % n);
+        total += fmax(fabs(b[0] - a[0]) / du, fabs(b[1] - a[1]) / dv);
+    }
+    return total;
+}
+
 /* Samples of a closed uv polyline, each segment cut into pieces no longer than (du, dv). */
 static size_t count_samples(const double *uv, size_t n, double du, double dv)
 {
@@ -665,9 +677,13 @@ sw_result sw__gpu_border_loop_make(const sw_sg_surface *srf, const double *uv, s
     size_t m = count_samples(uv, n, du, dv);
     /* The cap from the request: the view's pixels bound the samples a ribbon can use;
      * cells shrunk by a deep refinement (fovy 1e-9 grew memory at ~600 MB/s here) are widened
-     * until the loop fits. Each segment keeps one sample, so m <= n + budget after one pass. */
+     * until the loop fits. A segment of L cells takes at most L + 1 samples after widening by
+     * f, L / f + 1, so f = (sum of L) / (budget - n) keeps m <= budget (n <= budget / 2 by
+     * sw__gpu_border_budget). The sum is taken before the per-segment cap: scaled by the capped
+     * count, a loop of 748k vertices in cells of 7e-16 still asked for 3e9 samples. */
     if (m > max_samples) {
-        const double widen = (double)m / (double)max_samples;
+        const double room = max_samples > n ? (double)(max_samples - n) : 0.0;
+        const double widen = room > 0.0 ? length_in_cells(uv, n, du, dv) / room : INFINITY;
         du *= widen;
         dv *= widen;
         m = count_samples(uv, n, du, dv);
@@ -691,6 +707,11 @@ void sw__gpu_border_loop_free(sw__gpu_border_loop *bl)
     loop_grid_free(&bl->grid);
     sw__free(bl->s);
     sw__free(bl);
+}
+
+size_t sw__gpu_border_loop_samples(const sw__gpu_border_loop *bl)
+{
+    return bl->n_samples;
 }
 
 size_t sw__gpu_border_loop_bytes(const sw__gpu_border_loop *bl)

@@ -399,6 +399,37 @@ static sw_result copy_loops(face_loops *fl, const sw__fr_border_entry *e, sw_sta
     return SW_OK;
 }
 
+/* A knot span or item narrower than this fraction of the face's trim box is a sliver: knots a
+ * rounding apart, left by exporters and unit conversions (IGES copies and scaled B-reps of OCCT's
+ * samples hold spans of 1e-8 and 7e-16 of the box). One grid segment spans it, so its cell says
+ * nothing of how finely the face's loops must be flattened or its borders sampled; taken as the
+ * face's cell it cut a loop into 3e9 border samples. */
+#define SLIVER_FRACTION 1e-6
+
+int sw__fr_sliver(double extent, double box_extent)
+{
+    return !(extent > SLIVER_FRACTION * box_extent);
+}
+
+void sw__fr_grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2])
+{
+    cell[0] = cell[1] = INFINITY;
+    for (size_t p = 0; p < n; ++p) {
+        if (!pt[p].visible)
+            continue;
+        double wu = (pt[p].u1 - pt[p].u0) * (pt[p].s1 - pt[p].s0);
+        double wv = (pt[p].v1 - pt[p].v0) * (pt[p].t1 - pt[p].t0);
+        if (!sw__fr_sliver(wu, ub[1] - ub[0]))
+            cell[0] = fmin(cell[0], wu / pt[p].nu);
+        if (!sw__fr_sliver(wv, ub[3] - ub[2]))
+            cell[1] = fmin(cell[1], wv / pt[p].nv);
+    }
+    if (!(cell[0] < INFINITY) || !(cell[1] < INFINITY)) { /* slivers only */
+        cell[0] = fmin(cell[0], ub[1] - ub[0]);
+        cell[1] = fmin(cell[1], ub[3] - ub[2]);
+    }
+}
+
 sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *index,
                             sw_status *status)
 {

@@ -147,30 +147,6 @@ static int face_on_gpu(const sw__fr_tess *f, const sw_sg_bezier_set *set)
     return f->env->ctx->eval_mode == SW__GPU_EVAL_AUTO && face_gpu_eligible(set);
 }
 
-/* Smallest cell of the face's visible grids, in face parameters. Slivers (a patch column or row
- * below 1e-9 of the trim box, left by knots a rounding apart) are skipped: their cells say
- * nothing about how far apart the border may be sampled, and would cut every loop segment into
- * thousands of pieces. */
-static void grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2])
-{
-    const double min_u = 1e-9 * (ub[1] - ub[0]), min_v = 1e-9 * (ub[3] - ub[2]);
-    cell[0] = cell[1] = INFINITY;
-    for (size_t p = 0; p < n; ++p) {
-        if (!pt[p].visible)
-            continue;
-        double wu = (pt[p].u1 - pt[p].u0) * (pt[p].s1 - pt[p].s0);
-        double wv = (pt[p].v1 - pt[p].v0) * (pt[p].t1 - pt[p].t0);
-        if (wu > min_u)
-            cell[0] = fmin(cell[0], wu / pt[p].nu);
-        if (wv > min_v)
-            cell[1] = fmin(cell[1], wv / pt[p].nv);
-    }
-    if (!(cell[0] < INFINITY) || !(cell[1] < INFINITY)) { /* slivers only */
-        cell[0] = fmin(cell[0], ub[1] - ub[0]);
-        cell[1] = fmin(cell[1], ub[3] - ub[2]);
-    }
-}
-
 /* ---- tiled trim boxes (§5.3, §7: trim textures finer than one texture per face can hold) ----
  * A face whose trim texture would need more than k_tile_texels per direction has its trim box
  * cut into ku x kv equal tiles (powers of two). Only tiles whose part of the surface meets the
@@ -446,13 +422,8 @@ static sw_result tiled_draws(tiling *t, double sign, int on_gpu, sw_status *stat
     sw__fr_tess *f = t->f;
     int64_t loops = -1;
     sw_result r = tile_loops(t, &loops, status);
-    double cell[2] = {INFINITY, INFINITY};
-    for (size_t i = 0; i < t->n_cells; ++i)
-        if (t->cells[i].visible) {
-            const sw__gpu_patch *c = &t->cells[i];
-            cell[0] = fmin(cell[0], (c->u1 - c->u0) * (c->s1 - c->s0) / c->nu);
-            cell[1] = fmin(cell[1], (c->v1 - c->v0) * (c->t1 - c->t0) / c->nv);
-        }
+    double cell[2];
+    sw__fr_grid_cell(t->cells, t->n_cells, f->env->sv->faces[t->o->face].uv_box, cell);
     for (size_t i = 0; i < t->n_tiles && r == SW_OK; ++i)
         if (t->tiles[i].cls >= 0)
             r = tile_draw(t, &t->tiles[i], loops, sign, on_gpu, cell, status);
@@ -559,7 +530,7 @@ sw_result sw__fr_tess_direct(sw__fr_tess *f, const occurrence *o, sw_status *sta
         const double sign = sw__fr_normal_sign(f->env, o);
         size_t first = f->geo->mesh.n_idx;
         double cell[2];
-        grid_cell(pt, n, rec->uv_box, cell);
+        sw__fr_grid_cell(pt, n, rec->uv_box, cell);
         if (trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)) {
             r = tiled_face(f, o, set, pt, &need, sign, on_gpu, class_grids, status);
             if (on_gpu)

@@ -337,19 +337,26 @@ static sw_result draw_item_own(hl_face *hf, hl_choice *c, const sw__gpu_patch *p
     return r;
 }
 
-/* The finest trim texel of the chosen items, halved: the loops' flattening tolerance. */
+/* The finest trim texel of the chosen items, halved: the loops' flattening tolerance. Slivers
+ * (sw__fr_sliver) are skipped, as in the border's cell: a span of 7e-16 flattened a loop into
+ * 748k vertices. */
 static double loop_tolerance(const hl_face *hf)
 {
     int32_t max_entry = sw__gpu_atlas_max_entry(hf->f->env->ctx);
-    double tol = INFINITY;
+    const double *ub = hf->f->env->sv->faces[hf->o->face].uv_box;
+    double tol = INFINITY, all = INFINITY;
     for (size_t i = 0; i < hf->n_chosen; ++i) {
         const hl_choice *c = &hf->chosen[i];
-        tol =
-            fmin(tol, 0.5 * (c->rect[1] - c->rect[0]) / sw__fr_class_texels(c->need.u, max_entry));
-        tol =
-            fmin(tol, 0.5 * (c->rect[3] - c->rect[2]) / sw__fr_class_texels(c->need.v, max_entry));
+        const double w[2] = {c->rect[1] - c->rect[0], c->rect[3] - c->rect[2]};
+        const double texel[2] = {0.5 * w[0] / sw__fr_class_texels(c->need.u, max_entry),
+                                 0.5 * w[1] / sw__fr_class_texels(c->need.v, max_entry)};
+        for (int d = 0; d < 2; ++d) {
+            all = fmin(all, texel[d]);
+            if (!sw__fr_sliver(w[d], ub[2 * d + 1] - ub[2 * d]))
+                tol = fmin(tol, texel[d]);
+        }
     }
-    return tol;
+    return tol < INFINITY ? tol : all;
 }
 
 static sw_result draw_own_textures(hl_face *hf, sw__gpu_patch *pts, double sign, int on_gpu,
@@ -408,8 +415,11 @@ static trim_need face_need(const hl_face *hf, const sw__gpu_patch *pts)
         const hl_choice *c = &hf->chosen[i];
         if (!pts[i].visible)
             continue;
-        n.u = fmax(n.u, c->need.u * (ub[1] - ub[0]) / (c->rect[1] - c->rect[0]));
-        n.v = fmax(n.v, c->need.v * (ub[3] - ub[2]) / (c->rect[3] - c->rect[2]));
+        const double wu = c->rect[1] - c->rect[0], wv = c->rect[3] - c->rect[2];
+        if (!sw__fr_sliver(wu, ub[1] - ub[0])) /* a sliver's texel would ask 1e8 over the box */
+            n.u = fmax(n.u, c->need.u * (ub[1] - ub[0]) / wu);
+        if (!sw__fr_sliver(wv, ub[3] - ub[2]))
+            n.v = fmax(n.v, c->need.v * (ub[3] - ub[2]) / wv);
     }
     return n;
 }
@@ -427,16 +437,12 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
         sw__free(pts);
         return r;
     }
-    double cell[2] = {INFINITY, INFINITY};
-    for (size_t i = 0; i < hf->n_chosen; ++i) {
-        double c[2];
-        item_cell(&pts[i], c);
-        if (pts[i].visible) {
-            cell[0] = fmin(cell[0], c[0]);
-            cell[1] = fmin(cell[1], c[1]);
-        }
-    }
-    if (cell[0] < INFINITY) {
+    size_t visible = 0;
+    for (size_t i = 0; i < hf->n_chosen; ++i)
+        visible += (size_t)pts[i].visible;
+    if (visible > 0) {
+        double cell[2];
+        sw__fr_grid_cell(pts, hf->n_chosen, f->env->sv->faces[o->face].uv_box, cell);
         trim_need need = face_need(hf, pts);
         r = hf->trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)
                 ? draw_own_textures(hf, pts, sign, on_gpu, cell, status)

@@ -343,6 +343,8 @@ sw_result sw__gpu_border_loop_make(const sw_sg_surface *srf, const double *uv, s
                                    sw_status *status);
 void sw__gpu_border_loop_free(sw__gpu_border_loop *bl);
 size_t sw__gpu_border_loop_bytes(const sw__gpu_border_loop *bl);
+/* Its samples: at most max_samples whenever the loop's n <= max_samples / 2. */
+size_t sw__gpu_border_loop_samples(const sw__gpu_border_loop *bl);
 /* The most samples one ribbon may take in view v (a loop of n vertices). */
 size_t sw__gpu_border_budget(const sw__gpu_view *v, size_t n);
 /* The ribbon of a made loop (the same as sw__gpu_fat_border's with the make's arguments). */

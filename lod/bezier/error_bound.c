@@ -255,10 +255,15 @@ sw_result sw_lod_error_bound(int32_t dim, int32_t pa, int32_t qa, const double *
     difference_net(dim, pa, qa, ca, pb, qb, cb, wa, wb, tmp, e);
 
     search s = {dim, P, Q, e, work, 0.0, 0.0, d.rel_tol > 0.0 ? d.rel_tol : 0.02, 0.0, {hv, 0}, 0};
-    /* rounding: every coefficient is a convex combination of products (|.| <= (R + |c|) wA wB),
-     * a few ulps per step of the product and of each de Casteljau level, over W_k >= wmin^2 */
+    /* rounding, over W_k >= wmin^2: the translation rounds each coordinate once, by a few ulps
+     * of |c| w (2 |c| + R of each centred point, into each of D's two products: 8 |c|); every
+     * later coefficient is a convex combination of products of the centred nets
+     * (|.| <= R wA wB), a few ulps per step of the product and of each de Casteljau level. The
+     * distance from the origin is not multiplied by the steps: it made the allowance of a face
+     * 2e4 from the origin and 0.01 across 1e-9, more than the tolerance of a close view, and
+     * its hierarchy refined to the node cap. */
     const double cn = sqrt(f.c[0] * f.c[0] + f.c[1] * f.c[1] + f.c[2] * f.c[2]);
-    s.noise = 16.0 * DBL_EPSILON * (double)(P + Q + 2) * (f.radius + cn) * f.wratio;
+    s.noise = DBL_EPSILON * f.wratio * (16.0 * (double)(P + Q + 2) * f.radius + 8.0 * cn);
     double bound = run_search(&s, max_pieces);
     out->bound = isfinite(bound) ? bound + s.noise : INFINITY;
     out->found = s.found;

@@ -402,6 +402,16 @@ void check_poles(const Handle(Geom_BSplineSurface) & s, const std::string &what)
     }
 }
 
+/* The fewest poles OCCT's knot arrays can serve: degree + 1 on an open knot vector; on a periodic
+ * one, the period's flat knots (as many as its poles) must hold the degree + 1 - m knots that
+ * BSplCLib::KnotSequence copies from the neighbouring period on each side (m: the first knot's
+ * multiplicity). So 6 poles of degree 6 with a first knot of multiplicity 6 are a valid closed
+ * net (a face of OCCT's MODERN_Sink_1 holds one), 2 poles of degree 5 are not. */
+int poles_needed(int degree, bool periodic, int first_mult)
+{
+    return periodic ? degree + 1 - first_mult : degree + 1;
+}
+
 /* Too few poles for the degree, or knots beyond the scene's range (SW_SG_COORD_MAX) or not
  * finite: OCCT's B-spline constructors compare neighbouring knots only, so a NaN passes them, and
  * its span search then never ends. */
@@ -415,7 +425,9 @@ void check_knots(const Handle(Geom_BSplineSurface) & s, const std::string &what)
     for (int dir = 0; dir < 2; dir++) {
         const int poles = dir ? s->NbVPoles() : s->NbUPoles();
         const int degree = dir ? s->VDegree() : s->UDegree();
-        if (poles < degree + 1) {
+        const bool periodic = dir ? s->IsVPeriodic() : s->IsUPeriodic();
+        const int first_mult = dir ? s->VMultiplicity(1) : s->UMultiplicity(1);
+        if (poles < poles_needed(degree, periodic, first_mult)) {
             char buf[160];
             std::snprintf(buf, sizeof buf, ": %d control points in %c for degree %d", poles,
                           dir ? 'v' : 'u', degree);
@@ -473,7 +485,7 @@ void check_spline_curve(const Handle(Curve) & c, const char *of, const std::stri
     const Handle(Spline) bs = Handle(Spline)::DownCast(basis);
     if (bs.IsNull())
         return;
-    if (bs->NbPoles() < bs->Degree() + 1) /* as check_knots: OCCT reads past its arrays */
+    if (bs->NbPoles() < poles_needed(bs->Degree(), bs->IsPeriodic(), bs->Multiplicity(1)))
         throw face_error{what + ": " + of + " has fewer control points than its degree needs"};
     for (int i = 1; i <= bs->NbKnots(); i++) {
         const double k = bs->Knot(i);

@@ -15,7 +15,10 @@
 # (stage_trim.c) → screw and bottle at diagonal 0.01 fail (the ribbons of thin faces drawn
 # outside them: max 2.24 and 1.41 px); a fat border's inner point not kept in its loop's (u, v)
 # box (crack_fill.c box_exit) → Bottom at diagonal 10 fails (a sample on a degenerate edge stepped
-# 3e8 in u, onto the surface extrapolated: a spike of 276 px). Variants: the file itself; an IGES copy at its own size
+# 3e8 in u, onto the surface extrapolated: a spike of 276 px); knot spans of 1e-8 of the trim box
+# taken as a face's cell (stage_tessellate.c SLIVER_FRACTION 1e-9) → hammer at diagonal 0.01
+# fails (14 borders capped: bound exceeded), and widened by the capped count it ran out of memory.
+# Variants: the file itself; an IGES copy at its own size
 # (IGESControl_Writer: trims become B-spline pcurves); BREP copies uniformly scaled to bounding
 # diagonals of 0.01, 10 and 10,000 (a unit conversion: scaled_iges). Views: whole, mid, close.
 #  - full: every .brep under DATA/occ and .step under DATA/step (or the FILEs given), every
@@ -107,6 +110,7 @@ if [ "$mode" = quick ]; then
   one_model "$data/occ/bottle.brep" "iges" whole,mid
   one_model "$data/occ/bottle.brep" "d0.01" whole
   one_model "$data/occ/Bottom.brep" "d10" whole
+  one_model "$data/occ/hammer.brep" "d0.01" whole,close
   one_model "$data/occ/Pump_Nut.brep" "orig d10" whole,mid
   one_model "$data/occ/Motor-c.brep" "orig" whole
   one_model "$data/occ/shell1.brep" "d10000" whole

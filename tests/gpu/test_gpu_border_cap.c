@@ -6,7 +6,12 @@
  * above at 160 x 120. With cells of 1e-9 the loop asked for 10,000 x 4,096 = 4.1e7 samples
  * (~7 GB of samples and ribbon vertices). Planted fault (the budget check in
  * sw__gpu_fat_border removed): 1.6e8 ribbon vertices, and the vertex check fails (or the
- * allocation does). No GL needed. */
+ * allocation does). The loop's samples themselves are checked against the budget too, also with
+ * cells degenerate in one direction (1e-15 in v: a sliver knot span of a scaled IGES part gave
+ * 7e-16): every segment then asks for the per-segment cap of pieces, and a widening scaled by
+ * the capped count left 4.1e7 samples (planted: widening by m / budget in
+ * sw__gpu_border_loop_make: FAIL, 4.1e7 samples; the part itself ran out of memory). No GL
+ * needed. */
 #include "sw_gpu_internal.h"
 #include "test_check.h"
 
@@ -54,6 +59,23 @@ int main(void)
         CHECK(mesh.border_capped == (k == 1), "cells %g: border_capped %llu", cells[k],
               (unsigned long long)mesh.border_capped);
         sw__gpu_mesh_free(&mesh);
+    }
+    const double degenerate[3][2] = {{0.01, 0.01}, {1e-9, 1e-9}, {0.01, 1e-15}};
+    for (int k = 0; k < 3; ++k) {
+        sw__gpu_border_loop *bl = NULL;
+        sw_result r = sw__gpu_border_loop_make(&srf, uv, N_LOOP, 1, degenerate[k][0],
+                                               degenerate[k][1], 0, budget, &bl, &st);
+        CHECK(r == SW_OK, "cells %g x %g: %s", degenerate[k][0], degenerate[k][1], st.message);
+        if (r != SW_OK)
+            continue;
+        const size_t m = sw__gpu_border_loop_samples(bl);
+        printf("cells %g x %g: %zu samples (budget %zu)\n", degenerate[k][0], degenerate[k][1], m,
+               budget);
+        CHECK(m <= budget, "cells %g x %g: %zu samples over the budget %zu", degenerate[k][0],
+              degenerate[k][1], m, budget);
+        CHECK(m >= N_LOOP, "cells %g x %g: %zu samples for %d vertices", degenerate[k][0],
+              degenerate[k][1], m, N_LOOP);
+        sw__gpu_border_loop_free(bl);
     }
     free(uv);
     printf("%s\n", g_failures ? "FAILED" : "passed");

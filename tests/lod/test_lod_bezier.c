@@ -6,8 +6,10 @@
  *    reproduce the patch, products of Bernstein polynomials are pointwise products;
  *  - G1 reduction keeps the corners and both tangent directions at every corner (angle < 1e-9),
  *    keeps every weight positive, and reproduces a degree-elevated bicubic exactly;
- *  - the error bound: zero for equal nets, exact for a translated copy, and above the measured
- *    distance for the quarter circle whose paper-style ε_c (projected control points) is 0.
+ *  - the error bound: zero for equal nets, exact for a translated copy (also of a small part far
+ *    from the origin, whose rounding allowance must stay under a close view's tolerance), and
+ *    above the measured distance for the quarter circle whose paper-style ε_c (projected control
+ *    points) is 0.
  */
 #include "sw_lod_bezier.h"
 #include "sw_lod_error.h"
@@ -249,6 +251,35 @@ static void test_error_bound_examples(void **state)
     assert_true(er.bound >= measured && er.bound < 1.03 * measured);
 }
 
+/* A part 0.01 across, 2e4 from the origin (a scaled copy of a CAD part, about its box centre),
+ * against its copy moved by 1e-8: the bound must hold the distance and leave the tolerance of a
+ * close view (~1e-8 here) to the approximation. An allowance that multiplies the distance from
+ * the origin by the steps of the products and of de Casteljau (16 (P + Q + 2) ulps of 2e4 times
+ * the weights' spread: 2.5e-8, planted: FAIL) kept the part's hierarchy refining to its node cap
+ * (a close view of it took 36 s instead of 15 ms). */
+static void test_error_bound_far_from_origin(void **state)
+{
+    (void)state;
+    double a[36 * 4], b[36 * 4];
+    const double centre[3] = {-4281.1, 19153.5, 5738.6};
+    for (int32_t j = 0; j <= 5; ++j)
+        for (int32_t i = 0; i <= 5; ++i) {
+            double *p = a + (j * 6 + i) * 4, w = 0.5 + 1.5 * rnd();
+            const double x[3] = {0.002 * i, 0.002 * j, 0.001 * (2 * rnd() - 1)};
+            for (int c = 0; c < 3; ++c)
+                p[c] = w * (centre[c] + x[c]);
+            p[3] = w;
+        }
+    memcpy(b, a, sizeof b);
+    for (int k = 0; k < 36; ++k)
+        b[k * 4 + 2] = b[k * 4 + 3] * (a[k * 4 + 2] / a[k * 4 + 3] + 1e-8);
+    sw_lod_error_result er;
+    assert_int_equal(sw_lod_error_bound(4, 5, 5, a, 5, 5, b, NULL, &er, NULL), SW_OK);
+    print_message("part 2e4 from the origin moved by 1e-8: bound %.6g\n", er.bound);
+    assert_true(er.bound >= 1e-8 * (1.0 - 1e-3)); /* the move, up to the rounding of 2e4 + 1e-8 */
+    assert_true(er.bound < 1e-8 + 1e-9);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -258,6 +289,7 @@ int main(void)
         cmocka_unit_test(test_g1_reduction),
         cmocka_unit_test(test_reduction_of_elevated_cubic_is_exact),
         cmocka_unit_test(test_error_bound_examples),
+        cmocka_unit_test(test_error_bound_far_from_origin),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
