@@ -12,6 +12,7 @@
 #include <BRepBndLib.hxx>
 #include <BRepGProp.hxx>
 #include <BRepBuilderAPI_NurbsConvert.hxx>
+#include <BRepBuilderAPI_Transform.hxx>
 #include <BRepTools.hxx>
 #include <BRepTools_WireExplorer.hxx>
 #include <BRep_Builder.hxx>
@@ -589,10 +590,25 @@ void check_values(const TopoDS_Face &f, const Handle(Geom_Surface) & s, const st
     }
 }
 
+/* The face scaled by 2^scale_exp about the origin (its tolerances alike), or itself. */
+TopoDS_Face scaled_face(const TopoDS_Face &f, int scale_exp)
+{
+    if (scale_exp == 0)
+        return f;
+    gp_Trsf t;
+    t.SetScale(gp_Pnt(0.0, 0.0, 0.0), std::ldexp(1.0, scale_exp));
+    BRepBuilderAPI_Transform xf(f, t, Standard_True);
+    if (!xf.IsDone() || xf.Shape().IsNull() || xf.Shape().ShapeType() != TopAbs_FACE)
+        throw face_error{"the face could not be scaled for its conversion"};
+    return TopoDS::Face(xf.Shape());
+}
+
 /* Converts one face; throws face_error or Standard_Failure when it cannot. */
-face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what)
+face_data convert_face(const TopoDS_Face &source, TopoDS_Face &converted, const std::string &what,
+                       int scale_exp)
 {
     face_data fd;
+    const TopoDS_Face &f = source;
     fd.rec.kind = kind_of(BRepAdaptor_Surface(f, Standard_False).GetType());
     fd.rec.flags = f.Orientation() == TopAbs_REVERSED ? (uint32_t)SW_SG_FACE_REVERSED : 0u;
     fd.rec.tolerance = max_tolerance(f, TopAbs_EDGE);
@@ -608,10 +624,12 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     check_poles(Handle(Geom_BSplineSurface)::DownCast(raw), what);
     check_values(f, raw, what);
 
-    BRepBuilderAPI_NurbsConvert nc(f);
+    /* converted at a size where OCCT's absolute tolerances are small (import_scale_exp) */
+    const TopoDS_Face work = scaled_face(f, scale_exp);
+    BRepBuilderAPI_NurbsConvert nc(work);
     if (!nc.IsDone())
         throw face_error{"BRepBuilderAPI_NurbsConvert failed"};
-    TopoDS_Shape cs = nc.ModifiedShape(f);
+    TopoDS_Shape cs = nc.ModifiedShape(work);
     if (cs.IsNull() || cs.ShapeType() != TopAbs_FACE)
         throw face_error{"BRepBuilderAPI_NurbsConvert gave no face"};
     converted = TopoDS::Face(cs);
@@ -623,11 +641,18 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
                 fd.knots_v[fd.rec.n_v]};
 
     check_converted(converted, what);
-    wire_loops(f, converted, nc, fd);
-    const double tol3 = std::max(fd.rec.tolerance, max_tolerance(converted, TopAbs_VERTEX));
+    wire_loops(work, converted, nc, fd);
+    const double tol3 =
+        std::max(std::ldexp(fd.rec.tolerance, scale_exp), max_tolerance(converted, TopAbs_VERTEX));
     for (loop_data &ld : fd.loops) {
         shift_into_domain(ld, d, period);
         snap_loop(ld, s, d, tol3, what);
+    }
+    if (scale_exp != 0) { /* back to the file's size: a power of two, each pole exactly */
+        for (size_t i = 0; i < fd.cpw.size(); i += 4)
+            for (int c = 0; c < 3; c++)
+                fd.cpw[i + c] = std::ldexp(fd.cpw[i + c], -scale_exp);
+        converted = scaled_face(converted, -scale_exp);
     }
     if (fd.loops.empty()) { /* a face without wires is bounded by its surface's domain */
         loop_data ld;
@@ -652,6 +677,31 @@ face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::
     fd.rec.uv_box[2] = std::clamp(box[2], d.v0, d.v1),
     fd.rec.uv_box[3] = std::clamp(box[3], d.v0, d.v1);
     return fd;
+}
+
+int import_scale_exp(const TopoDS_Shape &shape)
+{
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    double largest = 0.0;
+    for (TopExp_Explorer ex(shape, TopAbs_VERTEX); ex.More(); ex.Next()) {
+        const gp_Pnt p = BRep_Tool::Pnt(TopoDS::Vertex(ex.Current()));
+        const double c[3] = {p.X(), p.Y(), p.Z()};
+        for (int k = 0; k < 3; k++) {
+            if (!std::isfinite(c[k]))
+                return 0; /* the faces' own checks say what is wrong */
+            lo[k] = std::min(lo[k], c[k]), hi[k] = std::max(hi[k], c[k]);
+            largest = std::max(largest, std::fabs(c[k]));
+        }
+    }
+    const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    if (!(diag > 0.0) || !(diag < 1.0))
+        return 0;
+    int e = 0;
+    std::frexp(diag, &e); /* diag in [2^(e-1), 2^e) */
+    int k = 7 - e;        /* diag 2^k in [64, 128) */
+    while (k > 0 && std::ldexp(largest, k) > 1e15)
+        k--;
+    return k;
 }
 
 /* ---- the scene's checks, face by face ---------------------------------------------------------

@@ -255,7 +255,7 @@ uint32_t importer::face_index(const TopoDS_Face &f)
     sw_result code = SW_OK;
     TopoDS_Face converted;
     try {
-        face_data fd = convert_face(f, converted, what);
+        face_data fd = convert_face(f, converted, what, scale_exp_);
         sw_status st{};
         if (validate_face(fd, what, &st) != SW_OK) {
             /* the message names the face already ("FILE: face N: ...") */
@@ -354,10 +354,12 @@ sw_result importer::convert(const TopoDS_Shape &shape, uint32_t parent, const do
             count_label_uses(l);
         }
         estimate_faces(all);
+        scale_exp_ = import_scale_exp(all);
     } else {
         std::unordered_set<const void *> seen;
         count_uses(shape, seen);
         estimate_faces(shape);
+        scale_exp_ = import_scale_exp(shape);
     }
     uint32_t top = node(xform ? SW_SG_NODE_TRANSFORM : SW_SG_NODE_GROUP, parent, 0, xform, nullptr,
                         name_.c_str());

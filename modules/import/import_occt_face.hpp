@@ -36,9 +36,16 @@ struct face_error {
 };
 
 /* The face as a NURBS surface with its loops (what = the face's name in messages); `converted` is
- * the face BRepBuilderAPI_NurbsConvert made. Throws face_error or Standard_Failure when it cannot.
- */
-face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what);
+ * the face BRepBuilderAPI_NurbsConvert made. The conversion runs on a copy scaled by 2^scale_exp
+ * (import_scale_exp) and the result is scaled back. Throws face_error or Standard_Failure when it
+ * cannot. */
+face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what,
+                       int scale_exp);
+/* The power of two by which a shape is scaled for its faces' conversion: OCCT converts with
+ * absolute tolerances (Precision::Confusion, 1e-7), so a part 0.01 across is converted to 1e-5 of
+ * its size. Nonzero when the vertices' box diagonal is below 1: it then brings it into
+ * [64, 128), unless the largest coordinate would pass 1e15. */
+int import_scale_exp(const TopoDS_Shape &shape);
 /* The scene's own checks of one face, before it is added (SW_ERR_INVALID_GEOMETRY and why). */
 sw_result validate_face(const face_data &fd, const std::string &what, sw_status *st);
 /* Exact repairs of a face the checks refuse (weights out of range rescaled by one power of two,

@@ -68,6 +68,7 @@ class importer
     sw__occt_face_observer *obs_;
     std::string path_, name_;
     std::string part_name_; /* the XCAF name of the part whose faces are being converted */
+    int scale_exp_ = 0;     /* faces converted scaled by 2^scale_exp_ (import_scale_exp) */
     sw_sg_import_report rep_{};
     uint32_t faces_estimate_ = 1;
 

@@ -17,7 +17,9 @@
 # box (crack_fill.c box_exit) → Bottom at diagonal 10 fails (a sample on a degenerate edge stepped
 # 3e8 in u, onto the surface extrapolated: a spike of 276 px); knot spans of 1e-8 of the trim box
 # taken as a face's cell (stage_tessellate.c SLIVER_FRACTION 1e-9) → hammer at diagonal 0.01
-# fails (14 borders capped: bound exceeded), and widened by the capped count it ran out of memory.
+# fails (14 borders capped: bound exceeded), and widened by the capped count it ran out of memory;
+# faces converted at the file's size (face_occt.cpp import_scale_exp returning 0) → Exhaust at
+# diagonal 0.01 fails (OCCT's 1e-7 tolerances: trims off by up to 74 px in the close view).
 # Variants: the file itself; an IGES copy at its own size
 # (IGESControl_Writer: trims become B-spline pcurves); BREP copies uniformly scaled to bounding
 # diagonals of 0.01, 10 and 10,000 (a unit conversion: scaled_iges). Views: whole, mid, close.
@@ -111,6 +113,7 @@ if [ "$mode" = quick ]; then
   one_model "$data/occ/bottle.brep" "d0.01" whole
   one_model "$data/occ/Bottom.brep" "d10" whole
   one_model "$data/occ/hammer.brep" "d0.01" whole,close
+  one_model "$data/occ/MODERN_Exhaust_1.brep" "d0.01" close
   one_model "$data/occ/Pump_Nut.brep" "orig d10" whole,mid
   one_model "$data/occ/Motor-c.brep" "orig" whole
   one_model "$data/occ/shell1.brep" "d10000" whole
