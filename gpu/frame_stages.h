@@ -372,8 +372,9 @@ sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *
 /* 1 when a part `extent` wide is a sliver of a face box `box_extent` wide (stage_tessellate.c). */
 int sw__fr_sliver(double extent, double box_extent);
 /* Smallest cell of the visible grids pt[0..n) of a face with trim box ub, in face parameters,
- * slivers skipped (the box's extent where only slivers are visible): its borders' sampling. */
-void sw__fr_grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2]);
+ * slivers skipped (the box's extent where only slivers are visible): its borders' sampling.
+ * Returns how many of pt are visible. */
+size_t sw__fr_grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2]);
 /* The fat borders along every loop of a flattened entry. */
 sw_result sw__fr_loop_borders(sw__fr_tess *t, const occurrence *o, int64_t loops,
                               const double cell[2], sw_status *status);

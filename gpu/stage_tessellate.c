@@ -411,12 +411,14 @@ int sw__fr_sliver(double extent, double box_extent)
     return !(extent > SLIVER_FRACTION * box_extent);
 }
 
-void sw__fr_grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2])
+size_t sw__fr_grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], double cell[2])
 {
+    size_t visible = 0;
     cell[0] = cell[1] = INFINITY;
     for (size_t p = 0; p < n; ++p) {
         if (!pt[p].visible)
             continue;
+        ++visible;
         double wu = (pt[p].u1 - pt[p].u0) * (pt[p].s1 - pt[p].s0);
         double wv = (pt[p].v1 - pt[p].v0) * (pt[p].t1 - pt[p].t0);
         if (!sw__fr_sliver(wu, ub[1] - ub[0]))
@@ -428,6 +430,7 @@ void sw__fr_grid_cell(const sw__gpu_patch *pt, size_t n, const double ub[4], dou
         cell[0] = fmin(cell[0], ub[1] - ub[0]);
         cell[1] = fmin(cell[1], ub[3] - ub[2]);
     }
+    return visible;
 }
 
 sw_result sw__fr_face_loops(sw__fr_tess *t, uint32_t face, double tol, int64_t *index,

@@ -437,12 +437,8 @@ static sw_result draw_chosen(hl_face *hf, sw_status *status)
         sw__free(pts);
         return r;
     }
-    size_t visible = 0;
-    for (size_t i = 0; i < hf->n_chosen; ++i)
-        visible += (size_t)pts[i].visible;
-    if (visible > 0) {
-        double cell[2];
-        sw__fr_grid_cell(pts, hf->n_chosen, f->env->sv->faces[o->face].uv_box, cell);
+    double cell[2];
+    if (sw__fr_grid_cell(pts, hf->n_chosen, f->env->sv->faces[o->face].uv_box, cell) > 0) {
         trim_need need = face_need(hf, pts);
         r = hf->trimmed && (need.u > k_tile_texels || need.v > k_tile_texels)
                 ? draw_own_textures(hf, pts, sign, on_gpu, cell, status)

@@ -590,7 +590,6 @@ void check_values(const TopoDS_Face &f, const Handle(Geom_Surface) & s, const st
     }
 }
 
-/* The face scaled by 2^scale_exp about the origin (its tolerances alike), or itself. */
 TopoDS_Face scaled_face(const TopoDS_Face &f, int scale_exp)
 {
     if (scale_exp == 0)
@@ -604,11 +603,10 @@ TopoDS_Face scaled_face(const TopoDS_Face &f, int scale_exp)
 }
 
 /* Converts one face; throws face_error or Standard_Failure when it cannot. */
-face_data convert_face(const TopoDS_Face &source, TopoDS_Face &converted, const std::string &what,
+face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what,
                        int scale_exp)
 {
     face_data fd;
-    const TopoDS_Face &f = source;
     fd.rec.kind = kind_of(BRepAdaptor_Surface(f, Standard_False).GetType());
     fd.rec.flags = f.Orientation() == TopAbs_REVERSED ? (uint32_t)SW_SG_FACE_REVERSED : 0u;
     fd.rec.tolerance = max_tolerance(f, TopAbs_EDGE);
@@ -648,12 +646,10 @@ face_data convert_face(const TopoDS_Face &source, TopoDS_Face &converted, const 
         shift_into_domain(ld, d, period);
         snap_loop(ld, s, d, tol3, what);
     }
-    if (scale_exp != 0) { /* back to the file's size: a power of two, each pole exactly */
-        for (size_t i = 0; i < fd.cpw.size(); i += 4)
-            for (int c = 0; c < 3; c++)
-                fd.cpw[i + c] = std::ldexp(fd.cpw[i + c], -scale_exp);
-        converted = scaled_face(converted, -scale_exp);
-    }
+    /* back to the file's size: a power of two, each pole exactly */
+    for (size_t i = 0; scale_exp != 0 && i < fd.cpw.size(); i += 4)
+        for (int c = 0; c < 3; c++)
+            fd.cpw[i + c] = std::ldexp(fd.cpw[i + c], -scale_exp);
     if (fd.loops.empty()) { /* a face without wires is bounded by its surface's domain */
         loop_data ld;
         ld.flags = SW_SG_LOOP_OUTER;

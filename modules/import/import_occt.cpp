@@ -256,6 +256,8 @@ uint32_t importer::face_index(const TopoDS_Face &f)
     TopoDS_Face converted;
     try {
         face_data fd = convert_face(f, converted, what, scale_exp_);
+        if (obs_) /* the observer sees it at the file's size, as the scene's face */
+            converted = scaled_face(converted, -scale_exp_);
         sw_status st{};
         if (validate_face(fd, what, &st) != SW_OK) {
             /* the message names the face already ("FILE: face N: ...") */

@@ -35,12 +35,14 @@ struct face_error {
     sw_result code = SW_ERR_INVALID_GEOMETRY;
 };
 
-/* The face as a NURBS surface with its loops (what = the face's name in messages); `converted` is
- * the face BRepBuilderAPI_NurbsConvert made. The conversion runs on a copy scaled by 2^scale_exp
- * (import_scale_exp) and the result is scaled back. Throws face_error or Standard_Failure when it
- * cannot. */
+/* The face as a NURBS surface with its loops (what = the face's name in messages). The conversion
+ * runs on a copy scaled by 2^scale_exp (import_scale_exp) and the poles are scaled back;
+ * `converted` is the face BRepBuilderAPI_NurbsConvert made, at the scaled size. Throws face_error
+ * or Standard_Failure when it cannot. */
 face_data convert_face(const TopoDS_Face &f, TopoDS_Face &converted, const std::string &what,
                        int scale_exp);
+/* The face scaled by 2^scale_exp about the origin (its tolerances alike), or itself. */
+TopoDS_Face scaled_face(const TopoDS_Face &f, int scale_exp);
 /* The power of two by which a shape is scaled for its faces' conversion: OCCT converts with
  * absolute tolerances (Precision::Confusion, 1e-7), so a part 0.01 across is converted to 1e-5 of
  * its size. Nonzero when the vertices' box diagonal is below 1: it then brings it into

@@ -256,12 +256,10 @@ bool make_views(model_ctx &m, std::vector<view> &views)
     sw_gpu_image img{};
     if (!render_mesh(m.gpu, m.coarse, frame_desc(iso, m.w, m.h), img))
         return false;
-    std::vector<uint8_t> covered((size_t)m.w * m.h), edges;
-    for (size_t i = 0; i < covered.size(); ++i)
-        covered[i] = std::isfinite(img.depth[i]);
-    edges = sw_test::edge_pixels(img.depth, m.w, m.h, sw_test::edge_params{});
-    long c = nearest_to_centre(covered, m.w, m.h), e = nearest_to_centre(edges, m.w, m.h);
-    bool ok = c >= 0 && e >= 0;
+    const std::vector<uint8_t> edges =
+        sw_test::edge_pixels(img.depth, m.w, m.h, sw_test::edge_params{});
+    const long e = nearest_to_centre(edges, m.w, m.h); /* none: nothing covered either */
+    bool ok = e >= 0;
     if (ok) {
         vec3 q = nearest_vertex(m.coarse, unproject(b, m.w, m.h, (int)(e % m.w), (int)(e / m.w),
                                                     img.depth[e]));
