@@ -3,10 +3,10 @@
  * borders of Balázs et al. 2004). Core-profile GL has no wide lines, so each boundary loop of a
  * drawn face (its trim loops, or its parameter box when untrimmed) becomes a ribbon of triangles:
  * the loop is sampled on the exact surface (NURBS evaluation in double), and every sample is
- * joined to a point of the face inside it, so far that its image lies width_px pixels from the
- * loop's image. The ribbon covers the face's own side of its exact border and reaches beyond it
- * only by k_outer x width_px: silhouettes and open boundaries grow by a fraction of a pixel, not
- * by the ribbon's width.
+ * joined to a point of the face inside it whose image lies width_px pixels across the loop's
+ * image, and to a point k_outer x width_px beyond it. The ribbon covers the face's own side of
+ * its exact border: silhouettes and open boundaries grow by a fraction of a pixel, not by the
+ * ribbon's width.
  * Why it closes the cracks: where faces A and B meet along a curve C, each is drawn within ε_img
  * of the exact surface, so an uncovered pixel between them lies on A's or B's side of C's image
  * within ε_img of it, and that face's ribbon covers its side of C to width_px = 2 ε_img; the
@@ -15,27 +15,31 @@
  * are flattened to half a trim texel, one texel moving the surface by at most the object
  * tolerance; samples are dropped only where the kept chord stays within width_px / 4 of them on
  * screen). Not rigorous between samples (the surface is not bounded there). A sliver k_outer x
- * width_px wide beyond C makes two ribbons meeting exactly on C overlap, so that no pixel centre
- * on C falls between them by rounding (without it, single-pixel holes remain at joins), and
- * closes gaps of the model itself up to 2 k_outer width_px = 0.5 px wide: faces of a B-rep meet
- * only within their edges' tolerances (linkrods.step: two B-spline faces 4.2e-4 apart, 0.36 px at
- * its mid view, left a crack pixel with a sliver of width_px / 8; a wider one grows silhouettes,
- * and at width_px / 2 Motor-c's whole view had 99.87 % of its edge pixels within 1 px).
+ * width_px wide beyond the chords makes two ribbons meeting on C overlap, so that no pixel centre
+ * on C falls between their chords (without it, single-pixel holes remain at joins; two faces
+ * sampled at different steps along one curve leave chords up to width_px / 4 apart), and closes
+ * gaps of the model itself up to 2 k_outer width_px = 0.5 px wide: faces of a B-rep meet only
+ * within their edges' tolerances (linkrods.step: two B-spline faces 4.2e-4 apart, 0.36 px at its
+ * mid view, left a crack pixel with a sliver of width_px / 8; a wider one grows silhouettes, and
+ * at width_px / 2 Motor-c's whole view had 99.87 % of its edge pixels within 1 px). The sliver
+ * lies at its sample's depth, across the loop's image (outer_point).
  * Ribbons are pushed back along their eye rays (images unchanged) by k_push x width_px pixels'
  * worth of their depth slope, so that they show only where no surface is drawn within that
  * depth: a ribbon lies on exact points, up to width_px / 4 from the chords the face is drawn by,
- * and its sliver on the tangent plane; in front of a neighbour drawn up to ε_img behind the exact
+ * and its sliver beyond the loop; in front of a neighbour drawn up to ε_img behind the exact
  * surface it made a dent that read as a depth edge at a grazing view (linkrods close-up through
  * the hierarchy: a 0.3 px dent, 0.6 % of splinewalk's edge pixels farther than 1 px from the
  * reference's). k_push x width_px = ε_img + width_px / 4 covers both.
- * The inner point: the step in (u, v) perpendicular to the loop whose tangent-plane image is
- * width_px pixels from the loop's image (first order), then
+ * The inner point: the step in (u, v) into the face whose image runs across the loop's image
+ * (across_loop) and lies width_px pixels from it (first order, inward_length), then
  *  - cut where the step leaves the face across its own loop (a ray cast in (u, v); none at a
  *    corner it leaves at once): at an acute corner or across a face narrower than the step, the
  *    ribbon would otherwise cover what lies beyond the face (a silhouette grew by up to 1.4 px);
  *  - evaluated on the surface, and halved while the surface bulges more than width_px / 4 on
- *    screen from the chord to it: a face seen edge-on needs a long step (capped at 4 x width_px
- *    in object size), which on a curved face leaves the surface (fins of a motor: 1 px and more).
+ *    screen from the chord to it, or its image lands over 2 x width_px from the loop's: a face
+ *    seen at a grazing angle needs a long step (not capped: Ball's inner race, foreshortened 30
+ *    times at its mid view, had ribbons 0.13 px wide under a cap of 4 x width_px in object size,
+ *    and pinholes), which on a curved face leaves the surface (fins of a motor: 1 px and more).
  * An affine face (sw_sg_surface_affine: a plane, the most common face of a CAD model) is exact
  * along any straight (u, v) segment and any grid, so its ribbon takes the loop's vertices only and
  * its inner points by the straight step, with no evaluation in between; the cut at the loop and
@@ -54,7 +58,7 @@
 #include <string.h>
 
 enum { MAX_PIECES_PER_SEGMENT = 4096 };
-static const double k_outer = 0.25; /* of the width: overlap on the far side (see above) */
+static const double k_outer = 0.25; /* of the width: overlap beyond the loop (see above) */
 static const double k_push = 0.375; /* of the width: depth push-back in pixels' worth of slope */
 
 typedef struct border_point {
@@ -170,6 +174,12 @@ static int screen_of(const sw__gpu_view *v, const double p[3], double out[2])
     return 1;
 }
 
+/* Depth of an eye-relative point along the view direction. */
+static double depth_of(const sw__gpu_view *v, const double p[3])
+{
+    return v->fwd[0] * p[0] + v->fwd[1] * p[1] + v->fwd[2] * p[2];
+}
+
 /* A segment from a to b on screen, its direction and squared length made once for the many
  * samples tested against it. */
 typedef struct screen_chord {
@@ -247,8 +257,9 @@ static void screen_deriv(const sw__gpu_view *v, const double p[3], const double 
 }
 
 /* Object-space length along the inward tangent `in` whose image moves width_px pixels away from
- * the loop's image (perpendicular to its screen tangent), capped at 4 x the screen-facing length
- * where the face is seen edge-on; 0 where the loop's image degenerates. */
+ * the loop's image (perpendicular to its screen tangent, first order); infinite where the face is
+ * seen exactly edge-on (inner_point cuts it at the loop's box and halves it), 0 where the loop's
+ * image degenerates. Not capped (see the inner point above). */
 static double inward_length(const sw__gpu_view *v, const double p[3], const double t[3],
                             const double in[3], double width_px)
 {
@@ -263,8 +274,7 @@ static double inward_length(const sw__gpu_view *v, const double p[3], const doub
     if (!(tl > 0.0))
         return 0.0;
     double perp = fabs(is[0] * ts[1] - is[1] * ts[0]) / tl; /* pixels per unit of `in` */
-    double cap = 4.0 * width_px * z / (v->focal_px * li);
-    return perp > width_px / cap ? width_px / perp : cap;
+    return perp > 0.0 ? width_px / perp : INFINITY;
 }
 
 /* ---- the loop's segments in a uniform grid over its (u, v) box, for ray casts ---------------- */
@@ -479,10 +489,42 @@ static void eval_point_affine(const ribbon_ctx *c, double u, double v, const dou
     }
 }
 
+/* The loop's image at a sample: its screen position and the unit direction of the quad's chord
+ * on screen (ok = 0 where either is behind the near plane or the chord's image is a point). */
+typedef struct loop_image {
+    int ok;
+    double at[2], dir[2];
+} loop_image;
+
+static loop_image loop_image_of(const sw__gpu_view *v, const border_point *e,
+                                const border_point *other)
+{
+    loop_image li = {0, {0.0, 0.0}, {0.0, 0.0}};
+    double to[2];
+    if (!screen_of(v, e->p, li.at) || !screen_of(v, other->p, to))
+        return li;
+    const double dx = to[0] - li.at[0], dy = to[1] - li.at[1], l = screen_length(dx, dy);
+    li.ok = l > 0.0 && l < INFINITY;
+    if (li.ok) {
+        li.dir[0] = dx / l;
+        li.dir[1] = dy / l;
+    }
+    return li;
+}
+
+/* Whether the image sq lies within `most` pixels of the loop sample's image (or that is
+ * unknown): first order fails where the surface turns towards or away from the eye along the step
+ * (a fold near a silhouette); a step whose image lands farther is halved. */
+static int within_reach(const loop_image *li, const double sq[2], double most)
+{
+    return !li->ok || screen_length(sq[0] - li->at[0], sq[1] - li->at[1]) <= most;
+}
+
 /* The inner point on an affine surface: exact along the step, so no bulge to halve for; halved
- * only while it or the chord's middle is behind the near plane, as for curved ones. */
-static double inner_point_affine(const ribbon_ctx *c, const border_point *e, const double r_uv[2],
-                                 double s, double out[3])
+ * while it or the chord's middle is behind the near plane, or its image lands more than 2 x
+ * width_px from the loop's (within_reach), as for curved ones. */
+static double inner_point_affine(const ribbon_ctx *c, const border_point *e, const loop_image *li,
+                                 const double r_uv[2], double s, double out[3])
 {
     enum { MAX_HALVINGS = 12 };
     for (int k = 0; k < MAX_HALVINGS; ++k, s *= 0.5) {
@@ -491,7 +533,8 @@ static double inner_point_affine(const ribbon_ctx *c, const border_point *e, con
             q[i] = e->p[i] + s * (c->su[i] * r_uv[0] + c->sv[i] * r_uv[1]);
             m[i] = 0.5 * (e->p[i] + q[i]);
         }
-        if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm)) {
+        if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm) &&
+            within_reach(li, sq, 2.0 * c->width_px)) {
             memcpy(out, q, sizeof q);
             return s;
         }
@@ -500,10 +543,11 @@ static double inner_point_affine(const ribbon_ctx *c, const border_point *e, con
 }
 
 /* The inner point of sample e for the step direction r_uv (first-order length h along r_uv):
- * cut at the loop, on the surface, halved while the surface bulges from the chord to it.
- * Returns the step taken along r_uv (0: the inner point is e itself). */
-static double inner_point(const ribbon_ctx *c, const border_point *e, const double r_uv[2],
-                          double h, double out[3])
+ * cut at the loop, on the surface, halved while the surface bulges from the chord to it or its
+ * image lands more than 2 x width_px from the loop's (within_reach). Returns the step taken along
+ * r_uv (0: the inner point is e itself). */
+static double inner_point(const ribbon_ctx *c, const border_point *e, const loop_image *li,
+                          const double r_uv[2], double h, double out[3])
 {
     enum { MAX_HALVINGS = 12 };
     memcpy(out, e->p, 3 * sizeof *out);
@@ -512,7 +556,7 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const doub
     double s = ray_exit(c->grid, e->uv, r_uv, box_exit(c->grid, e->uv, r_uv, h));
     const double tol = 0.25 * c->width_px;
     if (c->affine)
-        return inner_point_affine(c, e, r_uv, s, out);
+        return inner_point_affine(c, e, li, r_uv, s, out);
     for (int k = 0; k < MAX_HALVINGS; ++k, s *= 0.5) {
         double uq[2] = {e->uv[0] + s * r_uv[0], e->uv[1] + s * r_uv[1]};
         double um[2] = {e->uv[0] + 0.5 * s * r_uv[0], e->uv[1] + 0.5 * s * r_uv[1]};
@@ -522,12 +566,63 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const doub
         for (int i = 0; i < 3; ++i)
             chord[i] = 0.5 * (e->p[i] + q[i]);
         if (screen_of(c->v, q, sq) && screen_of(c->v, m, sm) && screen_of(c->v, chord, sc) &&
-            screen_length(sm[0] - sc[0], sm[1] - sc[1]) <= tol) {
+            screen_length(sm[0] - sc[0], sm[1] - sc[1]) <= tol &&
+            within_reach(li, sq, 2.0 * c->width_px)) {
             memcpy(out, q, sizeof q);
             return s;
         }
     }
     return 0.0;
+}
+
+/* The ribbon's direction into the face: the tangent vector `in` (its step in_uv in (u, v)) less
+ * its part along the loop (the chord t, t_uv), so that its image runs across the loop's image
+ * (first order). Where the surface's parameters are sheared on screen, `in`'s image runs nearly
+ * along the loop: a step along it reached across by a fraction of a pixel (the old 4 x width_px
+ * cap), or, uncapped, by width_px only after tens of pixels along the loop, a sliver quad whose
+ * depths stood in front of the face (linkrods' close view: 38 depth-edge pixels of its own). */
+static void across_loop(const sw__gpu_view *v, const double p[3], const double t[3],
+                        const double t_uv[2], const double in[3], const double in_uv[2],
+                        double dir[3], double dir_uv[2])
+{
+    double ts[2], is[2];
+    screen_deriv(v, p, t, ts);
+    screen_deriv(v, p, in, is);
+    const double tt = ts[0] * ts[0] + ts[1] * ts[1];
+    const double beta = tt > 0.0 && tt < INFINITY ? (is[0] * ts[0] + is[1] * ts[1]) / tt : 0.0;
+    for (int k = 0; k < 3; ++k)
+        dir[k] = in[k] - beta * t[k];
+    dir_uv[0] = in_uv[0] - beta * t_uv[0];
+    dir_uv[1] = in_uv[1] - beta * t_uv[1];
+}
+
+/* The outer point of sample e: k_outer x width_px beyond the loop's image, across it, at the
+ * sample's depth (pushed back with the quad). Not in the tangent plane: at a grazing view a point
+ * k_outer x width_px across the loop lies far along the tangent plane, which leaves a curved
+ * surface and stands in front of a neighbour face at a crease; capped in object space it lay a
+ * fraction of a pixel across, and between faces meeting along one curve, sampled at different
+ * steps, pixel centres fell between the two ribbons' chords (Ball's mid view: 0.17 px apart, 3
+ * pinholes). Returns its step along -dir to first order, for the trim lookup's (u, v); the sample
+ * itself (0) where the loop's image or dir's is degenerate. */
+static double outer_point(const ribbon_ctx *c, const border_point *e, const loop_image *li,
+                          const double dir[3], double h, double out[3])
+{
+    memcpy(out, e->p, 3 * sizeof *out);
+    double is[2];
+    screen_deriv(c->v, e->p, dir, is);
+    double nx = -li->dir[1], ny = li->dir[0], side = nx * is[0] + ny * is[1];
+    if (!li->ok || !(fabs(side) > 0.0))
+        return 0.0;
+    if (side > 0.0) { /* (nx, ny) points into the face: the outer point lies the other way */
+        nx = -nx;
+        ny = -ny;
+    }
+    const double z = depth_of(c->v, e->p);
+    const double x = (li->at[0] + k_outer * c->width_px * nx) / c->v->focal_px;
+    const double y = (li->at[1] + k_outer * c->width_px * ny) / c->v->focal_px;
+    for (int k = 0; k < 3; ++k)
+        out[k] = z * (c->v->fwd[k] + x * c->v->right[k] + y * c->v->up[k]);
+    return h < INFINITY ? -k_outer * h : 0.0;
 }
 
 /* Depth change per pixel from eye-relative a to b on screen (0 when either is behind the eye or
@@ -554,31 +649,31 @@ static void push_back(const ribbon_ctx *c, const border_point *const e[2], doubl
     double dz = k_push * c->width_px * slope;
     for (int end = 0; end < 2; ++end)
         for (int side = 0; side < 2; ++side) {
-            double *p = q[end][side],
-                   z = c->v->fwd[0] * p[0] + c->v->fwd[1] * p[1] + c->v->fwd[2] * p[2];
+            double *p = q[end][side], z = depth_of(c->v, p);
             double s = z > 0.0 ? 1.0 + dz / z : 1.0;
             for (int k = 0; k < 3; ++k)
                 p[k] *= s;
         }
 }
 
-/* One quad per loop segment, from k_outer x width_px outside the loop (in the tangent plane) to
- * the inner points, pushed back (push_back). Quads of consecutive segments share their points on
- * the loop on screen; their inner edges are not joined, which keeps a sharp corner of the loop
- * from folding a quad across it. */
+/* One quad per loop segment, from k_outer x width_px outside the loop (outer_point) to the inner
+ * points, across the loop's image (across_loop), pushed back (push_back). Quads of consecutive
+ * segments share their points on the loop on screen; their inner edges are not joined, which
+ * keeps a sharp corner of the loop from folding a quad across it. */
 static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, sw__gpu_mesh *mesh)
 {
     for (size_t i = 0; i < n; ++i) {
         const border_point *e[2] = {&bp[i], &bp[(i + 1) % n]};
-        const double *in = e[0]->in;
         double t[3] = {e[1]->p[0] - e[0]->p[0], e[1]->p[1] - e[0]->p[1], e[1]->p[2] - e[0]->p[2]};
-        double q[2][2][3], step[2][2];
+        const double t_uv[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
+        double q[2][2][3], step[2][2], dir_uv[2][2];
         for (int end = 0; end < 2; ++end) {
-            double h = inward_length(c->v, e[end]->p, t, in, c->width_px);
-            step[end][0] = -k_outer * h;
-            for (int k = 0; k < 3; ++k)
-                q[end][0][k] = e[end]->p[k] + step[end][0] * in[k];
-            step[end][1] = inner_point(c, e[end], e[0]->in_uv, h, q[end][1]);
+            const loop_image li = loop_image_of(c->v, e[end], e[1 - end]);
+            double dir[3];
+            across_loop(c->v, e[end]->p, t, t_uv, e[0]->in, e[0]->in_uv, dir, dir_uv[end]);
+            const double h = inward_length(c->v, e[end]->p, t, dir, c->width_px);
+            step[end][1] = inner_point(c, e[end], &li, dir_uv[end], h, q[end][1]);
+            step[end][0] = outer_point(c, e[end], &li, dir, h, q[end][0]);
         }
         push_back(c, e, q);
         uint32_t base = (uint32_t)mesh->n_v;
@@ -591,10 +686,10 @@ static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, s
                 }
                 o->st[0] = o->st[1] = 0.0f;
                 if (c->st_box) { /* inner point: its exact (u, v); outer: to first order */
-                    const double *b = c->st_box;
+                    const double *b = c->st_box, *d = dir_uv[end];
                     double s = step[end][side];
-                    o->st[0] = (float)((e[end]->uv[0] + s * e[0]->in_uv[0] - b[0]) / (b[1] - b[0]));
-                    o->st[1] = (float)((e[end]->uv[1] + s * e[0]->in_uv[1] - b[2]) / (b[3] - b[2]));
+                    o->st[0] = (float)((e[end]->uv[0] + s * d[0] - b[0]) / (b[1] - b[0]));
+                    o->st[1] = (float)((e[end]->uv[1] + s * d[1] - b[2]) / (b[3] - b[2]));
                 }
             }
         }

@@ -24,7 +24,8 @@
 # (IGESControl_Writer: trims become B-spline pcurves); BREP copies uniformly scaled to bounding
 # diagonals of 0.01, 10 and 10,000 (a unit conversion: scaled_iges). Views: whole, mid, close.
 #  - full: every .brep under DATA/occ and .step under DATA/step (or the FILEs given), every
-#    variant and view (`make conformance`: about two hours on 2 cores);
+#    variant and view (`make conformance`: about 40 minutes on 2 cores), or those named in
+#    CONF_VARIANTS (say "orig iges") and CONF_VIEWS (say "mid,close");
 #  - quick: a subset that must pass in `make test` (under 5 minutes).
 # A file without faces (wires only) is reported as skipped; a case whose reference or frame
 # takes over 180 s as "timeout", a view whose camera shows no reference face or no edge (a mid
@@ -121,7 +122,7 @@ else
   files=("$@")
   [ ${#files[@]} -gt 0 ] || files=("$data"/occ/*.brep "$data"/step/*.step)
   for f in "${files[@]}"; do
-    one_model "$f" "orig iges d0.01 d10 d10000" whole,mid,close
+    one_model "$f" "${CONF_VARIANTS:-orig iges d0.01 d10 d10000}" "${CONF_VIEWS:-whole,mid,close}"
   done
 fi
 pass=$(grep -c '^ok' cases.txt)
