@@ -31,7 +31,7 @@
  * the hierarchy: a 0.3 px dent, 0.6 % of splinewalk's edge pixels farther than 1 px from the
  * reference's). k_push x width_px = ε_img + width_px / 4 covers both.
  * The inner point: the step in (u, v) into the face whose image runs across the loop's image
- * (across_loop) and lies width_px pixels from it (first order, inward_length), then
+ * and lies width_px pixels from it (first order, across_loop), then
  *  - cut where the step leaves the face across its own loop (a ray cast in (u, v); none at a
  *    corner it leaves at once): at an acute corner or across a face narrower than the step, the
  *    ribbon would otherwise cover what lies beyond the face (a silhouette grew by up to 1.4 px);
@@ -96,7 +96,7 @@ static void eval_sample(const sw_sg_surface *srf, double u, double v, const doub
     out->n[1] = du[2] * dv[0] - du[0] * dv[2];
     out->n[2] = du[0] * dv[1] - du[1] * dv[0];
     /* du, dv are w^2 S_u, w^2 S_v; `in` is the true derivative along in_uv, so that a length h
-     * along `in` (inward_length) is the step h along in_uv in (u, v) that inner_point takes */
+     * along `in` (across_loop) is the step h along in_uv in (u, v) that inner_point takes */
     const double w2 = h[3] * h[3];
     for (int k = 0; k < 3; ++k)
         out->in[k] = (du[k] * in_uv[0] + dv[k] * in_uv[1]) / w2;
@@ -254,27 +254,6 @@ static void screen_deriv(const sw__gpu_view *v, const double p[3], const double 
     }
     out[0] = v->focal_px * (wr * z - r * wz) / (z * z);
     out[1] = v->focal_px * (wu * z - u * wz) / (z * z);
-}
-
-/* Object-space length along the inward tangent `in` whose image moves width_px pixels away from
- * the loop's image (perpendicular to its screen tangent, first order); infinite where the face is
- * seen exactly edge-on (inner_point cuts it at the loop's box and halves it), 0 where the loop's
- * image degenerates. Not capped (see the inner point above). */
-static double inward_length(const sw__gpu_view *v, const double p[3], const double t[3],
-                            const double in[3], double width_px)
-{
-    double z = v->fwd[0] * p[0] + v->fwd[1] * p[1] + v->fwd[2] * p[2];
-    double li = sqrt(in[0] * in[0] + in[1] * in[1] + in[2] * in[2]);
-    if (!(z > 0.0) || !(li > 0.0))
-        return 0.0;
-    double ts[2], is[2];
-    screen_deriv(v, p, t, ts);
-    screen_deriv(v, p, in, is);
-    double tl = screen_length(ts[0], ts[1]);
-    if (!(tl > 0.0))
-        return 0.0;
-    double perp = fabs(is[0] * ts[1] - is[1] * ts[0]) / tl; /* pixels per unit of `in` */
-    return perp > 0.0 ? width_px / perp : INFINITY;
 }
 
 /* ---- the loop's segments in a uniform grid over its (u, v) box, for ray casts ---------------- */
@@ -496,14 +475,13 @@ typedef struct loop_image {
     double at[2], dir[2];
 } loop_image;
 
-static loop_image loop_image_of(const sw__gpu_view *v, const border_point *e,
-                                const border_point *other)
+static loop_image loop_image_of(const border_point *e, const border_point *other)
 {
-    loop_image li = {0, {0.0, 0.0}, {0.0, 0.0}};
-    double to[2];
-    if (!screen_of(v, e->p, li.at) || !screen_of(v, other->p, to))
+    loop_image li = {0, {e->scr[0], e->scr[1]}, {0.0, 0.0}};
+    if (!e->in_front || !other->in_front) /* screen positions from thin_samples */
         return li;
-    const double dx = to[0] - li.at[0], dy = to[1] - li.at[1], l = screen_length(dx, dy);
+    const double dx = other->scr[0] - li.at[0], dy = other->scr[1] - li.at[1];
+    const double l = screen_length(dx, dy);
     li.ok = l > 0.0 && l < INFINITY;
     if (li.ok) {
         li.dir[0] = dx / l;
@@ -575,25 +553,44 @@ static double inner_point(const ribbon_ctx *c, const border_point *e, const loop
     return 0.0;
 }
 
-/* The ribbon's direction into the face: the tangent vector `in` (its step in_uv in (u, v)) less
- * its part along the loop (the chord t, t_uv), so that its image runs across the loop's image
- * (first order). Where the surface's parameters are sheared on screen, `in`'s image runs nearly
- * along the loop: a step along it reached across by a fraction of a pixel (the old 4 x width_px
- * cap), or, uncapped, by width_px only after tens of pixels along the loop, a sliver quad whose
- * depths stood in front of the face (linkrods' close view: 38 depth-edge pixels of its own). */
-static void across_loop(const sw__gpu_view *v, const double p[3], const double t[3],
-                        const double t_uv[2], const double in[3], const double in_uv[2],
-                        double dir[3], double dir_uv[2])
+/* The ribbon's step into the face at one end of a quad. */
+typedef struct across_step {
+    double dir[3], dir_uv[2]; /* `in` less its part along the loop, world and (u, v) */
+    double img[2];            /* dir's image per unit of it: across the loop's image */
+    double h;                 /* the length along dir whose image is width_px (first order):
+                                 infinite where the face is seen exactly edge-on (inner_point cuts
+                                 it at the loop's box and halves it); 0 where the loop's image or
+                                 the point degenerates */
+} across_step;
+
+/* The ribbon's step into the face: the tangent vector `in` (its step in_uv in (u, v)) less its
+ * part along the loop (the chord t, t_uv), so that its image runs across the loop's image (first
+ * order), and as long as it takes to land width_px pixels across: not capped in object size (see
+ * the inner point above). Where the surface's parameters are sheared on screen, `in`'s image runs
+ * nearly along the loop: a step along it reached across by a fraction of a pixel (the old 4 x
+ * width_px cap), or, uncapped, by width_px only after tens of pixels along the loop, a sliver quad
+ * whose depths stood in front of the face (linkrods' close view: 38 depth-edge pixels of its
+ * own). */
+static across_step across_loop(const sw__gpu_view *v, const double p[3], const double t[3],
+                               const double t_uv[2], const double in[3], const double in_uv[2],
+                               double width_px)
 {
+    across_step a = {{0.0, 0.0, 0.0}, {0.0, 0.0}, {0.0, 0.0}, 0.0};
     double ts[2], is[2];
     screen_deriv(v, p, t, ts);
     screen_deriv(v, p, in, is);
     const double tt = ts[0] * ts[0] + ts[1] * ts[1];
     const double beta = tt > 0.0 && tt < INFINITY ? (is[0] * ts[0] + is[1] * ts[1]) / tt : 0.0;
     for (int k = 0; k < 3; ++k)
-        dir[k] = in[k] - beta * t[k];
-    dir_uv[0] = in_uv[0] - beta * t_uv[0];
-    dir_uv[1] = in_uv[1] - beta * t_uv[1];
+        a.dir[k] = in[k] - beta * t[k];
+    a.dir_uv[0] = in_uv[0] - beta * t_uv[0];
+    a.dir_uv[1] = in_uv[1] - beta * t_uv[1];
+    a.img[0] = is[0] - beta * ts[0];
+    a.img[1] = is[1] - beta * ts[1];
+    const double across = screen_length(a.img[0], a.img[1]); /* pixels per unit of dir */
+    if (depth_of(v, p) > 0.0 && tt > 0.0 && tt < INFINITY)
+        a.h = across > 0.0 ? width_px / across : INFINITY;
+    return a;
 }
 
 /* The outer point of sample e: k_outer x width_px beyond the loop's image, across it, at the
@@ -602,15 +599,13 @@ static void across_loop(const sw__gpu_view *v, const double p[3], const double t
  * surface and stands in front of a neighbour face at a crease; capped in object space it lay a
  * fraction of a pixel across, and between faces meeting along one curve, sampled at different
  * steps, pixel centres fell between the two ribbons' chords (Ball's mid view: 0.17 px apart, 3
- * pinholes). Returns its step along -dir to first order, for the trim lookup's (u, v); the sample
- * itself (0) where the loop's image or dir's is degenerate. */
+ * pinholes). Returns its step along -a->dir to first order, for the trim lookup's (u, v); the
+ * sample itself (0) where the loop's image or the step's is degenerate. */
 static double outer_point(const ribbon_ctx *c, const border_point *e, const loop_image *li,
-                          const double dir[3], double h, double out[3])
+                          const across_step *a, double out[3])
 {
     memcpy(out, e->p, 3 * sizeof *out);
-    double is[2];
-    screen_deriv(c->v, e->p, dir, is);
-    double nx = -li->dir[1], ny = li->dir[0], side = nx * is[0] + ny * is[1];
+    double nx = -li->dir[1], ny = li->dir[0], side = nx * a->img[0] + ny * a->img[1];
     if (!li->ok || !(fabs(side) > 0.0))
         return 0.0;
     if (side > 0.0) { /* (nx, ny) points into the face: the outer point lies the other way */
@@ -622,7 +617,7 @@ static double outer_point(const ribbon_ctx *c, const border_point *e, const loop
     const double y = (li->at[1] + k_outer * c->width_px * ny) / c->v->focal_px;
     for (int k = 0; k < 3; ++k)
         out[k] = z * (c->v->fwd[k] + x * c->v->right[k] + y * c->v->up[k]);
-    return h < INFINITY ? -k_outer * h : 0.0;
+    return a->h < INFINITY ? -k_outer * a->h : 0.0;
 }
 
 /* Depth change per pixel from eye-relative a to b on screen (0 when either is behind the eye or
@@ -668,12 +663,12 @@ static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, s
         const double t_uv[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
         double q[2][2][3], step[2][2], dir_uv[2][2];
         for (int end = 0; end < 2; ++end) {
-            const loop_image li = loop_image_of(c->v, e[end], e[1 - end]);
-            double dir[3];
-            across_loop(c->v, e[end]->p, t, t_uv, e[0]->in, e[0]->in_uv, dir, dir_uv[end]);
-            const double h = inward_length(c->v, e[end]->p, t, dir, c->width_px);
-            step[end][1] = inner_point(c, e[end], &li, dir_uv[end], h, q[end][1]);
-            step[end][0] = outer_point(c, e[end], &li, dir, h, q[end][0]);
+            const loop_image li = loop_image_of(e[end], e[1 - end]);
+            const across_step a =
+                across_loop(c->v, e[end]->p, t, t_uv, e[0]->in, e[0]->in_uv, c->width_px);
+            memcpy(dir_uv[end], a.dir_uv, sizeof a.dir_uv);
+            step[end][1] = inner_point(c, e[end], &li, a.dir_uv, a.h, q[end][1]);
+            step[end][0] = outer_point(c, e[end], &li, &a, q[end][0]);
         }
         push_back(c, e, q);
         uint32_t base = (uint32_t)mesh->n_v;
