@@ -101,6 +101,39 @@ static void upload_ssbo(sw_gpu_context *ctx, GLuint buf, size_t *capacity, GLuin
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, binding, buf);
 }
 
+/* Exact trim edges' grids, cells and segments into storage buffers 6, 7, 8 (the surface
+ * programs' fragment stage: glsl/surface_trim.frag.glsl). */
+static void upload_edges(sw_gpu_context *ctx, const sw__gpu_edge_grids *e)
+{
+    if (!e || e->n_grids == 0)
+        return;
+    upload_ssbo(ctx, ctx->edge_ssbo[0], &ctx->edge_ssbo_cap[0], 6, e->n_grids * sizeof *e->grids,
+                e->grids);
+    upload_ssbo(ctx, ctx->edge_ssbo[1], &ctx->edge_ssbo_cap[1], 7,
+                e->n_cells * 2 * sizeof *e->cells, e->cells);
+    upload_ssbo(ctx, ctx->edge_ssbo[2], &ctx->edge_ssbo_cap[2], 8, e->n_segs * 4 * sizeof *e->segs,
+                e->segs);
+}
+
+void sw__gpu_draw_trim_lookup(const sw_gpu_context *ctx, const sw__gpu_draw *d, float rect[4],
+                              float *layer)
+{
+    memset(rect, 0, 4 * sizeof *rect);
+    *layer = 0.0f;
+    if (d->edge_grid >= 0) {
+        rect[0] = (float)d->edge_grid; /* exact below 2^24 grids: a frame holds far fewer */
+        rect[2] = -1.0f;
+    } else if (d->trim_entry >= 0) {
+        sw__gpu_trim_rect tr;
+        sw__gpu_atlas_rect(ctx, d->trim_entry, &tr);
+        rect[0] = (float)tr.x0;
+        rect[1] = (float)tr.y0;
+        rect[2] = (float)tr.w;
+        rect[3] = (float)tr.h;
+        *layer = (float)tr.layer;
+    }
+}
+
 static void upload_exact(sw_gpu_context *ctx, const sw__gpu_patch_batch *batch)
 {
     upload_ssbo(ctx, ctx->piece_ssbo, &ctx->piece_ssbo_cap, 2,
@@ -239,7 +272,7 @@ static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
     const sw__gpu_surface_program *prog = &ctx->surf.mesh[variant];
     int used = 0;
     for (size_t d = 0; d < n_draws; ++d) {
-        const int trimmed = draws[d].trim_entry >= 0;
+        const int trimmed = sw__gpu_draw_trimmed(&draws[d]);
         if (draws[d].n_idx == 0 || trimmed != (variant == SW__GPU_TRIMMED))
             continue;
         if (!used++)
@@ -248,11 +281,10 @@ static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
         glUniform4fv(prog->loc_uv_map, 1, draws[d].uv_map);
         /* set for untrimmed draws too (w = 0: the lookup accepts all): a host's shading draws
          * them with its trimmed program, which keeps the last trimmed draw's rectangle */
-        sw__gpu_trim_rect tr = {0, 0, 0, 0, 0};
-        if (trimmed)
-            sw__gpu_atlas_rect(ctx, draws[d].trim_entry, &tr);
-        glUniform4f(prog->loc_trim_rect, (float)tr.x0, (float)tr.y0, (float)tr.w, (float)tr.h);
-        glUniform1f(prog->loc_trim_layer, (float)tr.layer);
+        float rect[4], layer;
+        sw__gpu_draw_trim_lookup(ctx, &draws[d], rect, &layer);
+        glUniform4fv(prog->loc_trim_rect, 1, rect);
+        glUniform1f(prog->loc_trim_layer, layer);
         glDrawElements(GL_TRIANGLES, (GLsizei)draws[d].n_idx, GL_UNSIGNED_INT,
                        (const void *)(draws[d].first_idx * sizeof(uint32_t)));
     }
@@ -261,7 +293,7 @@ static void draw_mesh_variant(sw_gpu_context *ctx, const sw__gpu_view *view,
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
                              const sw__gpu_draw *draws, size_t n_draws,
-                             const sw__gpu_patch_batch *batch,
+                             const sw__gpu_patch_batch *batch, const sw__gpu_edge_grids *edges,
                              const sw__gpu_resident_list *resident, sw_status *status)
 {
     ctx->upload_bytes = 0;
@@ -285,6 +317,7 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, sw__gpu_atlas_texture(ctx));
+    upload_edges(ctx, edges);
     if (batch && batch->n_recs > 0)
         draw_patches(ctx, view, batch);
     bind_mesh(ctx, mesh);
@@ -469,9 +502,9 @@ sw_result sw_gpu_render_triangles(sw_gpu_context *ctx, const double *positions, 
     sw__gpu_mesh mesh = {0};
     if (r == SW_OK)
         r = triangles_to_mesh(positions, n_vertices, indices, n_indices, view.eye, &mesh, status);
-    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1, {0.0f, 0.0f, 0.0f, 0.0f}};
+    sw__gpu_draw draw = {0, mesh.n_idx, {0.8f, 0.8f, 0.8f, 1.0f}, -1, -1, {0.0f, 0.0f, 0.0f, 0.0f}};
     if (r == SW_OK)
-        r = sw__gpu_draw_frame(ctx, &view, &desc, &mesh, &draw, 1, NULL, NULL, status);
+        r = sw__gpu_draw_frame(ctx, &view, &desc, &mesh, &draw, 1, NULL, NULL, NULL, status);
     sw__gpu_mesh_free(&mesh);
     if (r == SW_OK)
         r = sw__gpu_readback(ctx, &view, desc.want_depth, out, status);

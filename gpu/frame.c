@@ -146,6 +146,7 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
     env->exact = d->eval_exact != 0;
     env->walkthrough = d->walkthrough != 0;
     env->lod_colors = d->lod_colors != 0;
+    env->trim_edges = d->trim_edges != 0;
     env->static_force = d->static_force;
     if (d->static_lods && sw_lod_static_set_scene(d->static_lods) != scene)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,

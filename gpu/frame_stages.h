@@ -51,6 +51,11 @@ static const double k_tile_texels = 512.0;
  * rather than cutting the node into parts: refining also sets the geometry, and a deeper cut
  * draws more triangles and fat borders than parts of the same bicubic. */
 static const double k_node_texels = 1024.0;
+/* With exact trim edges (desc.trim_edges), a trimmed draw whose trim texel would exceed this many
+ * pixels at its nearest point has its edges classified per fragment (trim_edges.c) instead, and
+ * its loops flattened to k_exact_flat_px on screen (they are its edges and its fat borders'). */
+static const double k_exact_texel_px = 0.25;
+static const double k_exact_flat_px = 0.125;
 
 /* Segment counts a direction may get, ascending: every count up to MAX_SEGMENTS for CPU grids;
  * for predefined grids (§4.2) the counts a grid class, or pieces of one class, can draw. */
@@ -71,6 +76,7 @@ typedef struct sw__fr_env {
     int exact;                  /* desc.eval_exact */
     int walkthrough;            /* desc.walkthrough: never wait for the pool */
     int lod_colors;             /* desc.lod_colors */
+    int trim_edges;             /* desc.trim_edges: exact edges where a texel would be coarse */
     int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
     sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
@@ -241,6 +247,7 @@ typedef struct pending_trim {
     int32_t clip;         /* 1: a tile or a node's part: the loops clipped to rect */
     double rect[4];       /* with clip: the tile (face parameters) */
     int32_t w, h;         /* texels of its class (the trim plan) */
+    int32_t grid;         /* its exact edges' grid in geometry.edges, or -1: a trim texture */
 } pending_trim;
 
 /* A face occurrence's loops, flattened once (a copy of the border cache's when it has them). */
@@ -261,6 +268,7 @@ typedef struct sw__fr_geometry {
     size_t n_shares, cap_shares;
     face_loops *loops;
     size_t n_loops, cap_loops;
+    sw__gpu_edge_grids edges; /* the exact trim edges' grids (the trim plan) */
     sw__gpu_patch_rec *recs; /* GPU-evaluated patches (§4.2) */
     float *cps;              /* their eye-relative homogeneous control points, 4 per point */
     size_t n_recs, cap_recs, n_cps, cap_cps;
@@ -435,6 +443,14 @@ sw_result sw__fr_trim_atlas(sw_gpu_context *ctx, const sw_sg_scene *scene, sw__f
 int32_t sw__fr_class_texels(double want, int32_t max_entry);
 /* Whether the trimmed region lies to the left of loop k's direction. */
 int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_t k);
+/* Whether a trimmed draw wanting need_u x need_v texels (a texel = the object tolerance at its
+ * nearest point) gets exact edges: desc.trim_edges, and its class's texel over k_exact_texel_px in
+ * either direction. */
+int sw__fr_exact_edges(const sw__fr_env *env, double need_u, double need_v, int32_t max_entry);
+/* The flattening tolerance (face parameters) of the loops of a draw's direction spanning `extent`
+ * and wanting `need` texels: half a texel of its class, or with exact edges k_exact_flat_px. */
+double sw__fr_trim_flat_tol(const sw__fr_env *env, double extent, double need, int exact,
+                            int32_t max_entry);
 
 /* ---- submit: stage_submit.c ------------------------------------------------------------------ */
 /* Batch, upload, draw. GL thread. */

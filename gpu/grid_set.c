@@ -12,6 +12,7 @@
 #include "sw_status_util.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 const int32_t sw__gpu_grid_segments[SW__GPU_GRID_CLASSES] = {1,  2,  3,  4,  6,  8,
                                                              12, 16, 24, 32, 48, 64};
@@ -57,6 +58,7 @@ sw_result sw__gpu_grids_create(sw_gpu_context *ctx, sw_status *status)
     glGenBuffers(1, &ctx->piece_ssbo);
     glGenBuffers(1, &ctx->knot_ssbo);
     glGenBuffers(1, &ctx->dcp_ssbo);
+    glGenBuffers(3, ctx->edge_ssbo);
     return sw__gpu_check(status, "grid set");
 }
 
@@ -69,6 +71,9 @@ void sw__gpu_grids_free(sw_gpu_context *ctx)
     glDeleteBuffers(1, &ctx->knot_ssbo);
     glDeleteBuffers(1, &ctx->dcp_ssbo);
     ctx->piece_ssbo = ctx->knot_ssbo = ctx->dcp_ssbo = 0;
+    glDeleteBuffers(3, ctx->edge_ssbo);
+    memset(ctx->edge_ssbo, 0, sizeof ctx->edge_ssbo);
+    memset(ctx->edge_ssbo_cap, 0, sizeof ctx->edge_ssbo_cap);
     ctx->patch_ssbo_cap = ctx->cp_ssbo_cap = 0;
     ctx->piece_ssbo_cap = ctx->knot_ssbo_cap = ctx->dcp_ssbo_cap = 0;
     glDeleteBuffers(1, &ctx->capture_ssbo);

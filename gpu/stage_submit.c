@@ -12,7 +12,7 @@
 
 static int trim_variant(const sw__gpu_draw *d)
 {
-    return d->trim_entry >= 0 ? SW__GPU_TRIMMED : SW__GPU_UNTRIMMED;
+    return sw__gpu_draw_trimmed(d) ? SW__GPU_TRIMMED : SW__GPU_UNTRIMMED;
 }
 
 /* Fills the records' colour and trim rectangle from their draws (trim entries are known after the
@@ -31,15 +31,8 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_pa
         sw__gpu_patch_rec *rec = &g->recs[i];
         const sw__gpu_draw *d = &g->draws[rec->draw];
         memcpy(rec->color, d->color, sizeof rec->color);
-        if (d->trim_entry >= 0) {
-            sw__gpu_trim_rect tr;
-            sw__gpu_atlas_rect(ctx, d->trim_entry, &tr);
-            rec->trim_rect[0] = (float)tr.x0;
-            rec->trim_rect[1] = (float)tr.y0;
-            rec->trim_rect[2] = (float)tr.w;
-            rec->trim_rect[3] = (float)tr.h;
-            rec->layer = (float)tr.layer;
-        }
+        if (sw__gpu_draw_trimmed(d))
+            sw__gpu_draw_trim_lookup(ctx, d, rec->trim_rect, &rec->layer);
         b->count[trim_variant(d)][rec->level_v][rec->level_u]++;
     }
     static const int k_order[SW__GPU_TRIM_VARIANTS] = {SW__GPU_UNTRIMMED, SW__GPU_TRIMMED};
@@ -86,6 +79,6 @@ sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
         desc->static_lods ? sw_lod_static_set_serial(desc->static_lods) : 0};
     sw__gpu_resident_begin(ctx, resident.set);
     return r == SW_OK ? sw__gpu_draw_frame(ctx, view, desc, &geo->mesh, geo->draws, geo->n_draws,
-                                           &batch, &resident, status)
+                                           &batch, &geo->edges, &resident, status)
                       : r;
 }

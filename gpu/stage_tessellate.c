@@ -31,6 +31,7 @@ void sw__fr_geometry_free(sw__fr_geometry *g)
     sw__free(g->knots);
     sw__free(g->dcps);
     sw__free(g->resident);
+    sw__gpu_edge_grids_free(&g->edges);
     sw__gpu_mesh_free(&g->mesh);
     memset(g, 0, sizeof *g);
 }
@@ -50,6 +51,7 @@ void sw__fr_geometry_empty(sw__fr_geometry *g)
     g->border_triangles = 0;
     g->n_resident = 0;
     g->resident_triangles = 0;
+    sw__gpu_edge_grids_empty(&g->edges);
 }
 
 void sw__fr_chunk_geometry_take(sw_gpu_context *ctx, sw__fr_geometry *dst)
@@ -112,6 +114,7 @@ sw_result sw__fr_add_draw(sw__fr_tess *t, const occurrence *o, size_t first_idx,
     d->n_idx = g->mesh.n_idx - first_idx;
     memcpy(d->color, o->color, sizeof d->color);
     d->trim_entry = -1;
+    d->edge_grid = -1;
     /* a face's CPU grids carry st over its uv box (fat borders: sw__fr_fat_border; triangle
      * meshes and static levels, st = 0: sw__fr_append_triangles) */
     memset(d->uv_map, 0, sizeof d->uv_map);
@@ -131,6 +134,7 @@ sw_result sw__fr_add_draw(sw__fr_tess *t, const occurrence *o, size_t first_idx,
         p->cell[0] = cell[0];
         p->cell[1] = cell[1];
         p->loops = -1;
+        p->grid = -1;
     }
     g->n_draws++;
     return SW_OK;

@@ -367,10 +367,11 @@ static sw_result tile_loops(tiling *t, int64_t *index, sw_status *status)
     double tol = INFINITY;
     for (size_t i = 0; i < t->n_tiles; ++i) {
         const tile *tl = &t->tiles[i];
-        tol = fmin(tol,
-                   0.5 * (tl->rect[1] - tl->rect[0]) / sw__fr_class_texels(tl->need.u, max_entry));
-        tol = fmin(tol,
-                   0.5 * (tl->rect[3] - tl->rect[2]) / sw__fr_class_texels(tl->need.v, max_entry));
+        const int exact = sw__fr_exact_edges(f->env, tl->need.u, tl->need.v, max_entry);
+        tol = fmin(tol, sw__fr_trim_flat_tol(f->env, tl->rect[1] - tl->rect[0], tl->need.u, exact,
+                                             max_entry));
+        tol = fmin(tol, sw__fr_trim_flat_tol(f->env, tl->rect[3] - tl->rect[2], tl->need.v, exact,
+                                             max_entry));
     }
     sw_result r = sw__fr_face_loops(f, t->o->face, tol, index, status);
     const face_loops *fl = r == SW_OK ? &f->geo->loops[*index] : NULL;

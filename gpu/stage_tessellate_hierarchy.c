@@ -337,7 +337,7 @@ static sw_result draw_item_own(hl_face *hf, hl_choice *c, const sw__gpu_patch *p
     return r;
 }
 
-/* The finest trim texel of the chosen items, halved: the loops' flattening tolerance. Slivers
+/* The loops' flattening tolerance: the finest of the chosen items' (sw__fr_trim_flat_tol). Slivers
  * (sw__fr_sliver) are skipped, as in the border's cell: a span of 7e-16 flattened a loop into
  * 748k vertices. */
 static double loop_tolerance(const hl_face *hf)
@@ -348,12 +348,14 @@ static double loop_tolerance(const hl_face *hf)
     for (size_t i = 0; i < hf->n_chosen; ++i) {
         const hl_choice *c = &hf->chosen[i];
         const double w[2] = {c->rect[1] - c->rect[0], c->rect[3] - c->rect[2]};
-        const double texel[2] = {0.5 * w[0] / sw__fr_class_texels(c->need.u, max_entry),
-                                 0.5 * w[1] / sw__fr_class_texels(c->need.v, max_entry)};
+        const int exact = sw__fr_exact_edges(hf->f->env, c->need.u, c->need.v, max_entry);
+        const double flat[2] = {
+            sw__fr_trim_flat_tol(hf->f->env, w[0], c->need.u, exact, max_entry),
+            sw__fr_trim_flat_tol(hf->f->env, w[1], c->need.v, exact, max_entry)};
         for (int d = 0; d < 2; ++d) {
-            all = fmin(all, texel[d]);
+            all = fmin(all, flat[d]);
             if (!sw__fr_sliver(w[d], ub[2 * d + 1] - ub[2 * d]))
-                tol = fmin(tol, texel[d]);
+                tol = fmin(tol, flat[d]);
         }
     }
     return tol < INFINITY ? tol : all;

@@ -67,14 +67,35 @@ int sw__fr_left_is_inside(const sw_sg_polyline *loops, uint32_t n_loops, uint32_
 
 /* ---- the plan ---------------------------------------------------------------------------------
  */
-/* Atlas texels the frame's trims take at `scale`: their classes' footprints, gutters included. */
+int sw__fr_exact_edges(const sw__fr_env *env, double need_u, double need_v, int32_t max_entry)
+{
+    if (!env->trim_edges)
+        return 0;
+    const double texel_u = env->eps_px * need_u / sw__fr_class_texels(need_u, max_entry);
+    const double texel_v = env->eps_px * need_v / sw__fr_class_texels(need_v, max_entry);
+    return fmax(texel_u, texel_v) > k_exact_texel_px;
+}
+
+double sw__fr_trim_flat_tol(const sw__fr_env *env, double extent, double need, int exact,
+                            int32_t max_entry)
+{
+    double tol = 0.5 * extent / sw__fr_class_texels(need, max_entry);
+    /* need texels of extent / need each keep the surface within ε_img px (§5.3) */
+    if (exact && need > 0.0)
+        tol = fmin(tol, k_exact_flat_px / env->eps_px * extent / need);
+    return tol;
+}
+
+/* Atlas texels the frame's trim textures take at `scale`: their classes' footprints, gutters
+ * included (exact edges take none). */
 static double trim_footprint(const sw__fr_geometry *g, int32_t max_entry, double scale)
 {
     const int32_t g2 = 2 * SW__GPU_ATLAS_GUTTER;
     double sum = 0.0;
     for (size_t i = 0; i < g->n_trims; ++i)
-        sum += (double)(sw__fr_class_texels(g->trims[i].width * scale, max_entry) + g2) *
-               (double)(sw__fr_class_texels(g->trims[i].height * scale, max_entry) + g2);
+        if (g->trims[i].grid < 0)
+            sum += (double)(sw__fr_class_texels(g->trims[i].width * scale, max_entry) + g2) *
+                   (double)(sw__fr_class_texels(g->trims[i].height * scale, max_entry) + g2);
     return sum;
 }
 
@@ -89,7 +110,8 @@ static double trim_scale(const sw__fr_geometry *g, int32_t max_entry, double bud
 {
     double total = 0.0;
     for (size_t i = 0; i < g->n_trims; ++i)
-        total += g->trims[i].width * g->trims[i].height;
+        if (g->trims[i].grid < 0)
+            total += g->trims[i].width * g->trims[i].height;
     double scale = total > budget ? sqrt(budget / total) : 1.0;
     for (int step = 0; step < 64; ++step) {
         const double foot = trim_footprint(g, max_entry, scale);
@@ -100,17 +122,47 @@ static double trim_scale(const sw__fr_geometry *g, int32_t max_entry, double bud
     return scale;
 }
 
-/* A whole-box texture's loops, flattened at half its texel, and the face's fat borders. */
-static sw_result plan_whole_box(sw__fr_tess *t, size_t i, sw_status *status)
+/* A whole-box trim's loops, flattened at half its texel (or for exact edges at k_exact_flat_px),
+ * and the face's fat borders. */
+static sw_result plan_whole_box(sw__fr_tess *t, size_t i, double tol, sw_status *status)
 {
     pending_trim *p = &t->geo->trims[i];
-    const double *ub = t->env->sv->faces[p->occ.face].uv_box;
-    const double tol = 0.5 * fmin((ub[1] - ub[0]) / p->w, (ub[3] - ub[2]) / p->h);
     int64_t loops = -1;
     sw_result r = sw__fr_face_loops(t, p->occ.face, tol, &loops, status);
     p->loops = loops;
     if (r == SW_OK) /* the borders add untrimmed draws: p stays where it is */
         r = sw__fr_loop_borders(t, &p->occ, loops, p->cell, status);
+    return r;
+}
+
+/* A trim's exact edges, when it wants them (sw__fr_exact_edges): a whole box's loops flattened
+ * for them (and its fat borders), the grid built. A grid that cannot be made leaves a trim
+ * texture (counted). */
+static sw_result plan_exact(sw__fr_tess *t, size_t i, int32_t max_entry, sw_status *status)
+{
+    pending_trim *p = &t->geo->trims[i];
+    const sw__fr_env *env = t->env;
+    p->grid = -1;
+    if (!sw__fr_exact_edges(env, p->width, p->height, max_entry))
+        return SW_OK;
+    const double *ub = env->sv->faces[p->occ.face].uv_box;
+    sw_result r = SW_OK;
+    if (!p->clip)
+        r = plan_whole_box(t, i,
+                           fmin(sw__fr_trim_flat_tol(env, ub[1] - ub[0], p->width, 1, max_entry),
+                                sw__fr_trim_flat_tol(env, ub[3] - ub[2], p->height, 1, max_entry)),
+                           status);
+    if (r != SW_OK)
+        return r;
+    const face_loops *fl = &t->geo->loops[p->loops];
+    r = sw__gpu_edge_grid_add(&t->geo->edges, fl->loops, fl->n, p->clip ? p->rect : ub, &p->grid,
+                              status);
+    if (r == SW_OK && p->grid >= 0) {
+        t->geo->draws[p->draw].edge_grid = p->grid;
+        t->st->trim_exact++;
+    } else if (r == SW_OK) {
+        t->st->trim_exact_fallbacks++;
+    }
     return r;
 }
 
@@ -123,10 +175,15 @@ sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_f
     t.st = st;
     t.geo = geo;
     const int32_t max_entry = sw__gpu_atlas_max_entry(env->ctx);
-    const double scale = trim_scale(geo, max_entry, env->ctx->atlas_frame_texels);
+    sw__gpu_edge_grids_empty(&geo->edges);
     sw_result r = SW_OK;
+    for (size_t i = 0; i < geo->n_trims && r == SW_OK; ++i)
+        r = plan_exact(&t, i, max_entry, status);
+    const double scale = trim_scale(geo, max_entry, env->ctx->atlas_frame_texels);
     for (size_t i = 0; i < geo->n_trims && r == SW_OK; ++i) {
         pending_trim *p = &geo->trims[i];
+        if (p->grid >= 0)
+            continue;
         p->w = sw__fr_class_texels(p->width * scale, max_entry);
         p->h = sw__fr_class_texels(p->height * scale, max_entry);
         /* coarser than its need (the budget's scale, an entry's size limit): its edge may move by
@@ -135,9 +192,14 @@ sw_result sw__fr_trim_plan(const sw__fr_env *env, sw__fr_geometry *geo, sw_gpu_f
             st->bound_exceeded++;
             st->budget_coarsened += scale < 1.0;
         }
-        if (!p->clip)
-            r = plan_whole_box(&t, i, status);
+        if (!p->clip && p->loops < 0) {
+            const double *ub = env->sv->faces[p->occ.face].uv_box;
+            r = plan_whole_box(&t, i, 0.5 * fmin((ub[1] - ub[0]) / p->w, (ub[3] - ub[2]) / p->h),
+                               status);
+        }
     }
+    for (size_t i = 0; i < geo->n_shares; ++i)
+        geo->draws[geo->shares[2 * i]].edge_grid = geo->draws[geo->shares[2 * i + 1]].edge_grid;
     return r;
 }
 
@@ -195,7 +257,8 @@ sw_result sw__fr_trim_atlas(sw_gpu_context *ctx, const sw_sg_scene *scene, sw__f
 {
     sw_result r = sw__gpu_atlas_begin(ctx, status);
     for (size_t i = 0; i < geo->n_trims && r == SW_OK; ++i)
-        r = atlas_entry(ctx, scene, geo, &geo->trims[i], status);
+        if (geo->trims[i].grid < 0)
+            r = atlas_entry(ctx, scene, geo, &geo->trims[i], status);
     sw__gpu_atlas_stats as;
     memset(&as, 0, sizeof as);
     if (r == SW_OK)

@@ -120,6 +120,10 @@ typedef struct sw_gpu_frame_desc {
                              each good enough, and beside the trim-texture path. 0: the
                              coarsest good level */
     int32_t lod_colors;   /* 1: each draw coloured by its representation (sw__fr_lod_color) */
+    int32_t trim_edges;   /* 1: a trimmed draw whose trim texel would exceed a quarter pixel has
+                             its edges classified per fragment against its loops, flattened to an
+                             eighth of a pixel (trim_edges.c), instead of a trim texture; 0: trim
+                             textures only */
     const sw_gpu_occurrence *occurrences; /* NULL: the scene's traversal (or bvh); else exactly
                               these occurrences of the scene's faces, culled one by one (bvh
                               ignored); read during prepare only */
@@ -159,6 +163,10 @@ typedef struct sw_gpu_frame_stats {
     uint64_t triangles;        /* every triangle drawn, fat borders included */
     uint64_t border_triangles; /* of triangles: the fat borders' (Guthe §7.1 crack filling) */
     uint64_t trim_textures, trim_texels;
+    uint64_t trim_exact;           /* trimmed draws with exact edges instead of a texture
+                                      (desc.trim_edges) */
+    uint64_t trim_exact_fallbacks; /* of those wanted, drawn with a texture: no grid could be
+                                      made (trim_edges.c's limits) */
     double ms_tessellate; /* traversal, bounds, CPU grids (without ms_hierarchy) */
     double ms_trim;       /* trim-texture generation */
     double ms_draw;       /* draw submission until glFinish */

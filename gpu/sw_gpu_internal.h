@@ -168,6 +168,8 @@ struct sw_gpu_context {
     uint32_t grid_first[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES]; /* [level v][level u] */
     uint32_t grid_count[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
     GLuint patch_ssbo, cp_ssbo; /* per-frame patch records and control points */
+    GLuint edge_ssbo[3];        /* per-frame exact trim edges: grids, cells, segments */
+    size_t edge_ssbo_cap[3];
     int32_t eval_mode;          /* sw__gpu_eval_mode */
     /* the submitting thread's scratch, kept between frames (no allocation once grown) */
     struct sw__gpu_patch_rec *recs_sorted;
@@ -442,15 +444,74 @@ int sw__gpu_trim_rect_class(const sw_sg_polyline *loops, uint32_t n_loops, const
 sw_result sw__gpu_trim_clip_loops(const sw_sg_polyline *loops, uint32_t n_loops,
                                   const double rect[4], sw_sg_polyline *out, sw_status *status);
 
+/* ---- exact trim edges (trim_edges.c): a draw's loops as per-fragment tests ------------------- */
+/* A grid of cells over a draw's rectangle (st in [0, 1]^2), as the fragment shader reads it
+ * (std430: glsl/surface_trim.frag.glsl's SwEdgeGrid). */
+enum { SW__GPU_EDGE_REFS = 5 }; /* reference points a cell may take (trim_edges.c) */
+typedef struct sw__gpu_edge_grid {
+    uint32_t n[2];       /* cells in s, t */
+    uint32_t first_cell; /* in the frame's cells */
+    uint32_t pad;
+} sw__gpu_edge_grid;
+
+/* A frame's grids: cells are 2 uint32 each (first entry in segs; entries << 4 | its reference
+ * point's number << 1 | that point's even-odd parity), segs 4 floats per entry (a segment's ends,
+ * clipped to the cell, relative to the cell's reference point, in cells). */
+typedef struct sw__gpu_edge_grids {
+    sw__gpu_edge_grid *grids;
+    uint32_t *cells;
+    float *segs;
+    size_t n_grids, n_cells, n_segs;
+    size_t cap_grids, cap_cells, cap_segs; /* in elements of each array (2, 4 per cell, entry) */
+} sw__gpu_edge_grids;
+
+/* Appends the grid of closed loops (face parameters) over rect = {u0, u1, v0, v1}; *index is its
+ * number, or -1 when it cannot be made within its limits (too many segments, no reference point
+ * clear of the loops, an empty rectangle): the caller draws a trim texture instead. Errors:
+ * SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__gpu_edge_grid_add(sw__gpu_edge_grids *out, const sw_sg_polyline *loops,
+                                uint32_t n_loops, const double rect[4], int32_t *index,
+                                sw_status *status);
+/* The fragment shader's test on the CPU, in float as the shader does it: 1 when (s, t) of grid
+ * index is inside the loops. */
+int sw__gpu_edge_grid_inside(const sw__gpu_edge_grids *g, int32_t index, float s, float t);
+void sw__gpu_edge_grids_empty(sw__gpu_edge_grids *g); /* counts zeroed, arrays kept */
+void sw__gpu_edge_grids_free(sw__gpu_edge_grids *g);
+/* Whether the path from a cell's reference point to d (both relative to it) crosses segment e =
+ * {a.x, a.y, b.x, b.y}: a and b strictly on opposite sides of the path's line, half-open (a
+ * vertex on the line counts on one side for both of its segments, so a path through it crosses
+ * the loop once or not at all), and the path's ends on opposite sides of the segment's line.
+ * glsl/surface_trim.frag.glsl does the same operations. */
+static inline int sw__gpu_edge_crosses(const float d[2], const float e[4])
+{
+    const int ends_apart = (d[0] * e[1] - d[1] * e[0] > 0.0f) != (d[0] * e[3] - d[1] * e[2] > 0.0f);
+    const float ex = e[2] - e[0], ey = e[3] - e[1];
+    const int path_apart =
+        (ex * -e[1] - ey * -e[0] > 0.0f) != (ex * (d[1] - e[1]) - ey * (d[0] - e[0]) > 0.0f);
+    return ends_apart && path_apart;
+}
+
 /* ---- drawing and readback (draw.c) ----------------------------------------------------------- */
 /* A range of the frame's index buffer drawn with one colour and trim texture (0 = untrimmed). */
 typedef struct sw__gpu_draw {
     size_t first_idx, n_idx;
     float color[4];
-    int32_t trim_entry; /* atlas entry, -1 = untrimmed */
+    int32_t trim_entry; /* atlas entry, -1 = none */
+    int32_t edge_grid;  /* exact trim edges' grid (trim_edges.c), -1 = none; trimmed when either
+                           is set */
     float uv_map[4];    /* the vertices' st to the face's parameters: (u, v) = (m0 + st.x m2,
                            m1 + st.y m3); zero: uv = 0 */
 } sw__gpu_draw;
+
+static inline int sw__gpu_draw_trimmed(const sw__gpu_draw *d)
+{
+    return d->trim_entry >= 0 || d->edge_grid >= 0;
+}
+/* A draw's trim lookup as the surface programs take it (u_trim_rect, u_trim_layer; a record's
+ * trim_rect, layer): its atlas rectangle in texels and layer; (grid, 0, -1, 0) for exact edges;
+ * zeros when untrimmed. */
+void sw__gpu_draw_trim_lookup(const sw_gpu_context *ctx, const sw__gpu_draw *d, float rect[4],
+                              float *layer);
 
 /* The frame's GPU-evaluated patches: records sorted by trim variant and grid class, control
  * points. */
@@ -491,7 +552,7 @@ struct sw__gpu_resident_list; /* below */
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,
                              const sw__gpu_draw *draws, size_t n_draws,
-                             const sw__gpu_patch_batch *batch,
+                             const sw__gpu_patch_batch *batch, const sw__gpu_edge_grids *edges,
                              const struct sw__gpu_resident_list *resident, sw_status *status);
 
 /* ---- resident static levels (resident.c) -------------------------------------------------------

@@ -377,6 +377,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->triangles = g->triangles;
     out->trim_textures = g->trim_textures;
     out->trim_texels = g->trim_texels;
+    out->trim_exact = g->trim_exact;
     out->patches_gpu_evaluated = g->patches_gpu_evaluated;
     out->patches_exact = g->patches_exact;
     out->atlas_pages = g->atlas_pages;
@@ -473,6 +474,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->present_depth = desc->present && desc->present_depth;
     frame->near_plane = desc->near_plane;
     frame->wireframe = desc->wireframe != 0;
+    frame->trim_edges = desc->trim_edges != 0;
     /* pixels leave the renderer only through output_path (the library returns no image): a
      * frame without one reads nothing back (at 1280x720 on llvmpipe the readback was a third of
      * a profile's frame, 14 of 42 ms); its raster work still ends in the draw's glFinish */

@@ -5,10 +5,23 @@
  * here by projecting the analytic shape) must be covered exactly when the analytic shape says so,
  * and covered pixels must carry the plane's depth. Also writes the frame as PNG and EXR.
  *
+ * Then close-ups, by trim textures and by exact trim edges (desc.trim_edges): the bolt hole
+ * filling the screen, and its edge at 10x and 200x that, each with and without fat borders. The
+ * edge displacement of a view is the largest distance, in pixels, from the exact boundary of a
+ * pixel centre classified wrongly. Exact edges must keep it within 0.25 px without fat borders
+ * (the loops are flattened to 1/8 px; what is left is float), and within 0.5 px with them (their
+ * outer sliver reaches k_outer x width = 0.25 px beyond the loop by design, gpu/crack_fill.c);
+ * they must also be what drew the trims (no trim texture in those views). Trim textures are
+ * reported beside them (a texel is up to ε_img on screen, and boundary texels count as inside).
+ * Planted fault seen failing: the shader's crossing test without its second condition (the
+ * path's ends on either side of the segment's line) → 9,065 pixels misclassified beyond 1 px,
+ * 26 px from the boundary.
+ *
  * Usage: test_gpu_analytic OUTDIR
  */
 #include <splinewalk/sw_image.h>
 #include "sw_gpu.h"
+#include "sw_gpu_internal.h"
 #include "sw_sg_scene.h"
 
 #include <math.h>
@@ -157,41 +170,113 @@ static int analytic(const double uv[2], double *dist)
     return in_square && rc > k_circle_r && !in_star;
 }
 
-static int check_frame(const sw_gpu_image *img)
+/* A view straight down at the square from (cx, cy, dist), looking along -z. */
+typedef struct front_view {
+    double cx, cy, dist;
+} front_view;
+
+/* Misclassified pixels: beyond 1 px from a boundary, and the largest distance of any. */
+typedef struct frame_check {
+    long checked, band, covered, wrong, bad_depth;
+    double max_wrong_px;
+} frame_check;
+
+static frame_check check_view(const sw_gpu_image *img, const front_view *v)
 {
-    double tan_y = tan(k_fovy * M_PI / 360.0), half = k_dist * tan_y; /* world half-height */
+    double tan_y = tan(k_fovy * M_PI / 360.0), half = v->dist * tan_y; /* world half-height */
     double px_per_uv = 2.0 * (H / 2.0) / half; /* the square spans 2 world units per uv unit */
-    long checked = 0, wrong = 0, covered = 0, band = 0, bad_depth = 0;
+    frame_check c = {0, 0, 0, 0, 0, 0.0};
     for (int y = 0; y < H; ++y) {
         for (int x = 0; x < W; ++x) {
-            double wx = ((x + 0.5) / (W / 2.0) - 1.0) * half;
-            double wy = (1.0 - (y + 0.5) / (H / 2.0)) * half;
+            double wx = v->cx + ((x + 0.5) / (W / 2.0) - 1.0) * half;
+            double wy = v->cy + (1.0 - (y + 0.5) / (H / 2.0)) * half;
             double uv[2] = {(wx + 1.0) / 2.0, (wy + 1.0) / 2.0}, d;
             int want = analytic(uv, &d);
             size_t i = (size_t)y * W + (size_t)x;
             int got = img->rgba[4 * i + 3] != 0;
-            covered += got;
-            if (got && fabs(img->depth[i] - k_dist) > 1e-5 * k_dist)
-                ++bad_depth;
+            c.covered += got;
+            if (got != want)
+                c.max_wrong_px = fmax(c.max_wrong_px, d * px_per_uv);
             if (d * px_per_uv <= 1.0) {
-                ++band;
+                ++c.band;
                 continue;
             }
-            ++checked;
+            ++c.checked;
+            if (got && fabs(img->depth[i] - v->dist) > 1e-5 * v->dist)
+                ++c.bad_depth;
             if (got != want) {
-                if (wrong < 10)
+                if (c.wrong < 10)
                     fprintf(stderr,
                             "pixel (%d,%d) uv (%.4f,%.4f) %.2f px from a boundary: "
                             "covered %d, expected %d\n",
                             x, y, uv[0], uv[1], d * px_per_uv, got, want);
-                ++wrong;
+                ++c.wrong;
             }
         }
     }
+    return c;
+}
+
+static int check_frame(const sw_gpu_image *img)
+{
+    const front_view v = {0.0, 0.0, k_dist};
+    frame_check c = check_view(img, &v);
     printf("analytic: %ld pixels checked (%ld within 1 px of a boundary skipped), %ld covered, "
            "%ld misclassified, %ld with wrong depth\n",
-           checked, band, covered, wrong, bad_depth);
-    return wrong == 0 && bad_depth == 0 && covered > W * H / 4;
+           c.checked, c.band, c.covered, c.wrong, c.bad_depth);
+    return c.wrong == 0 && c.bad_depth == 0 && c.covered > W * H / 4;
+}
+
+/* The close-ups: the bolt hole filling the screen, its edge at 10x and 200x (the camera over the
+ * circle's point at 30 degrees), by trim textures and exact edges, fat borders off and on. */
+static int check_close_ups(sw_gpu_context *ctx, const sw_sg_scene *scene)
+{
+    const double centre[2] = {-1.0 + 2.0 * k_circle_c[0], -1.0 + 2.0 * k_circle_c[1]};
+    const double r = 2.0 * k_circle_r, a = M_PI / 6.0;
+    const double fill = 1.15 * r / tan(k_fovy * M_PI / 360.0); /* the hole's diameter in view */
+    const front_view views[3] = {{centre[0], centre[1], fill},
+                                 {centre[0] + r * cos(a), centre[1] + r * sin(a), fill / 10.0},
+                                 {centre[0] + r * cos(a), centre[1] + r * sin(a), fill / 200.0}};
+    static const char *names[3] = {"hole fills the screen", "its edge at 10x", "its edge at 200x"};
+    int ok = 1;
+    printf("close-ups (edge displacement: the farthest misclassified pixel centre from the exact "
+           "boundary):\n");
+    for (int exact = 0; exact < 2; ++exact)
+        for (int borders = 0; borders < 2; ++borders)
+            for (int k = 0; k < 3; ++k) {
+                sw__gpu_set_crack_fill(ctx, borders);
+                sw_gpu_frame_desc desc;
+                memset(&desc, 0, sizeof desc);
+                desc.width = W;
+                desc.height = H;
+                desc.want_depth = 1;
+                desc.trim_edges = exact;
+                desc.camera = (sw_gpu_camera){{views[k].cx, views[k].cy, views[k].dist},
+                                              {views[k].cx, views[k].cy, 0.0},
+                                              {0, 1, 0},
+                                              k_fovy};
+                sw_gpu_image img;
+                sw_gpu_frame_stats fs;
+                sw_status st = {0};
+                if (sw_gpu_render_scene(ctx, scene, &desc, &img, &fs, &st) != SW_OK)
+                    return !fail("close-up render", &st);
+                frame_check c = check_view(&img, &views[k]);
+                const double limit = exact ? (borders ? 0.5 : 0.25) : INFINITY;
+                printf("  %-8s borders %-3s %-22s: %5.3f px (%ld wrong beyond 1 px), %llu trim "
+                       "textures (%llu texels), %llu exact\n",
+                       exact ? "exact" : "texture", borders ? "on" : "off", names[k],
+                       c.max_wrong_px, c.wrong, (unsigned long long)fs.trim_textures,
+                       (unsigned long long)fs.trim_texels, (unsigned long long)fs.trim_exact);
+                if (c.wrong != 0 || c.bad_depth != 0 || !(c.max_wrong_px <= limit) ||
+                    (exact && (fs.trim_exact == 0 || fs.trim_textures != 0)) ||
+                    (!exact && fs.trim_exact != 0)) {
+                    printf("  FAIL: %s %s\n", exact ? "exact" : "texture", names[k]);
+                    ok = 0;
+                }
+                sw_gpu_image_free(&img);
+            }
+    sw__gpu_set_crack_fill(ctx, 1);
+    return ok;
 }
 
 static int check_writes(const sw_gpu_image *img, const char *dir)
@@ -248,6 +333,8 @@ int main(int argc, char **argv)
     int ok = check_frame(&img) && fs.patches_trimmed == 4 && fs.trim_textures >= 1 &&
              fs.trim_textures <= 16;
     if (check_writes(&img, dir))
+        ok = 0;
+    if (!check_close_ups(ctx, scene))
         ok = 0;
     sw_gpu_image_free(&img);
     sw_gpu_context_free(ctx);

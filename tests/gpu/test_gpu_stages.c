@@ -592,6 +592,7 @@ static void check_submit_analytic(sw_gpu_context *ctx)
     sw__gpu_draw d;
     memset(&d, 0, sizeof d);
     d.trim_entry = -1;
+    d.edge_grid = -1;
     memcpy(d.color, rec.color, sizeof d.color);
     g.recs = &rec;
     g.n_recs = 1;

@@ -23,10 +23,11 @@
  * closure_at_view), and is printed either way. Failed views leave their frames and an edge diff
  * in OUTDIR.
  *
- * Usage: test_images [--hierarchy | --static] OUTDIR WIDTHxHEIGHT VIEWS FILE...
+ * Usage: test_images [--hierarchy | --static] [--exact-edges] OUTDIR WIDTHxHEIGHT VIEWS FILE...
  * VIEWS: comma list of whole,mid,close. --hierarchy draws through the bicubic hierarchies;
  * --static also draws super-surfaces from their static LODs where one is fine enough (its
  * declared ε_k within ε_img at its nearest point), so the same criteria check those levels.
+ * --exact-edges: trims by exact edges where a trim texel would be coarse (desc.trim_edges).
  * Env: SW_IMAGES_MAX_TRIANGLES caps the reference mesh (default 1500000); SW_IMAGES_DEBUG=1
  * prints the depths around the first splinewalk edge pixels farther than 1 px.
  */
@@ -370,6 +371,7 @@ reference_plan plan_reference(const model_ctx &m, const basis &b, const sw_gpu_i
 
 bool g_hierarchy = false;             /* --hierarchy: ours through the bicubic hierarchies */
 bool g_static = false;                /* --static: and super-surfaces from their static LODs */
+bool g_exact_edges = false;           /* --exact-edges: desc.trim_edges */
 struct sw_lod_cache *g_cache = nullptr; /* of the file being tested */
 struct sw_lod_static_set *g_statics = nullptr;
 
@@ -380,6 +382,7 @@ bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d_in, sw_gpu_image &out,
     sw_gpu_frame_desc d = d_in;
     d.hierarchies = g_cache;
     d.static_lods = g_statics;
+    d.trim_edges = g_exact_edges;
     auto t0 = std::chrono::steady_clock::now();
     sw_result r = sw_gpu_render_scene(m.gpu, m.scene, &d, &out, &fs, &st);
     ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -715,12 +718,15 @@ int main(int argc, char **argv)
             g_static = g_hierarchy = true; /* static LODs are drawn beside the hierarchies */
         else if (std::strcmp(argv[1], "--hierarchy") == 0)
             g_hierarchy = true;
+        else if (std::strcmp(argv[1], "--exact-edges") == 0)
+            g_exact_edges = true;
         else
             break;
     }
     if (argc < 5) {
         std::fprintf(stderr,
-                     "usage: %s [--hierarchy | --static] OUTDIR WIDTHxHEIGHT whole,mid,close "
+                     "usage: %s [--hierarchy | --static] [--exact-edges] OUTDIR WIDTHxHEIGHT "
+                     "whole,mid,close "
                      "FILE...\n",
                      argv[0]);
         return 2;

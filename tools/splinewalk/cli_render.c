@@ -11,7 +11,7 @@ static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--[no-]static-lod] [--lod-colors]\n"
-    "                         [--static-force K] [--no-occlusion] [--partial]\n"
+    "                         [--static-force K] [--no-occlusion] [--exact-edges] [--partial]\n"
     "                         [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
@@ -56,6 +56,9 @@ static const char k_usage[] =
     "  --no-occlusion      draw what the visible planar faces hide too (by default it is culled\n"
     "                      before it is tessellated, by a depth map of those faces on the\n"
     "                      visibility thread; the image is the same)\n"
+    "  --exact-edges       a trimmed surface whose trim texture would show texels over a quarter\n"
+    "                      pixel is cut per fragment against its trim loops (flattened to an\n"
+    "                      eighth of a pixel) instead: close-ups keep exact edges\n"
     "  --partial           import what is whole of a truncated file (see `import "
     "--help`)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help          this text\n";
 
@@ -88,6 +91,10 @@ static int parse_args(int argc, char **argv, render_args *a)
         }
         if (!strcmp(arg, "--lod-colors")) {
             a->frame.lod_colors = 1;
+            continue;
+        }
+        if (!strcmp(arg, "--exact-edges")) {
+            a->frame.trim_edges = 1;
             continue;
         }
         if (!strcmp(arg, "--static-force") && val) {

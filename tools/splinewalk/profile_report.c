@@ -92,6 +92,7 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_BORDER_LOOPS_KEPT] = (double)st->border_loops_kept;
     v[SW_RT_COL_BORDER_LOOPS_MADE] = (double)st->border_loops_made;
     v[SW_RT_COL_TRIM_TEXTURES] = (double)st->trim_textures;
+    v[SW_RT_COL_TRIM_EXACT] = (double)st->trim_exact;
     v[SW_RT_COL_TRIM_TEXELS] = (double)st->trim_texels;
     v[SW_RT_COL_TRIM_REUSED] = (double)st->trim_reused;
     v[SW_RT_COL_ATLAS_PAGES] = (double)st->atlas_pages;

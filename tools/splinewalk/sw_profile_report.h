@@ -93,6 +93,7 @@ const char *sw_rt_pool_kind_name(int kind);
     X(TRIM_TEXTURES, "trim_textures", COUNT, "trim textures used")                                 \
     X(TRIM_TEXELS, "trim_texels", COUNT, "texels of those trim textures")                          \
     X(TRIM_REUSED, "trim_reused", COUNT, "trim textures kept from earlier frames")                 \
+    X(TRIM_EXACT, "trim_exact", COUNT, "trimmed draws cut by exact edges, not a texture")          \
     X(ATLAS_PAGES, "atlas_pages", COUNT, "trim-atlas pages after the frame")                       \
     X(FALLBACK_DRAWS, "fallback_draws", COUNT, "walkthrough: drawn coarser than asked, queued")    \
     X(POOL_WAITS, "pool_waits", COUNT, "times the frame waited for the worker pool")               \

@@ -389,6 +389,12 @@ typedef struct sw_frame_desc {
                                 1, 3, 7 or 15 frames (the image is the same either way). The
                                 CLI turns it on unless --no-occlusion.
                                 0: frustum and back-patch culling */
+    int32_t trim_edges;        /* 1: exact trim edges — a trimmed surface whose trim texture's
+                                texel would exceed a quarter pixel at its nearest point is cut
+                                per fragment against its trim loops, flattened to an eighth of a
+                                pixel on screen, instead of by the texture (close-ups keep
+                                smooth edges at any zoom, and need no large textures); far
+                                surfaces keep their textures. 0: trim textures only */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
@@ -462,6 +468,8 @@ typedef struct sw_frame_stats {
      * spent (sw_renderer_desc.memory_budget_*): trim textures scaled down to the frame's share,
      * hierarchy leaves left unrefined; each is in bound_exceeded too */
     uint64_t budget_coarsened;
+    /* trimmed draws cut by exact trim edges instead of a texture (sw_frame_desc.trim_edges) */
+    uint64_t trim_exact;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
