@@ -651,14 +651,51 @@ static void push_back(const ribbon_ctx *c, const border_point *const e[2], doubl
         }
 }
 
+/* The point of chord keep -> behind (keep in front of the near plane, behind not) just in front
+ * of the near plane, its fields interpolated along the chord (exact on an affine surface), its
+ * loop direction the chord's (dir, in loop order). 0 when there is none. An end behind the near
+ * plane takes no step (nothing of it is on screen), so a ribbon tapered to nothing along the
+ * visible part of a loop segment reaching past the near plane: a plane seen from near its far
+ * edge showed a crack pixel there once trim textures no longer grew faces by a texel. What lies
+ * nearer than the plane is clipped anyway. */
+static int clip_to_near(const sw__gpu_view *v, const border_point *keep, const border_point *behind,
+                        const double dir[2], border_point *out)
+{
+    const double za = depth_of(v, keep->p), zb = depth_of(v, behind->p);
+    const double z = v->near_plane * (1.0 + 1e-4);
+    if (!(za > z) || !(zb < za))
+        return 0;
+    const double t = (za - z) / (za - zb), k = 1.0 - t;
+    for (int i = 0; i < 3; ++i) {
+        out->p[i] = k * keep->p[i] + t * behind->p[i];
+        out->n[i] = k * keep->n[i] + t * behind->n[i];
+        out->in[i] = k * keep->in[i] + t * behind->in[i];
+    }
+    for (int i = 0; i < 2; ++i) {
+        out->uv[i] = k * keep->uv[i] + t * behind->uv[i];
+        out->in_uv[i] = k * keep->in_uv[i] + t * behind->in_uv[i];
+        out->d_prev[i] = out->d_next[i] = dir[i];
+    }
+    out->in_front = screen_of(v, out->p, out->scr);
+    return out->in_front;
+}
+
 /* One quad per loop segment, from k_outer x width_px outside the loop (outer_point) to the inner
- * points, across the loop's image (across_loop), pushed back (push_back). Quads of consecutive
- * segments share their points on the loop on screen; their inner edges are not joined, which
- * keeps a sharp corner of the loop from folding a quad across it. */
+ * points, across the loop's image (across_loop), pushed back (push_back); an end behind the near
+ * plane moved to it (clip_to_near). Quads of consecutive segments share their points on the loop
+ * on screen; their inner edges are not joined, which keeps a sharp corner of the loop from
+ * folding a quad across it. */
 static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, sw__gpu_mesh *mesh)
 {
     for (size_t i = 0; i < n; ++i) {
         const border_point *e[2] = {&bp[i], &bp[(i + 1) % n]};
+        border_point clipped;
+        if (e[0]->in_front != e[1]->in_front) {
+            const int b = e[0]->in_front; /* the end behind */
+            const double dir[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
+            if (clip_to_near(c->v, e[1 - b], e[b], dir, &clipped))
+                e[b] = &clipped;
+        }
         double t[3] = {e[1]->p[0] - e[0]->p[0], e[1]->p[1] - e[0]->p[1], e[1]->p[2] - e[0]->p[2]};
         const double t_uv[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
         double q[2][2][3], step[2][2], dir_uv[2][2];

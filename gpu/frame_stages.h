@@ -219,7 +219,8 @@ sw_result sw__fr_select(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw__f
                         sw__fr_selection *sel, sw_gpu_frame_stats *st, sw_status *status);
 void sw__fr_selection_free(sw__fr_selection *sel);
 void sw__fr_selection_empty(sw__fr_selection *sel); /* counts zeroed, arrays kept */
-/* LOD colouring: static level k (fine -> coarse), or -1 for the per-frame path. */
+/* LOD colouring: static level k (fine -> coarse), -1 for the per-frame path, -2 for per-frame
+ * draws cut by exact trim edges. */
 void sw__fr_lod_color(int32_t level, float out[4]);
 /* The object-space tolerance of a unit under transform m at the view (frame-static's rule:
  * ε_img at the nearest depth of its box, over the transform's stretch), and its screen extent. */

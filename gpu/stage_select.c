@@ -32,10 +32,13 @@ static const float k_level_colors[6][4] = {
     {0.80f, 0.75f, 0.20f, 1.0f}, {0.90f, 0.50f, 0.15f, 1.0f}, {0.85f, 0.25f, 0.55f, 1.0f},
 };
 static const float k_dynamic_color[4] = {0.75f, 0.75f, 0.78f, 1.0f};
+static const float k_exact_edges_color[4] = {0.68f, 0.55f, 0.90f, 1.0f};
 
 void sw__fr_lod_color(int32_t level, float out[4])
 {
-    const float *c = level < 0 ? k_dynamic_color : k_level_colors[level > 5 ? 5 : level];
+    const float *c = level == -2 ? k_exact_edges_color
+                     : level < 0 ? k_dynamic_color
+                                 : k_level_colors[level > 5 ? 5 : level];
     memcpy(out, c, 4 * sizeof *out);
 }
 

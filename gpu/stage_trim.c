@@ -159,6 +159,8 @@ static sw_result plan_exact(sw__fr_tess *t, size_t i, int32_t max_entry, sw_stat
                               status);
     if (r == SW_OK && p->grid >= 0) {
         t->geo->draws[p->draw].edge_grid = p->grid;
+        if (env->lod_colors)
+            sw__fr_lod_color(-2, t->geo->draws[p->draw].color);
         t->st->trim_exact++;
     } else if (r == SW_OK) {
         t->st->trim_exact_fallbacks++;

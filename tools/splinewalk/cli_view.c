@@ -47,7 +47,10 @@ static const char k_usage[] =
     "  O             occlusion culling on / off: what visible planar faces hide is not drawn\n"
     "                (on unless --no-occlusion; the image is the same, the frame cheaper)\n"
     "  C             LOD colouring on / off: static levels fine to coarse blue, teal, green,\n"
-    "                yellow, orange, pink; per-frame tessellation grey\n"
+    "                yellow, orange, pink; per-frame tessellation grey, violet where cut by\n"
+    "                exact trim edges\n"
+    "  X             exact trim edges on / off: close-up trims cut per fragment by their\n"
+    "                loops instead of trim textures (--exact-edges)\n"
     "  A             trim-atlas overlay: the next page of the trim-texture atlas in the upper\n"
     "                right corner (white: inside the trimmed surface), then off\n"
     "  F             frame-time overlay on / off (bars of the last 120 frames, marks at 60 and\n"
@@ -80,6 +83,7 @@ static const char k_usage[] =
     "                    from the scene's `build-lod` cache, else built in the pool as\n"
     "                    needed, which is said on stderr; --static-lod is the default)\n"
     "  --lod-colors      start with LOD colouring on (C toggles it)\n"
+    "  --exact-edges     start with exact trim edges on, as for `render` (X toggles them)\n"
     "  --atlas-overlay   start with the trim atlas's first page shown (A cycles the "
     "pages)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help        this text\n";
 
@@ -87,7 +91,7 @@ typedef struct view_args {
     const char *scene, *record, *script, *screenshot, *profile;
     int32_t w, h;
     int frames, settle, overlay, wireframe, static_lods, no_static_lods, lod_colors, atlas_overlay,
-        no_occlusion, converged;
+        no_occlusion, converged, exact_edges;
     double error_px, speed;
     uint64_t budget_host, budget_gpu; /* --memory-budget; 0 = the default */
 } view_args;
@@ -134,6 +138,7 @@ static int parse_args(int argc, char **argv, view_args *a)
                     : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
                     : !strcmp(arg, "--no-occlusion")  ? &a->no_occlusion
                     : !strcmp(arg, "--converged")     ? &a->converged
+                    : !strcmp(arg, "--exact-edges")   ? &a->exact_edges
                                                       : NULL;
         if (flag) {
             *flag = 1;
@@ -236,7 +241,7 @@ typedef struct viewer {
     sw_cli_overlay overlay;
     sw_cli_atlas_view atlas;
     sw_renderer renderer;
-    int wireframe, static_lods, lod_colors, occlusion;
+    int wireframe, static_lods, lod_colors, occlusion, exact_edges;
 } viewer;
 
 static void record_key(viewer *v)
@@ -282,6 +287,8 @@ static void on_key(GLFWwindow *win, int key, int scancode, int action, int mods)
         v->occlusion = !v->occlusion;
     else if (key == GLFW_KEY_C)
         v->lod_colors = !v->lod_colors;
+    else if (key == GLFW_KEY_X)
+        v->exact_edges = !v->exact_edges;
     else if (key == GLFW_KEY_A) {
         uint32_t tex;
         int32_t pages, side;
@@ -353,6 +360,7 @@ static sw_frame_desc frame_desc(sw_scene scene, const viewer *v, int converged, 
     fd.wireframe = v->wireframe;
     fd.static_lods = v->static_lods;
     fd.lod_colors = v->lod_colors;
+    fd.trim_edges = v->exact_edges;
     fd.occlusion_culling = v->occlusion;
     fd.output_path = output;
     return fd;
@@ -587,7 +595,8 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
                 .wireframe = a->wireframe,
                 .static_lods = !a->no_static_lods,
                 .lod_colors = a->lod_colors,
-                .occlusion = !a->no_occlusion};
+                .occlusion = !a->no_occlusion,
+                .exact_edges = a->exact_edges};
     if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)
         return sw_cli_report("view", &st);
     walker_look_from(&v.wk, &v.home);

@@ -353,7 +353,8 @@ typedef struct sw_frame_desc {
                                 per-frame path. Walkthrough frames never wait for the builds;
                                 converged frames do. 0: every face by the per-frame path */
     int32_t lod_colors;      /* 1: each surface coloured by how it is drawn: static levels fine
-                                to coarse blue, teal, green, yellow, orange, pink; per-frame grey */
+                                to coarse blue, teal, green, yellow, orange, pink; per-frame grey,
+                                violet where cut by exact trim edges (trim_edges) */
     int32_t static_force;    /* tests of the joins: k > 0 draws super-surface i at choice
                                 (i + k) mod (n + 1) among its n levels good enough for the view,
                                 the last choice meaning the per-frame path: neighbours at
