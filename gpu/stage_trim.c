@@ -80,9 +80,11 @@ double sw__fr_trim_flat_tol(const sw__fr_env *env, double extent, double need, i
                             int32_t max_entry)
 {
     double tol = 0.5 * extent / sw__fr_class_texels(need, max_entry);
-    /* need texels of extent / need each keep the surface within ε_img px (§5.3) */
-    if (exact && need > 0.0)
-        tol = fmin(tol, k_exact_flat_px / env->eps_px * extent / need);
+    /* need texels of extent / need each keep the surface within ε_img px (§5.3); rounded down to
+     * a power of two of the extent, so that a face seen again at a similar size asks for the same
+     * loops (the border cache's key) rather than new ones every frame */
+    if (exact && need > 0.0 && extent > 0.0)
+        tol = fmin(tol, extent * exp2(floor(log2(k_exact_flat_px / env->eps_px / need))));
     return tol;
 }
 

@@ -48,6 +48,7 @@ typedef struct bp_job {
                 2 = walk at eye height 160 (sw_rt_path_walk: a generated building's rooms) */
     int static_lods; /* splinewalk: sw_frame_desc.static_lods (Kumar et al. 1997 static LODs) */
     int occlusion;   /* splinewalk: sw_frame_desc.occlusion_culling */
+    int exact_edges; /* splinewalk: sw_frame_desc.trim_edges */
     uint32_t frames, warmup_passes, passes;
     int32_t width, height;
     double error_px;

@@ -68,6 +68,8 @@ static const char k_usage[] =
     "                  CLI's walkthroughs)\n"
     "  --no-occlusion  splinewalk without occlusion culling (sw_frame_desc.occlusion_culling:\n"
     "                  what the visible planar faces hide is culled; default: on, as in the CLI)\n"
+    "  --no-exact-edges  splinewalk with trim textures only (sw_frame_desc.trim_edges: close-up\n"
+    "                  trims cut per fragment by their loops; default: on, as in the CLI)\n"
     "  --glibc-malloc  every peer with glibc's default trim and mmap thresholds; by default\n"
     "                  they are raised for all peers alike, as `splinewalk` does and\n"
     "                  docs/embedding.md advises (llvmpipe frees megabytes every frame)\n"
@@ -80,7 +82,7 @@ static const bp_peer_fn k_peer_fns[N_PEERS] = {bp_peer_splinewalk, bp_peer_glu, 
 
 typedef struct args {
     int use[N_PEERS];
-    int static_lods, occlusion, glibc_malloc;
+    int static_lods, occlusion, exact_edges, glibc_malloc;
     uint32_t frames, warmup, passes;
     int32_t w, h;
     double error_px;
@@ -115,7 +117,8 @@ static int parse(int argc, char **argv, args *a)
                 .h = 720,
                 .error_px = 0.5,
                 .static_lods = 1,
-                .occlusion = 1};
+                .occlusion = 1,
+                .exact_edges = 1};
     a->scenes = calloc((size_t)argc, sizeof *a->scenes);
     for (int i = 1; i < argc && a->scenes; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -132,6 +135,10 @@ static int parse(int argc, char **argv, args *a)
         }
         if (!strcmp(o, "--occlusion") || !strcmp(o, "--no-occlusion")) {
             a->occlusion = !strcmp(o, "--occlusion");
+            continue;
+        }
+        if (!strcmp(o, "--exact-edges") || !strcmp(o, "--no-exact-edges")) {
+            a->exact_edges = !strcmp(o, "--exact-edges");
             continue;
         }
         if (o[0] != '-') {
@@ -257,7 +264,8 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
                   .height = a->h,
                   .error_px = a->error_px,
                   .static_lods = a->static_lods,
-                  .occlusion = a->occlusion};
+                  .occlusion = a->occlusion,
+                  .exact_edges = a->exact_edges};
     sw_rt_camera_path path;
     memset(&path, 0, sizeof path);
     if (bp_job_path(&job, a->path_file, &path, err, sizeof err) != 0) {
@@ -272,11 +280,12 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
             fprintf(stderr, "bench_peers: %s: %s: %s\n", scene, k_peer_names[p], res[p].note);
             failed = 1;
         }
-    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s%s\n", scene,
-           job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
+    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s%s%s\n",
+           scene, job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
            a->path_file ? a->path_file : "orbit of the scene box",
            a->static_lods ? "" : "; splinewalk without static LODs",
-           a->occlusion ? "" : "; splinewalk without occlusion culling");
+           a->occlusion ? "" : "; splinewalk without occlusion culling",
+           a->exact_edges ? "" : "; splinewalk with trim textures only");
     printf("  peer       |  frame ms: median      p99 | first (ms) | peak RSS MB | triangles | "
            "splinewalk / peer: median p99 first RSS triangles\n");
     for (int p = 0; p < N_PEERS; ++p)

@@ -50,6 +50,7 @@ static const char k_usage[] =
     "  --walk           the walk `splinewalk path walk` makes (eye height 160, through the\n"
     "                   ground floor's rooms) instead of the orbit\n"
     "  --no-occlusion   without occlusion culling (default: on, as in the CLI)\n"
+    "  --no-exact-edges with trim textures only (default: exact trim edges, as in the CLI)\n"
     "  --dir DIR        where the scenes are generated (default bench-scaling-scenes)\n"
     "  --splinewalk B   the CLI that generates them (default: splinewalk beside this program)\n"
     "  --csv FILE       the rows as CSV (default: none; written aside, then renamed)\n"
@@ -63,7 +64,7 @@ typedef struct args {
     double error_px;
     const char *dir, *csv, *svg;
     int fly; /* bp_job.fly: 0 orbit, 1 fly-through, 2 walk */
-    int no_occlusion;
+    int no_occlusion, no_exact_edges;
     char splinewalk[PATH_MAX];
 } args;
 
@@ -74,8 +75,15 @@ static const char *path_name(int fly)
 
 static int parse(int argc, char **argv, args *a)
 {
-    *a = (args){1000, 100000, 120, 1, 1, 1280, 720, 0.5, "bench-scaling-scenes",
-                NULL, NULL,   0,   0, ""};
+    *a = (args){.min_n = 1000,
+                .max_n = 100000,
+                .frames = 120,
+                .warmup = 1,
+                .passes = 1,
+                .w = 1280,
+                .h = 720,
+                .error_px = 0.5,
+                .dir = "bench-scaling-scenes"};
     for (int i = 1; i < argc; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(o, "-h") || !strcmp(o, "--help"))
@@ -86,6 +94,10 @@ static int parse(int argc, char **argv, args *a)
         }
         if (!strcmp(o, "--no-occlusion")) {
             a->no_occlusion = 1;
+            continue;
+        }
+        if (!strcmp(o, "--no-exact-edges")) {
+            a->no_exact_edges = 1;
             continue;
         }
         if (!v)
@@ -241,12 +253,13 @@ int main(int argc, char **argv)
         return 1;
     }
     const char *lp = getenv("LP_NUM_THREADS"), *egl = getenv("EGL_PLATFORM");
-    printf("bench_scaling: %s of each box, %dx%d, eps_img %g px, occlusion culling %s, %u frames "
+    printf("bench_scaling: %s of each box, %dx%d, eps_img %g px, occlusion culling %s, exact trim "
+           "edges %s, %u frames "
            "x %u counted passes after %u warm-up, "
            "LP_NUM_THREADS=%s, EGL_PLATFORM=%s, %ld processors online\n",
-           path_name(a.fly), a.w, a.h, a.error_px, a.no_occlusion ? "off" : "on", a.frames,
-           a.passes, a.warmup, lp ? lp : "(unset)", egl ? egl : "(unset)",
-           sysconf(_SC_NPROCESSORS_ONLN));
+           path_name(a.fly), a.w, a.h, a.error_px, a.no_occlusion ? "off" : "on",
+           a.no_exact_edges ? "off" : "on", a.frames, a.passes, a.warmup, lp ? lp : "(unset)",
+           egl ? egl : "(unset)", sysconf(_SC_NPROCESSORS_ONLN));
     printf("  surfaces | occurrences | scene MB | frame ms: median     p99 | first (ms) | peak RSS "
            "MB | triangles\n");
     uint64_t ns[16];
@@ -260,6 +273,7 @@ int main(int argc, char **argv)
         bp_job job = {.scene = scene,
                       .fly = a.fly,
                       .occlusion = !a.no_occlusion,
+                      .exact_edges = !a.no_exact_edges,
                       .frames = a.frames,
                       .warmup_passes = a.warmup,
                       .passes = a.passes,

@@ -87,6 +87,7 @@ static int render_views(sw_scene scene, const demo_args *a)
         frame.error_px = a->error_px;
         frame.output_path = path;
         frame.occlusion_culling = 1;
+        frame.trim_edges = 1;
         frame.camera = k_inside;
         sw_result r = SW_OK;
         if (k_views[i].preset >= 0)

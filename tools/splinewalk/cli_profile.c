@@ -20,7 +20,7 @@ static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
     "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--lod-colors]\n"
-    "                          [--no-occlusion] [--exact-edges] [--memory-budget HOST[,GPU]]\n"
+    "                          [--no-occlusion] [--no-exact-edges] [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
     "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
@@ -62,8 +62,8 @@ static const char k_usage[] =
     "                    on stderr); static_drawn, static_faces, static_triangles,\n"
     "                    static_requests columns\n"
     "  --lod-colors      colour by representation, as for `render`\n"
-    "  --exact-edges     exact trim edges where a trim texel would exceed a quarter pixel, as\n"
-    "                    for `render` (trim_exact column)\n"
+    "  --no-exact-edges  trim textures only (by default exact trim edges where a trim texel\n"
+    "                    would exceed a quarter pixel, as for `render`: trim_exact column)\n"
     "  --no-occlusion    draw what visible planar faces hide too (culled by default, as for\n"
     "                    `render`: occlusion_tests, nodes_occluded, faces_occluded columns; a\n"
     "                    frame that hides nothing makes the next 1, 3, 7 or 15 go without "
@@ -123,8 +123,8 @@ static int parse_args(int argc, char **argv, profile_args *a)
             a->frame.lod_colors = 1;
             continue;
         }
-        if (!strcmp(arg, "--exact-edges")) {
-            a->frame.trim_edges = 1;
+        if (!strcmp(arg, "--exact-edges") || !strcmp(arg, "--no-exact-edges")) {
+            a->frame.trim_edges = !strcmp(arg, "--exact-edges");
             continue;
         }
         if (!strcmp(arg, "--converged") || !strcmp(arg, "--sequential")) {
@@ -326,6 +326,7 @@ int sw_cli_profile(int argc, char **argv)
         return 0;
     profile_args a = {0};
     a.frame.occlusion_culling = 1;
+    a.frame.trim_edges = 1;
     a.frame.static_lods = 1;
     int rc = parse_args(argc, argv, &a);
     if (rc)

@@ -11,7 +11,7 @@ static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--[no-]static-lod] [--lod-colors]\n"
-    "                         [--static-force K] [--no-occlusion] [--exact-edges] [--partial]\n"
+    "                         [--static-force K] [--no-occlusion] [--no-exact-edges] [--partial]\n"
     "                         [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
@@ -50,16 +50,17 @@ static const char k_usage[] =
     "  --no-static-lod     every face by the per-frame path, LOD cache or not\n"
     "  --lod-colors        colour each surface by how it is drawn: static levels fine to coarse\n"
     "                      blue, teal, green, yellow, orange, pink; per-frame tessellation grey,\n"
-    "                      violet where cut by exact trim edges (--exact-edges)\n"
+    "                      violet where cut by exact trim edges\n"
     "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
     "                      (i + K) mod (n + 1) of its n levels good enough for the view, the last\n"
     "                      choice meaning per-frame: neighbours at different levels\n"
     "  --no-occlusion      draw what the visible planar faces hide too (by default it is culled\n"
     "                      before it is tessellated, by a depth map of those faces on the\n"
     "                      visibility thread; the image is the same)\n"
-    "  --exact-edges       a trimmed surface whose trim texture would show texels over a quarter\n"
-    "                      pixel is cut per fragment against its trim loops (flattened to an\n"
-    "                      eighth of a pixel) instead: close-ups keep exact edges\n"
+    "  --no-exact-edges    trim textures only (Guthe et al. 2005 §4). By default a trimmed\n"
+    "                      surface whose trim texture would show texels over a quarter pixel is\n"
+    "                      cut per fragment against its trim loops, flattened to an eighth of a\n"
+    "                      pixel, instead (exact edges in close-ups, no large textures)\n"
     "  --partial           import what is whole of a truncated file (see `import "
     "--help`)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help          this text\n";
 
@@ -94,8 +95,8 @@ static int parse_args(int argc, char **argv, render_args *a)
             a->frame.lod_colors = 1;
             continue;
         }
-        if (!strcmp(arg, "--exact-edges")) {
-            a->frame.trim_edges = 1;
+        if (!strcmp(arg, "--exact-edges") || !strcmp(arg, "--no-exact-edges")) {
+            a->frame.trim_edges = !strcmp(arg, "--exact-edges");
             continue;
         }
         if (!strcmp(arg, "--static-force") && val) {
@@ -145,6 +146,7 @@ int sw_cli_render(int argc, char **argv)
     render_args a = {0};
     a.view = SW_VIEW_ISO;
     a.frame.occlusion_culling = 1;
+    a.frame.trim_edges = 1;
     a.frame.static_lods = -1; /* not given: from the scene's LOD cache when it has one */
     int rc = parse_args(argc, argv, &a);
     if (rc)

@@ -50,7 +50,7 @@ static const char k_usage[] =
     "                yellow, orange, pink; per-frame tessellation grey, violet where cut by\n"
     "                exact trim edges\n"
     "  X             exact trim edges on / off: close-up trims cut per fragment by their\n"
-    "                loops instead of trim textures (--exact-edges)\n"
+    "                loops instead of trim textures (on unless --no-exact-edges)\n"
     "  A             trim-atlas overlay: the next page of the trim-texture atlas in the upper\n"
     "                right corner (white: inside the trimmed surface), then off\n"
     "  F             frame-time overlay on / off (bars of the last 120 frames, marks at 60 and\n"
@@ -83,7 +83,8 @@ static const char k_usage[] =
     "                    from the scene's `build-lod` cache, else built in the pool as\n"
     "                    needed, which is said on stderr; --static-lod is the default)\n"
     "  --lod-colors      start with LOD colouring on (C toggles it)\n"
-    "  --exact-edges     start with exact trim edges on, as for `render` (X toggles them)\n"
+    "  --no-exact-edges  start with exact trim edges off: trim textures only, as for `render`\n"
+    "                    (X toggles them)\n"
     "  --atlas-overlay   start with the trim atlas's first page shown (A cycles the "
     "pages)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help        this text\n";
 
@@ -91,7 +92,7 @@ typedef struct view_args {
     const char *scene, *record, *script, *screenshot, *profile;
     int32_t w, h;
     int frames, settle, overlay, wireframe, static_lods, no_static_lods, lod_colors, atlas_overlay,
-        no_occlusion, converged, exact_edges;
+        no_occlusion, converged, no_exact_edges;
     double error_px, speed;
     uint64_t budget_host, budget_gpu; /* --memory-budget; 0 = the default */
 } view_args;
@@ -129,17 +130,17 @@ static int parse_args(int argc, char **argv, view_args *a)
                      .speed = 0.1};
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *val = i + 1 < argc ? argv[i + 1] : NULL;
-        int *flag = !strcmp(arg, "--settle")          ? &a->settle
-                    : !strcmp(arg, "--overlay")       ? &a->overlay
-                    : !strcmp(arg, "--wireframe")     ? &a->wireframe
-                    : !strcmp(arg, "--static-lod")    ? &a->static_lods
-                    : !strcmp(arg, "--no-static-lod") ? &a->no_static_lods
-                    : !strcmp(arg, "--lod-colors")    ? &a->lod_colors
-                    : !strcmp(arg, "--atlas-overlay") ? &a->atlas_overlay
-                    : !strcmp(arg, "--no-occlusion")  ? &a->no_occlusion
-                    : !strcmp(arg, "--converged")     ? &a->converged
-                    : !strcmp(arg, "--exact-edges")   ? &a->exact_edges
-                                                      : NULL;
+        int *flag = !strcmp(arg, "--settle")           ? &a->settle
+                    : !strcmp(arg, "--overlay")        ? &a->overlay
+                    : !strcmp(arg, "--wireframe")      ? &a->wireframe
+                    : !strcmp(arg, "--static-lod")     ? &a->static_lods
+                    : !strcmp(arg, "--no-static-lod")  ? &a->no_static_lods
+                    : !strcmp(arg, "--lod-colors")     ? &a->lod_colors
+                    : !strcmp(arg, "--atlas-overlay")  ? &a->atlas_overlay
+                    : !strcmp(arg, "--no-occlusion")   ? &a->no_occlusion
+                    : !strcmp(arg, "--converged")      ? &a->converged
+                    : !strcmp(arg, "--no-exact-edges") ? &a->no_exact_edges
+                                                       : NULL;
         if (flag) {
             *flag = 1;
             continue;
@@ -596,7 +597,7 @@ static int view_scene(view_args *a, GLFWwindow *win, sw_scene scene,
                 .static_lods = !a->no_static_lods,
                 .lod_colors = a->lod_colors,
                 .occlusion = !a->no_occlusion,
-                .exact_edges = a->exact_edges};
+                .exact_edges = !a->no_exact_edges};
     if (sw_camera_fit(scene, SW_VIEW_ISO, &v.home, &st) != SW_OK)
         return sw_cli_report("view", &st);
     walker_look_from(&v.wk, &v.home);
