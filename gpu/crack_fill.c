@@ -651,18 +651,18 @@ static void push_back(const ribbon_ctx *c, const border_point *const e[2], doubl
         }
 }
 
-/* The point of chord keep -> behind (keep in front of the near plane, behind not) just in front
- * of the near plane, its fields interpolated along the chord (exact on an affine surface), its
- * loop direction the chord's (dir, in loop order). 0 when there is none. An end behind the near
- * plane takes no step (nothing of it is on screen), so a ribbon tapered to nothing along the
- * visible part of a loop segment reaching past the near plane: a plane seen from near its far
- * edge showed a crack pixel there once trim textures no longer grew faces by a texel. What lies
- * nearer than the plane is clipped anyway. */
+/* The point of chord keep -> behind (keep in front of the near plane, behind not) at depth
+ * near_plane x (1 + margin), its fields interpolated along the chord (exact on an affine
+ * surface), its loop direction the chord's (dir, in loop order). 0 when there is none. An end
+ * behind the near plane takes no step (nothing of it is on screen), so a ribbon tapered to nothing
+ * along the visible part of a loop segment reaching past the near plane: a plane seen from near
+ * its far edge showed a crack pixel there once trim textures no longer grew faces by a texel. What
+ * lies nearer than the plane is clipped anyway. */
 static int clip_to_near(const sw__gpu_view *v, const border_point *keep, const border_point *behind,
-                        const double dir[2], border_point *out)
+                        const double dir[2], double margin, border_point *out)
 {
     const double za = depth_of(v, keep->p), zb = depth_of(v, behind->p);
-    const double z = v->near_plane * (1.0 + 1e-4);
+    const double z = v->near_plane * (1.0 + margin);
     if (!(za > z) || !(zb < za))
         return 0;
     const double t = (za - z) / (za - zb), k = 1.0 - t;
@@ -680,46 +680,76 @@ static int clip_to_near(const sw__gpu_view *v, const border_point *keep, const b
     return out->in_front;
 }
 
+/* A quad's two ends: outer [0] and inner [1] points, their steps along dir_uv, and the first-order
+ * step h that reaches width_px across. */
+typedef struct quad_ends {
+    double q[2][2][3], step[2][2], dir_uv[2][2], h[2];
+} quad_ends;
+
+static void quad_ends_of(const ribbon_ctx *c, const border_point *const e[2], quad_ends *qe)
+{
+    double t[3] = {e[1]->p[0] - e[0]->p[0], e[1]->p[1] - e[0]->p[1], e[1]->p[2] - e[0]->p[2]};
+    const double t_uv[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
+    for (int end = 0; end < 2; ++end) {
+        const loop_image li = loop_image_of(e[end], e[1 - end]);
+        const across_step a =
+            across_loop(c->v, e[end]->p, t, t_uv, e[0]->in, e[0]->in_uv, c->width_px);
+        memcpy(qe->dir_uv[end], a.dir_uv, sizeof a.dir_uv);
+        qe->h[end] = a.h;
+        qe->step[end][1] = inner_point(c, e[end], &li, a.dir_uv, a.h, qe->q[end][1]);
+        qe->step[end][0] = outer_point(c, e[end], &li, &a, qe->q[end][0]);
+    }
+}
+
+/* A quad's ends with an end behind the near plane moved in front of it (clip_to_near): at the
+ * plane, or farther when the step into the face from there runs back behind it (it is then cut
+ * short): the margins tried in turn. */
+static void quad_ends_clipped(const ribbon_ctx *c, const border_point *const e_in[2],
+                              border_point *clipped, const border_point **e, quad_ends *qe)
+{
+    static const double k_margins[] = {1e-4, 1e-3, 1e-2, 5e-2};
+    const int n = (int)(sizeof k_margins / sizeof k_margins[0]);
+    e[0] = e_in[0];
+    e[1] = e_in[1];
+    const int b = e_in[0]->in_front; /* the end behind */
+    const double dir[2] = {e_in[1]->uv[0] - e_in[0]->uv[0], e_in[1]->uv[1] - e_in[0]->uv[1]};
+    for (int k = 0; k < n; ++k) {
+        e[b] = clip_to_near(c->v, e_in[1 - b], e_in[b], dir, k_margins[k], clipped) ? clipped
+                                                                                    : e_in[b];
+        quad_ends_of(c, e, qe);
+        if (e[b] != clipped || !(qe->step[b][1] < 0.5 * qe->h[b]))
+            return;
+    }
+}
+
 /* One quad per loop segment, from k_outer x width_px outside the loop (outer_point) to the inner
  * points, across the loop's image (across_loop), pushed back (push_back); an end behind the near
- * plane moved to it (clip_to_near). Quads of consecutive segments share their points on the loop
- * on screen; their inner edges are not joined, which keeps a sharp corner of the loop from
- * folding a quad across it. */
+ * plane moved in front of it (quad_ends_clipped). Quads of consecutive segments share their points
+ * on the loop on screen; their inner edges are not joined, which keeps a sharp corner of the loop
+ * from folding a quad across it. */
 static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, sw__gpu_mesh *mesh)
 {
     for (size_t i = 0; i < n; ++i) {
-        const border_point *e[2] = {&bp[i], &bp[(i + 1) % n]};
+        const border_point *e_in[2] = {&bp[i], &bp[(i + 1) % n]}, *e[2] = {e_in[0], e_in[1]};
         border_point clipped;
-        if (e[0]->in_front != e[1]->in_front) {
-            const int b = e[0]->in_front; /* the end behind */
-            const double dir[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
-            if (clip_to_near(c->v, e[1 - b], e[b], dir, &clipped))
-                e[b] = &clipped;
-        }
-        double t[3] = {e[1]->p[0] - e[0]->p[0], e[1]->p[1] - e[0]->p[1], e[1]->p[2] - e[0]->p[2]};
-        const double t_uv[2] = {e[1]->uv[0] - e[0]->uv[0], e[1]->uv[1] - e[0]->uv[1]};
-        double q[2][2][3], step[2][2], dir_uv[2][2];
-        for (int end = 0; end < 2; ++end) {
-            const loop_image li = loop_image_of(e[end], e[1 - end]);
-            const across_step a =
-                across_loop(c->v, e[end]->p, t, t_uv, e[0]->in, e[0]->in_uv, c->width_px);
-            memcpy(dir_uv[end], a.dir_uv, sizeof a.dir_uv);
-            step[end][1] = inner_point(c, e[end], &li, a.dir_uv, a.h, q[end][1]);
-            step[end][0] = outer_point(c, e[end], &li, &a, q[end][0]);
-        }
-        push_back(c, e, q);
+        quad_ends qe;
+        if (e_in[0]->in_front != e_in[1]->in_front)
+            quad_ends_clipped(c, e_in, &clipped, e, &qe);
+        else
+            quad_ends_of(c, e, &qe);
+        push_back(c, e, qe.q);
         uint32_t base = (uint32_t)mesh->n_v;
         for (int end = 0; end < 2; ++end) {
             for (int side = 0; side < 2; ++side) {
                 sw__gpu_vertex *o = &mesh->v[mesh->n_v++];
                 for (int k = 0; k < 3; ++k) {
-                    o->pos[k] = (float)q[end][side][k];
+                    o->pos[k] = (float)qe.q[end][side][k];
                     o->nrm[k] = (float)e[end]->n[k];
                 }
                 o->st[0] = o->st[1] = 0.0f;
                 if (c->st_box) { /* inner point: its exact (u, v); outer: to first order */
-                    const double *b = c->st_box, *d = dir_uv[end];
-                    double s = step[end][side];
+                    const double *b = c->st_box, *d = qe.dir_uv[end];
+                    double s = qe.step[end][side];
                     o->st[0] = (float)((e[end]->uv[0] + s * d[0] - b[0]) / (b[1] - b[0]));
                     o->st[1] = (float)((e[end]->uv[1] + s * d[1] - b[2]) / (b[3] - b[2]));
                 }

@@ -249,6 +249,20 @@ void sw__gpu_host_state_save(sw__gpu_host_state *s)
     set_defaults(s);
 }
 
+/* A saved name, or 0 when the renderer deleted that object meanwhile (the host may have bound one
+ * of the renderer's: a tool showing the trim atlas binds its texture, which the atlas replaces
+ * when it grows or shrinks). GL unbinds a deleted object itself; binding its name again would be
+ * GL_INVALID_OPERATION. */
+static GLuint alive_texture(GLint name)
+{
+    return name && glIsTexture((GLuint)name) ? (GLuint)name : 0;
+}
+
+static GLuint alive_buffer(GLint name)
+{
+    return name && glIsBuffer((GLuint)name) ? (GLuint)name : 0;
+}
+
 static void restore_bindings(const sw__gpu_host_state *s)
 {
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)s->draw_fb);
@@ -257,22 +271,23 @@ static void restore_bindings(const sw__gpu_host_state *s)
     glUseProgram((GLuint)s->program);
     /* The element buffer is the vertex array's: bound after it. */
     glBindVertexArray((GLuint)s->vao);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, (GLuint)s->element_buffer);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, alive_buffer(s->element_buffer));
     /* Indexed first: binding a range also sets the generic binding point. */
     for (int t = 0; t < 2; t++)
         for (GLuint i = 0; i < (GLuint)s->n_indexed[t]; i++) {
             const sw__gpu_host_range *r = &s->indexed[t][i];
-            if (r->buffer && r->size > 0)
-                glBindBufferRange(k_indexed[t][0], i, (GLuint)r->buffer, (GLintptr)r->start,
+            const GLuint buffer = alive_buffer((GLint)r->buffer);
+            if (buffer && r->size > 0)
+                glBindBufferRange(k_indexed[t][0], i, buffer, (GLintptr)r->start,
                                   (GLsizeiptr)r->size);
             else
-                glBindBufferBase(k_indexed[t][0], i, (GLuint)r->buffer);
+                glBindBufferBase(k_indexed[t][0], i, buffer);
         }
     for (int i = 0; i < SW__GPU_HOST_BUFFERS; i++)
-        glBindBuffer(k_buffers[i][0], (GLuint)s->buffers[i]);
+        glBindBuffer(k_buffers[i][0], alive_buffer(s->buffers[i]));
     glActiveTexture(GL_TEXTURE0);
     for (int i = 0; i < SW__GPU_HOST_TEXTURES; i++)
-        glBindTexture(k_textures[i][0], (GLuint)s->textures[i]);
+        glBindTexture(k_textures[i][0], alive_texture(s->textures[i]));
     glBindSampler(0, (GLuint)s->sampler);
     glActiveTexture((GLenum)s->active_texture);
 }

@@ -46,10 +46,11 @@
  * gamma-encoded colour). SW_GLSL_FRAGMENT_LIBRARY gives it two functions to call:
  *     bool sw_trim_inside(sampler2DArray atlas, vec2 st, vec4 rect, float layer);
  *     vec4 sw_shade_library(vec3 pos, vec3 normal, vec2 uv, vec4 color);
- * (the trim-texture lookup of §4.3, which main has already applied, and the library's headlight
- * shading). Names starting with sw_, u_, v_ and o_ are the library's.
+ * (the trim lookup of §4.3 — a trim texture, or with sw_frame_desc.trim_edges exact edges read
+ * from storage buffers — which main has already applied, and the library's headlight shading).
+ * Names starting with sw_, u_, v_ and o_ (and the GLSL blocks SwEdge*) are the library's.
  * Bindings: the library uses texture unit 0 (the trim atlas, sampler u_trim) and shader storage
- * bindings 0-5; a host shader samples its own textures from units 1 and up, bound by the host
+ * bindings 0-8; a host shader samples its own textures from units 1 and up, bound by the host
  * before the draw (the library does not touch other units, and gives the active unit back).
  * Host uniforms are set with glProgramUniform* on the programs sw_renderer_shading_programs
  * lists; they keep their values across draws until the shading is replaced. Other GL state
@@ -128,7 +129,8 @@ SW_API sw_result sw_renderer_draw_nurbs(sw_renderer renderer, const sw_immediate
 /* ---- GLSL for host shaders ------------------------------------------------------------------- */
 typedef enum sw_glsl_kind {
     SW_GLSL_FRAGMENT_INTERFACE = 0,     /* #version 430 core, the inputs v_rel, v_nrm, v_st, v_uv,
-                                           v_color, v_trim_rect, v_trim_layer, sampler u_trim, output
+                                           v_color, v_trim_rect, v_trim_layer, sampler u_trim, the
+                                           exact trim edges' storage blocks (bindings 6-8), output
                                            o_color */
     SW_GLSL_FRAGMENT_LIBRARY = 1,       /* sw_trim_inside (§4.3) and sw_shade_library */
     SW_GLSL_FRAGMENT_DEFAULT_SHADE = 2, /* the sw_shade used without a host's */
