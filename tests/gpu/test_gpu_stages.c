@@ -16,7 +16,10 @@
  *    and lie in the face's trim box; after the atlas every trimmed draw has an entry of the
  *    planned size; the side of a loop its fat border covers is the face's for thin bands, holes
  *    and islands in either orientation (a probe a fixed fraction of the longest edge off the loop
- *    lands beyond a band 2π long and 0.002 wide: the ribbon then covers the outside);
+ *    lands beyond a band 2π long and 0.002 wide: the ribbon then covers the outside); with
+ *    exact trim edges every trim has a grid set on its draw (cells and segments inside the
+ *    frame's arrays, as many as counted) or a texture class, never both, and the chained stages
+ *    equal sw_gpu_render_scene's image (planted: the grid not set on its draw → fails);
  *  - chunks: the tessellation split among the pool's workers is the one thread's byte for byte,
  *    for per-frame faces and, with static LODs, for units at a static level with their borders;
  *  - submit: the stages chained by hand give the image sw_gpu_render_scene gives, byte for byte;
@@ -341,6 +344,39 @@ static void check_trim_plan(const stages *s, const char *name)
     CHECK(stray == 0, "%s: %zu loop vertices outside their face's trim box", name, stray);
 }
 
+/* With exact trim edges (desc.trim_edges): every trim either has a grid, set on its draw, whose
+ * cells and segments lie in the frame's arrays, or (too coarse a texel would not show) a texture
+ * class; at least one has a grid, and the grids take no atlas footprint. */
+static void check_exact_plan(const stages *s, const char *name)
+{
+    const sw__fr_geometry *g = &s->geo;
+    const sw__gpu_edge_grids *e = &g->edges;
+    size_t exact = 0, bad = 0;
+    for (size_t i = 0; i < g->n_trims; ++i) {
+        const pending_trim *p = &g->trims[i];
+        if (p->grid < 0) {
+            bad += p->w <= 0 || p->h <= 0 || g->draws[p->draw].edge_grid >= 0;
+            continue;
+        }
+        ++exact;
+        const sw__gpu_edge_grid *h = (size_t)p->grid < e->n_grids ? &e->grids[p->grid] : NULL;
+        bad += !h || g->draws[p->draw].edge_grid != p->grid;
+        if (!h)
+            continue;
+        const size_t n_cells = (size_t)h->n[0] * h->n[1];
+        bad += h->first_cell + n_cells > e->n_cells;
+        for (size_t c = 0; c < n_cells && h->first_cell + n_cells <= e->n_cells; ++c) {
+            const uint32_t *cell = &e->cells[2 * (h->first_cell + c)];
+            bad += (size_t)cell[0] + (cell[1] >> 4) > e->n_segs ||
+                   ((cell[1] >> 1) & 7u) >= SW__GPU_EDGE_REFS;
+        }
+    }
+    CHECK(exact > 0 && exact == s->st.trim_exact, "%s: %zu exact trims, %llu counted", name, exact,
+          (unsigned long long)s->st.trim_exact);
+    CHECK(bad == 0, "%s: %zu trims with a grid out of its arrays, or neither grid nor class", name,
+          bad);
+}
+
 static void check_atlas(sw_gpu_context *ctx, const stages *s, const char *name)
 {
     const sw__fr_geometry *g = &s->geo;
@@ -350,11 +386,19 @@ static void check_atlas(sw_gpu_context *ctx, const stages *s, const char *name)
         sw__gpu_trim_rect tr = {0, 0, 0, 0, 0};
         if (id >= 0)
             sw__gpu_atlas_rect(ctx, id, &tr);
-        bad += id < 0 || tr.w != g->trims[i].w || tr.h != g->trims[i].h;
+        if (g->trims[i].grid >= 0) /* exact edges: no texture */
+            bad += id >= 0;
+        else
+            bad += id < 0 || tr.w != g->trims[i].w || tr.h != g->trims[i].h;
     }
-    for (size_t i = 0; i < g->n_shares; ++i)
-        bad += g->draws[g->shares[2 * i]].trim_entry != g->draws[g->shares[2 * i + 1]].trim_entry;
-    CHECK(bad == 0, "%s: %zu trimmed draws without an atlas entry of the planned size", name, bad);
+    for (size_t i = 0; i < g->n_shares; ++i) {
+        const sw__gpu_draw *d = &g->draws[g->shares[2 * i]], *src = &g->draws[g->shares[2 * i + 1]];
+        bad += d->trim_entry != src->trim_entry || d->edge_grid != src->edge_grid;
+    }
+    CHECK(bad == 0,
+          "%s: %zu trimmed draws without an atlas entry of the planned size (or with one "
+          "beside exact edges)",
+          name, bad);
 }
 
 /* ---- submit ------------------------------------------------------------------------------------
@@ -698,6 +742,16 @@ static void run_model(sw_gpu_context *ctx, const char *path, int first_model)
         CHECK(coned.st.bound_exceeded == 0, "%s: %llu pieces over the error bound", path,
               (unsigned long long)coned.st.bound_exceeded);
     }
+    desc.trim_edges = 1; /* the same stages with exact trim edges */
+    stages exact;
+    if (run_prepare(&exact, ctx, scene, &desc, &st) != SW_OK) {
+        CHECK(0, "%s: stages with exact edges: %s", path, st.message);
+    } else {
+        check_exact_plan(&exact, path);
+        check_chain(ctx, scene, &desc, &exact, path);
+    }
+    stages_free(&exact);
+    desc.trim_edges = 0;
     check_bound_counted(ctx, scene, &desc, path);
     stages_free(&plain);
     stages_free(&coned);
