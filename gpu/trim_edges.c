@@ -93,9 +93,10 @@ static size_t segments_in_cells(const sw_sg_polyline *loops, uint32_t n_loops, c
     return n;
 }
 
-/* Calls visit(cell) for every cell of the grid that segment s meets (grown by k_cell_grow). */
-static void for_cells_of(const grid_build *g, const grid_seg *s, uint32_t seg,
-                         void (*visit)(grid_build *, size_t, uint32_t), grid_build *gb)
+/* Calls visit(g, cell, seg) for every cell of the grid that segment s meets (grown by
+ * k_cell_grow). */
+static void for_cells_of(grid_build *g, const grid_seg *s, uint32_t seg,
+                         void (*visit)(grid_build *, size_t, uint32_t))
 {
     const double lo[2] = {fmin(s->a[0], s->b[0]) - k_cell_grow,
                           fmin(s->a[1], s->b[1]) - k_cell_grow};
@@ -112,7 +113,7 @@ static void for_cells_of(const grid_build *g, const grid_seg *s, uint32_t seg,
                                    j + 1 + k_cell_grow};
             double t[2];
             if (sw__gpu_segment_clip(s->a, s->b, box, t))
-                visit(gb, (size_t)j * (size_t)g->n[0] + (size_t)i, seg);
+                visit(g, (size_t)j * (size_t)g->n[0] + (size_t)i, seg);
         }
 }
 
@@ -136,7 +137,7 @@ static int list_cells(grid_build *g)
     if (!g->count)
         return 0;
     for (size_t s = 0; s < g->n_segs && g->n_entries <= MAX_EDGE_ENTRIES; ++s)
-        for_cells_of(g, &g->segs[s], (uint32_t)s, count_entry, g);
+        for_cells_of(g, &g->segs[s], (uint32_t)s, count_entry);
     if (g->n_entries > MAX_EDGE_ENTRIES)
         return -1;
     uint32_t at = 0;
@@ -149,7 +150,7 @@ static int list_cells(grid_build *g)
     if (!g->entries)
         return 0;
     for (size_t s = 0; s < g->n_segs; ++s)
-        for_cells_of(g, &g->segs[s], (uint32_t)s, fill_entry, g);
+        for_cells_of(g, &g->segs[s], (uint32_t)s, fill_entry);
     /* fill advanced each start to the next cell's: shift back */
     for (size_t c = n_cells; c > 0; --c)
         g->count[c] = g->count[c - 1];
