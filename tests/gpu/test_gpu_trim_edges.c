@@ -13,7 +13,9 @@
  * Planted faults, each seen failing: the scanline not half-open in y (a vertex on it counted
  * twice or not at all) → "vertex rows" fails; the CPU test reading every cell's reference point
  * as the first candidate's → the cells that took another fail; the crossing test without its
- * second condition (the path's ends on either side of the segment's line) → every case fails.
+ * second condition (the path's ends on either side of the segment's line) → every case fails; no
+ * margin around the reference points (k_ref_margin 0) → the "blocked" cells keep a reference
+ * point on a segment: 5,131 points wrong.
  * No GL needed. */
 #include "sw_gpu_internal.h"
 #include "test_check.h"
@@ -199,22 +201,27 @@ int main(void)
         free_loops(&s);
     }
 
-    /* loops along the candidate reference points' coordinates: whichever candidate is taken (or
-     * none: no grid, the caller draws a texture), what is made must classify right */
+    /* segments through the first reference candidate of every cell they cross: a rectangle of 4
+     * segments gets a 4 x 4 grid, and its horizontal sides at heights (j + 0.47265625) / 4 pass
+     * exactly through candidate 0 of rows 1 and 2 (their vertices at x = 0.05 and 0.95 leave every
+     * cell of those rows crossed). Those 8 cells must take another candidate, and classify right */
     {
         sw__gpu_edge_grids g;
         memset(&g, 0, sizeof g);
-        int32_t grid = 7;
+        int32_t grid = -1;
         sw_status st = {0};
         const double r[4] = {0.0, 1.0, 0.0, 1.0};
-        add_rect(&s, 0.5317, 0.7071, 0.2718, 0.6931);
-        add_rect(&s, 0.1415, 0.6180, 0.4729, 0.8862);
-        add_rect(&s, 0.3183, 0.9, 0.5772, 0.95);
-        CHECK(sw__gpu_edge_grid_add(&g, s.l, s.n, r, &grid, &st) == SW_OK, "blocked: add failed");
-        printf("  blocked reference points: grid %d\n", grid);
-        if (grid >= 0) /* if one was made after all, it must still be right */
-            check_rect("blocked", &s, r, 5);
+        add_rect(&s, 0.05, 0.95, (1 + 0.47265625) / 4.0, (2 + 0.47265625) / 4.0);
+        CHECK(sw__gpu_edge_grid_add(&g, s.l, s.n, r, &grid, &st) == SW_OK && grid == 0,
+              "blocked: no grid");
+        uint32_t moved = 0;
+        if (grid == 0 && g.grids[0].n[0] == 4 && g.grids[0].n[1] == 4)
+            for (uint32_t c = 4; c < 12; ++c)
+                moved += ((g.cells[2 * c + 1] >> 1) & 7u) != 0;
+        printf("  blocked reference points: %u of the 8 cells on the sides took another\n", moved);
+        CHECK(moved == 8, "blocked: %u of 8 cells moved off candidate 0", moved);
         sw__gpu_edge_grids_free(&g);
+        check_rect("blocked", &s, r, 5);
         free_loops(&s);
     }
     printf(g_failures ? "FAILED (%d)\n" : "ok\n", g_failures);
