@@ -378,6 +378,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->trim_textures = g->trim_textures;
     out->trim_texels = g->trim_texels;
     out->trim_exact = g->trim_exact;
+    out->trim_exact_fallbacks = g->trim_exact_fallbacks;
     out->patches_gpu_evaluated = g->patches_gpu_evaluated;
     out->patches_exact = g->patches_exact;
     out->atlas_pages = g->atlas_pages;

@@ -159,10 +159,11 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
            (unsigned long long)s->faces_culled, (unsigned long long)s->triangles,
            (unsigned long long)s->trim_textures, (unsigned long long)s->trim_texels,
            (unsigned long long)s->trim_reused, (unsigned long long)s->atlas_pages);
-    if (s->trim_exact > 0)
+    if (s->trim_exact > 0 || s->trim_exact_fallbacks > 0)
         printf("%*s  exact trim edges: %llu trimmed draws cut per fragment by their loops, not by "
-               "a texture\n",
-               (int)strlen(label), "", (unsigned long long)s->trim_exact);
+               "a texture (%llu kept a texture: over the edge grid's limits)\n",
+               (int)strlen(label), "", (unsigned long long)s->trim_exact,
+               (unsigned long long)s->trim_exact_fallbacks);
     if (s->hierarchy_nodes > 0)
         printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
                (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);

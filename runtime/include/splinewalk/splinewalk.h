@@ -469,8 +469,10 @@ typedef struct sw_frame_stats {
      * spent (sw_renderer_desc.memory_budget_*): trim textures scaled down to the frame's share,
      * hierarchy leaves left unrefined; each is in bound_exceeded too */
     uint64_t budget_coarsened;
-    /* trimmed draws cut by exact trim edges instead of a texture (sw_frame_desc.trim_edges) */
-    uint64_t trim_exact;
+    /* trimmed draws cut by exact trim edges instead of a texture (sw_frame_desc.trim_edges), and
+     * those that wanted them but kept a texture (a grid over its limits: 2^22 loop segments, 2^20
+     * cell entries, or no reference point clear of the loops) */
+    uint64_t trim_exact, trim_exact_fallbacks;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
