@@ -140,7 +140,7 @@ struct sw__curves_renderer {
     GLuint prog, prog_comp, vao, vbo, fbo, tex, rb;
     int32_t fbo_w, fbo_h;
     GLint loc_size, loc_mode, loc_h;
-    GLint loc_c_size, loc_c_cov, loc_c_color, loc_c_origin, loc_c_ss;
+    GLint loc_c_size;
     int fault, vbaa;
     vtx *v;
     size_t n, cap;
@@ -168,10 +168,6 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
     r->loc_mode = glGetUniformLocation(r->prog, "u_mode");
     r->loc_h = glGetUniformLocation(r->prog, "u_h");
     r->loc_c_size = glGetUniformLocation(r->prog_comp, "u_size");
-    r->loc_c_cov = glGetUniformLocation(r->prog_comp, "u_cov");
-    r->loc_c_color = glGetUniformLocation(r->prog_comp, "u_color");
-    r->loc_c_origin = glGetUniformLocation(r->prog_comp, "u_origin");
-    r->loc_c_ss = glGetUniformLocation(r->prog_comp, "u_ss");
     glGenVertexArrays(1, &r->vao);
     glGenBuffers(1, &r->vbo);
     glBindVertexArray(r->vao);
@@ -185,7 +181,6 @@ sw_result sw__curves_renderer_create(sw__curves_renderer **out, sw_status *statu
     for (GLuint a = 0; a < 3; ++a)
         glVertexAttribPointer(4 + a, 4, GL_FLOAT, GL_FALSE, sizeof(vtx),
                               (void *)(offsetof(vtx, coef) + 16 * a));
-    glBindVertexArray(0);
     res = sw__gpu_check(status, "curves renderer set-up");
     if (res != SW_OK) {
         sw__curves_renderer_free(r);
@@ -438,11 +433,21 @@ static int emit_polygon(sw__curves_renderer *r, const xform *x, const sw__curves
     return 1;
 }
 
-sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
-                          const sw__curves_view *view, const float rgba[4], GLuint target_fbo,
-                          sw_status *status)
+/* Where a shape's coverage went: the target pixels [x0, x1) x [y0, y1) it may touch, drawn ss
+ * times larger with its origin at (ox, oy) when ss > 1 (the view-based path for small shapes). */
+typedef struct coverage {
+    int32_t x0, y0, x1, y1, ox, oy;
+    int ss;
+    int empty; /* nothing on the target */
+} coverage;
+
+/* Passes 1-3: the shape's coverage into the renderer's float target. */
+static sw_result draw_coverage(sw__curves_renderer *r, sw__curves_shape *shape,
+                               const sw__curves_view *view, coverage *cv, sw_status *status)
 {
-    assert(r && shape && view && rgba);
+    assert(r && shape && view);
+    memset(cv, 0, sizeof *cv);
+    cv->empty = 1;
     const double *m = view->m;
     /* the view's zoom: the largest singular value of its linear part */
     double a = m[0], b = m[1], c = m[3], d = m[4];
@@ -602,34 +607,95 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     }
     glDisable(GL_STENCIL_TEST);
     glStencilMask(0xff);
+    glDisable(GL_BLEND);
+    *cv = (coverage){x0, y0, x1, y1, ox, oy, ss, 0};
+    return SW_OK;
+}
 
-    /* 4: composite over the target */
+/* Pass 4's set-up: blending "over" into the target, the coverage texture on unit 0. */
+static void composite_begin(sw__curves_renderer *r, GLuint prog, const coverage *cv,
+                            const sw__curves_view *view, const float rgba[4], GLuint target_fbo)
+{
     glBindFramebuffer(GL_FRAMEBUFFER, target_fbo);
     glViewport(0, 0, view->width, view->height);
+    glEnable(GL_BLEND);
+    glBlendEquation(GL_FUNC_ADD);
     glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glUseProgram(r->prog_comp);
-    glUniform2f(r->loc_c_size, (float)view->width, (float)view->height);
-    glUniform1i(r->loc_c_cov, 0);
-    glUniform4f(r->loc_c_color, rgba[0] * rgba[3], rgba[1] * rgba[3], rgba[2] * rgba[3], rgba[3]);
-    glUniform2i(r->loc_c_origin, ox, oy);
-    glUniform1i(r->loc_c_ss, ss);
+    glUseProgram(prog);
+    glUniform1i(glGetUniformLocation(prog, "u_cov"), 0);
+    glUniform4f(glGetUniformLocation(prog, "u_color"), rgba[0] * rgba[3], rgba[1] * rgba[3],
+                rgba[2] * rgba[3], rgba[3]);
+    glUniform2i(glGetUniformLocation(prog, "u_origin"), cv->ox, cv->oy);
+    glUniform1i(glGetUniformLocation(prog, "u_ss"), cv->ss);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, r->tex);
-    {
-        /* the box in target pixels, drawn with the same vertex layout */
-        r->n = 0;
-        xform id = {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}};
-        r->clip[0] = r->clip[1] = -2.0;
-        r->clip[2] = view->width + 2.0;
-        r->clip[3] = view->height + 2.0;
-        double q[4][2] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-        if (!emit_polygon(r, &id, NULL, 0, (const double(*)[2])q, 4, -1.0f))
-            return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
-        glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(r->n * sizeof(vtx)), r->v, GL_STREAM_DRAW);
-        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)r->n);
-    }
+}
+
+/* Pass 4's draw: the coverage box in target pixels, with the fan's vertex layout. */
+static sw_result composite_box(sw__curves_renderer *r, const coverage *cv,
+                               const sw__curves_view *view, sw_status *status)
+{
+    glBindVertexArray(r->vao);
+    glBindBuffer(GL_ARRAY_BUFFER, r->vbo);
+    r->n = 0;
+    xform id = {{1, 0, 0, 0, 1, 0}, {1, 0, 0, 0, 1, 0}};
+    r->clip[0] = r->clip[1] = -2.0;
+    r->clip[2] = view->width + 2.0;
+    r->clip[3] = view->height + 2.0;
+    double q[4][2] = {{cv->x0, cv->y0}, {cv->x1, cv->y0}, {cv->x1, cv->y1}, {cv->x0, cv->y1}};
+    if (!emit_polygon(r, &id, NULL, 0, (const double(*)[2])q, 4, -1.0f))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(r->n * sizeof(vtx)), r->v, GL_STREAM_DRAW);
+    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)r->n);
     glDisable(GL_BLEND);
+    return SW_OK;
+}
+
+sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
+                          const sw__curves_view *view, const float rgba[4], GLuint target_fbo,
+                          sw_status *status)
+{
+    assert(rgba);
+    coverage cv;
+    sw_result res = draw_coverage(r, shape, view, &cv, status);
+    if (res != SW_OK || cv.empty)
+        return res;
+    /* 4: composite over the target */
+    composite_begin(r, r->prog_comp, &cv, view, rgba, target_fbo);
+    glUniform2f(r->loc_c_size, (float)view->width, (float)view->height);
+    res = composite_box(r, &cv, view, status);
     glBindVertexArray(0);
     glUseProgram(0);
-    return sw__gpu_check(status, "curves draw");
+    return res == SW_OK ? sw__gpu_check(status, "curves draw") : res;
+}
+
+sw_result sw__curves_draw_placed(sw__curves_renderer *r, sw__curves_shape *shape,
+                                 const sw__curves_view *view, const float rgba[4],
+                                 GLuint target_fbo, const sw__curves_depth *depth,
+                                 sw_status *status)
+{
+    assert(rgba && depth);
+    coverage cv;
+    sw_result res = draw_coverage(r, shape, view, &cv, status);
+    if (res != SW_OK || cv.empty)
+        return res;
+    composite_begin(r, r->prog_comp, &cv, view, rgba, target_fbo);
+    glUniform2f(r->loc_c_size, (float)view->width, (float)view->height);
+    /* 1 / d about the box's corner, so that float keeps its digits over the box */
+    const double *k = depth->inv_d;
+    glUniform3f(glGetUniformLocation(r->prog_comp, "u_inv_d"), (float)k[0], (float)k[1],
+                (float)(k[0] * cv.x0 + k[1] * cv.y0 + k[2]));
+    glUniform2f(glGetUniformLocation(r->prog_comp, "u_depth_origin"), (float)cv.x0, (float)cv.y0);
+    glUniform1f(glGetUniformLocation(r->prog_comp, "u_depth_scale"),
+                (float)(depth->near_plane * (1.0 + SW__CURVES_DECAL_PULL)));
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GEQUAL);
+    glDepthMask(GL_FALSE);
+    res = composite_box(r, &cv, view, status);
+    glUniform1f(glGetUniformLocation(r->prog_comp, "u_depth_scale"), 0.0f);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_TRUE);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    return res == SW_OK ? sw__gpu_check(status, "placed outline draw") : res;
 }

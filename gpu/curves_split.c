@@ -430,8 +430,8 @@ static void emit_bezier(builder *b, const double *h, int p)
     }
 }
 
-/* Bézier extraction of a clamped curve by knot insertion (scenegraph/knot_insert.c). */
-static void emit_curve(builder *b, const sw_sg_curve *c)
+sw_result sw__curves_for_each_bezier(const sw_sg_curve *c, sw__curves_bezier_fn fn, void *ctx,
+                                     sw_status *status)
 {
     const int p = c->degree;
     int32_t n = c->n;
@@ -440,8 +440,9 @@ static void emit_curve(builder *b, const sw_sg_curve *c)
     double *cpw = sw__malloc(sizeof(double) * 3 * cap_n);
     double *k2 = sw__malloc(sizeof(double) * (cap_n + (size_t)p + 1));
     double *c2 = sw__malloc(sizeof(double) * 3 * cap_n);
+    sw_result r = SW_OK;
     if (!knots || !cpw || !k2 || !c2) {
-        b->err = sw__fail(b->status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
+        r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "curves: out of memory");
         goto done;
     }
     memcpy(knots, c->knots, sizeof(double) * (size_t)(n + p + 1));
@@ -463,12 +464,27 @@ static void emit_curve(builder *b, const sw_sg_curve *c)
             i++;
     }
     for (int32_t s = 0; s + p < n; s += p)
-        emit_bezier(b, cpw + 3 * (size_t)s, p);
+        fn(ctx, cpw + 3 * (size_t)s, p);
 done:
     sw__free(knots);
     sw__free(cpw);
     sw__free(k2);
     sw__free(c2);
+    return r;
+}
+
+static void emit_bezier_fn(void *ctx, const double *h, int32_t p)
+{
+    builder *b = ctx;
+    if (b->err == SW_OK)
+        emit_bezier(b, h, p);
+}
+
+static void emit_curve(builder *b, const sw_sg_curve *c)
+{
+    sw_result r = sw__curves_for_each_bezier(c, emit_bezier_fn, b, b->status);
+    if (r != SW_OK && b->err == SW_OK)
+        b->err = r;
 }
 
 static int is_clamped(const sw_sg_curve *c)

@@ -116,6 +116,12 @@ void sw__curves_shape_free(sw__curves_shape *shape); /* NULL allowed */
 sw_result sw__curves_shape_fit_view(sw__curves_shape *shape, double px_per_unit, int *rebuilt,
                                     sw_status *status);
 
+/* Calls fn with each rational Bézier piece of a clamped curve (homogeneous, dim 3, degree p), in
+ * order, by knot insertion (scenegraph/knot_insert.c). Errors: SW_ERR_OUT_OF_MEMORY. */
+typedef void (*sw__curves_bezier_fn)(void *ctx, const double *h, int32_t p);
+sw_result sw__curves_for_each_bezier(const sw_sg_curve *c, sw__curves_bezier_fn fn, void *ctx,
+                                     sw_status *status);
+
 /* Evaluates a piece's implicit form at a model point (F as the shader computes it). */
 double sw__curves_piece_eval(const sw__curves_piece *p, double x, double y);
 
@@ -123,6 +129,39 @@ double sw__curves_piece_eval(const sw__curves_piece *p, double x, double y);
  * 1, u, v, u^2, u v, v^2, u^3, u^2 v, u v^2, v^3 with (u, v) = ((x, y) - centre) / size. */
 void sw__curves_piece_local_form(const sw__curves_piece *p, double centre[2], double *size,
                                  double c[10]);
+
+/* ---- outlines placed in 3D (curves_place.c; GL-free) --------------------------------------------
+ * A plane of the eye-relative world (the eye at the origin): plane point (x, y) is
+ * origin + x ax + y ay; ax and ay independent (not necessarily unit or orthogonal). */
+typedef struct sw__curves_plane {
+    double origin[3], ax[3], ay[3];
+} sw__curves_plane;
+
+/* The depth of a plane at the target's pixels: its inverse is affine on the screen,
+ * 1 / d = inv_d[0] px + inv_d[1] py + inv_d[2] (d along the view axis; px, py in pixels). */
+typedef struct sw__curves_depth {
+    double inv_d[3];
+    double near_plane; /* the frame's: window depth = near / d (reversed-Z, infinite far) */
+} sw__curves_depth;
+
+typedef struct sw__curves_projected {
+    sw__curves_shape *shape; /* the outline in target pixels (py up), built for 1 px per unit;
+                                NULL: none of it is in front of the near plane and near the
+                                target */
+    sw__curves_depth depth;  /* the plane's depth at each pixel, for sw__curves_draw_placed */
+    uint32_t fallbacks;      /* pieces drawn as their chord: a control point stayed behind the eye
+                                after SPLIT_CAP halvings (curves_place.c) */
+} sw__curves_projected;
+
+struct sw__gpu_view;
+/* Maps the loops of a planar outline (in the plane's (x, y)) through the view into an outline in
+ * the view's target pixels, exactly (projective images of its rational pieces), cut to the part
+ * in front of the view's near plane and to a guard band around the target; curves_place.c says
+ * how. The caller frees out->shape. Errors: those of sw__curves_shape_create (the loops', or a
+ * cut loop the 2D path refuses), SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__curves_project(const sw__curves_loop *loops, uint32_t n_loops,
+                             const sw__curves_plane *plane, const struct sw__gpu_view *view,
+                             sw__curves_projected *out, sw_status *status);
 
 /* ---- drawing (curves.c; the GL context's thread) ---------------------------------------------
  * A view maps model coordinates to pixels of the target: px = m[0] x + m[1] y + m[2],
@@ -150,6 +189,18 @@ void sw__curves_renderer_set_vbaa(sw__curves_renderer *r, int on);
 sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
                           const sw__curves_view *view, const float rgba[4], GLuint target_fbo,
                           sw_status *status);
+
+/* As sw__curves_draw for a projected outline (view: 1 px per unit), composited with depth into
+ * target_fbo, whose depth buffer holds the opaque scene (reversed-Z): each pixel's depth is the
+ * outline plane's there, pulled toward the eye by SW__CURVES_DECAL_PULL of its distance (an
+ * outline laid on a surface of the scene shows on it), tested GL_GEQUAL, not written. Leaves the
+ * depth test enabled with GL_GREATER and depth writes on (the frame's state); the rest as
+ * sw__curves_draw. */
+#define SW__CURVES_DECAL_PULL (1.0 / 4096.0)
+sw_result sw__curves_draw_placed(sw__curves_renderer *r, sw__curves_shape *shape,
+                                 const sw__curves_view *view, const float rgba[4],
+                                 GLuint target_fbo, const sw__curves_depth *depth,
+                                 sw_status *status);
 
 /* The GLSL sources of the curve programs (shaders.c embeds gpu/glsl): 0 curves.vert, 1
  * curves.frag, 2 curves_composite.frag. NULL for other indices. */

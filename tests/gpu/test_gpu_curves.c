@@ -34,6 +34,7 @@
  * errors the comparison catches: a wrong s_in / s_chord orientation, k, l, m of the wrong cubic
  * class, a band too narrow or cut lines overlapping at joins, a missing re-approximation.
  */
+#include "curves_reference.h"
 #include "sw_curves.h"
 #include "sw_gpu.h"
 
@@ -211,26 +212,8 @@ static int make_shape(const char *cls, tshape *s)
 /* ---- reference: flattening and exact clipped area ----------------------------------------------
  */
 
-typedef struct poly {
-    double (*p)[2];
-    size_t n, cap;
-} poly;
-
-static void poly_add(poly *pl, const double q[2])
-{
-    if (pl->n == pl->cap) {
-        pl->cap = pl->cap ? 2 * pl->cap : 1024;
-        pl->p = realloc(pl->p, pl->cap * sizeof *pl->p);
-        if (!pl->p)
-            abort();
-    }
-    pl->p[pl->n][0] = q[0];
-    pl->p[pl->n][1] = q[1];
-    pl->n++;
-}
-
 /* h: homogeneous Bézier (degree p) already in pixel space. Emits the end point of each chord. */
-static void flatten_bez(const double *h, int p, poly *pl, int depth)
+static void flatten_bez(const double *h, int p, ref_poly *pl, int depth)
 {
     double a[2] = {h[0] / h[2], h[1] / h[2]},
            e[2] = {h[3 * p] / h[3 * p + 2], h[3 * p + 1] / h[3 * p + 2]};
@@ -261,7 +244,7 @@ static void flatten_bez(const double *h, int p, poly *pl, int depth)
         flatten_bez(r, p, pl, depth + 1);
         return;
     }
-    poly_add(pl, e);
+    ref_poly_add(pl, e);
 }
 
 static void to_px(const double v[6], const double p[2], double out[2])
@@ -271,7 +254,7 @@ static void to_px(const double v[6], const double p[2], double out[2])
 }
 
 /* A curve's Bézier pieces (full knot insertion) flattened in pixel space. */
-static void flatten_curve(const tcurve *c, const double v[6], poly *pl)
+static void flatten_curve(const tcurve *c, const double v[6], ref_poly *pl)
 {
     int p = c->deg, n = c->n;
     double knots[256], cpw[3 * 256], k2[256], c2[3 * 256];
@@ -306,80 +289,6 @@ static void flatten_curve(const tcurve *c, const double v[6], poly *pl)
             h[3 * i + 2] = w;
         }
         flatten_bez(h, p, pl, 0);
-    }
-}
-
-/* integral of (clamp(x, i, i+1) - i) dy along a->b (y already within one row) */
-static double seg_cell(const double a[2], const double b[2], double i)
-{
-    double ts[4] = {0, 1, 0, 0};
-    int nt = 2;
-    double dx = b[0] - a[0];
-    if (dx != 0) {
-        for (int k = 0; k < 2; ++k) {
-            double t = (i + k - a[0]) / dx;
-            if (t > 0 && t < 1)
-                ts[nt++] = t;
-        }
-    }
-    for (int x = 1; x < nt; ++x) /* sort */
-        for (int y = x; y > 0 && ts[y] < ts[y - 1]; --y) {
-            double t = ts[y];
-            ts[y] = ts[y - 1];
-            ts[y - 1] = t;
-        }
-    double sum = 0;
-    for (int k = 0; k + 1 < nt; ++k) {
-        double p0[2] = {a[0] + ts[k] * dx, a[1] + ts[k] * (b[1] - a[1])};
-        double p1[2] = {a[0] + ts[k + 1] * dx, a[1] + ts[k + 1] * (b[1] - a[1])};
-        double g0 = fmin(fmax(p0[0], i), i + 1) - i, g1 = fmin(fmax(p1[0], i), i + 1) - i;
-        sum += 0.5 * (g0 + g1) * (p1[1] - p0[1]);
-    }
-    return sum;
-}
-
-/* Adds the winding-weighted area of the closed polyline in each pixel, times `sign`. */
-static void area_accumulate(const poly *pl, double sign, double *cov)
-{
-    static double row_cover[H][W + 1];
-    memset(row_cover, 0, sizeof row_cover);
-    for (size_t k = 0; k < pl->n; ++k) {
-        const double *a = pl->p[k], *b = pl->p[(k + 1) % pl->n];
-        double ylo = fmin(a[1], b[1]), yhi = fmax(a[1], b[1]);
-        if (yhi <= 0 || ylo >= H || a[1] == b[1])
-            continue;
-        int j0 = (int)floor(fmax(ylo, 0)), j1 = (int)floor(fmin(yhi, H - 1e-9));
-        for (int j = j0; j <= j1 && j < H; ++j) {
-            /* the part of a->b with y in [j, j+1] */
-            double t0 = (j - a[1]) / (b[1] - a[1]), t1 = (j + 1 - a[1]) / (b[1] - a[1]);
-            if (t0 > t1) {
-                double t = t0;
-                t0 = t1;
-                t1 = t;
-            }
-            t0 = fmax(t0, 0);
-            t1 = fmin(t1, 1);
-            if (t1 <= t0)
-                continue;
-            double p[2] = {a[0] + t0 * (b[0] - a[0]), a[1] + t0 * (b[1] - a[1])};
-            double q[2] = {a[0] + t1 * (b[0] - a[0]), a[1] + t1 * (b[1] - a[1])};
-            double dy = q[1] - p[1];
-            double xlo = fmin(p[0], q[0]), xhi = fmax(p[0], q[0]);
-            int i0 = (int)floor(xlo), i1 = (int)floor(xhi);
-            /* pixels entirely left of the part: clamp(x) - i = 1 */
-            int full = i0 < 0 ? 0 : i0 > W ? W : i0;
-            row_cover[j][0] += sign * dy;
-            row_cover[j][full] -= sign * dy;
-            for (int i = i0 < 0 ? 0 : i0; i <= i1 && i < W; ++i)
-                cov[j * W + i] += sign * seg_cell(p, q, i);
-        }
-    }
-    for (int j = 0; j < H; ++j) {
-        double acc = 0;
-        for (int i = 0; i < W; ++i) {
-            acc += row_cover[j][i];
-            cov[j * W + i] += acc;
-        }
     }
 }
 
@@ -513,11 +422,11 @@ static int run_zoom(sw__curves_renderer *r, sw__curves_shape *shape, const tshap
     static double ref[W * H];
     memset(ref, 0, sizeof ref);
     for (int L = 0; L < ts->n_loops; ++L) {
-        poly pl = {0};
+        ref_poly pl = {0};
         for (int k = 0; k < ts->n_curves; ++k)
             if (ts->loop_of[k] == L)
                 flatten_curve(&ts->c[k], v, &pl);
-        area_accumulate(&pl, ts->sign[L], ref);
+        ref_area_accumulate(&pl, ts->sign[L], W, H, ref);
         free(pl.p);
     }
     /* corners: the shape's own list (cusps, crossings, joins) and the test's */

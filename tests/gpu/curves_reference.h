@@ -1,0 +1,111 @@
+/* SPDX-License-Identifier: MIT */
+/* tests/gpu: exact area coverage of a closed polyline per pixel, in double precision — the
+ * reference of the outline tests (test_gpu_curves, test_gpu_curves_placed).
+ *
+ * For each pixel square S the area of the polygon inside S by Green's theorem over the outline
+ * clamped to S: A = sum over edges of integral (clamp(x) - x0) d clamp(y), exact for straight edges
+ * (the clamp is a retraction onto S homotopic to the identity outside S's interior, so winding
+ * numbers inside S are kept). Callers flatten their curves finely enough (1e-3 px) first. */
+#ifndef SW_TESTS_CURVES_REFERENCE_H
+#define SW_TESTS_CURVES_REFERENCE_H
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct ref_poly {
+    double (*p)[2];
+    size_t n, cap;
+} ref_poly;
+
+static void ref_poly_add(ref_poly *pl, const double q[2])
+{
+    if (pl->n == pl->cap) {
+        pl->cap = pl->cap ? 2 * pl->cap : 1024;
+        pl->p = realloc(pl->p, pl->cap * sizeof *pl->p);
+        if (!pl->p)
+            abort();
+    }
+    pl->p[pl->n][0] = q[0];
+    pl->p[pl->n][1] = q[1];
+    pl->n++;
+}
+
+/* integral of (clamp(x, i, i+1) - i) dy along a->b (y already within one row) */
+static double ref_seg_cell(const double a[2], const double b[2], double i)
+{
+    double ts[4] = {0, 1, 0, 0};
+    int nt = 2;
+    double dx = b[0] - a[0];
+    if (dx != 0) {
+        for (int k = 0; k < 2; ++k) {
+            double t = (i + k - a[0]) / dx;
+            if (t > 0 && t < 1)
+                ts[nt++] = t;
+        }
+    }
+    for (int x = 1; x < nt; ++x) /* sort */
+        for (int y = x; y > 0 && ts[y] < ts[y - 1]; --y) {
+            double t = ts[y];
+            ts[y] = ts[y - 1];
+            ts[y - 1] = t;
+        }
+    double sum = 0;
+    for (int k = 0; k + 1 < nt; ++k) {
+        double p0[2] = {a[0] + ts[k] * dx, a[1] + ts[k] * (b[1] - a[1])};
+        double p1[2] = {a[0] + ts[k + 1] * dx, a[1] + ts[k + 1] * (b[1] - a[1])};
+        double g0 = fmin(fmax(p0[0], i), i + 1) - i, g1 = fmin(fmax(p1[0], i), i + 1) - i;
+        sum += 0.5 * (g0 + g1) * (p1[1] - p0[1]);
+    }
+    return sum;
+}
+
+/* Adds the winding-weighted area of the closed polyline in each pixel of a w x h image, times
+ * `sign`, to cov (row-major, y up). */
+static void ref_area_accumulate(const ref_poly *pl, double sign, int w, int h, double *cov)
+{
+    double *row_cover = calloc((size_t)h * (size_t)(w + 1), sizeof *row_cover);
+    if (!row_cover)
+        abort();
+    for (size_t k = 0; k < pl->n; ++k) {
+        const double *a = pl->p[k], *b = pl->p[(k + 1) % pl->n];
+        double ylo = fmin(a[1], b[1]), yhi = fmax(a[1], b[1]);
+        if (yhi <= 0 || ylo >= h || a[1] == b[1])
+            continue;
+        int j0 = (int)floor(fmax(ylo, 0)), j1 = (int)floor(fmin(yhi, h - 1e-9));
+        for (int j = j0; j <= j1 && j < h; ++j) {
+            /* the part of a->b with y in [j, j+1] */
+            double t0 = (j - a[1]) / (b[1] - a[1]), t1 = (j + 1 - a[1]) / (b[1] - a[1]);
+            if (t0 > t1) {
+                double t = t0;
+                t0 = t1;
+                t1 = t;
+            }
+            t0 = fmax(t0, 0);
+            t1 = fmin(t1, 1);
+            if (t1 <= t0)
+                continue;
+            double p[2] = {a[0] + t0 * (b[0] - a[0]), a[1] + t0 * (b[1] - a[1])};
+            double q[2] = {a[0] + t1 * (b[0] - a[0]), a[1] + t1 * (b[1] - a[1])};
+            double dy = q[1] - p[1];
+            double xlo = fmin(p[0], q[0]), xhi = fmax(p[0], q[0]);
+            int i0 = (int)floor(xlo), i1 = (int)floor(xhi);
+            /* pixels entirely left of the part: clamp(x) - i = 1 */
+            int full = i0 < 0 ? 0 : i0 > w ? w : i0;
+            row_cover[(size_t)j * (w + 1)] += sign * dy;
+            row_cover[(size_t)j * (w + 1) + full] -= sign * dy;
+            for (int i = i0 < 0 ? 0 : i0; i <= i1 && i < w; ++i)
+                cov[j * w + i] += sign * ref_seg_cell(p, q, i);
+        }
+    }
+    for (int j = 0; j < h; ++j) {
+        double acc = 0;
+        for (int i = 0; i < w; ++i) {
+            acc += row_cover[(size_t)j * (w + 1) + i];
+            cov[j * w + i] += acc;
+        }
+    }
+    free(row_cover);
+}
+
+#endif
