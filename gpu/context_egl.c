@@ -4,6 +4,7 @@
  * desktop GL 4.5 core context (4.3 accepted when glClipControl exists), no surface, rendering
  * into an FBO with RGBA8 colour and 32-bit float depth for reversed-Z.
  */
+#include "sw_curves.h"
 #include "sw_gpu_internal.h"
 #include "sw_hooks.h"
 #include "sw_th_pool.h"
@@ -320,6 +321,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);
         sw__gpu_resident_free(ctx);
+        sw__curves_renderer_free(ctx->curves);
         sw__gpu_grids_free(ctx);
         glDeleteVertexArrays(1, &ctx->vao);
         glDeleteFramebuffers(1, &ctx->trim_fbo);

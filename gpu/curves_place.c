@@ -21,8 +21,8 @@
  * diminishing: no sign change, no root), bisected to 1e-13 of the piece's parameter, depth 60.
  * After the cuts every curve point is in front of the near plane, but a control point may not be:
  * pieces are halved until every control point's depth is at least a quarter of the near plane
- * (its weight in pixels then is positive), at most SPLIT_CAP times; a piece still short of it is
- * replaced by its chord and counted (`fallbacks`).
+ * (its weight in pixels then is positive), at most SPLIT_CAP times each and SPLIT_BUDGET times in
+ * all; a piece still short of it is replaced by its chord and counted (`fallbacks`).
  */
 #include "sw_curves.h"
 #include "sw_gpu_internal.h"
@@ -37,6 +37,10 @@
 enum {
     ROOT_DEPTH = 60, /* bisection levels of a root: 2^-60 of the piece's parameter */
     SPLIT_CAP = 24,  /* halvings of a piece for positive projected weights */
+    /* halvings for positive weights in one outline, all pieces together: splitting is only
+     * needed next to the near plane's cut and ends after a few levels there, but a piece
+     * crossing behind the eye (cut data gone wrong) would split into 2^SPLIT_CAP pieces */
+    SPLIT_BUDGET = 1 << 14,
 };
 #define ROOT_WIDTH 1e-13  /* parameter width at which a root is taken as found */
 #define SUB_MIN 1e-12     /* sub-pieces narrower than this (parameter) are dropped */
@@ -62,6 +66,7 @@ typedef struct place_ctx {
     size_t n_pool, cap_pool;
     int oom;
     uint32_t fallbacks;
+    uint32_t splits; /* halvings made for positive weights (at most SPLIT_BUDGET) */
 } place_ctx;
 
 static double *pool_take(place_ctx *c, size_t k, size_t *at)
@@ -372,7 +377,8 @@ static void project_piece(place_ctx *c, const proj_rows *r, double near_plane, c
     int ok = 1;
     for (int32_t k = 0; k <= p; ++k)
         ok &= cut_value(r->d, h + 3 * k) >= WEIGHT_FLOOR * near_plane * h[3 * k + 2];
-    if (!ok && depth < SPLIT_CAP) {
+    if (!ok && depth < SPLIT_CAP && c->splits < SPLIT_BUDGET) {
+        c->splits++;
         double l[3 * (SW_SG_MAX_DEGREE + 1)], rt[3 * (SW_SG_MAX_DEGREE + 1)];
         sw_lod_bez_subdivide(p, 0, 3, h, 0, 0.5, l, rt);
         project_piece(c, r, near_plane, l, p, depth + 1, out);

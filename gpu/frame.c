@@ -205,6 +205,8 @@ static sw_result run_stages(sw_gpu_frame_plan *p, sw_status *status)
         r = sw__fr_tessellate(env, &p->vis, &p->sel, &p->geo, &p->st, status);
     if (r == SW_OK)
         r = sw__fr_trim_plan(env, &p->geo, &p->st, status);
+    if (r == SW_OK)
+        r = sw__fr_shapes_plan(env, &p->vis, &p->geo, &p->st, status);
     return r;
 }
 

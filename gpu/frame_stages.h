@@ -12,7 +12,9 @@
  *   trim        (stage_trim.c)       pending trims -> resolutions and flattened loops (plain
  *                                    memory, with the trimmed faces' fat borders), then on the GL
  *                                    thread the atlas entries of the draws (§4, §4.4)
- *   submit      (stage_submit.c)     geometry -> batch, upload, draw, present, readback
+ *   outlines    (stage_shapes.c)     visible shape occurrences -> outlines in target pixels
+ *   submit      (stage_submit.c)     geometry -> batch, upload, draw (the outlines last),
+ *                                    present, readback
  *
  * cull, select, tessellate and the trim plan are GL-free and run in sw_gpu_frame_prepare (the
  * visibility thread); the trim atlas and submit run in sw_gpu_frame_submit (the GL thread).
@@ -21,6 +23,7 @@
 #ifndef SW_GPU_FRAME_STAGES_H
 #define SW_GPU_FRAME_STAGES_H
 
+#include "sw_curves.h"
 #include "sw_gpu_internal.h"
 #include "sw_lod_cache.h"
 #include "sw_lod_face_cones.h"
@@ -122,6 +125,7 @@ typedef struct sw__fr_instance {
     size_t first_face, n_faces;
 } sw__fr_instance;
 
+/* A mesh occurrence, or a shape occurrence (`mesh` is then its shape; box: of its plane box). */
 typedef struct sw__fr_mesh_occ {
     uint32_t mesh;
     double world[12];
@@ -136,6 +140,8 @@ typedef struct sw__fr_visible {
     sw__fr_faces unit_faces; /* their shown faces */
     sw__fr_mesh_occ *meshes; /* mesh occurrences inside the frustum */
     size_t n_meshes, cap_meshes;
+    sw__fr_mesh_occ *shapes; /* shape occurrences inside the frustum */
+    size_t n_shapes, cap_shapes;
 } sw__fr_visible;
 
 /* Before the view: the scene box the near plane is chosen from (eye-relative), and the mesh
@@ -259,6 +265,13 @@ typedef struct face_loops {
     double tol; /* the flattening's (the border cache's key with face) */
 } face_loops;
 
+/* An outline to draw after the opaque frame (stage_shapes.c). */
+typedef struct sw__fr_shape_draw {
+    sw__curves_shape *shape; /* in target pixels; owned */
+    sw__curves_depth depth;
+    float color[4];
+} sw__fr_shape_draw;
+
 typedef struct sw__fr_geometry {
     sw__gpu_mesh mesh; /* CPU grids, fat borders, triangles */
     sw__gpu_draw *draws;
@@ -285,6 +298,8 @@ typedef struct sw__fr_geometry {
     sw__gpu_resident_draw *resident;
     size_t n_resident, cap_resident;
     uint64_t resident_triangles;
+    sw__fr_shape_draw *shapes; /* the outlines (stage_shapes.c) */
+    size_t n_shapes, cap_shapes;
 } sw__fr_geometry;
 void sw__fr_geometry_free(sw__fr_geometry *g);
 /* Zeroes every count, keeping the arrays (the per-face trim loops owned are freed). */
@@ -452,6 +467,20 @@ int sw__fr_exact_edges(const sw__fr_env *env, double need_u, double need_v, int3
  * and wanting `need` texels: half a texel of its class, or with exact edges k_exact_flat_px. */
 double sw__fr_trim_flat_tol(const sw__fr_env *env, double extent, double need, int exact,
                             int32_t max_entry);
+
+/* ---- outlines: stage_shapes.c ------------------------------------------------------------- */
+/* Plain memory (prepare): each visible shape occurrence mapped into the target's pixels
+ * (sw__curves_project) as a geo->shapes entry; counted in st (drawn, culled behind the near
+ * plane, skipped when the 2D path refuses it, pieces drawn as chords). Errors:
+ * SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__fr_shapes_plan(const sw__fr_env *env, const sw__fr_visible *vis, sw__fr_geometry *geo,
+                             sw_gpu_frame_stats *st, sw_status *status);
+/* The GL thread, after the opaque draw into ctx->fbo: the outlines, in order, composited with
+ * depth (sw__curves_draw_placed). */
+sw_result sw__fr_draw_shapes(sw_gpu_context *ctx, const sw__gpu_view *view,
+                             const sw__fr_geometry *geo, sw_status *status);
+/* Frees the outlines' shapes (n_shapes 0; the array kept). */
+void sw__fr_shapes_empty(sw__fr_geometry *geo);
 
 /* ---- submit: stage_submit.c ------------------------------------------------------------------ */
 /* Batch, upload, draw. GL thread. */

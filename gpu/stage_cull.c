@@ -56,6 +56,7 @@ void sw__fr_visible_free(sw__fr_visible *vis)
     sw__fr_faces_free(&vis->unit_faces);
     sw__free(vis->instances);
     sw__free(vis->meshes);
+    sw__free(vis->shapes);
     memset(vis, 0, sizeof *vis);
 }
 
@@ -130,29 +131,42 @@ static sw_result collect_all(const sw__fr_env *env, const sw_gpu_frame_desc *des
 /* ---- meshes ------------------------------------------------------------------------------- */
 typedef struct mesh_taker {
     const sw__fr_env *env;
-    sw__fr_visible *vis;
+    sw__fr_mesh_occ **list; /* the visible set's meshes or shapes */
+    size_t *n, *cap;
+    int shapes;
     double *scene_box;
     int oom;
 } mesh_taker;
+
+/* A mesh's box, or a shape's plane box (in its plane z = 0). */
+static void local_box(const sw__fr_env *env, int shapes, uint32_t i, double box[6])
+{
+    if (!shapes) {
+        memcpy(box, env->sv->meshes[i].box, 6 * sizeof *box);
+        return;
+    }
+    const double *b = env->sv->shapes[i].box;
+    const double q[6] = {b[0], b[1], 0.0, b[2], b[3], 0.0};
+    memcpy(box, q, sizeof q);
+}
 
 static int take_mesh(void *ctx, uint32_t mesh, uint32_t node, const double world[12],
                      const float color[4])
 {
     (void)node;
     mesh_taker *c = ctx;
-    sw__fr_visible *vis = c->vis;
-    if (!sw__grow((void **)&vis->meshes, &vis->cap_meshes, vis->n_meshes + 1,
-                  sizeof *vis->meshes)) {
+    if (!sw__grow((void **)c->list, c->cap, *c->n + 1, sizeof **c->list)) {
         c->oom = 1;
         return 1;
     }
-    sw__fr_mesh_occ *o = &vis->meshes[vis->n_meshes++];
+    sw__fr_mesh_occ *o = &(*c->list)[(*c->n)++];
     o->mesh = mesh;
     memcpy(o->world, world, sizeof o->world);
     memcpy(o->color, color, sizeof o->color);
     /* the world box as the BVH boxes occurrences, then eye-relative like the view's planes */
-    double wb[6];
-    sw_sg_box_transform(world, c->env->sv->meshes[mesh].box, wb);
+    double lb[6], wb[6];
+    local_box(c->env, c->shapes, mesh, lb);
+    sw_sg_box_transform(world, lb, wb);
     sw__fr_eye_box(c->env->view.eye, wb, o->box);
     for (int k = 0; k < 3; ++k) {
         c->scene_box[k] = fmin(c->scene_box[k], o->box[k]);
@@ -161,36 +175,43 @@ static int take_mesh(void *ctx, uint32_t mesh, uint32_t node, const double world
     return 0;
 }
 
-/* Mesh occurrences join the scene box, so the near plane leaves a mesh close to the eye in
- * front of it. */
+/* Mesh and shape occurrences join the scene box, so the near plane leaves one close to the eye
+ * in front of it. */
 static sw_result collect_meshes(const sw__fr_env *env, sw__fr_visible *vis, double scene_box[6],
                                 sw_status *status)
 {
-    if (env->sv->n_meshes == 0)
-        return SW_OK;
-    mesh_taker c = {env, vis, scene_box, 0};
-    if (sw_sg_scene_traverse_meshes(env->scene, take_mesh, &c) != SW_OK || c.oom)
+    mesh_taker m = {env, &vis->meshes, &vis->n_meshes, &vis->cap_meshes, 0, scene_box, 0};
+    mesh_taker s = {env, &vis->shapes, &vis->n_shapes, &vis->cap_shapes, 1, scene_box, 0};
+    if ((env->sv->n_meshes &&
+         (sw_sg_scene_traverse_meshes(env->scene, take_mesh, &m) != SW_OK || m.oom)) ||
+        (env->sv->n_shapes &&
+         (sw_sg_scene_traverse_shapes(env->scene, take_mesh, &s) != SW_OK || s.oom)))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "mesh occurrences: out of memory");
     return SW_OK;
 }
 
-static void cull_meshes(const sw__fr_env *env, sw__fr_visible *vis, sw_gpu_frame_stats *st)
+/* Keeps the occurrences whose box meets the frustum; returns how many were dropped. */
+static uint64_t cull_boxes(const sw__fr_env *env, sw__fr_mesh_occ *list, size_t *n)
 {
     size_t k = 0;
-    for (size_t i = 0; i < vis->n_meshes; ++i) {
-        if (!sw__gpu_view_box_visible(&env->view, vis->meshes[i].box)) {
-            st->meshes_culled++;
-            continue;
-        }
-        vis->meshes[k++] = vis->meshes[i];
-    }
-    vis->n_meshes = k;
+    for (size_t i = 0; i < *n; ++i)
+        if (sw__gpu_view_box_visible(&env->view, list[i].box))
+            list[k++] = list[i];
+    uint64_t dropped = *n - k;
+    *n = k;
+    return dropped;
+}
+
+static void cull_meshes(const sw__fr_env *env, sw__fr_visible *vis, sw_gpu_frame_stats *st)
+{
+    st->meshes_culled += cull_boxes(env, vis->meshes, &vis->n_meshes);
+    st->shapes_culled += cull_boxes(env, vis->shapes, &vis->n_shapes);
 }
 
 void sw__fr_visible_empty(sw__fr_visible *vis)
 {
     vis->faces.n = vis->unit_faces.n = 0;
-    vis->n_instances = vis->n_meshes = 0;
+    vis->n_instances = vis->n_meshes = vis->n_shapes = 0;
 }
 
 sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *desc,

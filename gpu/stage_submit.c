@@ -2,7 +2,7 @@
 /* The submit stage, on the GL thread: the vertex-shader records sorted by grid class into one
  * batch (their colour and trim rectangle filled from their draws, whose atlas entries the trim
  * stage set), and the frame drawn (draw.c: upload, one program per path, reversed-Z depth) with
- * the static levels kept on the GPU (resident.c).
+ * the static levels kept on the GPU (resident.c), then the outlines over it (stage_shapes.c).
  * Presenting and reading back follow it in sw_gpu_frame_submit. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
@@ -78,7 +78,8 @@ sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
         geo->resident, geo->n_resident,
         desc->static_lods ? sw_lod_static_set_serial(desc->static_lods) : 0};
     sw__gpu_resident_begin(ctx, resident.set);
-    return r == SW_OK ? sw__gpu_draw_frame(ctx, view, desc, &geo->mesh, geo->draws, geo->n_draws,
-                                           &batch, &geo->edges, &resident, status)
-                      : r;
+    if (r == SW_OK)
+        r = sw__gpu_draw_frame(ctx, view, desc, &geo->mesh, geo->draws, geo->n_draws, &batch,
+                               &geo->edges, &resident, status);
+    return r == SW_OK ? sw__fr_draw_shapes(ctx, view, geo, status) : r;
 }

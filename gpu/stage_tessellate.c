@@ -20,7 +20,8 @@
 
 void sw__fr_geometry_free(sw__fr_geometry *g)
 {
-    sw__fr_geometry_empty(g); /* the trim loops it owns */
+    sw__fr_geometry_empty(g); /* the trim loops and outlines it owns */
+    sw__free(g->shapes);
     sw__free(g->draws);
     sw__free(g->trims);
     sw__free(g->shares);
@@ -52,6 +53,7 @@ void sw__fr_geometry_empty(sw__fr_geometry *g)
     g->n_resident = 0;
     g->resident_triangles = 0;
     sw__gpu_edge_grids_empty(&g->edges);
+    sw__fr_shapes_empty(g);
 }
 
 void sw__fr_chunk_geometry_take(sw_gpu_context *ctx, sw__fr_geometry *dst)

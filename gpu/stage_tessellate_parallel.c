@@ -186,7 +186,8 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 528, /* trim_exact*: the trim plan, not chunks */
+        sizeof(sw_gpu_frame_stats) == 560, /* trim_exact*: the trim plan; shapes_*: cull and the
+                                              outline stage, not chunks */
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;

@@ -250,6 +250,10 @@ typedef struct sw_gpu_frame_stats {
      * gpu/resident.c; of triangles), and the bytes sent to the GPU for the draw (the frame's
      * vertices, indices and patch data, and the resident levels uploaded this frame) */
     uint64_t resident_triangles, upload_bytes;
+    /* outlines (SW_SG_NODE_SHAPE occurrences; gpu/stage_shapes.c): drawn; culled (outside the
+     * frustum, or nothing of them in front of the near plane); skipped (refused by the 2D path
+     * after the near-plane cut); pieces drawn as their chord (sw__curves_projected.fallbacks) */
+    uint64_t shapes_drawn, shapes_culled, shapes_skipped, shape_fallbacks;
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

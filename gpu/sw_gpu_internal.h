@@ -187,6 +187,7 @@ struct sw_gpu_context {
     size_t cap_rec_source;
     /* static levels kept in GPU buffers between frames (resident.c); the frame's uploads */
     struct sw__gpu_resident *resident;
+    struct sw__curves_renderer *curves; /* the outlines' programs and coverage target (lazily) */
     int32_t resident_off;  /* 1: static levels sent with the frame's mesh (tests' A/B) */
     uint64_t upload_bytes; /* the last draw's: vertices, indices and patch data sent */
 };

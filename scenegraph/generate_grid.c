@@ -51,10 +51,28 @@ static int copy_meshes(const sw_sg_scene_view *v, sw_sg_builder *b, uint64_t poo
     return ok;
 }
 
+/* The model's shapes, their loops shifted by loop_base (where its loops went); *first = the
+ * index of its first shape in b. */
+static int copy_shapes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t loop_base,
+                       uint32_t *first)
+{
+    *first = 0;
+    int ok = 1;
+    for (uint32_t i = 0; ok && i < v->n_shapes; ++i) {
+        sw_sg_shape_rec s = v->shapes[i];
+        s.first_loop += loop_base;
+        const uint32_t got = sw_sg_builder_add_shape(b, &s);
+        if (i == 0)
+            *first = got;
+        ok = got != SW_SG_NONE && got == *first + i;
+    }
+    return ok;
+}
+
 /* Appends the geometry records of the model to `b` with indices and pool offsets shifted by what
- * `b` already holds (names come with the nodes); base[0..3] = face, loop, curve, mesh index
- * bases. */
-static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base[4],
+ * `b` already holds (names come with the nodes); base[0..4] = face, loop, curve, mesh, shape
+ * index bases. */
+static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base[5],
                              sw_status *status)
 {
     const uint64_t pool = v->n_pool ? sw_sg_builder_push_doubles(b, v->pool, v->n_pool) : 0;
@@ -90,6 +108,7 @@ static sw_result copy_arrays(const sw_sg_scene_view *v, sw_sg_builder *b, uint32
         ok = sw_sg_builder_add_adjacency(b, base[0] + v->adjacency[i].face_a,
                                          base[0] + v->adjacency[i].face_b) != SW_SG_NONE;
     ok = ok && copy_meshes(v, b, pool, &base[3]);
+    ok = ok && copy_shapes(v, b, base[1], &base[4]);
     if (!ok)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "copying a model: out of memory");
     return SW_OK;
@@ -135,8 +154,7 @@ static sw_result node_order(const sw_sg_scene_view *v, uint32_t base, uint32_t *
 
 /* Adds the model's nodes as detached nodes of the builder (the prototype), refs remapped. */
 static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_t base,
-                            uint32_t face_base, uint32_t mesh_base, uint32_t *proto,
-                            sw_status *status)
+                            const uint32_t geom_base[5], uint32_t *proto, sw_status *status)
 {
     uint32_t *order = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *order);
     uint32_t *map = sw__malloc((v->n_nodes ? v->n_nodes : 1) * sizeof *map);
@@ -147,8 +165,9 @@ static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_
         const sw_sg_node_rec *s = &v->nodes[order[k]];
         const uint32_t parent = s->parent == SW_SG_NONE ? SW_SG_NONE : map[s->parent];
         const uint32_t ref = s->kind == SW_SG_NODE_INSTANCE  ? map[s->ref]
-                             : s->kind == SW_SG_NODE_SURFACE ? face_base + s->ref
-                             : s->kind == SW_SG_NODE_MESH    ? mesh_base + s->ref
+                             : s->kind == SW_SG_NODE_SURFACE ? geom_base[0] + s->ref
+                             : s->kind == SW_SG_NODE_MESH    ? geom_base[3] + s->ref
+                             : s->kind == SW_SG_NODE_SHAPE   ? geom_base[4] + s->ref
                                                              : s->ref;
         const char *name = s->name == SW_SG_NONE ? NULL : v->strings + s->name;
         const uint32_t got = sw_sg_builder_add_node(b, (sw_sg_node_kind)s->kind, parent, ref,
@@ -165,9 +184,9 @@ static sw_result copy_nodes(const sw_sg_scene_view *v, sw_sg_builder *b, uint32_
 sw_result sw__sg_append_model(sw_sg_builder *b, const sw_sg_scene_view *model, uint32_t node_base,
                               uint32_t *proto, sw_status *status)
 {
-    uint32_t base[4];
+    uint32_t base[5];
     sw_result r = copy_arrays(model, b, base, status);
-    return r == SW_OK ? copy_nodes(model, b, node_base, base[0], base[3], proto, status) : r;
+    return r == SW_OK ? copy_nodes(model, b, node_base, base, proto, status) : r;
 }
 
 static sw_result check_desc(const sw_sg_grid_desc *d, sw_status *status)

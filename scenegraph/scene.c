@@ -17,7 +17,7 @@
 
 const char *const sw__sg_section_names[SW__SG_SEC_COUNT] = {
     "FACES",   "LOOPS", "CURVES", "NODES",  "ADJACENCY", "POOL",
-    "STRINGS", "META",  "LODS",   "MESHES", "INDICES",
+    "STRINGS", "META",  "LODS",   "MESHES", "INDICES",   "SHAPES",
 };
 const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT] = {
     sizeof(sw_sg_face_rec),
@@ -31,6 +31,7 @@ const uint32_t sw__sg_section_record_size[SW__SG_SEC_COUNT] = {
     1, /* LODS: opaque bytes */
     sizeof(sw_sg_mesh_rec),
     sizeof(uint32_t),
+    sizeof(sw_sg_shape_rec),
 };
 
 static const double identity12[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
@@ -197,6 +198,20 @@ uint32_t sw_sg_builder_add_mesh(sw_sg_builder *b, const sw_sg_mesh_rec *mesh)
     return vec_push(&b->vec[SW__SG_SEC_MESHES], &r);
 }
 
+uint32_t sw_sg_builder_add_shape(sw_sg_builder *b, const sw_sg_shape_rec *shape)
+{
+    sw_sg_shape_rec r = *shape;
+    const sw_sg_scene_view v = {
+        .loops = (const sw_sg_loop_rec *)(const void *)b->vec[SW__SG_SEC_LOOPS].data,
+        .curves = (const sw_sg_curve_rec *)(const void *)b->vec[SW__SG_SEC_CURVES].data,
+        .pool = (const double *)(const void *)b->vec[SW__SG_SEC_POOL].data,
+    };
+    assert(r.first_loop <= b->vec[SW__SG_SEC_LOOPS].n &&
+           r.n_loops <= b->vec[SW__SG_SEC_LOOPS].n - r.first_loop);
+    sw_sg_shape_box(&v, r.first_loop, r.n_loops, r.box);
+    return vec_push(&b->vec[SW__SG_SEC_SHAPES], &r);
+}
+
 uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind, uint32_t parent,
                                 uint32_t ref, const double xform[12], const float color[4],
                                 const char *name)
@@ -298,6 +313,8 @@ static void builder_move_arrays(sw_sg_builder *b, sw_sg_scene *scene)
     w->indices = scene->owned[SW__SG_SEC_INDICES];
     w->n_meshes = (uint32_t)b->vec[SW__SG_SEC_MESHES].n;
     w->n_indices = b->vec[SW__SG_SEC_INDICES].n;
+    w->shapes = scene->owned[SW__SG_SEC_SHAPES];
+    w->n_shapes = (uint32_t)b->vec[SW__SG_SEC_SHAPES].n;
 }
 
 sw_result sw_sg_builder_finish(sw_sg_builder *b, sw_sg_scene **out, sw_status *status)
@@ -384,6 +401,9 @@ const void *sw__sg_view_section(const sw_sg_scene_view *view, int s, uint64_t *b
     case SW__SG_SEC_INDICES:
         p = view->indices, n = view->n_indices;
         break;
+    case SW__SG_SEC_SHAPES:
+        p = view->shapes, n = view->n_shapes;
+        break;
     default:
         assert(!"not an array section");
     }
@@ -415,6 +435,25 @@ void sw_sg_scene_curve(const sw_sg_scene *scene, uint32_t curve, sw_sg_curve *ou
     out->dim = 3;
     out->knots = scene->view.pool + c->knots;
     out->cpw = scene->view.pool + c->cpw;
+}
+
+void sw_sg_shape_box(const sw_sg_scene_view *v, uint32_t first_loop, uint32_t n_loops,
+                     double box[4])
+{
+    box[0] = box[1] = INFINITY;
+    box[2] = box[3] = -INFINITY;
+    for (uint32_t L = first_loop; L < first_loop + n_loops; ++L) {
+        const sw_sg_loop_rec *l = &v->loops[L];
+        for (uint32_t k = l->first_curve; k < l->first_curve + l->n_curves; ++k) {
+            const double *cpw = v->pool + v->curves[k].cpw;
+            for (uint32_t i = 0; i < v->curves[k].n; ++i)
+                for (int d = 0; d < 2; ++d) {
+                    double x = cpw[3 * i + d] / cpw[3 * i + 2];
+                    box[d] = fmin(box[d], x);
+                    box[2 + d] = fmax(box[2 + d], x);
+                }
+        }
+    }
 }
 
 void sw_sg_mesh_box(const double *positions, uint32_t n, double box[6])
@@ -513,9 +552,9 @@ static int trav_push(trav_stack *st, uint32_t node, uint32_t depth, int follow,
 
 /* Iterative depth-first walk (no recursion: CAD assemblies nest deeply). The depth guard only
  * matters for an unvalidated scene: a validated one has no cycle, so no path is longer than
- * n_nodes. One of the visitors is set: faces or meshes. */
+ * n_nodes. One of the visitors is set: faces, or the nodes of kind `ref_kind` (meshes, shapes). */
 static sw_result traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit,
-                          sw_sg_mesh_visit_fn visit_mesh, void *ctx)
+                          sw_sg_mesh_visit_fn visit_ref, uint32_t ref_kind, void *ctx)
 {
     const sw_sg_scene_view *v = &scene->view;
     if (v->root >= v->n_nodes)
@@ -537,8 +576,9 @@ static sw_result traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit,
             if (visit(ctx, nd->ref, world, color))
                 break;
         }
-        if (visit_mesh && nd->kind == SW_SG_NODE_MESH && nd->ref < v->n_meshes) {
-            if (visit_mesh(ctx, nd->ref, e.node, world, color))
+        if (visit_ref && nd->kind == ref_kind &&
+            nd->ref < (ref_kind == SW_SG_NODE_MESH ? v->n_meshes : v->n_shapes)) {
+            if (visit_ref(ctx, nd->ref, e.node, world, color))
                 break;
         }
         if (ok && nd->first_child != SW_SG_NONE)
@@ -553,11 +593,17 @@ static sw_result traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit,
 
 sw_result sw_sg_scene_traverse(const sw_sg_scene *scene, sw_sg_visit_fn visit, void *ctx)
 {
-    return traverse(scene, visit, NULL, ctx);
+    return traverse(scene, visit, NULL, 0, ctx);
 }
 
 sw_result sw_sg_scene_traverse_meshes(const sw_sg_scene *scene, sw_sg_mesh_visit_fn visit,
                                       void *ctx)
 {
-    return traverse(scene, NULL, visit, ctx);
+    return traverse(scene, NULL, visit, SW_SG_NODE_MESH, ctx);
+}
+
+sw_result sw_sg_scene_traverse_shapes(const sw_sg_scene *scene, sw_sg_mesh_visit_fn visit,
+                                      void *ctx)
+{
+    return traverse(scene, NULL, visit, SW_SG_NODE_SHAPE, ctx);
 }

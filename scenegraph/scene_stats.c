@@ -109,6 +109,26 @@ static int stats_visit_mesh(void *ctx, uint32_t mesh, uint32_t node, const doubl
     return 0;
 }
 
+/* Grows the world box by the shape's plane box corners (z = 0) placed in the world. */
+static int stats_visit_shape(void *ctx, uint32_t shape, uint32_t node, const double world[12],
+                             const float color[4])
+{
+    (void)node;
+    (void)color;
+    stats_ctx *c = ctx;
+    const sw_sg_shape_rec *sh = &c->scene->view.shapes[shape];
+    for (int k = 0; k < 4; k++) {
+        double q[2] = {sh->box[(k & 1) ? 2 : 0], sh->box[(k & 2) ? 3 : 1]}, p[3];
+        for (int r = 0; r < 3; r++) {
+            const double *w = world + 4 * r;
+            p[r] = w[0] * q[0] + w[1] * q[1] + w[3];
+        }
+        box_add(c->out->bbox, p);
+    }
+    c->out->shape_occurrences++;
+    return 0;
+}
+
 static void face_stats(const sw_sg_scene_view *v, sw_sg_scene_stats *out)
 {
     for (uint32_t i = 0; i < v->n_faces; i++) {
@@ -161,7 +181,10 @@ sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats 
         out->mesh_triangles += v->meshes[i].n_triangles;
     if (r == SW_OK && v->n_meshes)
         r = sw_sg_scene_traverse_meshes(scene, stats_visit_mesh, &c);
-    if (out->face_occurrences == 0 && out->mesh_occurrences == 0)
+    out->shapes = v->n_shapes;
+    if (r == SW_OK && v->n_shapes)
+        r = sw_sg_scene_traverse_shapes(scene, stats_visit_shape, &c);
+    if (out->face_occurrences == 0 && out->mesh_occurrences == 0 && out->shape_occurrences == 0)
         memset(out->bbox, 0, sizeof out->bbox); /* nothing drawn: an empty box at the origin */
     out->memory_bytes = sw_sg_scene_memory(scene);
     return r;

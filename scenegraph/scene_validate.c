@@ -177,8 +177,9 @@ static sw_result check_node_records(const vctx *c)
         int ref_ok = nd->kind == SW_SG_NODE_SURFACE    ? nd->ref < v->n_faces
                      : nd->kind == SW_SG_NODE_INSTANCE ? nd->ref < v->n_nodes
                      : nd->kind == SW_SG_NODE_MESH     ? nd->ref < v->n_meshes
+                     : nd->kind == SW_SG_NODE_SHAPE    ? nd->ref < v->n_shapes
                                                        : 1;
-        if (nd->kind > SW_SG_NODE_MESH || !ref_ok)
+        if (nd->kind > SW_SG_NODE_SHAPE || !ref_ok)
             return sw__fail(c->status, SW_ERR_FORMAT, "%s: node %u%s: kind %u, ref %u", c->what, i,
                             at, nd->kind, nd->ref);
         if (!node_link_ok(nd->parent, v->n_nodes) || !node_link_ok(nd->first_child, v->n_nodes) ||
@@ -365,6 +366,31 @@ static sw_result check_meshes(const vctx *c)
     return SW_OK;
 }
 
+/* A shape's loop range, flags and stored box (exactly its curves' control points' box: culling
+ * trusts it). Runs after the loops and curves are checked. */
+static sw_result check_shapes(const vctx *c)
+{
+    const sw_sg_scene_view *v = c->v;
+    for (uint32_t i = 0; i < v->n_shapes; i++) {
+        const sw_sg_shape_rec *s = &v->shapes[i];
+        char at[48];
+        where(c, SW__SG_SEC_SHAPES, i, at);
+        if (s->n_loops == 0 || s->first_loop > v->n_loops ||
+            s->n_loops > v->n_loops - s->first_loop || s->flags || s->reserved)
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: shape %u%s: loops [%u, +%u) of %u, flags 0x%x, reserved %u",
+                            c->what, i, at, s->first_loop, s->n_loops, v->n_loops, s->flags,
+                            s->reserved);
+        double box[4];
+        sw_sg_shape_box(v, s->first_loop, s->n_loops, box);
+        if (memcmp(box, s->box, sizeof box) != 0)
+            return sw__fail(c->status, SW_ERR_FORMAT,
+                            "%s: shape %u%s: stored box is not the box of its curves", c->what, i,
+                            at);
+    }
+    return SW_OK;
+}
+
 static sw_result check_misc(const vctx *c)
 {
     const sw_sg_scene_view *v = c->v;
@@ -400,6 +426,8 @@ sw_result sw__sg_scene_validate_at(const sw_sg_scene_view *view, const char *wha
         r = check_curves(&c);
     if (r == SW_OK)
         r = check_meshes(&c);
+    if (r == SW_OK)
+        r = check_shapes(&c);
     if (r == SW_OK)
         sw__status_ok(status);
     return r;

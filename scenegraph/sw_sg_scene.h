@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* splinewalk scene: faces (trimmed NURBS surfaces), trim loops of 2D rational B-spline curves,
- * triangle meshes, a node tree (group, transform, instance, surface, mesh) with colours, and face
- * adjacency.
+ * triangle meshes, planar outlines (shapes), a node tree (group, transform, instance, surface,
+ * mesh, shape) with colours, and face adjacency.
  *
  * The scene is a set of flat arrays of fixed-size records that reference one pool of doubles by
  * offset. The same arrays are built in memory (sw_sg_builder, used by importers and generators) or
@@ -105,18 +105,30 @@ typedef struct sw_sg_mesh_rec {
     double box[6];      /* min xyz, max xyz of the positions, exactly (validated) */
 } sw_sg_mesh_rec;
 
+/* A filled planar outline (the shape nodes): loops [first_loop, first_loop + n_loops) of 2D
+ * rational B-spline curves in the plane z = 0 of its node's frame, filled by even-odd parity, drawn
+ * with exact anti-aliased edges over the scene (gpu/sw_curves.h). */
+typedef struct sw_sg_shape_rec {
+    uint32_t first_loop, n_loops; /* n_loops >= 1 */
+    uint32_t flags;               /* zero (none is defined) */
+    uint32_t reserved;            /* zero */
+    double box[4];                /* x0, y0, x1, y1 of its curves' control points, exactly
+                                     (validated): the curves lie inside it */
+} sw_sg_shape_rec;
+
 typedef enum sw_sg_node_kind {
     SW_SG_NODE_GROUP = 0,     /* children, identity transform */
     SW_SG_NODE_TRANSFORM = 1, /* children under xform */
     SW_SG_NODE_INSTANCE = 2,  /* draws the subtree of node `ref` under xform */
     SW_SG_NODE_SURFACE = 3,   /* draws face `ref` under xform */
     SW_SG_NODE_MESH = 4,      /* draws mesh `ref` under xform */
+    SW_SG_NODE_SHAPE = 5,     /* draws shape `ref` under xform */
 } sw_sg_node_kind;
 
 typedef struct sw_sg_node_rec {
     uint32_t kind;
     uint32_t parent, first_child, next_sibling; /* SW_SG_NONE when absent */
-    uint32_t ref;                               /* face (SURFACE) or prototype node (INSTANCE) */
+    uint32_t ref; /* face (SURFACE), prototype node (INSTANCE), mesh (MESH) or shape (SHAPE) */
     uint32_t name;                              /* byte offset into strings, SW_SG_NONE if none */
     float color[4];   /* linear RGBA; color[3] < 0 inherits the parent's */
     double xform[12]; /* row-major 3x4 local-to-parent */
@@ -139,7 +151,8 @@ typedef enum sw_sg_section {
     /* bits 7 and 8 are META and LODS, which have none */
     SW_SG_SEC_MESHES = 1u << 9,
     SW_SG_SEC_INDICES = 1u << 10,
-    SW_SG_SEC_ALL = ((1u << 7) - 1) | SW_SG_SEC_MESHES | SW_SG_SEC_INDICES,
+    SW_SG_SEC_SHAPES = 1u << 11,
+    SW_SG_SEC_ALL = ((1u << 7) - 1) | SW_SG_SEC_MESHES | SW_SG_SEC_INDICES | SW_SG_SEC_SHAPES,
 } sw_sg_section;
 
 typedef struct sw_sg_scene sw_sg_scene; /* opaque; arrays read through the accessors below */
@@ -160,6 +173,8 @@ typedef struct sw_sg_scene_view {
     const uint32_t *indices;
     uint32_t n_meshes;
     uint64_t n_indices;
+    const sw_sg_shape_rec *shapes;
+    uint32_t n_shapes;
 } sw_sg_scene_view;
 
 SW_MODULE_ABI const sw_sg_scene_view *sw_sg_scene_view_ptr(const sw_sg_scene *scene);
@@ -203,6 +218,13 @@ typedef int (*sw_sg_mesh_visit_fn)(void *ctx, uint32_t mesh, uint32_t node, cons
                                    const float color[4]);
 sw_result sw_sg_scene_traverse_meshes(const sw_sg_scene *scene, sw_sg_mesh_visit_fn visit,
                                       void *ctx);
+/* The same walk for shape occurrences (`mesh` is then the shape's index). Callers skip it when
+ * n_shapes is 0. */
+sw_result sw_sg_scene_traverse_shapes(const sw_sg_scene *scene, sw_sg_mesh_visit_fn visit,
+                                      void *ctx);
+/* The box (x0, y0, x1, y1) of the control points of a shape's curves; none: an empty box. */
+void sw_sg_shape_box(const sw_sg_scene_view *v, uint32_t first_loop, uint32_t n_loops,
+                     double box[4]);
 /* The box (min xyz, max xyz) of n points (3 doubles each); n = 0 gives an empty box (min > max). */
 void sw_sg_mesh_box(const double *positions, uint32_t n, double box[6]);
 /* Borrowed arrays of mesh `mesh` (index valid): positions (3 per vertex), normals (NULL: flat)
@@ -232,6 +254,10 @@ uint64_t sw_sg_builder_push_indices(sw_sg_builder *b, const uint32_t *indices, s
  * ignored). Returns the new index, or SW_SG_NONE when out of memory. Offsets are checked by
  * sw_sg_builder_finish (precondition here: the positions lie inside the pool). */
 uint32_t sw_sg_builder_add_mesh(sw_sg_builder *b, const sw_sg_mesh_rec *mesh);
+/* A shape whose loops were added: its box is computed here from their curves (rec->box is
+ * ignored; precondition: the loops and their curves are in the builder). Returns the new index,
+ * or SW_SG_NONE when out of memory. */
+uint32_t sw_sg_builder_add_shape(sw_sg_builder *b, const sw_sg_shape_rec *shape);
 /* Adds a node as the last child of `parent` (SW_SG_NONE: a detached node, e.g. a prototype);
  * links parent/first_child/next_sibling itself. xform NULL = identity, color NULL = inherit. */
 SW_MODULE_ABI uint32_t sw_sg_builder_add_node(sw_sg_builder *b, sw_sg_node_kind kind,
@@ -297,6 +323,8 @@ typedef struct sw_sg_scene_stats {
     uint64_t mesh_triangles;       /* of the meshes, each counted once */
     uint64_t mesh_occurrences;     /* meshes drawn after instance expansion */
     uint64_t triangle_occurrences; /* their triangles, instances expanded */
+    uint32_t shapes;
+    uint64_t shape_occurrences; /* shapes drawn after instance expansion */
 } sw_sg_scene_stats;
 /* Precondition: SW_SG_SEC_ALL required. Returns SW_OK or SW_ERR_OUT_OF_MEMORY (traversal). */
 sw_result sw_sg_scene_compute_stats(const sw_sg_scene *scene, sw_sg_scene_stats *out);

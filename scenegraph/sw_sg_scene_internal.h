@@ -24,6 +24,7 @@ enum {
     SW__SG_SEC_LODS,
     SW__SG_SEC_MESHES,
     SW__SG_SEC_INDICES,
+    SW__SG_SEC_SHAPES,
     SW__SG_SEC_COUNT
 };
 

@@ -9,7 +9,8 @@
  *   0       8     magic "SWSCENE\0"
  *   8       4     version = 1
  *   12      4     flags = 0
- *   16      4     section count = 8, 9 with the optional LODS section, 11 with meshes
+ *   16      4     section count = 8, 9 with the optional LODS section, 11 with meshes, 12 with
+ *                 shapes
  *   20      4     header size = 64
  *   24      8     total file size in bytes
  *   32      8     offset of the section table (16-byte aligned, >= 64)
@@ -20,8 +21,9 @@
  *   section table entry (40 bytes):
  *   0  u32 id (0 FACES, 1 LOOPS, 2 CURVES, 3 NODES, 4 ADJACENCY, 5 POOL, 6 STRINGS, 7 META,
  *            8 LODS: optional, the static-LOD cache, opaque bytes with their own format owned by
- *            lod/static/static_lod_io.c; only when the count is 9 or 11, and may be empty with 11;
- *            9 MESHES, 10 INDICES: triangle meshes, only when the count is 11)
+ *            lod/static/static_lod_io.c; only when the count is 9 or more, and may be empty with
+ *            11 or 12; 9 MESHES, 10 INDICES: triangle meshes, only when the count is 11 or 12 (may
+ *            be empty with 12); 11 SHAPES: planar outlines, only when the count is 12)
  *   4  u32 reserved, zero
  *   8  u64 offset of the section (16-byte aligned, after the table, sections do not overlap)
  *   16 u64 size in bytes = element count * record size
@@ -31,8 +33,9 @@
  *
  *   record sizes: FACES 96 (sw_sg_face_rec), LOOPS 16, CURVES 24, NODES 136, ADJACENCY 8,
  *   POOL 8 (double), STRINGS 1 (char; the last one NUL), META 16 (u32 root node, 12 zero bytes),
- *   MESHES 88 (sw_sg_mesh_rec), INDICES 4 (u32). A scene without meshes is written with 8 or 9
- *   sections, byte for byte as before the mesh sections existed.
+ *   MESHES 88 (sw_sg_mesh_rec), INDICES 4 (u32), SHAPES 48 (sw_sg_shape_rec). A scene without
+ *   shapes is written with 8, 9 or 11 sections, and one without meshes either with 8 or 9, byte
+ *   for byte as before those sections existed.
  *   Padding between sections is zero. The file ends where its last section ends.
  *
  * Open checks everything up to the section table (and META, 16 bytes) and that the file is as
@@ -69,6 +72,8 @@ _Static_assert(sizeof(sw_sg_node_rec) == 136 && offsetof(sw_sg_node_rec, xform) 
 _Static_assert(sizeof(sw_sg_adjacency_rec) == 8, "adjacency layout is part of the .sws format");
 _Static_assert(sizeof(sw_sg_mesh_rec) == 88 && offsetof(sw_sg_mesh_rec, box) == 40,
                "mesh record layout is part of the .sws format");
+_Static_assert(sizeof(sw_sg_shape_rec) == 48 && offsetof(sw_sg_shape_rec, box) == 16,
+               "shape record layout is part of the .sws format");
 _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/binary32");
 
 #define SWS_MAGIC "SWSCENE"
@@ -80,7 +85,9 @@ _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/bin
 #define SWS_SEC_LODS SW__SG_SEC_LODS      /* id of the optional cache section */
 #define SWS_CORE_SECTIONS 8u              /* FACES .. META: every file has them */
 #define SWS_LODS_SECTIONS 9u              /* and LODS */
-#define SWS_MAX_SECTIONS SW__SG_SEC_COUNT /* and MESHES, INDICES (LODS then possibly empty) */
+#define SWS_MESH_SECTIONS 11u             /* and MESHES, INDICES (LODS then possibly empty) */
+#define SWS_MAX_SECTIONS SW__SG_SEC_COUNT /* and SHAPES (the others possibly empty) */
+_Static_assert(SWS_MAX_SECTIONS == 12, "a new section needs a new section count here");
 
 typedef struct sws_header {
     uint32_t version, flags, section_count, header_size;
@@ -198,7 +205,8 @@ static void read_header(const unsigned char *p, sws_header *h)
  * header byte reads as corruption), the fields, then the file size. */
 static int section_count_ok(uint32_t n)
 {
-    return n == SWS_CORE_SECTIONS || n == SWS_LODS_SECTIONS || n == SWS_MAX_SECTIONS;
+    return n == SWS_CORE_SECTIONS || n == SWS_LODS_SECTIONS || n == SWS_MESH_SECTIONS ||
+           n == SWS_MAX_SECTIONS;
 }
 
 static sw_result check_header(const char *path, const unsigned char *p, uint64_t size,
@@ -230,10 +238,10 @@ static sw_result check_header(const char *path, const unsigned char *p, uint64_t
         !section_count_ok(h->section_count) || !h->reserved_zero)
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: header at offset 12: flags 0x%x, %u sections, header size %u, entry "
-                        "size %u (expected 0, %u, %u or %u, %u, %u, reserved zero)",
+                        "size %u (expected 0, %u, %u, %u or %u, %u, %u, reserved zero)",
                         path, h->flags, h->section_count, h->header_size, h->entry_size,
-                        SWS_CORE_SECTIONS, SWS_LODS_SECTIONS, SWS_MAX_SECTIONS, SWS_HEADER_SIZE,
-                        SWS_ENTRY_SIZE);
+                        SWS_CORE_SECTIONS, SWS_LODS_SECTIONS, SWS_MESH_SECTIONS, SWS_MAX_SECTIONS,
+                        SWS_HEADER_SIZE, SWS_ENTRY_SIZE);
     if (h->file_size > size)
         return sw__fail(status, SW_ERR_TRUNCATED,
                         "%s: offset %llu: file is %llu bytes, its section table says %llu", path,
@@ -255,7 +263,7 @@ static sw_result check_entry(const char *path, const unsigned char *ent, uint64_
     uint32_t id = rd32(ent);
     uint64_t off = rd64(ent + 8), sz = rd64(ent + 16), count = rd64(ent + 24);
     /* ids below n_sec, each once: with 8 sections the core ones, with 9 also LODS, with 11 also
-     * MESHES and INDICES */
+     * MESHES and INDICES, with 12 also SHAPES */
     if (id >= n_sec || (*seen & (1u << id)) || rd32(ent + 4) || rd32(ent + 36))
         return sw__fail(status, SW_ERR_FORMAT,
                         "%s: section table entry at offset %llu: unknown or repeated id %u", path,
@@ -354,8 +362,11 @@ static sw_result parse_table(sw_sg_scene *scene, const sws_header *h, sw_status 
     if (r != SW_OK)
         return r;
     memcpy(scene->sec, sec, sizeof scene->sec);
-    if (n_sec < SWS_MAX_SECTIONS) /* a file without meshes: the empty sections need no check */
+    /* a file without meshes or shapes: the empty sections need no check */
+    if (n_sec < SWS_MESH_SECTIONS)
         scene->verified |= SW_SG_SEC_MESHES | SW_SG_SEC_INDICES;
+    if (n_sec < SWS_MAX_SECTIONS)
+        scene->verified |= SW_SG_SEC_SHAPES;
     /* META is 16 bytes: verified here, as the root is part of the view. */
     const sw__sg_section_info *m = &scene->sec[SW__SG_SEC_META];
     uint32_t crc = sw__crc32c(0, p + m->offset, m->size);
@@ -394,6 +405,8 @@ static void map_view(sw_sg_scene *scene)
     v->indices = (const uint32_t *)(const void *)(p + s[SW__SG_SEC_INDICES].offset);
     v->n_meshes = (uint32_t)s[SW__SG_SEC_MESHES].count;
     v->n_indices = s[SW__SG_SEC_INDICES].count;
+    v->shapes = (const sw_sg_shape_rec *)(const void *)(p + s[SW__SG_SEC_SHAPES].offset);
+    v->n_shapes = (uint32_t)s[SW__SG_SEC_SHAPES].count;
 }
 
 /* open (non-blocking: a FIFO must not hang) + fstat (regular files only) + mmap; the descriptor
@@ -500,7 +513,7 @@ sw_result sw_sg_scene_open_bytes(const void *data, size_t size, const char *name
 /* ---- save ------------------------------------------------------------------------------------ */
 
 /* Header, table and META for a scene's view and n_sec sections (the 9th: lods, lods_bytes, maybe
- * empty when there are 11);
+ * empty when there are 11 or 12);
  * fills the section offsets and the file size. */
 static void build_header(const sw_sg_scene_view *v, uint32_t n_sec, const void *lods,
                          uint64_t lods_bytes, const void *ptr[SWS_MAX_SECTIONS],
@@ -603,9 +616,10 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
     sw_result r = sw_sg_scene_require(scene, SW_SG_SEC_ALL, status);
     if (r != SW_OK)
         return r;
-    const uint32_t n_sec = scene->view.n_meshes ? SWS_MAX_SECTIONS
-                           : lods && lods_size  ? SWS_LODS_SECTIONS
-                                                : SWS_CORE_SECTIONS;
+    const uint32_t n_sec = scene->view.n_shapes   ? SWS_MAX_SECTIONS
+                           : scene->view.n_meshes ? SWS_MESH_SECTIONS
+                           : lods && lods_size    ? SWS_LODS_SECTIONS
+                                                  : SWS_CORE_SECTIONS;
     enum { HEAD = SWS_HEADER_SIZE + SWS_MAX_SECTIONS * SWS_ENTRY_SIZE };
     const uint64_t head_bytes = SWS_HEADER_SIZE + (uint64_t)n_sec * SWS_ENTRY_SIZE;
     unsigned char head[HEAD], meta[16];

@@ -272,6 +272,36 @@ static uint64_t push_homogeneous(sw_sg_builder *b, const double *points, const d
     return at;
 }
 
+/* The loops' counts and pointers (a surface's trim loops, a shape's outline); their geometry is
+ * checked as it is pushed (add_loop). */
+static sw_result check_loops_desc(const char *fn, const sw_trim_loop *loops, uint32_t n,
+                                  sw_status *status)
+{
+    if (n && !loops)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn, n);
+    if (n > SW__NODES_MAX_LOOPS)
+        return sw__fail(status, SW_ERR_LIMIT, "%s: %u loops (at most %u)", fn, n,
+                        SW__NODES_MAX_LOOPS);
+    for (uint32_t l = 0; l < n; l++) {
+        const sw_trim_loop *lp = &loops[l];
+        if (!lp->curves || lp->curve_count < 1 || lp->curve_count > SW__NODES_MAX_LOOPS)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                            "%s: loop %u has no curves (or NULL curves)", fn, l);
+        for (uint32_t c = 0; c < lp->curve_count; c++) {
+            const sw_trim_curve *tc = &lp->curves[c];
+            if (tc->degree < 1 || tc->degree > SW_SG_MAX_DEGREE || tc->count < tc->degree + 1 ||
+                tc->count > SW__NODES_MAX_POINTS)
+                return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
+                                "%s: loop %u curve %u: degree %u with %u control points", fn, l, c,
+                                tc->degree, tc->count);
+            if (!tc->knots || !tc->points)
+                return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                                "%s: loop %u curve %u: NULL knots or points", fn, l, c);
+        }
+    }
+    return SW_OK;
+}
+
 static sw_result check_nurbs_desc(const sw_nurbs_desc *d, sw_status *status)
 {
     const char *fn = "NURBS surface";
@@ -288,36 +318,13 @@ static sw_result check_nurbs_desc(const sw_nurbs_desc *d, sw_status *status)
                         d->count_u, d->count_v, SW__NODES_MAX_POINTS);
     if (!d->knots_u || !d->knots_v || !d->points)
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: NULL knots or points", fn);
-    if (d->loop_count && !d->loops)
-        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "%s: %u loops but NULL loops", fn,
-                          d->loop_count);
-    if (d->loop_count > SW__NODES_MAX_LOOPS)
-        return sw__fail(status, SW_ERR_LIMIT, "%s: %u trim loops (at most %u)", fn, d->loop_count,
-                        SW__NODES_MAX_LOOPS);
-    for (uint32_t l = 0; l < d->loop_count; l++) {
-        const sw_trim_loop *lp = &d->loops[l];
-        if (!lp->curves || lp->curve_count < 1 || lp->curve_count > SW__NODES_MAX_LOOPS)
-            return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                            "%s: trim loop %u has no curves (or NULL curves)", fn, l);
-        for (uint32_t c = 0; c < lp->curve_count; c++) {
-            const sw_trim_curve *tc = &lp->curves[c];
-            if (tc->degree < 1 || tc->degree > SW_SG_MAX_DEGREE || tc->count < tc->degree + 1 ||
-                tc->count > SW__NODES_MAX_POINTS)
-                return sw__fail(status, SW_ERR_INVALID_GEOMETRY,
-                                "%s: loop %u curve %u: degree %u with %u control points", fn, l, c,
-                                tc->degree, tc->count);
-            if (!tc->knots || !tc->points)
-                return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
-                                "%s: loop %u curve %u: NULL knots or points", fn, l, c);
-        }
-    }
-    return SW_OK;
+    return check_loops_desc(fn, d->loops, d->loop_count, status);
 }
 
 /* One loop's curves pushed, checked and snapped closed (sw_sg_trim_snap_loop); *box grows by
  * their control points (the hull bounds the curves: weights are positive). */
-static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t index, double max_gap,
-                          double box[4], uint32_t *loop_out, sw_status *status)
+static sw_result add_loop(sw_sg_builder *b, const char *fn, const sw_trim_loop *lp, uint32_t index,
+                          double max_gap, double box[4], uint32_t *loop_out, sw_status *status)
 {
     uint32_t nc = lp->curve_count;
     uint64_t *kn = sw__malloc(nc * sizeof *kn), *cp = sw__malloc(nc * sizeof *cp);
@@ -333,9 +340,9 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
             r = SW_ERR_OUT_OF_MEMORY;
     }
     if (r == SW_ERR_OUT_OF_MEMORY)
-        sw__fail(status, r, "NURBS surface: out of memory");
+        sw__fail(status, r, "%s: out of memory", fn);
     char what[64];
-    snprintf(what, sizeof what, "NURBS surface, trim loop %u", index);
+    snprintf(what, sizeof what, "%s, loop %u", fn, index);
     double *pool = sw_sg_builder_pool_ptr(b); /* stable until the next push */
     double own[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
     for (uint32_t c = 0; r == SW_OK && c < nc; c++) {
@@ -367,12 +374,12 @@ static sw_result add_loop(sw_sg_builder *b, const sw_trim_loop *lp, uint32_t ind
         sw_sg_curve_rec cr = {tc->degree, tc->count, kn[c], cp[c]};
         uint32_t ci = sw_sg_builder_add_curve(b, &cr);
         if (ci == SW_SG_NONE)
-            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "NURBS surface: out of memory");
+            r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
         if (c == 0)
             rec.first_curve = ci;
     }
     if (r == SW_OK && (*loop_out = sw_sg_builder_add_loop(b, &rec)) == SW_SG_NONE)
-        r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "NURBS surface: out of memory");
+        r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
     sw__free(kn);
     sw__free(cp);
     sw__free(ptrs);
@@ -412,7 +419,7 @@ static sw_result fill_loops(sw_sg_builder *b, const sw_nurbs_desc *d, sw_sg_face
     double box[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
     for (uint32_t l = 0; l < d->loop_count; l++) {
         uint32_t li = SW_SG_NONE;
-        sw_result r = add_loop(b, &d->loops[l], l, max_gap, box, &li, status);
+        sw_result r = add_loop(b, "NURBS surface", &d->loops[l], l, max_gap, box, &li, status);
         if (r != SW_OK)
             return r;
         if (l == 0)
@@ -593,6 +600,60 @@ static sw_result mesh_geom(const sw_mesh_desc *d, sw_sg_scene **out, sw_status *
     return sw_sg_builder_finish(b, out, status);
 }
 
+/* ---- shapes ---- */
+
+/* The largest extent of the loops' control points (their finite ones): the outline's size, which
+ * the closing snap is relative to. */
+static double loops_size(const sw_trim_loop *loops, uint32_t n)
+{
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (uint32_t l = 0; l < n; l++)
+        for (uint32_t c = 0; c < loops[l].curve_count; c++)
+            for (uint32_t i = 0; i < loops[l].curves[c].count; i++)
+                for (int k = 0; k < 2; k++) {
+                    double x = loops[l].curves[c].points[2 * i + k];
+                    if (isfinite(x)) {
+                        lo[k] = fmin(lo[k], x);
+                        hi[k] = fmax(hi[k], x);
+                    }
+                }
+    double size = fmax(hi[0] - lo[0], hi[1] - lo[1]);
+    return size > 0.0 && isfinite(size) ? size : 0.0;
+}
+
+/* A private scene of one shape drawn by one SHAPE node under its root. */
+static sw_result shape_geom(const sw_shape_desc *d, sw_sg_scene **out, sw_status *status)
+{
+    const char *fn = "shape";
+    if (d->loop_count < 1)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: no loops", fn);
+    sw_result r = check_loops_desc(fn, d->loops, d->loop_count, status);
+    if (r != SW_OK)
+        return r;
+    sw_sg_builder *b = sw_sg_builder_create();
+    if (!b)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    const double max_gap = 1e-6 * loops_size(d->loops, d->loop_count);
+    double box[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
+    sw_sg_shape_rec rec = {SW_SG_NONE, d->loop_count, 0, 0, {0}};
+    for (uint32_t l = 0; r == SW_OK && l < d->loop_count; l++) {
+        uint32_t li = SW_SG_NONE;
+        r = add_loop(b, fn, &d->loops[l], l, max_gap, box, &li, status);
+        if (l == 0)
+            rec.first_loop = li;
+    }
+    uint32_t shape = r == SW_OK ? sw_sg_builder_add_shape(b, &rec) : SW_SG_NONE;
+    if (r == SW_OK &&
+        (shape == SW_SG_NONE ||
+         sw_sg_builder_add_node(b, SW_SG_NODE_SHAPE, 0, shape, NULL, NULL, NULL) == SW_SG_NONE))
+        r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    if (r != SW_OK) {
+        sw_sg_builder_free(b);
+        return r;
+    }
+    return sw_sg_builder_finish(b, out, status);
+}
+
 /* Triangles of a geometry scene's meshes (each once). */
 static uint32_t geom_triangles(const sw_sg_scene *geom)
 {
@@ -625,6 +686,10 @@ static sw_result make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *
         if (!d->mesh)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: MESH without mesh");
         return mesh_geom(d->mesh, out, status);
+    case SW_NODE_SHAPE:
+        if (!d->shape)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: SHAPE without shape");
+        return shape_geom(d->shape, out, status);
     default:
         return SW_OK;
     }
@@ -934,7 +999,8 @@ static sw_result edit_geometry(rt_node *n, const void *arg, sw_status *status)
                         n->id,
                         swap->kind == SW_NODE_NURBS     ? "NURBS"
                         : swap->kind == SW_NODE_TSPLINE ? "TSPLINE"
-                                                        : "MESH");
+                        : swap->kind == SW_NODE_MESH    ? "MESH"
+                                                        : "SHAPE");
     sw_sg_scene *old = n->geom;
     n->geom = swap->geom;
     n->geom_faces = sw_sg_scene_view_ptr(n->geom)->n_faces;
@@ -997,6 +1063,15 @@ sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *des
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_mesh: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_MESH, "sw_node_set_mesh"};
     return set_geometry(scene, node, &swap, mesh_geom(desc, &swap.geom, status), status);
+}
+
+sw_result sw_node_set_shape(sw_scene scene, sw_node node, const sw_shape_desc *desc,
+                            sw_status *status)
+{
+    if (!desc)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_shape: NULL desc");
+    geometry_swap swap = {NULL, SW_NODE_SHAPE, "sw_node_set_shape"};
+    return set_geometry(scene, node, &swap, shape_geom(desc, &swap.geom, status), status);
 }
 
 /* ---- queries -----------------------------------------------------------------------------------

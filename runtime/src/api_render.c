@@ -379,6 +379,10 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->trim_texels = g->trim_texels;
     out->trim_exact = g->trim_exact;
     out->trim_exact_fallbacks = g->trim_exact_fallbacks;
+    out->shapes_drawn = g->shapes_drawn;
+    out->shapes_culled = g->shapes_culled;
+    out->shapes_skipped = g->shapes_skipped;
+    out->shape_fallbacks = g->shape_fallbacks;
     out->patches_gpu_evaluated = g->patches_gpu_evaluated;
     out->patches_exact = g->patches_exact;
     out->atlas_pages = g->atlas_pages;

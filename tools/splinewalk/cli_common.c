@@ -164,6 +164,12 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
                "a texture (%llu kept a texture: over the edge grid's limits)\n",
                (int)strlen(label), "", (unsigned long long)s->trim_exact,
                (unsigned long long)s->trim_exact_fallbacks);
+    if (s->shapes_drawn + s->shapes_culled + s->shapes_skipped > 0)
+        printf("%*s  outlines: %llu drawn, %llu culled, %llu skipped (a loop without area after "
+               "the near-plane cut), %llu pieces drawn as chords\n",
+               (int)strlen(label), "", (unsigned long long)s->shapes_drawn,
+               (unsigned long long)s->shapes_culled, (unsigned long long)s->shapes_skipped,
+               (unsigned long long)s->shape_fallbacks);
     if (s->hierarchy_nodes > 0)
         printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
                (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);

@@ -473,6 +473,10 @@ typedef struct sw_frame_stats {
      * those that wanted them but kept a texture (a grid over its limits: 2^22 loop segments, 2^20
      * cell entries, or no reference point clear of the loops) */
     uint64_t trim_exact, trim_exact_fallbacks;
+    /* outlines (sw_nodes.h SHAPE nodes): drawn; culled (outside the view, or wholly behind the
+     * near plane); skipped (a loop left without area once cut at the near plane); pieces drawn
+     * as their chord (a control point stayed behind the eye after the splits' cap) */
+    uint64_t shapes_drawn, shapes_culled, shapes_skipped, shape_fallbacks;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before

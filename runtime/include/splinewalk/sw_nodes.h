@@ -4,8 +4,8 @@
  * A node scene is an sw_scene like a loaded one (sw_renderer_draw, sw_scene_save, sw_scene_pick,
  * sw_scene_get_info and sw_camera_fit take its handle), whose content the host builds and edits:
  * groups, transforms, instances of node subtrees, trimmed NURBS surfaces, T-splines, triangle
- * meshes, cameras, and files imported under a node (OpenCASCADE for STEP / IGES / BREP, or .sws /
- * .tsm).
+ * meshes, planar outlines (shapes: floor plans, markings), cameras, and files imported under a
+ * node (OpenCASCADE for STEP / IGES / BREP, or .sws / .tsm).
  *
  * Versions. The node tree is the mutable model; what is drawn is an immutable compiled version
  * (the scene graph's own scene, its BVH and its back-patch cones), made in the scene's worker
@@ -42,6 +42,15 @@
  * box, but with no screen-space error bound of their own — a mesh is as exact as its author made
  * it. sw_scene_save writes them into the .sws file (docs/sws-format.md, sections MESHES and
  * INDICES), sw_scene_pick hits them (the triangle and its barycentric weights).
+ *
+ * Shapes. A SHAPE node is a filled outline in the plane z = 0 of its node's frame: closed loops of
+ * lines and rational NURBS curves of any degree, filled by even-odd parity in the node's colour
+ * (its alpha blends it). It is drawn after the opaque scene with exact edges at any zoom,
+ * anti-aliased (Santana's implicit curves, gpu/sw_curves.h: the loops are mapped through the
+ * perspective exactly, cut at the near plane), and hidden by what lies in front of it; an outline
+ * laid on a surface (less than 1/4096 of its distance behind it) shows on that surface. It has no
+ * thickness: seen edge-on it covers nothing; it is not an occluder and not hit by sw_scene_pick.
+ * sw_scene_save writes it (section SHAPES).
  */
 #ifndef SPLINEWALK_SW_NODES_H
 #define SPLINEWALK_SW_NODES_H
@@ -98,6 +107,15 @@ typedef struct sw_trim_loop {
     uint32_t curve_count; /* >= 1 */
 } sw_trim_loop;
 
+/* A planar outline: closed loops of 2D rational B-spline curves (sw_trim_curve, with (x, y) for
+ * (u, v)) in the plane z = 0 of the node's frame; what is filled is inside an odd number of loops
+ * (even-odd). Each loop closes as a trim loop does (gaps up to 1e-6 of the outline's size are
+ * snapped) and must span an area. */
+typedef struct sw_shape_desc {
+    const sw_trim_loop *loops;
+    uint32_t loop_count; /* >= 1 */
+} sw_shape_desc;
+
 /* A trimmed NURBS surface S(u, v) = sum w_ij P_ij N_i(u) N_j(v) / sum w_ij N_i(u) N_j(v). */
 typedef struct sw_nurbs_desc {
     uint32_t degree_u, degree_v; /* 1..31 */
@@ -145,6 +163,7 @@ typedef enum sw_node_kind {
     SW_NODE_CAMERA = 5,    /* a camera (`camera`) in the parent's frame; draws nothing */
     SW_NODE_IMPORT = 6,    /* the content of `import_path` under `transform` */
     SW_NODE_MESH = 7,      /* a triangle mesh (`mesh`) under `transform` */
+    SW_NODE_SHAPE = 8,     /* a filled planar outline (`shape`) under `transform` */
     SW_NODE_KIND_COUNT
 } sw_node_kind;
 
@@ -157,7 +176,7 @@ typedef struct sw_node_desc {
     int32_t hidden;       /* 1: the node and its subtree are not drawn, nor are instances of it */
     float color[4];       /* linear RGBA; color[3] == 0 (all zero): the parent's colour */
     double transform[12]; /* row-major 3x4, local to parent; all zero: identity. Read for
-                             TRANSFORM, INSTANCE, NURBS, TSPLINE, IMPORT and MESH */
+                             TRANSFORM, INSTANCE, NURBS, TSPLINE, IMPORT, MESH and SHAPE */
     sw_node instance_of;  /* INSTANCE: the node whose subtree it draws (not one of its own
                              ancestors, nor a subtree that instances them) */
     const sw_nurbs_desc *nurbs;     /* NURBS: required */
@@ -168,6 +187,7 @@ typedef struct sw_node_desc {
     sw_warning_fn import_warning;   /* IMPORT: faces that could not be converted; NULL: none */
     void *user_data;                /* passed to import_warning, on the calling thread */
     const sw_mesh_desc *mesh;       /* MESH: required */
+    const sw_shape_desc *shape;     /* SHAPE: required */
 } sw_node_desc;
 
 /* Adds a node as the last child of desc->parent (or detached). Any thread; an IMPORT reads and
@@ -224,6 +244,12 @@ SW_API sw_result sw_node_set_tspline(sw_scene scene, sw_node node, const sw_tspl
  * as sw_node_add_mesh lists them; the node keeps its mesh then. */
 SW_API sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *desc,
                                   sw_status *status);
+/* The same for a SHAPE node: new loops (any counts). Errors: as sw_node_set_nurbs
+ * (SW_ERR_INVALID_ARGUMENT for a node that is not SHAPE, NULL loops or a loop without curves;
+ * SW_ERR_INVALID_GEOMETRY for a curve, a loop that does not close or spans no area, with the
+ * loop and curve named); the node keeps its outline then. */
+SW_API sw_result sw_node_set_shape(sw_scene scene, sw_node node, const sw_shape_desc *desc,
+                                   sw_status *status);
 
 typedef struct sw_node_info {
     sw_node_kind kind;
