@@ -381,6 +381,8 @@ sw_result sw_scene_get_info(sw_scene handle, sw_scene_info *out, sw_status *stat
     out->meshes = s->meshes;
     out->mesh_triangles = s->mesh_triangles;
     out->mesh_occurrences = s->mesh_occurrences;
+    out->shapes = s->shapes;
+    out->shape_occurrences = s->shape_occurrences;
     out->triangle_occurrences = s->triangle_occurrences;
     out->faces_skipped = scene->faces_skipped;
     out->faces_repaired = scene->faces_repaired;

@@ -298,5 +298,30 @@ grep -q "^  LOD cache       unusable (SW_ERR_CHECKSUM" bad_lods.txt || fail "inf
   fail "info --json: a damaged LOD cache"
 pass "info: the LOD cache's settings; a damaged cache said, the scene described"
 
+# outlines placed into a scene (`splinewalk outline`, docs/outlines.md): info counts them, a frame
+# draws them; a mistake names FILE:LINE:COLUMN and writes nothing (catches: the SHAPES section not
+# written or read, the command not registered, an error without its position, a file written
+# anyway)
+cat >plan.txt <<'TXT'
+# a floor plan on the floor and a sign above it
+outline name room color 0.8 0.1 0.1
+  M -0.02 -0.02 h 0.04 v 0.03 h -0.04 Z
+  M 0 0.005 m -0.005 0 a 0.005 0.005 0 1 0 0.01 0 a 0.005 0.005 0 1 0 -0.01 0 Z
+end
+outline name sign color 0.1 0.1 0.9 origin 0 0.03 0.01 x-axis 1 0 0 y-axis 0 0 1
+  M -0.01 0 L 0.01 0 L 0 0.015 Z
+end
+TXT
+"$sw" outline plan.txt --into nut.sws -o planned.sws >outline.txt 2>&1 || { fail "outline"; cat outline.txt; }
+grep -q "2 outlines (3 loops) -> planned.sws" outline.txt || { fail "outline: summary"; cat outline.txt; }
+"$sw" info planned.sws | grep -q "^  outlines        2; drawn 2" || fail "info: outlines not counted"
+"$sw" render planned.sws -o planned.png --size 320x240 >render_ol.txt 2>&1 || { fail "render planned.sws"; cat render_ol.txt; }
+grep -q "outlines: 2 drawn" render_ol.txt || { fail "render: outlines not drawn"; cat render_ol.txt; }
+printf 'outline\n  M 0 0 L 1 0 L 1 1\n  L 2\nend\n' >bad_plan.txt
+rm -f bad.sws
+expect_error "outline: a missing number" "bad_plan.txt:3:6:" bad_plan.txt -- "$sw" outline bad_plan.txt -o bad.sws
+[ ! -e bad.sws ] || fail "outline: a file written after a mistake"
+pass "outline: placed into a scene, counted, drawn; a mistake at its line and column"
+
 echo "$failures failure(s)"
 [ $failures -eq 0 ]

@@ -12,6 +12,7 @@
 #include <stdio.h>
 
 int sw_cli_import(int argc, char **argv);
+int sw_cli_outline(int argc, char **argv);
 int sw_cli_info(int argc, char **argv);
 int sw_cli_render(int argc, char **argv);
 int sw_cli_demo(int argc, char **argv);

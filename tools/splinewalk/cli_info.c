@@ -62,7 +62,8 @@ static void print_json(const char *path, const sw_scene_info *in, int got,
            "\"max_trim_curve_degree\": %u, \"control_points\": %llu, \"nodes\": %u, "
            "\"instances\": %u, \"face_occurrences\": %llu, \"adjacent_face_pairs\": %u, "
            "\"meshes\": %u, \"mesh_triangles\": %llu, \"mesh_occurrences\": %llu, "
-           "\"triangle_occurrences\": %llu, \"faces_skipped\": %u, \"faces_repaired\": %u, "
+           "\"triangle_occurrences\": %llu, \"shapes\": %u, \"shape_occurrences\": %llu, "
+           "\"faces_skipped\": %u, \"faces_repaired\": %u, "
            "\"partial\": %s, "
            "\"bbox\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g], \"memory_bytes\": %zu, ",
            in->trimmed_faces, in->loops, in->curves, (unsigned long long)in->bezier_patches,
@@ -70,7 +71,8 @@ static void print_json(const char *path, const sw_scene_info *in, int got,
            (unsigned long long)in->control_points, in->nodes, in->instances,
            (unsigned long long)in->face_occurrences, in->adjacent_face_pairs, in->meshes,
            (unsigned long long)in->mesh_triangles, (unsigned long long)in->mesh_occurrences,
-           (unsigned long long)in->triangle_occurrences, in->faces_skipped, in->faces_repaired,
+           (unsigned long long)in->triangle_occurrences, in->shapes,
+           (unsigned long long)in->shape_occurrences, in->faces_skipped, in->faces_repaired,
            in->partial ? "true" : "false", in->bbox_min[0], in->bbox_min[1], in->bbox_min[2],
            in->bbox_max[0], in->bbox_max[1], in->bbox_max[2], in->memory_bytes);
     print_lod_json(got, lods, lod_bytes, lod_status);
@@ -123,6 +125,9 @@ static void print_text(const char *path, const sw_scene_info *in)
         printf("  meshes          %u (%llu triangles); drawn %llu (%llu triangles)\n", in->meshes,
                (unsigned long long)in->mesh_triangles, (unsigned long long)in->mesh_occurrences,
                (unsigned long long)in->triangle_occurrences);
+    if (in->shapes)
+        printf("  outlines        %u; drawn %llu\n", in->shapes,
+               (unsigned long long)in->shape_occurrences);
     printf("  bounding box    [%g %g %g] - [%g %g %g]\n", in->bbox_min[0], in->bbox_min[1],
            in->bbox_min[2], in->bbox_max[0], in->bbox_max[1], in->bbox_max[2]);
     printf("  memory          %.2f MiB\n", (double)in->memory_bytes / (1024.0 * 1024.0));

@@ -14,6 +14,7 @@ typedef struct command {
 static const command k_commands[] = {
     {"import", sw_cli_import, "import STEP / IGES / BREP into a .sws scene file"},
     {"info", sw_cli_info, "describe a scene (surfaces, trims, patches, memory)"},
+    {"outline", sw_cli_outline, "place filled outlines (SVG path data) into a scene"},
     {"render", sw_cli_render, "render one converged frame headlessly to PNG / EXR"},
     {"path", sw_cli_path, "write a camera path (orbit or fly-through) fitted to a scene"},
     {"profile", sw_cli_profile, "time frames along a camera path: CSV, JSON, SVG, HTML report"},

@@ -149,7 +149,7 @@ typedef struct sw_scene_info {
     uint32_t nodes, instances;
     uint64_t face_occurrences; /* faces drawn, instances expanded */
     uint32_t adjacent_face_pairs;
-    double bbox_min[3], bbox_max[3]; /* of the surfaces and the meshes */
+    double bbox_min[3], bbox_max[3]; /* of the surfaces, the meshes and the outlines */
     size_t memory_bytes;
     uint32_t meshes;               /* triangle meshes (sw_nodes.h MESH nodes; .sws MESHES) */
     uint64_t mesh_triangles;       /* their triangles, each mesh once */
@@ -162,6 +162,8 @@ typedef struct sw_scene_info {
     int32_t partial;         /* 1: a truncated file imported in part (SW_LOAD_PARTIAL) */
     uint64_t lod_cache_bytes; /* the .sws file's static LOD cache (`splinewalk build-lod`), checked
                                  against its checksum; 0: none (or damaged) */
+    uint32_t shapes;          /* planar outlines (sw_nodes.h SHAPE nodes; .sws SHAPES) */
+    uint64_t shape_occurrences; /* outlines drawn, instances expanded */
 } sw_scene_info;
 
 /* Describes the scene (the first call on a scene verifies it and walks it once). Any thread.

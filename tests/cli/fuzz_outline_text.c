@@ -1,0 +1,71 @@
+/* SPDX-License-Identifier: MIT */
+/* libFuzzer harness for the outline text format (tools/splinewalk/outline_text.c). Any text must
+ * either be refused with a "FILE:LINE:COLUMN: " message and nothing handed out, or give outlines
+ * that every later step can take as they are: each item has loops, each loop curves of degree 1
+ * to 3 with degree + 1 finite control points, knots 0...0 1...1, weights positive and finite (or
+ * none), each curve ending bit for bit where the next begins (the last where the first begins),
+ * colours inside [0, 1], a finite transform whose third column is a unit vector.
+ * Planted: the closing line of a subpath left out: it fails on the first seed. */
+#include "outline_text.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void check_curve(const sw_trim_curve *c)
+{
+    if (c->degree < 1 || c->degree > 3 || c->count != c->degree + 1)
+        abort();
+    for (uint32_t i = 0; i < 2 * c->count; i++)
+        if (!isfinite(c->points[i]) || c->knots[i] != (i < c->count ? 0.0 : 1.0))
+            abort();
+    for (uint32_t i = 0; c->weights && i < c->count; i++)
+        if (!(c->weights[i] > 0.0) || !isfinite(c->weights[i]))
+            abort();
+}
+
+static void check_item(const sw_outline_item *it)
+{
+    if (it->shape.loop_count == 0 || !it->shape.loops)
+        abort();
+    for (int k = 0; k < 4; k++)
+        if (!(it->color[k] >= 0.0f && it->color[k] <= 1.0f))
+            abort();
+    for (int k = 0; k < 12; k++)
+        if (!isfinite(it->transform[k]))
+            abort();
+    const double *t = it->transform;
+    if (fabs(t[2] * t[2] + t[6] * t[6] + t[10] * t[10] - 1.0) > 1e-9)
+        abort();
+    for (uint32_t l = 0; l < it->shape.loop_count; l++) {
+        const sw_trim_loop *lp = &it->shape.loops[l];
+        if (lp->curve_count == 0)
+            abort();
+        for (uint32_t k = 0; k < lp->curve_count; k++) {
+            const sw_trim_curve *c = &lp->curves[k], *n = &lp->curves[(k + 1) % lp->curve_count];
+            check_curve(c);
+            if (c->points[2 * c->degree] != n->points[0] ||
+                c->points[2 * c->degree + 1] != n->points[1])
+                abort();
+        }
+    }
+}
+
+int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size);
+int LLVMFuzzerTestOneInput(const unsigned char *data, size_t size)
+{
+    sw_outline_doc doc;
+    char err[256];
+    int bad = sw_outline_parse((const char *)data, size, "fuzz", &doc, err, sizeof err);
+    if (bad) {
+        if (doc.n_items || doc.items || strncmp(err, "fuzz:", 5) != 0)
+            abort();
+        return 0;
+    }
+    if (doc.n_items == 0)
+        abort();
+    for (size_t i = 0; i < doc.n_items; i++)
+        check_item(&doc.items[i]);
+    sw_outline_doc_free(&doc);
+    return 0;
+}
