@@ -7,7 +7,7 @@
  *   loop-index        its first loop index past the LOOPS section
  * Structural corruptions of the header, the section table and the layout, each with the header
  * checksum made right again (a reader must find the fault itself, not by the checksum):
- *   version-2, bad-magic, flags, reserved, section-count-7, section-count-12, table-misaligned,
+ *   version-2, bad-magic, flags, reserved, section-count-7, section-count-13, table-misaligned,
  *   table-in-header, entry-size-48, size-field-long, size-field-short, section-overlap,
  *   section-past-end, section-misaligned, count-mismatch, duplicate-id, padding (a padding byte
  *   between two sections set), trailing (16 bytes appended, the size field updated)
@@ -106,8 +106,8 @@ static int corrupt_structure(unsigned char *file, uint64_t *size, const char *wh
         file[50] = 7;
     else if (!strcmp(what, "section-count-7"))
         wr32(file + 16, 7);
-    else if (!strcmp(what, "section-count-12"))
-        wr32(file + 16, 12);
+    else if (!strcmp(what, "section-count-13"))
+        wr32(file + 16, 13); /* 8, 9, 11 and 12 are counts of the format */
     else if (!strcmp(what, "table-misaligned"))
         wr64(file + 32, rd64(file + 32) + 8);
     else if (!strcmp(what, "table-in-header"))

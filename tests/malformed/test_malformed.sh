@@ -52,7 +52,7 @@ bad-magic SW_ERR_FORMAT
 flags SW_ERR_FORMAT
 reserved SW_ERR_FORMAT
 section-count-7 SW_ERR_FORMAT
-section-count-12 SW_ERR_FORMAT
+section-count-13 SW_ERR_FORMAT
 table-misaligned SW_ERR_FORMAT
 table-in-header SW_ERR_FORMAT
 entry-size-48 SW_ERR_FORMAT
