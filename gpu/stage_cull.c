@@ -138,15 +138,19 @@ typedef struct mesh_taker {
     int oom;
 } mesh_taker;
 
-/* A mesh's box, or a shape's plane box (in its plane z = 0). */
+/* A mesh's box, or a shape's plane box (in its plane z = 0); a label on screen's: its anchor
+ * (its extent in the world depends on the view). */
 static void local_box(const sw__fr_env *env, int shapes, uint32_t i, double box[6])
 {
     if (!shapes) {
         memcpy(box, env->sv->meshes[i].box, 6 * sizeof *box);
         return;
     }
-    const double *b = env->sv->shapes[i].box;
-    const double q[6] = {b[0], b[1], 0.0, b[2], b[3], 0.0};
+    const sw_sg_shape_rec *s = &env->sv->shapes[i];
+    const double *b = s->box;
+    const int screen = (s->flags & SW_SG_SHAPE_SCREEN) != 0;
+    const double q[6] = {screen ? 0.0 : b[0], screen ? 0.0 : b[1], 0.0,
+                         screen ? 0.0 : b[2], screen ? 0.0 : b[3], 0.0};
     memcpy(box, q, sizeof q);
 }
 
@@ -190,12 +194,15 @@ static sw_result collect_meshes(const sw__fr_env *env, sw__fr_visible *vis, doub
     return SW_OK;
 }
 
-/* Keeps the occurrences whose box meets the frustum; returns how many were dropped. */
-static uint64_t cull_boxes(const sw__fr_env *env, sw__fr_mesh_occ *list, size_t *n)
+/* Keeps the occurrences whose box meets the frustum (a label on screen: always, its text may show
+ * where its anchor does not; the outline stage culls it behind the near plane); returns how many
+ * were dropped. */
+static uint64_t cull_boxes(const sw__fr_env *env, sw__fr_mesh_occ *list, size_t *n, int shapes)
 {
     size_t k = 0;
     for (size_t i = 0; i < *n; ++i)
-        if (sw__gpu_view_box_visible(&env->view, list[i].box))
+        if ((shapes && (env->sv->shapes[list[i].mesh].flags & SW_SG_SHAPE_SCREEN)) ||
+            sw__gpu_view_box_visible(&env->view, list[i].box))
             list[k++] = list[i];
     uint64_t dropped = *n - k;
     *n = k;
@@ -204,8 +211,8 @@ static uint64_t cull_boxes(const sw__fr_env *env, sw__fr_mesh_occ *list, size_t 
 
 static void cull_meshes(const sw__fr_env *env, sw__fr_visible *vis, sw_gpu_frame_stats *st)
 {
-    st->meshes_culled += cull_boxes(env, vis->meshes, &vis->n_meshes);
-    st->shapes_culled += cull_boxes(env, vis->shapes, &vis->n_shapes);
+    st->meshes_culled += cull_boxes(env, vis->meshes, &vis->n_meshes, 0);
+    st->shapes_culled += cull_boxes(env, vis->shapes, &vis->n_shapes, 1);
 }
 
 void sw__fr_visible_empty(sw__fr_visible *vis)

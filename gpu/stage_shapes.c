@@ -35,14 +35,31 @@ static sw_result shape_loops(const sw__fr_env *env, const sw_sg_shape_rec *s,
     return SW_OK;
 }
 
-/* The occurrence's plane in eye-relative world coordinates: (x, y, 0) under its transform. */
-static void shape_plane(const sw__fr_env *env, const double world[12], sw__curves_plane *pl)
+/* The occurrence's plane in eye-relative world coordinates: (x, y, 0) under its transform; for
+ * a label on screen (SW_SG_SHAPE_SCREEN) the plane through its node's origin facing the camera,
+ * scaled so that one unit is px_size pixels at that depth (the plane is parallel to the screen:
+ * every point of it is at the origin's depth). 0: the origin is not in front of the near plane. */
+static int shape_plane(const sw__fr_env *env, const sw_sg_shape_rec *s, const double world[12],
+                       sw__curves_plane *pl)
 {
+    const sw__gpu_view *v = &env->view;
     for (int k = 0; k < 3; ++k) {
-        pl->origin[k] = world[4 * k + 3] - env->view.eye[k];
+        pl->origin[k] = world[4 * k + 3] - v->eye[k];
         pl->ax[k] = world[4 * k];
         pl->ay[k] = world[4 * k + 1];
     }
+    if (!(s->flags & SW_SG_SHAPE_SCREEN))
+        return 1;
+    const double d =
+        v->fwd[0] * pl->origin[0] + v->fwd[1] * pl->origin[1] + v->fwd[2] * pl->origin[2];
+    if (!(d > v->near_plane))
+        return 0;
+    const double unit = s->px_size * d / v->focal_px;
+    for (int k = 0; k < 3; ++k) {
+        pl->ax[k] = unit * v->right[k];
+        pl->ay[k] = unit * v->up[k];
+    }
+    return 1;
 }
 
 sw_result sw__fr_shapes_plan(const sw__fr_env *env, const sw__fr_visible *vis, sw__fr_geometry *geo,
@@ -59,7 +76,10 @@ sw_result sw__fr_shapes_plan(const sw__fr_env *env, const sw__fr_visible *vis, s
         if (r != SW_OK)
             break;
         sw__curves_plane plane;
-        shape_plane(env, o->world, &plane);
+        if (!shape_plane(env, s, o->world, &plane)) {
+            st->shapes_culled++; /* a label whose anchor is behind the near plane */
+            continue;
+        }
         sw__curves_projected pr;
         sw_status why = {0};
         sw_result pr_r = sw__curves_project(loops, s->n_loops, &plane, &env->view, &pr, &why);

@@ -117,8 +117,11 @@ static int stats_visit_shape(void *ctx, uint32_t shape, uint32_t node, const dou
     (void)color;
     stats_ctx *c = ctx;
     const sw_sg_shape_rec *sh = &c->scene->view.shapes[shape];
+    const int screen = (sh->flags & SW_SG_SHAPE_SCREEN) != 0; /* a label on screen: its anchor */
     for (int k = 0; k < 4; k++) {
-        double q[2] = {sh->box[(k & 1) ? 2 : 0], sh->box[(k & 2) ? 3 : 1]}, p[3];
+        double q[2] = {screen ? 0.0 : sh->box[(k & 1) ? 2 : 0],
+                       screen ? 0.0 : sh->box[(k & 2) ? 3 : 1]},
+               p[3];
         for (int r = 0; r < 3; r++) {
             const double *w = world + 4 * r;
             p[r] = w[0] * q[0] + w[1] * q[1] + w[3];

@@ -375,12 +375,16 @@ static sw_result check_shapes(const vctx *c)
         const sw_sg_shape_rec *s = &v->shapes[i];
         char at[48];
         where(c, SW__SG_SEC_SHAPES, i, at);
+        const int screen = (s->flags & SW_SG_SHAPE_SCREEN) != 0;
         if (s->n_loops == 0 || s->first_loop > v->n_loops ||
-            s->n_loops > v->n_loops - s->first_loop || s->flags || s->reserved)
+            s->n_loops > v->n_loops - s->first_loop ||
+            (s->flags & ~(uint32_t)SW_SG_SHAPE_FLAGS_ALL) || s->reserved ||
+            (screen ? !(s->px_size > 0.0 && s->px_size <= SW_SG_SHAPE_MAX_PX) : s->px_size != 0.0))
             return sw__fail(c->status, SW_ERR_FORMAT,
-                            "%s: shape %u%s: loops [%u, +%u) of %u, flags 0x%x, reserved %u",
+                            "%s: shape %u%s: loops [%u, +%u) of %u, flags 0x%x, reserved %u, %g px "
+                            "per unit",
                             c->what, i, at, s->first_loop, s->n_loops, v->n_loops, s->flags,
-                            s->reserved);
+                            s->reserved, s->px_size);
         double box[4];
         sw_sg_shape_box(v, s->first_loop, s->n_loops, box);
         if (memcmp(box, s->box, sizeof box) != 0)

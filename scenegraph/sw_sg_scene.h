@@ -105,15 +105,24 @@ typedef struct sw_sg_mesh_rec {
     double box[6];      /* min xyz, max xyz of the positions, exactly (validated) */
 } sw_sg_mesh_rec;
 
-/* A filled planar outline (the shape nodes): loops [first_loop, first_loop + n_loops) of 2D
+/* A filled planar outline (shape and label nodes): loops [first_loop, first_loop + n_loops) of 2D
  * rational B-spline curves in the plane z = 0 of its node's frame, filled by even-odd parity, drawn
  * with exact anti-aliased edges over the scene (gpu/sw_curves.h). */
+enum sw_sg_shape_flags {
+    /* Billboarded at its node's origin, constant size on screen: the plane faces the camera
+     * (x right, y up on the screen) and one unit of it is px_size pixels (a label); the node's
+     * rotation and scale are not used. */
+    SW_SG_SHAPE_SCREEN = 1u << 0,
+    SW_SG_SHAPE_FLAGS_ALL = (1u << 1) - 1,
+};
+#define SW_SG_SHAPE_MAX_PX 16384.0 /* px_size at most */
 typedef struct sw_sg_shape_rec {
     uint32_t first_loop, n_loops; /* n_loops >= 1 */
-    uint32_t flags;               /* zero (none is defined) */
+    uint32_t flags;               /* sw_sg_shape_flags */
     uint32_t reserved;            /* zero */
     double box[4];                /* x0, y0, x1, y1 of its curves' control points, exactly
                                      (validated): the curves lie inside it */
+    double px_size; /* SCREEN: pixels per unit, in (0, SW_SG_SHAPE_MAX_PX]; otherwise 0 */
 } sw_sg_shape_rec;
 
 typedef enum sw_sg_node_kind {

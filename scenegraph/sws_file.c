@@ -33,7 +33,7 @@
  *
  *   record sizes: FACES 96 (sw_sg_face_rec), LOOPS 16, CURVES 24, NODES 136, ADJACENCY 8,
  *   POOL 8 (double), STRINGS 1 (char; the last one NUL), META 16 (u32 root node, 12 zero bytes),
- *   MESHES 88 (sw_sg_mesh_rec), INDICES 4 (u32), SHAPES 48 (sw_sg_shape_rec). A scene without
+ *   MESHES 88 (sw_sg_mesh_rec), INDICES 4 (u32), SHAPES 56 (sw_sg_shape_rec). A scene without
  *   shapes is written with 8, 9 or 11 sections, and one without meshes either with 8 or 9, byte
  *   for byte as before those sections existed.
  *   Padding between sections is zero. The file ends where its last section ends.
@@ -72,7 +72,7 @@ _Static_assert(sizeof(sw_sg_node_rec) == 136 && offsetof(sw_sg_node_rec, xform) 
 _Static_assert(sizeof(sw_sg_adjacency_rec) == 8, "adjacency layout is part of the .sws format");
 _Static_assert(sizeof(sw_sg_mesh_rec) == 88 && offsetof(sw_sg_mesh_rec, box) == 40,
                "mesh record layout is part of the .sws format");
-_Static_assert(sizeof(sw_sg_shape_rec) == 48 && offsetof(sw_sg_shape_rec, box) == 16,
+_Static_assert(sizeof(sw_sg_shape_rec) == 56 && offsetof(sw_sg_shape_rec, px_size) == 48,
                "shape record layout is part of the .sws format");
 _Static_assert(sizeof(double) == 8 && sizeof(float) == 4, "IEEE 754 binary64/binary32");
 

@@ -16,6 +16,7 @@ packages=(
   libxml2-utils jq  # tests/profile: xmllint checks the SVG and HTML, jq the JSON
   strace  # tests/io: kills a writer at its fsync and rename (signal injection)
   libgeos-dev  # bench/triangulate: GEOS's polygon CDT against CGAL's (docs/licensing.md)
+  libfreetype-dev fonts-dejavu-core  # the text module: label glyphs (DejaVu Sans by default)
 )
 if [ "${SW_WITH_CLANG:-0}" = 1 ]; then
   packages+=(clang libclang-rt-14-dev)

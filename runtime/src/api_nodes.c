@@ -3,6 +3,7 @@
  * asks api_nodes_compile.c for a new version; geometry descs are checked and turned into small
  * private scenes here, outside the edit lock, so a slow import never holds the scene up. */
 #include "api_nodes_internal.h"
+#include "sw_sg_text.h"
 #include "sw_hooks.h"
 
 #include "sw_lod_face_cones.h"
@@ -19,6 +20,7 @@ static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
 
 #define SW__NODES_MAX_POINTS (1u << 20)
 #define SW__NODES_MAX_LOOPS 65536u
+#define SW__NODES_MAX_LABEL 1024u     /* bytes of a label's text */
 #define SW__NODES_MAX_MESH (1u << 24) /* vertices, and triangles, of one mesh */
 
 /* ---- the model's life --------------------------------------------------------------------------
@@ -621,24 +623,25 @@ static double loops_size(const sw_trim_loop *loops, uint32_t n)
     return size > 0.0 && isfinite(size) ? size : 0.0;
 }
 
-/* A private scene of one shape drawn by one SHAPE node under its root. */
-static sw_result shape_geom(const sw_shape_desc *d, sw_sg_scene **out, sw_status *status)
+/* A private scene of one outline drawn by one SHAPE node under its root (flags, px_size: as
+ * sw_sg_shape_rec's). */
+static sw_result shape_scene(const char *fn, const sw_trim_loop *loops, uint32_t n_loops,
+                             uint32_t flags, double px_size, sw_sg_scene **out, sw_status *status)
 {
-    const char *fn = "shape";
-    if (d->loop_count < 1)
+    if (n_loops < 1)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "%s: no loops", fn);
-    sw_result r = check_loops_desc(fn, d->loops, d->loop_count, status);
+    sw_result r = check_loops_desc(fn, loops, n_loops, status);
     if (r != SW_OK)
         return r;
     sw_sg_builder *b = sw_sg_builder_create();
     if (!b)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
-    const double max_gap = 1e-6 * loops_size(d->loops, d->loop_count);
+    const double max_gap = 1e-6 * loops_size(loops, n_loops);
     double box[4] = {INFINITY, -INFINITY, INFINITY, -INFINITY};
-    sw_sg_shape_rec rec = {SW_SG_NONE, d->loop_count, 0, 0, {0}};
-    for (uint32_t l = 0; r == SW_OK && l < d->loop_count; l++) {
+    sw_sg_shape_rec rec = {SW_SG_NONE, n_loops, flags, 0, {0}, px_size};
+    for (uint32_t l = 0; r == SW_OK && l < n_loops; l++) {
         uint32_t li = SW_SG_NONE;
-        r = add_loop(b, fn, &d->loops[l], l, max_gap, box, &li, status);
+        r = add_loop(b, fn, &loops[l], l, max_gap, box, &li, status);
         if (l == 0)
             rec.first_loop = li;
     }
@@ -652,6 +655,100 @@ static sw_result shape_geom(const sw_shape_desc *d, sw_sg_scene **out, sw_status
         return r;
     }
     return sw_sg_builder_finish(b, out, status);
+}
+
+static sw_result shape_geom(const sw_shape_desc *d, sw_sg_scene **out, sw_status *status)
+{
+    return shape_scene("shape", d->loops, d->loop_count, 0, 0.0, out, status);
+}
+
+/* ---- labels ---- */
+
+static sw_result check_label_desc(const sw_label_desc *d, size_t *len, sw_status *status)
+{
+    if (!d->text)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "label: NULL text");
+    *len = strnlen(d->text, SW__NODES_MAX_LABEL + 1);
+    if (*len == 0 || *len > SW__NODES_MAX_LABEL)
+        return sw__fail(status, *len ? SW_ERR_LIMIT : SW_ERR_INVALID_ARGUMENT,
+                        "label: %s text (1..%u bytes)", *len ? "too long a" : "an empty",
+                        SW__NODES_MAX_LABEL);
+    const double most = d->screen_size ? SW_SG_SHAPE_MAX_PX : 1e15;
+    if (!(d->size > 0.0 && d->size <= most))
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "label: size %g outside (0, %g]%s",
+                        d->size, most, d->screen_size ? " pixels" : "");
+    if (d->align < 0 || d->align > 2)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "label: align %d (0 start, 1 middle, 2 end)", (int)d->align);
+    return SW_OK;
+}
+
+/* The glyph outline's pieces as the loops of a shape: em units times `scale`, shifted by -shift
+ * along the baseline. */
+static sw_result label_loops(const sw_sg_text_outline *t, double scale, double shift,
+                             sw_trim_loop **loops_out, sw_trim_curve **curves_out,
+                             double **nums_out, sw_status *status)
+{
+    static const double k_knots[4][8] = {
+        {0}, {0, 0, 1, 1}, {0, 0, 0, 1, 1, 1}, {0, 0, 0, 0, 1, 1, 1, 1}};
+    sw_trim_loop *loops = sw__calloc(t->n_contours, sizeof *loops);
+    sw_trim_curve *curves = sw__calloc(t->n_pieces, sizeof *curves);
+    double *nums = sw__calloc(t->n_pieces, 8 * sizeof *nums);
+    if (!loops || !curves || !nums) {
+        sw__free(loops);
+        sw__free(curves);
+        sw__free(nums);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "label: out of memory");
+    }
+    for (size_t i = 0; i < t->n_pieces; i++) {
+        const sw_sg_text_piece *q = &t->pieces[i];
+        double *p = nums + 8 * i;
+        for (uint32_t k = 0; k <= q->degree; k++) {
+            p[2 * k] = scale * (q->p[k][0] - shift);
+            p[2 * k + 1] = scale * q->p[k][1];
+        }
+        curves[i] = (sw_trim_curve){q->degree, q->degree + 1, k_knots[q->degree], p, NULL};
+    }
+    for (uint32_t k = 0; k < t->n_contours; k++) {
+        size_t first = k ? t->contour_end[k - 1] : 0;
+        loops[k] = (sw_trim_loop){curves + first, (uint32_t)(t->contour_end[k] - first)};
+    }
+    *loops_out = loops;
+    *curves_out = curves;
+    *nums_out = nums;
+    return SW_OK;
+}
+
+/* A label: its glyphs' outlines (the text module) as a shape, scaled to its size in the world,
+ * or in em units drawn `size` pixels per em on screen. */
+static sw_result label_geom(const sw_label_desc *d, sw_sg_scene **out, sw_status *status)
+{
+    size_t len = 0;
+    sw_result r = check_label_desc(d, &len, status);
+    if (r != SW_OK)
+        return r;
+    sw_sg_text_outline t;
+    r = sw_sg_text_outline_make(d->font_path, d->text, len, &t, status);
+    if (r != SW_OK)
+        return r;
+    if (t.n_contours == 0) {
+        sw_sg_text_outline_free(&t);
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "label: \"%.40s\" has no glyph outline to draw (spaces only?)", d->text);
+    }
+    sw_trim_loop *loops = NULL;
+    sw_trim_curve *curves = NULL;
+    double *nums = NULL;
+    r = label_loops(&t, d->screen_size ? 1.0 : d->size, 0.5 * d->align * t.advance, &loops, &curves,
+                    &nums, status);
+    if (r == SW_OK)
+        r = shape_scene("label", loops, t.n_contours, d->screen_size ? SW_SG_SHAPE_SCREEN : 0u,
+                        d->screen_size ? d->size : 0.0, out, status);
+    sw__free(loops);
+    sw__free(curves);
+    sw__free(nums);
+    sw_sg_text_outline_free(&t);
+    return r;
 }
 
 /* Triangles of a geometry scene's meshes (each once). */
@@ -690,6 +787,10 @@ static sw_result make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *
         if (!d->shape)
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: SHAPE without shape");
         return shape_geom(d->shape, out, status);
+    case SW_NODE_LABEL:
+        if (!d->label)
+            return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "sw_node_add: LABEL without label");
+        return label_geom(d->label, out, status);
     default:
         return SW_OK;
     }
@@ -1000,7 +1101,8 @@ static sw_result edit_geometry(rt_node *n, const void *arg, sw_status *status)
                         swap->kind == SW_NODE_NURBS     ? "NURBS"
                         : swap->kind == SW_NODE_TSPLINE ? "TSPLINE"
                         : swap->kind == SW_NODE_MESH    ? "MESH"
-                                                        : "SHAPE");
+                        : swap->kind == SW_NODE_SHAPE   ? "SHAPE"
+                                                        : "LABEL");
     sw_sg_scene *old = n->geom;
     n->geom = swap->geom;
     n->geom_faces = sw_sg_scene_view_ptr(n->geom)->n_faces;
@@ -1063,6 +1165,15 @@ sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_desc *des
         return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_mesh: NULL desc");
     geometry_swap swap = {NULL, SW_NODE_MESH, "sw_node_set_mesh"};
     return set_geometry(scene, node, &swap, mesh_geom(desc, &swap.geom, status), status);
+}
+
+sw_result sw_node_set_label(sw_scene scene, sw_node node, const sw_label_desc *desc,
+                            sw_status *status)
+{
+    if (!desc)
+        return SW__MISUSE(status, SW_ERR_INVALID_ARGUMENT, "sw_node_set_label: NULL desc");
+    geometry_swap swap = {NULL, SW_NODE_LABEL, "sw_node_set_label"};
+    return set_geometry(scene, node, &swap, label_geom(desc, &swap.geom, status), status);
 }
 
 sw_result sw_node_set_shape(sw_scene scene, sw_node node, const sw_shape_desc *desc,

@@ -22,6 +22,14 @@
  * differ) from a file of 12 sections; bad outlines (an open loop, a loop without area, no loops, a
  * SHAPE edit of a MESH node) are refused with the loop named and change nothing.
  *
+ * Labels (the text module, sw_text.h): refused with SW_ERR_UNSUPPORTED before sw_text_install;
+ * then a label on screen ("Room 101", 24 px, billboarded) and one fixed in the world ("Hall", 2
+ * units on the floor, at the cameras' target) drawn from two distances, the second twice the first:
+ * the screen label's height in pixels stays the same (within 1 px), the world label's halves (ratio
+ * 0.4-0.6); a label whose anchor is behind the camera is culled; saved and reloaded, the same
+ * image; bad labels (not UTF-8, empty, spaces only, size 0, a missing font file) refused, the byte
+ * or file named.
+ *
  * What it catches (each planted once and seen failing): outlines not drawn (every view);
  * composited without the depth test (over the wall: aside, low); without the decal pull (hidden
  * by its own floor: low); the plane's axes swapped (every view); not cut at the near plane (low:
@@ -29,6 +37,7 @@
  * refused: its SHAPE node names no shape).
  */
 #include <splinewalk/sw_nodes.h>
+#include <splinewalk/sw_text.h>
 
 #include "test_check.h"
 
@@ -478,6 +487,106 @@ static void test_save_reload(sw_renderer r, built *b)
     sw_scene_destroy(loaded);
 }
 
+/* The rows (image, top first) holding pixels of one colour class; 0 when none. */
+static int class_height(const char *png, int want)
+{
+    int w = 0, h = 0, top = -1, bottom = -1;
+    unsigned char *img = sw_test_read_rgba(png, &w, &h);
+    for (int y = 0; img && y < h; y++)
+        for (int x = 0; x < w; x++)
+            if (classify(img + 4 * ((size_t)y * w + x)) == want) {
+                top = top < 0 ? y : top;
+                bottom = y;
+            }
+    free(img);
+    return top < 0 ? 0 : bottom - top + 1;
+}
+
+static sw_result add_label(sw_scene s, const char *text, const char *font, double size, int screen,
+                           const double at[3], float r, float g, float b, sw_node *n, sw_status *st)
+{
+    sw_label_desc l = {text, font, size, screen, 1};
+    sw_node_desc d = {0};
+    d.kind = SW_NODE_LABEL;
+    d.label = &l;
+    d.color[0] = r, d.color[1] = g, d.color[2] = b, d.color[3] = 1;
+    const double xf[12] = {1, 0, 0, at[0], 0, 1, 0, at[1], 0, 0, 1, at[2]};
+    memcpy(d.transform, xf, sizeof xf);
+    return sw_node_add(s, &d, n, st);
+}
+
+static void expect_bad_label(sw_scene s, const char *text, const char *font, double size,
+                             sw_result want, const char *needle)
+{
+    sw_status st = {0};
+    sw_node n = {0};
+    const double at[3] = {0, 0, 0};
+    sw_result got = add_label(s, text, font, size, 1, at, 1, 0, 0, &n, &st);
+    CHECK(got == want && n.id == 0, "bad label (%s): %s, expected %s", needle,
+          sw_result_id_str(got), sw_result_id_str(want));
+    CHECK(strstr(st.message, needle), "bad label: message \"%s\" lacks \"%s\"", st.message, needle);
+}
+
+static void test_labels(sw_renderer r)
+{
+    sw_scene s;
+    sw_status st = {0};
+    CHECK(sw_scene_create(NULL, &s, &st) == SW_OK, "scene: %s", st.message);
+    sw_node floor, room, hall, behind;
+    sw_node_desc d = {0};
+    sw_mesh_desc fm = quad(g_floor);
+    d.kind = SW_NODE_MESH;
+    d.mesh = &fm;
+    d.color[0] = d.color[1] = d.color[2] = 0.5f, d.color[3] = 1;
+    CHECK(sw_node_add(s, &d, &floor, &st) == SW_OK, "floor: %s", st.message);
+    const double above[3] = {-3, 1, 1}, on[3] = {0, 1, 0}, back[3] = {0, -40, 3};
+    CHECK(add_label(s, "Room 101", NULL, 24, 1, above, 1, 0, 0, &room, &st) == SW_ERR_UNSUPPORTED,
+          "a label without the text module: %s", st.message);
+    CHECK(strstr(st.message, "sw_text_install") != NULL, "no module: '%s'", st.message);
+    CHECK(sw_text_install() == SW_OK, "sw_text_install");
+    CHECK(add_label(s, "Room 101", NULL, 24, 1, above, 1, 0, 0, &room, &st) == SW_OK,
+          "screen label: %s", st.message);
+    CHECK(add_label(s, "Hall", NULL, 2.0, 0, on, 0, 0, 1, &hall, &st) == SW_OK, "world label: %s",
+          st.message);
+    CHECK(add_label(s, "behind", NULL, 24, 1, back, 1, 0, 0, &behind, &st) == SW_OK,
+          "label behind: %s", st.message);
+    const sw_camera near_cam = {{0, -8, 6}, {0, 1, 0.5}, {0, 0, 1}, 45};
+    sw_camera far_cam = near_cam;
+    for (int k = 0; k < 3; k++) /* twice as far from the labels, looking the same way */
+        far_cam.eye[k] = near_cam.target[k] + 2 * (near_cam.eye[k] - near_cam.target[k]);
+    char a[1024], b[1024];
+    sw_frame_stats fs;
+    draw(r, s, &near_cam, 0, "labels_near", a, &fs);
+    CHECK(fs.shapes_drawn == 2 && fs.shapes_culled == 1,
+          "labels near: %llu drawn, %llu culled (2 and the one behind the camera)",
+          (unsigned long long)fs.shapes_drawn, (unsigned long long)fs.shapes_culled);
+    draw(r, s, &far_cam, 0, "labels_far", b, &fs);
+    const int red_a = class_height(a, RED), red_b = class_height(b, RED);
+    const int blue_a = class_height(a, BLUE), blue_b = class_height(b, BLUE);
+    printf("labels: screen label %d -> %d px tall, world label %d -> %d px at twice the "
+           "distance\n",
+           red_a, red_b, blue_a, blue_b);
+    CHECK(red_a > 12 && abs(red_a - red_b) <= 1, "screen label: %d px near, %d px far", red_a,
+          red_b);
+    CHECK(blue_a > 10 && blue_b >= 0.4 * blue_a && blue_b <= 0.6 * blue_a,
+          "world label: %d px near, %d px far", blue_a, blue_b);
+    char sws[1024], c[1024];
+    snprintf(sws, sizeof sws, "%s/labels.sws", g_work);
+    CHECK(sw_scene_save(s, sws, &st) == SW_OK, "save labels: %s", st.message);
+    sw_scene loaded = {0};
+    sw_scene_load_desc ld = {.path = sws};
+    CHECK(sw_scene_load(&ld, &loaded, &st) == SW_OK, "load labels: %s", st.message);
+    draw(r, loaded, &near_cam, 0, "labels_reloaded", c, &fs);
+    CHECK(sw_test_differing_percent(a, c) == 0.0, "reloaded labels draw another image");
+    sw_scene_destroy(loaded);
+    expect_bad_label(s, "\xff", NULL, 24, SW_ERR_INVALID_ARGUMENT, "byte 0");
+    expect_bad_label(s, "", NULL, 24, SW_ERR_INVALID_ARGUMENT, "empty");
+    expect_bad_label(s, "   ", NULL, 24, SW_ERR_INVALID_ARGUMENT, "no glyph");
+    expect_bad_label(s, "x", NULL, 0, SW_ERR_INVALID_ARGUMENT, "size");
+    expect_bad_label(s, "x", "/no/such/font.ttf", 24, SW_ERR_NOT_FOUND, "/no/such/font.ttf");
+    sw_scene_destroy(s);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -496,6 +605,7 @@ int main(int argc, char **argv)
     test_save_reload(r, &b);
     test_bad(&b);
     test_set_shape(r, &b);
+    test_labels(r);
     sw_renderer_destroy(r);
     sw_scene_destroy(b.scene);
     printf("shapes: %d failure(s)\n", g_failures);

@@ -4,7 +4,8 @@
  * that every later step can take as they are: each item has loops, each loop curves of degree 1
  * to 3 with degree + 1 finite control points, knots 0...0 1...1, weights positive and finite (or
  * none), each curve ending bit for bit where the next begins (the last where the first begins),
- * colours inside [0, 1], a finite transform whose third column is a unit vector.
+ * colours inside [0, 1], a finite transform whose third column is a unit vector; a label has
+ * its NUL-terminated text of at most 1,024 bytes, a positive finite size, align 0..2, no loops.
  * Planted: the closing line of a subpath left out: it fails on the first seed. */
 #include "outline_text.h"
 
@@ -24,8 +25,21 @@ static void check_curve(const sw_trim_curve *c)
             abort();
 }
 
+static void check_label(const sw_outline_item *it)
+{
+    const sw_label_desc *l = &it->label;
+    if (!l->text || strlen(l->text) > 1024 || !(l->size > 0.0) || !isfinite(l->size) ||
+        l->align < 0 || l->align > 2 || (l->screen_size != 0 && l->screen_size != 1) ||
+        (l->font_path && strlen(l->font_path) > 4095) || it->shape.loop_count != 0)
+        abort();
+}
+
 static void check_item(const sw_outline_item *it)
 {
+    if (it->is_label) {
+        check_label(it);
+        return;
+    }
     if (it->shape.loop_count == 0 || !it->shape.loops)
         abort();
     for (int k = 0; k < 4; k++)

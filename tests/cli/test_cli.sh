@@ -311,17 +311,20 @@ end
 outline name sign color 0.1 0.1 0.9 origin 0 0.03 0.01 x-axis 1 0 0 y-axis 0 0 1
   M -0.01 0 L 0.01 0 L 0 0.015 Z
 end
+label "Nut \\ \"M8\"" size 20 screen align middle origin 0 0 0.03 color 0.9 0.9 0.1
 TXT
 "$sw" outline plan.txt --into nut.sws -o planned.sws >outline.txt 2>&1 || { fail "outline"; cat outline.txt; }
-grep -q "2 outlines (3 loops) -> planned.sws" outline.txt || { fail "outline: summary"; cat outline.txt; }
-"$sw" info planned.sws | grep -q "^  outlines        2; drawn 2" || fail "info: outlines not counted"
+grep -q "2 outlines (3 loops), 1 labels -> planned.sws" outline.txt || { fail "outline: summary"; cat outline.txt; }
+"$sw" info planned.sws | grep -q "^  outlines        3; drawn 3" || fail "info: outlines not counted"
 "$sw" render planned.sws -o planned.png --size 320x240 >render_ol.txt 2>&1 || { fail "render planned.sws"; cat render_ol.txt; }
-grep -q "outlines: 2 drawn" render_ol.txt || { fail "render: outlines not drawn"; cat render_ol.txt; }
+grep -q "outlines: 3 drawn" render_ol.txt || { fail "render: outlines not drawn"; cat render_ol.txt; }
 printf 'outline\n  M 0 0 L 1 0 L 1 1\n  L 2\nend\n' >bad_plan.txt
 rm -f bad.sws
 expect_error "outline: a missing number" "bad_plan.txt:3:6:" bad_plan.txt -- "$sw" outline bad_plan.txt -o bad.sws
 [ ! -e bad.sws ] || fail "outline: a file written after a mistake"
-pass "outline: placed into a scene, counted, drawn; a mistake at its line and column"
+printf 'label "no font" font "/no/such/font.ttf"\n' >bad_font.txt
+expect_error "outline: a label's missing font" SW_ERR_NOT_FOUND /no/such/font.ttf -- "$sw" outline bad_font.txt -o bad.sws
+pass "outline: outlines and a label placed into a scene, counted, drawn; a mistake at its line and column"
 
 echo "$failures failure(s)"
 [ $failures -eq 0 ]

@@ -11,6 +11,7 @@
  *   sweep flag says; the large-arc flag picks the arc over 180 degrees (four pieces of a circle
  *   through two points one radius apart) or under (one);
  * - placement: origin, x-axis, y-axis into the row-major transform (z column their unit normal);
+ * - `label` lines: the quoted text with its escapes, size, screen, align, font, defaults;
  * - mistakes are refused with FILE:LINE:COLUMN: a missing number, an unsupported command, "inf"
  *   and "0x10" as numbers, 1e999, a second `outline` without `end`, a missing `end`, path data
  *   outside a block, a NUL byte, a colour outside [0, 1], parallel axes, an empty file.
@@ -212,6 +213,31 @@ static void test_arcs(void)
     sw_outline_doc_free(&b);
 }
 
+static void test_labels(void)
+{
+    sw_outline_doc doc;
+    char err[256];
+    const char *t = "outline\nM 0 0 L 1 0 L 0 1 Z\nend\n"
+                    "label \"A \\\"b\\\" \\\\ c\" size 12.5 screen align end font \"/x y.ttf\" "
+                    "origin 1 2 3\n"
+                    "label \"plain\"\n";
+    CHECK(parse(t, &doc, err, sizeof err) == 0, "labels: %s", err);
+    if (doc.n_items != 3)
+        return;
+    const sw_outline_item *a = &doc.items[1], *b = &doc.items[2];
+    CHECK(!doc.items[0].is_label && a->is_label && b->is_label, "kinds");
+    CHECK(!strcmp(a->label.text, "A \"b\" \\ c"), "text '%s'", a->label.text);
+    CHECK(a->label.size == 12.5 && a->label.screen_size == 1 && a->label.align == 2,
+          "size %g screen %d align %d", a->label.size, a->label.screen_size, a->label.align);
+    CHECK(a->label.font_path && !strcmp(a->label.font_path, "/x y.ttf"), "font");
+    CHECK(a->transform[3] == 1 && a->transform[7] == 2 && a->transform[11] == 3, "origin");
+    CHECK(a->shape.loop_count == 0 && a->line == 4, "a label has no loops (line %d)", a->line);
+    CHECK(!strcmp(b->label.text, "plain") && b->label.size == 1.0 && !b->label.screen_size &&
+              b->label.align == 0 && !b->label.font_path,
+          "defaults");
+    sw_outline_doc_free(&doc);
+}
+
 static void expect_error(const char *text, size_t len, const char *where, const char *needle)
 {
     sw_outline_doc doc;
@@ -243,6 +269,12 @@ static void test_errors(void)
     BAD("", "t.txt:1:", "no outline");
     BAD("outline bogus 1\nM 0 0 L 1 1\nend\n", "t.txt:1:", "unknown option 'bogus'");
     BAD("outline\nM 0 0 A 1 1 0 2 0 1 1\nend\n", "t.txt:2:", "flag");
+    BAD("label \"abc\n", "t.txt:1:", "closing");
+    BAD("label \"a\" align top\n", "t.txt:1:", "align 'top'");
+    BAD("label \"a\" size -1\n", "t.txt:1:", "positive");
+    BAD("label \"a\" size 0\n", "t.txt:1:", "positive");
+    BAD("label \"\\q\"\n", "t.txt:1:", "escapes");
+    BAD("label plain\n", "t.txt:1:", "double-quoted");
     const char nul[] = "outline\nM 0 0\0L 1 1\nend\n";
     expect_error(nul, sizeof nul - 1, "t.txt:", "NUL");
 }
@@ -251,6 +283,7 @@ int main(void)
 {
     test_lines();
     test_arcs();
+    test_labels();
     test_errors();
     printf("outline text: %d failure(s)\n", g_failures);
     return g_failures != 0;

@@ -13,6 +13,9 @@
 #if SW_CLI_LOD_BUILD
 #include <splinewalk/sw_lod_build.h>
 #endif
+#if SW_CLI_TEXT
+#include <splinewalk/sw_text.h>
+#endif
 
 void sw_cli_install_modules(void)
 {
@@ -24,5 +27,8 @@ void sw_cli_install_modules(void)
 #endif
 #if SW_CLI_LOD_BUILD
     (void)sw_lod_build_install();
+#endif
+#if SW_CLI_TEXT
+    (void)sw_text_install();
 #endif
 }

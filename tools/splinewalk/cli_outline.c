@@ -16,6 +16,8 @@ static const char k_usage[] =
     "Places filled planar outlines (floor plans, markings, signs) into a scene: each block of\n"
     "OUTLINES.txt (docs/outlines.md) is SVG path data (M L H V Q C A Z, absolute or relative)\n"
     "in the plane of its `origin`, `x-axis` and `y-axis`, filled even-odd in its `color`.\n"
+    "A `label \"TEXT\"` line places a line of text (glyph outlines through FreeType), fixed in\n"
+    "that plane or, with `screen`, facing the camera at a constant size in pixels.\n"
     "Curves stay curves: lines, quadratic and cubic Béziers as given, arcs as exact conics;\n"
     "frames draw them with exact anti-aliased edges at any zoom, hidden by what lies in front,\n"
     "shown on a surface they lie on. With --into, SCENE's content (a .sws, STEP, IGES, BREP or\n"
@@ -34,16 +36,19 @@ static int add_outlines(sw_scene scene, const sw_outline_doc *doc, const char *f
     for (size_t i = 0; i < doc->n_items; i++) {
         const sw_outline_item *it = &doc->items[i];
         sw_node_desc d = {0};
-        d.kind = SW_NODE_SHAPE;
+        d.kind = it->is_label ? SW_NODE_LABEL : SW_NODE_SHAPE;
         d.shape = &it->shape;
+        d.label = &it->label;
         d.name = it->name[0] ? it->name : NULL;
         memcpy(d.color, it->color, sizeof d.color);
         memcpy(d.transform, it->transform, sizeof d.transform);
         sw_status st = {0};
         sw_node n;
         if (sw_node_add(scene, &d, &n, &st) != SW_OK) {
-            fprintf(stderr, "splinewalk outline: %s:%d: outline %zu%s%s: %s\n", file, it->line,
-                    i + 1, it->name[0] ? " " : "", it->name, st.message);
+            fprintf(stderr, "splinewalk outline: %s (%s): %s:%d: %s %zu%s%s: %s\n",
+                    sw_result_str(st.result), sw_result_id_str(st.result), file, it->line,
+                    it->is_label ? "label" : "outline", i + 1, it->name[0] ? " " : "", it->name,
+                    st.message);
             return 1;
         }
     }
@@ -116,11 +121,13 @@ int sw_cli_outline(int argc, char **argv)
     if (rc == 0 && sw_scene_save(scene, out, &st) != SW_OK)
         rc = sw_cli_report("outline", &st);
     if (rc == 0) {
-        size_t loops = 0;
-        for (size_t i = 0; i < doc.n_items; i++)
+        size_t loops = 0, labels = 0;
+        for (size_t i = 0; i < doc.n_items; i++) {
             loops += doc.items[i].shape.loop_count;
-        printf("%s%s%s: %zu outlines (%zu loops) -> %s\n", into ? into : "", into ? " + " : "", in,
-               doc.n_items, loops, out);
+            labels += doc.items[i].is_label;
+        }
+        printf("%s%s%s: %zu outlines (%zu loops), %zu labels -> %s\n", into ? into : "",
+               into ? " + " : "", in, doc.n_items - labels, loops, labels, out);
     }
     if (scene.id)
         sw_scene_destroy(scene);

@@ -28,6 +28,7 @@ typedef struct loop_rec {
 typedef struct item_rec {
     sw_outline_item item;
     size_t first_loop, n_loops;
+    size_t text, font; /* a label's strings: offsets into the parser's chars, or SIZE_MAX */
 } item_rec;
 
 typedef struct parser {
@@ -46,6 +47,8 @@ typedef struct parser {
     size_t n_loops, cap_loops;
     item_rec *items;
     size_t n_items, cap_items;
+    char *chars; /* labels' text and font paths, NUL-terminated back to back */
+    size_t n_chars, cap_chars;
     /* the path being read */
     int in_item;
     char cmd; /* the last command letter (0: none yet) */
@@ -428,14 +431,52 @@ static int read_vec3(parser *p, const char *what, double out[3])
            read_number(p, what, &out[2]);
 }
 
-/* `outline [name N] [color R G B [A]] [origin X Y Z] [x-axis X Y Z] [y-axis X Y Z]` */
-static int begin_item(parser *p)
+/* A double-quoted string ("\\" and "\"" escaped; no line break) into p->chars; *at its offset. */
+static int read_quoted(parser *p, const char *what, size_t max, size_t *at)
+{
+    skip_space(p, 0);
+    if (at_end_of_line(p) || p->text[p->pos] != '"')
+        return fail(p, "expected a double-quoted %s", what);
+    p->pos++;
+    *at = p->n_chars;
+    size_t n = 0;
+    for (;;) {
+        if (at_end_of_line(p))
+            return fail(p, "the %s's closing '\"' is missing", what);
+        char c = p->text[p->pos++];
+        if (c == '"')
+            break;
+        if (c == '\\') {
+            if (at_end_of_line(p) || (p->text[p->pos] != '"' && p->text[p->pos] != '\\'))
+                return fail(p, "only \\\" and \\\\ are escapes in a %s", what);
+            c = p->text[p->pos++];
+        }
+        if (++n > max)
+            return fail(p, "the %s is longer than %zu bytes", what, max);
+        if (!grow(p, (void **)&p->chars, &p->cap_chars, p->n_chars + 1, 1))
+            return 0;
+        p->chars[p->n_chars++] = c;
+    }
+    if (!grow(p, (void **)&p->chars, &p->cap_chars, p->n_chars + 1, 1))
+        return 0;
+    p->chars[p->n_chars++] = '\0';
+    return 1;
+}
+
+/* `outline [name N] [color R G B [A]] [origin X Y Z] [x-axis X Y Z] [y-axis X Y Z]`, or
+ * `label "TEXT" [size S] [screen] [align start|middle|end] [font "PATH"]` and the same options */
+static int begin_item(parser *p, int is_label)
 {
     if (p->n_items >= SW_OUTLINE_MAX_ITEMS)
         return fail(p, "more than %u outlines in one file", SW_OUTLINE_MAX_ITEMS);
     item_rec it;
     memset(&it, 0, sizeof it);
     it.item.line = p->line;
+    it.text = it.font = SIZE_MAX;
+    it.item.is_label = is_label;
+    it.item.label.size = 1.0;
+    if (is_label && !read_quoted(p, "label text", 1024, &it.text))
+        return 0;
     const float dark[4] = {0.05f, 0.05f, 0.05f, 1.0f};
     memcpy(it.item.color, dark, sizeof dark);
     double origin[3] = {0, 0, 0}, ax[3] = {1, 0, 0}, ay[3] = {0, 1, 0};
@@ -465,8 +506,28 @@ static int begin_item(parser *p)
         } else if (!strcmp(key, "y-axis")) {
             if (!read_vec3(p, "y-axis X Y Z", ay))
                 return 0;
+        } else if (is_label && !strcmp(key, "size")) {
+            if (!read_number(p, "size S", &it.item.label.size))
+                return 0;
+            if (!(it.item.label.size > 0.0))
+                return fail(p, "a label's size must be positive");
+        } else if (is_label && !strcmp(key, "screen")) {
+            it.item.label.screen_size = 1;
+        } else if (is_label && !strcmp(key, "align")) {
+            char a[16];
+            read_word(p, a, sizeof a);
+            it.item.label.align = !strcmp(a, "start")    ? 0
+                                  : !strcmp(a, "middle") ? 1
+                                  : !strcmp(a, "end")    ? 2
+                                                         : -1;
+            if (it.item.label.align < 0)
+                return fail(p, "align '%s' (start, middle or end)", a);
+        } else if (is_label && !strcmp(key, "font")) {
+            if (!read_quoted(p, "font path", 4095, &it.font))
+                return 0;
         } else {
-            return fail(p, "unknown option '%s' (name, color, origin, x-axis, y-axis)", key);
+            return fail(p, "unknown option '%s' (name, color, origin, x-axis, y-axis%s)", key,
+                        is_label ? ", size, screen, align, font" : "");
         }
     }
     const double n[3] = {ax[1] * ay[2] - ax[2] * ay[1], ax[2] * ay[0] - ax[0] * ay[2],
@@ -485,6 +546,8 @@ static int begin_item(parser *p)
     if (!grow(p, (void **)&p->items, &p->cap_items, p->n_items + 1, sizeof *p->items))
         return 0;
     p->items[p->n_items++] = it;
+    if (is_label)
+        return 1; /* one line: no path, no `end` */
     p->in_item = 1;
     p->cmd = 0;
     p->subpath_open = 0;
@@ -513,11 +576,11 @@ static int parse_line(parser *p)
     size_t save = p->pos;
     char word[16];
     read_word(p, word, sizeof word);
-    if (!strcmp(word, "outline")) {
+    if (!strcmp(word, "outline") || !strcmp(word, "label")) {
         if (p->in_item)
-            return fail(p, "'outline' inside the outline begun on line %d (missing 'end')",
+            return fail(p, "'%s' inside the outline begun on line %d (missing 'end')", word,
                         p->items[p->n_items - 1].item.line);
-        return begin_item(p);
+        return begin_item(p, word[0] == 'l');
     }
     if (!strcmp(word, "end")) {
         if (!p->in_item)
@@ -539,6 +602,7 @@ typedef struct storage {
     sw_trim_curve *curves;
     sw_trim_loop *loops;
     double *nums;
+    char *chars;
 } storage;
 
 static int finish(parser *p, sw_outline_doc *out)
@@ -560,6 +624,8 @@ static int finish(parser *p, sw_outline_doc *out)
     }
     s->nums = p->nums; /* moved */
     p->nums = NULL;
+    s->chars = p->chars;
+    p->chars = NULL;
     for (size_t i = 0; i < p->n_curves; i++) {
         const curve_rec *c = &p->curves[i];
         s->curves[i] =
@@ -573,6 +639,12 @@ static int finish(parser *p, sw_outline_doc *out)
         items[i] = p->items[i].item;
         items[i].shape.loops = s->loops + p->items[i].first_loop;
         items[i].shape.loop_count = (uint32_t)p->items[i].n_loops;
+        if (items[i].is_label) {
+            items[i].shape = (sw_shape_desc){NULL, 0};
+            items[i].label.text = s->chars + p->items[i].text;
+            items[i].label.font_path =
+                p->items[i].font == SIZE_MAX ? NULL : s->chars + p->items[i].font;
+        }
     }
     out->items = items;
     out->n_items = p->n_items;
@@ -617,9 +689,10 @@ int sw_outline_parse(const char *text, size_t len, const char *file, sw_outline_
         fail(&p, "the outline begun on line %d has no 'end'", p.items[p.n_items - 1].item.line);
     }
     if (!p.failed && p.n_items == 0)
-        fail(&p, "no outline in the text ('outline' ... path ... 'end')");
+        fail(&p, "no outline in the text ('outline' ... path ... 'end', or 'label \"TEXT\"')");
     int ok = !p.failed && finish(&p, out);
     free(p.nums);
+    free(p.chars);
     free(p.curves);
     free(p.loops);
     free(p.items);
@@ -635,6 +708,7 @@ void sw_outline_doc_free(sw_outline_doc *doc)
         free(s->curves);
         free(s->loops);
         free(s->nums);
+        free(s->chars);
         free(s);
     }
     free(doc->items);

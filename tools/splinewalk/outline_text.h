@@ -10,17 +10,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Limits (each refused with a message past it). */
+/* Limits (each refused with a message past it). A label's text: 1..1024 bytes. */
 #define SW_OUTLINE_MAX_TEXT (64u << 20)  /* bytes of a file */
 #define SW_OUTLINE_MAX_ITEMS 60000u      /* outlines of a file (a node scene holds 65,535 nodes) */
 #define SW_OUTLINE_MAX_CURVES (1u << 20) /* curves of one outline */
 
 typedef struct sw_outline_item {
     char name[64];        /* "" when none */
-    int line;             /* of its `outline` line */
+    int line;             /* of its `outline` or `label` line */
     float color[4];       /* linear RGBA */
     double transform[12]; /* row-major 3 x 4: plane (x, y) -> origin + x x-axis + y y-axis */
-    sw_shape_desc shape;  /* loops and curves owned by the document */
+    sw_shape_desc shape;  /* an outline: loops and curves owned by the document */
+    int is_label;         /* a `label` line: `label` below, `shape` empty */
+    sw_label_desc label;  /* text and font owned by the document */
 } sw_outline_item;
 
 typedef struct sw_outline_doc {

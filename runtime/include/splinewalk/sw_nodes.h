@@ -51,6 +51,13 @@
  * laid on a surface (less than 1/4096 of its distance behind it) shows on that surface. It has no
  * thickness: seen edge-on it covers nothing; it is not an occluder and not hit by sw_scene_pick.
  * sw_scene_save writes it (section SHAPES).
+ *
+ * Labels. A LABEL node is a line of text drawn as its glyphs' outlines (a TrueType or OpenType
+ * font through FreeType: the text module, libsplinewalk_text, sw_text.h; without it a label is
+ * refused with SW_ERR_UNSUPPORTED), with the shapes' exact edges at any zoom: fixed in the world
+ * (in the plane z = 0 of its node's frame, the baseline along x) or billboarded at its node's
+ * origin with a constant size on screen. Saved as a shape (its glyphs' outlines, section SHAPES):
+ * a saved scene needs no font to be drawn again.
  */
 #ifndef SPLINEWALK_SW_NODES_H
 #define SPLINEWALK_SW_NODES_H
@@ -116,6 +123,19 @@ typedef struct sw_shape_desc {
     uint32_t loop_count; /* >= 1 */
 } sw_shape_desc;
 
+/* A line of text. */
+typedef struct sw_label_desc {
+    const char *text;      /* UTF-8, one line (no control characters), 1..1024 bytes */
+    const char *font_path; /* a .ttf / .otf file; NULL: the text module's default (DejaVu Sans) */
+    double size;           /* the em height: pixels on screen when screen_size, else units of the
+                              node's frame; (0, 16384] pixels or (0, 1e15] units */
+    int32_t screen_size;   /* 1: billboarded at the node's origin (facing the camera, upright on
+                              the screen), `size` pixels tall whatever its distance; the node's
+                              rotation and scale are not used. 0: fixed in the world */
+    int32_t align;         /* where the node's origin lies on the baseline: 0 the text's start,
+                              1 its middle, 2 its end */
+} sw_label_desc;
+
 /* A trimmed NURBS surface S(u, v) = sum w_ij P_ij N_i(u) N_j(v) / sum w_ij N_i(u) N_j(v). */
 typedef struct sw_nurbs_desc {
     uint32_t degree_u, degree_v; /* 1..31 */
@@ -164,6 +184,7 @@ typedef enum sw_node_kind {
     SW_NODE_IMPORT = 6,    /* the content of `import_path` under `transform` */
     SW_NODE_MESH = 7,      /* a triangle mesh (`mesh`) under `transform` */
     SW_NODE_SHAPE = 8,     /* a filled planar outline (`shape`) under `transform` */
+    SW_NODE_LABEL = 9,     /* a line of text (`label`) under `transform` */
     SW_NODE_KIND_COUNT
 } sw_node_kind;
 
@@ -176,7 +197,7 @@ typedef struct sw_node_desc {
     int32_t hidden;       /* 1: the node and its subtree are not drawn, nor are instances of it */
     float color[4];       /* linear RGBA; color[3] == 0 (all zero): the parent's colour */
     double transform[12]; /* row-major 3x4, local to parent; all zero: identity. Read for
-                             TRANSFORM, INSTANCE, NURBS, TSPLINE, IMPORT, MESH and SHAPE */
+                             TRANSFORM, INSTANCE, NURBS, TSPLINE, IMPORT, MESH, SHAPE and LABEL */
     sw_node instance_of;  /* INSTANCE: the node whose subtree it draws (not one of its own
                              ancestors, nor a subtree that instances them) */
     const sw_nurbs_desc *nurbs;     /* NURBS: required */
@@ -188,6 +209,7 @@ typedef struct sw_node_desc {
     void *user_data;                /* passed to import_warning, on the calling thread */
     const sw_mesh_desc *mesh;       /* MESH: required */
     const sw_shape_desc *shape;     /* SHAPE: required */
+    const sw_label_desc *label;     /* LABEL: required */
 } sw_node_desc;
 
 /* Adds a node as the last child of desc->parent (or detached). Any thread; an IMPORT reads and
@@ -249,6 +271,13 @@ SW_API sw_result sw_node_set_mesh(sw_scene scene, sw_node node, const sw_mesh_de
  * SW_ERR_INVALID_GEOMETRY for a curve, a loop that does not close or spans no area, with the
  * loop and curve named); the node keeps its outline then. */
 SW_API sw_result sw_node_set_shape(sw_scene scene, sw_node node, const sw_shape_desc *desc,
+                                   sw_status *status);
+/* The same for a LABEL node: new text, font, size or placement. Errors: as sw_node_set_nurbs
+ * (SW_ERR_INVALID_ARGUMENT for a node that is not LABEL, NULL or empty text, a size or align
+ * out of range, text that is not UTF-8 or holds a control character (the byte named), text with
+ * no glyph outline (spaces only)), SW_ERR_UNSUPPORTED (no text module), and the font's:
+ * SW_ERR_NOT_FOUND, SW_ERR_NOT_REGULAR_FILE, SW_ERR_FORMAT (not a font FreeType reads). */
+SW_API sw_result sw_node_set_label(sw_scene scene, sw_node node, const sw_label_desc *desc,
                                    sw_status *status);
 
 typedef struct sw_node_info {
