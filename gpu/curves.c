@@ -613,9 +613,10 @@ static sw_result draw_coverage(sw__curves_renderer *r, sw__curves_shape *shape,
 }
 
 /* Pass 4's set-up: blending "over" into the target, the coverage texture on unit 0. */
-static void composite_begin(sw__curves_renderer *r, GLuint prog, const coverage *cv,
-                            const sw__curves_view *view, const float rgba[4], GLuint target_fbo)
+static void composite_begin(sw__curves_renderer *r, const coverage *cv, const sw__curves_view *view,
+                            const float rgba[4], GLuint target_fbo)
 {
+    const GLuint prog = r->prog_comp;
     glBindFramebuffer(GL_FRAMEBUFFER, target_fbo);
     glViewport(0, 0, view->width, view->height);
     glEnable(GL_BLEND);
@@ -627,6 +628,7 @@ static void composite_begin(sw__curves_renderer *r, GLuint prog, const coverage 
                 rgba[2] * rgba[3], rgba[3]);
     glUniform2i(glGetUniformLocation(prog, "u_origin"), cv->ox, cv->oy);
     glUniform1i(glGetUniformLocation(prog, "u_ss"), cv->ss);
+    glUniform2f(r->loc_c_size, (float)view->width, (float)view->height);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, r->tex);
 }
@@ -651,9 +653,10 @@ static sw_result composite_box(sw__curves_renderer *r, const coverage *cv,
     return SW_OK;
 }
 
-sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
-                          const sw__curves_view *view, const float rgba[4], GLuint target_fbo,
-                          sw_status *status)
+/* The four passes; with depth (a placed outline) the composite takes its plane's depth. */
+static sw_result draw_outline(sw__curves_renderer *r, sw__curves_shape *shape,
+                              const sw__curves_view *view, const float rgba[4], GLuint target_fbo,
+                              const sw__curves_depth *depth, sw_status *status)
 {
     assert(rgba);
     coverage cv;
@@ -661,12 +664,36 @@ sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
     if (res != SW_OK || cv.empty)
         return res;
     /* 4: composite over the target */
-    composite_begin(r, r->prog_comp, &cv, view, rgba, target_fbo);
-    glUniform2f(r->loc_c_size, (float)view->width, (float)view->height);
+    composite_begin(r, &cv, view, rgba, target_fbo);
+    if (depth) {
+        /* 1 / d about the box's corner, so that float keeps its digits over the box */
+        const double *k = depth->inv_d;
+        glUniform3f(glGetUniformLocation(r->prog_comp, "u_inv_d"), (float)k[0], (float)k[1],
+                    (float)(k[0] * cv.x0 + k[1] * cv.y0 + k[2]));
+        glUniform2f(glGetUniformLocation(r->prog_comp, "u_depth_origin"), (float)cv.x0,
+                    (float)cv.y0);
+        glUniform1f(glGetUniformLocation(r->prog_comp, "u_depth_scale"),
+                    (float)(depth->near_plane * (1.0 + SW__CURVES_DECAL_PULL)));
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_GEQUAL);
+        glDepthMask(GL_FALSE);
+    }
     res = composite_box(r, &cv, view, status);
+    if (depth) {
+        glUniform1f(glGetUniformLocation(r->prog_comp, "u_depth_scale"), 0.0f);
+        glDepthFunc(GL_GREATER);
+        glDepthMask(GL_TRUE);
+    }
     glBindVertexArray(0);
     glUseProgram(0);
     return res == SW_OK ? sw__gpu_check(status, "curves draw") : res;
+}
+
+sw_result sw__curves_draw(sw__curves_renderer *r, sw__curves_shape *shape,
+                          const sw__curves_view *view, const float rgba[4], GLuint target_fbo,
+                          sw_status *status)
+{
+    return draw_outline(r, shape, view, rgba, target_fbo, NULL, status);
 }
 
 sw_result sw__curves_draw_placed(sw__curves_renderer *r, sw__curves_shape *shape,
@@ -674,28 +701,6 @@ sw_result sw__curves_draw_placed(sw__curves_renderer *r, sw__curves_shape *shape
                                  GLuint target_fbo, const sw__curves_depth *depth,
                                  sw_status *status)
 {
-    assert(rgba && depth);
-    coverage cv;
-    sw_result res = draw_coverage(r, shape, view, &cv, status);
-    if (res != SW_OK || cv.empty)
-        return res;
-    composite_begin(r, r->prog_comp, &cv, view, rgba, target_fbo);
-    glUniform2f(r->loc_c_size, (float)view->width, (float)view->height);
-    /* 1 / d about the box's corner, so that float keeps its digits over the box */
-    const double *k = depth->inv_d;
-    glUniform3f(glGetUniformLocation(r->prog_comp, "u_inv_d"), (float)k[0], (float)k[1],
-                (float)(k[0] * cv.x0 + k[1] * cv.y0 + k[2]));
-    glUniform2f(glGetUniformLocation(r->prog_comp, "u_depth_origin"), (float)cv.x0, (float)cv.y0);
-    glUniform1f(glGetUniformLocation(r->prog_comp, "u_depth_scale"),
-                (float)(depth->near_plane * (1.0 + SW__CURVES_DECAL_PULL)));
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_GEQUAL);
-    glDepthMask(GL_FALSE);
-    res = composite_box(r, &cv, view, status);
-    glUniform1f(glGetUniformLocation(r->prog_comp, "u_depth_scale"), 0.0f);
-    glDepthFunc(GL_GREATER);
-    glDepthMask(GL_TRUE);
-    glBindVertexArray(0);
-    glUseProgram(0);
-    return res == SW_OK ? sw__gpu_check(status, "placed outline draw") : res;
+    assert(depth);
+    return draw_outline(r, shape, view, rgba, target_fbo, depth, status);
 }

@@ -60,10 +60,28 @@ typedef struct sw_rt_model {
     sw_status compile_status;
 } sw_rt_model;
 
-/* A private one-face scene of a checked NURBS desc (api_nodes.c): the one check and conversion
+/* Limits of the geometry descs. */
+#define SW__NODES_MAX_POINTS (1u << 20)
+#define SW__NODES_MAX_LOOPS 65536u
+#define SW__NODES_MAX_LABEL 1024u     /* bytes of a label's text */
+#define SW__NODES_MAX_MESH (1u << 24) /* vertices, and triangles, of one mesh */
+
+/* A private one-face scene of a checked NURBS desc (api_nodes_geom.c): the one check and conversion
  * of sw_nurbs_desc, shared by NURBS nodes and immediate objects (api_immediate.c). Errors:
  * SW_ERR_INVALID_ARGUMENT, SW_ERR_INVALID_GEOMETRY, SW_ERR_LIMIT, SW_ERR_OUT_OF_MEMORY. */
 sw_result sw__rt_nurbs_geom(const sw_nurbs_desc *d, sw_sg_scene **out, sw_status *status);
+/* The private scene of a geometry node's desc (NURBS, TSPLINE, IMPORT, MESH, SHAPE, LABEL; *out
+ * NULL for the other kinds), and the same per kind for the set_* edits (api_nodes_geom.c).
+ * Errors: sw_nodes.h's for sw_node_add and each sw_node_set_*. */
+sw_result sw__rt_make_geom(const sw_node_desc *d, sw_sg_scene **out, sw_status *status);
+sw_result sw__rt_tspline_geom(const sw_tspline_desc *d, sw_sg_scene **out, sw_status *status);
+sw_result sw__rt_mesh_geom(const sw_mesh_desc *d, sw_sg_scene **out, sw_status *status);
+sw_result sw__rt_shape_geom(const sw_shape_desc *d, sw_sg_scene **out, sw_status *status);
+sw_result sw__rt_label_geom(const sw_label_desc *d, sw_sg_scene **out, sw_status *status);
+/* Mesh triangles a geometry scene holds (each mesh once), saturated at UINT32_MAX. */
+uint32_t sw__rt_geom_triangles(const sw_sg_scene *geom);
+/* Whether all n values are finite. */
+int sw__rt_all_finite(const double *v, size_t n);
 
 /* The node API's checks of a desc's transform (all zero: identity; else finite, invertible) and
  * colour (finite, >= 0; color[3] == 0: inherit, stored as -1), for the immediate draws. Errors:

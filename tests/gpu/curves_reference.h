@@ -9,9 +9,40 @@
 #ifndef SW_TESTS_CURVES_REFERENCE_H
 #define SW_TESTS_CURVES_REFERENCE_H
 
+#include "sw_sg_geom.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* A clamped 2D rational B-spline (homogeneous, dim 3; degree p, n <= 64 control points) as its
+ * Bézier pieces by full knot insertion (sw_sg_curve_insert_knot): emit(ctx, piece, p) for each,
+ * the piece's p + 1 homogeneous control points. */
+static void ref_curve_pieces(int p, int n, const double *knots_in, const double *cpw_in,
+                             void (*emit)(void *ctx, const double *h, int p), void *ctx)
+{
+    double knots[256], cpw[3 * 256], k2[256], c2[3 * 256];
+    memcpy(knots, knots_in, sizeof(double) * (n + p + 1));
+    memcpy(cpw, cpw_in, sizeof(double) * 3 * n);
+    for (int i = p + 1; i < n;) {
+        double t = knots[i];
+        int mult = 0;
+        while (i + mult < n && knots[i + mult] == t)
+            mult++;
+        if (mult < p) {
+            sw_sg_curve g = {p, n, 3, knots, cpw};
+            sw_sg_curve_insert_knot(&g, t, p - mult, k2, c2);
+            n += p - mult;
+            memcpy(knots, k2, sizeof(double) * (n + p + 1));
+            memcpy(cpw, c2, sizeof(double) * 3 * n);
+        }
+        i += p;
+        while (i < n && knots[i] == t)
+            i++;
+    }
+    for (int k = 0; k + p < n; k += p)
+        emit(ctx, cpw + 3 * k, p);
+}
 
 typedef struct ref_poly {
     double (*p)[2];

@@ -253,43 +253,32 @@ static void to_px(const double v[6], const double p[2], double out[2])
     out[1] = v[3] * p[0] + v[4] * p[1] + v[5];
 }
 
+typedef struct px_flatten {
+    const double *v;
+    ref_poly *pl;
+} px_flatten;
+
+/* One Bézier piece mapped to pixel space (an affine map: weights kept) and flattened. */
+static void flatten_piece(void *ctx, const double *cpw, int p)
+{
+    const px_flatten *f = ctx;
+    double h[3 * 32];
+    for (int i = 0; i <= p; ++i) {
+        double e[2] = {cpw[3 * i] / cpw[3 * i + 2], cpw[3 * i + 1] / cpw[3 * i + 2]}, q[2];
+        to_px(f->v, e, q);
+        double w = cpw[3 * i + 2];
+        h[3 * i] = w * q[0];
+        h[3 * i + 1] = w * q[1];
+        h[3 * i + 2] = w;
+    }
+    flatten_bez(h, p, f->pl, 0);
+}
+
 /* A curve's Bézier pieces (full knot insertion) flattened in pixel space. */
 static void flatten_curve(const tcurve *c, const double v[6], ref_poly *pl)
 {
-    int p = c->deg, n = c->n;
-    double knots[256], cpw[3 * 256], k2[256], c2[3 * 256];
-    memcpy(knots, c->knots, sizeof(double) * (n + p + 1));
-    memcpy(cpw, c->cpw, sizeof(double) * 3 * n);
-    for (int i = p + 1; i < n;) {
-        double t = knots[i];
-        int mult = 0;
-        while (i + mult < n && knots[i + mult] == t)
-            mult++;
-        if (mult < p) {
-            sw_sg_curve g = {p, n, 3, knots, cpw};
-            sw_sg_curve_insert_knot(&g, t, p - mult, k2, c2);
-            n += p - mult;
-            memcpy(knots, k2, sizeof(double) * (n + p + 1));
-            memcpy(cpw, c2, sizeof(double) * 3 * n);
-        }
-        i += p;
-        while (i < n && knots[i] == t)
-            i++;
-    }
-    for (int s = 0; s + p < n; s += p) {
-        double h[3 * 32];
-        for (int i = 0; i <= p; ++i) {
-            double e[2] = {cpw[3 * (s + i)] / cpw[3 * (s + i) + 2],
-                           cpw[3 * (s + i) + 1] / cpw[3 * (s + i) + 2]},
-                   q[2];
-            to_px(v, e, q);
-            double w = cpw[3 * (s + i) + 2];
-            h[3 * i] = w * q[0];
-            h[3 * i + 1] = w * q[1];
-            h[3 * i + 2] = w;
-        }
-        flatten_bez(h, p, pl, 0);
-    }
+    px_flatten f = {v, pl};
+    ref_curve_pieces(c->deg, c->n, c->knots, c->cpw, flatten_piece, &f);
 }
 
 /* A local form's value and gradient (polynomial kinds only), for the probe. */

@@ -226,31 +226,22 @@ static void flatten_piece(const scene_view *s, const double *h, int p, ref_poly 
     ref_poly_add(pl, e);
 }
 
+typedef struct plane_flatten {
+    const scene_view *s;
+    ref_poly *pl;
+} plane_flatten;
+
+static void flatten_bezier(void *ctx, const double *h, int p)
+{
+    const plane_flatten *f = ctx;
+    flatten_piece(f->s, h, p, f->pl, 0);
+}
+
 /* A curve's Bézier pieces by knot insertion, flattened. */
 static void flatten_curve(const scene_view *s, const tcurve *c, ref_poly *pl)
 {
-    int p = c->deg, n = c->n;
-    double knots[64], cpw[3 * 64], k2[64], c2[3 * 64];
-    memcpy(knots, c->knots, sizeof(double) * (n + p + 1));
-    memcpy(cpw, c->cpw, sizeof(double) * 3 * n);
-    for (int i = p + 1; i < n;) {
-        double t = knots[i];
-        int mult = 0;
-        while (i + mult < n && knots[i + mult] == t)
-            mult++;
-        if (mult < p) {
-            sw_sg_curve g = {p, n, 3, knots, cpw};
-            sw_sg_curve_insert_knot(&g, t, p - mult, k2, c2);
-            n += p - mult;
-            memcpy(knots, k2, sizeof(double) * (n + p + 1));
-            memcpy(cpw, c2, sizeof(double) * 3 * n);
-        }
-        i += p;
-        while (i < n && knots[i] == t)
-            i++;
-    }
-    for (int k = 0; k + p < n; k += p)
-        flatten_piece(s, cpw + 3 * k, p, pl, 0);
+    plane_flatten f = {s, pl};
+    ref_curve_pieces(c->deg, c->n, c->knots, c->cpw, flatten_bezier, &f);
 }
 
 /* The polygon cut to depth >= near (Sutherland-Hodgman), projected; cut points become corners. */
