@@ -18,7 +18,7 @@
 /* A clamped 2D rational B-spline (homogeneous, dim 3; degree p, n <= 64 control points) as its
  * Bézier pieces by full knot insertion (sw_sg_curve_insert_knot): emit(ctx, piece, p) for each,
  * the piece's p + 1 homogeneous control points. */
-static void ref_curve_pieces(int p, int n, const double *knots_in, const double *cpw_in,
+static inline void ref_curve_pieces(int p, int n, const double *knots_in, const double *cpw_in,
                              void (*emit)(void *ctx, const double *h, int p), void *ctx)
 {
     double knots[256], cpw[3 * 256], k2[256], c2[3 * 256];
@@ -49,7 +49,7 @@ typedef struct ref_poly {
     size_t n, cap;
 } ref_poly;
 
-static void ref_poly_add(ref_poly *pl, const double q[2])
+static inline void ref_poly_add(ref_poly *pl, const double q[2])
 {
     if (pl->n == pl->cap) {
         pl->cap = pl->cap ? 2 * pl->cap : 1024;
@@ -63,7 +63,7 @@ static void ref_poly_add(ref_poly *pl, const double q[2])
 }
 
 /* integral of (clamp(x, i, i+1) - i) dy along a->b (y already within one row) */
-static double ref_seg_cell(const double a[2], const double b[2], double i)
+static inline double ref_seg_cell(const double a[2], const double b[2], double i)
 {
     double ts[4] = {0, 1, 0, 0};
     int nt = 2;
@@ -93,7 +93,7 @@ static double ref_seg_cell(const double a[2], const double b[2], double i)
 
 /* Adds the winding-weighted area of the closed polyline in each pixel of a w x h image, times
  * `sign`, to cov (row-major, y up). */
-static void ref_area_accumulate(const ref_poly *pl, double sign, int w, int h, double *cov)
+static inline void ref_area_accumulate(const ref_poly *pl, double sign, int w, int h, double *cov)
 {
     double *row_cover = calloc((size_t)h * (size_t)(w + 1), sizeof *row_cover);
     if (!row_cover)
