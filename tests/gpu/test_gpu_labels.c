@@ -292,9 +292,9 @@ int main(int argc, char **argv)
             focus[1] = 0.25 * q->p[0][1] + 0.5 * q->p[1][1] + 0.25 * q->p[2][1];
             break;
         }
-    static const double zooms[4] = {1, 10, 100, 1000};
-    double width[4];
-    for (int z = 0; z < 4; z++)
+    static const double zooms[5] = {1, 10, 100, 1000, 0.5};
+    double width[5];
+    for (int z = 0; z < 5; z++)
         run_zoom(r, shape, &g, zooms[z], focus, fbo, &width[z]);
     for (int z = 0; z < 4; z++)
         if (!(width[z] >= 0.5 && width[z] <= 2.0 && width[z] <= 1.5 * width[0] &&
