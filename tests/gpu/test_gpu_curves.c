@@ -212,41 +212,6 @@ static int make_shape(const char *cls, tshape *s)
 /* ---- reference: flattening and exact clipped area ----------------------------------------------
  */
 
-/* h: homogeneous Bézier (degree p) already in pixel space. Emits the end point of each chord. */
-static void flatten_bez(const double *h, int p, ref_poly *pl, int depth)
-{
-    double a[2] = {h[0] / h[2], h[1] / h[2]},
-           e[2] = {h[3 * p] / h[3 * p + 2], h[3 * p + 1] / h[3 * p + 2]};
-    double d[2] = {e[0] - a[0], e[1] - a[1]}, len2 = d[0] * d[0] + d[1] * d[1], worst = 0;
-    for (int i = 1; i < p; ++i) {
-        double q[2] = {h[3 * i] / h[3 * i + 2] - a[0], h[3 * i + 1] / h[3 * i + 2] - a[1]};
-        double s = len2 > 0 ? (q[0] * d[0] + q[1] * d[1]) / len2 : 0;
-        s = s < 0 ? 0 : s > 1 ? 1 : s;
-        worst = fmax(worst, hypot(q[0] - s * d[0], q[1] - s * d[1]));
-    }
-    if (worst > 1e-3 && depth < 60) {
-        double l[3 * 32], r[3 * 32], t[3 * 32];
-        memcpy(t, h, sizeof(double) * 3 * (p + 1));
-        for (int c = 0; c < 3; ++c) {
-            l[c] = t[c];
-            r[3 * p + c] = t[3 * p + c];
-        }
-        for (int lev = 1; lev <= p; ++lev) {
-            for (int i = 0; i <= p - lev; ++i)
-                for (int c = 0; c < 3; ++c)
-                    t[3 * i + c] = 0.5 * (t[3 * i + c] + t[3 * (i + 1) + c]);
-            for (int c = 0; c < 3; ++c) {
-                l[3 * lev + c] = t[c];
-                r[3 * (p - lev) + c] = t[3 * (p - lev) + c];
-            }
-        }
-        flatten_bez(l, p, pl, depth + 1);
-        flatten_bez(r, p, pl, depth + 1);
-        return;
-    }
-    ref_poly_add(pl, e);
-}
-
 static void to_px(const double v[6], const double p[2], double out[2])
 {
     out[0] = v[0] * p[0] + v[1] * p[1] + v[2];
@@ -271,7 +236,7 @@ static void flatten_piece(void *ctx, const double *cpw, int p)
         h[3 * i + 1] = w * q[1];
         h[3 * i + 2] = w;
     }
-    flatten_bez(h, p, f->pl, 0);
+    ref_flatten_bezier(h, p, f->pl, 0);
 }
 
 /* A curve's Bézier pieces (full knot insertion) flattened in pixel space. */

@@ -120,35 +120,6 @@ static void to_px(const double v[6], const double p[2], double out[2])
     out[1] = v[3] * p[0] + v[4] * p[1] + v[5];
 }
 
-static void flatten(const double (*q)[2], int deg, ref_poly *pl, int depth)
-{
-    double a[2] = {q[0][0], q[0][1]}, e[2] = {q[deg][0], q[deg][1]};
-    double d[2] = {e[0] - a[0], e[1] - a[1]}, len2 = d[0] * d[0] + d[1] * d[1], worst = 0;
-    for (int i = 1; i < deg; i++) {
-        double r[2] = {q[i][0] - a[0], q[i][1] - a[1]};
-        double s = len2 > 0 ? (r[0] * d[0] + r[1] * d[1]) / len2 : 0;
-        s = s < 0 ? 0 : s > 1 ? 1 : s;
-        worst = fmax(worst, hypot(r[0] - s * d[0], r[1] - s * d[1]));
-    }
-    if (worst > 1e-3 && depth < 60) {
-        double t[4][2], l[4][2], r[4][2];
-        memcpy(t, q, sizeof(double) * 2 * (deg + 1));
-        memcpy(l[0], t[0], sizeof l[0]);
-        memcpy(r[deg], t[deg], sizeof r[0]);
-        for (int lev = 1; lev <= deg; lev++) {
-            for (int i = 0; i <= deg - lev; i++)
-                for (int c = 0; c < 2; c++)
-                    t[i][c] = 0.5 * (t[i][c] + t[i + 1][c]);
-            memcpy(l[lev], t[0], sizeof l[0]);
-            memcpy(r[deg - lev], t[deg - lev], sizeof r[0]);
-        }
-        flatten((const double(*)[2])l, deg, pl, depth + 1);
-        flatten((const double(*)[2])r, deg, pl, depth + 1);
-        return;
-    }
-    ref_poly_add(pl, e);
-}
-
 /* Coverage and the edge length inside the target (px). */
 static double reference(const glyphs *g, const double v[6], double *cov)
 {
@@ -159,10 +130,12 @@ static double reference(const glyphs *g, const double v[6], double *cov)
         ref_poly pl = {0};
         for (size_t i = first; i < g->t.contour_end[l]; i++) {
             const sw_sg_text_piece *q = &g->t.pieces[i];
-            double px[4][2];
-            for (uint32_t k = 0; k <= q->degree; k++)
-                to_px(v, q->p[k], px[k]);
-            flatten((const double(*)[2])px, (int)q->degree, &pl, 0);
+            double h[12];
+            for (uint32_t k = 0; k <= q->degree; k++) {
+                to_px(v, q->p[k], h + 3 * k);
+                h[3 * k + 2] = 1.0;
+            }
+            ref_flatten_bezier(h, (int)q->degree, &pl, 0);
         }
         for (size_t k = 0; k < pl.n; k++) {
             const double *a = pl.p[k], *b = pl.p[(k + 1) % pl.n];
