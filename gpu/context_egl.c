@@ -321,6 +321,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);
         sw__gpu_resident_free(ctx);
+        sw__gpu_grid_cache_free(ctx);
         sw__curves_renderer_free(ctx->curves);
         sw__gpu_grids_free(ctx);
         glDeleteVertexArrays(1, &ctx->vao);

@@ -208,13 +208,17 @@ sw_result sw__gpu_capture_read(sw_gpu_context *ctx, sw__gpu_capture_vertex **out
 /* The frame's GPU-evaluated patches (§4.2): records and control points into two shader storage
  * buffers, then per trim variant (the untrimmed first, as the batch holds them) one instanced
  * draw per non-empty grid class, attribute-less. */
+void sw__gpu_upload_patches(sw_gpu_context *ctx, const sw__gpu_patch_rec *recs, size_t n_recs,
+                            const float *cps, size_t n_cps)
+{
+    upload_ssbo(ctx, ctx->patch_ssbo, &ctx->patch_ssbo_cap, 0, n_recs * sizeof *recs, recs);
+    upload_ssbo(ctx, ctx->cp_ssbo, &ctx->cp_ssbo_cap, 1, n_cps * 4 * sizeof *cps, cps);
+}
+
 static void draw_patches(sw_gpu_context *ctx, const sw__gpu_view *view,
                          const sw__gpu_patch_batch *batch)
 {
-    upload_ssbo(ctx, ctx->patch_ssbo, &ctx->patch_ssbo_cap, 0, batch->n_recs * sizeof *batch->recs,
-                batch->recs);
-    upload_ssbo(ctx, ctx->cp_ssbo, &ctx->cp_ssbo_cap, 1, batch->n_cps * 4 * sizeof *batch->cps,
-                batch->cps);
+    sw__gpu_upload_patches(ctx, batch->recs, batch->n_recs, batch->cps, batch->n_cps);
     if (batch->exact)
         upload_exact(ctx, batch);
     else
@@ -297,6 +301,7 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw__gpu_resident_list *resident, sw_status *status)
 {
     ctx->upload_bytes = 0;
+    ctx->grid_hits = ctx->grid_misses = ctx->grid_triangles = ctx->grid_extra_triangles = 0;
     const float *bg = desc->background;
     sw_result r = sw__gpu_target_ensure(ctx, view->width, view->height, status);
     if (r != SW_OK)
@@ -318,6 +323,9 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D_ARRAY, sw__gpu_atlas_texture(ctx));
     upload_edges(ctx, edges);
+    r = batch ? sw__gpu_grid_cache_draw(ctx, view, batch, status) : SW_OK;
+    if (r != SW_OK)
+        return r;
     if (batch && batch->n_recs > 0)
         draw_patches(ctx, view, batch);
     bind_mesh(ctx, mesh);

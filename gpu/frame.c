@@ -34,6 +34,11 @@ void sw__gpu_set_resident(sw_gpu_context *ctx, int on)
     ctx->resident_off = !on;
 }
 
+void sw__gpu_set_grids_resident(sw_gpu_context *ctx, int on)
+{
+    ctx->grids_resident_off = !on;
+}
+
 void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on)
 {
     ctx->border_affine_off = !on;
@@ -147,6 +152,8 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
     env->walkthrough = d->walkthrough != 0;
     env->lod_colors = d->lod_colors != 0;
     env->trim_edges = d->trim_edges != 0;
+    /* the debug capture reads the per-frame evaluation's vertices */
+    env->grids_resident = !env->exact && !ctx->grids_resident_off && ctx->capture_max == 0;
     env->static_force = d->static_force;
     if (d->static_lods && sw_lod_static_set_scene(d->static_lods) != scene)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
@@ -291,8 +298,12 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
         sw__gpu_host_state_restore(&host);
     double t4 = sw__clock_ms();
 
-    st->triangles += geo->mesh.n_idx / 3 - geo->border_triangles + geo->resident_triangles;
-    st->resident_triangles = geo->resident_triangles;
+    st->triangles += (uint64_t)((int64_t)(geo->mesh.n_idx / 3 - geo->border_triangles +
+                                          geo->resident_triangles) +
+                                ctx->grid_extra_triangles);
+    st->resident_triangles = geo->resident_triangles + ctx->grid_triangles;
+    st->grid_hits = ctx->grid_hits;
+    st->grid_misses = ctx->grid_misses;
     st->upload_bytes = ctx->upload_bytes;
     st->border_triangles = geo->border_triangles;
     st->ms_trim = t2 - t1;

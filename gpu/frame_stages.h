@@ -80,6 +80,7 @@ typedef struct sw__fr_env {
     int walkthrough;            /* desc.walkthrough: never wait for the pool */
     int lod_colors;             /* desc.lod_colors */
     int trim_edges;             /* desc.trim_edges: exact edges where a texel would be coarse */
+    int grids_resident;         /* Bézier grids drawn from the context's kept grids */
     int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
     sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
@@ -174,6 +175,7 @@ typedef struct hl_item {
 typedef struct hl_choice {
     hl_item it;
     double cpw[64]; /* the item's bicubic, eye-relative world, homogeneous */
+    double cpo[64]; /* the same in the face's object space */
     double rect[4]; /* its rectangle in face parameters */
     double err_w;   /* its error bound in world units */
     double eps_obj; /* ε_obj at its nearest depth */
@@ -284,8 +286,10 @@ typedef struct sw__fr_geometry {
     size_t n_loops, cap_loops;
     sw__gpu_edge_grids edges; /* the exact trim edges' grids (the trim plan) */
     sw__gpu_patch_rec *recs; /* GPU-evaluated patches (§4.2) */
-    float *cps;              /* their eye-relative homogeneous control points, 4 per point */
-    size_t n_recs, cap_recs, n_cps, cap_cps;
+    float *cps; /* their homogeneous control points, 4 per point: eye-relative, or local to the
+                   patch's centre for a record drawn from the kept grids (places[i].resident) */
+    sw__gpu_grid_place *places; /* per record */
+    size_t n_recs, cap_recs, n_cps, cap_cps, cap_places;
     /* exact path (eval_exact): pieces, knots and eye-relative control points in double */
     sw__gpu_exact_piece *pieces;
     size_t n_pieces, cap_pieces;
@@ -413,7 +417,10 @@ int32_t sw__fr_class_segments(int32_t n);
  * control points in float, then projects), in pixels at the nearest depth of `box` (its
  * eye-relative box): 16 FLT_EPSILON R, R the largest control point over its weight (the bound
  * test_gpu_tspline_capture checks against double evaluation, with |P| <= R for positive weights).
- * The grid density is chosen for what it leaves of ε_img. */
+ * The grid density is chosen for what it leaves of ε_img. With kept grids (env->grids_resident)
+ * three times that: such a grid is evaluated around its centre (16 FLT_EPSILON s R_local, s the
+ * occurrence's stretch) and placed in float (a few FLT_EPSILON (R + s R_local)), and a patch is
+ * kept only where s R_local <= R (sw__fr_gpu_patch); the others are evaluated eye-relative. */
 double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
                              const double box[6]);
 /* The screen a grid density is chosen on: ε_img less what other errors spend (`spent_px`), at

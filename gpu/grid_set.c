@@ -85,4 +85,9 @@ void sw__gpu_grids_free(sw_gpu_context *ctx)
     sw__free(ctx->recs_sorted);
     ctx->recs_sorted = NULL;
     ctx->cap_recs_sorted = 0;
+    sw__free(ctx->grid_recs_sorted);
+    sw__free(ctx->grid_places_sorted);
+    ctx->grid_recs_sorted = NULL;
+    ctx->grid_places_sorted = NULL;
+    ctx->cap_grid_recs_sorted = ctx->cap_grid_places_sorted = 0;
 }

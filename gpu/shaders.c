@@ -26,6 +26,7 @@ static const char *const k_surface_fs_main = sw_glsl_surface_main_frag;
 static const char *const k_surface_fs_main_untrimmed = sw_glsl_surface_main_untrimmed_frag;
 static const char *const k_eval_vs = sw_glsl_eval_vert;
 static const char *const k_exact_vs = sw_glsl_exact_vert;
+static const char *const k_grid_vs = sw_glsl_grid_vert;
 static const char *const k_trim_vs = sw_glsl_trim_vert;
 static const char *const k_trim_fs = sw_glsl_trim_frag;
 static const char *const k_present_vs = sw_glsl_present_vert;
@@ -109,14 +110,17 @@ static void locate_uniforms(sw__gpu_surface_program *p)
     p->loc_capture = glGetUniformLocation(p->prog, "u_capture");
 }
 
-/* The programs of one trim variant: the vertex stages with the fragment parts `fs`. */
+/* The programs of one trim variant: the vertex stages with the fragment parts `fs` (a host's
+ * shading, `grids` 0, has no program of kept grids: its frames evaluate every grid). */
 static sw_result link_variant(const char *const fs[4], sw_result fail, sw__gpu_surface_programs *p,
-                              int variant, sw_status *status)
+                              int variant, int grids, sw_status *status)
 {
-    static const char *const k_names[3] = {"mesh", "patch evaluation", "exact evaluation"};
-    const char *const vs[3] = {k_mesh_vs, k_eval_vs, k_exact_vs};
-    sw__gpu_surface_program *out[3] = {&p->mesh[variant], &p->eval[variant], &p->exact[variant]};
-    for (int k = 0; k < 3; ++k) {
+    static const char *const k_names[4] = {"mesh", "patch evaluation", "exact evaluation",
+                                           "kept grids"};
+    const char *const vs[4] = {k_mesh_vs, k_eval_vs, k_exact_vs, k_grid_vs};
+    sw__gpu_surface_program *out[4] = {&p->mesh[variant], &p->eval[variant], &p->exact[variant],
+                                       &p->grid[variant]};
+    for (int k = 0; k < (grids ? 4 : 3); ++k) {
         char name[64];
         snprintf(name, sizeof name, "%s%s", k_names[k],
                  variant == SW__GPU_UNTRIMMED ? " (untrimmed)" : "");
@@ -138,9 +142,9 @@ static sw_result link_surfaces(const char *shade, sw_result fail, int both,
                                     k_surface_fs_main};
     const char *const untrimmed[4] = {k_surface_fs_interface, k_surface_fs_trim, shade,
                                       k_surface_fs_main_untrimmed};
-    sw_result r = link_variant(trimmed, fail, p, SW__GPU_TRIMMED, status);
+    sw_result r = link_variant(trimmed, fail, p, SW__GPU_TRIMMED, both, status);
     if (r == SW_OK && both)
-        r = link_variant(untrimmed, fail, p, SW__GPU_UNTRIMMED, status);
+        r = link_variant(untrimmed, fail, p, SW__GPU_UNTRIMMED, both, status);
     if (r != SW_OK) {
         sw__gpu_shading_free(NULL, p);
         return r;
@@ -149,13 +153,45 @@ static sw_result link_surfaces(const char *shade, sw_result fail, int both,
         p->mesh[SW__GPU_UNTRIMMED] = p->mesh[SW__GPU_TRIMMED];
         p->eval[SW__GPU_UNTRIMMED] = p->eval[SW__GPU_TRIMMED];
         p->exact[SW__GPU_UNTRIMMED] = p->exact[SW__GPU_TRIMMED];
+        p->grid[SW__GPU_UNTRIMMED] = p->grid[SW__GPU_TRIMMED]; /* none */
     }
+    return SW_OK;
+}
+
+/* The Bézier evaluation's vertex stage alone, its position, unit normal and st captured by
+ * transform feedback in sw__gpu_vertex's layout (resident_grids.c evaluates kept grids with it). */
+static sw_result link_grid_eval(sw__gpu_surface_program *out, sw_status *status)
+{
+    GLuint v = 0;
+    sw_result r = compile(GL_VERTEX_SHADER, k_eval_vs, "grid evaluation", &v, status);
+    if (r != SW_OK)
+        return r;
+    GLuint p = glCreateProgram();
+    glAttachShader(p, v);
+    static const char *const k_captured[3] = {"v_rel", "v_nrm", "v_st"};
+    glTransformFeedbackVaryings(p, 3, k_captured, GL_INTERLEAVED_ATTRIBS);
+    glLinkProgram(p);
+    glDeleteShader(v);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[400];
+        glGetProgramInfoLog(p, sizeof log, NULL, log);
+        glDeleteProgram(p);
+        return sw__fail(status, SW_ERR_GL, "program grid evaluation does not link: %s", log);
+    }
+    memset(out, 0, sizeof *out);
+    out->prog = p;
+    locate_uniforms(out);
     return SW_OK;
 }
 
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
 {
     sw_result r = link_surfaces(k_surface_fs_default_shade, SW_ERR_GL, 1, &ctx->surf, status);
+    if (r != SW_OK)
+        return r;
+    r = link_grid_eval(&ctx->prog_grid_eval, status);
     if (r != SW_OK)
         return r;
     r = sw__gpu_program_link(k_trim_vs, k_trim_fs, "trim", &ctx->prog_trim, status);
@@ -170,8 +206,8 @@ sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
 void sw__gpu_shading_free(sw_gpu_context *ctx, sw__gpu_surface_programs *p)
 {
     (void)ctx; /* the context is current: its programs are deleted with it */
-    sw__gpu_surface_program *all[3] = {p->mesh, p->eval, p->exact};
-    for (int k = 0; k < 3; ++k) {
+    sw__gpu_surface_program *all[4] = {p->mesh, p->eval, p->exact, p->grid};
+    for (int k = 0; k < 4; ++k) {
         glDeleteProgram(all[k][SW__GPU_TRIMMED].prog);
         if (all[k][SW__GPU_UNTRIMMED].prog != all[k][SW__GPU_TRIMMED].prog)
             glDeleteProgram(all[k][SW__GPU_UNTRIMMED].prog);
@@ -182,6 +218,8 @@ void sw__gpu_shading_free(sw_gpu_context *ctx, sw__gpu_surface_programs *p)
 void sw__gpu_programs_free(sw_gpu_context *ctx)
 {
     sw__gpu_shading_free(ctx, &ctx->surf);
+    glDeleteProgram(ctx->prog_grid_eval.prog);
+    ctx->prog_grid_eval.prog = 0;
     glDeleteProgram(ctx->prog_trim);
     ctx->prog_trim = 0;
     glDeleteProgram(ctx->prog_present);

@@ -132,6 +132,11 @@ static void choose(hl_face *hf, const hl_item *it, const double cpw[64], double 
     hf->n_chosen++;
     c->it = *it;
     memcpy(c->cpw, cpw, sizeof c->cpw);
+    const sw_lod_hnode *n = &hf->h->nodes[it->node];
+    if (full_range(it->range))
+        memcpy(c->cpo, n->cpw, sizeof c->cpo);
+    else
+        sw_lod_bez_restrict(3, 3, 4, n->cpw, it->range, c->cpo);
     item_rect(&hf->h->nodes[it->node], it->range, c->rect);
     c->err_w = err_w;
     c->eps_obj = eps_obj;

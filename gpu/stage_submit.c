@@ -15,6 +15,73 @@ static int trim_variant(const sw__gpu_draw *d)
     return sw__gpu_draw_trimmed(d) ? SW__GPU_TRIMMED : SW__GPU_UNTRIMMED;
 }
 
+/* A kept-grid record drawn by a frame without the kept grids' programs (a host's shading): its
+ * control points back to eye-relative, placed as its grid would be. */
+static void unplace(float *cps, size_t n, const sw__gpu_grid_place *pl)
+{
+    for (size_t i = 0; i < n; ++i) {
+        float *p = cps + 4 * i;
+        double q[3];
+        for (int r = 0; r < 3; ++r)
+            q[r] = (double)pl->rot[4 * r] * p[0] + (double)pl->rot[4 * r + 1] * p[1] +
+                   (double)pl->rot[4 * r + 2] * p[2] + (double)pl->rot[4 * r + 3] * p[3];
+        for (int r = 0; r < 3; ++r)
+            p[r] = (float)q[r];
+    }
+}
+
+/* Whether record i is drawn from the kept grids (a geometry made without placements has none). */
+static int kept(const sw__fr_geometry *g, size_t i)
+{
+    return g->places && g->places[i].resident;
+}
+
+/* The records drawn from the kept grids, by trim variant (untrimmed first) into
+ * ctx->grid_recs_sorted; the others are left in g's order with places[i].resident 0. */
+static sw_result grid_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_patch_batch *b,
+                            sw_status *status)
+{
+    size_t count[SW__GPU_TRIM_VARIANTS] = {0, 0};
+    const int programs =
+        ctx->surf.grid[SW__GPU_TRIMMED].prog && ctx->surf.grid[SW__GPU_UNTRIMMED].prog;
+    for (size_t i = 0; g->places && i < g->n_recs; ++i) {
+        sw__gpu_grid_place *pl = &g->places[i];
+        if (pl->resident && !programs) {
+            const sw__gpu_patch_rec *rec = &g->recs[i];
+            if (i == 0 || g->recs[i - 1].cp != rec->cp) /* pieces share their points */
+                unplace(g->cps + 4 * (size_t)rec->cp,
+                        (size_t)(rec->deg_u + 1) * (size_t)(rec->deg_v + 1), pl);
+            pl->resident = 0;
+        }
+        if (pl->resident)
+            count[trim_variant(&g->draws[g->recs[i].draw])]++;
+    }
+    const size_t n = count[0] + count[1];
+    if (n == 0)
+        return SW_OK;
+    if (!sw__grow((void **)&ctx->grid_recs_sorted, &ctx->cap_grid_recs_sorted, n,
+                  sizeof *ctx->grid_recs_sorted) ||
+        !sw__grow((void **)&ctx->grid_places_sorted, &ctx->cap_grid_places_sorted, n,
+                  sizeof *ctx->grid_places_sorted))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
+    b->grid_first[SW__GPU_UNTRIMMED] = 0;
+    b->grid_count[SW__GPU_UNTRIMMED] = count[SW__GPU_UNTRIMMED];
+    b->grid_first[SW__GPU_TRIMMED] = count[SW__GPU_UNTRIMMED];
+    b->grid_count[SW__GPU_TRIMMED] = count[SW__GPU_TRIMMED];
+    size_t next[SW__GPU_TRIM_VARIANTS] = {b->grid_first[0], b->grid_first[1]};
+    for (size_t i = 0; i < g->n_recs; ++i) {
+        if (!kept(g, i))
+            continue;
+        const size_t at = next[trim_variant(&g->draws[g->recs[i].draw])]++;
+        ctx->grid_recs_sorted[at] = g->recs[i];
+        ctx->grid_places_sorted[at] = g->places[i];
+    }
+    b->grid_recs = ctx->grid_recs_sorted;
+    b->grid_places = ctx->grid_places_sorted;
+    b->n_grid_recs = n;
+    return SW_OK;
+}
+
 /* Fills the records' colour and trim rectangle from their draws (trim entries are known after the
  * atlas commit) and sorts them by trim variant and grid class into ctx->recs_sorted (counting
  * sort), the untrimmed first. */
@@ -33,8 +100,17 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_pa
         memcpy(rec->color, d->color, sizeof rec->color);
         if (sw__gpu_draw_trimmed(d))
             sw__gpu_draw_trim_lookup(ctx, d, rec->trim_rect, &rec->layer);
-        b->count[trim_variant(d)][rec->level_v][rec->level_u]++;
     }
+    sw_result r = grid_batch(ctx, g, b, status);
+    if (r != SW_OK)
+        return r;
+    size_t n_rest = 0;
+    for (size_t i = 0; i < g->n_recs; ++i)
+        if (!kept(g, i)) {
+            const sw__gpu_patch_rec *rec = &g->recs[i];
+            b->count[trim_variant(&g->draws[rec->draw])][rec->level_v][rec->level_u]++;
+            n_rest++;
+        }
     static const int k_order[SW__GPU_TRIM_VARIANTS] = {SW__GPU_UNTRIMMED, SW__GPU_TRIMMED};
     uint32_t at = 0, next[SW__GPU_TRIM_VARIANTS][SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
     for (int k = 0; k < SW__GPU_TRIM_VARIANTS; ++k)
@@ -50,13 +126,15 @@ static sw_result build_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_pa
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
     for (size_t i = 0; i < g->n_recs; ++i) {
         const sw__gpu_patch_rec *rec = &g->recs[i];
+        if (kept(g, i))
+            continue;
         uint32_t slot = next[trim_variant(&g->draws[rec->draw])][rec->level_v][rec->level_u]++;
         ctx->recs_sorted[slot] = *rec;
         if (keep)
             ctx->rec_source[slot] = (uint32_t)i;
     }
     b->recs = ctx->recs_sorted;
-    b->n_recs = g->n_recs;
+    b->n_recs = n_rest;
     b->cps = g->cps;
     b->n_cps = g->n_cps;
     b->exact = g->n_pieces > 0;
@@ -78,6 +156,7 @@ sw_result sw__fr_submit(sw_gpu_context *ctx, const sw__gpu_view *view,
         geo->resident, geo->n_resident,
         desc->static_lods ? sw_lod_static_set_serial(desc->static_lods) : 0};
     sw__gpu_resident_begin(ctx, resident.set);
+    sw__gpu_grid_cache_begin(ctx);
     if (r == SW_OK)
         r = sw__gpu_draw_frame(ctx, view, desc, &geo->mesh, geo->draws, geo->n_draws, &batch,
                                &geo->edges, &resident, status);

@@ -10,6 +10,7 @@
  * then meshes (stage_tessellate_mesh.c). Grid densities come from one rigorous bound
  * (lod/bezier/sampling.c's sw_lod_screen_segments) over the grid classes' segment counts. */
 #include "frame_stages.h"
+#include "sw_crc32c.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
 
@@ -27,6 +28,7 @@ void sw__fr_geometry_free(sw__fr_geometry *g)
     sw__free(g->shares);
     sw__free(g->loops);
     sw__free(g->recs);
+    sw__free(g->places);
     sw__free(g->cps);
     sw__free(g->pieces);
     sw__free(g->knots);
@@ -179,6 +181,8 @@ double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
         const double *p = cpw + 4 * i;
         r = fmax(r, sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / fabs(p[3]));
     }
+    if (env->grids_resident)
+        r *= 3.0; /* evaluated around a centre, then placed (frame_stages.h) */
     const double z = fmax(sw__gpu_view_box_depth(&env->view, box), env->view.near_plane);
     const double px = 16.0 * FLT_EPSILON * r * env->view.focal_px / z;
     return isfinite(px) ? px : INFINITY;
@@ -264,6 +268,61 @@ static sw_result exact_piece(sw__fr_tess *t, const occurrence *o, const sw__gpu_
     return SW_OK;
 }
 
+/* The largest |P| of homogeneous points over their weights. */
+static double radius_of(const double *cpw, size_t n)
+{
+    double r = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double *p = cpw + 4 * i;
+        r = fmax(r, sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / fabs(p[3]));
+    }
+    return r;
+}
+
+/* The patch's control points around its centre (object space: x - w c, w), in float, when its
+ * grid may be kept: a patch larger than its distance from the eye (s R_local > R, s the
+ * occurrence's stretch) is not (the float bound of sw__fr_float_error_px). 0: not kept. */
+static int local_points(const occurrence *o, const sw__gpu_patch *pt, size_t n, float *out)
+{
+    if (!pt->cpo || n > 16)
+        return 0;
+    double local[64] = {0};
+    for (size_t i = 0; i < n; ++i) {
+        const double *p = pt->cpo + 4 * i;
+        for (int k = 0; k < 3; ++k)
+            local[4 * i + k] = p[k] - p[3] * pt->centre[k];
+        local[4 * i + 3] = p[3];
+    }
+    if (!(sw__fr_stretch_bound(o->world) * radius_of(local, n) <= radius_of(pt->cpw, n)))
+        return 0;
+    for (size_t i = 0; i < 4 * n; ++i)
+        out[i] = (float)local[i];
+    return 1;
+}
+
+/* The placement of a kept grid of occurrence o: its 3 x 3 rows with the centre's eye-relative
+ * position (double, then float) and the cofactor rows (normals of any affine map). */
+static void place_of(const sw__fr_env *env, const occurrence *o, const double centre[3],
+                     sw__gpu_grid_place *pl)
+{
+    const double *m = o->world; /* rows: m[4 r + c], translation in m[4 r + 3] */
+    const double at[4] = {centre[0], centre[1], centre[2], 1.0};
+    double off[4];
+    sw__fr_xform_h(m, env->view.eye, at, off);
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c)
+            pl->rot[4 * r + c] = (float)m[4 * r + c];
+        pl->rot[4 * r + 3] = (float)off[r];
+        const int r1 = (r + 1) % 3, r2 = (r + 2) % 3;
+        for (int c = 0; c < 3; ++c) {
+            const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            pl->cof[4 * r + c] =
+                (float)(m[4 * r1 + c1] * m[4 * r2 + c2] - m[4 * r1 + c2] * m[4 * r2 + c1]);
+        }
+        pl->cof[4 * r + 3] = 0.0f;
+    }
+}
+
 /* Appends the control points of a visible patch (float, eye-relative homogeneous) and one record
  * per piece of its sampled domain (§4.2). Pieces share their edge parameters bit for bit. */
 sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_patch *pt,
@@ -284,10 +343,19 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
     split_class(pt->nv, &kv, &lv);
     size_t n_rec = (size_t)ku * (size_t)kv;
     if (!sw__grow((void **)&g->cps, &g->cap_cps, 4 * (g->n_cps + n_cp), sizeof *g->cps) ||
-        !sw__grow((void **)&g->recs, &g->cap_recs, g->n_recs + n_rec, sizeof *g->recs))
+        !sw__grow((void **)&g->recs, &g->cap_recs, g->n_recs + n_rec, sizeof *g->recs) ||
+        !sw__grow((void **)&g->places, &g->cap_places, g->n_recs + n_rec, sizeof *g->places))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "patch records: out of memory");
-    for (size_t i = 0; i < 4 * n_cp; ++i)
-        g->cps[4 * g->n_cps + i] = (float)pt->cpw[i];
+    float *cps = g->cps + 4 * g->n_cps;
+    sw__gpu_grid_place place;
+    memset(&place, 0, sizeof place);
+    place.resident =
+        !exact && t->env->grids_resident && n_cp <= 16 && local_points(o, pt, n_cp, cps);
+    if (place.resident)
+        place_of(t->env, o, pt->centre, &place);
+    else
+        for (size_t i = 0; i < 4 * n_cp; ++i)
+            cps[i] = (float)pt->cpw[i];
     double bw = ub[1] - ub[0], bh = ub[3] - ub[2];
     float map[4] = {(float)((pt->u0 - ub[0]) / bw), (float)((pt->u1 - pt->u0) / bw),
                     (float)((pt->v0 - ub[2]) / bh), (float)((pt->v1 - pt->v0) / bh)};
@@ -310,6 +378,14 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
             rec->level_u = lu;
             rec->level_v = lv;
             memcpy(rec->uv_map, uv_map, sizeof uv_map);
+            sw__gpu_grid_place *pl = &g->places[g->n_recs - 1];
+            *pl = place;
+            if (place.resident) { /* the key of its grid: what it is evaluated from */
+                pl->hash = sw__crc32c(0, cps, 4 * n_cp * sizeof *cps);
+                const int32_t deg[2] = {rec->deg_u, rec->deg_v};
+                pl->hash = sw__crc32c(pl->hash, deg, sizeof deg);
+                pl->hash = sw__crc32c(pl->hash, rec->st, sizeof rec->st);
+            }
             if (t->env->ctx->patch_hook)
                 sw__fr_report_patch(t, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
                                     sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1,

@@ -52,8 +52,8 @@ static sw_result face_bezier(sw__fr_tess *f, uint32_t face, const sw_sg_bezier_s
 
 /* Sets up one patch: eye-relative control points, clipping to the uv box, culling, density. */
 static void patch_setup(sw__fr_tess *f, const occurrence *o, const sw_sg_bezier_patch *bp,
-                        const double ub[4], int class_grids, double *cpw, sw__gpu_patch *pt,
-                        trim_need *need)
+                        const double ub[4], int class_grids, const double f_centre[3], double *cpw,
+                        sw__gpu_patch *pt, trim_need *need)
 {
     size_t n = (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1);
     double box[6];
@@ -66,6 +66,8 @@ static void patch_setup(sw__fr_tess *f, const occurrence *o, const sw_sg_bezier_
     pt->deg_u = bp->deg_u;
     pt->deg_v = bp->deg_v;
     pt->cpw = cpw;
+    pt->cpo = bp->cpw;
+    memcpy(pt->centre, f_centre, sizeof pt->centre);
     pt->u0 = bp->u0;
     pt->u1 = bp->u1;
     pt->v0 = bp->v0;
@@ -514,11 +516,17 @@ sw_result sw__fr_tess_direct(sw__fr_tess *f, const occurrence *o, sw_status *sta
     trim_need need = {1.0, 1.0};
     size_t at = 0, drawn = 0;
     int on_gpu = face_on_gpu(f, set);
+    /* one centre for the face's kept grids: patches sharing an edge keep bit-identical vertices
+     * along it (eval.vert.glsl), as eye-relative ones do */
+    double centre[3] = {0.0, 0.0, 0.0};
+    if (n > 0)
+        for (int k = 0; k < 3; ++k)
+            centre[k] = set->patches[0].cpw[k] / set->patches[0].cpw[3];
     /* CPU_GRIDS mode draws the grids the vertex shader would (the reference of §4.2's path). */
     int class_grids = f->env->exact || face_gpu_eligible(set);
     for (size_t p = 0; p < n; ++p) {
         const sw_sg_bezier_patch *bp = &set->patches[p];
-        patch_setup(f, o, bp, rec->uv_box, class_grids, cpw + at, &pt[p], &need);
+        patch_setup(f, o, bp, rec->uv_box, class_grids, centre, cpw + at, &pt[p], &need);
         pt[p].col = (int32_t)(p % (size_t)n_cols);
         pt[p].row = (int32_t)(p / (size_t)n_cols);
         at += (size_t)(bp->deg_u + 1) * (size_t)(bp->deg_v + 1) * 4;

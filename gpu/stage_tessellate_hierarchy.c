@@ -139,6 +139,9 @@ static int item_patch(const hl_face *hf, hl_choice *c, sw__gpu_patch *pt)
     memset(pt, 0, sizeof *pt);
     pt->deg_u = pt->deg_v = 3;
     pt->cpw = c->cpw;
+    pt->cpo = c->cpo;
+    for (int k = 0; k < 3; ++k) /* nodes share no edges bit for bit: each its own centre */
+        pt->centre[k] = c->cpo[k] / c->cpo[3];
     pt->u0 = c->rect[0];
     pt->u1 = c->rect[1];
     pt->v0 = c->rect[2];
@@ -201,6 +204,7 @@ static int halve_item(const hl_choice *c, int dirs, hl_choice out[4])
             hl_choice *p = &out[b * nu + a];
             *p = *c;
             sw_lod_bez_restrict(3, 3, 4, c->cpw, r, p->cpw);
+            sw_lod_bez_restrict(3, 3, 4, c->cpo, r, p->cpo);
             const double du = c->rect[1] - c->rect[0], dv = c->rect[3] - c->rect[2];
             const double iu = c->it.range[1] - c->it.range[0], iv = c->it.range[3] - c->it.range[2];
             p->rect[0] = c->rect[0] + du * r[0];
@@ -262,8 +266,10 @@ static sw_result item_patches(hl_face *hf, sw__gpu_patch **pts, size_t *cap_pts,
         }
     }
     /* a patch points at its item's control points, which growing the items may have moved */
-    for (size_t i = 0; i < hf->n_chosen; ++i)
+    for (size_t i = 0; i < hf->n_chosen; ++i) {
         (*pts)[i].cpw = hf->chosen[i].cpw;
+        (*pts)[i].cpo = hf->chosen[i].cpo;
+    }
     return SW_OK;
 }
 

@@ -134,6 +134,8 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
                   sizeof *dst->loops) ||
         !sw__grow((void **)&dst->recs, &dst->cap_recs, dst->n_recs + src->n_recs,
                   sizeof *dst->recs) ||
+        !sw__grow((void **)&dst->places, &dst->cap_places, dst->n_recs + src->n_recs,
+                  sizeof *dst->places) ||
         !sw__grow((void **)&dst->cps, &dst->cap_cps, 4 * (cps0 + src->n_cps), sizeof *dst->cps) ||
         !sw__grow((void **)&dst->resident, &dst->cap_resident, dst->n_resident + src->n_resident,
                   sizeof *dst->resident))
@@ -160,6 +162,8 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
         memcpy(dst->loops + loops0, src->loops, src->n_loops * sizeof *src->loops);
     dst->n_loops += src->n_loops;
     src->n_loops = 0; /* moved */
+    if (src->n_recs > 0)
+        memcpy(dst->places + dst->n_recs, src->places, src->n_recs * sizeof *src->places);
     for (size_t i = 0; i < src->n_recs; ++i) {
         sw__gpu_patch_rec rec = src->recs[i];
         rec.cp += (uint32_t)cps0;
@@ -186,8 +190,8 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 560, /* trim_exact*: the trim plan; shapes_*: cull and the
-                                              outline stage, not chunks */
+        sizeof(sw_gpu_frame_stats) == 576, /* trim_exact*: the trim plan; shapes_*: cull and the
+                                              outline stage; grid_*: submit; not chunks */
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;

@@ -254,6 +254,10 @@ typedef struct sw_gpu_frame_stats {
      * frustum, or nothing of them in front of the near plane); skipped (refused by the 2D path
      * after the near-plane cut); pieces drawn as their chord (sw__curves_projected.fallbacks) */
     uint64_t shapes_drawn, shapes_culled, shapes_skipped, shape_fallbacks;
+    /* the submit stage's: Bézier patch grids drawn from those kept on the GPU between frames
+     * (gpu/resident_grids.c; their triangles are in resident_triangles), and grids evaluated
+     * into it in this frame */
+    uint64_t grid_hits, grid_misses;
 } sw_gpu_frame_stats;
 
 typedef struct sw_gpu_image {

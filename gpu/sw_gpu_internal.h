@@ -125,6 +125,8 @@ typedef struct sw__gpu_surface_programs {
     sw__gpu_surface_program mesh[SW__GPU_TRIM_VARIANTS]; /* grids and plain triangles */
     sw__gpu_surface_program eval[SW__GPU_TRIM_VARIANTS]; /* rational Bézier patches (§4.2) */
     sw__gpu_surface_program exact[SW__GPU_TRIM_VARIANTS]; /* from knots (eval_exact) */
+    /* grids kept on the GPU (resident_grids.c); 0 in a host's shading, whose frames send them */
+    sw__gpu_surface_program grid[SW__GPU_TRIM_VARIANTS];
 } sw__gpu_surface_programs;
 
 struct sw_gpu_context {
@@ -190,6 +192,16 @@ struct sw_gpu_context {
     struct sw__curves_renderer *curves; /* the outlines' programs and coverage target (lazily) */
     int32_t resident_off;  /* 1: static levels sent with the frame's mesh (tests' A/B) */
     uint64_t upload_bytes; /* the last draw's: vertices, indices and patch data sent */
+    /* patch grids kept on the GPU between frames (resident_grids.c), the program that evaluates
+     * them once (eval.vert.glsl, captured by transform feedback), and the last draw's counts */
+    struct sw__gpu_grid_cache *grid_cache;
+    sw__gpu_surface_program prog_grid_eval;
+    int32_t grids_resident_off; /* 1: every grid evaluated in each frame (tests' A/B) */
+    uint64_t grid_hits, grid_misses, grid_triangles;
+    int64_t grid_extra_triangles; /* drawn less needed: > 0 where a finer grid was kept */
+    struct sw__gpu_patch_rec *grid_recs_sorted; /* the submitting thread's, by trim variant */
+    struct sw__gpu_grid_place *grid_places_sorted;
+    size_t cap_grid_recs_sorted, cap_grid_places_sorted;
 };
 
 /* Last GL error as SW_ERR_GL naming `what`, or SW_OK. */
@@ -300,6 +312,8 @@ sw_result sw__gpu_mesh_reserve(sw__gpu_mesh *m, size_t more_v, size_t more_idx, 
 typedef struct sw__gpu_patch {
     int32_t deg_u, deg_v;
     double *cpw;           /* (deg_u+1)(deg_v+1)*4, eye-relative world, homogeneous */
+    const double *cpo;     /* the same in the occurrence's object space; NULL: not known */
+    double centre[3];      /* object space: the origin of its grid kept on the GPU */
     double s0, s1, t0, t1; /* the part of the local domain inside the face's uv_box */
     double u0, u1, v0, v1; /* its parameter rectangle in the face's domain */
     int32_t col, row;      /* position in the face's patch grid */
@@ -359,6 +373,9 @@ void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 /* Static levels drawn from the GPU copies the context keeps (default), or sent with each frame's
  * mesh: the A/B of the tests and benchmarks. Between frames. */
 void sw__gpu_set_resident(sw_gpu_context *ctx, int on);
+/* Patch grids drawn from those the context keeps (default), or evaluated in every frame: the A/B
+ * of the tests and benchmarks. Between frames. */
+void sw__gpu_set_grids_resident(sw_gpu_context *ctx, int on);
 /* Fat borders of affine faces by their loop's vertices (default) or sampled as curved ones: the
  * A/B of bench_prepare and the test that both cover alike. */
 void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on);
@@ -532,7 +549,16 @@ typedef struct sw__gpu_patch_batch {
     /* records of each trim variant (SW__GPU_TRIMMED, SW__GPU_UNTRIMMED) and grid class */
     uint32_t first[SW__GPU_TRIM_VARIANTS][SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
     uint32_t count[SW__GPU_TRIM_VARIANTS][SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
+    /* records drawn from the grids kept on the GPU (their cps local), by trim variant */
+    const sw__gpu_patch_rec *grid_recs;
+    const struct sw__gpu_grid_place *grid_places;
+    size_t n_grid_recs;
+    size_t grid_first[SW__GPU_TRIM_VARIANTS], grid_count[SW__GPU_TRIM_VARIANTS];
 } sw__gpu_patch_batch;
+
+/* Patch records and control points into storage buffers 0 and 1 (the evaluation program's). */
+void sw__gpu_upload_patches(sw_gpu_context *ctx, const sw__gpu_patch_rec *recs, size_t n_recs,
+                            const float *cps, size_t n_cps);
 
 /* Creates the grid classes' index buffer (grid_set.c). */
 sw_result sw__gpu_grids_create(sw_gpu_context *ctx, sw_status *status);
@@ -590,6 +616,27 @@ void sw__gpu_resident_free(sw_gpu_context *ctx);
 /* Bytes of GPU buffers held, and the budget (tests; 0 keeps only the last frame's levels). */
 size_t sw__gpu_resident_bytes(const sw_gpu_context *ctx);
 size_t sw__gpu_resident_set_budget(sw_gpu_context *ctx, size_t bytes);
+
+/* ---- patch grids kept on the GPU (resident_grids.c)
+ * ---------------------------------------------- A record of the Bézier path whose control points
+ * the tessellation wrote in the patch's own space (around `centre`, sw__gpu_patch) carries its
+ * placement: drawn from the grid the context keeps for its inputs, evaluated (once) when there is
+ * none. */
+typedef struct sw__gpu_grid_place {
+    uint32_t hash;     /* CRC-32C of its local control points, degrees and st (not its class) */
+    uint32_t resident; /* 1: the record's control points are local and it is drawn from the cache */
+    float rot[12];     /* rows of the occurrence's 3 x 3, w: the centre's eye-relative position */
+    float cof[12];     /* rows of the 3 x 3's cofactor matrix (normals); w set by the draw */
+} sw__gpu_grid_place;
+/* Draws the batch's grid records (grid_recs, by trim variant) from the kept grids, evaluating
+ * those missing; counts hits, misses and triangles in ctx. Errors: SW_ERR_OUT_OF_MEMORY. */
+sw_result sw__gpu_grid_cache_draw(sw_gpu_context *ctx, const sw__gpu_view *view,
+                                  const sw__gpu_patch_batch *batch, sw_status *status);
+/* Before each frame's draw: over the budget, the grids the last frame did not draw are freed. */
+void sw__gpu_grid_cache_begin(sw_gpu_context *ctx);
+void sw__gpu_grid_cache_free(sw_gpu_context *ctx);
+size_t sw__gpu_grid_cache_bytes(const sw_gpu_context *ctx);
+size_t sw__gpu_grid_cache_set_budget(sw_gpu_context *ctx, size_t bytes);
 /* The host's GL state (host_state.c says which), saved and set to GL's defaults when the
  * renderer starts working in an adopted context or on a presenting frame (desc.present), and
  * restored when it ends. */

@@ -419,6 +419,8 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->occluders_drawn = g->occluders_drawn;
     out->resident_triangles = g->resident_triangles;
     out->upload_bytes = g->upload_bytes;
+    out->grid_hits = g->grid_hits;
+    out->grid_misses = g->grid_misses;
 }
 
 static int camera_is_zero(const sw_camera *c)

@@ -16,6 +16,8 @@
  *    draws: the images still agree); with the default budget nothing is dropped; a frame of
  *    another static set (here none) drops them all (catches: a table that never evicts, planted;
  *    copies of a freed set's levels found by a new set's units).
+ * Patch grids kept on the GPU (test_gpu_resident_grids) are off here: their uploads are not the
+ * static levels'.
  * Usage: test_gpu_resident MODEL */
 #include <splinewalk/sw_lod_build.h>
 #include "frame_stages.h"
@@ -180,6 +182,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "FAIL: pool, context, import, BVH or LOD sets: %s\n", st.message);
         return 1;
     }
+    sw__gpu_set_grids_resident(ctx, 0);
     view_pair(ctx, &m, 3.0, 1);
     view_pair(ctx, &m, 6.0, 1);
     budget(ctx, &m);

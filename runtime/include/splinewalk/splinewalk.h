@@ -479,6 +479,10 @@ typedef struct sw_frame_stats {
      * near plane); skipped (a loop left without area once cut at the near plane); pieces drawn
      * as their chord (a control point stayed behind the eye after the splits' cap) */
     uint64_t shapes_drawn, shapes_culled, shapes_skipped, shape_fallbacks;
+    /* patch grids drawn from those the renderer keeps on the GPU between frames (their
+     * triangles are in resident_triangles), and grids evaluated into it for this frame (the
+     * first sight of a patch, or a view that needs it finer than kept) */
+    uint64_t grid_hits, grid_misses;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
