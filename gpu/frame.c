@@ -153,7 +153,8 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
     env->lod_colors = d->lod_colors != 0;
     env->trim_edges = d->trim_edges != 0;
     /* the debug capture reads the per-frame evaluation's vertices */
-    env->grids_resident = !env->exact && !ctx->grids_resident_off && ctx->capture_max == 0;
+    env->grids_resident =
+        !env->exact && !d->no_kept_grids && !ctx->grids_resident_off && ctx->capture_max == 0;
     env->static_force = d->static_force;
     if (d->static_lods && sw_lod_static_set_scene(d->static_lods) != scene)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT,

@@ -124,6 +124,8 @@ typedef struct sw_gpu_frame_desc {
                              its edges classified per fragment against its loops, flattened to an
                              eighth of a pixel (trim_edges.c), instead of a trim texture; 0: trim
                              textures only */
+    int32_t no_kept_grids; /* 1: every Bézier grid evaluated in the frame; 0: grids kept on the
+                              GPU between frames (resident_grids.c) */
     const sw_gpu_occurrence *occurrences; /* NULL: the scene's traversal (or bvh); else exactly
                               these occurrences of the scene's faces, culled one by one (bvh
                               ignored); read during prepare only */

@@ -49,6 +49,7 @@ typedef struct bp_job {
     int static_lods; /* splinewalk: sw_frame_desc.static_lods (Kumar et al. 1997 static LODs) */
     int occlusion;   /* splinewalk: sw_frame_desc.occlusion_culling */
     int exact_edges; /* splinewalk: sw_frame_desc.trim_edges */
+    int kept_grids;  /* splinewalk: !sw_frame_desc.no_kept_grids */
     uint32_t frames, warmup_passes, passes;
     int32_t width, height;
     double error_px;

@@ -70,6 +70,8 @@ static const char k_usage[] =
     "                  what the visible planar faces hide is culled; default: on, as in the CLI)\n"
     "  --no-exact-edges  splinewalk with trim textures only (sw_frame_desc.trim_edges: close-up\n"
     "                  trims cut per fragment by their loops; default: on, as in the CLI)\n"
+    "  --no-kept-grids  splinewalk evaluating every patch grid in each frame\n"
+    "                  (sw_frame_desc.no_kept_grids; default: grids kept on the GPU)\n"
     "  --glibc-malloc  every peer with glibc's default trim and mmap thresholds; by default\n"
     "                  they are raised for all peers alike, as `splinewalk` does and\n"
     "                  docs/embedding.md advises (llvmpipe frees megabytes every frame)\n"
@@ -82,7 +84,7 @@ static const bp_peer_fn k_peer_fns[N_PEERS] = {bp_peer_splinewalk, bp_peer_glu, 
 
 typedef struct args {
     int use[N_PEERS];
-    int static_lods, occlusion, exact_edges, glibc_malloc;
+    int static_lods, occlusion, exact_edges, kept_grids, glibc_malloc;
     uint32_t frames, warmup, passes;
     int32_t w, h;
     double error_px;
@@ -118,7 +120,8 @@ static int parse(int argc, char **argv, args *a)
                 .error_px = 0.5,
                 .static_lods = 1,
                 .occlusion = 1,
-                .exact_edges = 1};
+                .exact_edges = 1,
+                .kept_grids = 1};
     a->scenes = calloc((size_t)argc, sizeof *a->scenes);
     for (int i = 1; i < argc && a->scenes; ++i) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -135,6 +138,10 @@ static int parse(int argc, char **argv, args *a)
         }
         if (!strcmp(o, "--occlusion") || !strcmp(o, "--no-occlusion")) {
             a->occlusion = !strcmp(o, "--occlusion");
+            continue;
+        }
+        if (!strcmp(o, "--no-kept-grids")) {
+            a->kept_grids = 0;
             continue;
         }
         if (!strcmp(o, "--exact-edges") || !strcmp(o, "--no-exact-edges")) {
@@ -265,7 +272,8 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
                   .error_px = a->error_px,
                   .static_lods = a->static_lods,
                   .occlusion = a->occlusion,
-                  .exact_edges = a->exact_edges};
+                  .exact_edges = a->exact_edges,
+                  .kept_grids = a->kept_grids};
     sw_rt_camera_path path;
     memset(&path, 0, sizeof path);
     if (bp_job_path(&job, a->path_file, &path, err, sizeof err) != 0) {
@@ -280,12 +288,13 @@ static int run_scene(const args *a, const char *scene, FILE *csv)
             fprintf(stderr, "bench_peers: %s: %s: %s\n", scene, k_peer_names[p], res[p].note);
             failed = 1;
         }
-    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s%s%s\n",
+    printf("\n%s (BREP: %s), %u frames x %u counted passes after %u warm-up, path: %s%s%s%s%s\n",
            scene, job.brep ? job.brep : "none", a->frames, a->passes, a->warmup,
            a->path_file ? a->path_file : "orbit of the scene box",
            a->static_lods ? "" : "; splinewalk without static LODs",
            a->occlusion ? "" : "; splinewalk without occlusion culling",
-           a->exact_edges ? "" : "; splinewalk with trim textures only");
+           a->exact_edges ? "" : "; splinewalk with trim textures only",
+           a->kept_grids ? "" : "; splinewalk evaluating every grid in each frame");
     printf("  peer       |  frame ms: median      p99 | first (ms) | peak RSS MB | triangles | "
            "splinewalk / peer: median p99 first RSS triangles\n");
     for (int p = 0; p < N_PEERS; ++p)

@@ -25,6 +25,7 @@ static sw_frame_desc frame_at(const sw_run *r, uint32_t i, int converged)
     f.static_lods = r->job.static_lods;
     f.occlusion_culling = r->job.occlusion;
     f.trim_edges = r->job.exact_edges;
+    f.no_kept_grids = !r->job.kept_grids;
     bp_frame_camera(&r->job, i, &f.camera);
     return f;
 }

@@ -482,6 +482,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->near_plane = desc->near_plane;
     frame->wireframe = desc->wireframe != 0;
     frame->trim_edges = desc->trim_edges != 0;
+    frame->no_kept_grids = desc->no_kept_grids != 0;
     /* pixels leave the renderer only through output_path (the library returns no image): a
      * frame without one reads nothing back (at 1280x720 on llvmpipe the readback was a third of
      * a profile's frame, 14 of 42 ms); its raster work still ends in the draw's glFinish */

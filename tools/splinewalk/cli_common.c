@@ -174,11 +174,16 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
         printf("%*s  hierarchy: %llu nodes drawn, %llu refinement rounds\n", (int)strlen(label), "",
                (unsigned long long)s->hierarchy_nodes, (unsigned long long)s->refine_rounds);
     if (s->static_drawn > 0 || s->static_requests > 0)
-        printf("%*s  static LODs: %llu super-surface instances drawn (%llu faces, %llu triangles, "
-               "%llu from GPU buffers kept between frames), %llu builds queued\n",
+        printf("%*s  static LODs: %llu super-surface instances drawn (%llu faces, %llu "
+               "triangles), %llu builds queued\n",
                (int)strlen(label), "", (unsigned long long)s->static_drawn,
                (unsigned long long)s->static_faces, (unsigned long long)s->static_triangles,
-               (unsigned long long)s->resident_triangles, (unsigned long long)s->static_requests);
+               (unsigned long long)s->static_requests);
+    if (s->resident_triangles > 0)
+        printf("%*s  kept on the GPU: %llu of the triangles drawn from buffers kept between frames "
+               "(static levels, patch grids); %llu patch grids found kept, %llu evaluated\n",
+               (int)strlen(label), "", (unsigned long long)s->resident_triangles,
+               (unsigned long long)s->grid_hits, (unsigned long long)s->grid_misses);
     if (s->bound_exceeded > 0 && s->bound_excess_px > 0.0)
         printf("%*s  error bound: %llu pieces drawn over it (worst known excess %.3g px)\n",
                (int)strlen(label), "", (unsigned long long)s->bound_exceeded, s->bound_excess_px);

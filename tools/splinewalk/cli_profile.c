@@ -20,7 +20,8 @@ static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
     "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--lod-colors]\n"
-    "                          [--no-occlusion] [--no-exact-edges] [--memory-budget HOST[,GPU]]\n"
+    "                          [--no-occlusion] [--no-exact-edges] [--no-kept-grids]\n"
+    "                          [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders N frames of SCENE headlessly along the camera path PATH (docs/camera-path.md; made\n"
     "by `splinewalk path orbit|fly`) through the public renderer API. Threaded (the default), the\n"
@@ -64,6 +65,8 @@ static const char k_usage[] =
     "  --lod-colors      colour by representation, as for `render`\n"
     "  --no-exact-edges  trim textures only (by default exact trim edges where a trim texel\n"
     "                    would exceed a quarter pixel, as for `render`: trim_exact column)\n"
+    "  --no-kept-grids   every patch grid evaluated in each frame (by default grids are kept on\n"
+    "                    the GPU between frames, as for `render`: grid_hits, grid_misses)\n"
     "  --no-occlusion    draw what visible planar faces hide too (culled by default, as for\n"
     "                    `render`: occlusion_tests, nodes_occluded, faces_occluded columns; a\n"
     "                    frame that hides nothing makes the next 1, 3, 7 or 15 go without "
@@ -121,6 +124,10 @@ static int parse_args(int argc, char **argv, profile_args *a)
         }
         if (!strcmp(arg, "--lod-colors")) {
             a->frame.lod_colors = 1;
+            continue;
+        }
+        if (!strcmp(arg, "--no-kept-grids")) {
+            a->frame.no_kept_grids = 1;
             continue;
         }
         if (!strcmp(arg, "--exact-edges") || !strcmp(arg, "--no-exact-edges")) {

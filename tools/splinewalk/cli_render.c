@@ -12,7 +12,7 @@ static const char k_usage[] =
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--[no-]static-lod] [--lod-colors]\n"
     "                         [--static-force K] [--no-occlusion] [--no-exact-edges] [--partial]\n"
-    "                         [--memory-budget HOST[,GPU]]\n"
+    "                         [--no-kept-grids] [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as "
@@ -61,6 +61,11 @@ static const char k_usage[] =
     "                      surface whose trim texture would show texels over a quarter pixel is\n"
     "                      cut per fragment against its trim loops, flattened to an eighth of a\n"
     "                      pixel, instead (exact edges in close-ups, no large textures)\n"
+    "  --no-kept-grids     every patch grid evaluated in the frame from control points sent\n"
+    "                      with it (Guthe et al. 2005 §4.2). By default a grid is evaluated\n"
+    "                      once into GPU memory and drawn again while the view asks for its\n"
+    "                      density or one up to twice as coarse (the same image, within\n"
+    "                      rounding; a frame of `render` is the first, so nothing is reused)\n"
     "  --partial           import what is whole of a truncated file (see `import "
     "--help`)\n" SW_CLI_MEMORY_BUDGET_HELP "  -h, --help          this text\n";
 
@@ -93,6 +98,10 @@ static int parse_args(int argc, char **argv, render_args *a)
         }
         if (!strcmp(arg, "--lod-colors")) {
             a->frame.lod_colors = 1;
+            continue;
+        }
+        if (!strcmp(arg, "--no-kept-grids")) {
+            a->frame.no_kept_grids = 1;
             continue;
         }
         if (!strcmp(arg, "--exact-edges") || !strcmp(arg, "--no-exact-edges")) {

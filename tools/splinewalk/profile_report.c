@@ -111,6 +111,8 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_FACES_OCCLUDED] = (double)st->faces_occluded;
     v[SW_RT_COL_RESIDENT_TRIANGLES] = (double)st->resident_triangles;
     v[SW_RT_COL_UPLOAD_BYTES] = (double)st->upload_bytes;
+    v[SW_RT_COL_GRID_HITS] = (double)st->grid_hits;
+    v[SW_RT_COL_GRID_MISSES] = (double)st->grid_misses;
     v[SW_RT_COL_RESIDENT_BYTES] = resident_bytes;
     v[SW_RT_COL_CAPTURED] = captured ? 1.0 : 0.0;
 }

@@ -114,7 +114,9 @@ const char *sw_rt_pool_kind_name(int kind);
     X(FACES_OCCLUDED, "faces_occluded", COUNT,                                                     \
       "--occlusion: face occurrences culled as hidden (of faces_culled)")                          \
     X(RESIDENT_TRIANGLES, "resident_triangles", COUNT,                                             \
-      "of triangles: drawn from GPU buffers kept between frames (static levels)")                  \
+      "of triangles: drawn from GPU buffers kept between frames (static levels, patch grids)")     \
+    X(GRID_HITS, "grid_hits", COUNT, "patch grids drawn from those kept on the GPU")               \
+    X(GRID_MISSES, "grid_misses", COUNT, "patch grids evaluated into the kept ones this frame")    \
     X(UPLOAD_BYTES, "upload_bytes", COUNT,                                                         \
       "bytes sent to the GPU for the draw (vertices, indices, patch data, new resident levels)")   \
     SW_RT_POOL_KINDS(SW_RT__POOL_MS_COLUMN, X)                                                     \

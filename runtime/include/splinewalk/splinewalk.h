@@ -398,6 +398,12 @@ typedef struct sw_frame_desc {
                                 pixel on screen, instead of by the texture (close-ups keep
                                 smooth edges at any zoom, and need no large textures); far
                                 surfaces keep their textures. 0: trim textures only */
+    int32_t no_kept_grids;     /* 0: patch grids are kept on the GPU between frames — evaluated
+                                the first time a patch is drawn at a density class, then drawn
+                                again while the view asks for that class or one up to twice as
+                                coarse (every instance of a part shares them); 1: every grid
+                                evaluated in each frame from control points sent with it (the
+                                A/B of benchmarks) */
 } sw_frame_desc;
 
 typedef struct sw_frame_stats {
