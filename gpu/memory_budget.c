@@ -44,7 +44,7 @@ void sw_gpu_set_memory_budget(sw_gpu_context *ctx, uint64_t host, uint64_t gpu)
     ctx->atlas_frame_texels = ctx->atlas_max_texels / 2.0;
     ctx->hierarchy_bytes = (size_t)(host / 2);
     sw__gpu_resident_set_budget(ctx, (size_t)(gpu / 8 * 3));
-    sw__gpu_grid_cache_set_budget(ctx, (size_t)(gpu / 8));
+    sw__gpu_grid_cache_set_budget(ctx, (size_t)(gpu / 16));
     sw__fr_border_cache_set_budget(ctx->borders,
                                    (size_t)fmin((double)k_border_cache_max, (double)(host / 16)));
 }

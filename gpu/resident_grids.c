@@ -27,7 +27,7 @@
 #include <string.h>
 
 /* Bytes of vertex storage kept past a frame unless the memory budget says otherwise. */
-static const size_t k_default_budget = (size_t)128 << 20;
+static const size_t k_default_budget = (size_t)64 << 20;
 enum { MIN_TABLE = 1 << 10, MAX_CPS = 16 };
 
 typedef struct grid_key {
