@@ -50,6 +50,25 @@ static sw_result compile(GLenum type, const char *src, const char *what, GLuint 
     return SW_OK;
 }
 
+/* Links program p (its shaders attached; vertex shader v deleted here) into *out, or deletes it
+ * and fails with `fail` naming `what`. */
+static sw_result link_checked(GLuint p, GLuint v, const char *what, sw_result fail, GLuint *out,
+                              sw_status *status)
+{
+    glLinkProgram(p);
+    glDeleteShader(v);
+    GLint ok = 0;
+    glGetProgramiv(p, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char log[400];
+        glGetProgramInfoLog(p, sizeof log, NULL, log);
+        glDeleteProgram(p);
+        return sw__fail(status, fail, "program %s does not link: %s", what, log);
+    }
+    *out = p;
+    return SW_OK;
+}
+
 /* Links a vertex stage with the surface fragment stage, assembled from its parts around the
  * shading function `shade` (the library's, or a host's: its compile errors are the host's, hence
  * SW_ERR_INVALID_ARGUMENT). */
@@ -76,17 +95,8 @@ static sw_result link_parts(const char *vs, const char *const *fs, GLsizei n_fs,
     GLuint p = glCreateProgram();
     glAttachShader(p, v);
     glAttachShader(p, f);
-    glLinkProgram(p);
-    glDeleteShader(v);
     glDeleteShader(f);
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        glDeleteProgram(p);
-        return sw__fail(status, fail, "program %s does not link: %s", what, log);
-    }
-    *out = p;
-    return SW_OK;
+    return link_checked(p, v, what, fail, out, status);
 }
 
 sw_result sw__gpu_program_link(const char *vs, const char *fs, const char *what, GLuint *out,
@@ -170,20 +180,11 @@ static sw_result link_grid_eval(sw__gpu_surface_program *out, sw_status *status)
     glAttachShader(p, v);
     static const char *const k_captured[3] = {"v_rel", "v_nrm", "v_st"};
     glTransformFeedbackVaryings(p, 3, k_captured, GL_INTERLEAVED_ATTRIBS);
-    glLinkProgram(p);
-    glDeleteShader(v);
-    GLint ok = 0;
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[400];
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        glDeleteProgram(p);
-        return sw__fail(status, SW_ERR_GL, "program grid evaluation does not link: %s", log);
-    }
     memset(out, 0, sizeof *out);
-    out->prog = p;
-    locate_uniforms(out);
-    return SW_OK;
+    r = link_checked(p, v, "grid evaluation", SW_ERR_GL, &out->prog, status);
+    if (r == SW_OK)
+        locate_uniforms(out);
+    return r;
 }
 
 sw_result sw__gpu_programs_create(sw_gpu_context *ctx, sw_status *status)
