@@ -211,6 +211,18 @@ static void evict(struct sw__gpu_grid_cache *c)
     table_rebuild(c, live_entries(c)); /* on failure the old table stays: it still finds all */
 }
 
+/* Every entry dropped and every slot given back: the next frame evaluates what it draws. */
+static void reset(struct sw__gpu_grid_cache *c)
+{
+    c->n_entries = c->n_free_entries = 0;
+    for (int v = 0; v < SW__GPU_GRID_CLASSES; ++v)
+        for (int u = 0; u < SW__GPU_GRID_CLASSES; ++u)
+            c->free_slots[v][u].n = 0;
+    c->used_vertices = c->live_vertices = 0;
+    if (c->table)
+        memset(c->table, 0, c->table_size * sizeof *c->table);
+}
+
 void sw__gpu_grid_cache_begin(sw_gpu_context *ctx)
 {
     struct sw__gpu_grid_cache *c = ctx->grid_cache;
@@ -218,6 +230,13 @@ void sw__gpu_grid_cache_begin(sw_gpu_context *ctx)
         return;
     c->frame++;
     evict(c);
+    /* Freed slots serve only their class: as the classes a walk asks for shift, the buffer's
+     * high-water mark could grow past the budget while most of it lies free. Past twice the
+     * budget and twice what is live, everything is dropped instead, so the buffer never holds
+     * more than max(2 x budget, 2 x a frame's grids) (the buffer keeps its size for the next). */
+    const size_t used = c->used_vertices * sizeof(sw__gpu_vertex);
+    if (used > 2 * c->budget && used > 2 * c->live_vertices * sizeof(sw__gpu_vertex))
+        reset(c);
 }
 
 size_t sw__gpu_grid_cache_set_budget(sw_gpu_context *ctx, size_t bytes)
@@ -228,6 +247,11 @@ size_t sw__gpu_grid_cache_set_budget(sw_gpu_context *ctx, size_t bytes)
     const size_t was = c->budget;
     c->budget = bytes;
     return was;
+}
+
+size_t sw__gpu_grid_cache_held(const sw_gpu_context *ctx)
+{
+    return ctx->grid_cache ? ctx->grid_cache->used_vertices * sizeof(sw__gpu_vertex) : 0;
 }
 
 size_t sw__gpu_grid_cache_bytes(const sw_gpu_context *ctx)
@@ -270,7 +294,7 @@ static uint32_t slot_take(struct sw__gpu_grid_cache *c, int32_t lu, int32_t lv)
 static int64_t entry_add(struct sw__gpu_grid_cache *c, uint32_t h, const grid_key *k)
 {
     const size_t verts = class_vertices(k->level_u, k->level_v);
-    if (c->used_vertices + verts > UINT32_MAX)
+    if (c->used_vertices + verts > INT32_MAX) /* an indirect command's base vertex is signed */
         return -1;
     if (2 * (live_entries(c) + 1) > c->table_size && !table_rebuild(c, live_entries(c) + 1))
         return -1;

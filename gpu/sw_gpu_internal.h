@@ -635,7 +635,10 @@ sw_result sw__gpu_grid_cache_draw(sw_gpu_context *ctx, const sw__gpu_view *view,
 /* Before each frame's draw: over the budget, the grids the last frame did not draw are freed. */
 void sw__gpu_grid_cache_begin(sw_gpu_context *ctx);
 void sw__gpu_grid_cache_free(sw_gpu_context *ctx);
+/* Bytes of the kept grids, and of the vertex buffer up to its high-water mark (freed slots
+ * included: at most twice the budget or twice what is kept). */
 size_t sw__gpu_grid_cache_bytes(const sw_gpu_context *ctx);
+size_t sw__gpu_grid_cache_held(const sw_gpu_context *ctx);
 size_t sw__gpu_grid_cache_set_budget(sw_gpu_context *ctx, size_t bytes);
 /* The host's GL state (host_state.c says which), saved and set to GL's defaults when the
  * renderer starts working in an adopted context or on a presenting frame (desc.present), and

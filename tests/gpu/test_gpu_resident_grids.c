@@ -18,7 +18,8 @@
  *  - Another scene in the same context draws as a fresh context does (keys are content: a face
  *    index reused by other geometry finds nothing of the old one).
  *  - Its budget holds: with a budget of 0 a frame keeps what the frame before it drew and no
- *    more, and draws the same image (catches: a cache that never evicts).
+ *    more, and draws the same image (catches: a cache that never evicts); its vertex buffer does
+ *    not fill with freed slots of classes no longer asked for.
  * Usage: test_gpu_resident_grids MODEL OTHER_MODEL */
 #include "frame_stages.h"
 #include "gpu_test_compare.h"
@@ -26,6 +27,7 @@
 #include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -261,6 +263,25 @@ static void budget(sw_gpu_context *ctx, const model *m)
               "(%llu grids evaluated)",
               full, kept, (unsigned long long)s_again.grid_misses);
     compare(ctx, m, &far, "budget 0, far");
+    /* coming closer in small steps over a budget of 0, back out and in again (slightly off the
+     * first steps' distances): every frame asks for other classes, whose slots the freed ones are
+     * not; the buffer up to its high-water mark stays within twice the most the kept grids held
+     * (a frame begins with at most twice what it keeps, or the cache is dropped; its misses add
+     * no more than it keeps). Catches freed slots piling up: planted, 2.2 times. */
+    size_t most = 0, held = 0;
+    for (int k = 0; k < 90 && ok; ++k) { /* in, out, in */
+        const int step = k / 30 % 2 ? 29 - k % 30 : k % 30;
+        const sw_gpu_frame_desc d = view_at(m, 3.0 * pow(0.92, step) * (k >= 30 ? 1.03 : 1.0), 0);
+        ok = render(ctx, m, &d, 1, &img, &s_again, "budget 0, closer");
+        sw_gpu_image_free(&img);
+        most = sw__gpu_grid_cache_bytes(ctx) > most ? sw__gpu_grid_cache_bytes(ctx) : most;
+        held = sw__gpu_grid_cache_held(ctx);
+        CHECK(held <= 2 * most,
+              "budget 0, step %d closer: %zu bytes in the buffer, %zu kept at most", k, held, most);
+    }
+    printf("budget 0, 30 steps closer, back, closer again: %zu bytes in the buffer, at most %zu "
+           "kept\n",
+           held, most);
 }
 
 static int model_make(const char *path, model *m)
