@@ -12,9 +12,10 @@
  * 0's textures of every target and its sampler, the active unit), the capabilities in k_caps,
  * viewport and scissor box, blend, depth, stencil, colour and clear state, rasterisation (cull,
  * front face, polygon mode and offset, line width, point size, provoking vertex, primitive
- * restart index, patch vertices, logic op), clip control and pixel pack / unpack parameters. The
- * renderer binds textures on unit 0 only and touches no other unit, image unit or
- * transform-feedback state. */
+ * restart index, patch vertices, logic op), clip control, pixel pack / unpack parameters, and the
+ * transform feedback object with its generic buffer binding (the renderer evaluates kept patch
+ * grids into its own object's buffers, resident_grids.c). The renderer binds textures on unit 0
+ * only and touches no other unit or image unit. */
 #include "sw_gpu_internal.h"
 
 #include <string.h>
@@ -124,6 +125,8 @@ static void save_bindings(sw__gpu_host_state *s)
     glGetIntegerv(GL_CURRENT_PROGRAM, &s->program);
     glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &s->vao);
     glGetIntegerv(GL_ELEMENT_ARRAY_BUFFER_BINDING, &s->element_buffer);
+    glGetIntegerv(GL_TRANSFORM_FEEDBACK_BINDING, &s->xfb_object);
+    glGetIntegerv(GL_TRANSFORM_FEEDBACK_BUFFER_BINDING, &s->xfb_buffer);
     for (int i = 0; i < SW__GPU_HOST_BUFFERS; i++)
         glGetIntegerv(k_buffers[i][1], &s->buffers[i]);
     static const GLenum max[2] = {GL_MAX_UNIFORM_BUFFER_BINDINGS,
@@ -201,6 +204,8 @@ static void set_defaults(const sw__gpu_host_state *s)
 {
     glBindVertexArray(0);
     glUseProgram(0);
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
+    glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, 0);
     for (int t = 0; t < 2; t++)
         for (GLuint i = 0; i < (GLuint)s->n_indexed[t]; i++)
             glBindBufferBase(k_indexed[t][0], i, 0);
@@ -269,6 +274,9 @@ static void restore_bindings(const sw__gpu_host_state *s)
     glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)s->read_fb);
     glBindRenderbuffer(GL_RENDERBUFFER, (GLuint)s->renderbuffer);
     glUseProgram((GLuint)s->program);
+    /* The generic transform-feedback binding is the object's: bound after it. */
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, (GLuint)s->xfb_object);
+    glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, alive_buffer(s->xfb_buffer));
     /* The element buffer is the vertex array's: bound after it. */
     glBindVertexArray((GLuint)s->vao);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, alive_buffer(s->element_buffer));

@@ -78,6 +78,8 @@ struct sw__gpu_grid_cache {
     size_t table_size;
     slot_list free_slots[SW__GPU_GRID_CLASSES][SW__GPU_GRID_CLASSES];
     GLuint vbo, instances, indirect, vao;
+    GLuint
+        xfb; /* the transform feedback object misses are captured with (a host's stays its own) */
     size_t vbo_vertices, used_vertices; /* capacity and high-water mark */
     size_t instance_bytes, indirect_bytes;
     size_t live_vertices, budget;
@@ -266,6 +268,7 @@ void sw__gpu_grid_cache_free(sw_gpu_context *ctx)
         return;
     GLuint bufs[3] = {c->vbo, c->instances, c->indirect};
     glDeleteBuffers(3, bufs);
+    glDeleteTransformFeedbacks(1, &c->xfb);
     glDeleteVertexArrays(1, &c->vao);
     for (int v = 0; v < SW__GPU_GRID_CLASSES; ++v)
         for (int u = 0; u < SW__GPU_GRID_CLASSES; ++u)
@@ -397,6 +400,9 @@ static void evaluate_misses(sw_gpu_context *ctx, struct sw__gpu_grid_cache *c,
     glBindVertexArray(ctx->vao); /* attribute-less, as the per-frame evaluation draws */
     for (GLuint a = 0; a < 3; ++a)
         glDisableVertexAttribArray(a);
+    if (!c->xfb)
+        glGenTransformFeedbacks(1, &c->xfb);
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, c->xfb);
     glEnable(GL_RASTERIZER_DISCARD);
     int32_t lu = -1, lv = -1;
     for (size_t i = 0; i < n_miss; ++i) {
@@ -419,6 +425,7 @@ static void evaluate_misses(sw_gpu_context *ctx, struct sw__gpu_grid_cache *c,
     }
     glDisable(GL_RASTERIZER_DISCARD);
     glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
 }
 
 static void instance_of(const sw__gpu_patch_rec *r, const sw__gpu_grid_place *pl, grid_instance *o)

@@ -657,6 +657,7 @@ typedef struct sw__gpu_host_range {
 typedef struct sw__gpu_host_state {
     GLint draw_fb, read_fb, viewport[4];
     GLint renderbuffer, program, vao, element_buffer, buffers[SW__GPU_HOST_BUFFERS];
+    GLint xfb_object, xfb_buffer; /* transform feedback object and its generic buffer binding */
     GLint n_indexed[2];
     sw__gpu_host_range indexed[2][SW__GPU_HOST_INDEXED];            /* uniform, shader storage */
     GLint active_texture, textures[SW__GPU_HOST_TEXTURES], sampler; /* unit 0's */

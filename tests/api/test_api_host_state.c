@@ -6,15 +6,16 @@
  *
  * The test is the host: it makes its own EGL context (surfaceless, 4.5 core), binds its own
  * objects everywhere (program, vertex array with an element buffer and attributes, every buffer
- * target, indexed uniform and shader storage ranges, renderbuffer, draw and read framebuffers,
- * textures on units 0 and 3, a sampler on unit 0, active unit 3) and sets every other piece of
- * state the renderer could touch to a value that is not GL's default. It snapshots all of it with
- * its own list of glGet queries (independent of the library's), then creates a renderer in that
- * context, draws (presenting into its framebuffer, also by depth, plain, wireframe, static
- * LODs, a split frame) and destroys it, comparing the snapshot after each call: any one value not
- * restored fails, by name. The frame presented under the host's odd state (scissor, colour mask,
- * pixel store, depth range, polygon mode, clip control, sampler, ...) must equal, pixel for pixel,
- * the one presented under GL's defaults, and must not be empty. */
+ * target, indexed uniform and shader storage ranges, a transform feedback object and its ranges,
+ * renderbuffer, draw and read framebuffers, textures on units 0 and 3, a sampler on unit 0, active
+ * unit 3) and sets every other piece of state the renderer could touch to a value that is not GL's
+ * default. It snapshots all of it with its own list of glGet queries (independent of the
+ * library's), then creates a renderer in that context, draws (presenting into its framebuffer, also
+ * by depth, plain, wireframe, static LODs, a split frame) and destroys it, comparing the snapshot
+ * after each call: any one value not restored fails, by name. The frame presented under the host's
+ * odd state (scissor, colour mask, pixel store, depth range, polygon mode, clip control, sampler,
+ * ...) must equal, pixel for pixel, the one presented under GL's defaults, and must not be empty.
+ */
 #include <splinewalk/sw_import.h>
 #include <splinewalk/sw_lod_build.h>
 #include <splinewalk/splinewalk.h>
@@ -46,7 +47,7 @@ enum { W = 200, H = 150 };
  */
 
 typedef struct host_objects {
-    GLuint fbo_draw, fbo_read, rb[3], program, vao, buffers[12], tex[4], sampler;
+    GLuint fbo_draw, fbo_read, rb[3], program, vao, buffers[12], tex[4], sampler, xfb;
 } host_objects;
 
 static void make_host_objects(host_objects *o)
@@ -86,6 +87,7 @@ static void make_host_objects(host_objects *o)
         glBufferData(GL_COPY_WRITE_BUFFER, 4096, NULL, GL_STATIC_DRAW);
     }
     glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+    glGenTransformFeedbacks(1, &o->xfb);
     glGenVertexArrays(1, &o->vao);
     glBindVertexArray(o->vao);
     glBindBuffer(GL_ARRAY_BUFFER, o->buffers[0]);
@@ -133,6 +135,11 @@ static void set_odd_state(const host_objects *o)
     glBindBuffer(GL_COPY_WRITE_BUFFER, o->buffers[3]);
     glBindBuffer(GL_DRAW_INDIRECT_BUFFER, o->buffers[4]);
     glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, o->buffers[5]);
+    /* a transform feedback object of the host's, a range at its binding 0, another buffer at
+     * its generic binding (the renderer captures kept patch grids with one of its own) */
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, o->xfb);
+    glBindBufferRange(GL_TRANSFORM_FEEDBACK_BUFFER, 0, o->buffers[6], 256, 512);
+    glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, o->buffers[7]);
     glActiveTexture(GL_TEXTURE3);
 
     glEnable(GL_BLEND);
@@ -223,6 +230,11 @@ static const query k_queries[] = {
     Q(INT, GL_COPY_WRITE_BUFFER_BINDING, 0, 1),
     Q(INT, GL_DRAW_INDIRECT_BUFFER_BINDING, 0, 1),
     Q(INT, GL_DISPATCH_INDIRECT_BUFFER_BINDING, 0, 1),
+    Q(INT, GL_TRANSFORM_FEEDBACK_BINDING, 0, 1),
+    Q(INT, GL_TRANSFORM_FEEDBACK_BUFFER_BINDING, 0, 1),
+    Q(INT_I, GL_TRANSFORM_FEEDBACK_BUFFER_BINDING, 0, 1),
+    Q(INT64_I, GL_TRANSFORM_FEEDBACK_BUFFER_START, 0, 1),
+    Q(INT64_I, GL_TRANSFORM_FEEDBACK_BUFFER_SIZE, 0, 1),
     Q(INT_I, GL_UNIFORM_BUFFER_BINDING, 0, 1),
     Q(INT64_I, GL_UNIFORM_BUFFER_START, 0, 1),
     Q(INT64_I, GL_UNIFORM_BUFFER_SIZE, 0, 1),
