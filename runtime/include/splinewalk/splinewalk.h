@@ -271,11 +271,11 @@ typedef struct sw_renderer_desc {
                                 uniform / storage ranges, framebuffers, renderbuffer,
                                 texture unit 0 and its sampler, the active unit),
                                 capabilities, viewport, scissor, blend, depth, stencil,
-                                colour masks and clear values, rasterisation, clip control
-                                and pixel store; the renderer draws as in a fresh context
-                                meanwhile (zero-to-one clip depth, reversed-Z). Not
-                                restored: texture units other than 0, image units,
-                                transform feedback, queries, GL errors. */
+                                colour masks and clear values, rasterisation, clip control,
+                                pixel store, the transform feedback object and its generic
+                                buffer; the renderer draws as in a fresh context meanwhile
+                                (zero-to-one clip depth, reversed-Z). Not restored: texture
+                                units other than 0, image units, queries, GL errors. */
     /* The memory budget of what the renderer keeps between frames, in bytes; 0 = the default.
      * Host: half to the bicubic hierarchies (over it they refine no further and faces not yet
      * built are drawn by their Bézier patches), a sixteenth (at most
