@@ -139,6 +139,27 @@ static inline void ref_area_accumulate(const ref_poly *pl, double sign, int w, i
     free(row_cover);
 }
 
+/* The homogeneous Bézier piece h (degree p <= 31, 3 numbers a point) halved at t = 1/2 (de
+ * Casteljau): l and r take p + 1 points each. */
+static inline void ref_split_half(const double *h, int p, double *l, double *r)
+{
+    double t[3 * 32];
+    memcpy(t, h, sizeof(double) * 3 * (size_t)(p + 1));
+    for (int c = 0; c < 3; ++c) {
+        l[c] = t[c];
+        r[3 * p + c] = t[3 * p + c];
+    }
+    for (int lev = 1; lev <= p; ++lev) {
+        for (int i = 0; i <= p - lev; ++i)
+            for (int c = 0; c < 3; ++c)
+                t[3 * i + c] = 0.5 * (t[3 * i + c] + t[3 * (i + 1) + c]);
+        for (int c = 0; c < 3; ++c) {
+            l[3 * lev + c] = t[c];
+            r[3 * (p - lev) + c] = t[3 * (p - lev) + c];
+        }
+    }
+}
+
 /* h: a homogeneous Bézier piece (degree p <= 31) already in pixel space, halved until its control
  * points lie within 1e-3 px of its chord (the convex hull property then puts the curve that close
  * to the chord): appends the end point of each chord. */
@@ -154,21 +175,8 @@ static inline void ref_flatten_bezier(const double *h, int p, ref_poly *pl, int 
         worst = fmax(worst, hypot(q[0] - s * d[0], q[1] - s * d[1]));
     }
     if (worst > 1e-3 && depth < 60) {
-        double l[3 * 32], r[3 * 32], t[3 * 32];
-        memcpy(t, h, sizeof(double) * 3 * (p + 1));
-        for (int c = 0; c < 3; ++c) {
-            l[c] = t[c];
-            r[3 * p + c] = t[3 * p + c];
-        }
-        for (int lev = 1; lev <= p; ++lev) {
-            for (int i = 0; i <= p - lev; ++i)
-                for (int c = 0; c < 3; ++c)
-                    t[3 * i + c] = 0.5 * (t[3 * i + c] + t[3 * (i + 1) + c]);
-            for (int c = 0; c < 3; ++c) {
-                l[3 * lev + c] = t[c];
-                r[3 * (p - lev) + c] = t[3 * (p - lev) + c];
-            }
-        }
+        double l[3 * 32], r[3 * 32];
+        ref_split_half(h, p, l, r);
         ref_flatten_bezier(l, p, pl, depth + 1);
         ref_flatten_bezier(r, p, pl, depth + 1);
         return;

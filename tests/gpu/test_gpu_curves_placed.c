@@ -164,25 +164,6 @@ static void to_px(const scene_view *s, const double q[2], double out[2])
     out[1] = 0.5 * H * (1 + dot3(s->v.up, p) / (d * s->v.tan_y));
 }
 
-static void split_half(const double *h, int p, double *l, double *r)
-{
-    double t[3 * 12];
-    memcpy(t, h, sizeof(double) * 3 * (p + 1));
-    for (int c = 0; c < 3; ++c) {
-        l[c] = t[c];
-        r[3 * p + c] = t[3 * p + c];
-    }
-    for (int lev = 1; lev <= p; ++lev) {
-        for (int i = 0; i <= p - lev; ++i)
-            for (int c = 0; c < 3; ++c)
-                t[3 * i + c] = 0.5 * (t[3 * i + c] + t[3 * (i + 1) + c]);
-        for (int c = 0; c < 3; ++c) {
-            l[3 * lev + c] = t[c];
-            r[3 * (p - lev) + c] = t[3 * (p - lev) + c];
-        }
-    }
-}
-
 /* Emits the end point (plane coordinates) of each chord of piece h (homogeneous, degree p). */
 static void flatten_piece(const scene_view *s, const double *h, int p, ref_poly *pl, int depth)
 {
@@ -218,7 +199,7 @@ static void flatten_piece(const scene_view *s, const double *h, int p, ref_poly 
     }
     if (split) {
         double l[3 * 12], r[3 * 12];
-        split_half(h, p, l, r);
+        ref_split_half(h, p, l, r);
         flatten_piece(s, l, p, pl, depth + 1);
         flatten_piece(s, r, p, pl, depth + 1);
         return;
