@@ -65,6 +65,14 @@ static void send(sw_gpu_context *ctx, GLenum target, GLuint buf, size_t *capacit
         ctx->upload_bytes += bytes;
 }
 
+void sw__gpu_stream(sw_gpu_context *ctx, GLenum target, GLuint *buf, size_t *capacity, size_t bytes,
+                    const void *data)
+{
+    if (!*buf)
+        glGenBuffers(1, buf);
+    send(ctx, target, *buf, capacity, bytes, data);
+}
+
 static void bind_mesh(sw_gpu_context *ctx, const sw__gpu_mesh *mesh)
 {
     if (!ctx->mesh_vbo) {

@@ -347,18 +347,6 @@ static int64_t lookup(struct sw__gpu_grid_cache *c, const sw__gpu_patch_rec *rec
     return entry_add(c, hash_of(pl->hash, lu, lv), &k);
 }
 
-/* Buffer buf holds at least `bytes` (its content is not kept). */
-static void ensure_storage(GLenum target, GLuint *buf, size_t *have, size_t bytes, GLenum usage)
-{
-    if (!*buf)
-        glGenBuffers(1, buf);
-    glBindBuffer(target, *buf);
-    if (bytes > *have) {
-        *have = bytes + bytes / 4;
-        glBufferData(target, (GLsizeiptr)*have, NULL, usage);
-    }
-}
-
 /* The vertex buffer grown to the high-water mark, its content copied on the GPU. */
 static void vbo_grow(struct sw__gpu_grid_cache *c)
 {
@@ -532,13 +520,10 @@ sw_result sw__gpu_grid_cache_draw(sw_gpu_context *ctx, const sw__gpu_view *view,
         triangles += ctx->grid_count[lv][lu] / 3;
         needed += ctx->grid_count[r->level_v][r->level_u] / 3;
     }
-    ensure_storage(GL_ARRAY_BUFFER, &c->instances, &c->instance_bytes, n * sizeof *c->inst,
-                   GL_STREAM_DRAW);
-    glBufferSubData(GL_ARRAY_BUFFER, 0, (GLsizeiptr)(n * sizeof *c->inst), c->inst);
-    ensure_storage(GL_DRAW_INDIRECT_BUFFER, &c->indirect, &c->indirect_bytes, n * sizeof *c->cmds,
-                   GL_STREAM_DRAW);
-    glBufferSubData(GL_DRAW_INDIRECT_BUFFER, 0, (GLsizeiptr)(n * sizeof *c->cmds), c->cmds);
-    ctx->upload_bytes += n * (sizeof *c->inst + sizeof *c->cmds);
+    sw__gpu_stream(ctx, GL_ARRAY_BUFFER, &c->instances, &c->instance_bytes, n * sizeof *c->inst,
+                   c->inst);
+    sw__gpu_stream(ctx, GL_DRAW_INDIRECT_BUFFER, &c->indirect, &c->indirect_bytes,
+                   n * sizeof *c->cmds, c->cmds);
     if (!c->vao)
         vao_make(c);
     glBindVertexArray(c->vao);

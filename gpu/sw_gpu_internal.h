@@ -556,6 +556,10 @@ typedef struct sw__gpu_patch_batch {
     size_t grid_first[SW__GPU_TRIM_VARIANTS], grid_count[SW__GPU_TRIM_VARIANTS];
 } sw__gpu_patch_batch;
 
+/* A frame's bytes into *buf (made when 0), bound to target: storage grown by glBufferData only
+ * when they do not fit (a quarter more), else overwritten; counted in ctx->upload_bytes. */
+void sw__gpu_stream(sw_gpu_context *ctx, GLenum target, GLuint *buf, size_t *capacity, size_t bytes,
+                    const void *data);
 /* Patch records and control points into storage buffers 0 and 1 (the evaluation program's). */
 void sw__gpu_upload_patches(sw_gpu_context *ctx, const sw__gpu_patch_rec *recs, size_t n_recs,
                             const float *cps, size_t n_cps);
