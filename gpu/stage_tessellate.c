@@ -173,14 +173,21 @@ static void split_class(int32_t n, int32_t *pieces, int32_t *level)
     *level = class_for((n + *pieces - 1) / *pieces);
 }
 
-double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
-                             const double box[6])
+/* The largest |P| of homogeneous points over their weights. */
+static double radius_of(const double *cpw, size_t n)
 {
     double r = 0.0;
     for (size_t i = 0; i < n; ++i) {
         const double *p = cpw + 4 * i;
         r = fmax(r, sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / fabs(p[3]));
     }
+    return r;
+}
+
+double sw__fr_float_error_px(const sw__fr_env *env, const double *cpw, size_t n,
+                             const double box[6])
+{
+    double r = radius_of(cpw, n);
     if (env->grids_resident)
         r *= 3.0; /* evaluated around a centre, then placed (frame_stages.h) */
     const double z = fmax(sw__gpu_view_box_depth(&env->view, box), env->view.near_plane);
@@ -268,17 +275,6 @@ static sw_result exact_piece(sw__fr_tess *t, const occurrence *o, const sw__gpu_
     return SW_OK;
 }
 
-/* The largest |P| of homogeneous points over their weights. */
-static double radius_of(const double *cpw, size_t n)
-{
-    double r = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        const double *p = cpw + 4 * i;
-        r = fmax(r, sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) / fabs(p[3]));
-    }
-    return r;
-}
-
 /* The patch's control points around its centre (object space: x - w c, w), in float, when its
  * grid may be kept: a patch larger than its distance from the eye (s R_local > R, s the
  * occurrence's stretch) is not (the float bound of sw__fr_float_error_px). 0: not kept. */
@@ -349,11 +345,13 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
     float *cps = g->cps + 4 * g->n_cps;
     sw__gpu_grid_place place;
     memset(&place, 0, sizeof place);
-    place.resident =
-        !exact && t->env->grids_resident && n_cp <= 16 && local_points(o, pt, n_cp, cps);
-    if (place.resident)
+    /* env->grids_resident is off on the exact path */
+    place.resident = t->env->grids_resident && local_points(o, pt, n_cp, cps);
+    if (place.resident) { /* the key of its grid: what it is evaluated from (st: per piece) */
         place_of(t->env, o, pt->centre, &place);
-    else
+        const int32_t deg[2] = {pt->deg_u, pt->deg_v};
+        place.hash = sw__crc32c(sw__crc32c(0, cps, 4 * n_cp * sizeof *cps), deg, sizeof deg);
+    } else
         for (size_t i = 0; i < 4 * n_cp; ++i)
             cps[i] = (float)pt->cpw[i];
     double bw = ub[1] - ub[0], bh = ub[3] - ub[2];
@@ -380,12 +378,8 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
             memcpy(rec->uv_map, uv_map, sizeof uv_map);
             sw__gpu_grid_place *pl = &g->places[g->n_recs - 1];
             *pl = place;
-            if (place.resident) { /* the key of its grid: what it is evaluated from */
-                pl->hash = sw__crc32c(0, cps, 4 * n_cp * sizeof *cps);
-                const int32_t deg[2] = {rec->deg_u, rec->deg_v};
-                pl->hash = sw__crc32c(pl->hash, deg, sizeof deg);
-                pl->hash = sw__crc32c(pl->hash, rec->st, sizeof rec->st);
-            }
+            if (place.resident)
+                pl->hash = sw__crc32c(place.hash, rec->st, sizeof rec->st);
             if (t->env->ctx->patch_hook)
                 sw__fr_report_patch(t, o, pt, rec->st[0], rec->st[1], rec->st[2], rec->st[3],
                                     sw__gpu_grid_segments[lu], sw__gpu_grid_segments[lv], 1,
