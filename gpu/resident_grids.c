@@ -109,8 +109,8 @@ static struct sw__gpu_grid_cache *cache_of(sw_gpu_context *ctx)
     return ctx->grid_cache;
 }
 
-static void key_of(const sw__gpu_patch_rec *rec, const float *cps, int32_t lu, int32_t lv,
-                   grid_key *k)
+/* The key of a record's grid but its class. */
+static void key_of(const sw__gpu_patch_rec *rec, const float *cps, grid_key *k)
 {
     memset(k, 0, sizeof *k);
     const size_t n = (size_t)(rec->deg_u + 1) * (size_t)(rec->deg_v + 1);
@@ -118,8 +118,6 @@ static void key_of(const sw__gpu_patch_rec *rec, const float *cps, int32_t lu, i
     memcpy(k->st, rec->st, sizeof k->st);
     k->deg_u = rec->deg_u;
     k->deg_v = rec->deg_v;
-    k->level_u = lu;
-    k->level_v = lv;
 }
 
 static uint32_t hash_of(uint32_t content, int32_t lu, int32_t lv)
@@ -139,7 +137,7 @@ static int64_t find(const struct sw__gpu_grid_cache *c, uint32_t h, const grid_k
         if (!e)
             return -1;
         const grid_entry *g = &c->entries[e - 1];
-        if (g->hash == h && memcmp(&g->key, k, sizeof *k) == 0)
+        if (g->live && g->hash == h && memcmp(&g->key, k, sizeof *k) == 0)
             return (int64_t)(e - 1);
     }
 }
@@ -208,10 +206,12 @@ static void evict(struct sw__gpu_grid_cache *c)
         if (c->entries[e].live && c->entries[e].last_frame + 1 < c->frame)
             old[n++] = (keyed){c->entries[e].last_frame, (uint32_t)e};
     qsort(old, n, sizeof *old, by_key);
-    for (size_t i = 0; i < n && c->live_vertices * sizeof(sw__gpu_vertex) > c->budget; ++i)
-        entry_free(c, old[i].index);
+    size_t freed = 0;
+    for (; freed < n && c->live_vertices * sizeof(sw__gpu_vertex) > c->budget; ++freed)
+        entry_free(c, old[freed].index);
     sw__free(old);
-    table_rebuild(c, live_entries(c)); /* on failure the old table stays: it still finds all */
+    if (freed) /* freed entries leave no tombstones: the table is made again */
+        table_rebuild(c, live_entries(c)); /* else the old one stays: find skips the freed */
 }
 
 /* Every entry dropped and every slot given back: the next frame evaluates what it draws. */
@@ -332,17 +332,20 @@ static int64_t lookup(struct sw__gpu_grid_cache *c, const sw__gpu_patch_rec *rec
                       const sw__gpu_grid_place *pl, const float *cps, int *miss)
 {
     grid_key k;
+    key_of(rec, cps, &k);
     *miss = 0;
     const int32_t lu = rec->level_u, lv = rec->level_v;
     const int32_t su = sw__gpu_grid_segments[lu], sv = sw__gpu_grid_segments[lv];
     for (int32_t b = lv; b < SW__GPU_GRID_CLASSES && sw__gpu_grid_segments[b] <= 2 * sv; ++b)
         for (int32_t a = lu; a < SW__GPU_GRID_CLASSES && sw__gpu_grid_segments[a] <= 2 * su; ++a) {
-            key_of(rec, cps, a, b, &k);
+            k.level_u = a;
+            k.level_v = b;
             const int64_t e = find(c, hash_of(pl->hash, a, b), &k);
             if (e >= 0)
                 return e;
         }
-    key_of(rec, cps, lu, lv, &k);
+    k.level_u = lu;
+    k.level_v = lv;
     *miss = 1;
     return entry_add(c, hash_of(pl->hash, lu, lv), &k);
 }
