@@ -32,11 +32,12 @@ static const char *const k_trim_fs = sw_glsl_trim_frag;
 static const char *const k_present_vs = sw_glsl_present_vert;
 static const char *const k_present_fs = sw_glsl_present_frag;
 
-static sw_result compile(GLenum type, const char *src, const char *what, GLuint *out,
-                         sw_status *status)
+/* Compiles a shader from n source strings; fails with `fail`, the message naming `what`. */
+static sw_result compile(GLenum type, const char *const *src, GLsizei n, const char *what,
+                         sw_result fail, GLuint *out, sw_status *status)
 {
     GLuint sh = glCreateShader(type);
-    glShaderSource(sh, 1, &src, NULL);
+    glShaderSource(sh, n, src, NULL);
     glCompileShader(sh);
     GLint ok = 0;
     glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
@@ -44,7 +45,7 @@ static sw_result compile(GLenum type, const char *src, const char *what, GLuint 
         char log[400];
         glGetShaderInfoLog(sh, sizeof log, NULL, log);
         glDeleteShader(sh);
-        return sw__fail(status, SW_ERR_GL, "shader %s does not compile: %s", what, log);
+        return sw__fail(status, fail, "%s does not compile: %s", what, log);
     }
     *out = sh;
     return SW_OK;
@@ -75,22 +76,17 @@ static sw_result link_checked(GLuint p, GLuint v, const char *what, sw_result fa
 static sw_result link_parts(const char *vs, const char *const *fs, GLsizei n_fs, const char *what,
                             sw_result fail, GLuint *out, sw_status *status)
 {
-    GLuint v = 0, f = glCreateShader(GL_FRAGMENT_SHADER);
-    sw_result r = compile(GL_VERTEX_SHADER, vs, what, &v, status);
-    if (r != SW_OK) {
-        glDeleteShader(f);
+    GLuint v = 0, f = 0;
+    char label[128];
+    snprintf(label, sizeof label, "shader %s", what);
+    sw_result r = compile(GL_VERTEX_SHADER, &vs, 1, label, SW_ERR_GL, &v, status);
+    if (r != SW_OK)
         return r;
-    }
-    glShaderSource(f, n_fs, fs, NULL);
-    glCompileShader(f);
-    GLint ok = 0;
-    glGetShaderiv(f, GL_COMPILE_STATUS, &ok);
-    char log[400];
-    if (!ok) {
-        glGetShaderInfoLog(f, sizeof log, NULL, log);
+    snprintf(label, sizeof label, "fragment shader of %s", what);
+    r = compile(GL_FRAGMENT_SHADER, fs, n_fs, label, fail, &f, status);
+    if (r != SW_OK) {
         glDeleteShader(v);
-        glDeleteShader(f);
-        return sw__fail(status, fail, "fragment shader of %s does not compile: %s", what, log);
+        return r;
     }
     GLuint p = glCreateProgram();
     glAttachShader(p, v);
@@ -173,7 +169,8 @@ static sw_result link_surfaces(const char *shade, sw_result fail, int both,
 static sw_result link_grid_eval(sw__gpu_surface_program *out, sw_status *status)
 {
     GLuint v = 0;
-    sw_result r = compile(GL_VERTEX_SHADER, k_eval_vs, "grid evaluation", &v, status);
+    sw_result r =
+        compile(GL_VERTEX_SHADER, &k_eval_vs, 1, "shader grid evaluation", SW_ERR_GL, &v, status);
     if (r != SW_OK)
         return r;
     GLuint p = glCreateProgram();
