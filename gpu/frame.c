@@ -299,9 +299,8 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
         sw__gpu_host_state_restore(&host);
     double t4 = sw__clock_ms();
 
-    st->triangles += (uint64_t)((int64_t)(geo->mesh.n_idx / 3 - geo->border_triangles +
-                                          geo->resident_triangles) +
-                                ctx->grid_extra_triangles);
+    st->triangles += geo->mesh.n_idx / 3 - geo->border_triangles + geo->resident_triangles;
+    st->triangles += (uint64_t)ctx->grid_extra_triangles; /* >= 0: never a coarser grid kept */
     st->resident_triangles = geo->resident_triangles + ctx->grid_triangles;
     st->grid_hits = ctx->grid_hits;
     st->grid_misses = ctx->grid_misses;
