@@ -15,21 +15,6 @@ static int trim_variant(const sw__gpu_draw *d)
     return sw__gpu_draw_trimmed(d) ? SW__GPU_TRIMMED : SW__GPU_UNTRIMMED;
 }
 
-/* A kept-grid record drawn by a frame without the kept grids' programs (a host's shading): its
- * control points back to eye-relative, placed as its grid would be. */
-static void unplace(float *cps, size_t n, const sw__gpu_grid_place *pl)
-{
-    for (size_t i = 0; i < n; ++i) {
-        float *p = cps + 4 * i;
-        double q[3];
-        for (int r = 0; r < 3; ++r)
-            q[r] = (double)pl->rot[4 * r] * p[0] + (double)pl->rot[4 * r + 1] * p[1] +
-                   (double)pl->rot[4 * r + 2] * p[2] + (double)pl->rot[4 * r + 3] * p[3];
-        for (int r = 0; r < 3; ++r)
-            p[r] = (float)q[r];
-    }
-}
-
 /* Whether record i is drawn from the kept grids (a geometry made without placements has none). */
 static int kept(const sw__fr_geometry *g, size_t i)
 {
@@ -37,28 +22,22 @@ static int kept(const sw__fr_geometry *g, size_t i)
 }
 
 /* The records drawn from the kept grids, by trim variant (untrimmed first) into
- * ctx->grid_recs_sorted; the others are left in g's order with places[i].resident 0. */
+ * ctx->grid_recs_sorted. A frame under a host's shading has none (its prepare evaluates every
+ * grid: the host's programs include none for kept grids). */
 static sw_result grid_batch(sw_gpu_context *ctx, sw__fr_geometry *g, sw__gpu_patch_batch *b,
                             sw_status *status)
 {
     size_t count[SW__GPU_TRIM_VARIANTS] = {0, 0};
-    const int programs =
-        ctx->surf.grid[SW__GPU_TRIMMED].prog && ctx->surf.grid[SW__GPU_UNTRIMMED].prog;
-    for (size_t i = 0; g->places && i < g->n_recs; ++i) {
-        sw__gpu_grid_place *pl = &g->places[i];
-        if (pl->resident && !programs) {
-            const sw__gpu_patch_rec *rec = &g->recs[i];
-            if (i == 0 || g->recs[i - 1].cp != rec->cp) /* pieces share their points */
-                unplace(g->cps + 4 * (size_t)rec->cp,
-                        (size_t)(rec->deg_u + 1) * (size_t)(rec->deg_v + 1), pl);
-            pl->resident = 0;
-        }
-        if (pl->resident)
+    for (size_t i = 0; i < g->n_recs; ++i)
+        if (kept(g, i))
             count[trim_variant(&g->draws[g->recs[i].draw])]++;
-    }
     const size_t n = count[0] + count[1];
     if (n == 0)
         return SW_OK;
+    if (!ctx->surf.grid[SW__GPU_TRIMMED].prog || !ctx->surf.grid[SW__GPU_UNTRIMMED].prog)
+        return sw__fail(status, SW_ERR_INVALID_ARGUMENT,
+                        "frame: kept grids under a shading without their programs (a host's "
+                        "shading: prepare the frame with no_kept_grids)");
     if (!sw__grow((void **)&ctx->grid_recs_sorted, &ctx->cap_grid_recs_sorted, n,
                   sizeof *ctx->grid_recs_sorted) ||
         !sw__grow((void **)&ctx->grid_places_sorted, &ctx->cap_grid_places_sorted, n,

@@ -759,6 +759,8 @@ static sw_result prepare_frame(sw_rt_renderer *r, const sw_frame_desc *desc, sw_
         j->job.desc.occurrences = extra->occurrences;
         j->job.desc.n_occurrences = extra->n_occurrences;
         j->shading = extra->shading;
+        /* a host's shading has no program for kept grids: its frame evaluates every grid */
+        j->job.desc.no_kept_grids |= extra->shading != NULL;
     }
     j->job.pool_waits_before = sw_th_thread_waits().waits - w0;
     j->job.frame = ++r->frames_prepared;
