@@ -71,6 +71,8 @@ typedef struct border_point {
                                     segment; at a vertex, its two segments) */
     double scr[2];               /* screen position (thinning), valid when in_front */
     int in_front;
+    int away;     /* the surface faces away from the eye here (a closed shell's back) */
+    int run_away; /* after thinning: so did every sample from the kept one before to this one */
 } border_point;
 
 /* A loop sample in the surface's own space: what a ribbon takes from the surface there, for any
@@ -210,6 +212,8 @@ static size_t thin_samples(const sw__gpu_view *v, border_point *bp, size_t n, do
     enum { MAX_RUN = 64 };
     for (size_t k = 0; k < n; ++k)
         bp[k].in_front = screen_of(v, bp[k].p, bp[k].scr);
+    if (n == 0)
+        return 0;
     size_t kept = 1, i = 1;
     while (i < n) {
         size_t end = i; /* extend the run [last kept = input i - 1, end] while every sample fits */
@@ -225,9 +229,14 @@ static size_t thin_samples(const sw__gpu_view *v, border_point *bp, size_t n, do
                 ++end;
             }
         }
-        bp[kept++] = bp[end];
+        int away = bp[kept - 1].away; /* the samples the kept ones span: i - 1 .. end */
+        for (size_t k = i; k <= end; ++k)
+            away &= bp[k].away;
+        bp[kept] = bp[end];
+        bp[kept++].run_away = away;
         i = end + 1;
     }
+    bp[0].run_away = bp[0].away && bp[kept - 1].away; /* the closing chord: input n - 1 to 0 */
     return kept;
 }
 
@@ -731,6 +740,10 @@ static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, s
 {
     for (size_t i = 0; i < n; ++i) {
         const border_point *e_in[2] = {&bp[i], &bp[(i + 1) % n]}, *e[2] = {e_in[0], e_in[1]};
+        if (e_in[1]->run_away) { /* hidden by the shell's front (see sample_facing) */
+            mesh->border_quads_away++;
+            continue;
+        }
         border_point clipped;
         quad_ends qe;
         if (e_in[0]->in_front != e_in[1]->in_front)
@@ -881,9 +894,52 @@ size_t sw__gpu_border_loop_bytes(const sw__gpu_border_loop *bl)
     return sizeof *bl + bl->n_samples * sizeof *bl->s + grid;
 }
 
+/* 1 when the surface at object point p with normal n (S_u x S_v, any positive scale) faces away
+ * from the eye by more than k_away, on a face bounding a closed shell seen from outside. Such a
+ * point is hidden: the eye ray to it leaves the solid there, so it entered it before, through a
+ * surface facing the eye, which is drawn within ε_img and whose own cracks its own ribbons cover
+ * (where that front surface ends at a silhouette crease, its ribbon covers the pixels on its
+ * side, which is the side a back face folds under). A ribbon quad is left out only when every
+ * sample it spans faces away; the margin keeps the ribbons along smooth silhouettes, where the
+ * normal turns between samples. */
+static int sample_facing_away(const sw__gpu_ribbon_facing *f, const double p[3], const double n[3])
+{
+    static const double k_away = 0.1; /* cosine beyond the silhouette: about 6 degrees */
+    const double d[3] = {f->eye[0] - p[0], f->eye[1] - p[1], f->eye[2] - p[2]};
+    const double dn = f->outward * (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]);
+    const double nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    return dn < 0.0 && dn * dn > k_away * k_away * nn * dd;
+}
+
+/* Marks the samples facing away (none without `facing`). */
+static void mark_away(const sw__gpu_border_loop *bl, const sw__gpu_ribbon_facing *f,
+                      border_point *bp)
+{
+    for (size_t i = 0; i < bl->n_samples; ++i) {
+        bp[i].away = 0;
+        if (!f)
+            continue;
+        const border_sample *s = &bl->s[i];
+        if (!bl->affine) {
+            bp[i].away = sample_facing_away(f, s->p, s->n);
+            continue;
+        }
+        double p[3], n[3];
+        const double *o = bl->aff_o, *du = bl->aff_du, *dv = bl->aff_dv;
+        for (int k = 0; k < 3; ++k)
+            p[k] = o[k] + s->uv[0] * du[k] + s->uv[1] * dv[k];
+        n[0] = du[1] * dv[2] - du[2] * dv[1];
+        n[1] = du[2] * dv[0] - du[0] * dv[2];
+        n[2] = du[0] * dv[1] - du[1] * dv[0];
+        bp[i].away = sample_facing_away(f, p, n);
+    }
+}
+
 sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
                                 const sw__gpu_border_loop *bl, double width_px,
-                                const double *st_box, sw__gpu_mesh *mesh, sw_status *status)
+                                const double *st_box, const sw__gpu_ribbon_facing *facing,
+                                sw__gpu_mesh *mesh, sw_status *status)
 {
     const size_t m = bl->n_samples;
     mesh->border_capped += (uint64_t)bl->capped;
@@ -912,6 +968,7 @@ sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
             place_sample(s, world, v->eye, &bp[i]);
         }
     }
+    mark_away(bl, facing, bp);
     emit_ribbon(&c, bp, thin_samples(v, bp, m, 0.25 * width_px), mesh);
     sw__free(bp);
     return SW_OK;
@@ -920,7 +977,8 @@ sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
                              double du, double dv, double width_px, const double *st_box,
-                             int affine, sw__gpu_mesh *mesh, sw_status *status)
+                             int affine, const sw__gpu_ribbon_facing *facing, sw__gpu_mesh *mesh,
+                             sw_status *status)
 {
     if (n < 2 || !(du > 0.0) || !(dv > 0.0))
         return SW_OK;
@@ -928,7 +986,7 @@ sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
     sw_result r = sw__gpu_border_loop_make(srf, uv, n, left_inside, du, dv, affine,
                                            sw__gpu_border_budget(v, n), &bl, status);
     if (r == SW_OK)
-        r = sw__gpu_fat_border_of(v, world, bl, width_px, st_box, mesh, status);
+        r = sw__gpu_fat_border_of(v, world, bl, width_px, st_box, facing, mesh, status);
     sw__gpu_border_loop_free(bl);
     return r;
 }

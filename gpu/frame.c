@@ -44,6 +44,11 @@ void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on)
     ctx->border_affine_off = !on;
 }
 
+void sw__gpu_set_back_ribbons(sw_gpu_context *ctx, int keep)
+{
+    ctx->back_ribbons_kept = keep != 0;
+}
+
 void sw__gpu_set_eval_mode(sw_gpu_context *ctx, sw__gpu_eval_mode mode)
 {
     ctx->eval_mode = (int32_t)mode;
@@ -205,8 +210,10 @@ static sw_result run_stages(sw_gpu_frame_plan *p, sw_status *status)
     sw_result r = sw__fr_cull_scene_box(env, &p->desc, &p->vis, scene_box, status);
     if (r == SW_OK)
         r = sw__fr_env_view(env, &p->desc, scene_box, status);
-    if (r == SW_OK)
+    if (r == SW_OK) {
+        env->eye_outside_solids = sw__fr_eye_outside_shells(env, &p->desc);
         r = sw__fr_cull(env, &p->desc, &p->vis, &p->st, status);
+    }
     if (r == SW_OK)
         r = sw__fr_select(env, &p->hy, &p->vis, &p->sel, &p->st, status);
     if (r == SW_OK)

@@ -77,6 +77,30 @@ double sw__fr_stretch_bound(const double m[12])
     return sqrt(col * row);
 }
 
+void sw__fr_cofactor3(const double m[12], double out[9])
+{
+    for (int r = 0; r < 3; ++r) {
+        const int r1 = (r + 1) % 3, r2 = (r + 2) % 3;
+        for (int c = 0; c < 3; ++c) {
+            const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+            out[3 * r + c] = m[4 * r1 + c1] * m[4 * r2 + c2] - m[4 * r1 + c2] * m[4 * r2 + c1];
+        }
+    }
+}
+
+int sw__fr_eye_in_object(const double m[12], const double eye[3], double out[3])
+{
+    double cof[9];
+    sw__fr_cofactor3(m, cof);
+    const double det = m[0] * cof[0] + m[1] * cof[1] + m[2] * cof[2];
+    if (!(fabs(det) > 0.0) || !isfinite(det))
+        return 0;
+    const double rel[3] = {eye[0] - m[3], eye[1] - m[7], eye[2] - m[11]};
+    for (int c = 0; c < 3; ++c) /* M^-1 = cof^T / det */
+        out[c] = (cof[c] * rel[0] + cof[3 + c] * rel[1] + cof[6 + c] * rel[2]) / det;
+    return isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]);
+}
+
 double sw__fr_det3(const double m[12])
 {
     return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +

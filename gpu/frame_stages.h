@@ -81,6 +81,7 @@ typedef struct sw__fr_env {
     int lod_colors;             /* desc.lod_colors */
     int trim_edges;             /* desc.trim_edges: exact edges where a texel would be coarse */
     int grids_resident;         /* Bézier grids drawn from the context's kept grids */
+    int eye_outside_solids;     /* sw__fr_eye_outside_shells: closed shells seen from outside */
     int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
     sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
@@ -159,6 +160,13 @@ void sw__fr_visible_free(sw__fr_visible *vis);
 void sw__fr_visible_empty(sw__fr_visible *vis); /* counts zeroed, arrays kept */
 /* Kumar §4.4's back-patch test of one face occurrence with its eye-relative box. */
 int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6]);
+/* 1 when the frame may take the eye to be outside every closed shell, as leaving out the parts of
+ * their fat borders that face away needs (gpu/crack_fill.c): desc has face cones and a face BVH,
+ * and no ray of six from the eye along the axes meets a closed shell first from inside it (an eye
+ * inside a solid — a walk through a wall, a close-up inside a part — sees that solid's faces from
+ * behind). A ray escaping, or meeting a face from outside, says the eye is outside that solid;
+ * six rays rather than one for solids that overlap, as assemblies' parts may. */
+int sw__fr_eye_outside_shells(const sw__fr_env *env, const sw_gpu_frame_desc *desc);
 
 /* ---- select: stage_select.c, stage_hierarchy.c ------------------------------------------- */
 /* Texels wanted per direction of a trim texture. */
@@ -504,6 +512,11 @@ void sw__fr_eye_box(const double eye[3], const double world[6], double out[6]);
 /* Eye-relative box of an object box's corners under m. */
 void sw__fr_eye_box_of(const double eye[3], const double obj[6], const double m[12], double out[6]);
 double sw__fr_det3(const double m[12]);
+/* Cofactor matrix of the linear part (row-major 3 x 3): det(M) M^-T, the map of normals under any
+ * invertible affine transform (up to the sign of det). */
+void sw__fr_cofactor3(const double m[12], double out[9]);
+/* The world point eye in m's own space; 0 for a singular or non-finite map. */
+int sw__fr_eye_in_object(const double m[12], const double eye[3], double out[3]);
 /* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm, 1 for a rigid one. */
 double sw__fr_stretch_bound(const double m[12]);
 

@@ -25,6 +25,7 @@
  * is culled whole: no level is chosen, asked for or drawn. */
 #include "frame_stages.h"
 #include "occlusion.h"
+#include "sw_sg_pick.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
 
@@ -495,6 +496,53 @@ static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bv
 }
 
 /* ---- back-patch culling ------------------------------------------------------------------ */
+/* 1 when the first face ray `dir` from the eye meets is a closed shell's, met from inside it
+ * (its outward normal along the ray: the ray leaves the solid there). */
+static int ray_leaves_shell(const sw__fr_env *env, const sw_sg_bvh *bvh, const double dir[3])
+{
+    sw_sg_pick_hit hit;
+    sw_status st = {0};
+    if (sw_sg_pick(env->scene, bvh, env->view.eye, dir, 0.0, &hit, &st) != SW_OK)
+        return 1; /* unknown: taken as inside */
+    if (hit.face == SW_SG_NONE)
+        return 0;
+    const uint32_t flags = env->sv->faces[hit.face].flags;
+    if (!(flags & SW_SG_FACE_CLOSED_SHELL))
+        return 0;
+    sw_sg_surface srf;
+    sw_sg_scene_face_surface(env->scene, hit.face, &srf);
+    double h[12], du[3], dv[3], n[3], cof[9];
+    sw_sg_surface_eval_h1(&srf, hit.uv[0], hit.uv[1], h);
+    for (int k = 0; k < 3; ++k) { /* w^2 S_u, w^2 S_v */
+        du[k] = h[4 + k] * h[3] - h[k] * h[7];
+        dv[k] = h[8 + k] * h[3] - h[k] * h[11];
+    }
+    n[0] = du[1] * dv[2] - du[2] * dv[1];
+    n[1] = du[2] * dv[0] - du[0] * dv[2];
+    n[2] = du[0] * dv[1] - du[1] * dv[0];
+    const double *m = bvh->items[hit.item].world;
+    sw__fr_cofactor3(m, cof); /* det(M) M^-T: the world normal, times the sign of det */
+    double along = 0.0;
+    for (int r = 0; r < 3; ++r)
+        along += dir[r] * (cof[3 * r] * n[0] + cof[3 * r + 1] * n[1] + cof[3 * r + 2] * n[2]);
+    along *= sw__fr_det3(m) < 0.0 ? -1.0 : 1.0;
+    along *= flags & SW_SG_FACE_REVERSED ? -1.0 : 1.0;
+    return along > 0.0;
+}
+
+int sw__fr_eye_outside_shells(const sw__fr_env *env, const sw_gpu_frame_desc *desc)
+{
+    static const double k_dirs[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                        {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+    const sw_sg_bvh *bvh = face_bvh(desc);
+    if (!desc->face_cones || !bvh || !bvh->n_items)
+        return 0;
+    for (int k = 0; k < 6; ++k)
+        if (ray_leaves_shell(env, bvh, k_dirs[k]))
+            return 0;
+    return 1;
+}
+
 int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6])
 {
     sw_lod_cone w;

@@ -305,16 +305,14 @@ static void place_of(const sw__fr_env *env, const occurrence *o, const double ce
     const double at[4] = {centre[0], centre[1], centre[2], 1.0};
     double off[4];
     sw__fr_xform_h(m, env->view.eye, at, off);
+    double cof[9];
+    sw__fr_cofactor3(m, cof);
     for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c)
-            pl->rot[4 * r + c] = (float)m[4 * r + c];
-        pl->rot[4 * r + 3] = (float)off[r];
-        const int r1 = (r + 1) % 3, r2 = (r + 2) % 3;
         for (int c = 0; c < 3; ++c) {
-            const int c1 = (c + 1) % 3, c2 = (c + 2) % 3;
-            pl->cof[4 * r + c] =
-                (float)(m[4 * r1 + c1] * m[4 * r2 + c2] - m[4 * r1 + c2] * m[4 * r2 + c1]);
+            pl->rot[4 * r + c] = (float)m[4 * r + c];
+            pl->cof[4 * r + c] = (float)cof[3 * r + c];
         }
+        pl->rot[4 * r + 3] = (float)off[r];
         pl->cof[4 * r + 3] = 0.0f;
     }
 }
@@ -395,10 +393,11 @@ sw_result sw__fr_gpu_patch(sw__fr_tess *t, const occurrence *o, const sw__gpu_pa
 
 /* The ribbon appended to the mesh from index `first` as its own draw (none when empty). */
 static sw_result ribbon_draw(sw__fr_tess *t, const occurrence *o, size_t first, uint64_t capped,
-                             const double cell[2], const double *st_box, const double *st_rect,
-                             size_t share, sw_status *status)
+                             uint64_t away, const double cell[2], const double *st_box,
+                             const double *st_rect, size_t share, sw_status *status)
 {
     sw__fr_geometry *g = t->geo;
+    t->st->border_quads_away += g->mesh.border_quads_away - away;
     /* sampled coarser than its cells (the view's sample budget): it may leave a crack open */
     t->st->borders_capped += g->mesh.border_capped - capped;
     t->st->bound_exceeded += g->mesh.border_capped - capped;
@@ -426,6 +425,21 @@ static sw_result ribbon_draw(sw__fr_tess *t, const occurrence *o, size_t first, 
     return r;
 }
 
+/* The side of occurrence o's face the eye sees, when the frame may leave out the back of its
+ * ribbons: a face bounding a closed shell, in a frame whose eye is outside the solids (the premise
+ * of back-patch culling). NULL otherwise. */
+static const sw__gpu_ribbon_facing *facing_of(const sw__fr_tess *t, const occurrence *o,
+                                              sw__gpu_ribbon_facing *f)
+{
+    const uint32_t flags = t->env->sv->faces[o->face].flags;
+    if (!t->env->eye_outside_solids || t->env->ctx->back_ribbons_kept ||
+        !(flags & SW_SG_FACE_CLOSED_SHELL) ||
+        !sw__fr_eye_in_object(o->world, t->env->view.eye, f->eye))
+        return NULL;
+    f->outward = flags & SW_SG_FACE_REVERSED ? -1.0 : 1.0;
+    return f;
+}
+
 /* §7.1: a fat border along one closed uv loop of a drawn face, as its own draw. */
 sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *uv, size_t n,
                             int left_inside, const double cell[2], const double *st_box,
@@ -435,14 +449,16 @@ sw_result sw__fr_fat_border(sw__fr_tess *t, const occurrence *o, const double *u
     sw_sg_surface srf;
     sw_sg_scene_face_surface(t->env->scene, o->face, &srf);
     const size_t first = g->mesh.n_idx;
-    const uint64_t capped = g->mesh.border_capped;
+    const uint64_t capped = g->mesh.border_capped, away = g->mesh.border_quads_away;
     /* st over the face's uv box when the ribbon is drawn untrimmed: no lookup reads it, but the
      * shading's uv (u_uv_map) does */
     const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
-    sw_result r = sw__gpu_fat_border(&t->env->view, &srf, o->world, uv, n, left_inside, cell[0],
-                                     cell[1], 2.0 * t->env->eps_px, st_rect,
-                                     !t->env->ctx->border_affine_off, &g->mesh, status);
-    return r == SW_OK ? ribbon_draw(t, o, first, capped, cell, st_box, st_rect, share, status) : r;
+    sw__gpu_ribbon_facing f;
+    sw_result r = sw__gpu_fat_border(
+        &t->env->view, &srf, o->world, uv, n, left_inside, cell[0], cell[1], 2.0 * t->env->eps_px,
+        st_rect, !t->env->ctx->border_affine_off, facing_of(t, o, &f), &g->mesh, status);
+    return r == SW_OK ? ribbon_draw(t, o, first, capped, away, cell, st_box, st_rect, share, status)
+                      : r;
 }
 
 sw_result sw__fr_placed_border(sw__fr_tess *t, const occurrence *o, const sw__gpu_border_loop *bl,
@@ -451,11 +467,13 @@ sw_result sw__fr_placed_border(sw__fr_tess *t, const occurrence *o, const sw__gp
 {
     sw__fr_geometry *g = t->geo;
     const size_t first = g->mesh.n_idx;
-    const uint64_t capped = g->mesh.border_capped;
+    const uint64_t capped = g->mesh.border_capped, away = g->mesh.border_quads_away;
     const double *st_rect = st_box ? st_box : t->env->sv->faces[o->face].uv_box;
+    sw__gpu_ribbon_facing f;
     sw_result r = sw__gpu_fat_border_of(&t->env->view, o->world, bl, 2.0 * t->env->eps_px, st_rect,
-                                        &g->mesh, status);
-    return r == SW_OK ? ribbon_draw(t, o, first, capped, cell, st_box, st_rect, share, status) : r;
+                                        facing_of(t, o, &f), &g->mesh, status);
+    return r == SW_OK ? ribbon_draw(t, o, first, capped, away, cell, st_box, st_rect, share, status)
+                      : r;
 }
 
 /* The entry's loops copied into fl (the trim stage draws from them on the submitting thread,

@@ -12,18 +12,6 @@
 #include <math.h>
 #include <string.h>
 
-/* The cofactor matrix of the linear part of m (row-major 3x3): det(M) M^-T, the map of normals
- * under any invertible affine transform (up to a positive factor when det > 0; shading is
- * two-sided, so the sign does not matter). */
-static void normal_matrix(const double m[12], double out[9])
-{
-    const double a = m[0], b = m[1], c = m[2], d = m[4], e = m[5], g = m[6], h = m[8], i = m[9],
-                 k = m[10];
-    out[0] = e * k - g * i, out[1] = g * h - d * k, out[2] = d * i - e * h;
-    out[3] = c * i - b * k, out[4] = a * k - c * h, out[5] = b * h - a * i;
-    out[6] = b * g - c * e, out[7] = c * d - a * g, out[8] = a * e - b * d;
-}
-
 /* Eye-relative position of object point p under m (the float the GPU gets). */
 static void eye_position(const sw__fr_tess *f, const double m[12], const double *p, double out[3])
 {
@@ -108,7 +96,7 @@ sw_result sw__fr_tess_meshes(sw__fr_tess *f, const sw__fr_visible *vis, sw_statu
         t.normals_d = normals;
         t.n_vertices = rec->n_vertices;
         t.n_triangles = rec->n_triangles;
-        normal_matrix(mo->world, t.normal_matrix);
+        sw__fr_cofactor3(mo->world, t.normal_matrix); /* normals: shading is two-sided */
         occurrence o;
         memset(&o, 0, sizeof o);
         memcpy(o.world, mo->world, sizeof o.world);

@@ -190,7 +190,7 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 576, /* trim_exact*: the trim plan; shapes_*: cull and the
+        sizeof(sw_gpu_frame_stats) == 584, /* trim_exact*: the trim plan; shapes_*: cull and the
                                               outline stage; grid_*: submit; not chunks */
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
@@ -213,6 +213,7 @@ static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
     d->borders_capped += s->borders_capped;
     d->border_loops_kept += s->border_loops_kept;
     d->border_loops_made += s->border_loops_made;
+    d->border_quads_away += s->border_quads_away;
     d->static_units_drawn += s->static_units_drawn;
     d->static_faces += s->static_faces;
     d->static_triangles += s->static_triangles;

@@ -240,6 +240,9 @@ typedef struct sw_gpu_frame_stats {
     /* fat-border loops placed from samples kept in the border cache, and loops whose samples
      * this frame made (and kept) */
     uint64_t border_loops_kept, border_loops_made;
+    /* fat-border quads left out because the closed shell they lie on faces away from the eye
+     * there (desc.face_cones: the eye is outside the solids; gpu/crack_fill.c) */
+    uint64_t border_quads_away;
     /* the tessellation in chunks (desc.pool): chunks, those the pool's workers took, and the
      * time the preparing thread waited at the join for chunks a worker was still running */
     uint64_t tess_chunks, tess_chunks_by_pool;

@@ -178,6 +178,7 @@ struct sw_gpu_context {
     size_t cap_recs_sorted;
     int32_t crack_fill_off;        /* 1: no fat borders (§7.1) */
     int32_t border_affine_off;     /* 1: affine faces' borders sampled as curved ones */
+    int32_t back_ribbons_kept;     /* 1: closed shells' ribbons drawn where they face away too */
     sw__gpu_patch_hook patch_hook; /* debug hook, NULL = none */
     void *patch_hook_user;
     /* exact evaluation from knots and control points (eval_exact) */
@@ -285,6 +286,7 @@ typedef struct sw__gpu_mesh {
     size_t n_v, cap_v, n_idx, cap_idx;
     uint64_t border_capped; /* fat borders sampled coarser than their cells: the sample budget
                                of sw__gpu_fat_border was hit (counted, never reset here) */
+    uint64_t border_quads_away; /* fat-border quads left out facing away (likewise) */
 } sw__gpu_mesh;
 
 /* The context's border cache (border_cache.c; frame_stages.h has its frame-side calls). */
@@ -341,12 +343,18 @@ sw_result sw__gpu_tessellate_face(const sw__gpu_patch *patches, int32_t n_cols, 
  * up to fit, and mesh->border_capped counts it (the ribbon then follows the loop's chords at
  * coarser steps: within the budget, not the grid's cells). affine: 1 lets an affine surface
  * (sw_sg_surface_affine, a plane) take the ribbon from its loop's vertices and straight inner
- * steps, with no evaluation between (exact there); 0 samples it as any other.
+ * steps, with no evaluation between (exact there); 0 samples it as any other. facing: NULL, or
+ * the face bounds a closed shell seen from outside: the ribbon leaves out what faces away.
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT. */
+typedef struct sw__gpu_ribbon_facing {
+    double eye[3];  /* the eye in the surface's own space (before `world`) */
+    double outward; /* +1: the shell's outside is along S_u x S_v; -1: along -(S_u x S_v) */
+} sw__gpu_ribbon_facing;
 sw_result sw__gpu_fat_border(const sw__gpu_view *v, const sw_sg_surface *srf,
                              const double world[12], const double *uv, size_t n, int left_inside,
                              double du, double dv, double width_px, const double *st_box,
-                             int affine, sw__gpu_mesh *mesh, sw_status *status);
+                             int affine, const sw__gpu_ribbon_facing *facing, sw__gpu_mesh *mesh,
+                             sw_status *status);
 /* The view-independent part of one loop's fat border: its samples on the surface in the
  * surface's own space (at steps no longer than (du, dv), widened to at most max_samples and then
  * counted as capped) and its segment grid, which sw__gpu_fat_border_of places under any view and
@@ -367,7 +375,8 @@ size_t sw__gpu_border_budget(const sw__gpu_view *v, size_t n);
 /* The ribbon of a made loop (the same as sw__gpu_fat_border's with the make's arguments). */
 sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
                                 const sw__gpu_border_loop *bl, double width_px,
-                                const double *st_box, sw__gpu_mesh *mesh, sw_status *status);
+                                const double *st_box, const sw__gpu_ribbon_facing *facing,
+                                sw__gpu_mesh *mesh, sw_status *status);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 /* Static levels drawn from the GPU copies the context keeps (default), or sent with each frame's
@@ -379,6 +388,9 @@ void sw__gpu_set_grids_resident(sw_gpu_context *ctx, int on);
 /* Fat borders of affine faces by their loop's vertices (default) or sampled as curved ones: the
  * A/B of bench_prepare and the test that both cover alike. */
 void sw__gpu_set_border_affine(sw_gpu_context *ctx, int on);
+/* keep = 1: the parts of closed shells' fat borders that face away from the eye are drawn too (by
+ * default a frame whose desc has face cones leaves them out): the A/B of tests. Between frames. */
+void sw__gpu_set_back_ribbons(sw_gpu_context *ctx, int keep);
 
 /* ---- trim textures (trim_texture.c) --------------------------------------------------------- */
 /* Renders loops already in the clip space of one atlas page into layer `layer` of the R8 array

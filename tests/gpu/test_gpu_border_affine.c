@@ -78,7 +78,7 @@ int main(void)
     sw__gpu_mesh m[2] = {{0}, {0}}; /* affine path, general path */
     for (int k = 0; k < 2; ++k) {
         sw_result r = sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, 0.01, 0.01, 1.0, NULL,
-                                         k == 0, &m[k], &st);
+                                         k == 0, NULL, &m[k], &st);
         CHECK(r == SW_OK, "%s path: %s", k ? "general" : "affine", st.message);
     }
     printf("ribbon quads: affine path %zu, general path %zu (loop of %d segments)\n", m[0].n_v / 4,
@@ -102,8 +102,8 @@ int main(void)
         cpw_half[i] = 0.5 * cpw[i];
     const sw_sg_surface half = {1, 1, 2, 2, knots, knots, cpw_half};
     sw__gpu_mesh mh = {0};
-    CHECK(sw__gpu_fat_border(&v, &half, world, uv, N_LOOP, 1, 0.01, 0.01, 1.0, NULL, 0, &mh, &st) ==
-              SW_OK,
+    CHECK(sw__gpu_fat_border(&v, &half, world, uv, N_LOOP, 1, 0.01, 0.01, 1.0, NULL, 0, NULL, &mh,
+                             &st) == SW_OK,
           "weights 0.5: %s", st.message);
     double *h = malloc(2 * (mh.n_v + 1) * sizeof *h);
     if (!h)

@@ -48,7 +48,7 @@ int main(void)
     for (int k = 0; k < 2; ++k) {
         sw__gpu_mesh mesh = {0};
         sw_result r = sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, cells[k], cells[k], 1.0,
-                                         NULL, 0, &mesh, &st);
+                                         NULL, 0, NULL, &mesh, &st);
         printf("cells %g: %s, %zu ribbon vertices, border_capped %llu\n", cells[k],
                sw_result_str(r), mesh.n_v, (unsigned long long)mesh.border_capped);
         CHECK(r == SW_OK, "cells %g: %s", cells[k], st.message);

@@ -75,7 +75,7 @@ int main(void)
         return 1;
     }
     sw__gpu_mesh m = {0};
-    CHECK(sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, 0.005, 0.005, 1.0, st_box, 0, &m,
+    CHECK(sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, 0.005, 0.005, 1.0, st_box, 0, NULL, &m,
                              &st) == SW_OK,
           "ribbon: %s", st.message);
     double narrow = INFINITY, wide = 0.0, dz_lo = INFINITY, dz_hi = -INFINITY;

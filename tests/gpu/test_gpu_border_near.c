@@ -60,8 +60,8 @@ int main(void)
         return 1;
     }
     sw__gpu_mesh m = {0};
-    CHECK(sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, 0.05, 0.05, 1.0, st_box, 1, &m, &st) ==
-              SW_OK,
+    CHECK(sw__gpu_fat_border(&v, &srf, world, uv, N_LOOP, 1, 0.05, 0.05, 1.0, st_box, 1, NULL, &m,
+                             &st) == SW_OK,
           "ribbon: %s", st.message);
     double nearest = INFINITY, narrow = INFINITY, wide = 0.0;
     size_t ends = 0;

@@ -21,7 +21,9 @@
  * to them are left out of the displacement; their count must be 0 where the B-rep is closed at
  * the view (no free edge, and twice its largest tolerance below a pixel at the nearest depth;
  * closure_at_view), and is printed either way. Failed views leave their frames and an edge diff
- * in OUTDIR.
+ * in OUTDIR. Frames are drawn as the renderer draws them: with the scene's face cones and BVH
+ * (closed shells' back faces culled, and their fat borders' parts facing away left out while the
+ * eye is outside the solids: the close view of Motor-c looks from inside one of its solids).
  *
  * Usage: test_images [--hierarchy | --static] [--exact-edges] OUTDIR WIDTHxHEIGHT VIEWS FILE...
  * VIEWS: comma list of whole,mid,close. --hierarchy draws through the bicubic hierarchies;
@@ -36,6 +38,8 @@
 #include "occt_reference.hpp"
 
 #include "sw_gpu.h"
+#include "sw_lod_face_cones.h"
+#include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
 
 #include <algorithm>
@@ -374,6 +378,8 @@ bool g_static = false;                /* --static: and super-surfaces from their
 bool g_exact_edges = false;           /* --exact-edges: desc.trim_edges */
 struct sw_lod_cache *g_cache = nullptr; /* of the file being tested */
 struct sw_lod_static_set *g_statics = nullptr;
+sw_lod_face_cones *g_cones = nullptr; /* the file's: frames culled and filled as the renderer's */
+sw_sg_bvh *g_bvh = nullptr;
 
 bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d_in, sw_gpu_image &out, double &ms,
                  sw_gpu_frame_stats &fs)
@@ -383,6 +389,8 @@ bool render_ours(model_ctx &m, const sw_gpu_frame_desc &d_in, sw_gpu_image &out,
     d.hierarchies = g_cache;
     d.static_lods = g_statics;
     d.trim_edges = g_exact_edges;
+    d.face_cones = g_cones;
+    d.bvh = g_bvh;
     auto t0 = std::chrono::steady_clock::now();
     sw_result r = sw_gpu_render_scene(m.gpu, m.scene, &d, &out, &fs, &st);
     ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -622,11 +630,13 @@ bool run_view(model_ctx &m, const view &v)
                            : "",
                 covered_pixels(ip.ref));
     std::printf("    splinewalk: %llu triangles, %llu trimmed + %llu untrimmed patches, %llu trim "
-                "textures of %.3g texels, %.0f ms; covers %ld px; bound exceeded %llu\n",
+                "textures of %.3g texels, %.0f ms; covers %ld px; bound exceeded %llu; %llu faces "
+                "culled facing away, %llu ribbon quads facing away left out\n",
                 (unsigned long long)fs.triangles, (unsigned long long)fs.patches_trimmed,
                 (unsigned long long)fs.patches_untrimmed, (unsigned long long)fs.trim_textures,
                 (double)fs.trim_texels, ms_ours, covered_pixels(ip.ours),
-                (unsigned long long)fs.bound_exceeded);
+                (unsigned long long)fs.bound_exceeded, (unsigned long long)fs.faces_backculled,
+                (unsigned long long)fs.border_quads_away);
     if (g_static)
         std::printf("    static LODs: %llu super-surface instances, %llu faces, %llu triangles\n",
                     (unsigned long long)fs.static_units_drawn, (unsigned long long)fs.static_faces,
@@ -701,7 +711,16 @@ bool run_file(sw_gpu_context *gpu, const std::string &path, const std::string &o
     sw_test_hierarchies *hier = g_hierarchy ? sw_test_hierarchies_create(scene) : nullptr;
     g_cache = sw_test_hierarchies_cache(hier);
     g_statics = g_static && hier ? sw_test_hierarchies_statics(hier) : nullptr;
+    if (ok && (sw_lod_face_cones_build(scene, &g_cones, &st) != SW_OK ||
+               sw_sg_bvh_build(scene, &g_bvh, &st) != SW_OK)) {
+        std::fprintf(stderr, "face cones and BVH of %s: %s\n", path.c_str(), st.message);
+        ok = false;
+    }
     ok = ok && (!g_hierarchy || hier) && (!g_static || g_statics) && run_model(m, path, list);
+    sw_lod_face_cones_free(g_cones);
+    g_cones = nullptr;
+    sw_sg_bvh_free(g_bvh);
+    g_bvh = nullptr;
     sw_test_hierarchies_free(hier);
     g_cache = nullptr;
     g_statics = nullptr;
