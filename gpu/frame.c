@@ -200,6 +200,7 @@ sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *d, const dou
     sw_result r =
         sw__gpu_view_init(&env->view, &d->camera, d->width, d->height, near_plane, status);
     screen_view_init(env);
+    env->eye_outside_solids = r == SW_OK && sw__fr_eye_outside_shells(env, d);
     return r;
 }
 
@@ -210,10 +211,8 @@ static sw_result run_stages(sw_gpu_frame_plan *p, sw_status *status)
     sw_result r = sw__fr_cull_scene_box(env, &p->desc, &p->vis, scene_box, status);
     if (r == SW_OK)
         r = sw__fr_env_view(env, &p->desc, scene_box, status);
-    if (r == SW_OK) {
-        env->eye_outside_solids = sw__fr_eye_outside_shells(env, &p->desc);
+    if (r == SW_OK)
         r = sw__fr_cull(env, &p->desc, &p->vis, &p->st, status);
-    }
     if (r == SW_OK)
         r = sw__fr_select(env, &p->hy, &p->vis, &p->sel, &p->st, status);
     if (r == SW_OK)

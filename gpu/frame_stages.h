@@ -93,8 +93,8 @@ typedef struct sw__fr_env {
 sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scene *scene,
                           const sw_gpu_frame_desc *desc, sw_status *status);
 /* The view, its near plane from the eye-relative scene box (the cull stage's) unless the desc
- * gives one; the density bound's view and the grid classes' segment counts. Errors: those of
- * sw__gpu_view_init. */
+ * gives one; the density bound's view and the grid classes' segment counts; whether the eye is
+ * outside the closed shells (sw__fr_eye_outside_shells). Errors: those of sw__gpu_view_init. */
 sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *desc, const double scene_box[6],
                           sw_status *status);
 
