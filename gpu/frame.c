@@ -200,7 +200,7 @@ sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *d, const dou
     sw_result r =
         sw__gpu_view_init(&env->view, &d->camera, d->width, d->height, near_plane, status);
     screen_view_init(env);
-    env->eye_outside_solids = r == SW_OK && sw__fr_eye_outside_shells(env, d);
+    env->eye_shells = r == SW_OK ? sw__fr_eye_shells(env, d) : SW__FR_EYE_UNKNOWN;
     return r;
 }
 

@@ -81,7 +81,7 @@ typedef struct sw__fr_env {
     int lod_colors;             /* desc.lod_colors */
     int trim_edges;             /* desc.trim_edges: exact edges where a texel would be coarse */
     int grids_resident;         /* Bézier grids drawn from the context's kept grids */
-    int eye_outside_solids;     /* sw__fr_eye_outside_shells: closed shells seen from outside */
+    int eye_shells;             /* sw__fr_eye_shells: the eye inside a closed shell, or not */
     int32_t static_force;       /* desc.static_force */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
     sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
@@ -93,8 +93,8 @@ typedef struct sw__fr_env {
 sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scene *scene,
                           const sw_gpu_frame_desc *desc, sw_status *status);
 /* The view, its near plane from the eye-relative scene box (the cull stage's) unless the desc
- * gives one; the density bound's view and the grid classes' segment counts; whether the eye is
- * outside the closed shells (sw__fr_eye_outside_shells). Errors: those of sw__gpu_view_init. */
+ * gives one; the density bound's view and the grid classes' segment counts; where the eye is
+ * with respect to the closed shells (sw__fr_eye_shells). Errors: those of sw__gpu_view_init. */
 sw_result sw__fr_env_view(sw__fr_env *env, const sw_gpu_frame_desc *desc, const double scene_box[6],
                           sw_status *status);
 
@@ -160,13 +160,15 @@ void sw__fr_visible_free(sw__fr_visible *vis);
 void sw__fr_visible_empty(sw__fr_visible *vis); /* counts zeroed, arrays kept */
 /* Kumar §4.4's back-patch test of one face occurrence with its eye-relative box. */
 int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6]);
-/* 1 when the frame may take the eye to be outside every closed shell, as leaving out the parts of
- * their fat borders that face away needs (gpu/crack_fill.c): desc has face cones and a face BVH,
- * and no ray of six from the eye along the axes meets a closed shell first from inside it (an eye
- * inside a solid — a walk through a wall, a close-up inside a part — sees that solid's faces from
- * behind). A ray escaping, or meeting a face from outside, says the eye is outside that solid;
- * six rays rather than one for solids that overlap, as assemblies' parts may. */
-int sw__fr_eye_outside_shells(const sw__fr_env *env, const sw_gpu_frame_desc *desc);
+/* Where the eye is with respect to the closed shells (SW_SG_FACE_CLOSED_SHELL), which back-patch
+ * culling and leaving out fat borders facing away (gpu/crack_fill.c) both take to be seen from
+ * outside. UNKNOWN without face cones or a face BVH; INSIDE when one of six rays from the eye along
+ * the axes meets a closed shell first from inside it (an eye inside a solid — a walk through a
+ * wall, a close-up inside a part — sees that solid's faces from behind); else OUTSIDE: each ray
+ * escaped or met a face from outside (six rays rather than one for solids that overlap, as an
+ * assembly's parts may). */
+enum { SW__FR_EYE_UNKNOWN = 0, SW__FR_EYE_INSIDE = 1, SW__FR_EYE_OUTSIDE = 2 };
+int sw__fr_eye_shells(const sw__fr_env *env, const sw_gpu_frame_desc *desc);
 
 /* ---- select: stage_select.c, stage_hierarchy.c ------------------------------------------- */
 /* Texels wanted per direction of a trim texture. */

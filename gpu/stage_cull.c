@@ -11,7 +11,8 @@
  * Back-patch culling (Kumar §4.4): an occurrence of a closed-shell face whose outward cone, in the
  * world, faces away from every view direction into its box is dropped before anything is asked
  * of the pool, so culled faces cost nothing further. Sound only for an eye outside the solids:
- * from inside a solid's material its back faces are what one sees.
+ * from inside a solid's material its back faces are what one sees, so a frame whose eye is found
+ * inside one (sw__fr_eye_shells, with a face BVH) culls none.
  *
  * The unit-instance BVH. With static LODs the frame culls the set's BVH whose leaves are unit
  * instances (lod/static/sw_lod_static_set.h: the face occurrences grouped by (unit, transform)
@@ -530,17 +531,17 @@ static int ray_leaves_shell(const sw__fr_env *env, const sw_sg_bvh *bvh, const d
     return along > 0.0;
 }
 
-int sw__fr_eye_outside_shells(const sw__fr_env *env, const sw_gpu_frame_desc *desc)
+int sw__fr_eye_shells(const sw__fr_env *env, const sw_gpu_frame_desc *desc)
 {
     static const double k_dirs[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
                                         {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     const sw_sg_bvh *bvh = face_bvh(desc);
     if (!desc->face_cones || !bvh || !bvh->n_items)
-        return 0;
+        return SW__FR_EYE_UNKNOWN;
     for (int k = 0; k < 6; ++k)
         if (ray_leaves_shell(env, bvh, k_dirs[k]))
-            return 0;
-    return 1;
+            return SW__FR_EYE_INSIDE;
+    return SW__FR_EYE_OUTSIDE;
 }
 
 int sw__fr_face_back_facing(const sw_lod_face_cones *fc, const occurrence *o, const double box[6])
@@ -775,7 +776,8 @@ static sw_result collect_instances_occluded(const sw__fr_env *env, const sw_gpu_
 sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__fr_visible *vis,
                       sw_gpu_frame_stats *st, sw_status *status)
 {
-    const sw_lod_face_cones *fc = desc->face_cones;
+    /* from inside a solid its faces are seen from behind: no back-patch culling then */
+    const sw_lod_face_cones *fc = env->eye_shells == SW__FR_EYE_INSIDE ? NULL : desc->face_cones;
     sw_result r = fc ? check_cones(env, fc, status) : SW_OK;
     /* a wireframe frame shows what lies behind its faces' triangles: nothing occludes there */
     const int occlusion =

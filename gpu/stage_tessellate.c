@@ -426,13 +426,13 @@ static sw_result ribbon_draw(sw__fr_tess *t, const occurrence *o, size_t first, 
 }
 
 /* The side of occurrence o's face the eye sees, when the frame may leave out the back of its
- * ribbons: a face bounding a closed shell, in a frame whose eye is outside the solids (the premise
- * of back-patch culling). NULL otherwise. */
+ * ribbons: a face bounding a closed shell, in a frame whose eye is found outside the solids (the
+ * premise of back-patch culling). NULL otherwise. */
 static const sw__gpu_ribbon_facing *facing_of(const sw__fr_tess *t, const occurrence *o,
                                               sw__gpu_ribbon_facing *f)
 {
     const uint32_t flags = t->env->sv->faces[o->face].flags;
-    if (!t->env->eye_outside_solids || t->env->ctx->back_ribbons_kept ||
+    if (t->env->eye_shells != SW__FR_EYE_OUTSIDE || t->env->ctx->back_ribbons_kept ||
         !(flags & SW_SG_FACE_CLOSED_SHELL) ||
         !sw__fr_eye_in_object(o->world, t->env->view.eye, f->eye))
         return NULL;

@@ -16,6 +16,7 @@
 #include "sw_lod_face_cones.h"
 #include "sw_sg_bvh.h"
 #include "sw_sg_import.h"
+#include "sw_sg_pick.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -160,6 +161,60 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
     return culled;
 }
 
+/* A view from inside the solid material: a ray from outside toward an occurrence's box enters the
+ * model at its first hit; the eye stands 1e-4 of the diagonal beyond it, looking on along the ray,
+ * where the solid's own faces are seen from behind. The frame must then do no back-patch culling
+ * and leave no fat-border quad out (both assume an eye outside the solids): with the cones it must
+ * equal the frame without them, pixel for pixel. Without the eye test the faces ahead, whose
+ * outward cones face away from the eye, were culled. Returns 0 when the ray met nothing. */
+static int inside_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_lod_face_cones *fc,
+                       const sw_sg_bvh *t, const char *name)
+{
+    const double *b = t->nodes[0].box, *ib = t->items[t->n_items / 2].box;
+    double c[3], dir[3] = {-0.3, -0.2, -0.93}, diag = 0.0, o[3];
+    for (int k = 0; k < 3; ++k) { /* toward an occurrence's box: instances may stand apart */
+        c[k] = 0.5 * (ib[k] + ib[3 + k]);
+        diag += (b[3 + k] - b[k]) * (b[3 + k] - b[k]);
+    }
+    diag = sqrt(diag);
+    for (int k = 0; k < 3; ++k)
+        o[k] = c[k] - 2.0 * diag * dir[k];
+    sw_sg_pick_hit hit;
+    sw_status st = {0};
+    if (sw_sg_pick(scene, t, o, dir, 0.0, &hit, &st) != SW_OK || hit.face == SW_SG_NONE)
+        return 0;
+    const double n = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    sw_gpu_frame_desc d;
+    memset(&d, 0, sizeof d);
+    d.width = W;
+    d.height = H;
+    d.bvh = t;
+    for (int k = 0; k < 3; ++k) {
+        d.camera.eye[k] = hit.point[k] + 1e-4 * diag * dir[k] / n;
+        d.camera.target[k] = d.camera.eye[k] + dir[k];
+    }
+    d.camera.up[0] = 1.0;
+    d.camera.fovy_deg = 60.0;
+    sw_gpu_image a = {0}, bi = {0};
+    sw_gpu_frame_stats fa, fb;
+    int ok = sw_gpu_render_scene(ctx, scene, &d, &a, &fa, &st) == SW_OK;
+    d.face_cones = fc;
+    ok = ok && sw_gpu_render_scene(ctx, scene, &d, &bi, &fb, &st) == SW_OK;
+    CHECK(ok, "%s inside view: render: %s", name, st.message);
+    if (ok) {
+        sw_test_image_diff df = sw_test_compare_images(&a, &bi, 0);
+        printf("  inside the material (face %u hit): %ld px covered, %ld differ with the cones; "
+               "back-culled %llu, ribbon quads left out %llu\n",
+               hit.face, df.covered, df.any, (unsigned long long)fb.faces_backculled,
+               (unsigned long long)fb.border_quads_away);
+        CHECK(df.any == 0 && fb.faces_backculled == 0 && fb.border_quads_away == 0,
+              "%s inside view: culled as if seen from outside (%ld px differ)", name, df.any);
+    }
+    sw_gpu_image_free(&a);
+    sw_gpu_image_free(&bi);
+    return 1;
+}
+
 /* Cones, BVH and hierarchy cache of the scene, then every view; returns the culled total
  * (UINT64_MAX: failed). */
 static uint64_t run_scene(sw_gpu_context *ctx, const sw_sg_scene *scene, const char *name)
@@ -179,6 +234,8 @@ static uint64_t run_scene(sw_gpu_context *ctx, const sw_sg_scene *scene, const c
         printf("%s: %u faces, %u closed-shell, %u with a bounded cone; %u occurrences\n", name,
                fc->n_faces, closed_faces(scene), fc->n_bounded, t->n_items);
         culled = compare_views(ctx, scene, fc, t, cache);
+        if (closed_faces(scene) > 0 && !inside_view(ctx, scene, fc, t, name))
+            CHECK(0, "%s: the ray into the model met nothing", name);
     }
     sw_lod_cache_destroy(cache);
     sw_lod_face_cones_free(fc);
