@@ -318,6 +318,7 @@ void sw_gpu_context_free(sw_gpu_context *ctx)
     if (adopted) /* deleting may bind on the way: the host's bindings come back */
         sw__gpu_host_state_save(&host);
     if (ctx->gl_ready) {
+        sw__gpu_frame_complete(ctx);
         sw__gpu_programs_free(ctx);
         sw__gpu_atlas_free(ctx);
         sw__gpu_resident_free(ctx);

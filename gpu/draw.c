@@ -345,7 +345,6 @@ sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
     draw_mesh_variant(ctx, view, draws, n_draws, SW__GPU_TRIMMED);
     if (desc->wireframe)
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-    glFinish();
     return r == SW_OK ? sw__gpu_check(status, "frame draw") : r;
 }
 

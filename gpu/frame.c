@@ -8,8 +8,8 @@
  *
  * Times: ms_hierarchy is the converged wait for hierarchy builds and refinements; ms_tessellate the
  * rest of prepare (culling, selection, bounds, grids, trim resolutions, loops and borders);
- * ms_trim the atlas; ms_draw upload and draw until glFinish; ms_readback presenting and reading
- * back. */
+ * ms_trim the atlas; ms_draw upload and draw calls, then the wait for the frame before to complete
+ * (one frame in flight: no glFinish); ms_readback presenting and reading back. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
 #include "sw_status_util.h"
@@ -279,9 +279,9 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     if (host_state)
         sw__gpu_host_state_save(&host);
     double t1 = sw__clock_ms();
-    /* GPU time of the trim textures and the draw, by two GL_TIMESTAMP queries (the second one
-     * is after the draw's glFinish, so its result is there without a wait of its own). A
-     * GL_TIME_ELAPSED query gave 7.5e6 ms for the first frame of a context on llvmpipe. */
+    /* GPU time of the trim textures and the draw, by two GL_TIMESTAMP queries read once the frame
+     * is complete (a GL_TIME_ELAPSED query gave 7.5e6 ms for the first frame of a context on
+     * llvmpipe) */
     GLuint query[2] = {0, 0};
     glGenQueries(2, query);
     glQueryCounter(query[0], GL_TIMESTAMP);
@@ -291,16 +291,20 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     if (r == SW_OK)
         r = sw__fr_submit(ctx, &plan->env.view, desc, geo, status);
     glQueryCounter(query[1], GL_TIMESTAMP);
-    GLuint64 ns[2] = {0, 0};
-    glGetQueryObjectui64v(query[0], GL_QUERY_RESULT, &ns[0]);
-    glGetQueryObjectui64v(query[1], GL_QUERY_RESULT, &ns[1]);
-    glDeleteQueries(2, query);
-    st->ms_gpu = ns[1] > ns[0] ? 1e-6 * (double)(ns[1] - ns[0]) : 0.0;
+    /* No glFinish: the frame is fenced and flushed, and this thread waits only for the frame
+     * before it, so the rasterizer works on this one while the next is prepared and uploaded. */
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    st->ms_gpu = sw__gpu_frame_complete(ctx); /* the frame before's */
+    ctx->frame_fence = fence;
+    memcpy(ctx->frame_query, query, sizeof query);
     double t3 = sw__clock_ms();
     if (r == SW_OK && desc->present)
         r = sw__gpu_present(ctx, &plan->env.view, desc->present_depth, &host, status);
-    if (r == SW_OK && !desc->no_readback)
+    if (r == SW_OK && !desc->no_readback) {
         r = sw__gpu_readback(ctx, &plan->env.view, desc->want_depth, out, status);
+        st->ms_gpu = sw__gpu_frame_complete(ctx); /* read back: this frame is complete */
+    }
     if (host_state)
         sw__gpu_host_state_restore(&host);
     double t4 = sw__clock_ms();
@@ -328,6 +332,26 @@ sw_result sw_gpu_frame_submit_keep(sw_gpu_context *ctx, sw_gpu_frame_plan *plan,
     if (r == SW_OK)
         sw__status_ok(status);
     return r;
+}
+
+double sw__gpu_frame_complete(sw_gpu_context *ctx)
+{
+    if (!ctx->frame_fence)
+        return 0.0;
+    GLenum w;
+    do /* a second at a time: a fence that never signals is a lost context, reported by GL */
+        w = glClientWaitSync(ctx->frame_fence, GL_SYNC_FLUSH_COMMANDS_BIT, 1000000000u);
+    while (w == GL_TIMEOUT_EXPIRED);
+    glDeleteSync(ctx->frame_fence);
+    ctx->frame_fence = 0;
+    GLuint64 ns[2] = {0, 0};
+    if (w != GL_WAIT_FAILED) {
+        glGetQueryObjectui64v(ctx->frame_query[0], GL_QUERY_RESULT, &ns[0]);
+        glGetQueryObjectui64v(ctx->frame_query[1], GL_QUERY_RESULT, &ns[1]);
+    }
+    glDeleteQueries(2, ctx->frame_query);
+    memset(ctx->frame_query, 0, sizeof ctx->frame_query);
+    return ns[1] > ns[0] ? 1e-6 * (double)(ns[1] - ns[0]) : 0.0;
 }
 
 sw_result sw_gpu_frame_submit(sw_gpu_context *ctx, sw_gpu_frame_plan *plan, sw_gpu_image *out,

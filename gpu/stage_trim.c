@@ -276,6 +276,5 @@ sw_result sw__fr_trim_atlas(sw_gpu_context *ctx, const sw_sg_scene *scene, sw__f
     st->atlas_texels = (uint64_t)as.pages * (uint64_t)as.side * (uint64_t)as.side;
     st->atlas_switches = as.switches;
     st->atlas_allocations = as.allocations;
-    glFinish();
     return r;
 }

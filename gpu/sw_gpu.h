@@ -171,7 +171,7 @@ typedef struct sw_gpu_frame_stats {
                                       made (trim_edges.c's limits) */
     double ms_tessellate; /* traversal, bounds, CPU grids (without ms_hierarchy) */
     double ms_trim;       /* trim-texture generation */
-    double ms_draw;       /* draw submission until glFinish */
+    double ms_draw;       /* upload and draw calls, then the wait for the frame before */
     double ms_readback;
     double ms_gpu; /* GPU time of trim textures + draw (two GL_TIMESTAMP queries) */
     /* trim-texture atlas (Guthe §4.4), kept in the context across frames */

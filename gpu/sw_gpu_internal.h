@@ -151,6 +151,10 @@ struct sw_gpu_context {
     GLuint vao;
     /* main render target */
     GLuint fbo, tex_color, tex_depth; /* textures: the depth-compositing present samples them */
+    /* the last submitted frame's completion fence and GL_TIMESTAMP queries (0: none pending):
+     * the next submit waits for it (one frame in flight) instead of each frame's glFinish */
+    GLsync frame_fence;
+    GLuint frame_query[2];
     int32_t fbo_w, fbo_h;
     GLuint trim_fbo, trim_vbo;
     GLuint mesh_vbo, mesh_ibo;   /* per-frame streaming buffers */
@@ -377,6 +381,9 @@ sw_result sw__gpu_fat_border_of(const sw__gpu_view *v, const double world[12],
                                 const sw__gpu_border_loop *bl, double width_px,
                                 const double *st_box, const sw__gpu_ribbon_facing *facing,
                                 sw__gpu_mesh *mesh, sw_status *status);
+/* Waits until the last submitted frame is complete and returns its GPU time (ms, by its timestamp
+ * queries; 0 when no frame is pending). GL owner thread. */
+double sw__gpu_frame_complete(sw_gpu_context *ctx);
 /* Crack filling on (default) or off, for tests that measure what it closes. */
 void sw__gpu_set_crack_fill(sw_gpu_context *ctx, int on);
 /* Static levels drawn from the GPU copies the context keeps (default), or sent with each frame's
@@ -589,8 +596,7 @@ double sw__gpu_near_plane(const double eye[3], const double world_box[6]);
  * desc->wireframe) the batch's patches (NULL = none), one instanced draw per trim variant and grid
  * class, then uploads `mesh` and draws its ranges, the untrimmed first. The patches go first: the
  * mesh's fat borders lie behind them (crack_fill.c), so most of their fragments fail the depth
- * test before they are shaded. Waits for the GPU (glFinish) so that the caller's timing is the
- * real draw time. */
+ * test before they are shaded. Does not wait for the GPU: the frame's submit fences it. */
 struct sw__gpu_resident_list; /* below */
 sw_result sw__gpu_draw_frame(sw_gpu_context *ctx, const sw__gpu_view *view,
                              const sw_gpu_frame_desc *desc, const sw__gpu_mesh *mesh,

@@ -23,7 +23,7 @@
 typedef struct bp_result {
     int ok;                   /* 1: the peer ran; else `note` says why not */
     uint32_t frames;          /* frames measured (warm-up passes excluded) */
-    double median_ms, p99_ms; /* frame time: draw + glFinish, no readback */
+    double median_ms, p99_ms; /* frame time: the interval between completions */
     double first_frame_ms;    /* load + preprocessing + the first frame, from the child's start */
     double peak_rss_bytes;    /* child's VmHWM minus its VmRSS at the fork */
     double triangles;         /* per frame, median over the measured frames */

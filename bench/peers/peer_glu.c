@@ -454,6 +454,8 @@ static int setup(glu_run *r, sw_gpu_context **ctx, char *err, size_t err_size)
         return -1;
     }
     r->draw = bt_draw_create(r->job->width, r->job->height, err, err_size);
+    if (r->draw) /* frame time: the interval between completions */
+        bt_draw_set_pipelined(r->draw, 1);
     return r->draw ? 0 : -1;
 }
 

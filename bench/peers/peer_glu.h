@@ -6,14 +6,14 @@
  * occurrence of the splinewalk scene (sw_sg_scene_traverse: instance transforms applied to the
  * homogeneous control points, made eye-relative per frame in float) is tessellated every frame
  * with its trim loops (gluBeginTrim, gluNurbsCurve with GLU_MAP1_TRIM_3), the triangles uploaded
- * to one VBO and drawn with splinewalk's view-projection and glFinish (bench/tessellation's
- * bt_draw). GLU needs no GL context in tessellator mode; its few fixed-function calls
- * (glPushAttrib, ...) only raise errors in the 4.5 core context, which are drained and counted.
- * Mesa's GLU has no order limit that the samples reach (degree 12 surfaces, degree 11 trims
- * pass), but it crashes on a few faces it accepts: every face is screened once in child processes
- * (peer_glu.c says how) before the timed frames. A face GLU reports an error for ("knot
- * multiplicity greater than order of spline", ...) or that crashed it is counted as refused, with
- * its first error or signal, and not drawn.
+ * to one VBO and drawn with splinewalk's view-projection, fenced, waiting for the frame before
+ * (bench/tessellation's bt_draw, pipelined). GLU needs no GL context in tessellator mode; its few
+ * fixed-function calls (glPushAttrib, ...) only raise errors in the 4.5 core context, which are
+ * drained and counted. Mesa's GLU has no order limit that the samples reach (degree 12 surfaces,
+ * degree 11 trims pass), but it crashes on a few faces it accepts: every face is screened once in
+ * child processes (peer_glu.c says how) before the timed frames. A face GLU reports an error for
+ * ("knot multiplicity greater than order of spline", ...) or that crashed it is counted as refused,
+ * with its first error or signal, and not drawn.
  */
 #ifndef BP_PEER_GLU_H
 #define BP_PEER_GLU_H

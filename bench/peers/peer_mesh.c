@@ -94,6 +94,7 @@ int bp_peer_occt(const bp_job *job, bp_result *out)
     if (sw_gpu_context_create_headless(&ctx, &st) != SW_OK)
         snprintf(out->note, sizeof out->note, "%s", st.message);
     else if ((d = bt_draw_create(job->width, job->height, out->note, sizeof out->note)) != NULL) {
+        bt_draw_set_pipelined(d, 1); /* frame time: the interval between completions */
         if (bt_draw_upload(d, m.v, m.n_v, BP_OCCT_VERTEX_FLOATS, m.idx, m.n_idx) != 0)
             snprintf(out->note, sizeof out->note, "GL error uploading %zu triangles", m.n_idx / 3);
         else if ((rc = frames(job, d, m.n_idx, t_start, out)) != 0)

@@ -3,7 +3,8 @@
  * equal to ε_img at the path's nearest viewing distance — the object-space size of ε_img pixels
  * at the smallest eye-to-scene-box distance d along the path: ε_img · 2 d tan(fovy / 2) / height
  * — uploaded once into one VBO, and drawn every frame through splinewalk's view-projection
- * (translated to world space) with glFinish (bench/tessellation's bt_draw). Its triangles per
+ * (translated to world space), fenced, waiting for the frame before (bench/tessellation's bt_draw,
+ * pipelined). Its triangles per
  * frame are all of them: nothing is culled.
  */
 #ifndef BP_PEER_MESH_H

@@ -3,7 +3,7 @@
  * threaded (sw_renderer_prepare of frame i + 1 on the renderer's visibility thread while
  * sw_renderer_submit draws frame i, as bench/pipeline), walkthrough mode, default renderer (one
  * pool worker per processor, hierarchies). No readback: a frame's time is prepare(i + 1) +
- * submit(i), whose draw ends with glFinish.
+ * submit(i), which fences frame i and waits for frame i - 1 to complete.
  */
 #ifndef BP_PEER_SPLINEWALK_H
 #define BP_PEER_SPLINEWALK_H

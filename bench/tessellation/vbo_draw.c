@@ -13,7 +13,40 @@ struct bt_draw {
     int32_t w, h;
     GLuint fbo, rb_color, rb_depth, prog, vao, vbo, ibo;
     GLint loc_vp;
+    int pipelined;    /* bt_draw_set_pipelined */
+    GLsync in_flight; /* pipelined: the last frame's fence */
 };
+
+/* Waits for the fenced frame (if any) to complete. */
+static void wait_in_flight(bt_draw *d)
+{
+    if (!d->in_flight)
+        return;
+    while (glClientWaitSync(d->in_flight, GL_SYNC_FLUSH_COMMANDS_BIT, 1000000000u) ==
+           GL_TIMEOUT_EXPIRED)
+        ;
+    glDeleteSync(d->in_flight);
+    d->in_flight = 0;
+}
+
+void bt_draw_set_pipelined(bt_draw *d, int on)
+{
+    wait_in_flight(d);
+    d->pipelined = on;
+}
+
+/* The end of a frame: glFinish, or pipelined, its fence, then the wait for the frame before. */
+static void end_frame(bt_draw *d)
+{
+    if (!d->pipelined) {
+        glFinish();
+        return;
+    }
+    GLsync fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+    glFlush();
+    wait_in_flight(d);
+    d->in_flight = fence;
+}
 
 static const char *const k_vs = "#version 430 core\n"
                                 "layout(location = 0) in vec3 a_pos;\n"
@@ -126,6 +159,7 @@ void bt_draw_free(bt_draw *d)
 {
     if (!d)
         return;
+    wait_in_flight(d);
     glDeleteBuffers(1, &d->vbo);
     glDeleteBuffers(1, &d->ibo);
     glDeleteVertexArrays(1, &d->vao);
@@ -182,7 +216,7 @@ unsigned bt_draw_uploaded(bt_draw *d, const float view_proj[16], size_t n_idx)
     glUseProgram(d->prog);
     glUniformMatrix4fv(d->loc_vp, 1, GL_FALSE, view_proj);
     glDrawElements(GL_TRIANGLES, (GLsizei)n_idx, GL_UNSIGNED_INT, (const void *)0);
-    glFinish();
+    end_frame(d);
     return glGetError();
 }
 

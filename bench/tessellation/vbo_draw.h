@@ -17,8 +17,9 @@ bt_draw *bt_draw_create(int32_t width, int32_t height, char *err, size_t err_siz
 void bt_draw_free(bt_draw *d);
 
 /* Clears, uploads vertices (`stride` floats apart: position at 0, normal at 3) and triangle
- * indices, draws them and waits for the GPU (glFinish). Returns 0 or the first GL error code
- * (also one pending from before the call: GLU must not have touched GL). */
+ * indices, draws them and waits for the GPU (glFinish; pipelined: for the frame before). Returns 0
+ * or the first GL error code (also one pending from before the call: GLU must not have touched GL).
+ */
 unsigned bt_draw_mesh(bt_draw *d, const float view_proj[16], const float *v, size_t n_v,
                       size_t stride, const uint32_t *idx, size_t n_idx);
 /* The two halves of bt_draw_mesh, for a mesh uploaded once and drawn every frame (bench/peers'
@@ -28,6 +29,10 @@ unsigned bt_draw_mesh(bt_draw *d, const float view_proj[16], const float *v, siz
 unsigned bt_draw_upload(bt_draw *d, const float *v, size_t n_v, size_t stride, const uint32_t *idx,
                         size_t n_idx);
 unsigned bt_draw_uploaded(bt_draw *d, const float view_proj[16], size_t n_idx);
+/* on = 1: a draw ends with a fence and waits for the frame before it instead of glFinish (one
+ * frame in flight), so the time between successive draws' returns is the interval between frames'
+ * completions, as for splinewalk's renderer (bench/peers). Waits for a pending frame first. */
+void bt_draw_set_pipelined(bt_draw *d, int on);
 /* Clears pending GL errors and returns how many there were. GLU issues a few fixed-function calls
  * (glPushAttrib, glEnable(GL_MAP2_VERTEX_4), ...) even in tessellator mode; in a core context they
  * only raise errors, which the caller drains and reports. */

@@ -485,7 +485,7 @@ static void frame_from_desc(const sw_frame_desc *desc, sw_gpu_frame_desc *frame)
     frame->no_kept_grids = desc->no_kept_grids != 0;
     /* pixels leave the renderer only through output_path (the library returns no image): a
      * frame without one reads nothing back (at 1280x720 on llvmpipe the readback was a third of
-     * a profile's frame, 14 of 42 ms); its raster work still ends in the draw's glFinish */
+     * a profile's frame, 14 of 42 ms); its raster work ends before the next submit returns */
     frame->no_readback = !desc->output_path;
     frame->want_depth = 0;
     if (desc->output_path) {

@@ -68,7 +68,7 @@ const char *sw_rt_pool_kind_name(int kind);
     X(PREPARE_MS, "prepare_ms", STAGE,                                                             \
       "threaded: handing the next frame to the visibility thread (sw_renderer_prepare)")           \
     X(TRIM_MS, "trim_ms", STAGE, "trim-texture generation into the atlas")                         \
-    X(DRAW_MS, "draw_ms", STAGE, "draw submission until glFinish")                                 \
+    X(DRAW_MS, "draw_ms", STAGE, "upload and draw, then waiting for the frame before")             \
     X(READBACK_MS, "readback_ms", STAGE, "glReadPixels of the frame")                              \
     X(WRITE_MS, "write_ms", STAGE, "PNG write (captured frames only)")                             \
     X(OTHER_MS, "other_ms", STAGE, "frame_ms minus the stages above")                              \
@@ -97,7 +97,7 @@ const char *sw_rt_pool_kind_name(int kind);
     X(ATLAS_PAGES, "atlas_pages", COUNT, "trim-atlas pages after the frame")                       \
     X(FALLBACK_DRAWS, "fallback_draws", COUNT, "walkthrough: drawn coarser than asked, queued")    \
     X(POOL_WAITS, "pool_waits", COUNT, "times the frame waited for the worker pool")               \
-    X(GPU_MS, "gpu_ms", GPU, "GPU time of trim + draw (GL timer query; overlaps them)")            \
+    X(GPU_MS, "gpu_ms", GPU, "GPU time of the frame before's trim + draw (GL timer queries)")      \
     X(STATIC_DRAWN, "static_drawn", COUNT, "super-surface instances drawn from static LODs")       \
     X(STATIC_FACES, "static_faces", COUNT, "face instances they cover (of faces_drawn)")           \
     X(STATIC_TRIANGLES, "static_triangles", COUNT, "their triangles (of triangles)")               \

@@ -437,8 +437,9 @@ typedef struct sw_frame_stats {
      * in sw_renderer_draw all of ms_visibility) + trim + draw + readback + write + the call's own
      * overhead (sw_renderer_draw's prepare included) */
     double ms_visibility, ms_wait_visibility;
-    double ms_gpu; /* GPU time of the trim textures and the draw, by a GL timer query (on
-                      llvmpipe: the rasterizer threads' work; it overlaps ms_trim + ms_draw) */
+    double ms_gpu; /* GPU time of the trim textures and the draw, by GL timer queries, of the
+                      frame before (read when it completed; of this frame when it was read back);
+                      on llvmpipe the rasterizer threads' work */
     uint64_t faces_backculled; /* of faces_culled: back-facing surfaces of closed shells (Kumar
                                   §4.4 back-patch culling by normal cones) */
     /* static LODs (desc.static_lods) */
@@ -526,7 +527,10 @@ SW_API sw_result sw_renderer_draw(sw_renderer renderer, const sw_frame_desc *des
  * submitted. */
 SW_API sw_result sw_renderer_prepare(sw_renderer renderer, const sw_frame_desc *desc,
                                      sw_status *status);
-/* Draws the oldest prepared frame. stats may be NULL; written on success only. Errors: those of
+/* Draws the oldest prepared frame. A submit returns once its frame's GL commands are issued and
+ * the frame submitted before it has completed (one frame in flight, no glFinish): what the host
+ * issues next in the context comes after the frame, as GL orders commands, and a frame written to
+ * output_path is complete on return. stats may be NULL; written on success only. Errors: those of
  * sw_renderer_draw, including those its preparation met (then nothing is drawn and the frame is
  * gone); SW_ERR_INVALID_ARGUMENT when no frame is prepared. sw_renderer_draw refuses to run
  * while prepared frames wait (SW_ERR_INVALID_ARGUMENT); sw_renderer_destroy drops them. */
