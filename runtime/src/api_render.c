@@ -413,6 +413,7 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->border_triangles = g->border_triangles;
     out->border_loops_kept = g->border_loops_kept;
     out->border_loops_made = g->border_loops_made;
+    out->border_quads_away = g->border_quads_away;
     out->occlusion_tests = g->occlusion_tests;
     out->nodes_occluded = g->nodes_occluded;
     out->faces_occluded = g->faces_occluded;

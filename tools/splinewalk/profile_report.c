@@ -91,6 +91,7 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_BORDER_TRIANGLES] = (double)st->border_triangles;
     v[SW_RT_COL_BORDER_LOOPS_KEPT] = (double)st->border_loops_kept;
     v[SW_RT_COL_BORDER_LOOPS_MADE] = (double)st->border_loops_made;
+    v[SW_RT_COL_BORDER_QUADS_AWAY] = (double)st->border_quads_away;
     v[SW_RT_COL_TRIM_TEXTURES] = (double)st->trim_textures;
     v[SW_RT_COL_TRIM_EXACT] = (double)st->trim_exact;
     v[SW_RT_COL_TRIM_TEXELS] = (double)st->trim_texels;

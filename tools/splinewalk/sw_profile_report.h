@@ -90,6 +90,7 @@ const char *sw_rt_pool_kind_name(int kind);
     X(BORDER_TRIANGLES, "border_triangles", COUNT, "of those, the fat borders' (crack filling)")   \
     X(BORDER_LOOPS_KEPT, "border_loops_kept", COUNT, "fat-border loops from kept samples")         \
     X(BORDER_LOOPS_MADE, "border_loops_made", COUNT, "fat-border loops sampled and kept")          \
+    X(BORDER_QUADS_AWAY, "border_quads_away", COUNT, "fat-border quads left out, facing away")     \
     X(TRIM_TEXTURES, "trim_textures", COUNT, "trim textures used")                                 \
     X(TRIM_TEXELS, "trim_texels", COUNT, "texels of those trim textures")                          \
     X(TRIM_REUSED, "trim_reused", COUNT, "trim textures kept from earlier frames")                 \

@@ -490,6 +490,9 @@ typedef struct sw_frame_stats {
      * triangles are in resident_triangles), and grids evaluated into it for this frame (the
      * first sight of a patch, or a view that needs it finer than kept) */
     uint64_t grid_hits, grid_misses;
+    /* fat-border quads left out where a closed shell faces away from the eye (hidden by its own
+     * front; only while the eye is found outside every solid) */
+    uint64_t border_quads_away;
 } sw_frame_stats;
 
 /* Renders one frame of this call's camera: converged by default (every refinement done before
