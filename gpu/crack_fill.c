@@ -740,7 +740,7 @@ static void emit_ribbon(const ribbon_ctx *c, const border_point *bp, size_t n, s
 {
     for (size_t i = 0; i < n; ++i) {
         const border_point *e_in[2] = {&bp[i], &bp[(i + 1) % n]}, *e[2] = {e_in[0], e_in[1]};
-        if (e_in[1]->run_away) { /* hidden by the shell's front (see sample_facing) */
+        if (e_in[1]->run_away) { /* hidden by the shell's front (sample_facing_away) */
             mesh->border_quads_away++;
             continue;
         }
