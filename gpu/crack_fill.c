@@ -89,14 +89,9 @@ static void eval_sample(const sw_sg_surface *srf, double u, double v, const doub
     double h[12];
     sw_sg_surface_eval_h1(srf, u, v, h);
     double du[3], dv[3];
-    for (int k = 0; k < 3; ++k) {
+    sw_sg_h1_tangents(h, du, dv, out->n);
+    for (int k = 0; k < 3; ++k)
         out->p[k] = h[k] / h[3];
-        du[k] = h[4 + k] * h[3] - h[k] * h[7];
-        dv[k] = h[8 + k] * h[3] - h[k] * h[11];
-    }
-    out->n[0] = du[1] * dv[2] - du[2] * dv[1];
-    out->n[1] = du[2] * dv[0] - du[0] * dv[2];
-    out->n[2] = du[0] * dv[1] - du[1] * dv[0];
     /* du, dv are w^2 S_u, w^2 S_v; `in` is the true derivative along in_uv, so that a length h
      * along `in` (across_loop) is the step h along in_uv in (u, v) that inner_point takes */
     const double w2 = h[3] * h[3];

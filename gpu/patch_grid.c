@@ -74,13 +74,7 @@ static void eval_h1(const sw__gpu_patch *pt, double s, double t, double h[12])
 static double normal_from_h(const double h[12], double n[3])
 {
     double ds[3], dt[3];
-    for (int k = 0; k < 3; ++k) {
-        ds[k] = h[4 + k] * h[3] - h[k] * h[7];
-        dt[k] = h[8 + k] * h[3] - h[k] * h[11];
-    }
-    n[0] = ds[1] * dt[2] - ds[2] * dt[1];
-    n[1] = ds[2] * dt[0] - ds[0] * dt[2];
-    n[2] = ds[0] * dt[1] - ds[1] * dt[0];
+    sw_sg_h1_tangents(h, ds, dt, n);
     double ln = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     double ls = sqrt(ds[0] * ds[0] + ds[1] * ds[1] + ds[2] * ds[2]);
     double lt = sqrt(dt[0] * dt[0] + dt[1] * dt[1] + dt[2] * dt[2]);

@@ -514,13 +514,7 @@ static int ray_leaves_shell(const sw__fr_env *env, const sw_sg_bvh *bvh, const d
     sw_sg_scene_face_surface(env->scene, hit.face, &srf);
     double h[12], du[3], dv[3], n[3], cof[9];
     sw_sg_surface_eval_h1(&srf, hit.uv[0], hit.uv[1], h);
-    for (int k = 0; k < 3; ++k) { /* w^2 S_u, w^2 S_v */
-        du[k] = h[4 + k] * h[3] - h[k] * h[7];
-        dv[k] = h[8 + k] * h[3] - h[k] * h[11];
-    }
-    n[0] = du[1] * dv[2] - du[2] * dv[1];
-    n[1] = du[2] * dv[0] - du[0] * dv[2];
-    n[2] = du[0] * dv[1] - du[1] * dv[0];
+    sw_sg_h1_tangents(h, du, dv, n); /* n: S_u x S_v times w^4 > 0 */
     const double *m = bvh->items[hit.item].world;
     sw__fr_cofactor3(m, cof); /* det(M) M^-T: the world normal, times the sign of det */
     double along = 0.0;

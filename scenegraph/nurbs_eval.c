@@ -253,6 +253,17 @@ void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[
     }
 }
 
+void sw_sg_h1_tangents(const double h[12], double su[3], double sv[3], double n[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        su[k] = h[4 + k] * h[3] - h[k] * h[7];
+        sv[k] = h[8 + k] * h[3] - h[k] * h[11];
+    }
+    n[0] = su[1] * sv[2] - su[2] * sv[1];
+    n[1] = su[2] * sv[0] - su[0] * sv[2];
+    n[2] = su[0] * sv[1] - su[1] * sv[0];
+}
+
 /* The Greville abscissa of pole i: the mean of its degree interior knots. */
 static double greville(const double *knots, int32_t degree, int32_t i)
 {

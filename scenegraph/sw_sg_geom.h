@@ -107,6 +107,9 @@ SW_MODULE_ABI void sw_sg_surface_eval_d2(const sw_sg_surface *s, double u, doubl
                                          sw_sg_surface_d2 *out);
 /* Homogeneous point and first derivatives: h[0..3] = S^w, h[4..7] = dS^w/du, h[8..11] = dS^w/dv. */
 void sw_sg_surface_eval_h1(const sw_sg_surface *s, double u, double v, double h[12]);
+/* From such an h: w^2 S_u and w^2 S_v (the derivatives of the rational surface scaled by w^2 > 0,
+ * free of the division) and their cross product, the normal S_u x S_v scaled by w^4. */
+void sw_sg_h1_tangents(const double h[12], double su[3], double sv[3], double n[3]);
 /* 1 when the surface is an affine map of its parameters, S(u, v) = origin + u du + v dv, to
  * within 1e-12 of its control net's magnitude (planes, as CAD files store them, at any degree):
  * equal weights and every pole on the affine function at its Greville abscissae, which a B-spline
