@@ -911,23 +911,16 @@ static int sample_facing_away(const sw__gpu_ribbon_facing *f, const double p[3],
 static void mark_away(const sw__gpu_border_loop *bl, const sw__gpu_ribbon_facing *f,
                       border_point *bp)
 {
+    const double *o = bl->aff_o, *du = bl->aff_du, *dv = bl->aff_dv;
+    const double aff_n[3] = {du[1] * dv[2] - du[2] * dv[1], du[2] * dv[0] - du[0] * dv[2],
+                             du[0] * dv[1] - du[1] * dv[0]}; /* an affine surface's one normal */
     for (size_t i = 0; i < bl->n_samples; ++i) {
-        bp[i].away = 0;
-        if (!f)
-            continue;
         const border_sample *s = &bl->s[i];
-        if (!bl->affine) {
-            bp[i].away = sample_facing_away(f, s->p, s->n);
-            continue;
-        }
-        double p[3], n[3];
-        const double *o = bl->aff_o, *du = bl->aff_du, *dv = bl->aff_dv;
-        for (int k = 0; k < 3; ++k)
+        double p[3];
+        for (int k = 0; bl->affine && k < 3; ++k) /* affine samples keep only their (u, v) */
             p[k] = o[k] + s->uv[0] * du[k] + s->uv[1] * dv[k];
-        n[0] = du[1] * dv[2] - du[2] * dv[1];
-        n[1] = du[2] * dv[0] - du[0] * dv[2];
-        n[2] = du[0] * dv[1] - du[1] * dv[0];
-        bp[i].away = sample_facing_away(f, p, n);
+        bp[i].away =
+            f && (bl->affine ? sample_facing_away(f, p, aff_n) : sample_facing_away(f, s->p, s->n));
     }
 }
 
