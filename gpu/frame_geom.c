@@ -88,19 +88,6 @@ void sw__fr_cofactor3(const double m[12], double out[9])
     }
 }
 
-int sw__fr_eye_in_object(const double m[12], const double eye[3], double out[3])
-{
-    double cof[9];
-    sw__fr_cofactor3(m, cof);
-    const double det = m[0] * cof[0] + m[1] * cof[1] + m[2] * cof[2];
-    if (!(fabs(det) > 0.0) || !isfinite(det))
-        return 0;
-    const double rel[3] = {eye[0] - m[3], eye[1] - m[7], eye[2] - m[11]};
-    for (int c = 0; c < 3; ++c) /* M^-1 = cof^T / det */
-        out[c] = (cof[c] * rel[0] + cof[3 + c] * rel[1] + cof[6 + c] * rel[2]) / det;
-    return isfinite(out[0]) && isfinite(out[1]) && isfinite(out[2]);
-}
-
 double sw__fr_det3(const double m[12])
 {
     return m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) +

@@ -434,7 +434,7 @@ static const sw__gpu_ribbon_facing *facing_of(const sw__fr_tess *t, const occurr
     const uint32_t flags = t->env->sv->faces[o->face].flags;
     if (t->env->eye_shells != SW__FR_EYE_OUTSIDE || t->env->ctx->back_ribbons_kept ||
         !(flags & SW_SG_FACE_CLOSED_SHELL) ||
-        !sw__fr_eye_in_object(o->world, t->env->view.eye, f->eye))
+        !sw_sg_to_local(o->world, t->env->view.eye, NULL, f->eye, NULL))
         return NULL;
     f->outward = flags & SW_SG_FACE_REVERSED ? -1.0 : 1.0;
     return f;

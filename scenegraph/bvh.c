@@ -34,6 +34,34 @@ void sw_sg_bvh_face_box(const sw_sg_scene *scene, uint32_t face, double box[6])
         }
 }
 
+int sw_sg_to_local(const double m[12], const double p[3], const double d[3], double lp[3],
+                   double ld[3])
+{
+    const double a[9] = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]};
+    const double inv[9] = {
+        /* cofactors, transposed: M^-1 = inv / det */
+        a[4] * a[8] - a[5] * a[7], a[2] * a[7] - a[1] * a[8], a[1] * a[5] - a[2] * a[4],
+        a[5] * a[6] - a[3] * a[8], a[0] * a[8] - a[2] * a[6], a[2] * a[3] - a[0] * a[5],
+        a[3] * a[7] - a[4] * a[6], a[1] * a[6] - a[0] * a[7], a[0] * a[4] - a[1] * a[3]};
+    const double det = a[0] * inv[0] + a[1] * inv[3] + a[2] * inv[6];
+    if (!(fabs(det) > 1e-300))
+        return 0;
+    int finite = 1;
+    if (p) {
+        const double rel[3] = {p[0] - m[3], p[1] - m[7], p[2] - m[11]};
+        for (int i = 0; i < 3; ++i) {
+            lp[i] = (inv[3 * i] * rel[0] + inv[3 * i + 1] * rel[1] + inv[3 * i + 2] * rel[2]) / det;
+            finite &= isfinite(lp[i]);
+        }
+    }
+    if (d)
+        for (int i = 0; i < 3; ++i) {
+            ld[i] = (inv[3 * i] * d[0] + inv[3 * i + 1] * d[1] + inv[3 * i + 2] * d[2]) / det;
+            finite &= isfinite(ld[i]);
+        }
+    return finite;
+}
+
 void sw_sg_box_transform(const double m[12], const double b[6], double out[6])
 {
     for (int k = 0; k < 3; ++k) {

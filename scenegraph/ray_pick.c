@@ -286,19 +286,8 @@ static double ray_box(const double o[3], const double inv_d[3], const double box
 /* The ray in an occurrence's frame (inverse of world = M x + T); 0 for a singular transform. */
 static int world_ray(const double m[12], const double o[3], const double d[3], local_ray *r)
 {
-    double a[9] = {m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]};
-    double inv[9] = {
-        a[4] * a[8] - a[5] * a[7], a[2] * a[7] - a[1] * a[8], a[1] * a[5] - a[2] * a[4],
-        a[5] * a[6] - a[3] * a[8], a[0] * a[8] - a[2] * a[6], a[2] * a[3] - a[0] * a[5],
-        a[3] * a[7] - a[4] * a[6], a[1] * a[6] - a[0] * a[7], a[0] * a[4] - a[1] * a[3]};
-    double det = a[0] * inv[0] + a[1] * inv[3] + a[2] * inv[6];
-    if (!(fabs(det) > 1e-300))
+    if (!sw_sg_to_local(m, o, d, r->o, r->d))
         return 0;
-    double rel[3] = {o[0] - m[3], o[1] - m[7], o[2] - m[11]};
-    for (int i = 0; i < 3; ++i) {
-        r->o[i] = (inv[3 * i] * rel[0] + inv[3 * i + 1] * rel[1] + inv[3 * i + 2] * rel[2]) / det;
-        r->d[i] = (inv[3 * i] * d[0] + inv[3 * i + 1] * d[1] + inv[3 * i + 2] * d[2]) / det;
-    }
     ray_planes(r);
     return 1;
 }

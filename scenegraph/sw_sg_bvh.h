@@ -65,6 +65,11 @@ void sw_sg_bvh_face_box(const sw_sg_scene *scene, uint32_t face, double box[6]);
  * sw_sg_bvh_build boxes an occurrence: a caller that boxes occurrences itself gets the same
  * doubles. */
 void sw_sg_box_transform(const double m[12], const double box[6], double out[6]);
+/* A world point p and direction d (either may be NULL) in the frame of the row-major 3 x 4
+ * transform m (world = M x + T): M^-1 (p - T) into lp, M^-1 d into ld. 0 (outputs untouched or
+ * partly written) when M is singular (|det| <= 1e-300) or a result is not finite. */
+int sw_sg_to_local(const double m[12], const double p[3], const double d[3], double lp[3],
+                   double ld[3]);
 size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh);
 
 /* ---- view-frustum culling (Kumar §4.4) --------------------------------------------------------
