@@ -234,7 +234,7 @@ sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *
         /* the unit-instance BVH's scene box is the face BVH's root box: the same near plane */
         sw__fr_box_empty(scene_box);
         if (bvh && bvh->n_nodes)
-            sw__fr_eye_box(env->view.eye, bvh->nodes[0].box, scene_box);
+            sw__fr_eye_box(env->view.eye, bvh->box, scene_box);
         else if (!bvh && units->n_occs)
             sw__fr_eye_box(env->view.eye, units->scene_box, scene_box);
     } else {
@@ -272,7 +272,9 @@ static int take_bvh_item(void *ctx, uint32_t item, sw_sg_cull_class cls)
 {
     (void)cls;
     bvh_taker *t = ctx;
-    const sw_sg_bvh_item *it = &t->bvh->items[item];
+    sw_sg_bvh_item_view view;
+    sw_sg_bvh_item_at(t->bvh, item, &view);
+    const sw_sg_bvh_item_view *it = &view;
     occurrence o;
     double box[6];
     sw__fr_occurrence_init(&o, it->face, it->world, it->color);
@@ -342,7 +344,9 @@ struct occ_walk {
  * drawn into the map. */
 static void occ_item(occ_walk *w, uint32_t item, int inside)
 {
-    const sw_sg_bvh_item *it = &w->bvh->items[item];
+    sw_sg_bvh_item_view view;
+    sw_sg_bvh_item_at(w->bvh, item, &view);
+    const sw_sg_bvh_item_view *it = &view;
     if (!inside) {
         w->cs.items_tested++;
         if (sw_sg_frustum_classify(&w->fr, it->box) == SW_SG_CULL_OUTSIDE)
@@ -384,8 +388,9 @@ static uint64_t node_occurrences(const occ_walk *w, const sw_sg_bvh_node *node)
 
 static double node_distance(const occ_walk *w, int32_t node)
 {
-    double eb[6];
-    sw__fr_eye_box(w->env->view.eye, w->bvh->nodes[node].box, eb);
+    double box[6], eb[6];
+    sw_sg_bvh_node_box(w->bvh, (uint32_t)node, box);
+    sw__fr_eye_box(w->env->view.eye, box, eb);
     return sw__gpu_box_distance(eb);
 }
 
@@ -398,11 +403,14 @@ static void occ_walk_bvh(occ_walk *w)
     inside_of[0] = 0;
     while (n > 0 && !w->oom) {
         --n;
-        const sw_sg_bvh_node *node = &w->bvh->nodes[stack[n]];
+        const uint32_t id = stack[n];
+        const sw_sg_bvh_node *node = &w->bvh->nodes[id];
         int inside = inside_of[n];
         w->cs.nodes_visited++;
+        double box[6];
+        sw_sg_bvh_node_box(w->bvh, id, box);
         if (!inside) {
-            const sw_sg_cull_class k = sw_sg_frustum_classify(&w->fr, node->box);
+            const sw_sg_cull_class k = sw_sg_frustum_classify(&w->fr, box);
             if (k == SW_SG_CULL_OUTSIDE) {
                 w->cs.nodes_outside++;
                 continue;
@@ -411,22 +419,23 @@ static void occ_walk_bvh(occ_walk *w)
         }
         *(inside ? &w->cs.nodes_inside : &w->cs.nodes_partly) += 1;
         double eb[6];
-        sw__fr_eye_box(w->env->view.eye, node->box, eb);
+        sw__fr_eye_box(w->env->view.eye, box, eb);
         if (sw__occ_map_box_hidden(&w->map, eb)) {
             w->nodes_occluded++;
             w->faces_occluded += node_occurrences(w, node);
             continue;
         }
-        if (node->child[0] < 0 || n + 2 > OCC_STACK) {
+        if (node->second < 0 || n + 2 > OCC_STACK) {
             for (uint32_t i = node->first; i < node->first + node->count && !w->oom; ++i)
                 w->item(w, i, inside);
             continue;
         }
         /* the nearer child on top of the stack */
-        const int near1 = node_distance(w, node->child[1]) < node_distance(w, node->child[0]);
-        stack[n] = (uint32_t)node->child[near1 ? 0 : 1];
+        const int32_t child[2] = {(int32_t)id + 1, node->second};
+        const int near1 = node_distance(w, child[1]) < node_distance(w, child[0]);
+        stack[n] = (uint32_t)child[near1 ? 0 : 1];
         inside_of[n++] = (uint8_t)inside;
-        stack[n] = (uint32_t)node->child[near1 ? 1 : 0];
+        stack[n] = (uint32_t)child[near1 ? 1 : 0];
         inside_of[n++] = (uint8_t)inside;
     }
 }
@@ -484,7 +493,9 @@ static sw_result collect_bvh_occluded(const sw__fr_env *env, const sw_sg_bvh *bv
     if (w.n_kept > 1) /* kept may be NULL */
         qsort(w.kept, w.n_kept, sizeof *w.kept, cmp_u32);
     for (size_t i = 0; i < w.n_kept && !w.oom; ++i) {
-        const sw_sg_bvh_item *it = &bvh->items[w.kept[i]];
+        sw_sg_bvh_item_view view;
+        sw_sg_bvh_item_at(bvh, w.kept[i], &view);
+        const sw_sg_bvh_item_view *it = &view;
         occurrence o;
         double box[6];
         sw__fr_occurrence_init(&o, it->face, it->world, it->color);
@@ -515,7 +526,7 @@ static int ray_leaves_shell(const sw__fr_env *env, const sw_sg_bvh *bvh, const d
     double h[12], du[3], dv[3], n[3], cof[9];
     sw_sg_surface_eval_h1(&srf, hit.uv[0], hit.uv[1], h);
     sw_sg_h1_tangents(h, du, dv, n); /* n: S_u x S_v times w^4 > 0 */
-    const double *m = bvh->items[hit.item].world;
+    const double *m = sw_sg_bvh_item_world(bvh, hit.item);
     sw__fr_cofactor3(m, cof); /* det(M) M^-T: the world normal, times the sign of det */
     double along = 0.0;
     for (int r = 0; r < 3; ++r)
@@ -580,7 +591,7 @@ static void cull_back_faces(const sw_lod_face_cones *fc, sw__fr_faces *faces,
  * every view direction into the instance's box (the cone is the full one unless the unit is part
  * of a closed shell). */
 static int instance_back_facing(const instance_taker *t, const sw_lod_static_unit *un,
-                                const sw_sg_bvh_item *it)
+                                const sw_sg_bvh_item_view *it)
 {
     sw_lod_cone w;
     if (!sw_lod_cone_to_world(&un->cone, it->world, &w))
@@ -595,8 +606,8 @@ enum { FACE_OUTSIDE = 0, FACE_BACK = 1, FACE_SHOWN = 2 };
 /* Face occurrence k of an instance: outside the frustum (tested only when the instance is partly
  * visible), back-facing on its own (with cones), or shown; o and eb are set unless outside. */
 static int face_shown(const instance_taker *t, const sw_lod_static_instance *in,
-                      const sw_sg_bvh_item *it, uint32_t k, sw_sg_cull_class cls, occurrence *o,
-                      double eb[6])
+                      const sw_sg_bvh_item_view *it, uint32_t k, sw_sg_cull_class cls,
+                      occurrence *o, double eb[6])
 {
     const sw_lod_static_occ *oc = &t->in->occs[in->first_occ + k];
     double wb[6];
@@ -624,7 +635,7 @@ static int push_instance(sw__fr_visible *vis, uint32_t item, size_t first)
 
 /* The instance's shown faces into vis->unit_faces; culled whole when none is. */
 static void take_shown_faces(instance_taker *t, const sw_lod_static_instance *in,
-                             const sw_sg_bvh_item *it, uint32_t item, sw_sg_cull_class cls)
+                             const sw_sg_bvh_item_view *it, uint32_t item, sw_sg_cull_class cls)
 {
     sw__fr_visible *vis = t->vis;
     const size_t first = vis->unit_faces.n;
@@ -647,7 +658,9 @@ static void take_shown_faces(instance_taker *t, const sw_lod_static_instance *in
 static int take_instance(void *ctx, uint32_t item, sw_sg_cull_class cls)
 {
     instance_taker *t = ctx;
-    const sw_sg_bvh_item *it = &t->in->bvh->items[item];
+    sw_sg_bvh_item_view view;
+    sw_sg_bvh_item_at(t->in->bvh, item, &view);
+    const sw_sg_bvh_item_view *it = &view;
     const sw_lod_static_instance *in = &t->in->instances[it->face];
     t->occs_seen += in->n_occ;
     if (in->unit != SW_LOD_STATIC_NO_UNIT && t->fc &&
@@ -695,7 +708,7 @@ static sw_result collect_instances(const sw__fr_env *env, const sw_lod_face_cone
  * (the level was chosen so), as a per-frame tessellation is, so the map's margins hold for it.
  * The instances are then put in increasing item order, as sw_sg_bvh_cull reports them. */
 static void occ_instance_faces(occ_walk *w, const sw_lod_static_instance *in,
-                               const sw_sg_bvh_item *it, uint32_t item, sw_sg_cull_class cls)
+                               const sw_sg_bvh_item_view *it, uint32_t item, sw_sg_cull_class cls)
 {
     sw__fr_visible *vis = w->taker->vis;
     const size_t first = vis->unit_faces.n;
@@ -721,7 +734,9 @@ static void occ_instance_faces(occ_walk *w, const sw_lod_static_instance *in,
 
 static void occ_instance(occ_walk *w, uint32_t item, int inside)
 {
-    const sw_sg_bvh_item *it = &w->bvh->items[item];
+    sw_sg_bvh_item_view view;
+    sw_sg_bvh_item_at(w->bvh, item, &view);
+    const sw_sg_bvh_item_view *it = &view;
     sw_sg_cull_class cls = SW_SG_CULL_INSIDE;
     if (!inside) {
         w->cs.items_tested++;

@@ -150,7 +150,9 @@ static sw_result select_instances(const sw__fr_env *env, const sw__fr_visible *v
     const sw_lod_static_instances *ins = sw_lod_static_set_instances(env->statics);
     for (size_t i = 0; i < vis->n_instances; ++i) {
         const sw__fr_instance *vi = &vis->instances[i];
-        const sw_sg_bvh_item *it = &ins->bvh->items[vi->item];
+        sw_sg_bvh_item_view view;
+        sw_sg_bvh_item_at(ins->bvh, vi->item, &view);
+        const sw_sg_bvh_item_view *it = &view;
         const sw_lod_static_instance *in = &ins->instances[it->face];
         sw__fr_static_pick pick = {(uint32_t)i, NULL, -1, 0.0};
         if (in->unit != SW_LOD_STATIC_NO_UNIT)

@@ -112,7 +112,9 @@ sw_result sw__fr_tess_static(sw__fr_tess *t, const sw__fr_visible *vis,
 {
     const sw__fr_instance *vi = &vis->instances[pick->instance];
     const sw_lod_static_instances *ins = sw_lod_static_set_instances(t->env->statics);
-    const sw_sg_bvh_item *it = &ins->bvh->items[vi->item];
+    sw_sg_bvh_item_view view;
+    sw_sg_bvh_item_at(ins->bvh, vi->item, &view);
+    const sw_sg_bvh_item_view *it = &view;
     const sw_lod_static_occ *oc0 = &ins->occs[ins->instances[it->face].first_occ];
     occurrence first;
     sw__fr_occurrence_init(&first, oc0->face, it->world, oc0->color);

@@ -9,11 +9,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Items and places being collected (sw_sg_bvh_build's traversal, sw_sg_bvh_build_items). */
 typedef struct build {
     const sw_sg_scene *scene;
     double *face_box; /* 6 per face, local; NaN[0] until computed */
     sw_sg_bvh_item *items;
     size_t n_items, cap_items;
+    sw_sg_bvh_place *places;
+    size_t n_places, cap_places;
+    double box[6]; /* the union of the items' boxes, in double (empty to begin with) */
     int oom;
 } build;
 
@@ -78,31 +82,6 @@ void sw_sg_box_transform(const double m[12], const double b[6], double out[6])
     }
 }
 
-static int visit(void *ctx, uint32_t face, const double world[12], const float color[4])
-{
-    build *b = ctx;
-    if (b->n_items == b->cap_items) {
-        size_t cap = b->cap_items ? 2 * b->cap_items : 256;
-        sw_sg_bvh_item *p = cap <= INT32_MAX ? sw__realloc(b->items, cap * sizeof *p) : NULL;
-        if (!p) {
-            b->oom = 1;
-            return 1;
-        }
-        b->items = p;
-        b->cap_items = cap;
-    }
-    double *lb = b->face_box + 6 * (size_t)face;
-    if (isnan(lb[0]))
-        sw_sg_bvh_face_box(b->scene, face, lb);
-    sw_sg_bvh_item *it = &b->items[b->n_items++];
-    memcpy(it->world, world, sizeof it->world);
-    sw_sg_box_transform(world, lb, it->box);
-    static const float k_none[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
-    memcpy(it->color, color ? color : k_none, sizeof it->color);
-    it->face = face;
-    return 0;
-}
-
 static void box_union(double out[6], const double b[6])
 {
     for (int k = 0; k < 3; ++k) {
@@ -111,9 +90,99 @@ static void box_union(double out[6], const double b[6])
     }
 }
 
-static double centre(const sw_sg_bvh_item *it, int axis)
+static void box_empty(double b[6])
 {
-    return 0.5 * (it->box[axis] + it->box[3 + axis]);
+    for (int k = 0; k < 3; ++k) {
+        b[k] = INFINITY;
+        b[3 + k] = -INFINITY;
+    }
+}
+
+/* The float offset from origin o rounded down (up: dir = +1) so that o + (double)f <= x (>= x)
+ * as sw_sg_bvh_box_at computes it: a stored box bounds the double one whatever the two roundings
+ * (to float, and of the addition back) do. At most a few steps: each rounding is within an ulp. */
+static float offset_outward(double x, double o, int dir)
+{
+    float f = (float)(x - o);
+    if (dir < 0)
+        while (o + (double)f > x)
+            f = nextafterf(f, -INFINITY);
+    else
+        while (o + (double)f < x)
+            f = nextafterf(f, INFINITY);
+    return f;
+}
+
+static void box_store(const double o[3], const double box[6], float out[6])
+{
+    for (int k = 0; k < 3; ++k) {
+        out[k] = offset_outward(box[k], o[k], -1);
+        out[3 + k] = offset_outward(box[3 + k], o[k], 1);
+    }
+}
+
+/* The place of an item with this transform and colour: the last one when they match it (the
+ * occurrences of one node come together), else a new one at the centre of `box`. */
+static int place_of(build *b, const double world[12], const float color[4], const double box[6],
+                    uint32_t *out)
+{
+    static const float k_none[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+    const float *c = color ? color : k_none;
+    if (b->n_places) {
+        const sw_sg_bvh_place *last = &b->places[b->n_places - 1];
+        if (!memcmp(last->world, world, sizeof last->world) &&
+            !memcmp(last->color, c, sizeof last->color)) {
+            *out = (uint32_t)(b->n_places - 1);
+            return 1;
+        }
+    }
+    if (b->n_places >= INT32_MAX ||
+        !sw__grow((void **)&b->places, &b->cap_places, b->n_places + 1, sizeof *b->places))
+        return 0;
+    sw_sg_bvh_place *p = &b->places[b->n_places];
+    memcpy(p->world, world, sizeof p->world);
+    memcpy(p->color, c, sizeof p->color);
+    for (int k = 0; k < 3; ++k) {
+        const double mid = 0.5 * box[k] + 0.5 * box[3 + k];
+        p->origin[k] = isfinite(mid) ? mid : 0.0;
+    }
+    *out = (uint32_t)b->n_places++;
+    return 1;
+}
+
+/* Appends one item: its place, its box stored relative to the place's origin. */
+static int add_item(build *b, uint32_t face, const double world[12], const float color[4],
+                    const double box[6])
+{
+    uint32_t place;
+    if (b->n_items >= INT32_MAX || !place_of(b, world, color, box, &place) ||
+        !sw__grow((void **)&b->items, &b->cap_items, b->n_items + 1, sizeof *b->items)) {
+        b->oom = 1;
+        return 0;
+    }
+    sw_sg_bvh_item *it = &b->items[b->n_items++];
+    box_store(b->places[place].origin, box, it->box);
+    box_union(b->box, box);
+    it->face = face;
+    it->place = place;
+    return 1;
+}
+
+static int visit(void *ctx, uint32_t face, const double world[12], const float color[4])
+{
+    build *b = ctx;
+    double *lb = b->face_box + 6 * (size_t)face;
+    if (isnan(lb[0]))
+        sw_sg_bvh_face_box(b->scene, face, lb);
+    double box[6];
+    sw_sg_box_transform(world, lb, box);
+    return !add_item(b, face, world, color, box);
+}
+
+static double centre(const sw_sg_bvh *t, const sw_sg_bvh_item *it, int axis)
+{
+    const double o = t->places[it->place].origin[axis];
+    return o + 0.5 * ((double)it->box[axis] + (double)it->box[3 + axis]);
 }
 
 static void swap_items(sw_sg_bvh_item *a, sw_sg_bvh_item *b)
@@ -125,15 +194,16 @@ static void swap_items(sw_sg_bvh_item *a, sw_sg_bvh_item *b)
 
 /* Quickselect (Lomuto partition, middle pivot): afterwards the item at mid has its sorted place
  * along axis among [lo, hi), smaller centres before it and larger after. */
-static void select_median(sw_sg_bvh_item *items, uint32_t lo, uint32_t hi, uint32_t mid, int axis)
+static void select_median(sw_sg_bvh *t, uint32_t lo, uint32_t hi, uint32_t mid, int axis)
 {
+    sw_sg_bvh_item *items = t->items;
     int64_t l = lo, h = (int64_t)hi - 1;
     while (l < h) {
         swap_items(&items[l + (h - l) / 2], &items[h]);
-        const double pivot = centre(&items[h], axis);
+        const double pivot = centre(t, &items[h], axis);
         int64_t store = l;
         for (int64_t i = l; i < h; ++i)
-            if (centre(&items[i], axis) < pivot)
+            if (centre(t, &items[i], axis) < pivot)
                 swap_items(&items[i], &items[store++]);
         swap_items(&items[store], &items[h]);
         if (store == (int64_t)mid)
@@ -146,24 +216,27 @@ static void select_median(sw_sg_bvh_item *items, uint32_t lo, uint32_t hi, uint3
 }
 
 /* Builds the subtree of items [lo, hi); returns its node index (nodes preallocated: 2n - 1 at
- * most, so pointers into them stay valid). Recursion depth is O(log n): median splits. */
+ * most, so pointers into them stay valid). The first child is built right after its parent.
+ * Recursion depth is O(log n): median splits. */
 static uint32_t build_node(sw_sg_bvh *t, uint32_t lo, uint32_t hi)
 {
     const uint32_t id = t->n_nodes++;
     sw_sg_bvh_node *n = &t->nodes[id];
-    double cb[6];
-    for (int k = 0; k < 3; ++k) {
-        n->box[k] = cb[k] = INFINITY;
-        n->box[3 + k] = cb[3 + k] = -INFINITY;
-    }
+    double box[6], cb[6];
+    box_empty(box);
+    box_empty(cb);
     for (uint32_t i = lo; i < hi; ++i) {
-        box_union(n->box, t->items[i].box);
+        double ib[6];
+        sw_sg_bvh_item_box(t, i, ib);
+        box_union(box, ib);
         for (int k = 0; k < 3; ++k) {
-            cb[k] = fmin(cb[k], centre(&t->items[i], k));
-            cb[3 + k] = fmax(cb[3 + k], centre(&t->items[i], k));
+            const double c = centre(t, &t->items[i], k);
+            cb[k] = fmin(cb[k], c);
+            cb[3 + k] = fmax(cb[3 + k], c);
         }
     }
-    n->child[0] = n->child[1] = -1;
+    box_store(t->origin, box, n->box);
+    n->second = -1;
     n->first = lo;
     n->count = hi - lo;
     if (hi - lo <= SW_SG_BVH_LEAF)
@@ -174,31 +247,53 @@ static uint32_t build_node(sw_sg_bvh *t, uint32_t lo, uint32_t hi)
             axis = k;
     const uint32_t mid = lo + (hi - lo) / 2;
     if (cb[3 + axis] > cb[axis]) /* all centres equal: any split is as good */
-        select_median(t->items, lo, hi, mid, axis);
-    const int32_t a = (int32_t)build_node(t, lo, mid);
-    const int32_t b = (int32_t)build_node(t, mid, hi);
-    n->child[0] = a;
-    n->child[1] = b;
+        select_median(t, lo, hi, mid, axis);
+    build_node(t, lo, mid);
+    const int32_t second = (int32_t)build_node(t, mid, hi);
+    t->nodes[id].second = second;
     return id;
 }
 
-/* Takes `items` (n of them, malloc'ed; freed on failure) and builds the hierarchy over them. */
-static sw_result finish(sw_sg_bvh_item *items, size_t n, sw_sg_bvh **out, sw_status *status)
+static void shrink_to_fit(void **p, size_t n, size_t elem)
 {
+    void *fit = sw__realloc(*p, (n ? n : 1) * elem);
+    if (fit)
+        *p = fit;
+}
+
+/* Takes b's items and places and builds the hierarchy over them (b's arrays freed on failure). */
+static sw_result finish(build *b, sw_sg_bvh **out, sw_status *status)
+{
+    const size_t n = b->n_items;
     sw_sg_bvh *t = sw__calloc(1, sizeof *t);
     if (t) {
-        t->items = items;
+        t->items = b->items;
         t->n_items = (uint32_t)n;
+        t->places = b->places;
+        t->n_places = (uint32_t)b->n_places;
         t->nodes = sw__malloc((n ? 2 * n : 1) * sizeof *t->nodes);
     }
     if (!t || !t->nodes) {
-        if (!t)
-            sw__free(items);
+        if (!t) {
+            sw__free(b->items);
+            sw__free(b->places);
+        }
         sw_sg_bvh_free(t);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
     }
-    if (n)
+    memcpy(t->box, b->box, sizeof t->box);
+    if (n) {
+        for (int k = 0; k < 3; ++k) {
+            const double mid = 0.5 * t->box[k] + 0.5 * t->box[3 + k];
+            t->origin[k] = isfinite(mid) ? mid : 0.0;
+        }
         build_node(t, 0, t->n_items);
+        /* the 2n nodes reserved are about n / 2 used (leaves of up to SW_SG_BVH_LEAF items), and
+         * the growing arrays up to twice their use: kept at their size */
+        shrink_to_fit((void **)&t->nodes, t->n_nodes, sizeof *t->nodes);
+        shrink_to_fit((void **)&t->items, t->n_items, sizeof *t->items);
+        shrink_to_fit((void **)&t->places, t->n_places, sizeof *t->places);
+    }
     *out = t;
     return SW_OK;
 }
@@ -207,7 +302,9 @@ sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *
 {
     *out = NULL;
     const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    build b = {scene, sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), NULL, 0, 0, 0};
+    build b = {.scene = scene,
+               .face_box = sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double))};
+    box_empty(b.box);
     if (!b.face_box)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
     for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
@@ -216,21 +313,70 @@ sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *
     sw__free(b.face_box);
     if (r != SW_OK || b.oom) {
         sw__free(b.items);
-        return sw__fail(status, b.cap_items >= INT32_MAX / 2 ? SW_ERR_LIMIT : SW_ERR_OUT_OF_MEMORY,
-                        "BVH: %zu occurrences: out of memory", b.n_items);
+        sw__free(b.places);
+        return sw__fail(status, b.n_items >= INT32_MAX ? SW_ERR_LIMIT : SW_ERR_OUT_OF_MEMORY,
+                        "BVH: %zu occurrences: %s", b.n_items,
+                        b.n_items >= INT32_MAX ? "more than 2^31 - 1" : "out of memory");
     }
-    return finish(b.items, b.n_items, out, status);
+    return finish(&b, out, status);
 }
 
-sw_result sw_sg_bvh_build_items(sw_sg_bvh_item *items, uint32_t n, sw_sg_bvh **out,
+typedef struct box_walk {
+    const sw_sg_scene *scene;
+    double *face_box; /* as build's */
+    uint64_t n;
+    double box[6];
+} box_walk;
+
+static int visit_box(void *ctx, uint32_t face, const double world[12], const float color[4])
+{
+    (void)color;
+    box_walk *w = ctx;
+    double *lb = w->face_box + 6 * (size_t)face;
+    if (isnan(lb[0]))
+        sw_sg_bvh_face_box(w->scene, face, lb);
+    double box[6];
+    sw_sg_box_transform(world, lb, box);
+    box_union(w->box, box);
+    w->n++;
+    return 0;
+}
+
+sw_result sw_sg_occurrences_box(const sw_sg_scene *scene, uint64_t *n, double box[6],
+                                sw_status *status)
+{
+    const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
+    box_walk w = {scene, sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), 0, {0}};
+    if (!w.face_box)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occurrence box: out of memory");
+    for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
+        w.face_box[i] = NAN;
+    box_empty(w.box);
+    sw_result r = sw_sg_scene_traverse(scene, visit_box, &w);
+    sw__free(w.face_box);
+    if (r != SW_OK)
+        return sw__fail(status, r, "occurrence box: out of memory");
+    *n = w.n;
+    memcpy(box, w.box, sizeof w.box);
+    return SW_OK;
+}
+
+sw_result sw_sg_bvh_build_items(const sw_sg_bvh_input *items, uint32_t n, sw_sg_bvh **out,
                                 sw_status *status)
 {
     *out = NULL;
-    if (n > INT32_MAX) {
-        sw__free(items);
+    if (n > INT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "BVH: %u items (at most 2^31 - 1)", n);
+    build b = {0};
+    box_empty(b.box);
+    for (uint32_t i = 0; i < n && !b.oom; ++i)
+        add_item(&b, items[i].face, items[i].world, items[i].color, items[i].box);
+    if (b.oom) {
+        sw__free(b.items);
+        sw__free(b.places);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: %u items: out of memory", n);
     }
-    return finish(items, n, out, status);
+    return finish(&b, out, status);
 }
 
 sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out, sw_status *status)
@@ -238,18 +384,17 @@ sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out
     *out = NULL;
     if (n > INT32_MAX)
         return sw__fail(status, SW_ERR_LIMIT, "BVH: %u boxes (at most 2^31 - 1)", n);
-    sw_sg_bvh_item *items = sw__malloc((n ? n : 1) * sizeof *items);
-    if (!items)
-        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: %u boxes: out of memory", n);
     static const double k_identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
-    for (uint32_t i = 0; i < n; ++i) {
-        memcpy(items[i].world, k_identity, sizeof k_identity);
-        memcpy(items[i].box, boxes + 6 * (size_t)i, sizeof items[i].box);
-        for (int k = 0; k < 4; ++k)
-            items[i].color[k] = -1.0f;
-        items[i].face = i;
+    build b = {0};
+    box_empty(b.box);
+    for (uint32_t i = 0; i < n && !b.oom; ++i)
+        add_item(&b, i, k_identity, NULL, boxes + 6 * (size_t)i);
+    if (b.oom) {
+        sw__free(b.items);
+        sw__free(b.places);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: %u boxes: out of memory", n);
     }
-    return sw_sg_bvh_build_items(items, n, out, status);
+    return finish(&b, out, status);
 }
 
 void sw_sg_bvh_free(sw_sg_bvh *bvh)
@@ -258,13 +403,15 @@ void sw_sg_bvh_free(sw_sg_bvh *bvh)
         return;
     sw__free(bvh->items);
     sw__free(bvh->nodes);
+    sw__free(bvh->places);
     sw__free(bvh);
 }
 
 size_t sw_sg_bvh_memory(const sw_sg_bvh *bvh)
 {
-    return bvh ? sizeof *bvh + bvh->n_items * sizeof *bvh->items +
-                     2 * (size_t)bvh->n_items * sizeof *bvh->nodes
+    return bvh ? sizeof *bvh + (size_t)bvh->n_items * sizeof *bvh->items +
+                     (size_t)bvh->n_nodes * sizeof *bvh->nodes +
+                     (size_t)bvh->n_places * sizeof *bvh->places
                : 0;
 }
 
@@ -331,7 +478,9 @@ static int report_tested(cull *c, uint32_t first, uint32_t count)
 {
     for (uint32_t i = first; i < first + count; ++i) {
         c->st.items_tested++;
-        const sw_sg_cull_class k = sw_sg_frustum_classify(c->fr, c->bvh->items[i].box);
+        double box[6];
+        sw_sg_bvh_item_box(c->bvh, i, box);
+        const sw_sg_cull_class k = sw_sg_frustum_classify(c->fr, box);
         if (k == SW_SG_CULL_OUTSIDE)
             continue;
         c->st.items_visible++;
@@ -356,9 +505,12 @@ int sw_sg_bvh_cull(const sw_sg_bvh *bvh, const sw_sg_frustum *fr, sw_sg_bvh_cull
     stack[0] = 0;
     int stop = 0;
     while (n > 0 && !stop) {
-        const sw_sg_bvh_node *node = &bvh->nodes[stack[--n]];
+        const uint32_t id = stack[--n];
+        const sw_sg_bvh_node *node = &bvh->nodes[id];
         c.st.nodes_visited++;
-        const sw_sg_cull_class k = sw_sg_frustum_classify(fr, node->box);
+        double box[6];
+        sw_sg_bvh_node_box(bvh, id, box);
+        const sw_sg_cull_class k = sw_sg_frustum_classify(fr, box);
         if (k == SW_SG_CULL_OUTSIDE) {
             c.st.nodes_outside++;
         } else if (k == SW_SG_CULL_INSIDE) {
@@ -366,9 +518,9 @@ int sw_sg_bvh_cull(const sw_sg_bvh *bvh, const sw_sg_frustum *fr, sw_sg_bvh_cull
             stop = report_all(&c, node->first, node->count);
         } else {
             c.st.nodes_partly++;
-            if (node->child[0] >= 0 && n + 2 <= CULL_STACK) {
-                stack[n++] = (uint32_t)node->child[1];
-                stack[n++] = (uint32_t)node->child[0];
+            if (node->second >= 0 && n + 2 <= CULL_STACK) {
+                stack[n++] = (uint32_t)node->second;
+                stack[n++] = id + 1;
             } else {
                 stop = report_tested(&c, node->first, node->count);
             }

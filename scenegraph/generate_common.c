@@ -365,20 +365,17 @@ void sw__gen_instance(sw__gen *g, uint32_t parent, int m, const double xf[12], c
     g->instances++;
 }
 
-/* Each model's occurrences and control-net box (its BVH's root, as the grid measures). */
+/* Each model's occurrences and the box of their control nets (as the grid measures). */
 sw_result sw__gen_measure(sw__gen *g, const char *const *names, sw_status *status)
 {
     for (int m = 0; m < g->n_models; ++m) {
-        sw_sg_bvh *t = NULL;
         if (!g->models[m])
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "model %s missing", names[m]);
-        sw_result r = sw_sg_bvh_build(g->models[m], &t, status);
+        uint64_t n = 0;
+        sw_result r = sw_sg_occurrences_box(g->models[m], &n, g->model_box[m], status);
         if (r != SW_OK)
             return r;
-        g->model_occ[m] = t->n_items;
-        if (t->n_items)
-            memcpy(g->model_box[m], t->nodes[0].box, sizeof g->model_box[m]);
-        sw_sg_bvh_free(t);
+        g->model_occ[m] = n;
         if (!g->model_occ[m])
             return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "model %s draws no faces", names[m]);
     }

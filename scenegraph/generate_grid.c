@@ -205,18 +205,15 @@ static sw_result check_desc(const sw_sg_grid_desc *d, sw_status *status)
     return SW_OK;
 }
 
-/* The model's box and occurrence count (its BVH's root), the spacing, the limit on occurrences. */
+/* The model's box and occurrence count (sw_sg_occurrences_box), the spacing, the limit on
+ * occurrences. */
 static sw_result measure(const sw_sg_scene *model, const sw_sg_grid_desc *d, sw_sg_grid_report *rep,
                          sw_status *status)
 {
-    sw_sg_bvh *t = NULL;
-    sw_result r = sw_sg_bvh_build(model, &t, status);
+    uint64_t per = 0;
+    sw_result r = sw_sg_occurrences_box(model, &per, rep->model_box, status);
     if (r != SW_OK)
         return r;
-    const uint64_t per = t->n_items;
-    if (per)
-        memcpy(rep->model_box, t->nodes[0].box, sizeof rep->model_box);
-    sw_sg_bvh_free(t);
     if (per == 0)
         return sw__fail(status, SW_ERR_INVALID_ARGUMENT, "grid: the model draws no faces");
     rep->occurrences = per * d->count;

@@ -410,28 +410,36 @@ sw_result sw_sg_pick(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const doubl
         stack[top++] = 0;
     sw_result r = SW_OK;
     while (top > 0 && r == SW_OK) {
-        const sw_sg_bvh_node *n = &bvh->nodes[stack[--top]];
-        if (ray_box(origin, inv_d, n->box, best) == INFINITY)
+        const uint32_t id = (uint32_t)stack[--top];
+        const sw_sg_bvh_node *n = &bvh->nodes[id];
+        double box[6];
+        sw_sg_bvh_node_box(bvh, id, box);
+        if (ray_box(origin, inv_d, box, best) == INFINITY)
             continue;
-        if (n->child[0] >= 0) {
+        if (n->second >= 0) {
             /* The nearer child is popped first, so the best hit shrinks early and prunes more. */
-            double t0 = ray_box(origin, inv_d, bvh->nodes[n->child[0]].box, best);
-            double t1 = ray_box(origin, inv_d, bvh->nodes[n->child[1]].box, best);
+            const int32_t child[2] = {(int32_t)id + 1, n->second};
+            double b0[6], b1[6];
+            sw_sg_bvh_node_box(bvh, (uint32_t)child[0], b0);
+            sw_sg_bvh_node_box(bvh, (uint32_t)child[1], b1);
+            double t0 = ray_box(origin, inv_d, b0, best);
+            double t1 = ray_box(origin, inv_d, b1, best);
             int near = t1 < t0;
-            stack[top++] = n->child[1 - near];
-            stack[top++] = n->child[near];
+            stack[top++] = child[1 - near];
+            stack[top++] = child[near];
             continue;
         }
         for (uint32_t i = n->first; i < n->first + n->count && r == SW_OK; ++i) {
-            const sw_sg_bvh_item *it = &bvh->items[i];
+            sw_sg_bvh_item_view it;
+            sw_sg_bvh_item_at(bvh, i, &it);
             local_ray lr;
-            if (ray_box(origin, inv_d, it->box, best) == INFINITY ||
-                !world_ray(it->world, origin, dir, &lr))
+            if (ray_box(origin, inv_d, it.box, best) == INFINITY ||
+                !world_ray(it.world, origin, dir, &lr))
                 continue;
             int found = 0;
-            r = face_pick(scene, it->face, &lr, &best, hit->uv, &found, status);
+            r = face_pick(scene, it.face, &lr, &best, hit->uv, &found, status);
             if (found) {
-                hit->face = it->face;
+                hit->face = it.face;
                 hit->item = i;
                 hit->t = best;
             }

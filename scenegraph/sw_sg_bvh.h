@@ -6,8 +6,10 @@
  * expanded), median split along the longest axis of the centroids' box, at most SW_SG_BVH_LEAF
  * items per leaf. A face occurrence's box is its face's control-net box (computed once per face,
  * shared by instances) mapped through the occurrence transform: eight corners, so it bounds the
- * surface however the transform rotates. A finished BVH is immutable and may be read from any
- * thread.
+ * surface however the transform rotates. Stored lean (32 bytes an item, 36 a node, a shared
+ * place per run of items with one transform and colour): boxes in float, rounded outward, relative
+ * to a point near them, read back in double by sw_sg_bvh_item_box / sw_sg_bvh_node_box. A finished
+ * BVH is immutable and may be read from any thread.
  */
 #ifndef SW_SG_BVH_H
 #define SW_SG_BVH_H
@@ -15,6 +17,7 @@
 #include "sw_sg_scene.h"
 
 #include <splinewalk/sw_result.h>
+#include <float.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
@@ -23,16 +26,37 @@ extern "C" {
 
 enum { SW_SG_BVH_LEAF = 4 };
 
-typedef struct sw_sg_bvh_item {
+/* What a caller builds a hierarchy from (sw_sg_bvh_build_items): one item, whole. */
+typedef struct sw_sg_bvh_input {
     double world[12]; /* occurrence transform, row-major 3 x 4 */
     double box[6];    /* world box: min xyz, max xyz */
     float color[4];
-    uint32_t face; /* the face (sw_sg_bvh_build), else the caller's id of the item */
+    uint32_t face; /* the caller's id of the item */
+} sw_sg_bvh_input;
+
+/* What items share: a transform and a colour (the occurrences of one scene node share one), and the
+ * point their boxes are stored relative to (near them, so that a float box keeps the precision of
+ * its own size wherever the scene lies). */
+typedef struct sw_sg_bvh_place {
+    double world[12]; /* row-major 3 x 4 */
+    double origin[3];
+    float color[4];
+} sw_sg_bvh_place;
+
+/* An item as stored: 32 bytes, so that a BVH over 10^6 occurrences costs tens of MiB. Its box is
+ * float, relative to its place's origin and rounded outward: origin + (double)box[k] bounds the
+ * world box exactly as computed in double (sw_sg_bvh_item_box). */
+typedef struct sw_sg_bvh_item {
+    float box[6];
+    uint32_t face;  /* the face (sw_sg_bvh_build), else the caller's id of the item */
+    uint32_t place; /* index into places */
 } sw_sg_bvh_item;
 
+/* A node, its box stored like an item's relative to the BVH's origin (sw_sg_bvh_node_box). An
+ * inner node's first child is the node after it (built depth first), its second `second`. */
 typedef struct sw_sg_bvh_node {
-    double box[6];
-    int32_t child[2];      /* -1 at a leaf */
+    float box[6];
+    int32_t second;        /* -1 at a leaf */
     uint32_t first, count; /* the subtree's items, contiguous in `items` */
 } sw_sg_bvh_node;
 
@@ -41,7 +65,62 @@ typedef struct sw_sg_bvh {
     uint32_t n_items;
     sw_sg_bvh_node *nodes; /* nodes[0] is the root (none when n_items == 0) */
     uint32_t n_nodes;
+    sw_sg_bvh_place *places;
+    uint32_t n_places;
+    double origin[3]; /* what node boxes are relative to */
+    double box[6];    /* the union of the items' boxes in double, exact (empty: min > max) */
 } sw_sg_bvh;
+
+/* An item whole: its transform and colour (its place's) and its world box in double. */
+typedef struct sw_sg_bvh_item_view {
+    const double *world; /* 12 */
+    const float *color;  /* 4; colour[3] < 0: unset */
+    double box[6];
+    uint32_t face;
+} sw_sg_bvh_item_view;
+
+/* A stored box back in double: origin + offset; an offset beyond float's range (a coordinate past
+ * 3e38 from the origin) reads as +-DBL_MAX, still bounding, and finite so that plane tests never
+ * meet 0 x inf. */
+static inline void sw_sg_bvh_box_at(const double origin[3], const float b[6], double out[6])
+{
+    for (int k = 0; k < 6; ++k) {
+        const double x = origin[k % 3] + (double)b[k];
+        out[k] = x > DBL_MAX ? DBL_MAX : x < -DBL_MAX ? -DBL_MAX : x;
+    }
+}
+
+static inline void sw_sg_bvh_item_box(const sw_sg_bvh *bvh, uint32_t item, double out[6])
+{
+    const sw_sg_bvh_item *it = &bvh->items[item];
+    sw_sg_bvh_box_at(bvh->places[it->place].origin, it->box, out);
+}
+
+static inline void sw_sg_bvh_node_box(const sw_sg_bvh *bvh, uint32_t node, double out[6])
+{
+    sw_sg_bvh_box_at(bvh->origin, bvh->nodes[node].box, out);
+}
+
+/* Child k (0, 1) of a node, -1 at a leaf. */
+static inline int32_t sw_sg_bvh_child(const sw_sg_bvh *bvh, uint32_t node, int k)
+{
+    const int32_t second = bvh->nodes[node].second;
+    return second < 0 ? -1 : k ? second : (int32_t)node + 1;
+}
+
+static inline const double *sw_sg_bvh_item_world(const sw_sg_bvh *bvh, uint32_t item)
+{
+    return bvh->places[bvh->items[item].place].world;
+}
+
+static inline void sw_sg_bvh_item_at(const sw_sg_bvh *bvh, uint32_t item, sw_sg_bvh_item_view *out)
+{
+    const sw_sg_bvh_place *p = &bvh->places[bvh->items[item].place];
+    out->world = p->world;
+    out->color = p->color;
+    sw_sg_bvh_item_box(bvh, item, out->box);
+    out->face = bvh->items[item].face;
+}
 
 /* Builds the BVH of a scene whose NODES, FACES and POOL sections are required and validated.
  * Errors: SW_ERR_OUT_OF_MEMORY, SW_ERR_LIMIT (more than 2^31 occurrences). *out owned by the
@@ -52,11 +131,16 @@ sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *
  * (e.g. one face's Bézier patches) for callers that cull their own pieces. Errors as above. */
 sw_result sw_sg_bvh_build_boxes(const double *boxes, uint32_t n, sw_sg_bvh **out,
                                 sw_status *status);
-/* The same hierarchy over n items the caller made (world, box, colour, face = its own id); takes
- * `items` (malloc'ed; freed on failure too) and reorders them into leaf order. Errors as above. */
-sw_result sw_sg_bvh_build_items(sw_sg_bvh_item *items, uint32_t n, sw_sg_bvh **out,
+/* The same hierarchy over n items the caller made (world, box, colour, face = its own id); reads
+ * `items` (consecutive items with the same transform and colour share a place). Errors as above. */
+sw_result sw_sg_bvh_build_items(const sw_sg_bvh_input *items, uint32_t n, sw_sg_bvh **out,
                                 sw_status *status);
 void sw_sg_bvh_free(sw_sg_bvh *bvh); /* NULL allowed */
+/* The number of a scene's face occurrences and the union of their boxes in double, each boxed as
+ * sw_sg_bvh_build boxes it (an empty box, min > max, when there are none), without building the
+ * hierarchy. Preconditions as sw_sg_bvh_build. Errors: SW_ERR_OUT_OF_MEMORY. */
+sw_result sw_sg_occurrences_box(const sw_sg_scene *scene, uint64_t *n, double box[6],
+                                sw_status *status);
 
 /* The object-space box of a face as its occurrences are boxed: its whole control net (Euclidean
  * points), min xyz, max xyz. Precondition: FACES and POOL required. */

@@ -242,7 +242,7 @@ typedef struct inst_build {
     const sw_lod_static_set *s;
     uint32_t *map; /* open addressing: (unit, transform) -> instance + 1; 0 empty */
     size_t cap_map;
-    sw_sg_bvh_item *items; /* per instance: its transform; face = its index */
+    sw_sg_bvh_input *items; /* per instance: its transform; face = its index */
     size_t n_items, cap_items;
     sw_lod_static_instance *inst;
     size_t cap_inst;
@@ -287,7 +287,7 @@ static int new_instance(inst_build *b, uint32_t unit, const double world[12], si
         !sw__grow((void **)&b->items, &b->cap_items, b->n_items + 1, sizeof *b->items) ||
         !sw__grow((void **)&b->inst, &b->cap_inst, b->n_items + 1, sizeof *b->inst))
         return 0;
-    sw_sg_bvh_item *it = &b->items[b->n_items];
+    sw_sg_bvh_input *it = &b->items[b->n_items];
     memset(it, 0, sizeof *it);
     memcpy(it->world, world, sizeof it->world);
     for (int k = 0; k < 4; ++k)
@@ -383,6 +383,8 @@ static sw_result finish_instances(sw_lod_static_set *s, inst_build *b, sw_status
         sw_sg_box_transform(b->items[i].world, local, b->items[i].box);
     }
     sw_result r = sw_sg_bvh_build_items(b->items, (uint32_t)b->n_items, &s->bvh, status);
+    sw__free(b->items);
+    b->items = NULL;
     if (r != SW_OK)
         return r;
     s->in = (sw_lod_static_instances){s->bvh,  s->instances,       (uint32_t)b->n_items,

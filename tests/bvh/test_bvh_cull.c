@@ -13,6 +13,8 @@
  *    themselves: every face occurrence of the scene's traversal in exactly one instance, of its
  *    face's unit and transform, no (unit, transform) twice, each leaf's box the unit's box
  *    through the transform (checked against a traversal of our own).
+ *  - storage: items stored as float offsets read back as bounds of their double boxes, tight to
+ *    float rounding, far from the origin too (stored_boxes).
  * For random cameras of six classes (inside the model, outside looking at it, outside looking
  * away, looking along the grid's rows from its side, seeing a corner of it, a narrow field of
  * view) with and without a far plane:
@@ -227,6 +229,88 @@ static sw_sg_cull_class brute_class(const sw_sg_frustum *fr, const double world[
     return all_in ? SW_SG_CULL_INSIDE : SW_SG_CULL_PARTLY;
 }
 
+/* 1 when a stored box bounds the exact one (computed in double) and is no looser than float's
+ * rounding (2 ulps) of offsets from a point within `spread` of `origin` allows, plus the double
+ * sum back. */
+static int box_stored_well(const double exact[6], const double stored[6], const double origin[3],
+                           double spread)
+{
+    for (int k = 0; k < 6; ++k) {
+        const double slack = fabs(stored[k] - exact[k]),
+                     allowed = 2.5e-7 * (fabs(exact[k] - origin[k % 3]) + spread) +
+                               4.5e-16 * fabs(exact[k]);
+        if ((k < 3 ? stored[k] > exact[k] : stored[k] < exact[k]) || slack > allowed)
+            return 0;
+    }
+    return 1;
+}
+
+/* Items stored as float offsets (sw_sg_bvh.h): boxes far from the origin and much smaller than
+ * their distance to it, in places of one item and places shared by many, must read back as
+ * bounds of the double boxes, tight to float rounding of their own size, and the nodes' boxes
+ * must bound their items'. Storing offsets rounded to nearest (not outward) fails the first;
+ * offsets from the scene's centre instead of each place's origin fail the second. */
+static void stored_boxes(void)
+{
+    enum { N = 3000 };
+    sw_sg_bvh_input *in = malloc(N * sizeof *in);
+    double(*centre)[3] = malloc(N * sizeof *centre); /* the run's point: every box within 1.01 */
+    for (uint32_t i = 0; i < N; ++i) {
+        memset(&in[i], 0, sizeof in[i]);
+        /* runs of 10 items share a transform and colour: one place */
+        const uint32_t run = i / 10;
+        const double far = run % 3 == 0   ? 1e6
+                           : run % 3 == 1 ? -3e4
+                                          : 7.0,
+                     size = uniform(1e-4, 1e-2), shift = far * (double)(run % 7 + 1);
+        in[i].world[0] = in[i].world[5] = in[i].world[10] = 1.0;
+        in[i].world[3] = shift;
+        for (int k = 0; k < 3; ++k) {
+            const double c = shift + uniform(-1.0, 1.0);
+            in[i].box[k] = c - size * uniform(0.1, 1.0);
+            in[i].box[3 + k] = c + size * uniform(0.1, 1.0);
+        }
+        in[i].color[3] = -1.0f;
+        in[i].face = i;
+        for (int k = 0; k < 3; ++k)
+            centre[i][k] = shift;
+    }
+    sw_sg_bvh *t = NULL;
+    sw_status st = {0};
+    if (sw_sg_bvh_build_items(in, N, &t, &st) != SW_OK) {
+        CHECK(0, "stored boxes: %s", st.message);
+        free(in);
+        free(centre);
+        return;
+    }
+    uint32_t loose = 0, unbounded = 0;
+    for (uint32_t i = 0; i < t->n_items; ++i) {
+        double b[6];
+        sw_sg_bvh_item_box(t, i, b);
+        /* a place's origin is within 2.02 of its run's point */
+        loose += !box_stored_well(in[t->items[i].face].box, b, centre[t->items[i].face], 2.02);
+    }
+    for (uint32_t n = 0; n < t->n_nodes; ++n) {
+        double nb[6], ib[6];
+        sw_sg_bvh_node_box(t, n, nb);
+        for (uint32_t i = t->nodes[n].first; i < t->nodes[n].first + t->nodes[n].count; ++i) {
+            sw_sg_bvh_item_box(t, i, ib);
+            for (int k = 0; k < 3; ++k)
+                unbounded += ib[k] < nb[k] || ib[3 + k] > nb[3 + k];
+        }
+    }
+    CHECK(t->n_places == N / 10 && loose == 0 && unbounded == 0,
+          "stored boxes: %u places for %u runs, %u item boxes loose or not bounding, %u node "
+          "sides not bounding their items",
+          t->n_places, N / 10, loose, unbounded);
+    printf("stored boxes: %u items, %u places, %u nodes, %zu bytes (%.1f per item)\n", t->n_items,
+           t->n_places, t->n_nodes, sw_sg_bvh_memory(t),
+           (double)sw_sg_bvh_memory(t) / (double)t->n_items);
+    sw_sg_bvh_free(t);
+    free(in);
+    free(centre);
+}
+
 typedef struct shape {
     uint32_t n_items, n_nodes, depth, n_leaves;
     uint32_t *parent; /* per node; parent index < child index (nodes in preorder) */
@@ -237,16 +321,17 @@ static shape tree_shape(const sw_sg_bvh *t)
     shape s = {t->n_items, t->n_nodes, 0, 0, calloc(t->n_nodes ? t->n_nodes : 1, sizeof(uint32_t))};
     uint32_t *depth = calloc(t->n_nodes ? t->n_nodes : 1, sizeof *depth);
     for (uint32_t i = 0; i < t->n_nodes; ++i) {
-        const sw_sg_bvh_node *n = &t->nodes[i];
         s.depth = depth[i] > s.depth ? depth[i] : s.depth;
-        if (n->child[0] < 0) {
+        if (sw_sg_bvh_child(t, i, 0) < 0) {
             s.n_leaves++;
             continue;
         }
         for (int c = 0; c < 2; ++c) {
-            CHECK((uint32_t)n->child[c] > i, "node %u: child %d before it", i, n->child[c]);
-            s.parent[n->child[c]] = i;
-            depth[n->child[c]] = depth[i] + 1;
+            const int32_t child = sw_sg_bvh_child(t, i, c);
+            CHECK((uint32_t)child > i && (uint32_t)child < t->n_nodes, "node %u: child %d", i,
+                  child);
+            s.parent[child] = i;
+            depth[child] = depth[i] + 1;
         }
     }
     free(depth);
@@ -289,8 +374,10 @@ static void check_items(const sw_sg_bvh *t, const sw_sg_frustum *fr, const char 
                         const sink *s, const sw_sg_bvh_cull_stats *st)
 {
     uint32_t missing = 0, extra = 0, vis = 0;
+    double box[6];
     for (uint32_t i = 0; i < t->n_items; ++i) {
-        w->brute[i] = brute_class(fr, t->items[i].box) != SW_SG_CULL_OUTSIDE;
+        sw_sg_bvh_item_box(t, i, box);
+        w->brute[i] = brute_class(fr, box) != SW_SG_CULL_OUTSIDE;
         w->prefix[i] = vis;
         vis += w->brute[i];
         missing += w->brute[i] && !w->seen[i];
@@ -303,8 +390,10 @@ static void check_items(const sw_sg_bvh *t, const sw_sg_frustum *fr, const char 
     CHECK(s->out_of_order == 0, "%s: %lld items out of increasing order", what,
           (long long)s->out_of_order);
     uint32_t wrong_class = 0;
-    for (uint32_t i = 0; i < t->n_items; ++i)
-        wrong_class += w->seen[i] && s->cls[i] != (unsigned char)brute_class(fr, t->items[i].box);
+    for (uint32_t i = 0; i < t->n_items; ++i) {
+        sw_sg_bvh_item_box(t, i, box);
+        wrong_class += w->seen[i] && s->cls[i] != (unsigned char)brute_class(fr, box);
+    }
     CHECK(wrong_class == 0, "%s: %u items reported with another class than their box's", what,
           wrong_class);
     uint64_t inside = 0;
@@ -322,12 +411,14 @@ static void check_nodes(const sw_sg_bvh *t, const shape *sh, const sw_sg_frustum
     for (uint32_t i = 0; i < t->n_nodes; ++i) {
         const sw_sg_bvh_node *n = &t->nodes[i];
         const uint32_t p = sh->parent[i];
-        w->cls[i] = (unsigned char)brute_class(fr, n->box);
+        double box[6];
+        sw_sg_bvh_node_box(t, i, box);
+        w->cls[i] = (unsigned char)brute_class(fr, box);
         w->reach[i] = i == 0 || (w->reach[p] && w->cls[p] == SW_SG_CULL_PARTLY);
         if (!w->reach[i])
             continue;
         by[w->cls[i]]++;
-        const int leaf = n->child[0] < 0;
+        const int leaf = n->second < 0;
         const uint32_t below = w->prefix[n->first + n->count] - w->prefix[n->first];
         r->wasted += below == 0;
         r->frontier += below > 0 &&
@@ -419,7 +510,7 @@ static void run_bvh(const sw_sg_bvh *t, const char *name)
     memset(sums, 0, sizeof sums);
     for (int cls = 0; cls < N_CLASSES; ++cls) {
         for (int k = 0; k < CAMERAS_PER_CLASS; ++k) {
-            const camera cam = make_camera(cls, t->nodes[0].box);
+            const camera cam = make_camera(cls, t->box);
             sw_sg_frustum fr;
             make_frustum(&cam, &fr);
             char what[96];
@@ -580,7 +671,9 @@ static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *s
     uint64_t misplaced = 0, bad_box = 0, twice = 0;
     for (uint32_t i = 0; i < in->n_instances; ++i) {
         const sw_lod_static_instance *ins = &in->instances[i];
-        const sw_sg_bvh_item *it = &in->bvh->items[of_item[i]];
+        sw_sg_bvh_item_view it_view;
+        sw_sg_bvh_item_at(in->bvh, of_item[i], &it_view);
+        const sw_sg_bvh_item_view *it = &it_view;
         for (uint32_t k = 0; k < ins->n_occ; ++k)
             misplaced +=
                 sw_lod_static_set_unit_of(set, in->occs[ins->first_occ + k].face) != ins->unit;
@@ -589,8 +682,10 @@ static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *s
                                   ? sw_lod_static_set_unit(set, ins->unit)->box
                                   : in->face_boxes + 6 * (size_t)in->occs[ins->first_occ].face;
         sw_sg_box_transform(it->world, local, box);
-        bad_box += memcmp(box, it->box, sizeof box) != 0 || ins->n_occ == 0 ||
-                   (ins->unit == SW_LOD_STATIC_NO_UNIT && ins->n_occ != 1);
+        bad_box +=
+            !box_stored_well(box, it->box, in->bvh->places[in->bvh->items[of_item[i]].place].origin,
+                             0.0) ||
+            ins->n_occ == 0 || (ins->unit == SW_LOD_STATIC_NO_UNIT && ins->n_occ != 1);
     }
     /* occurrences matched to instances by (face, transform): each exactly once */
     unsigned char *used = calloc(in->n_occs + 1, 1);
@@ -599,8 +694,8 @@ static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *s
         const uint32_t unit = sw_lod_static_set_unit_of(set, l.face[j]);
         for (uint32_t i = 0; i < in->n_instances && !found; ++i) {
             const sw_lod_static_instance *ins = &in->instances[i];
-            if (ins->unit != unit ||
-                memcmp(in->bvh->items[of_item[i]].world, l.world[j], sizeof l.world[j]) != 0)
+            if (ins->unit != unit || memcmp(sw_sg_bvh_item_world(in->bvh, of_item[i]), l.world[j],
+                                            sizeof l.world[j]) != 0)
                 continue;
             for (uint32_t k = 0; k < ins->n_occ && !found; ++k)
                 if (in->occs[ins->first_occ + k].face == l.face[j] && !used[ins->first_occ + k])
@@ -612,8 +707,8 @@ static void check_instances(const sw_sg_scene *scene, const sw_lod_static_set *s
         for (uint32_t j = i + 1; j < in->n_instances; ++j)
             twice += in->instances[i].unit != SW_LOD_STATIC_NO_UNIT &&
                      in->instances[i].unit == in->instances[j].unit &&
-                     memcmp(in->bvh->items[of_item[i]].world, in->bvh->items[of_item[j]].world,
-                            sizeof(double[12])) == 0;
+                     memcmp(sw_sg_bvh_item_world(in->bvh, of_item[i]),
+                            sw_sg_bvh_item_world(in->bvh, of_item[j]), sizeof(double[12])) == 0;
     CHECK(misplaced == 0 && bad_box == 0 && twice == 0,
           "%s: %llu occurrences misplaced, %llu bad leaf boxes, %llu (unit, transform) pairs twice",
           name, (unsigned long long)misplaced, (unsigned long long)bad_box,
@@ -700,6 +795,7 @@ int main(int argc, char **argv)
     }
     sw_sg_scene_free(crank);
     sw_sg_scene_free(terrain);
+    stored_boxes(); /* last: the cameras above keep their random sequence */
     puts(g_failures ? "FAIL" : "PASS");
     return g_failures ? 1 : 0;
 }

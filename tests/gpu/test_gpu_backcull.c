@@ -118,7 +118,7 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
         memset(&d, 0, sizeof d);
         d.width = W;
         d.height = H;
-        d.camera = view_camera(t->nodes[0].box, v);
+        d.camera = view_camera(t->box, v);
         d.bvh = v % 2 == 0 ? t : NULL;
         d.hierarchies = v >= N_VIEWS - 2 ? cache : NULL;
         sw_gpu_image a = {0}, b = {0};
@@ -170,7 +170,9 @@ static uint64_t compare_views(sw_gpu_context *ctx, const sw_sg_scene *scene,
 static int inside_view(sw_gpu_context *ctx, const sw_sg_scene *scene, const sw_lod_face_cones *fc,
                        const sw_sg_bvh *t, const char *name)
 {
-    const double *b = t->nodes[0].box, *ib = t->items[t->n_items / 2].box;
+    const double *b = t->box;
+    double ib[6];
+    sw_sg_bvh_item_box(t, t->n_items / 2, ib);
     double c[3], dir[3] = {-0.3, -0.2, -0.93}, diag = 0.0, o[3];
     for (int k = 0; k < 3; ++k) { /* toward an occurrence's box: instances may stand apart */
         c[k] = 0.5 * (ib[k] + ib[3 + k]);
@@ -278,7 +280,7 @@ static int mirror_plane(const char *path, double *x)
     sw_status st = {0};
     int ok = scene && sw_sg_bvh_build(scene, &t, &st) == SW_OK && t->n_nodes > 0;
     if (ok)
-        *x = t->nodes[0].box[3] + 0.1 * (t->nodes[0].box[3] - t->nodes[0].box[0]);
+        *x = t->box[3] + 0.1 * (t->box[3] - t->box[0]);
     sw_sg_bvh_free(t);
     sw_sg_scene_free(scene);
     return ok;

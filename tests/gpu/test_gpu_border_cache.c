@@ -64,7 +64,7 @@ static sw_gpu_frame_desc view_at(const scene_set *s, double scale)
     sw_gpu_frame_desc d = {0};
     d.width = W;
     d.height = H;
-    d.camera = sw_test_view_camera_at(s->bvh->nodes[0].box, 1, scale);
+    d.camera = sw_test_view_camera_at(s->bvh->box, 1, scale);
     d.hierarchies = s->cache;
     d.bvh = s->bvh;
     d.pool = g_pool; /* chunks look entries up and add them at once */

@@ -42,8 +42,11 @@ static int box_contains(const double outer[6], const double inner[6])
     return 1;
 }
 
-static void check_item(const sw_sg_scene *scene, const sw_sg_bvh_item *it)
+static void check_item(const sw_sg_scene *scene, const sw_sg_bvh *t, uint32_t item)
 {
+    sw_sg_bvh_item_view view;
+    sw_sg_bvh_item_at(t, item, &view);
+    const sw_sg_bvh_item_view *it = &view;
     sw_sg_surface s;
     sw_sg_scene_face_surface(scene, it->face, &s);
     const double *m = it->world;
@@ -70,14 +73,19 @@ static void check_structure(const sw_sg_scene *scene, const sw_sg_bvh *t)
     for (uint32_t i = 0; i < t->n_nodes; ++i) {
         const sw_sg_bvh_node *n = &t->nodes[i];
         CHECK(n->first + n->count <= t->n_items, "node %u: range out of the items", i);
-        for (uint32_t k = n->first; k < n->first + n->count && k < t->n_items; ++k)
-            CHECK(box_contains(n->box, t->items[k].box), "node %u: item %u outside its box", i, k);
-        if (n->child[0] < 0) {
+        double nb[6], ib[6];
+        sw_sg_bvh_node_box(t, i, nb);
+        for (uint32_t k = n->first; k < n->first + n->count && k < t->n_items; ++k) {
+            sw_sg_bvh_item_box(t, k, ib);
+            CHECK(box_contains(nb, ib), "node %u: item %u outside its box", i, k);
+        }
+        if (n->second < 0) {
             leaf_items += n->count;
             max_leaf = n->count > max_leaf ? n->count : max_leaf;
             continue;
         }
-        const sw_sg_bvh_node *a = &t->nodes[n->child[0]], *b = &t->nodes[n->child[1]];
+        const sw_sg_bvh_node *a = &t->nodes[sw_sg_bvh_child(t, i, 0)],
+                             *b = &t->nodes[sw_sg_bvh_child(t, i, 1)];
         CHECK(a->first == n->first && b->first == a->first + a->count &&
                   a->count + b->count == n->count,
               "node %u: children's ranges do not split its own", i);
@@ -85,7 +93,7 @@ static void check_structure(const sw_sg_scene *scene, const sw_sg_bvh *t)
     CHECK(leaf_items == t->n_items && max_leaf <= SW_SG_BVH_LEAF,
           "leaves hold %u items (of %u), at most %u each", leaf_items, t->n_items, max_leaf);
     for (uint32_t k = 0; k < t->n_items; ++k)
-        check_item(scene, &t->items[k]);
+        check_item(scene, t, k);
     printf("  structure: %u items, %u nodes, %zu bytes\n", t->n_items, t->n_nodes,
            sw_sg_bvh_memory(t));
 }
@@ -150,7 +158,7 @@ static void run_scene(sw_gpu_context *ctx, const sw_sg_scene *scene, const char 
         return;
     }
     check_structure(scene, t);
-    compare_views(ctx, scene, t, t->nodes[0].box);
+    compare_views(ctx, scene, t, t->box);
     sw_sg_bvh_free(t);
 }
 

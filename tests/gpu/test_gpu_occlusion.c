@@ -373,7 +373,7 @@ static int compare_view(sw_gpu_context *ctx, const scene_set *s, int k, const sw
  * (only without static LODs: the unit-instance path draws no wireframe of its own kind). */
 static void walk_views(sw_gpu_context *ctx, const scene_set *s, int step)
 {
-    const double *b = s->bvh->nodes[0].box;
+    const double *b = s->bvh->box;
     uint64_t sums[3] = {0, 0, 0}; /* faces drawn off, on; occluded */
     const int last = s->statics ? WALK + 2 : WALK + 3;
     for (int k = 0; k < last; k += k < WALK ? step : 1) {

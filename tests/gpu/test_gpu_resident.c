@@ -48,7 +48,7 @@ static sw_gpu_frame_desc view_at(const model *m, double scale)
     sw_gpu_frame_desc d = {0};
     d.width = W;
     d.height = H;
-    d.camera = sw_test_view_camera_at(m->bvh->nodes[0].box, 1, scale);
+    d.camera = sw_test_view_camera_at(m->bvh->box, 1, scale);
     d.hierarchies = m->cache;
     d.bvh = m->bvh;
     d.pool = g_pool;

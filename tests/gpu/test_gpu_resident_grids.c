@@ -50,7 +50,7 @@ static sw_gpu_frame_desc view_at(const model *m, double scale, int direct)
     sw_gpu_frame_desc d = {0};
     d.width = W;
     d.height = H;
-    d.camera = sw_test_view_camera_at(m->bvh->nodes[0].box, 1, scale);
+    d.camera = sw_test_view_camera_at(m->bvh->box, 1, scale);
     d.hierarchies = direct ? NULL : m->cache;
     d.bvh = m->bvh;
     d.pool = g_pool;
@@ -197,7 +197,7 @@ static void placements(sw_gpu_context *ctx, const model *m)
     size_t n = 0;
     sw_gpu_occurrence *occ = occurrences_under(m, k_mirror, &n);
     sw_gpu_frame_desc d = view_at(m, 1.5, 0);
-    const double *b = m->bvh->nodes[0].box;
+    const double *b = m->bvh->box;
     double box[6]; /* the model's box under the map (its corners' images bound it) */
     for (int k = 0; k < 3; ++k) {
         box[k] = 1e300;

@@ -129,7 +129,9 @@ static void check_cull_exact(const stages *s, const sw_sg_bvh *bvh, const char *
     view_frustum(&s->env.view, &fr);
     size_t expected = 0, missing = 0;
     for (uint32_t i = 0; i < bvh->n_items; ++i) {
-        const sw_sg_bvh_item *it = &bvh->items[i];
+        sw_sg_bvh_item_view it_view;
+        sw_sg_bvh_item_at(bvh, i, &it_view);
+        const sw_sg_bvh_item_view *it = &it_view;
         if (sw_sg_frustum_classify(&fr, it->box) == SW_SG_CULL_OUTSIDE)
             continue;
         expected++;
@@ -711,10 +713,10 @@ static void run_model(sw_gpu_context *ctx, const char *path, int first_model)
     sw_gpu_frame_desc desc = {0};
     desc.width = W;
     desc.height = H;
-    desc.camera = sw_test_view_camera(bvh->nodes[0].box, 1);
+    desc.camera = sw_test_view_camera(bvh->box, 1);
     desc.camera.fovy_deg = 15.0;
     for (int k = 0; k < 3; ++k) {
-        const double shift = 0.2 * (bvh->nodes[0].box[k] - desc.camera.target[k]);
+        const double shift = 0.2 * (bvh->box[k] - desc.camera.target[k]);
         desc.camera.target[k] += shift;
         desc.camera.eye[k] += shift;
     }

@@ -108,7 +108,7 @@ void check_on_surface(const sw_sg_scene *scene, const sw_sg_bvh *bvh, const sw_s
     sw_sg_scene_face_surface(scene, h.face, &srf);
     double local[3], world[3];
     sw_sg_surface_eval(&srf, h.uv[0], h.uv[1], local);
-    const double *m = bvh->items[h.item].world;
+    const double *m = sw_sg_bvh_item_world(bvh, h.item);
     for (int i = 0; i < 3; ++i)
         world[i] =
             m[4 * i] * local[0] + m[4 * i + 1] * local[1] + m[4 * i + 2] * local[2] + m[4 * i + 3];
@@ -173,7 +173,8 @@ bool run_model(const char *path, int n_rays, ot::rng &rng)
         // Three rays in four aim at a point of a random surface occurrence (thin models such as
         // linkrods are mostly empty space), the fourth at a random point of the box.
         if (r % 4 != 3) {
-            const sw_sg_bvh_item &it = bvh->items[rng.next() % bvh->n_items];
+            sw_sg_bvh_item_view it;
+            sw_sg_bvh_item_at(bvh, (uint32_t)(rng.next() % bvh->n_items), &it);
             double l[3];
             face_point(im.scene, it.face, rng, l);
             for (int k = 0; k < 3; ++k)
