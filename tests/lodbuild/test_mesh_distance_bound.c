@@ -9,6 +9,7 @@
  *  - dense: a 60 x 60 barycentric lattice of every triangle, each point's exact distance to the
  *    mesh; the bound must lie above it and within the 5 % it certifies to (plus the lattice's
  *    spacing).
+ *  - coplanar: a coarse square over a fine grid of it, with and without a hole in the grid.
  * What it catches: a bound that takes one corner's candidate for a piece whose other corners are
  * nearer other triangles (the paraboloid's value would fall below the lattice's), a piece left
  * out of the acceptance (an upper below the analytic maximum), a wrong Lipschitz fallback, a
@@ -223,6 +224,64 @@ static void test_coarse_against_fine(void **state)
     mesh_free(&fine);
 }
 
+/* The plane z = 0's grid with the squares of [-h, h]^2 taken out (h a multiple of the grid's
+ * step): a window in a wall. */
+static mesh plane_with_hole(double h)
+{
+    mesh m = height_field(NULL);
+    uint32_t kept = 0;
+    for (uint32_t t = 0; t < m.n_t; ++t) {
+        double c[2] = {0.0, 0.0};
+        for (int k = 0; k < 3; ++k)
+            for (int a = 0; a < 2; ++a)
+                c[a] += m.pos[3 * m.tri[3 * t + k] + a] / 3.0;
+        if (fabs(c[0]) < h && fabs(c[1]) < h)
+            continue;
+        for (int k = 0; k < 3; ++k)
+            m.tri[3 * kept + k] = m.tri[3 * t + k];
+        kept++;
+    }
+    m.n_t = kept;
+    return m;
+}
+
+/* Coplanar meshes (a wall and its decimated level): a coarse square over the fine grid of the
+ * same square is within rounding of it everywhere, certified without splitting it (the planar
+ * certificate: over the union of the fine triangles the distance is the heights'); a coarse
+ * square over a fine grid with a hole is as far from it as the hole's centre from its rim, which
+ * the bound must not miss. Certifying a piece inside the plane's union without checking the
+ * union's boundary (the hole's rim) gives 0 there; fails. */
+static void test_coplanar(void **state)
+{
+    (void)state;
+    double pos[12] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0}; /* the square, two triangles */
+    uint32_t tri[6] = {0, 1, 2, 0, 2, 3};
+    mesh square = {pos, tri, 4, 2};
+    mesh fine = height_field(NULL);
+    sw_lod_mesh_distance *df = tree_of(&fine);
+    const sw_lod_mesh_bound flat = bound_of(df, &square, 0.05, 1e-9, 12);
+    assert_true(flat.upper <= 1e-9);
+    assert_int_equal(flat.pieces, 2);
+    sw_lod_mesh_distance_free(df);
+    mesh_free(&fine);
+    /* the hole [-0.25, 0.25]^2 (the grid's step is 1/24): its centre is 0.25 from the rim */
+    mesh holed = plane_with_hole(0.25);
+    sw_lod_mesh_distance *dh = tree_of(&holed);
+    const double dense = lattice_max(dh, &square, 60);
+    const sw_lod_mesh_bound b = bound_of(dh, &square, 0.05, 1e-9, 12);
+    print_message("  holed: lattice %.9f\n", dense);
+    assert_true(dense >= 0.2499 && dense <= 0.25 + 1e-12);
+    assert_true(b.upper >= 0.25 - 1e-12 && b.upper <= 1.06 * 0.25);
+    /* the fine wall against the square: inside it everywhere (the rim's pieces too) */
+    sw_lod_mesh_distance *ds = tree_of(&square);
+    const sw_lod_mesh_bound back = bound_of(ds, &holed, 0.05, 1e-9, 12);
+    assert_true(back.upper <= 1e-9);
+    assert_int_equal(back.pieces, holed.n_t);
+    sw_lod_mesh_distance_free(ds);
+    sw_lod_mesh_distance_free(dh);
+    mesh_free(&holed);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -230,6 +289,7 @@ int main(void)
         cmocka_unit_test(test_far_corner),
         cmocka_unit_test(test_interior_maximum),
         cmocka_unit_test(test_coarse_against_fine),
+        cmocka_unit_test(test_coplanar),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
