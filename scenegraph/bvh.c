@@ -168,14 +168,31 @@ static int add_item(build *b, uint32_t face, const double world[12], const float
     return 1;
 }
 
+/* Per face, its control-net box once computed (NaN until then): NULL when out of memory. */
+static double *face_boxes_new(const sw_sg_scene *scene)
+{
+    const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
+    double *fb = sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double));
+    for (size_t i = 0; fb && i < 6 * (size_t)n_faces; ++i)
+        fb[i] = NAN;
+    return fb;
+}
+
+/* An occurrence's world box: its face's box (computed on first use) through world. */
+static void occurrence_box(const sw_sg_scene *scene, double *face_boxes, uint32_t face,
+                           const double world[12], double out[6])
+{
+    double *lb = face_boxes + 6 * (size_t)face;
+    if (isnan(lb[0]))
+        sw_sg_bvh_face_box(scene, face, lb);
+    sw_sg_box_transform(world, lb, out);
+}
+
 static int visit(void *ctx, uint32_t face, const double world[12], const float color[4])
 {
     build *b = ctx;
-    double *lb = b->face_box + 6 * (size_t)face;
-    if (isnan(lb[0]))
-        sw_sg_bvh_face_box(b->scene, face, lb);
     double box[6];
-    sw_sg_box_transform(world, lb, box);
+    occurrence_box(b->scene, b->face_box, face, world, box);
     return !add_item(b, face, world, color, box);
 }
 
@@ -301,14 +318,10 @@ static sw_result finish(build *b, sw_sg_bvh **out, sw_status *status)
 sw_result sw_sg_bvh_build(const sw_sg_scene *scene, sw_sg_bvh **out, sw_status *status)
 {
     *out = NULL;
-    const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    build b = {.scene = scene,
-               .face_box = sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double))};
+    build b = {.scene = scene, .face_box = face_boxes_new(scene)};
     box_empty(b.box);
     if (!b.face_box)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "BVH: out of memory");
-    for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
-        b.face_box[i] = NAN;
     sw_result r = sw_sg_scene_traverse(scene, visit, &b);
     sw__free(b.face_box);
     if (r != SW_OK || b.oom) {
@@ -332,11 +345,8 @@ static int visit_box(void *ctx, uint32_t face, const double world[12], const flo
 {
     (void)color;
     box_walk *w = ctx;
-    double *lb = w->face_box + 6 * (size_t)face;
-    if (isnan(lb[0]))
-        sw_sg_bvh_face_box(w->scene, face, lb);
     double box[6];
-    sw_sg_box_transform(world, lb, box);
+    occurrence_box(w->scene, w->face_box, face, world, box);
     box_union(w->box, box);
     w->n++;
     return 0;
@@ -345,12 +355,9 @@ static int visit_box(void *ctx, uint32_t face, const double world[12], const flo
 sw_result sw_sg_occurrences_box(const sw_sg_scene *scene, uint64_t *n, double box[6],
                                 sw_status *status)
 {
-    const uint32_t n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
-    box_walk w = {scene, sw__malloc((n_faces ? n_faces : 1) * 6 * sizeof(double)), 0, {0}};
+    box_walk w = {scene, face_boxes_new(scene), 0, {0}};
     if (!w.face_box)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occurrence box: out of memory");
-    for (size_t i = 0; i < 6 * (size_t)n_faces; ++i)
-        w.face_box[i] = NAN;
     box_empty(w.box);
     sw_result r = sw_sg_scene_traverse(scene, visit_box, &w);
     sw__free(w.face_box);
