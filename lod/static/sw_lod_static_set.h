@@ -77,11 +77,12 @@ typedef struct sw_lod_static_instance {
 } sw_lod_static_instance;
 
 /* The unit instances and their BVH (sw_sg_bvh.h). bvh->items[k] is instance
- * instances[bvh->items[k].face] with its transform (world) and box: the unit's box, or the lone
- * face's control-net box (sw_sg_bvh_face_box), through the transform (sw_sg_box_transform);
- * colour unset. face_boxes: sw_sg_bvh_face_box of every face (6 doubles each), so that a frame
- * boxes an occurrence exactly as the face-occurrence BVH (sw_sg_bvh_build) does. scene_box: the
- * world box of every face occurrence so boxed, the root box of that BVH. */
+ * instances[bvh->items[k].face]; sw_sg_bvh_item_at gives its transform (world) and box: the
+ * unit's box, or the lone face's control-net box (sw_sg_bvh_face_box), through the transform
+ * (sw_sg_box_transform), as the BVH stores it (rounded outward); colour unset. face_boxes:
+ * sw_sg_bvh_face_box of every face (6 doubles each), so that a frame boxes an occurrence exactly
+ * as the face-occurrence BVH (sw_sg_bvh_build) does. scene_box: the world box of every face
+ * occurrence so boxed, the exact box (bvh->box) of that BVH. */
 typedef struct sw_lod_static_instances {
     const sw_sg_bvh *bvh;
     const sw_lod_static_instance *instances;
