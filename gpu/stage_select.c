@@ -65,15 +65,7 @@ double sw__fr_unit_tolerance(const sw__fr_env *env, const double obj_box[6], con
     return eps_world / sw__fr_stretch_bound(m);
 }
 
-/* A static level is drawn only when it has at most this many triangles per Bézier patch: its
- * vertices are sent every frame, while the per-frame path evaluates each patch's grid in the
- * vertex shader from 16 control points, so a fine static level (a rigorous level 0 has 100-500
- * per patch on the sample models) costs more than the patches it replaces; the per-frame
- * path drew ~40 per patch on the 64-CrankArm grid's orbit. Kumar §4 meant static LODs for the far
- * field, where few triangles do. */
-static const double k_static_max_tri_per_patch = 24.0;
-
-/* Coarsest level within tol, -1 when none. */
+/* Coarsest level within tol that is kept, -1 when none. */
 static int32_t level_within(const sw_lod_static_chain *c, double tol)
 {
     for (int32_t k = c->n_levels - 1; k >= 0; --k)
@@ -82,13 +74,26 @@ static int32_t level_within(const sw_lod_static_chain *c, double tol)
     return -1;
 }
 
-/* The level to draw for tol: the coarsest within it, if cheap enough (see above). */
+/* The level to draw for tol: the coarsest within it, if cheap enough (sw_lod_static.h says why
+ * finer ones are not drawn). */
 static int32_t level_to_draw(const sw_lod_static_chain *c, double tol)
 {
     const int32_t k = level_within(c, tol);
-    if (k < 0 || c->levels[k].n_triangles > k_static_max_tri_per_patch * c->n_patches)
-        return -1;
-    return k;
+    return k >= 0 && sw_lod_static_level_drawable(c, k) ? k : -1;
+}
+
+/* Tests: the choice-th kept level of those within tol, -1 (the per-frame path) for
+ * choice == their count; choice taken modulo count + 1. */
+static int32_t forced_level(const sw_lod_static_chain *c, double tol, uint32_t choice)
+{
+    int32_t kept[SW_LOD_CACHE_MAX_LEVELS];
+    uint32_t n = 0;
+    const int32_t w = level_within(c, tol);
+    for (int32_t k = 0; k <= w && n < SW_LOD_CACHE_MAX_LEVELS; ++k)
+        if (c->levels[k].n_triangles > 0)
+            kept[n++] = k;
+    choice %= n + 1;
+    return choice == n ? -1 : kept[choice];
 }
 
 /* The chain to use, asked for when missing: walkthrough frames only queue the build (drawn by
@@ -124,14 +129,12 @@ static int32_t choose_level(const sw__fr_env *env, uint32_t unit, const double m
     const double tol = sw__fr_unit_tolerance(env, un->box, m, extent_px);
     if (env->static_force > 0) {
         /* tests: neighbours at different levels, each within the view's tolerance, and beside
-         * the per-frame path: unit i takes choice (i + k) mod (valid levels + 1) */
+         * the per-frame path: unit i takes choice i + k among the kept levels within it */
         const sw_lod_static_chain *c = unit_chain(env, unit, st);
         if (!c)
             return -1;
-        const uint32_t n_valid = (uint32_t)(level_within(c, tol) + 1);
-        const uint32_t k = (unit + (uint32_t)env->static_force) % (n_valid + 1);
         *chain = c;
-        return k == n_valid ? -1 : (int32_t)k;
+        return forced_level(c, tol, unit + (uint32_t)env->static_force);
     }
     if (un->delta > tol)
         return -1; /* not even level 0 would do: do not build it for this view */

@@ -53,6 +53,31 @@ size_t sw_lod_static_memory(const sw_lod_static_chain *chain)
     return b;
 }
 
+int sw_lod_static_level_drawable(const sw_lod_static_chain *c, int32_t k)
+{
+    const uint32_t n = c->levels[k].n_triangles;
+    return n > 0 && n <= SW_LOD_STATIC_MAX_DRAWN_TRIANGLES_PER_PATCH * c->n_patches;
+}
+
+size_t sw_lod_static_drop_undrawn(sw_lod_static_chain *c)
+{
+    size_t freed = 0;
+    for (int32_t k = 0; k < c->n_levels; ++k) {
+        sw_lod_static_level *l = &c->levels[k];
+        if (l->n_triangles == 0 || sw_lod_static_level_drawable(c, k))
+            continue;
+        freed += (size_t)l->n_vertices * SW_LOD_STATIC_VERTEX_BYTES +
+                 (size_t)l->n_triangles * SW_LOD_STATIC_TRIANGLE_BYTES;
+        const sw_lod_static_level kept = {.eps = l->eps,
+                                          .eps_target = l->eps_target,
+                                          .bound = {l->bound[0], l->bound[1]},
+                                          .n_triangles_dropped = l->n_triangles};
+        sw__sl_level_free(l);
+        *l = kept;
+    }
+    return freed;
+}
+
 double sw_lod_static_default_delta(const double box[6])
 {
     const double d = SW_LOD_STATIC_DELTA_REL * sqrt((box[3] - box[0]) * (box[3] - box[0]) +

@@ -66,8 +66,8 @@ typedef struct writer {
 
 static void put(writer *w, const void *data, size_t n)
 {
-    if (w->oom)
-        return;
+    if (w->oom || n == 0)
+        return; /* n == 0: data may be NULL (an empty level's arrays) */
     if (w->n + n > w->cap) {
         size_t cap = w->cap ? w->cap : 4096;
         while (cap < w->n + n)
@@ -246,6 +246,8 @@ static sw_result read_level(reader *r, const sw_lod_static_set *set, const sw_lo
     if (!finite_all(d, 4) || !(l->eps >= 0.0))
         return bad(r, "a level's ε is not a finite non-negative number", NULL);
     const uint64_t nv = l->n_vertices, nt = l->n_triangles;
+    if (nv == 0 && nt == 0)
+        return SW_OK; /* a level not stored (finer than a frame draws): its ε alone */
     if (!(l->positions = take_array(r, 3 * nv, sizeof *l->positions)) ||
         !(l->normals = take_array(r, 3 * nv, sizeof *l->normals)) ||
         !(l->uv = take_array(r, 2 * nv, sizeof *l->uv)) ||
@@ -287,6 +289,8 @@ static sw_result read_chain(reader *r, const sw_lod_static_set *set, uint32_t un
         if (res != SW_OK)
             return res;
     }
+    sw__lod_static_set_trim(set, c); /* now, not at adoption: a cache written before levels
+                                        were dropped is not held whole while it is parsed */
     return SW_OK;
 }
 
@@ -372,6 +376,7 @@ static sw_result summarize_level(reader *r, int32_t k, sw_lod_static_cache_summa
         return bad(r, "a level's ε is not a finite non-negative number", NULL);
     if (!skip(r, nv, SW_LOD_STATIC_VERTEX_BYTES) || !skip(r, nt, SW_LOD_STATIC_TRIANGLE_BYTES))
         return bad(r, "a level's arrays run past the end", NULL);
+    out->level_dropped[k] += nv == 0 && nt == 0;
     const int first = out->level_chains[k]++ == 0;
     out->level_vertices[k] += nv;
     out->level_triangles[k] += nt;

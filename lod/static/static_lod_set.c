@@ -31,6 +31,7 @@ struct sw_lod_static_set {
     const sw_sg_scene *scene;
     sw_th_pool *pool;
     sw_lod_static_desc levels;
+    int keep_undrawn; /* sw_lod_static_set_desc */
     sw_lod_supersurfaces *ss;
     uint32_t n_faces;
     uint32_t *unit_of_face;       /* n_faces */
@@ -432,6 +433,7 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     s->scene = scene;
     s->pool = pool;
     s->serial = atomic_fetch_add(&g_set_serial, 1) + 1;
+    s->keep_undrawn = desc && desc->keep_undrawn;
     s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     /* resolved now: the cache key (lod/static/static_lod_io.c) hashes the values the chains get */
     sw_result r = sw_lod_static_desc_resolve(desc ? &desc->levels : NULL, &s->levels, status);
@@ -572,8 +574,16 @@ sw_result sw_lod_static_set_failure(const sw_lod_static_set *s, uint32_t unit, c
 /* ---- builds -----------------------------------------------------------------------------------
  */
 
-static void publish(slot *sl, sw_lod_static_chain *chain)
+void sw__lod_static_set_trim(const sw_lod_static_set *s, sw_lod_static_chain *chain)
 {
+    if (!s->keep_undrawn)
+        sw_lod_static_drop_undrawn(chain);
+}
+
+/* The levels no frame draws are dropped first: a chain is read by frames only. */
+static void publish(sw_lod_static_set *s, slot *sl, sw_lod_static_chain *chain)
+{
+    sw__lod_static_set_trim(s, chain);
     atomic_store_explicit(&sl->chain, chain, memory_order_release);
     atomic_store_explicit(&sl->state, SW_LOD_STATIC_READY, memory_order_release);
 }
@@ -602,7 +612,7 @@ static void build_task(void *ctx)
     atomic_fetch_add(&s->build_ns, sw__clock_ns() - t0);
     atomic_fetch_add(&s->n_builds, 1);
     if (r == SW_OK) {
-        publish(sl, chain);
+        publish(s, sl, chain);
         return;
     }
     sl->failure = st;
@@ -670,7 +680,7 @@ sw_result sw_lod_static_set_adopt(sw_lod_static_set *s, uint32_t unit, sw_lod_st
         sw_lod_static_free(chain);
         return SW_ERR_INVALID_ARGUMENT;
     }
-    publish(sl, chain);
+    publish(s, sl, chain);
     atomic_fetch_add(&s->n_adopted, 1);
     return SW_OK;
 }

@@ -78,6 +78,8 @@ typedef struct sw_lod_static_level {
     double bound[2];   /* certified upper bounds of the one-sided distances level -> level 0 and
                           level 0 -> level (sw_lod_mesh_distance_bound; 0 for level 0). The first
                           is certified only down to the second, which is all ε_k needs. */
+    uint32_t n_triangles_dropped; /* triangles the level had when its arrays were dropped
+                          (sw_lod_static_drop_undrawn: it is then empty, its ε kept); 0 else */
 } sw_lod_static_level;
 
 typedef struct sw_lod_static_chain {
@@ -144,6 +146,26 @@ enum { SW_LOD_STATIC_VERTEX_BYTES = 56, SW_LOD_STATIC_TRIANGLE_BYTES = 12 };
 
 /* Bytes the chain owns. */
 size_t sw_lod_static_memory(const sw_lod_static_chain *chain);
+
+/* A frame draws a static level only when it has at most this many triangles per Bézier patch:
+ * its vertices are sent every frame, while the per-frame path evaluates each patch's grid in the
+ * vertex shader from 16 control points, so a fine static level (a rigorous level 0 has 100-500
+ * per patch on the sample models) costs more than the patches it replaces; the per-frame path
+ * drew ~40 per patch on the 64-CrankArm grid's orbit. Kumar §4 meant static LODs for the far
+ * field, where few triangles do. */
+#define SW_LOD_STATIC_MAX_DRAWN_TRIANGLES_PER_PATCH 24.0
+
+/* Whether a frame may draw level k of the chain: it is kept and within the limit above. */
+int sw_lod_static_level_drawable(const sw_lod_static_chain *chain, int32_t k);
+
+/* Frees the arrays of every level no frame draws (finer than the limit above: level 0 of most
+ * chains, which exists to decimate and certify the others from), keeping each one's ε, bounds and
+ * former triangle count (n_triangles_dropped); such a level is then empty (0 vertices, 0
+ * triangles), in memory and in a LOD cache written from it. On the 10^6-surface building this is
+ * half of the cache. Levels only get coarser with k, so a frame's choice is unchanged: the
+ * coarsest level within its tolerance was finer than it draws, or is still there. Returns the
+ * bytes freed. */
+size_t sw_lod_static_drop_undrawn(sw_lod_static_chain *chain);
 
 /* How the two-sided distance is sampled. Zero fields take the defaults. */
 typedef struct sw_lod_static_measure_desc {

@@ -98,6 +98,8 @@ typedef struct sw_lod_static_set_desc {
     sw_lod_ss_desc clustering; /* §3 */
     sw_lod_static_desc levels; /* §4.1-§4.2; delta 0 = per unit, SW_LOD_STATIC_DELTA_REL x its
                                   diagonal */
+    int keep_undrawn; /* 1: chains keep the levels no frame draws (sw_lod_static_drop_undrawn),
+                         for tests that force them into a frame to check their joins */
 } sw_lod_static_set_desc;
 
 typedef struct sw_lod_static_set_stats {
@@ -130,6 +132,8 @@ uint64_t sw_lod_static_set_serial(const sw_lod_static_set *set);
 const sw_sg_scene *sw_lod_static_set_scene(const sw_lod_static_set *set);
 /* The level settings the set builds with (its desc's, zero fields as given). */
 const sw_lod_static_desc *sw__lod_static_set_levels(const sw_lod_static_set *set);
+/* A chain about to be published: its undrawn levels dropped unless the set keeps them. */
+void sw__lod_static_set_trim(const sw_lod_static_set *set, sw_lod_static_chain *chain);
 /* The unit of `face`, SW_LOD_STATIC_NO_UNIT for a face out of range. */
 uint32_t sw_lod_static_set_unit_of(const sw_lod_static_set *set, uint32_t face);
 const sw_lod_static_unit *sw_lod_static_set_unit(const sw_lod_static_set *set, uint32_t unit);
@@ -165,7 +169,9 @@ void sw_lod_static_set_get_stats(const sw_lod_static_set *set, sw_lod_static_set
  *   1: a chain follows): i32 levels, u32 patches, f64 δ, and per level u32 vertices, u32
  *   triangles, f64 ε, ε_target, bound[2] (the certified distances to and from level 0), then
  * positions (f64 x 3), normals (f32 x 3), (u, v) (f64 x 2), faces (u32) per vertex and the
- * triangles (u32 x 3); little-endian. The key hashes the units (their faces and patches) and the
+ * triangles (u32 x 3); little-endian. A level no frame draws is stored empty, its ε kept
+ * (sw_lod_static_drop_undrawn); a reader drops such levels of an older cache as it reads them.
+ * The key hashes the units (their faces and patches) and the
  * level settings, so a cache made for another clustering, scene or setting is refused rather than
  * misread. */
 
@@ -198,6 +204,8 @@ typedef struct sw_lod_static_cache_summary {
     sw_lod_static_cache_settings settings;
     double delta_min, delta_max; /* level 0's rigorous bound δ over the chains (object units) */
     uint32_t level_chains[SW_LOD_CACHE_MAX_LEVELS];
+    uint32_t level_dropped[SW_LOD_CACHE_MAX_LEVELS]; /* of those, stored empty: finer than a
+                                                        frame draws (sw_lod_static_drop_undrawn) */
     uint64_t level_vertices[SW_LOD_CACHE_MAX_LEVELS], level_triangles[SW_LOD_CACHE_MAX_LEVELS];
     double level_eps_min[SW_LOD_CACHE_MAX_LEVELS], level_eps_max[SW_LOD_CACHE_MAX_LEVELS];
 } sw_lod_static_cache_summary;

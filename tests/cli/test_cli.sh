@@ -269,14 +269,19 @@ vfaces=$(sed -n 's/.*"faces": \([0-9]*\),.*/\1/p' v1.json)
 pass "generate vehicle: usage errors, missing data, 1000 surfaces ($vfaces unique), BREP read back, rendered"
 
 # info and the static LOD cache of a .sws: "none" before build-lod; after it, per level the
-# triangles build-lod itself reported (catches: info reading the section wrongly, or not at all)
+# triangles build-lod itself reported stored (catches: info reading the section wrongly, or not at
+# all); and a level finer than a frame draws not stored (catches: every level written whole)
 "$sw" import "$data/occ/Pump_Nut.brep" -o nut.sws >/dev/null 2>&1 || fail "import Pump_Nut"
 "$sw" info nut.sws | grep -q "^  LOD cache       none" || fail "info: a scene without LODs not said"
 "$sw" info nut.sws --json | grep -q '"lod_cache": null}' || fail "info --json: no lod_cache null"
 "$sw" build-lod nut.sws >lods.txt 2>&1 || { fail "build-lod nut.sws"; cat lods.txt; }
-built=$(awk '$1 ~ /^[0-9]$/ && $4 == "%" { printf "%s:%s ", $1, $2 }' lods.txt)
+built=$(awk '$1 ~ /^[0-9]$/ && $4 == "%" { printf "%s:%s ", $1, $NF }' lods.txt)
 shown=$("$sw" info nut.sws | awk '$1 == "level" { printf "%s:%s ", $2, $5 }')
 [ -n "$built" ] && [ "$built" = "$shown" ] || fail "info's LOD levels '$shown', build-lod's '$built'"
+awk '$1 == "0" && $4 == "%" { exit !($2 > 0 && $NF < $2) }' lods.txt ||
+  fail "build-lod stored all of level 0 (it is never drawn)"
+"$sw" info nut.sws | grep -q "^    level 0 .*not stored: finer than a frame draws" ||
+  fail "info: levels not stored not said"
 "$sw" info nut.sws --json | python3 -c 'import json, sys; c = json.load(sys.stdin)["lod_cache"]; sys.exit(not (c["chains"] > 0 and len(c["levels"]) == 5))' ||
   fail "info --json: lod_cache"
 pass "info: the LOD cache (none; then levels $shown as build-lod built them)"

@@ -85,6 +85,11 @@ static int check_bounds(const sw_lod_static_set *set, const sw_sg_scene *scene)
         const sw_lod_static_patch *p = sw_lod_static_set_patches(set) + un->first_patch;
         for (int32_t k = 0; c && k < c->n_levels; ++k) {
             const sw_lod_static_level *l = &c->levels[k];
+            CHECK(l->n_triangles == 0 || sw_lod_static_level_drawable(c, k),
+                  "unit %u level %d: %u triangles over %u patches kept, finer than a frame draws",
+                  u, k, l->n_triangles, c->n_patches);
+            if (l->n_triangles == 0)
+                continue; /* not kept: no frame draws it */
             const sw_lod_static_measure_desc md = {4391u + (uint32_t)k, 11, 5, 1};
             sw_lod_static_distance d;
             sw_status st = {0};
@@ -115,12 +120,14 @@ static int chains_equal(const sw_lod_static_chain *a, const sw_lod_static_chain 
     for (int32_t k = 0; k < a->n_levels; ++k) {
         const sw_lod_static_level *x = &a->levels[k], *y = &b->levels[k];
         const size_t nv = x->n_vertices;
-        if (x->n_vertices != y->n_vertices || x->n_triangles != y->n_triangles || x->eps != y->eps ||
-            memcmp(x->positions, y->positions, 3 * nv * sizeof(double)) ||
-            memcmp(x->normals, y->normals, 3 * nv * sizeof(float)) ||
-            memcmp(x->uv, y->uv, 2 * nv * sizeof(double)) ||
-            memcmp(x->face, y->face, nv * sizeof(uint32_t)) ||
-            memcmp(x->triangles, y->triangles, 3 * (size_t)x->n_triangles * sizeof(uint32_t)))
+        if (x->n_vertices != y->n_vertices || x->n_triangles != y->n_triangles || x->eps != y->eps)
+            return 0;
+        if (nv &&
+            (memcmp(x->positions, y->positions, 3 * nv * sizeof(double)) ||
+             memcmp(x->normals, y->normals, 3 * nv * sizeof(float)) ||
+             memcmp(x->uv, y->uv, 2 * nv * sizeof(double)) ||
+             memcmp(x->face, y->face, nv * sizeof(uint32_t)) ||
+             memcmp(x->triangles, y->triangles, 3 * (size_t)x->n_triangles * sizeof(uint32_t))))
             return 0;
     }
     return 1;

@@ -43,8 +43,10 @@ struct sw_lod_static_set *sw_test_hierarchies_statics(sw_test_hierarchies *h)
 {
     sw_status st = {0};
     (void)sw_lod_build_install(); /* the levels are built by the LOD-building module */
+    /* every level kept: the tests force fine ones into frames to check their joins */
+    const sw_lod_static_set_desc desc = {.keep_undrawn = 1};
     if (h && !h->statics &&
-        sw_lod_static_set_create(h->scene, h->pool, NULL, &h->statics, &st) != SW_OK)
+        sw_lod_static_set_create(h->scene, h->pool, &desc, &h->statics, &st) != SW_OK)
         fprintf(stderr, "static LODs: %s\n", st.message);
     return h ? h->statics : NULL;
 }

@@ -22,9 +22,11 @@ static const char k_usage[] =
     "renamed over OUT), so that `profile`, `view` and `render` start from them instead of\n"
     "building them (walkthroughs build what is missing in the background; `render` uses static\n"
     "LODs by default only when the file has them).\n"
-    "Prints, per level, the triangles against level 0 (the exact adaptive tessellation) and the\n"
-    "declared errors; a progress bar on stderr. A super-surface whose build fails is named and\n"
-    "drawn by the per-frame path; the others are kept.\n"
+    "Prints, per level, the triangles against level 0 (the exact adaptive tessellation), the\n"
+    "declared errors and the triangles stored (a level finer than any frame draws, more than\n"
+    "24 triangles per Bézier patch, is stored as its error alone); a progress bar on stderr.\n"
+    "A super-surface whose build fails is named and drawn by the per-frame path; the others are\n"
+    "kept.\n"
     "\n"
     "options:\n"
     "  -o, --output FILE   the .sws to write (default: SCENE itself; SCENE must then be a .sws)\n"
@@ -87,7 +89,8 @@ static void build_all(sw_lod_static_set *set)
 }
 
 typedef struct level_sum {
-    uint64_t triangles;
+    uint64_t triangles; /* as built, kept or not */
+    uint64_t kept;      /* in levels a frame draws, which the cache stores */
     double eps_rel_max; /* declared ε / δ, largest */
     uint32_t chains;
 } level_sum;
@@ -108,7 +111,8 @@ static void print_summary(const sw_lod_static_set *set, uint64_t patches)
             continue;
         }
         for (int32_t k = 0; k < c->n_levels && k < 9; ++k) {
-            sum[k].triangles += c->levels[k].n_triangles;
+            sum[k].triangles += c->levels[k].n_triangles + c->levels[k].n_triangles_dropped;
+            sum[k].kept += c->levels[k].n_triangles;
             sum[k].chains++;
             const double rel = c->levels[k].eps / c->delta;
             sum[k].eps_rel_max = rel > sum[k].eps_rel_max ? rel : sum[k].eps_rel_max;
@@ -116,11 +120,14 @@ static void print_summary(const sw_lod_static_set *set, uint64_t patches)
     }
     printf("%u super-surfaces of whole faces (%llu Bézier patches), %u built, %u failed\n", n,
            (unsigned long long)patches, n - failed, failed);
-    printf("level  triangles   vs level 0   per patch   largest declared ε / δ\n");
+    printf(
+        "level  triangles   vs level 0   per patch   largest declared ε / δ   stored triangles\n");
     for (int k = 0; k < 9 && sum[k].chains; ++k)
-        printf("%5d  %9llu   %9.1f %%   %9.2f   %8.1f\n", k, (unsigned long long)sum[k].triangles,
+        printf("%5d  %9llu   %9.1f %%   %9.2f   %8.1f                 %9llu\n", k,
+               (unsigned long long)sum[k].triangles,
                100.0 * (double)sum[k].triangles / (double)(sum[0].triangles ? sum[0].triangles : 1),
-               (double)sum[k].triangles / (double)(patches ? patches : 1), sum[k].eps_rel_max);
+               (double)sum[k].triangles / (double)(patches ? patches : 1), sum[k].eps_rel_max,
+               (unsigned long long)sum[k].kept);
 }
 
 static sw_result write_cache(sw_sg_scene *sg, const sw_lod_static_set *set, const char *out,

@@ -193,12 +193,16 @@ static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t
            delta, (int)d->n_levels, d->eps_first, d->eps_growth,
            c->settings.eps_rule == SW_LOD_STATIC_EPS_RULE ? "certified" : "of another rule",
            d->max_vertices_per_patch, d->max_vertices);
-    for (uint32_t k = 0; k < c->max_levels; ++k)
+    for (uint32_t k = 0; k < c->max_levels; ++k) {
         printf("    level %u       %u super-surfaces, %llu triangles, %llu vertices, %.2f MiB, ε "
-               "%g-%g\n",
+               "%g-%g",
                k, c->level_chains[k], (unsigned long long)c->level_triangles[k],
                (unsigned long long)c->level_vertices[k], level_bytes(c, k) / (1024.0 * 1024.0),
                c->level_eps_min[k], c->level_eps_max[k]);
+        if (c->level_dropped[k])
+            printf(" (%u of them not stored: finer than a frame draws)", c->level_dropped[k]);
+        printf("\n");
+    }
 }
 
 static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes,
@@ -223,11 +227,11 @@ static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t
            c->settings.eps_rule == SW_LOD_STATIC_EPS_RULE ? "true" : "false", d->max_vertices,
            d->max_vertices_per_patch);
     for (uint32_t k = 0; k < c->max_levels; ++k)
-        printf("%s{\"chains\": %u, \"triangles\": %llu, \"vertices\": %llu, \"bytes\": %.0f, "
-               "\"eps_min\": %.17g, \"eps_max\": %.17g}",
-               k ? ", " : "", c->level_chains[k], (unsigned long long)c->level_triangles[k],
-               (unsigned long long)c->level_vertices[k], level_bytes(c, k), c->level_eps_min[k],
-               c->level_eps_max[k]);
+        printf("%s{\"chains\": %u, \"not_stored\": %u, \"triangles\": %llu, \"vertices\": %llu, "
+               "\"bytes\": %.0f, \"eps_min\": %.17g, \"eps_max\": %.17g}",
+               k ? ", " : "", c->level_chains[k], c->level_dropped[k],
+               (unsigned long long)c->level_triangles[k], (unsigned long long)c->level_vertices[k],
+               level_bytes(c, k), c->level_eps_min[k], c->level_eps_max[k]);
     printf("]}");
 }
 
