@@ -300,6 +300,11 @@ sw_result sw_sg_scene_save_lods(sw_sg_scene *scene, const char *path, const void
  * section: a scene in memory or a file without one), SW_ERR_CHECKSUM. Any thread. */
 sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *size,
                            sw_status *status);
+/* Hands the memory of the LODS section's pages back once its reader has decoded it (they are
+ * read from the file again if it is read again: *data of sw_sg_scene_lods stays valid). The
+ * checksum pass of sw_sg_scene_lods already does so behind itself. No-op for a scene in memory.
+ * Any thread. */
+void sw_sg_scene_lods_release(const sw_sg_scene *scene);
 /* Maps a .sws file. Checks the header, version, the section table and that the file is as long as
  * the table says (a short mapping would raise SIGBUS); checksums are verified per section by
  * sw_sg_scene_require. Opens without blocking and accepts a regular file only

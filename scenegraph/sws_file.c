@@ -575,6 +575,27 @@ static sw_result write_body(sw__out *out, const unsigned char *head, uint64_t he
     return r;
 }
 
+/* Hands the whole pages of [p, p + n) of a mapped scene back to the kernel: a read-only
+ * private file mapping reads them from the file again if they are touched again. */
+static void release_pages(const sw_sg_scene *scene, const unsigned char *p, size_t n)
+{
+    if (!scene->map || scene->map_on_heap || n == 0)
+        return;
+    const long ps = sysconf(_SC_PAGESIZE);
+    const uintptr_t page = ps > 0 ? (uintptr_t)ps : 4096u;
+    const uintptr_t a = ((uintptr_t)p + page - 1) & ~(page - 1);
+    const uintptr_t b = ((uintptr_t)p + n) & ~(page - 1);
+    if (b > a)
+        (void)madvise((void *)a, b - a, MADV_DONTNEED); /* advice: a failure only keeps them */
+}
+
+void sw_sg_scene_lods_release(const sw_sg_scene *scene)
+{
+    const sw__sg_section_info *e = &scene->sec[SWS_SEC_LODS];
+    if (scene->map && e->size)
+        release_pages(scene, (const unsigned char *)scene->map + e->offset, (size_t)e->size);
+}
+
 sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *size,
                            sw_status *status)
 {
@@ -584,7 +605,15 @@ sw_result sw_sg_scene_lods(const sw_sg_scene *scene, const void **data, size_t *
     if (!scene->map || e->size == 0)
         return sw__fail(status, SW_ERR_NOT_FOUND, "%s: no LODS section", scene->path);
     const unsigned char *p = (const unsigned char *)scene->map + e->offset;
-    const uint32_t crc = sw__crc32c(0, p, e->size);
+    /* in steps whose pages are handed back behind the sum: a cache of a million surfaces is
+     * hundreds of MiB that its reader decodes into memory of its own right after */
+    enum { STEP = 16u << 20 };
+    uint32_t crc = 0;
+    for (uint64_t at = 0; at < e->size; at += STEP) {
+        const size_t n = (size_t)(e->size - at < STEP ? e->size - at : STEP);
+        crc = sw__crc32c(crc, p + at, n);
+        release_pages(scene, p + at, n);
+    }
     if (crc != e->checksum)
         return sw__fail(status, SW_ERR_CHECKSUM,
                         "%s: section LODS at offset %llu: checksum mismatch (stored 0x%08x, "

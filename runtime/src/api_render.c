@@ -527,8 +527,10 @@ static void statics_task(void *ctx)
         atomic_store(&r->statics_state, 3);
         return;
     }
-    if (found == SW_OK)
+    if (found == SW_OK) {
         found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &cst);
+        sw_sg_scene_lods_release(r->cache_scene->sg); /* decoded (or refused): its pages go */
+    }
     if (found == SW_ERR_NOT_FOUND)
         sw__log(SW_LOG_WARN,
                 "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
