@@ -40,6 +40,13 @@ void sw_lod_static_free(sw_lod_static_chain *chain)
     sw__free(chain);
 }
 
+/* A level's arrays' bytes, in memory and in a LOD cache alike. */
+static size_t level_bytes(const sw_lod_static_level *l)
+{
+    return (size_t)l->n_vertices * SW_LOD_STATIC_VERTEX_BYTES +
+           (size_t)l->n_triangles * SW_LOD_STATIC_TRIANGLE_BYTES;
+}
+
 size_t sw_lod_static_memory(const sw_lod_static_chain *chain)
 {
     if (!chain)
@@ -47,8 +54,7 @@ size_t sw_lod_static_memory(const sw_lod_static_chain *chain)
     size_t b = sizeof *chain + (size_t)chain->n_levels * sizeof *chain->levels;
     for (int32_t k = 0; k < chain->n_levels; ++k) {
         const sw_lod_static_level *l = &chain->levels[k];
-        b += (size_t)l->n_vertices * SW_LOD_STATIC_VERTEX_BYTES +
-             (size_t)l->n_triangles * SW_LOD_STATIC_TRIANGLE_BYTES;
+        b += level_bytes(l);
     }
     return b;
 }
@@ -59,22 +65,48 @@ int sw_lod_static_level_drawable(const sw_lod_static_chain *c, int32_t k)
     return n > 0 && n <= SW_LOD_STATIC_MAX_DRAWN_TRIANGLES_PER_PATCH * c->n_patches;
 }
 
+/* Whether two levels hold the same mesh, bit for bit (a decimation that found nothing to
+ * collapse: the borders are locked, and a plane's two triangles stay two). */
+static int same_mesh(const sw_lod_static_level *a, const sw_lod_static_level *b)
+{
+    const size_t nv = a->n_vertices;
+    return a->n_vertices == b->n_vertices && a->n_triangles == b->n_triangles && nv > 0 &&
+           memcmp(a->positions, b->positions, 3 * nv * sizeof *a->positions) == 0 &&
+           memcmp(a->normals, b->normals, 3 * nv * sizeof *a->normals) == 0 &&
+           memcmp(a->uv, b->uv, 2 * nv * sizeof *a->uv) == 0 &&
+           memcmp(a->face, b->face, nv * sizeof *a->face) == 0 &&
+           memcmp(a->triangles, b->triangles, 3 * (size_t)a->n_triangles * sizeof *a->triangles) ==
+               0;
+}
+
+/* Level l's arrays freed, its ε and bounds kept. */
+static size_t drop_level(sw_lod_static_level *l)
+{
+    const size_t freed = level_bytes(l);
+    const sw_lod_static_level kept = {.eps = l->eps,
+                                      .eps_target = l->eps_target,
+                                      .bound = {l->bound[0], l->bound[1]},
+                                      .n_triangles_dropped = l->n_triangles};
+    sw__sl_level_free(l);
+    *l = kept;
+    return freed;
+}
+
 size_t sw_lod_static_drop_undrawn(sw_lod_static_chain *c)
 {
     size_t freed = 0;
-    for (int32_t k = 0; k < c->n_levels; ++k) {
-        sw_lod_static_level *l = &c->levels[k];
-        if (l->n_triangles == 0 || sw_lod_static_level_drawable(c, k))
-            continue;
-        freed += (size_t)l->n_vertices * SW_LOD_STATIC_VERTEX_BYTES +
-                 (size_t)l->n_triangles * SW_LOD_STATIC_TRIANGLE_BYTES;
-        const sw_lod_static_level kept = {.eps = l->eps,
-                                          .eps_target = l->eps_target,
-                                          .bound = {l->bound[0], l->bound[1]},
-                                          .n_triangles_dropped = l->n_triangles};
-        sw__sl_level_free(l);
-        *l = kept;
+    for (int32_t k = c->n_levels - 1; k >= 1; --k) {
+        sw_lod_static_level *l = &c->levels[k], *finer = &c->levels[k - 1];
+        if (same_mesh(l, finer)) {
+            /* both ε bound the one mesh: the finer level keeps the smaller, so that every
+             * tolerance that took level k takes the same mesh as level k - 1 */
+            finer->eps = fmin(finer->eps, l->eps);
+            freed += drop_level(l);
+        }
     }
+    for (int32_t k = 0; k < c->n_levels; ++k)
+        if (c->levels[k].n_triangles > 0 && !sw_lod_static_level_drawable(c, k))
+            freed += drop_level(&c->levels[k]);
     return freed;
 }
 

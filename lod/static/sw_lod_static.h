@@ -158,13 +158,15 @@ size_t sw_lod_static_memory(const sw_lod_static_chain *chain);
 /* Whether a frame may draw level k of the chain: it is kept and within the limit above. */
 int sw_lod_static_level_drawable(const sw_lod_static_chain *chain, int32_t k);
 
-/* Frees the arrays of every level no frame draws (finer than the limit above: level 0 of most
- * chains, which exists to decimate and certify the others from), keeping each one's ε, bounds and
- * former triangle count (n_triangles_dropped); such a level is then empty (0 vertices, 0
- * triangles), in memory and in a LOD cache written from it. On the 10^6-surface building this is
- * half of the cache. Levels only get coarser with k, so a frame's choice is unchanged: the
- * coarsest level within its tolerance was finer than it draws, or is still there. Returns the
- * bytes freed. */
+/* Frees the arrays of every level no frame draws, keeping each one's ε, bounds and former
+ * triangle count (n_triangles_dropped); such a level is then empty (0 vertices, 0 triangles), in
+ * memory and in a LOD cache written from it. Two kinds: a level finer than the limit above (level
+ * 0 of most chains, which exists to decimate and certify the others from; levels only get
+ * coarser with k, so the coarsest level within a tolerance was finer than a frame draws or is
+ * still there), and a level whose mesh is the next finer level's, bit for bit (a decimation with
+ * nothing to collapse: a plane's two triangles), whose ε the finer one takes when smaller, so
+ * that a frame draws the same mesh. On the 10^6-surface building the first kind is half of the
+ * cache. Returns the bytes freed. */
 size_t sw_lod_static_drop_undrawn(sw_lod_static_chain *chain);
 
 /* How the two-sided distance is sampled. Zero fields take the defaults. */

@@ -75,15 +75,54 @@ static void check_units(const sw_lod_static_set *set, const sw_sg_scene *scene)
     free(seen);
 }
 
+/* The same mesh, bit for bit (ε not compared). */
+static int meshes_equal(const sw_lod_static_level *x, const sw_lod_static_level *y)
+{
+    const size_t nv = x->n_vertices;
+    if (x->n_vertices != y->n_vertices || x->n_triangles != y->n_triangles)
+        return 0;
+    return nv == 0 ||
+           !(memcmp(x->positions, y->positions, 3 * nv * sizeof(double)) ||
+             memcmp(x->normals, y->normals, 3 * nv * sizeof(float)) ||
+             memcmp(x->uv, y->uv, 2 * nv * sizeof(double)) ||
+             memcmp(x->face, y->face, nv * sizeof(uint32_t)) ||
+             memcmp(x->triangles, y->triangles, 3 * (size_t)x->n_triangles * sizeof(uint32_t)));
+}
+
+/* No two kept levels of a chain hold the same mesh, and a level dropped after a kept one has an
+ * ε no smaller than it (a duplicate's ε is taken by the finer level when smaller; catches
+ * duplicates stored, or an ε lost with them). Returns the levels dropped. */
+static uint32_t check_kept_levels(const sw_lod_static_chain *c, uint32_t unit)
+{
+    uint32_t dropped = 0;
+    int32_t prev = -1;
+    for (int32_t k = 0; k < c->n_levels; ++k) {
+        const sw_lod_static_level *l = &c->levels[k];
+        if (l->n_triangles == 0) {
+            dropped += l->n_triangles_dropped > 0;
+            CHECK(prev < 0 || c->levels[prev].eps <= l->eps,
+                  "unit %u: level %d dropped after level %d, ε %.17g < %.17g kept", unit, k, prev,
+                  l->eps, prev < 0 ? 0.0 : c->levels[prev].eps);
+            continue;
+        }
+        CHECK(prev < 0 || !meshes_equal(&c->levels[prev], l),
+              "unit %u: levels %d and %d both kept, the same mesh", unit, prev, k);
+        prev = k;
+    }
+    return dropped;
+}
+
 /* Re-measures every level of every READY unit; returns the violations. */
 static int check_bounds(const sw_lod_static_set *set, const sw_sg_scene *scene)
 {
     int checks = 0, violations = 0;
+    uint32_t dropped = 0;
     double worst_ratio = 0.0;
     for (uint32_t u = 0; u < sw_lod_static_set_unit_count(set); ++u) {
         const sw_lod_static_chain *c = sw_lod_static_set_get(set, u);
         const sw_lod_static_unit *un = sw_lod_static_set_unit(set, u);
         const sw_lod_static_patch *p = sw_lod_static_set_patches(set) + un->first_patch;
+        dropped += c ? check_kept_levels(c, u) : 0;
         for (int32_t k = 0; c && k < c->n_levels; ++k) {
             const sw_lod_static_level *l = &c->levels[k];
             CHECK(l->n_triangles == 0 || sw_lod_static_level_drawable(c, k),
@@ -109,8 +148,9 @@ static int check_bounds(const sw_lod_static_set *set, const sw_sg_scene *scene)
             }
         }
     }
-    printf("  bounds: %d levels re-measured both ways, %d violations, worst measured / ε %.3f\n",
-           checks, violations, worst_ratio);
+    printf("  bounds: %d kept levels re-measured both ways, %d violations, worst measured / ε "
+           "%.3f; %u levels not kept (finer than drawn, or a duplicate)\n",
+           checks, violations, worst_ratio, dropped);
     return violations;
 }
 
@@ -118,19 +158,9 @@ static int chains_equal(const sw_lod_static_chain *a, const sw_lod_static_chain 
 {
     if (a->n_levels != b->n_levels || a->n_patches != b->n_patches || a->delta != b->delta)
         return 0;
-    for (int32_t k = 0; k < a->n_levels; ++k) {
-        const sw_lod_static_level *x = &a->levels[k], *y = &b->levels[k];
-        const size_t nv = x->n_vertices;
-        if (x->n_vertices != y->n_vertices || x->n_triangles != y->n_triangles || x->eps != y->eps)
+    for (int32_t k = 0; k < a->n_levels; ++k)
+        if (a->levels[k].eps != b->levels[k].eps || !meshes_equal(&a->levels[k], &b->levels[k]))
             return 0;
-        if (nv &&
-            (memcmp(x->positions, y->positions, 3 * nv * sizeof(double)) ||
-             memcmp(x->normals, y->normals, 3 * nv * sizeof(float)) ||
-             memcmp(x->uv, y->uv, 2 * nv * sizeof(double)) ||
-             memcmp(x->face, y->face, nv * sizeof(uint32_t)) ||
-             memcmp(x->triangles, y->triangles, 3 * (size_t)x->n_triangles * sizeof(uint32_t))))
-            return 0;
-    }
     return 1;
 }
 
