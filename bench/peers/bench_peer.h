@@ -25,6 +25,9 @@ typedef struct bp_result {
     uint32_t frames;          /* frames measured (warm-up passes excluded) */
     double median_ms, p99_ms; /* frame time: the interval between completions */
     double first_frame_ms;    /* load + preprocessing + the first frame, from the child's start */
+    double settle_ms; /* with bp_job.settle_target_ms: from the child's start to the end of the
+                         first bp_settle_window frames whose median is within the target; -1
+                         when none is */
     double peak_rss_bytes;    /* child's VmHWM minus its VmRSS at the fork */
     double triangles;         /* per frame, median over the measured frames */
     double scene_bytes;       /* splinewalk: sw_scene_info.memory_bytes; else 0 */
@@ -54,7 +57,11 @@ typedef struct bp_job {
     int32_t width, height;
     double error_px;
     double scene_box[6]; /* world box (min xyz, max xyz) of the scene (peers' matrices, OCCT) */
+    double settle_target_ms; /* splinewalk: > 0 measures bp_result.settle_ms against it */
 } bp_job;
+
+/* Frames whose median frame time says a walk has settled (bp_result.settle_ms). */
+enum { bp_settle_window = 10 };
 
 typedef int (*bp_peer_fn)(const bp_job *job, bp_result *out);
 

@@ -30,10 +30,16 @@ static sw_frame_desc frame_at(const sw_run *r, uint32_t i, int converged)
     return f;
 }
 
+/* Per-frame figures of a pass (each array may be NULL): frame time, triangles, fat-border
+ * triangles and the frame's end (bench_now_ms). */
+typedef struct pass_out {
+    double *ms, *tri, *border, *end;
+} pass_out;
+
 /* One pass along the path, converged (every frame waits for the hierarchies and static levels it
- * asks for) or walkthrough; ms[i], tri[i] and border[i] (its fat-border triangles) for frame i
- * (each may be NULL). The first frame's end time goes to *t_first when not NULL. */
-static int pass(sw_run *r, int converged, double *ms, double *tri, double *border, double *t_first)
+ * asks for) or walkthrough; frame i's figures into o (NULL: none). The first frame's end time goes
+ * to *t_first when not NULL. */
+static int pass(sw_run *r, int converged, const pass_out *o, double *t_first)
 {
     /* the first image of all is a walkthrough frame: time to first frame is what a user waits */
     sw_frame_desc f = frame_at(r, 0, converged && !t_first);
@@ -52,14 +58,29 @@ static int pass(sw_run *r, int converged, double *ms, double *tri, double *borde
         double t1 = bench_now_ms();
         if (i == 0 && t_first)
             *t_first = t1;
-        if (ms)
-            ms[i] = t1 - t0;
-        if (tri)
-            tri[i] = (double)fs.triangles;
-        if (border)
-            border[i] = (double)fs.border_triangles;
+        if (o) {
+            o->ms[i] = t1 - t0;
+            o->tri[i] = (double)fs.triangles;
+            o->border[i] = (double)fs.border_triangles;
+            o->end[i] = t1;
+        }
     }
     return 0;
+}
+
+/* The end of the first bp_settle_window consecutive frames whose median is within target, from
+ * t_start; -1 when none is. */
+static double settle_time(const double *ms, const double *end, uint32_t n, double target,
+                          double t_start)
+{
+    for (uint32_t i = bp_settle_window; i <= n; ++i) {
+        double median, p99;
+        if (bp_summarize(ms + i - bp_settle_window, bp_settle_window, &median, &p99) != 0)
+            return -1.0;
+        if (median <= target)
+            return end[i - 1] - t_start;
+    }
+    return -1.0;
 }
 
 static int load(sw_run *r, sw_rt_camera_path *own_path, bp_result *out)
@@ -93,9 +114,9 @@ static int measure(sw_run *r, double t_start, bp_result *out)
 {
     uint32_t n = r->job.frames * r->job.passes;
     double *ms = calloc(n, sizeof *ms), *tri = calloc(n, sizeof *tri);
-    double *border = calloc(n, sizeof *border);
+    double *border = calloc(n, sizeof *border), *end = calloc(n, sizeof *end);
     double t_first = 0.0;
-    int rc = ms && tri && border ? 0 : -1;
+    int rc = ms && tri && border && end ? 0 : -1;
     if (rc == 0 && sw_renderer_create(NULL, &r->renderer, &r->st) != SW_OK)
         rc = -1;
     /* Warm-up passes (the first frame among them) are converged: every hierarchy and static
@@ -105,15 +126,20 @@ static int measure(sw_run *r, double t_start, bp_result *out)
      * get the same passes. */
     const double t_warm = bench_now_ms();
     for (uint32_t w = 0; rc == 0 && w < r->job.warmup_passes; ++w)
-        rc = pass(r, 1, NULL, NULL, NULL, w == 0 ? &t_first : NULL);
+        rc = pass(r, 1, NULL, w == 0 ? &t_first : NULL);
     const double warm_ms = bench_now_ms() - t_warm;
-    for (uint32_t p = 0; rc == 0 && p < r->job.passes; ++p)
-        rc = pass(r, 0, ms + p * r->job.frames, tri + p * r->job.frames, border + p * r->job.frames,
-                  r->job.warmup_passes == 0 && p == 0 ? &t_first : NULL);
+    for (uint32_t p = 0; rc == 0 && p < r->job.passes; ++p) {
+        const size_t at = (size_t)p * r->job.frames;
+        const pass_out o = {ms + at, tri + at, border + at, end + at};
+        rc = pass(r, 0, &o, r->job.warmup_passes == 0 && p == 0 ? &t_first : NULL);
+    }
     if (rc == 0) {
         double tri_p99, border_median, border_p99;
         out->frames = n;
         out->first_frame_ms = t_first - t_start;
+        out->settle_ms = r->job.settle_target_ms > 0.0
+                             ? settle_time(ms, end, n, r->job.settle_target_ms, t_start)
+                             : -1.0;
         rc = bp_summarize(ms, n, &out->median_ms, &out->p99_ms) == 0 &&
                      bp_summarize(tri, n, &out->triangles, &tri_p99) == 0 &&
                      bp_summarize(border, n, &border_median, &border_p99) == 0
@@ -132,6 +158,7 @@ static int measure(sw_run *r, double t_start, bp_result *out)
     free(ms);
     free(tri);
     free(border);
+    free(end);
     return rc;
 }
 

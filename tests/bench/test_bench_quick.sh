@@ -45,7 +45,8 @@ done
 "$peers" --frames 1 tiny.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "bench_peers --frames 1: not 2"
 "$peers" --peers gl tiny.sws >/dev/null 2>&1; [ $? -eq 2 ] || fail "bench_peers --peers gl: not 2"
 "$scaling" --help >help.txt || fail "bench_scaling --help exit status"
-for opt in --min --max --frames --size --error --fly --dir --splinewalk --csv --svg; do
+for opt in --min --max --frames --size --error --fly --dir --splinewalk --csv --svg --cold \
+  --target --vehicle; do
   grep -q -- "$opt" help.txt || fail "bench_scaling --help does not mention $opt"
 done
 "$scaling" --min 10 >/dev/null 2>&1; [ $? -eq 2 ] || fail "bench_scaling --min 10: not 2"
@@ -84,6 +85,17 @@ awk -F, 'NR == 2 { a = $3 } NR == 3 { b = $3 } END { exit !(b > a) }' scaling.cs
   >fly.txt 2>&1 || { cat fly.txt; fail "bench_scaling --fly exit status"; }
 grep -q "fly-through" fly.txt || fail "bench_scaling --fly does not say it flies"
 check_csv fly.csv 1 surfaces median_ms p99_ms first_frame_ms peak_rss_bytes triangles_per_frame
+# a cold start of a car park: no warm-up, static LODs built as needed; with a target no frame
+# misses, the first 10 frames settle (catches a settle time never measured or not printed)
+"$scaling" --vehicle --cold --target 1e9 --min 100 --max 100 --frames 12 --size 160x120 \
+  --dir scenes --csv cold.csv >cold.txt 2>&1 || { cat cold.txt; fail "bench_scaling --cold exit status"; }
+[ -f scenes/vehicle-100.sws ] && grep -q "generated vehicles" cold.txt ||
+  fail "bench_scaling --vehicle did not draw a car park"
+grep -q "settled: 10 frames' median <= 1e+09 ms" cold.txt || { cat cold.txt; fail "--cold: not settled"; }
+check_csv cold.csv 1 surfaces median_ms first_frame_ms settle_ms
+awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) at[$i] = i; next }
+  { exit !($(at["settle_ms"]) >= $(at["first_frame_ms"])) }' cold.csv ||
+  fail "--cold: settled before the first frame"
 [ "$(grep -c '<polyline' scaling.svg)" -eq 4 ] && tail -n 1 scaling.svg | grep -q '</svg>' \
   && pass "scaling.svg: 4 lines, closed" || fail "scaling.svg malformed"
 
