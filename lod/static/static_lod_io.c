@@ -247,7 +247,7 @@ static sw_result read_level(reader *r, const sw_lod_static_set *set, const sw_lo
         return bad(r, "a level's ε is not a finite non-negative number", NULL);
     const uint64_t nv = l->n_vertices, nt = l->n_triangles;
     if (nv == 0 && nt == 0)
-        return SW_OK; /* a level not stored (finer than a frame draws): its ε alone */
+        return SW_OK; /* a level not stored (no frame draws it): its ε alone */
     if (!(l->positions = take_array(r, 3 * nv, sizeof *l->positions)) ||
         !(l->normals = take_array(r, 3 * nv, sizeof *l->normals)) ||
         !(l->uv = take_array(r, 2 * nv, sizeof *l->uv)) ||

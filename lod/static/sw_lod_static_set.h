@@ -204,8 +204,8 @@ typedef struct sw_lod_static_cache_summary {
     sw_lod_static_cache_settings settings;
     double delta_min, delta_max; /* level 0's rigorous bound δ over the chains (object units) */
     uint32_t level_chains[SW_LOD_CACHE_MAX_LEVELS];
-    uint32_t level_dropped[SW_LOD_CACHE_MAX_LEVELS]; /* of those, stored empty: finer than a
-                                                        frame draws (sw_lod_static_drop_undrawn) */
+    uint32_t level_dropped[SW_LOD_CACHE_MAX_LEVELS]; /* of those, stored empty: no frame draws
+                                                        them (sw_lod_static_drop_undrawn) */
     uint64_t level_vertices[SW_LOD_CACHE_MAX_LEVELS], level_triangles[SW_LOD_CACHE_MAX_LEVELS];
     double level_eps_min[SW_LOD_CACHE_MAX_LEVELS], level_eps_max[SW_LOD_CACHE_MAX_LEVELS];
 } sw_lod_static_cache_summary;

@@ -280,7 +280,7 @@ shown=$("$sw" info nut.sws | awk '$1 == "level" { printf "%s:%s ", $2, $5 }')
 [ -n "$built" ] && [ "$built" = "$shown" ] || fail "info's LOD levels '$shown', build-lod's '$built'"
 awk '$1 == "0" && $4 == "%" { exit !($2 > 0 && $NF < $2) }' lods.txt ||
   fail "build-lod stored all of level 0 (it is never drawn)"
-"$sw" info nut.sws | grep -q "^    level 0 .*not stored: finer than a frame draws" ||
+"$sw" info nut.sws | grep -q "^    level 0 .*not stored: too fine to draw" ||
   fail "info: levels not stored not said"
 "$sw" info nut.sws --json | python3 -c 'import json, sys; c = json.load(sys.stdin)["lod_cache"]; sys.exit(not (c["chains"] > 0 and len(c["levels"]) == 5))' ||
   fail "info --json: lod_cache"

@@ -200,7 +200,8 @@ static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t
                (unsigned long long)c->level_vertices[k], level_bytes(c, k) / (1024.0 * 1024.0),
                c->level_eps_min[k], c->level_eps_max[k]);
         if (c->level_dropped[k])
-            printf(" (%u of them not stored: finer than a frame draws)", c->level_dropped[k]);
+            printf(" (%u of them not stored: too fine to draw, or a finer level's mesh)",
+                   c->level_dropped[k]);
         printf("\n");
     }
 }
