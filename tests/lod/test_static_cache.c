@@ -22,6 +22,7 @@
  */
 #include <splinewalk/sw_lod_build.h>
 #include "model_import.h"
+#include "sw_hooks.h"
 #include "sw_lod_static_set.h"
 #include "sw_sg_scene.h"
 #include "test_check.h"
@@ -110,6 +111,74 @@ static uint32_t check_kept_levels(const sw_lod_static_chain *c, uint32_t unit)
         prev = k;
     }
     return dropped;
+}
+
+/* A level of nt triangles over 3 vertices (the corners of one triangle, repeated), coordinates
+ * offset by `shift` so that two levels differ or not; arrays from the library's allocator, which
+ * sw_lod_static_free uses. */
+static sw_lod_static_level synthetic_level(uint32_t nt, double shift, double eps)
+{
+    sw_lod_static_level l = {.n_vertices = 3, .n_triangles = nt, .eps = eps, .eps_target = eps};
+    l.positions = sw__calloc(9, sizeof *l.positions);
+    l.normals = sw__calloc(9, sizeof *l.normals);
+    l.uv = sw__calloc(6, sizeof *l.uv);
+    l.face = sw__calloc(3, sizeof *l.face);
+    l.triangles = sw__calloc(3 * (size_t)nt, sizeof *l.triangles);
+    if (!l.positions || !l.normals || !l.uv || !l.face || !l.triangles)
+        return l;
+    for (int v = 0; v < 3; ++v) {
+        l.positions[3 * v + v] = 1.0 + shift;
+        l.normals[3 * v + 2] = 1.0f;
+    }
+    for (uint32_t t = 0; t < nt; ++t)
+        for (uint32_t c = 0; c < 3; ++c)
+            l.triangles[3 * t + c] = c;
+    return l;
+}
+
+/* sw_lod_static_drop_undrawn on a chain made here, one patch: level 0 has 30 triangles (over the
+ * 24 a frame draws per patch: dropped, its ε kept), levels 1 and 2 differ, level 3 is level 2's
+ * mesh bit for bit with a smaller ε (dropped, level 2 takes its ε), level 4 is level 3's mesh
+ * with a larger ε (dropped, level 2's ε stays). Catches: a level too fine kept, a duplicate kept,
+ * a duplicate's smaller ε lost (a frame would then take a finer mesh than it may) or its larger
+ * one taken, a distinct level dropped, a dropped level's ε or triangle count not kept. */
+static void check_drop_rules(void)
+{
+    sw_lod_static_chain *c = sw__calloc(1, sizeof *c);
+    if (!c || !(c->levels = sw__calloc(5, sizeof *c->levels))) {
+        CHECK(0, "synthetic chain: out of memory");
+        sw_lod_static_free(c);
+        return;
+    }
+    c->n_levels = 5;
+    c->n_patches = 1;
+    c->delta = 0.1;
+    c->levels[0] = synthetic_level(30, 0.0, 0.1);
+    c->levels[1] = synthetic_level(20, 0.0, 0.3);
+    c->levels[2] = synthetic_level(4, 0.5, 0.9);
+    c->levels[3] = synthetic_level(4, 0.5, 0.7);
+    c->levels[4] = synthetic_level(4, 0.5, 2.0);
+    const size_t before = sw_lod_static_memory(c);
+    const size_t freed = sw_lod_static_drop_undrawn(c);
+    const sw_lod_static_level *l = c->levels;
+    CHECK(l[0].n_triangles == 0 && l[0].n_vertices == 0 && l[0].n_triangles_dropped == 30 &&
+              l[0].eps == 0.1,
+          "level 0 (30 triangles over 1 patch): %u triangles kept, %u dropped, ε %g",
+          l[0].n_triangles, l[0].n_triangles_dropped, l[0].eps);
+    CHECK(l[1].n_triangles == 20 && l[1].eps == 0.3, "level 1 (distinct, drawable) changed");
+    CHECK(l[2].n_triangles == 4 && l[2].eps == 0.7,
+          "level 2: %u triangles, ε %g (its duplicate's smaller ε 0.7 expected)", l[2].n_triangles,
+          l[2].eps);
+    CHECK(l[3].n_triangles == 0 && l[3].n_triangles_dropped == 4 && l[3].eps == 0.7,
+          "level 3 (level 2's mesh) kept or its ε changed");
+    CHECK(l[4].n_triangles == 0 && l[4].n_triangles_dropped == 4 && l[4].eps == 2.0,
+          "level 4 (level 3's mesh) kept or its ε changed");
+    CHECK(before - freed == sw_lod_static_memory(c), "freed %zu of %zu bytes, %zu left", freed,
+          before, sw_lod_static_memory(c));
+    printf("  drop rules on a made chain: levels kept %s%s%s%s%s, %zu bytes freed\n",
+           l[0].n_triangles ? "0" : "-", l[1].n_triangles ? "1" : "-", l[2].n_triangles ? "2" : "-",
+           l[3].n_triangles ? "3" : "-", l[4].n_triangles ? "4" : "-", freed);
+    sw_lod_static_free(c);
 }
 
 /* Re-measures every level of every READY unit; returns the violations. */
@@ -438,6 +507,7 @@ int main(int argc, char **argv)
         check_file(scene, blob, size, argv[2]);
     }
     check_pages_released(scene, argv[2]);
+    check_drop_rules();
     free(blob);
     sw_lod_static_set_destroy(a);
     sw_th_pool_destroy(pool);
