@@ -30,8 +30,8 @@ static sw_frame_desc frame_at(const sw_run *r, uint32_t i, int converged)
     return f;
 }
 
-/* Per-frame figures of a pass (each array may be NULL): frame time, triangles, fat-border
- * triangles and the frame's end (bench_now_ms). */
+/* Per-frame figures of a pass, one entry per frame in each array: frame time, triangles,
+ * fat-border triangles and the frame's end (bench_now_ms). */
 typedef struct pass_out {
     double *ms, *tri, *border, *end;
 } pass_out;
