@@ -166,6 +166,9 @@ sw_result sw__fr_env_init(sw__fr_env *env, sw_gpu_context *ctx, const sw_sg_scen
                         "frame: the static LODs belong to another scene");
     /* static LODs cull and draw only the scene's own occurrences, and not on the exact path */
     env->statics = env->exact || d->occurrences ? NULL : d->static_lods;
+    /* a set whose proxies were never started keeps the plain cull of its instances */
+    env->proxies = env->statics && !d->no_proxies && env->static_force == 0 &&
+                   sw_lod_static_set_proxies_started(env->statics);
     env->pool = d->pool;
     memcpy(env->view.eye, d->camera.eye, sizeof env->view.eye);
     return SW_OK;

@@ -83,6 +83,7 @@ typedef struct sw__fr_env {
     int grids_resident;         /* Bézier grids drawn from the context's kept grids */
     int eye_shells;             /* sw__fr_eye_shells: the eye inside a closed shell, or not */
     int32_t static_force;       /* desc.static_force */
+    int proxies;                /* statics and not desc.no_proxies: the cut may stop at proxies */
     sw_lod_static_set *statics; /* NULL: every face by the per-frame path */
     sw_th_pool *pool;           /* desc.pool: tessellation chunks shared with its workers */
     struct sw__fr_border_cache *borders; /* the context's, held by this frame; NULL: none */
@@ -140,6 +141,8 @@ typedef struct sw__fr_visible {
     sw__fr_instance *instances; /* with static LODs: the visible unit instances, BVH order */
     size_t n_instances, cap_instances;
     sw__fr_faces unit_faces; /* their shown faces */
+    uint32_t *proxies;       /* with static LODs: nodes of their BVH drawn as proxies, ascending */
+    size_t n_proxies, cap_proxies;
     sw__fr_mesh_occ *meshes; /* mesh occurrences inside the frustum */
     size_t n_meshes, cap_meshes;
     sw__fr_mesh_occ *shapes; /* shape occurrences inside the frustum */
@@ -238,7 +241,8 @@ sw_result sw__fr_select(const sw__fr_env *env, sw__fr_hierarchy *hy, const sw__f
 void sw__fr_selection_free(sw__fr_selection *sel);
 void sw__fr_selection_empty(sw__fr_selection *sel); /* counts zeroed, arrays kept */
 /* LOD colouring: static level k (fine -> coarse), -1 for the per-frame path, -2 for per-frame
- * draws cut by exact trim edges. */
+ * draws cut by exact trim edges, SW__FR_PROXY_COLOR for cluster proxies. */
+enum { SW__FR_PROXY_COLOR = -3 };
 void sw__fr_lod_color(int32_t level, float out[4]);
 /* The object-space tolerance of a unit under transform m at the view (frame-static's rule:
  * ε_img at the nearest depth of its box, over the transform's stretch), and its screen extent. */
@@ -448,6 +452,8 @@ sw_result sw__fr_tess_hierarchy(sw__fr_tess *t, const occurrence *o, const hl_ch
 /* stage_tessellate_static.c: a unit instance at its static level, with its faces' borders. */
 sw_result sw__fr_tess_static(sw__fr_tess *t, const sw__fr_visible *vis,
                              const sw__fr_static_pick *pick, sw_status *status);
+/* The cull stage's proxies (vis->proxies), each part a draw; their instances' faces counted. */
+sw_result sw__fr_tess_proxies(sw__fr_tess *t, const sw__fr_visible *vis, sw_status *status);
 /* stage_tessellate_mesh.c: triangles in object space for sw__fr_append_triangles. */
 typedef struct sw__fr_triangles {
     const double *positions; /* 3 per vertex */

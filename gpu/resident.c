@@ -22,7 +22,8 @@ static const size_t k_default_budget = (size_t)512 << 20;
 
 typedef struct resident_entry {
     GLuint vao, vbo, ibo; /* vao 0: empty */
-    GLsizei n_idx;
+    GLsizei n_idx;        /* the triangles' indices; the lines' follow them in ibo */
+    GLsizei n_line_idx;
     size_t bytes;
     uint64_t last_frame;
 } resident_entry;
@@ -150,7 +151,8 @@ static sw_result upload(sw_gpu_context *ctx, struct sw__gpu_resident *t, residen
         v[i].st[0] = v[i].st[1] = 0.0f;
     }
     const size_t vbytes = (size_t)lv->n_vertices * sizeof *v,
-                 ibytes = (size_t)lv->n_triangles * 3 * sizeof *lv->triangles;
+                 tbytes = (size_t)lv->n_triangles * 3 * sizeof *lv->triangles,
+                 lbytes = (size_t)d->n_lines * 2 * sizeof *d->lines, ibytes = tbytes + lbytes;
     glGenVertexArrays(1, &e->vao);
     glGenBuffers(1, &e->vbo);
     glGenBuffers(1, &e->ibo);
@@ -158,10 +160,14 @@ static sw_result upload(sw_gpu_context *ctx, struct sw__gpu_resident *t, residen
     glBindBuffer(GL_ARRAY_BUFFER, e->vbo);
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)vbytes, v, GL_STATIC_DRAW);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, e->ibo);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)ibytes, lv->triangles, GL_STATIC_DRAW);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)ibytes, NULL, GL_STATIC_DRAW);
+    glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, (GLsizeiptr)tbytes, lv->triangles);
+    if (lbytes)
+        glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, (GLintptr)tbytes, (GLsizeiptr)lbytes, d->lines);
     sw__free(v);
     sw__gpu_vertex_layout();
     e->n_idx = (GLsizei)(3 * lv->n_triangles);
+    e->n_line_idx = (GLsizei)(2 * d->n_lines);
     e->bytes = vbytes + ibytes;
     t->bytes += e->bytes;
     ctx->upload_bytes += e->bytes;
@@ -196,6 +202,9 @@ sw_result sw__gpu_resident_draw_all(sw_gpu_context *ctx, const sw__gpu_surface_p
         glUniform3fv(prog->loc_model_off, 1, d->off);
         glUniform4fv(prog->loc_color, 1, d->color);
         glDrawElements(GL_TRIANGLES, e->n_idx, GL_UNSIGNED_INT, NULL);
+        if (e->n_line_idx && d->draw_lines)
+            glDrawElements(GL_LINES, e->n_line_idx, GL_UNSIGNED_INT,
+                           (const void *)((size_t)e->n_idx * sizeof(uint32_t)));
     }
     static const float identity[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, zero[3] = {0, 0, 0};
     glUniformMatrix3fv(prog->loc_model_rot, 1, GL_TRUE, identity);

@@ -57,6 +57,7 @@ void sw__fr_visible_free(sw__fr_visible *vis)
     sw__fr_faces_free(&vis->faces);
     sw__fr_faces_free(&vis->unit_faces);
     sw__free(vis->instances);
+    sw__free(vis->proxies);
     sw__free(vis->meshes);
     sw__free(vis->shapes);
     memset(vis, 0, sizeof *vis);
@@ -220,7 +221,7 @@ static void cull_meshes(const sw__fr_env *env, sw__fr_visible *vis, sw_gpu_frame
 void sw__fr_visible_empty(sw__fr_visible *vis)
 {
     vis->faces.n = vis->unit_faces.n = 0;
-    vis->n_instances = vis->n_meshes = vis->n_shapes = 0;
+    vis->n_instances = vis->n_meshes = vis->n_shapes = vis->n_proxies = 0;
 }
 
 sw_result sw__fr_cull_scene_box(const sw__fr_env *env, const sw_gpu_frame_desc *desc,
@@ -324,10 +325,10 @@ typedef struct occ_walk occ_walk;
 struct occ_walk {
     const sw__fr_env *env;
     const sw_sg_bvh *bvh; /* the faces' BVH, or the static set's of unit instances */
-    const sw_gpu_occluders *oc;
+    const sw_gpu_occluders *oc; /* NULL: no occlusion culling (a walk for proxies alone) */
     const sw_lod_face_cones *fc;
     sw_sg_frustum fr;
-    sw__occ_map map;
+    sw__occ_map map; /* unused without oc */
     /* a leaf's item not outside the frustum (inside: its node is wholly inside) */
     void (*item)(occ_walk *w, uint32_t item, int inside);
     uint32_t *kept; /* visible items */
@@ -339,6 +340,17 @@ struct occ_walk {
     uint64_t faces_taken;
     int oom;
 };
+
+/* The map's test and drawing; without occluders nothing is hidden. */
+static int occ_hidden(occ_walk *w, const double eb[6])
+{
+    return w->oc && sw__occ_map_box_hidden(&w->map, eb);
+}
+
+static int occ_add_face(occ_walk *w, uint32_t face, const double world[12])
+{
+    return w->oc ? sw__occ_map_add_face(&w->map, w->oc, face, world, w->env->view.eye) : 0;
+}
 
 /* One item of a leaf: frustum (unless its node is inside), occlusion, back face; kept ones are
  * drawn into the map. */
@@ -355,7 +367,7 @@ static void occ_item(occ_walk *w, uint32_t item, int inside)
     w->cs.items_visible++;
     double eb[6];
     sw__fr_eye_box(w->env->view.eye, it->box, eb);
-    if (sw__occ_map_box_hidden(&w->map, eb)) {
+    if (occ_hidden(w, eb)) {
         w->faces_occluded++;
         return;
     }
@@ -368,7 +380,7 @@ static void occ_item(occ_walk *w, uint32_t item, int inside)
         }
     }
     if (!sw__grow((void **)&w->kept, &w->cap_kept, w->n_kept + 1, sizeof *w->kept) ||
-        sw__occ_map_add_face(&w->map, w->oc, it->face, it->world, w->env->view.eye) < 0) {
+        occ_add_face(w, it->face, it->world) < 0) {
         w->oom = 1;
         return;
     }
@@ -392,6 +404,29 @@ static double node_distance(const occ_walk *w, int32_t node)
     sw_sg_bvh_node_box(w->bvh, (uint32_t)node, box);
     sw__fr_eye_box(w->env->view.eye, box, eb);
     return sw__gpu_box_distance(eb);
+}
+
+/* The cut of the unit-instance BVH stops at a node whose proxy is within the view's tolerance at
+ * the nearest depth of the node's box (the select stage's rule, stage_select.c, in world units:
+ * the proxy is placed in the world); the node's instances count as taken. */
+static int take_proxy(occ_walk *w, uint32_t node, const double eb[6])
+{
+    const sw_lod_proxy *p = sw_lod_static_set_proxy(w->env->statics, node);
+    if (!p)
+        return 0;
+    const sw__gpu_view *v = &w->env->view;
+    const double z = sw__gpu_view_box_depth(v, eb);
+    if (p->err > sw_lod_object_tolerance(w->env->eps_px, z, v->focal_px, v->tan_x, v->tan_y))
+        return 0;
+    sw__fr_visible *vis = w->taker->vis;
+    if (!sw__grow((void **)&vis->proxies, &vis->cap_proxies, vis->n_proxies + 1,
+                  sizeof *vis->proxies)) {
+        w->oom = 1;
+        return 1;
+    }
+    vis->proxies[vis->n_proxies++] = node;
+    w->faces_taken += node_occurrences(w, &w->bvh->nodes[node]);
+    return 1;
 }
 
 static void occ_walk_bvh(occ_walk *w)
@@ -420,11 +455,13 @@ static void occ_walk_bvh(occ_walk *w)
         *(inside ? &w->cs.nodes_inside : &w->cs.nodes_partly) += 1;
         double eb[6];
         sw__fr_eye_box(w->env->view.eye, box, eb);
-        if (sw__occ_map_box_hidden(&w->map, eb)) {
+        if (occ_hidden(w, eb)) {
             w->nodes_occluded++;
             w->faces_occluded += node_occurrences(w, node);
             continue;
         }
+        if (w->taker && w->env->proxies && take_proxy(w, id, eb))
+            continue;
         if (node->second < 0 || n + 2 > OCC_STACK) {
             for (uint32_t i = node->first; i < node->first + node->count && !w->oom; ++i)
                 w->item(w, i, inside);
@@ -460,7 +497,7 @@ static sw_result occ_walk_run(occ_walk *w, const sw__fr_env *env, const sw_sg_bv
     w->item = item;
     w->taker = taker;
     view_frustum(env, &w->fr);
-    if (!sw__occ_map_init(&w->map, &env->view, env->eps_px))
+    if (oc && !sw__occ_map_init(&w->map, &env->view, env->eps_px))
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "occlusion map: out of memory");
     occ_walk_bvh(w);
     return SW_OK;
@@ -719,12 +756,11 @@ static void occ_instance_faces(occ_walk *w, const sw_lod_static_instance *in,
         w->back += shown == FACE_BACK;
         if (shown != FACE_SHOWN)
             continue;
-        if (sw__occ_map_box_hidden(&w->map, eb)) {
+        if (occ_hidden(w, eb)) {
             w->faces_occluded++;
             continue;
         }
-        if (!sw__fr_faces_push(&vis->unit_faces, &o, eb) ||
-            sw__occ_map_add_face(&w->map, w->oc, o.face, it->world, w->env->view.eye) < 0)
+        if (!sw__fr_faces_push(&vis->unit_faces, &o, eb) || occ_add_face(w, o.face, it->world) < 0)
             w->oom = 1;
     }
     w->faces_taken += vis->unit_faces.n - first;
@@ -748,7 +784,7 @@ static void occ_instance(occ_walk *w, uint32_t item, int inside)
     const sw_lod_static_instance *in = &w->taker->in->instances[it->face];
     double eb[6];
     sw__fr_eye_box(w->env->view.eye, it->box, eb);
-    if (sw__occ_map_box_hidden(&w->map, eb)) {
+    if (occ_hidden(w, eb)) {
         w->faces_occluded += in->n_occ;
         return;
     }
@@ -778,6 +814,8 @@ static sw_result collect_instances_occluded(const sw__fr_env *env, const sw_gpu_
         return r;
     if (vis->n_instances > 1)
         qsort(vis->instances, vis->n_instances, sizeof *vis->instances, cmp_instance);
+    if (vis->n_proxies > 1)
+        qsort(vis->proxies, vis->n_proxies, sizeof *vis->proxies, cmp_u32);
     st->faces_culled += t.in->n_occs - w.faces_taken;
     return occ_walk_finish(&w, st, status);
 }
@@ -794,9 +832,12 @@ sw_result sw__fr_cull(const sw__fr_env *env, const sw_gpu_frame_desc *desc, sw__
     if (r == SW_OK && desc->occluders &&
         desc->occluders->scene_serial != sw_sg_scene_serial(env->scene))
         r = sw__fail(status, SW_ERR_INVALID_ARGUMENT, "frame: occluders of another scene");
+    /* the near-to-far walk also serves a cut that may stop at proxies, occluders or not */
     if (r == SW_OK && static_instances(env))
-        r = occlusion ? collect_instances_occluded(env, desc->occluders, fc, vis, st, status)
-                      : collect_instances(env, fc, vis, st, status);
+        r = occlusion || env->proxies
+                ? collect_instances_occluded(env, occlusion ? desc->occluders : NULL, fc, vis, st,
+                                             status)
+                : collect_instances(env, fc, vis, st, status);
     else if (r == SW_OK && occlusion)
         r = collect_bvh_occluded(env, face_bvh(desc), desc->occluders, fc, &vis->faces, st, status);
     else if (r == SW_OK && face_bvh(desc))

@@ -33,12 +33,14 @@ static const float k_level_colors[6][4] = {
 };
 static const float k_dynamic_color[4] = {0.75f, 0.75f, 0.78f, 1.0f};
 static const float k_exact_edges_color[4] = {0.68f, 0.55f, 0.90f, 1.0f};
+static const float k_proxy_color[4] = {0.95f, 0.35f, 0.25f, 1.0f};
 
 void sw__fr_lod_color(int32_t level, float out[4])
 {
-    const float *c = level == -2 ? k_exact_edges_color
-                     : level < 0 ? k_dynamic_color
-                                 : k_level_colors[level > 5 ? 5 : level];
+    const float *c = level == SW__FR_PROXY_COLOR ? k_proxy_color
+                     : level == -2               ? k_exact_edges_color
+                     : level < 0                 ? k_dynamic_color
+                                                 : k_level_colors[level > 5 ? 5 : level];
     memcpy(out, c, 4 * sizeof *out);
 }
 

@@ -613,6 +613,8 @@ sw_result sw__fr_tessellate(const sw__fr_env *env, const sw__fr_visible *vis,
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "frame: out of memory");
     sw_result r = sw__fr_tess_picks(&t, vis, sel, status);
     if (r == SW_OK)
+        r = sw__fr_tess_proxies(&t, vis, status);
+    if (r == SW_OK)
         r = sw__fr_tess_meshes(&t, vis, status);
     for (uint32_t i = 0; i < env->sv->n_faces; ++i) {
         sw_sg_bezier_set *set = atomic_load_explicit(&t.bez[i], memory_order_relaxed);

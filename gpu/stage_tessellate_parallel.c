@@ -190,8 +190,9 @@ static sw_result append_geometry(sw__fr_geometry *dst, sw__fr_geometry *src, sw_
 static void add_stats(sw_gpu_frame_stats *d, const sw_gpu_frame_stats *s)
 {
     _Static_assert(
-        sizeof(sw_gpu_frame_stats) == 584, /* trim_exact*: the trim plan; shapes_*: cull and the
-                                              outline stage; grid_*: submit; not chunks */
+        sizeof(sw_gpu_frame_stats) == 616, /* trim_exact*: the trim plan; shapes_*: cull and the
+                                              outline stage; grid_*: submit; proxy*: drawn after
+                                              the chunks; not chunks */
         "a field was added to sw_gpu_frame_stats: add it here if tessellation counts it");
     d->faces_drawn += s->faces_drawn;
     d->faces_culled += s->faces_culled;

@@ -16,6 +16,7 @@
  * from both sides' errors because both are bounded by the same ε_img. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
+#include "sw_lod_proxy.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -43,6 +44,9 @@ static sw_result resident_level(sw__fr_tess *t, const occurrence *o, uint32_t un
     d->level = lv;
     d->unit = unit;
     d->index = level;
+    d->lines = NULL;
+    d->n_lines = 0;
+    d->draw_lines = 0;
     const double centre[4] = {0.5 * (box[0] + box[3]), 0.5 * (box[1] + box[4]),
                               0.5 * (box[2] + box[5]), 1.0};
     double off[4];
@@ -132,6 +136,73 @@ sw_result sw__fr_tess_static(sw__fr_tess *t, const sw__fr_visible *vis,
         r = face_borders(t, &o, pick->extent_px, status);
         t->st->static_faces++;
         t->st->faces_drawn++;
+    }
+    return r;
+}
+
+/* ---- cluster proxies (lod/static/sw_lod_proxy.h) -----------------------------------------------
+ * A proxy is drawn as it is: in the world (its positions relative to its centre), each part a
+ * draw in its colour, no fat border. Its bound holds both ways within the tolerance the cut chose
+ * it for, as a static level's does, so a crack between it and a neighbour drawn otherwise lies
+ * within the neighbour's fat borders (that neighbour is a static or per-frame face, and borders
+ * every face it draws); the clustering welds what lies inside one proxy across its cells. */
+static sw_result proxy_part(sw__fr_tess *t, const sw_lod_proxy *p, uint32_t k, sw_status *status)
+{
+    const sw_lod_static_level *lv = &p->parts[k];
+    occurrence o;
+    const double world[12] = {1, 0, 0, p->centre[0], 0, 1, 0, p->centre[1], 0, 0, 1, p->centre[2]};
+    sw__fr_occurrence_init(&o, 0, world, p->colors[k]);
+    if (t->env->lod_colors)
+        sw__fr_lod_color(SW__FR_PROXY_COLOR, o.color);
+    t->st->proxy_triangles += lv->n_triangles;
+    if (t->env->ctx->resident_off) {
+        const sw__fr_triangles tr = {.positions = lv->positions,
+                                     .normals_f = lv->normals,
+                                     .normal_matrix = {1, 0, 0, 0, 1, 0, 0, 0, 1},
+                                     .n_vertices = lv->n_vertices,
+                                     .n_triangles = lv->n_triangles,
+                                     .triangles = lv->triangles};
+        return sw__fr_append_triangles(t, &o, &tr, status);
+    }
+    sw__fr_geometry *g = t->geo;
+    if (g->n_resident == g->cap_resident &&
+        !sw__grow((void **)&g->resident, &g->cap_resident, g->n_resident + 1, sizeof *g->resident))
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
+    sw__gpu_resident_draw *d = &g->resident[g->n_resident++];
+    memset(d, 0, sizeof *d);
+    d->level = lv;
+    /* numbered after the units: one table keys both */
+    d->unit = sw_lod_static_set_unit_count(t->env->statics) + p->key + k;
+    d->index = 0;
+    for (int r = 0; r < 3; ++r) {
+        d->off[r] = (float)(p->centre[r] - t->env->view.eye[r]);
+        d->rot[4 * r] = 1.0f;
+    }
+    memcpy(d->color, o.color, sizeof d->color);
+    d->lines = p->lines[k];
+    d->n_lines = p->n_lines[k];
+    d->draw_lines = !t->env->ctx->crack_fill_off; /* the proxies' crack fill */
+    g->resident_triangles += lv->n_triangles;
+    return SW_OK;
+}
+
+sw_result sw__fr_tess_proxies(sw__fr_tess *t, const sw__fr_visible *vis, sw_status *status)
+{
+    sw_result r = SW_OK;
+    for (size_t i = 0; i < vis->n_proxies && r == SW_OK; ++i) {
+        const sw_lod_proxy *p = sw_lod_static_set_proxy(t->env->statics, vis->proxies[i]);
+        for (uint32_t k = 0; k < p->n_parts && r == SW_OK; ++k)
+            r = proxy_part(t, p, k, status);
+        const sw_sg_bvh_node *node =
+            &sw_lod_static_set_instances(t->env->statics)->bvh->nodes[vis->proxies[i]];
+        const sw_lod_static_instances *ins = sw_lod_static_set_instances(t->env->statics);
+        uint64_t faces = 0;
+        for (uint32_t it = node->first; it < node->first + node->count; ++it)
+            faces += ins->instances[ins->bvh->items[it].face].n_occ;
+        t->st->proxies_drawn++;
+        t->st->proxy_instances += node->count;
+        t->st->proxy_faces += faces;
+        t->st->faces_drawn += faces;
     }
     return r;
 }

@@ -114,6 +114,9 @@ typedef struct sw_gpu_frame_desc {
                               level within the view's tolerance at its nearest point, built in
                               the pool on first need (walkthrough: queued, drawn per frame
                               meanwhile; converged: waited for). Ignored with eval_exact */
+    int32_t no_proxies;   /* 1: no cluster proxies (sw_lod_static_set_build_proxies); 0: the cut
+                             of the unit-instance BVH stops at a node whose built proxy is within
+                             the view's tolerance and draws it instead of its subtree */
     int32_t static_force; /* tests of the joins: k > 0 draws unit i at choice (i + k) mod
                              (n + 1) among its n levels within the view's tolerance, the last
                              choice meaning the per-frame path: neighbours at different levels,
@@ -227,6 +230,10 @@ typedef struct sw_gpu_frame_stats {
     uint64_t static_requests;    /* walkthrough: unit builds queued, not waited for */
     uint64_t static_waits;       /* converged: units the frame waited for */
     uint32_t static_levels_used; /* bit k: some unit drawn at level k (31: 31 and beyond) */
+    uint64_t proxies_drawn;      /* cluster proxies drawn (desc.no_proxies) */
+    uint64_t proxy_instances;    /* unit instances they stand for (not in static_units_drawn) */
+    uint64_t proxy_faces;        /* face occurrences they cover (of faces_drawn) */
+    uint64_t proxy_triangles;    /* their triangles (of triangles) */
     /* triangle meshes (SW_SG_NODE_MESH occurrences; gpu/stage_tessellate_mesh.c) */
     uint64_t meshes_drawn, meshes_culled; /* occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */

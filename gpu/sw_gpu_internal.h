@@ -617,6 +617,11 @@ typedef struct sw__gpu_resident_draw {
     float rot[9];     /* row-major: the instance transform's 3 x 3 (normals too: similarities) */
     float off[3];     /* eye-relative world position of the centre */
     float color[4];
+    const uint32_t *lines; /* a cluster proxy's open edges (kept with its triangles), drawn as
+                              one-pixel lines after them when draw_lines is set
+                              (lod/static/sw_lod_static_set.h says why); NULL: none */
+    uint32_t n_lines;
+    int32_t draw_lines;
 } sw__gpu_resident_draw;
 typedef struct sw__gpu_resident_list {
     const sw__gpu_resident_draw *draws;

@@ -104,7 +104,11 @@ size_t sw_lod_static_drop_undrawn(sw_lod_static_chain *c)
             freed += drop_level(l);
         }
     }
-    for (int32_t k = 0; k < c->n_levels; ++k)
+    /* the coarsest mesh stays even when too fine to draw: cluster proxies are made from it */
+    int32_t coarsest = c->n_levels - 1;
+    while (coarsest > 0 && c->levels[coarsest].n_triangles == 0)
+        --coarsest;
+    for (int32_t k = 0; k < coarsest; ++k)
         if (c->levels[k].n_triangles > 0 && !sw_lod_static_level_drawable(c, k))
             freed += drop_level(&c->levels[k]);
     return freed;

@@ -50,6 +50,7 @@ struct sw_lod_static_set {
     _Atomic uint64_t build_ns;
     _Atomic int cancelled; /* builds not started yet return at once (the set is going away) */
     uint64_t serial;       /* sw_lod_static_set_serial */
+    sw__lod_proxies *proxies;
 };
 
 static _Atomic uint64_t g_set_serial; /* sets made by this process */
@@ -455,6 +456,8 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
         r = unit_cones(s, status);
     if (r == SW_OK)
         r = make_instances(s, status);
+    if (r == SW_OK)
+        r = sw__lod_proxies_create(s->bvh->n_nodes, &s->proxies, status);
     if (r == SW_OK && !(s->slots = sw__calloc(s->n_units ? s->n_units : 1, sizeof *s->slots)))
         r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LODs: out of memory");
     if (r != SW_OK) {
@@ -471,10 +474,36 @@ void sw_lod_static_set_cancel(sw_lod_static_set *s)
         atomic_store_explicit(&s->cancelled, 1, memory_order_release);
 }
 
+int sw__lod_static_set_cancelled(const sw_lod_static_set *s)
+{
+    return atomic_load_explicit(&s->cancelled, memory_order_acquire);
+}
+
+sw_result sw_lod_static_set_build_proxies(sw_lod_static_set *s, sw_status *status)
+{
+    return sw__lod_proxies_start(s, s->proxies, s->pool, status);
+}
+
+int sw_lod_static_set_proxies_started(const sw_lod_static_set *s)
+{
+    return sw__lod_proxies_started(s->proxies);
+}
+
+void sw_lod_static_set_wait_proxies(sw_lod_static_set *s)
+{
+    sw__lod_proxies_wait(s->pool, s->proxies);
+}
+
+const sw_lod_proxy *sw_lod_static_set_proxy(const sw_lod_static_set *s, uint32_t node)
+{
+    return sw__lod_proxies_get(s->proxies, node);
+}
+
 void sw_lod_static_set_destroy(sw_lod_static_set *s)
 {
     if (!s)
         return;
+    sw__lod_proxies_destroy(s->pool, s->proxies); /* its builds read the chains */
     if (s->slots) {
         for (uint32_t u = 0; u < s->n_units; ++u) {
             sw_th_group_wait(s->pool, &s->slots[u].group);
@@ -708,4 +737,5 @@ void sw_lod_static_set_get_stats(const sw_lod_static_set *s, sw_lod_static_set_s
     out->builds = atomic_load(&s->n_builds);
     out->adopted = atomic_load(&s->n_adopted);
     out->build_seconds = 1e-9 * (double)atomic_load(&s->build_ns);
+    sw__lod_proxies_stats(s->proxies, out);
 }

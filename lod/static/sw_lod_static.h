@@ -163,7 +163,8 @@ int sw_lod_static_level_drawable(const sw_lod_static_chain *chain, int32_t k);
  * memory and in a LOD cache written from it. Two kinds: a level finer than the limit above (level
  * 0 of most chains, which exists to decimate and certify the others from; levels only get
  * coarser with k, so the coarsest level within a tolerance was finer than a frame draws or is
- * still there), and a level whose mesh is the next finer level's, bit for bit (a decimation with
+ * still there) but the chain's coarsest mesh, which cluster proxies are made from (sw_lod_proxy.h),
+ * and a level whose mesh is the next finer level's, bit for bit (a decimation with
  * nothing to collapse: a plane's two triangles), whose ε the finer one takes when smaller, so
  * that a frame draws the same mesh. The two take the 10^6-surface building's LOD cache from 1,107
  * to 420 MiB. Returns the bytes freed. */

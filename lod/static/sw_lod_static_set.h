@@ -108,6 +108,12 @@ typedef struct sw_lod_static_set_stats {
     uint64_t adopted;     /* chains handed in (sw_lod_static_set_adopt: read from a cache) */
     double build_seconds; /* summed over builds (pool threads in parallel) */
     size_t memory_bytes;  /* the chains' memory */
+    /* cluster proxies (sw_lod_static_set_build_proxies) */
+    uint64_t proxies, proxies_failed; /* nodes given a proxy; candidates that could not be */
+    uint64_t proxy_triangles;
+    size_t proxy_bytes;
+    double proxy_seconds; /* summed over builds */
+    int proxies_building; /* 1 while builds are queued or running */
 } sw_lod_static_set_stats;
 
 /* Clusters the scene (§3), forms the units and their instances with the instances' BVH; builds no
@@ -160,6 +166,59 @@ sw_result sw_lod_static_set_adopt(sw_lod_static_set *set, uint32_t unit,
 sw_result sw_lod_static_set_failure(const sw_lod_static_set *set, uint32_t unit,
                                     const char **message);
 void sw_lod_static_set_get_stats(const sw_lod_static_set *set, sw_lod_static_set_stats *out);
+
+/* ---- cluster proxies (static_proxy.c; sw_lod_proxy.h: how a proxy is made, why its bound holds)
+ * Across objects (Erikson et al. 2001's HLODs): a node of the unit-instance BVH with enough
+ * instances under it gets one mesh standing for all of them, with a bound `err` certified both
+ * ways against their exact surfaces. A frame's cut stops at a node whose proxy is within the
+ * view's tolerance at the node box's nearest depth and draws it instead of its subtree. Parts keep
+ * the instances' colours apart (a draw each).
+ *
+ * Cracks. Within its bound a proxy may have gaps the clustering did not weld: between units whose
+ * levels approximate a shared border independently (ε_a + ε_b apart), and where a strip thinner
+ * than a cell collapsed. Each is bounded by open edges (used by one triangle of the part), at most
+ * 2 err wide, so at most 2 ε_img = 1 px on screen where the proxy is drawn. The frame draws every
+ * open edge as a one-pixel line too (the rasterizer's diamond rule covers each pixel whose centre
+ * lies within half a pixel of the line along its minor axis, and a pixel inside a gap under 1 px
+ * wide is that close to one of its two sides): the proxies' analogue of fat borders. */
+typedef struct sw_lod_proxy {
+    double centre[3];           /* world: the point the parts' positions are relative to */
+    sw_lod_static_level *parts; /* one per colour: positions and normals only (uv, face NULL) */
+    float (*colors)[4];         /* per part: the instances' colour as the set gives it */
+    uint32_t **lines;           /* per part: its open edges (2 vertex indices each) */
+    uint32_t *n_lines;          /* per part: how many */
+    uint32_t n_parts;
+    uint32_t key;     /* parts are numbered key .. key + n_parts - 1, unique in the set */
+    double err;       /* world units, both ways, to the exact surfaces of the instances */
+    double input_err; /* of it, the inputs' own (their levels' ε, child proxies' err) */
+    double cell;      /* the clustering's cell */
+    uint32_t n_triangles, instances;
+    uint64_t input_triangles, vanished;
+} sw_lod_proxy;
+
+/* Starts building the proxies of every node whose instances' chains are READY (a cache adopted),
+ * in the pool at background priority; once per set (later calls do nothing). Frames draw the
+ * proxies as they are published. Errors: SW_ERR_OUT_OF_MEMORY. */
+sw_result sw_lod_static_set_build_proxies(sw_lod_static_set *set, sw_status *status);
+/* 1 once sw_lod_static_set_build_proxies was called (some proxies may be built yet). No lock. */
+int sw_lod_static_set_proxies_started(const sw_lod_static_set *set);
+/* Returns once the proxy builds started are done, running pool tasks meanwhile (converged
+ * frames). */
+void sw_lod_static_set_wait_proxies(sw_lod_static_set *set);
+/* The proxy of a node of sw_lod_static_set_instances()->bvh once built, else NULL. No lock. */
+const sw_lod_proxy *sw_lod_static_set_proxy(const sw_lod_static_set *set, uint32_t node);
+
+/* static_proxy.c and static_lod_set.c */
+typedef struct sw__lod_proxies sw__lod_proxies;
+sw_result sw__lod_proxies_create(uint32_t n_nodes, sw__lod_proxies **out, sw_status *status);
+void sw__lod_proxies_destroy(sw_th_pool *pool, sw__lod_proxies *p); /* waits for its builds */
+sw_result sw__lod_proxies_start(const sw_lod_static_set *set, sw__lod_proxies *p, sw_th_pool *pool,
+                                sw_status *status);
+const sw_lod_proxy *sw__lod_proxies_get(const sw__lod_proxies *p, uint32_t node);
+void sw__lod_proxies_stats(const sw__lod_proxies *p, sw_lod_static_set_stats *out);
+void sw__lod_proxies_wait(sw_th_pool *pool, sw__lod_proxies *p);
+int sw__lod_proxies_started(const sw__lod_proxies *p);
+int sw__lod_static_set_cancelled(const sw_lod_static_set *set);
 
 /* ---- the LOD cache (static_lod_io.c) ---------------------------------------------------------
  * The READY chains as one byte string (the .sws file's LODS section, `splinewalk build-lod`):

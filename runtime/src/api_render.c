@@ -404,6 +404,9 @@ static void copy_stats(const sw_gpu_frame_stats *g, sw_frame_stats *out)
     out->meshes_culled = g->meshes_culled;
     out->mesh_triangles = g->mesh_triangles;
     out->static_requests = g->static_requests;
+    out->proxies_drawn = g->proxies_drawn;
+    out->proxy_instances = g->proxy_instances;
+    out->proxy_triangles = g->proxy_triangles;
     out->bound_exceeded = g->bound_exceeded;
     out->budget_coarsened = g->budget_coarsened;
     out->bound_excess_px = g->bound_excess_px;
@@ -531,6 +534,9 @@ static void statics_task(void *ctx)
         found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &cst);
         sw_sg_scene_lods_release(r->cache_scene->sg); /* decoded (or refused): its pages go */
     }
+    /* every chain is there: the cluster proxies can be made from them (in the pool) */
+    if (found == SW_OK && sw_lod_static_set_build_proxies(set, &st) != SW_OK)
+        sw__log(SW_LOG_WARN, "static LODs: %s: no cluster proxies", st.message);
     if (found == SW_ERR_NOT_FOUND)
         sw__log(SW_LOG_WARN,
                 "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
@@ -566,6 +572,9 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
     if (!frame->walkthrough)
         sw_th_group_wait(r->pool, &r->statics_group);
     const int state = atomic_load(&r->statics_state);
+    /* converged frames are the same frame for the same view: proxies made meanwhile would not be */
+    if (state == 2 && !frame->walkthrough && !frame->no_proxies && atomic_load(&r->statics))
+        sw_lod_static_set_wait_proxies(atomic_load(&r->statics));
     if (state == 3 && !frame->walkthrough)
         return sw__fail(status, r->statics_failure.result, "static LODs: %s",
                         r->statics_failure.message);
@@ -615,6 +624,7 @@ static sw_result gpu_frame(sw_rt_renderer *r, sw_rt_scene *scene, const sw_frame
     frame->pool = r->pool;
     frame->lod_colors = desc->lod_colors != 0;
     frame->static_force = desc->static_force > 0 ? desc->static_force : 0;
+    frame->no_proxies = desc->no_proxies != 0;
     if (desc->occlusion_culling && !r->occluders)
         res = sw_gpu_occluders_build(scene->sg, &r->occluders, status);
     frame->occluders = desc->occlusion_culling && !occlusion_resting(r) ? r->occluders : NULL;

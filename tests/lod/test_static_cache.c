@@ -23,6 +23,7 @@
 #include <splinewalk/sw_lod_build.h>
 #include "model_import.h"
 #include "sw_hooks.h"
+#include "sw_lod_static_internal.h"
 #include "sw_lod_static_set.h"
 #include "sw_sg_scene.h"
 #include "test_check.h"
@@ -178,6 +179,18 @@ static void check_drop_rules(void)
     printf("  drop rules on a made chain: levels kept %s%s%s%s%s, %zu bytes freed\n",
            l[0].n_triangles ? "0" : "-", l[1].n_triangles ? "1" : "-", l[2].n_triangles ? "2" : "-",
            l[3].n_triangles ? "3" : "-", l[4].n_triangles ? "4" : "-", freed);
+    /* every level too fine: the coarsest mesh stays, the proxies' input; a finer one goes */
+    sw_lod_static_level *m = c->levels;
+    for (int k = 0; k < 5; ++k)
+        sw__sl_level_free(&m[k]);
+    m[0] = synthetic_level(40, 0.0, 0.1);
+    m[1] = synthetic_level(30, 0.5, 0.3);
+    c->n_levels = 2;
+    sw_lod_static_drop_undrawn(c);
+    CHECK(m[0].n_triangles == 0 && m[1].n_triangles == 30,
+          "levels of 40 and 30 triangles over 1 patch: %u and %u kept (0 and 30 expected: the "
+          "coarsest stays for the proxies)",
+          m[0].n_triangles, m[1].n_triangles);
     sw_lod_static_free(c);
 }
 
@@ -192,9 +205,13 @@ static int check_bounds(const sw_lod_static_set *set, const sw_sg_scene *scene)
         const sw_lod_static_unit *un = sw_lod_static_set_unit(set, u);
         const sw_lod_static_patch *p = sw_lod_static_set_patches(set) + un->first_patch;
         dropped += c ? check_kept_levels(c, u) : 0;
+        int32_t coarsest = c ? c->n_levels - 1 : 0;
+        while (c && coarsest > 0 && c->levels[coarsest].n_triangles == 0)
+            --coarsest;
         for (int32_t k = 0; c && k < c->n_levels; ++k) {
             const sw_lod_static_level *l = &c->levels[k];
-            CHECK(l->n_triangles == 0 || sw_lod_static_level_drawable(c, k),
+            /* the coarsest mesh stays for the cluster proxies, drawable or not */
+            CHECK(l->n_triangles == 0 || k == coarsest || sw_lod_static_level_drawable(c, k),
                   "unit %u level %d: %u triangles over %u patches kept, finer than a frame draws",
                   u, k, l->n_triangles, c->n_patches);
             if (l->n_triangles == 0)

@@ -179,6 +179,11 @@ void sw_cli_print_frame_stats(const char *label, const sw_frame_stats *s)
                (int)strlen(label), "", (unsigned long long)s->static_drawn,
                (unsigned long long)s->static_faces, (unsigned long long)s->static_triangles,
                (unsigned long long)s->static_requests);
+    if (s->proxies_drawn > 0)
+        printf(
+            "%*s  cluster proxies: %llu drawn for %llu super-surface instances (%llu triangles)\n",
+            (int)strlen(label), "", (unsigned long long)s->proxies_drawn,
+            (unsigned long long)s->proxy_instances, (unsigned long long)s->proxy_triangles);
     if (s->resident_triangles > 0)
         printf("%*s  kept on the GPU: %llu of the triangles drawn from buffers kept between frames "
                "(static levels, patch grids); %llu patch grids found kept, %llu evaluated\n",

@@ -19,7 +19,8 @@
 static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
-    "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--lod-colors]\n"
+    "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--no-proxies]\n"
+    "                          [--lod-colors]"
     "                          [--no-occlusion] [--no-exact-edges] [--no-kept-grids]\n"
     "                          [--memory-budget HOST[,GPU]]\n"
     "\n"
@@ -62,6 +63,9 @@ static const char k_usage[] =
     "                    scene's `build-lod` cache, else built in the pool on first need (said\n"
     "                    on stderr); static_drawn, static_faces, static_triangles,\n"
     "                    static_requests columns\n"
+    "  --no-proxies      no cluster proxies (by default, once a LOD cache is read, far groups of\n"
+    "                    super-surface instances are drawn as one merged mesh within the\n"
+    "                    bound: proxies_drawn, proxy_instances, proxy_triangles columns)\n"
     "  --lod-colors      colour by representation, as for `render`\n"
     "  --no-exact-edges  trim textures only (by default exact trim edges where a trim texel\n"
     "                    would exceed a quarter pixel, as for `render`: trim_exact column)\n"
@@ -120,6 +124,10 @@ static int parse_args(int argc, char **argv, profile_args *a)
         }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--no-static-lod")) {
             a->frame.static_lods = !strcmp(arg, "--static-lod");
+            continue;
+        }
+        if (!strcmp(arg, "--no-proxies")) {
+            a->frame.no_proxies = 1;
             continue;
         }
         if (!strcmp(arg, "--lod-colors")) {

@@ -11,8 +11,9 @@ static const char k_usage[] =
     "usage: splinewalk render SCENE -o FRAME.png [--size 1280x720] [--view iso|front|top|right]\n"
     "                         [--camera ex,ey,ez,tx,ty,tz,ux,uy,uz,fovy] [--error PX]\n"
     "                         [--eval hierarchy|bezier|exact] [--[no-]static-lod] [--lod-colors]\n"
-    "                         [--static-force K] [--no-occlusion] [--no-exact-edges] [--partial]\n"
-    "                         [--no-kept-grids] [--memory-budget HOST[,GPU]]\n"
+    "                         [--static-force K] [--no-proxies] [--no-occlusion] "
+    "[--no-exact-edges]\n"
+    "                         [--partial] [--no-kept-grids] [--memory-budget HOST[,GPU]]\n"
     "\n"
     "Renders one converged frame of SCENE (.sws, or any file `import` reads, imported on the fly)\n"
     "headlessly through EGL (Mesa's llvmpipe when there is no GPU) and writes it as PNG, or as "
@@ -48,6 +49,9 @@ static const char k_usage[] =
     "                      when SCENE has a LOD cache; without one it is off (building the\n"
     "                      levels costs more than they save in one frame)\n"
     "  --no-static-lod     every face by the per-frame path, LOD cache or not\n"
+    "  --no-proxies        (with static LODs from a LOD cache) no cluster proxies: by default\n"
+    "                      groups of far super-surface instances, across objects, are drawn as\n"
+    "                      one merged mesh whose certified error is within the bound\n"
     "  --lod-colors        colour each surface by how it is drawn: static levels fine to coarse\n"
     "                      blue, teal, green, yellow, orange, pink; per-frame tessellation grey,\n"
     "                      violet where cut by exact trim edges\n"
@@ -94,6 +98,10 @@ static int parse_args(int argc, char **argv, render_args *a)
         }
         if (!strcmp(arg, "--static-lod") || !strcmp(arg, "--no-static-lod")) {
             a->frame.static_lods = !strcmp(arg, "--static-lod");
+            continue;
+        }
+        if (!strcmp(arg, "--no-proxies")) {
+            a->frame.no_proxies = 1;
             continue;
         }
         if (!strcmp(arg, "--lod-colors")) {

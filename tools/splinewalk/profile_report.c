@@ -35,7 +35,7 @@ _Static_assert(SW_RT_COL_POOL_FIRST_TASKS - SW_RT_COL_POOL_FIRST_MS == SW_RT_POO
                "one ms and one tasks column per pool task kind, in order");
 /* Pool kinds' colours (same order as the kinds). */
 static const char *const k_pool_colour[] = {"#a0a0a0", "#4c8bd6", "#9ecae9", "#8e6bbf", "#59a14f",
-                                            "#edc948", "#f28e2b", "#e15759", "#76b7b2"};
+                                            "#edc948", "#f28e2b", "#ff9da7", "#e15759", "#76b7b2"};
 _Static_assert(sizeof k_pool_colour / sizeof k_pool_colour[0] == SW_RT_POOL_KIND_COUNT,
                "one colour per pool task kind");
 
@@ -104,6 +104,9 @@ void sw_rt_profile_row(const sw_frame_stats *st, uint32_t index, double t, doubl
     v[SW_RT_COL_STATIC_FACES] = (double)st->static_faces;
     v[SW_RT_COL_STATIC_TRIANGLES] = (double)st->static_triangles;
     v[SW_RT_COL_STATIC_REQUESTS] = (double)st->static_requests;
+    v[SW_RT_COL_PROXIES_DRAWN] = (double)st->proxies_drawn;
+    v[SW_RT_COL_PROXY_INSTANCES] = (double)st->proxy_instances;
+    v[SW_RT_COL_PROXY_TRIANGLES] = (double)st->proxy_triangles;
     v[SW_RT_COL_BOUND_EXCEEDED] = (double)st->bound_exceeded;
     v[SW_RT_COL_BUDGET_COARSENED] = (double)st->budget_coarsened;
     v[SW_RT_COL_BOUND_EXCESS_PX] = st->bound_excess_px;

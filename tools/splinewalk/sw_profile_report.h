@@ -41,6 +41,7 @@
     X(A, STATIC_CLUSTER, "static_cluster", "super-surface clustering of a scene (static LODs)")    \
     X(A, STATIC_BUILD, "static_build", "static LOD builds of one super-surface")                   \
     X(A, STATIC_RETIRE, "static_retire", "freeing a retired set of static LODs")                   \
+    X(A, STATIC_PROXY, "static_proxy", "cluster proxy builds (HLOD)")                              \
     X(A, COMPILE, "compile", "node scenes' compile tasks")                                         \
     X(A, FRAME_STAGE, "frame_stage", "chunks of a frame's tessellation taken by workers")
 enum {
@@ -103,6 +104,9 @@ const char *sw_rt_pool_kind_name(int kind);
     X(STATIC_FACES, "static_faces", COUNT, "face instances they cover (of faces_drawn)")           \
     X(STATIC_TRIANGLES, "static_triangles", COUNT, "their triangles (of triangles)")               \
     X(STATIC_REQUESTS, "static_requests", COUNT, "walkthrough: static LOD builds queued")          \
+    X(PROXIES_DRAWN, "proxies_drawn", COUNT, "cluster proxies drawn (HLOD across objects)")        \
+    X(PROXY_INSTANCES, "proxy_instances", COUNT, "super-surface instances they stand for")         \
+    X(PROXY_TRIANGLES, "proxy_triangles", COUNT, "their triangles (of triangles)")                 \
     X(BOUND_EXCEEDED, "bound_exceeded", COUNT,                                                     \
       "pieces drawn whose error bound exceeds the screen-space error (capped grids, floors)")      \
     X(BOUND_EXCESS_PX, "bound_excess_px", PIXELS,                                                  \

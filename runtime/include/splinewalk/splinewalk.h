@@ -354,6 +354,11 @@ typedef struct sw_frame_desc {
                                 coarsest level within ε_img at its nearest point, else by the
                                 per-frame path. Walkthrough frames never wait for the builds;
                                 converged frames do. 0: every face by the per-frame path */
+    int32_t no_proxies;      /* with static_lods, 0: cluster proxies across objects (HLOD): once
+                                the LOD cache is read, BVH nodes of many super-surface instances
+                                get one merged mesh with a certified error, built in the worker
+                                pool, and a frame draws it instead of the node's instances where
+                                that error is within ε_img; 1: none */
     int32_t lod_colors;      /* 1: each surface coloured by how it is drawn: static levels fine
                                 to coarse blue, teal, green, yellow, orange, pink; per-frame grey,
                                 violet where cut by exact trim edges (trim_edges) */
@@ -447,6 +452,9 @@ typedef struct sw_frame_stats {
     uint64_t static_faces;     /* face instances they cover (of faces_drawn) */
     uint64_t static_triangles; /* their triangles (of triangles) */
     uint64_t static_requests;  /* walkthrough: builds queued instead of waited for */
+    uint64_t proxies_drawn;    /* cluster proxies drawn (desc.no_proxies) */
+    uint64_t proxy_instances;  /* super-surface instances they stand for */
+    uint64_t proxy_triangles;  /* their triangles (of triangles) */
     /* triangle meshes (sw_nodes.h MESH nodes) */
     uint64_t meshes_drawn, meshes_culled; /* mesh occurrences inside / outside the frustum */
     uint64_t mesh_triangles;              /* their triangles drawn (of triangles) */

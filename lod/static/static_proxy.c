@@ -1,0 +1,565 @@
+/* SPDX-License-Identifier: MIT */
+/* Cluster proxies of a static set (sw_lod_proxy.h says what a proxy is and why its bound holds;
+ * sw_lod_static_set.h how frames use them).
+ *
+ * Which nodes. Every node of the unit-instance BVH with at least k_min_instances instances under
+ * it is a candidate. A proxy aims at an error that is a fixed share of its node's diagonal
+ * (k_aim_of_diagonal), so that the cut takes it where the node spans a few tens of pixels. Its
+ * inputs are within most of that aim where they can be: per child, the child's proxy when its
+ * error is, else every instance under the child at the coarsest stored level that is (else its
+ * finest), placed in the world by the instance's transform. The clustering's cells take the rest.
+ * A node with an instance that has no stored level (a face with no unit, a failed or missing
+ * chain) gets no proxy, nor do its ancestors.
+ *
+ * Builds. Pool tasks, one per subtree at depth k_split_depth (the nodes below it built bottom-up in
+ * the task); the last of them builds the nodes above. Each proxy is published by one pointer store
+ * (release) as soon as it is made; frames read it with no lock and draw what exists. */
+#include "sw_clock.h"
+#include "sw_hooks.h"
+#include "sw_lod_proxy.h"
+#include "sw_lod_static_set.h"
+#include "sw_status_util.h"
+
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum {
+    k_min_instances = 8, /* a proxy stands for at least this many instances */
+    k_split_depth = 6,   /* subtrees built by tasks of their own */
+    k_max_parts = 1024,  /* colours one proxy keeps apart; more fail the proxy */
+};
+/* The error a proxy aims at, as a share of its node's diagonal: the cut takes it where the node
+ * spans about 1 / (2 x this) = 64 px at ε_img = 0.5. Of it, the inputs take k_input_share (their
+ * levels as coarse as that allows: fewest triangles) and the clustering's cells k_cell_share (the
+ * clustering bound is at most a cell's diagonal, about half a cell in practice). Measured on the
+ * 10^5-surface car park's fly-through (docs/performance.md): aiming at a 128th with 0.8 / 0.2
+ * draws 15 % fewer triangles than a 256th with cells as large as the inputs' error. */
+static const double k_aim_of_diagonal = 1.0 / 128.0;
+static const double k_input_share = 0.8, k_cell_share = 0.2;
+
+static sw_th_task_kind_slot k_proxy_kind = SW_TH_TASK_KIND_SLOT("static_proxy");
+
+struct sw__lod_proxies {
+    _Atomic(sw_lod_proxy *) *node; /* per BVH node: its proxy once built */
+    uint32_t n_nodes;
+    _Atomic int started;
+    _Atomic int64_t subtrees_left;
+    _Atomic uint32_t next_key;
+    _Atomic uint64_t built, failed, triangles, bytes, ns;
+    sw_th_group group;
+};
+
+sw_result sw__lod_proxies_create(uint32_t n_nodes, sw__lod_proxies **out, sw_status *status)
+{
+    sw__lod_proxies *p = sw__calloc(1, sizeof *p);
+    if (p)
+        p->node = sw__calloc(n_nodes ? n_nodes : 1, sizeof *p->node);
+    if (!p || !p->node) {
+        sw__free(p);
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
+    }
+    p->n_nodes = n_nodes;
+    *out = p;
+    return SW_OK;
+}
+
+static void proxy_free(sw_lod_proxy *x)
+{
+    if (!x)
+        return;
+    for (uint32_t k = 0; k < x->n_parts; ++k) {
+        sw__free(x->parts[k].positions);
+        sw__free(x->parts[k].normals);
+        sw__free(x->parts[k].triangles);
+        if (x->lines)
+            sw__free(x->lines[k]);
+    }
+    sw__free(x->parts);
+    sw__free(x->colors);
+    sw__free(x->lines);
+    sw__free(x->n_lines);
+    sw__free(x);
+}
+
+void sw__lod_proxies_destroy(sw_th_pool *pool, sw__lod_proxies *p)
+{
+    if (!p)
+        return;
+    sw_th_group_wait(pool, &p->group);
+    for (uint32_t n = 0; n < p->n_nodes; ++n)
+        proxy_free(atomic_load(&p->node[n]));
+    sw__free(p->node);
+    sw__free(p);
+}
+
+int sw__lod_proxies_started(const sw__lod_proxies *p)
+{
+    return atomic_load_explicit(&p->started, memory_order_acquire);
+}
+
+void sw__lod_proxies_wait(sw_th_pool *pool, sw__lod_proxies *p)
+{
+    if (sw_th_group_pending(&p->group) == 0)
+        return;
+    sw_th_wait_begin();
+    sw_th_group_wait(pool, &p->group);
+    sw_th_wait_end();
+}
+
+const sw_lod_proxy *sw__lod_proxies_get(const sw__lod_proxies *p, uint32_t node)
+{
+    return node < p->n_nodes ? atomic_load_explicit(&p->node[node], memory_order_acquire) : NULL;
+}
+
+void sw__lod_proxies_stats(const sw__lod_proxies *p, sw_lod_static_set_stats *out)
+{
+    out->proxies = atomic_load(&p->built);
+    out->proxies_failed = atomic_load(&p->failed);
+    out->proxy_triangles = atomic_load(&p->triangles);
+    out->proxy_bytes = (size_t)atomic_load(&p->bytes);
+    out->proxy_seconds = 1e-9 * (double)atomic_load(&p->ns);
+    out->proxies_building = atomic_load(&p->started) && atomic_load(&p->subtrees_left) > 0;
+}
+
+/* ---- one proxy's inputs ------------------------------------------------------------------------
+ */
+typedef struct gather {
+    const sw_lod_static_set *set;
+    const sw_lod_static_instances *in;
+    double centre[3];
+    double *pos;
+    float *nrm;
+    uint32_t *part, *tri;
+    size_t n_v, cap_pos, cap_nrm, cap_part, n_t, cap_tri;
+    float (*colors)[4];
+    uint32_t n_colors;
+    double err; /* the inputs' own error, world units */
+    uint32_t instances;
+} gather;
+
+static void gather_free(gather *g)
+{
+    sw__free(g->pos);
+    sw__free(g->nrm);
+    sw__free(g->part);
+    sw__free(g->tri);
+    sw__free(g->colors);
+}
+
+/* The part of colour c, added when new; -1 past k_max_parts or out of memory. */
+static int32_t part_of(gather *g, const float c[4])
+{
+    for (uint32_t k = 0; k < g->n_colors; ++k)
+        if (!memcmp(g->colors[k], c, sizeof g->colors[k]))
+            return (int32_t)k;
+    if (g->n_colors == k_max_parts) /* colours beyond it: the proxy is not made */
+        return -1;
+    float(*colors)[4] = sw__realloc(g->colors, (g->n_colors + 1) * sizeof *colors);
+    if (!colors)
+        return -1;
+    g->colors = colors;
+    memcpy(g->colors[g->n_colors], c, sizeof g->colors[0]);
+    return (int32_t)g->n_colors++;
+}
+
+static int reserve(gather *g, size_t nv, size_t nt)
+{
+    return sw__grow((void **)&g->pos, &g->cap_pos, 3 * (g->n_v + nv), sizeof *g->pos) &&
+           sw__grow((void **)&g->nrm, &g->cap_nrm, 3 * (g->n_v + nv), sizeof *g->nrm) &&
+           sw__grow((void **)&g->part, &g->cap_part, g->n_v + nv, sizeof *g->part) &&
+           sw__grow((void **)&g->tri, &g->cap_tri, 3 * (g->n_t + nt), sizeof *g->tri);
+}
+
+/* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm. */
+static double stretch_bound(const double m[12])
+{
+    double col = 0.0, row = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        double c = 0.0, r = 0.0;
+        for (int j = 0; j < 3; ++j) {
+            c += fabs(m[4 * j + i]);
+            r += fabs(m[4 * i + j]);
+        }
+        col = fmax(col, c);
+        row = fmax(row, r);
+    }
+    return sqrt(col * row);
+}
+
+/* Appends a mesh: positions mapped by m (3 x 4, row-major; NULL: moved by `shift`), normals by its
+ * linear part (similarities: shading is two-sided, as the static levels' draws), one part. */
+static int append_mesh(gather *g, const sw_lod_static_level *lv, const double *m,
+                       const double shift[3], int32_t part)
+{
+    if (part < 0 || g->n_v + lv->n_vertices > UINT32_MAX ||
+        !reserve(g, lv->n_vertices, lv->n_triangles))
+        return 0;
+    for (uint32_t i = 0; i < lv->n_vertices; ++i) {
+        const double *p = lv->positions + 3 * (size_t)i;
+        const float *n = lv->normals + 3 * (size_t)i;
+        double *q = g->pos + 3 * g->n_v;
+        float *qn = g->nrm + 3 * g->n_v;
+        double nn[3], len = 0.0;
+        for (int r = 0; r < 3; ++r) {
+            q[r] = m ? m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3]
+                     : p[r] + shift[r];
+            q[r] -= m ? g->centre[r] : 0.0;
+            nn[r] = m ? m[4 * r] * n[0] + m[4 * r + 1] * n[1] + m[4 * r + 2] * n[2] : n[r];
+            len += nn[r] * nn[r];
+        }
+        len = sqrt(len);
+        for (int r = 0; r < 3; ++r)
+            qn[r] = len > 0.0 ? (float)(nn[r] / len) : 0.0f;
+        g->part[g->n_v++] = (uint32_t)part;
+    }
+    const uint32_t base = (uint32_t)(g->n_v - lv->n_vertices);
+    for (size_t k = 0; k < 3 * (size_t)lv->n_triangles; ++k)
+        g->tri[3 * g->n_t + k] = base + lv->triangles[k];
+    g->n_t += lv->n_triangles;
+    return 1;
+}
+
+/* The coarsest stored level of a chain whose error under a transform of stretch s is within
+ * `within`, else its finest stored level. */
+static const sw_lod_static_level *level_for(const sw_lod_static_chain *c, double s, double within)
+{
+    const sw_lod_static_level *finest = NULL;
+    for (int32_t k = c->n_levels - 1; k >= 0; --k) {
+        const sw_lod_static_level *lv = &c->levels[k];
+        if (lv->n_triangles == 0)
+            continue;
+        if (lv->eps * s <= within)
+            return lv;
+        finest = lv;
+    }
+    return finest;
+}
+
+/* Every instance under BVH node `node`, each at its coarsest level within `within`: 0 when one has
+ * no stored level (or out of memory). */
+static int gather_instances(gather *g, uint32_t node, double within)
+{
+    const sw_sg_bvh *bvh = g->in->bvh;
+    const sw_sg_bvh_node *nd = &bvh->nodes[node];
+    for (uint32_t i = nd->first; i < nd->first + nd->count; ++i) {
+        sw_sg_bvh_item_view it;
+        sw_sg_bvh_item_at(bvh, i, &it);
+        const sw_lod_static_instance *ins = &g->in->instances[it.face];
+        if (ins->unit == SW_LOD_STATIC_NO_UNIT)
+            return 0;
+        const sw_lod_static_chain *c = sw_lod_static_set_get(g->set, ins->unit);
+        const double s = stretch_bound(it.world);
+        const sw_lod_static_level *lv = c ? level_for(c, s, within) : NULL;
+        if (!lv)
+            return 0;
+        if (!append_mesh(g, lv, it.world, NULL, part_of(g, g->in->occs[ins->first_occ].color)))
+            return 0;
+        g->err = fmax(g->err, lv->eps * s);
+        g->instances++;
+    }
+    return 1;
+}
+
+static int gather_proxy(gather *g, const sw_lod_proxy *x)
+{
+    const double shift[3] = {x->centre[0] - g->centre[0], x->centre[1] - g->centre[1],
+                             x->centre[2] - g->centre[2]};
+    for (uint32_t k = 0; k < x->n_parts; ++k)
+        if (!append_mesh(g, &x->parts[k], NULL, shift, part_of(g, x->colors[k])))
+            return 0;
+    g->err = fmax(g->err, x->err);
+    g->instances += x->instances;
+    return 1;
+}
+
+/* ---- one proxy
+ * ----------------------------------------------------------------------------------- */
+
+static int u64_cmp(const void *pa, const void *pb)
+{
+    const uint64_t a = *(const uint64_t *)pa, b = *(const uint64_t *)pb;
+    return (a > b) - (a < b);
+}
+
+/* The edges of a part used by one triangle only, as vertex pairs (lower index first). */
+static int open_edges(const sw_lod_static_level *lv, uint32_t **out, uint32_t *n_out)
+{
+    const size_t n = 3 * (size_t)lv->n_triangles;
+    uint64_t *e = sw__malloc((n + 1) * sizeof *e);
+    uint32_t *lines = sw__malloc((2 * n + 2) * sizeof *lines);
+    if (!e || !lines) {
+        sw__free(e);
+        sw__free(lines);
+        return 0;
+    }
+    for (size_t t = 0; t < lv->n_triangles; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = lv->triangles[3 * t + (size_t)k];
+            const uint32_t b = lv->triangles[3 * t + (size_t)(k + 1) % 3];
+            e[3 * t + (size_t)k] = a < b ? (uint64_t)a << 32 | b : (uint64_t)b << 32 | a;
+        }
+    qsort(e, n, sizeof *e, u64_cmp);
+    uint32_t m = 0;
+    for (size_t i = 0; i < n;) {
+        size_t j = i + 1;
+        while (j < n && e[j] == e[i])
+            ++j;
+        if (j - i == 1) {
+            lines[2 * m] = (uint32_t)(e[i] >> 32);
+            lines[2 * m + 1] = (uint32_t)e[i];
+            ++m;
+        }
+        i = j;
+    }
+    sw__free(e);
+    *out = lines;
+    *n_out = m;
+    return 1;
+}
+
+/* The output split into one level per part (its vertices are grouped by part). */
+static sw_lod_proxy *split_parts(const gather *g, const sw_lod_proxy_mesh *m)
+{
+    sw_lod_proxy *x = sw__calloc(1, sizeof *x);
+    if (!x)
+        return NULL;
+    const size_t np = g->n_colors ? g->n_colors : 1;
+    x->parts = sw__calloc(np, sizeof *x->parts);
+    x->colors = sw__calloc(np, sizeof *x->colors);
+    x->lines = sw__calloc(np, sizeof *x->lines);
+    x->n_lines = sw__calloc(np, sizeof *x->n_lines);
+    uint32_t *first = sw__calloc((size_t)g->n_colors + 1, sizeof *first);
+    if (!x->parts || !x->colors || !x->lines || !x->n_lines || !first) {
+        sw__free(first);
+        proxy_free(x);
+        return NULL;
+    }
+    for (uint32_t v = 0; v < m->n_vertices; ++v)
+        first[m->part[v] + 1]++;
+    for (uint32_t k = 0; k < g->n_colors; ++k)
+        first[k + 1] += first[k];
+    uint32_t *nt = sw__calloc(g->n_colors ? g->n_colors : 1, sizeof *nt);
+    int ok = nt != NULL;
+    for (uint32_t t = 0; ok && t < m->n_triangles; ++t)
+        nt[m->part[m->tri[3 * (size_t)t]]]++;
+    for (uint32_t k = 0; ok && k < g->n_colors; ++k) {
+        const uint32_t nv = first[k + 1] - first[k];
+        if (nv == 0 || nt[k] == 0)
+            continue;
+        sw_lod_static_level *lv = &x->parts[x->n_parts];
+        memcpy(x->colors[x->n_parts++], g->colors[k], sizeof x->colors[0]);
+        lv->positions = sw__malloc(3 * (size_t)nv * sizeof *lv->positions);
+        lv->normals = sw__malloc(3 * (size_t)nv * sizeof *lv->normals);
+        lv->triangles = sw__malloc(3 * (size_t)nt[k] * sizeof *lv->triangles);
+        if (!lv->positions || !lv->normals || !lv->triangles) {
+            ok = 0;
+            break;
+        }
+        memcpy(lv->positions, m->pos + 3 * (size_t)first[k], 3 * (size_t)nv * sizeof *m->pos);
+        memcpy(lv->normals, m->nrm + 3 * (size_t)first[k], 3 * (size_t)nv * sizeof *m->nrm);
+        lv->n_vertices = nv;
+        for (uint32_t t = 0; t < m->n_triangles; ++t) {
+            const uint32_t *tr = m->tri + 3 * (size_t)t;
+            if (m->part[tr[0]] != k)
+                continue;
+            for (int c = 0; c < 3; ++c)
+                lv->triangles[3 * (size_t)lv->n_triangles + (size_t)c] = tr[c] - first[k];
+            lv->n_triangles++;
+        }
+        ok = open_edges(lv, &x->lines[x->n_parts - 1], &x->n_lines[x->n_parts - 1]);
+    }
+    sw__free(nt);
+    sw__free(first);
+    if (!ok) {
+        proxy_free(x);
+        return NULL;
+    }
+    return x;
+}
+
+static double box_diagonal(const double b[6])
+{
+    return sqrt((b[3] - b[0]) * (b[3] - b[0]) + (b[4] - b[1]) * (b[4] - b[1]) +
+                (b[5] - b[2]) * (b[5] - b[2]));
+}
+
+/* Clusters the gathered inputs on cells of size h (the top of the file). */
+static sw_lod_proxy *cluster_inputs(const gather *g, double diag, double h, sw_status *st)
+{
+    const sw_lod_proxy_input in = {g->pos,      g->nrm, g->part,         (uint32_t)g->n_v,
+                                   g->n_colors, g->tri, (uint32_t)g->n_t};
+    const double origin[3] = {-0.5 * diag, -0.5 * diag, -0.5 * diag};
+    sw_lod_proxy_mesh m;
+    if (sw_lod_proxy_cluster(&in, h, origin, &m, st) != SW_OK)
+        return NULL;
+    sw_lod_proxy *x = m.n_triangles && isfinite(m.bound) ? split_parts(g, &m) : NULL;
+    if (x) {
+        x->err = g->err + m.bound;
+        x->input_err = g->err;
+        x->n_triangles = m.n_triangles;
+        x->vanished = m.vanished;
+        x->cell = h;
+    }
+    sw_lod_proxy_mesh_free(&m);
+    return x;
+}
+
+static size_t proxy_bytes(const sw_lod_proxy *x)
+{
+    size_t b = sizeof *x + x->n_parts * (sizeof *x->parts + sizeof *x->colors);
+    for (uint32_t k = 0; k < x->n_parts; ++k)
+        b += (size_t)x->parts[k].n_vertices * (3 * sizeof(double) + 3 * sizeof(float)) +
+             (size_t)x->parts[k].n_triangles * 3 * sizeof(uint32_t) +
+             (size_t)x->n_lines[k] * 2 * sizeof(uint32_t);
+    return b;
+}
+
+static int is_candidate(const sw_sg_bvh *bvh, int32_t node)
+{
+    return node >= 0 && bvh->nodes[node].count >= k_min_instances;
+}
+
+/* Builds node's proxy from its children's proxies or instances, and publishes it. */
+static void build_node(const sw_lod_static_set *set, sw__lod_proxies *p, uint32_t node)
+{
+    const sw_lod_static_instances *in = sw_lod_static_set_instances(set);
+    const sw_sg_bvh *bvh = in->bvh;
+    if (!is_candidate(bvh, (int32_t)node) || sw__lod_static_set_cancelled(set))
+        return;
+    const uint64_t t0 = sw__clock_ns();
+    gather g;
+    memset(&g, 0, sizeof g);
+    g.set = set;
+    g.in = in;
+    double box[6];
+    sw_sg_bvh_node_box(bvh, node, box);
+    for (int k = 0; k < 3; ++k)
+        g.centre[k] = 0.5 * (box[k] + box[3 + k]);
+    const double diag = box_diagonal(box), aim = diag * k_aim_of_diagonal;
+    const double within = k_input_share * aim, cell = k_cell_share * aim;
+    int ok = 1;
+    if (bvh->nodes[node].second < 0) {
+        ok = gather_instances(&g, node, within);
+    } else {
+        for (int c = 0; c < 2 && ok; ++c) {
+            const int32_t child = sw_sg_bvh_child(bvh, node, c);
+            const sw_lod_proxy *x = sw__lod_proxies_get(p, (uint32_t)child);
+            ok = x && x->err <= within ? gather_proxy(&g, x)
+                                       : gather_instances(&g, (uint32_t)child, within);
+        }
+    }
+    sw_status st = {0};
+    sw_lod_proxy *x = ok && g.n_t ? cluster_inputs(&g, diag, cell, &st) : NULL;
+    if (x) {
+        for (int k = 0; k < 3; ++k)
+            x->centre[k] = g.centre[k];
+        x->instances = g.instances;
+        x->input_triangles = g.n_t;
+        x->key = atomic_fetch_add(&p->next_key, x->n_parts);
+        atomic_fetch_add(&p->built, 1);
+        atomic_fetch_add(&p->triangles, x->n_triangles);
+        atomic_fetch_add(&p->bytes, proxy_bytes(x));
+        atomic_store_explicit(&p->node[node], x, memory_order_release);
+    } else {
+        atomic_fetch_add(&p->failed, 1);
+    }
+    atomic_fetch_add(&p->ns, sw__clock_ns() - t0);
+    gather_free(&g);
+}
+
+/* Post-order over node's subtree down to depth `stop` (exclusive; -1: no limit): children first. */
+static void build_subtree(const sw_lod_static_set *set, sw__lod_proxies *p, uint32_t node,
+                          int depth, int stop)
+{
+    const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
+    if (!is_candidate(bvh, (int32_t)node) || depth == stop)
+        return;
+    if (stop >= 0 && bvh->nodes[node].second < 0)
+        return; /* a leaf above the split depth is a task's root, built by it */
+    for (int c = 0; c < 2; ++c) {
+        const int32_t child = sw_sg_bvh_child(bvh, node, c);
+        if (child >= 0)
+            build_subtree(set, p, (uint32_t)child, depth + 1, stop);
+    }
+    build_node(set, p, node);
+}
+
+typedef struct subtree_job {
+    const sw_lod_static_set *set;
+    sw__lod_proxies *p;
+    uint32_t node;
+} subtree_job;
+
+static void subtree_task(void *ctx)
+{
+    subtree_job *job = ctx;
+    build_subtree(job->set, job->p, job->node, k_split_depth, -1);
+    if (atomic_fetch_sub(&job->p->subtrees_left, 1) == 1) /* the last: the nodes above */
+        build_subtree(job->set, job->p, 0, 0, k_split_depth);
+    sw__free(job);
+}
+
+/* The nodes at depth k_split_depth (or leaves above it) that are candidates. */
+static uint32_t split_roots(const sw_sg_bvh *bvh, uint32_t node, int depth, uint32_t *out)
+{
+    if (!is_candidate(bvh, (int32_t)node))
+        return 0;
+    if (depth == k_split_depth || bvh->nodes[node].second < 0) {
+        if (out)
+            out[0] = node;
+        return 1;
+    }
+    uint32_t n = 0;
+    for (int c = 0; c < 2; ++c)
+        n += split_roots(bvh, (uint32_t)sw_sg_bvh_child(bvh, node, c), depth + 1,
+                         out ? out + n : NULL);
+    return n;
+}
+
+sw_result sw__lod_proxies_start(const sw_lod_static_set *set, sw__lod_proxies *p, sw_th_pool *pool,
+                                sw_status *status)
+{
+    int expect = 0;
+    if (!atomic_compare_exchange_strong(&p->started, &expect, 1))
+        return SW_OK;
+    const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
+    const uint32_t n = bvh->n_nodes ? split_roots(bvh, 0, 0, NULL) : 0;
+    if (n == 0)
+        return SW_OK;
+    uint32_t *roots = sw__malloc(n * sizeof *roots);
+    if (!roots)
+        return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
+    split_roots(bvh, 0, 0, roots);
+    /* a root at depth < k_split_depth is a leaf: built whole by its task, as deeper roots are */
+    atomic_store(&p->subtrees_left, n);
+    sw_result r = SW_OK;
+    for (uint32_t i = 0; i < n; ++i) {
+        subtree_job *job = sw__malloc(sizeof *job);
+        const sw_th_task task = {subtree_task,
+                                 job,
+                                 SW_TH_PRIORITY_BACKGROUND,
+                                 NULL,
+                                 0,
+                                 &p->group,
+                                 sw_th_task_kind_of(&k_proxy_kind)};
+        if (job)
+            *job = (subtree_job){set, p, roots[i]};
+        if (!job || sw_th_pool_submit(pool, &task) != SW_OK) {
+            sw__free(job);
+            /* the ones not submitted are built here, so that the count still ends at 0 */
+            subtree_job here = {set, p, roots[i]};
+            subtree_job *copy = sw__malloc(sizeof *copy);
+            if (copy) {
+                *copy = here;
+                subtree_task(copy);
+            } else {
+                atomic_fetch_sub(&p->subtrees_left, 1);
+                r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
+            }
+        }
+    }
+    sw__free(roots);
+    return r;
+}
