@@ -50,6 +50,7 @@ typedef struct bp_job {
     int fly; /* with path NULL: 0 = orbit (sw_rt_path_orbit), 1 = fly-through (sw_rt_path_fly),
                 2 = walk at eye height 160 (sw_rt_path_walk: a generated building's rooms) */
     int static_lods; /* splinewalk: sw_frame_desc.static_lods (Kumar et al. 1997 static LODs) */
+    int no_proxies;  /* splinewalk: sw_frame_desc.no_proxies (no cluster proxies) */
     int occlusion;   /* splinewalk: sw_frame_desc.occlusion_culling */
     int exact_edges; /* splinewalk: sw_frame_desc.trim_edges */
     int kept_grids;  /* splinewalk: !sw_frame_desc.no_kept_grids */

@@ -23,6 +23,7 @@ static sw_frame_desc frame_at(const sw_run *r, uint32_t i, int converged)
     f.error_px = r->job.error_px;
     f.walkthrough = !converged;
     f.static_lods = r->job.static_lods;
+    f.no_proxies = r->job.no_proxies;
     f.occlusion_culling = r->job.occlusion;
     f.trim_edges = r->job.exact_edges;
     f.no_kept_grids = !r->job.kept_grids;

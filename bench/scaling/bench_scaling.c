@@ -56,6 +56,8 @@ static const char k_usage[] =
     "  --no-exact-edges with trim textures only (default: exact trim edges, as in the CLI)\n"
     "  --static-lods    draw far super-surfaces from static LODs, prebuilt: a scene without a\n"
     "                   LOD cache gets one first (`splinewalk build-lod`, timed and printed)\n"
+    "  --no-proxies     with static LODs: no cluster proxies (default: far groups of\n"
+    "                   super-surface instances drawn as one merged mesh within the bound)\n"
     "  --cold           a cold start: static LODs on but none prebuilt (scenes with a LOD cache\n"
     "                   are refused), built in the pool as the walk needs them; no warm-up; also\n"
     "                   prints when 10 consecutive frames' median first fell to --target\n"
@@ -74,7 +76,7 @@ typedef struct args {
     double error_px;
     const char *dir, *csv, *svg;
     int fly; /* bp_job.fly: 0 orbit, 1 fly-through, 2 walk */
-    int no_occlusion, no_exact_edges, static_lods;
+    int no_occlusion, no_exact_edges, static_lods, no_proxies;
     int cold;         /* static LODs built as the walk needs them, no warm-up */
     double target_ms; /* the frame time a cold start settles at */
     const char *kind; /* what `splinewalk generate` makes: "building" or "vehicle" */
@@ -117,6 +119,10 @@ static int parse(int argc, char **argv, args *a)
         }
         if (!strcmp(o, "--static-lods")) {
             a->static_lods = 1;
+            continue;
+        }
+        if (!strcmp(o, "--no-proxies")) {
+            a->no_proxies = 1;
             continue;
         }
         if (!strcmp(o, "--cold")) {
@@ -343,7 +349,8 @@ int main(int argc, char **argv)
            a.kind, path_name(a.fly), a.w, a.h, a.error_px, a.no_occlusion ? "off" : "on",
            a.no_exact_edges ? "off" : "on",
            a.cold ? "on (cold start: none prebuilt, built in the pool as the walk needs them)"
-           : a.static_lods ? "on (prebuilt)"
+           : a.static_lods ? (a.no_proxies ? "on (prebuilt), no cluster proxies"
+                                           : "on (prebuilt), cluster proxies")
                            : "off",
            a.frames, a.passes, a.warmup, lp ? lp : "(unset)", egl ? egl : "(unset)",
            sysconf(_SC_NPROCESSORS_ONLN));
@@ -364,6 +371,7 @@ int main(int argc, char **argv)
         bp_job job = {.scene = scene,
                       .fly = a.fly,
                       .static_lods = a.static_lods,
+                      .no_proxies = a.no_proxies,
                       .occlusion = !a.no_occlusion,
                       .exact_edges = !a.no_exact_edges,
                       .frames = a.frames,

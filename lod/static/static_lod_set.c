@@ -489,6 +489,11 @@ int sw_lod_static_set_proxies_started(const sw_lod_static_set *s)
     return sw__lod_proxies_started(s->proxies);
 }
 
+int sw_lod_static_set_proxies_done(const sw_lod_static_set *s)
+{
+    return sw__lod_proxies_done(s->proxies);
+}
+
 void sw_lod_static_set_wait_proxies(sw_lod_static_set *s)
 {
     sw__lod_proxies_wait(s->pool, s->proxies);

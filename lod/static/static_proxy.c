@@ -5,15 +5,18 @@
  * Which nodes. Every node of the unit-instance BVH with at least k_min_instances instances under
  * it is a candidate. A proxy aims at an error that is a fixed share of its node's diagonal
  * (k_aim_of_diagonal), so that the cut takes it where the node spans a few tens of pixels. Its
- * inputs are within most of that aim where they can be: per child, the child's proxy when its
- * error is, else every instance under the child at the coarsest stored level that is (else its
- * finest), placed in the world by the instance's transform. The clustering's cells take the rest.
- * A node with an instance that has no stored level (a face with no unit, a failed or missing
- * chain) gets no proxy, nor do its ancestors.
+ * inputs are, per child, the child's proxy, else every instance under the child at the coarsest
+ * stored level within most of that aim (else its finest), placed in the world by the instance's
+ * transform; the clustering's cells take the rest of the aim, and grow where a proxy made from
+ * proxies would otherwise keep more than half their triangles (k_max_cells_of_aim). A node with
+ * an instance that has no stored level (a face with no unit, a failed or missing chain) gets no
+ * proxy, nor do its ancestors.
  *
  * Builds. Pool tasks, one per subtree at depth k_split_depth (the nodes below it built bottom-up in
- * the task); the last of them builds the nodes above. Each proxy is published by one pointer store
- * (release) as soon as it is made; frames read it with no lock and draw what exists. */
+ * the task); the last of them builds the nodes above. A task stages what it builds, then publishes
+ * its subtree's proxies breadth first (larger nodes first) within its share of k_proxy_budget and
+ * drops the rest; each proxy is published by one pointer store (release) and never changes, so
+ * frames read it with no lock and draw what exists. */
 #include "sw_clock.h"
 #include "sw_hooks.h"
 #include "sw_lod_proxy.h"
@@ -38,25 +41,43 @@ enum {
  * draws 15 % fewer triangles than a 256th with cells as large as the inputs' error. */
 static const double k_aim_of_diagonal = 1.0 / 128.0;
 static const double k_input_share = 0.8, k_cell_share = 0.2;
+/* A proxy made from its children's proxies keeps at most half their triangles: its cells double
+ * (its error grows) until it does, up to this many aims. Inputs are copies placed in the world (an
+ * instanced unit's level once per instance), so without it the 10^6 building's proxies copied its
+ * walls' levels at every depth of the tree (peak RSS 4.8 GB). */
+static const double k_max_cells_of_aim = 8.0;
+/* Bytes of proxies a set keeps, shared evenly by the subtree tasks, each publishing its larger
+ * nodes first (the far field) and dropping what does not fit: proxies copy instanced geometry into
+ * the world, so their memory follows the scene's occurrences, not its units. */
+static const size_t k_proxy_budget = (size_t)384 << 20;
 
 static sw_th_task_kind_slot k_proxy_kind = SW_TH_TASK_KIND_SLOT("static_proxy");
 
 struct sw__lod_proxies {
-    _Atomic(sw_lod_proxy *) *node; /* per BVH node: its proxy once built */
+    _Atomic(sw_lod_proxy *) *node; /* per BVH node: its proxy once published */
+    sw_lod_proxy **staged;         /* per BVH node: built, not yet published (its task's alone) */
+    size_t share;                  /* bytes each subtree task may publish */
     uint32_t n_nodes;
     _Atomic int started;
     _Atomic int64_t subtrees_left;
+    _Atomic int done; /* every build finished (the last task's nodes above included) */
     _Atomic uint32_t next_key;
-    _Atomic uint64_t built, failed, triangles, bytes, ns;
+    _Atomic uint64_t built, failed, pruned, triangles, bytes, ns;
     sw_th_group group;
 };
 
 sw_result sw__lod_proxies_create(uint32_t n_nodes, sw__lod_proxies **out, sw_status *status)
 {
     sw__lod_proxies *p = sw__calloc(1, sizeof *p);
-    if (p)
+    if (p) {
         p->node = sw__calloc(n_nodes ? n_nodes : 1, sizeof *p->node);
-    if (!p || !p->node) {
+        p->staged = sw__calloc(n_nodes ? n_nodes : 1, sizeof *p->staged);
+    }
+    if (!p || !p->node || !p->staged) {
+        if (p) {
+            sw__free(p->node);
+            sw__free(p->staged);
+        }
         sw__free(p);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
     }
@@ -88,15 +109,23 @@ void sw__lod_proxies_destroy(sw_th_pool *pool, sw__lod_proxies *p)
     if (!p)
         return;
     sw_th_group_wait(pool, &p->group);
-    for (uint32_t n = 0; n < p->n_nodes; ++n)
+    for (uint32_t n = 0; n < p->n_nodes; ++n) {
         proxy_free(atomic_load(&p->node[n]));
+        proxy_free(p->staged[n]); /* a cancelled build's */
+    }
     sw__free(p->node);
+    sw__free(p->staged);
     sw__free(p);
 }
 
 int sw__lod_proxies_started(const sw__lod_proxies *p)
 {
     return atomic_load_explicit(&p->started, memory_order_acquire);
+}
+
+int sw__lod_proxies_done(const sw__lod_proxies *p)
+{
+    return atomic_load_explicit(&p->done, memory_order_acquire);
 }
 
 void sw__lod_proxies_wait(sw_th_pool *pool, sw__lod_proxies *p)
@@ -117,10 +146,11 @@ void sw__lod_proxies_stats(const sw__lod_proxies *p, sw_lod_static_set_stats *ou
 {
     out->proxies = atomic_load(&p->built);
     out->proxies_failed = atomic_load(&p->failed);
+    out->proxies_pruned = atomic_load(&p->pruned);
     out->proxy_triangles = atomic_load(&p->triangles);
     out->proxy_bytes = (size_t)atomic_load(&p->bytes);
     out->proxy_seconds = 1e-9 * (double)atomic_load(&p->ns);
-    out->proxies_building = atomic_load(&p->started) && atomic_load(&p->subtrees_left) > 0;
+    out->proxies_building = atomic_load(&p->started) && !atomic_load(&p->done);
 }
 
 /* ---- one proxy's inputs ------------------------------------------------------------------------
@@ -385,15 +415,23 @@ static double box_diagonal(const double b[6])
                 (b[5] - b[2]) * (b[5] - b[2]));
 }
 
-/* Clusters the gathered inputs on cells of size h (the top of the file). */
-static sw_lod_proxy *cluster_inputs(const gather *g, double diag, double h, sw_status *st)
+/* Clusters the gathered inputs on cells of size h, doubled while the output has more than
+ * `limit` triangles, up to k_max_cells_of_aim aims (the top of the file). */
+static sw_lod_proxy *cluster_inputs(const gather *g, double diag, double h, double aim,
+                                    uint64_t limit, sw_status *st)
 {
     const sw_lod_proxy_input in = {g->pos,      g->nrm, g->part,         (uint32_t)g->n_v,
                                    g->n_colors, g->tri, (uint32_t)g->n_t};
     const double origin[3] = {-0.5 * diag, -0.5 * diag, -0.5 * diag};
     sw_lod_proxy_mesh m;
-    if (sw_lod_proxy_cluster(&in, h, origin, &m, st) != SW_OK)
-        return NULL;
+    for (;;) {
+        if (sw_lod_proxy_cluster(&in, h, origin, &m, st) != SW_OK)
+            return NULL;
+        if (m.n_triangles <= limit || 2.0 * h > k_max_cells_of_aim * aim)
+            break;
+        sw_lod_proxy_mesh_free(&m);
+        h *= 2.0;
+    }
     sw_lod_proxy *x = m.n_triangles && isfinite(m.bound) ? split_parts(g, &m) : NULL;
     if (x) {
         x->err = g->err + m.bound;
@@ -414,6 +452,63 @@ static size_t proxy_bytes(const sw_lod_proxy *x)
              (size_t)x->parts[k].n_triangles * 3 * sizeof(uint32_t) +
              (size_t)x->n_lines[k] * 2 * sizeof(uint32_t);
     return b;
+}
+
+/* A child's proxy as its parent's build sees it: staged by the same task, or published. */
+static const sw_lod_proxy *built(const sw__lod_proxies *p, uint32_t node)
+{
+    return p->staged[node] ? p->staged[node] : sw__lod_proxies_get(p, node);
+}
+
+/* Makes a staged proxy visible to frames (one release store: it is complete and never changes). */
+static void publish(sw__lod_proxies *p, uint32_t node)
+{
+    sw_lod_proxy *x = p->staged[node];
+    p->staged[node] = NULL;
+    x->key = atomic_fetch_add(&p->next_key, x->n_parts);
+    atomic_fetch_add(&p->built, 1);
+    atomic_fetch_add(&p->triangles, x->n_triangles);
+    atomic_fetch_add(&p->bytes, proxy_bytes(x));
+    atomic_store_explicit(&p->node[node], x, memory_order_release);
+}
+
+static void drop_staged(sw__lod_proxies *p, uint32_t node)
+{
+    proxy_free(p->staged[node]);
+    p->staged[node] = NULL;
+    atomic_fetch_add(&p->pruned, 1);
+}
+
+/* Publishes the staged proxies of root's subtree breadth first — larger nodes (farther views,
+ * fewer triangles each) first — while they fit in `share` bytes; drops the others. */
+static void publish_within(const sw_sg_bvh *bvh, sw__lod_proxies *p, uint32_t root, size_t share)
+{
+    const uint32_t end = root + 2 * bvh->nodes[root].count; /* past the subtree's nodes */
+    uint32_t *queue = sw__malloc(((size_t)bvh->nodes[root].count * 2 + 1) * sizeof *queue);
+    size_t head = 0, tail = 0, used = 0;
+    if (!queue) { /* out of memory: what was built goes, nothing half-published */
+        for (uint32_t n = root; n < bvh->n_nodes && n < end; ++n)
+            if (p->staged[n])
+                drop_staged(p, n);
+        return;
+    }
+    queue[tail++] = root;
+    while (head < tail) {
+        const uint32_t n = queue[head++];
+        sw_lod_proxy *x = p->staged[n];
+        if (x && used + proxy_bytes(x) <= share) {
+            used += proxy_bytes(x);
+            publish(p, n);
+        } else if (x) {
+            drop_staged(p, n);
+        }
+        for (int c = 0; c < 2; ++c) {
+            const int32_t child = sw_sg_bvh_child(bvh, n, c);
+            if (child >= 0 && bvh->nodes[child].count >= k_min_instances)
+                queue[tail++] = (uint32_t)child;
+        }
+    }
+    sw__free(queue);
 }
 
 static int is_candidate(const sw_sg_bvh *bvh, int32_t node)
@@ -439,29 +534,26 @@ static void build_node(const sw_lod_static_set *set, sw__lod_proxies *p, uint32_
         g.centre[k] = 0.5 * (box[k] + box[3 + k]);
     const double diag = box_diagonal(box), aim = diag * k_aim_of_diagonal;
     const double within = k_input_share * aim, cell = k_cell_share * aim;
-    int ok = 1;
+    int ok = 1, from_proxies = 0;
     if (bvh->nodes[node].second < 0) {
         ok = gather_instances(&g, node, within);
     } else {
         for (int c = 0; c < 2 && ok; ++c) {
             const int32_t child = sw_sg_bvh_child(bvh, node, c);
-            const sw_lod_proxy *x = sw__lod_proxies_get(p, (uint32_t)child);
-            ok = x && x->err <= within ? gather_proxy(&g, x)
-                                       : gather_instances(&g, (uint32_t)child, within);
+            const sw_lod_proxy *x = built(p, (uint32_t)child);
+            from_proxies |= x != NULL;
+            ok = x ? gather_proxy(&g, x) : gather_instances(&g, (uint32_t)child, within);
         }
     }
     sw_status st = {0};
-    sw_lod_proxy *x = ok && g.n_t ? cluster_inputs(&g, diag, cell, &st) : NULL;
+    const uint64_t limit = from_proxies ? g.n_t / 2 : UINT64_MAX;
+    sw_lod_proxy *x = ok && g.n_t ? cluster_inputs(&g, diag, cell, aim, limit, &st) : NULL;
     if (x) {
         for (int k = 0; k < 3; ++k)
             x->centre[k] = g.centre[k];
         x->instances = g.instances;
         x->input_triangles = g.n_t;
-        x->key = atomic_fetch_add(&p->next_key, x->n_parts);
-        atomic_fetch_add(&p->built, 1);
-        atomic_fetch_add(&p->triangles, x->n_triangles);
-        atomic_fetch_add(&p->bytes, proxy_bytes(x));
-        atomic_store_explicit(&p->node[node], x, memory_order_release);
+        p->staged[node] = x;
     } else {
         atomic_fetch_add(&p->failed, 1);
     }
@@ -495,9 +587,16 @@ typedef struct subtree_job {
 static void subtree_task(void *ctx)
 {
     subtree_job *job = ctx;
+    const sw_sg_bvh *bvh = sw_lod_static_set_instances(job->set)->bvh;
     build_subtree(job->set, job->p, job->node, k_split_depth, -1);
-    if (atomic_fetch_sub(&job->p->subtrees_left, 1) == 1) /* the last: the nodes above */
+    publish_within(bvh, job->p, job->node, job->p->share);
+    if (atomic_fetch_sub(&job->p->subtrees_left, 1) == 1) { /* the last: the nodes above */
         build_subtree(job->set, job->p, 0, 0, k_split_depth);
+        for (uint32_t n = 0; n < bvh->n_nodes; ++n) /* the few above the split, whole */
+            if (job->p->staged[n])
+                publish(job->p, n);
+        atomic_store_explicit(&job->p->done, 1, memory_order_release);
+    }
     sw__free(job);
 }
 
@@ -526,14 +625,17 @@ sw_result sw__lod_proxies_start(const sw_lod_static_set *set, sw__lod_proxies *p
         return SW_OK;
     const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
     const uint32_t n = bvh->n_nodes ? split_roots(bvh, 0, 0, NULL) : 0;
-    if (n == 0)
+    if (n == 0) {
+        atomic_store_explicit(&p->done, 1, memory_order_release);
         return SW_OK;
+    }
     uint32_t *roots = sw__malloc(n * sizeof *roots);
     if (!roots)
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
     split_roots(bvh, 0, 0, roots);
     /* a root at depth < k_split_depth is a leaf: built whole by its task, as deeper roots are */
     atomic_store(&p->subtrees_left, n);
+    p->share = k_proxy_budget / n;
     sw_result r = SW_OK;
     for (uint32_t i = 0; i < n; ++i) {
         subtree_job *job = sw__malloc(sizeof *job);
@@ -555,7 +657,8 @@ sw_result sw__lod_proxies_start(const sw_lod_static_set *set, sw__lod_proxies *p
                 *copy = here;
                 subtree_task(copy);
             } else {
-                atomic_fetch_sub(&p->subtrees_left, 1);
+                if (atomic_fetch_sub(&p->subtrees_left, 1) == 1)
+                    atomic_store_explicit(&p->done, 1, memory_order_release);
                 r = sw__fail(status, SW_ERR_OUT_OF_MEMORY, "proxies: out of memory");
             }
         }

@@ -110,6 +110,7 @@ typedef struct sw_lod_static_set_stats {
     size_t memory_bytes;  /* the chains' memory */
     /* cluster proxies (sw_lod_static_set_build_proxies) */
     uint64_t proxies, proxies_failed; /* nodes given a proxy; candidates that could not be */
+    uint64_t proxies_pruned;          /* built, then dropped: over the proxies' memory budget */
     uint64_t proxy_triangles;
     size_t proxy_bytes;
     double proxy_seconds; /* summed over builds */
@@ -197,13 +198,15 @@ typedef struct sw_lod_proxy {
 } sw_lod_proxy;
 
 /* Starts building the proxies of every node whose instances' chains are READY (a cache adopted),
- * in the pool at background priority; once per set (later calls do nothing). Frames draw the
- * proxies as they are published. Errors: SW_ERR_OUT_OF_MEMORY. */
+ * in the pool at background priority; once per set (later calls do nothing). Proxies are
+ * published as they are built, within a memory budget (static_proxy.c). Errors:
+ * SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_lod_static_set_build_proxies(sw_lod_static_set *set, sw_status *status);
-/* 1 once sw_lod_static_set_build_proxies was called (some proxies may be built yet). No lock. */
+/* 1 once sw_lod_static_set_build_proxies was called (some proxies may be built yet), and once
+ * every proxy build has finished. No lock. */
 int sw_lod_static_set_proxies_started(const sw_lod_static_set *set);
-/* Returns once the proxy builds started are done, running pool tasks meanwhile (converged
- * frames). */
+int sw_lod_static_set_proxies_done(const sw_lod_static_set *set);
+/* Returns once the proxy builds started are done, running pool tasks meanwhile. */
 void sw_lod_static_set_wait_proxies(sw_lod_static_set *set);
 /* The proxy of a node of sw_lod_static_set_instances()->bvh once built, else NULL. No lock. */
 const sw_lod_proxy *sw_lod_static_set_proxy(const sw_lod_static_set *set, uint32_t node);
@@ -218,6 +221,7 @@ const sw_lod_proxy *sw__lod_proxies_get(const sw__lod_proxies *p, uint32_t node)
 void sw__lod_proxies_stats(const sw__lod_proxies *p, sw_lod_static_set_stats *out);
 void sw__lod_proxies_wait(sw_th_pool *pool, sw__lod_proxies *p);
 int sw__lod_proxies_started(const sw__lod_proxies *p);
+int sw__lod_proxies_done(const sw__lod_proxies *p);
 int sw__lod_static_set_cancelled(const sw_lod_static_set *set);
 
 /* ---- the LOD cache (static_lod_io.c) ---------------------------------------------------------

@@ -52,6 +52,7 @@ typedef struct sw_rt_renderer {
     _Atomic int statics_state;
     sw_th_group statics_group;
     sw_status statics_failure;
+    _Atomic int statics_from_cache; /* the set's chains came from the scene's LOD cache */
     sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
     int time_pool_tasks;      /* sw_rt_renderer_time_pool_tasks: the pool times its tasks */
@@ -534,9 +535,7 @@ static void statics_task(void *ctx)
         found = sw_lod_static_set_load(set, cache, cache_bytes, path, NULL, &cst);
         sw_sg_scene_lods_release(r->cache_scene->sg); /* decoded (or refused): its pages go */
     }
-    /* every chain is there: the cluster proxies can be made from them (in the pool) */
-    if (found == SW_OK && sw_lod_static_set_build_proxies(set, &st) != SW_OK)
-        sw__log(SW_LOG_WARN, "static LODs: %s: no cluster proxies", st.message);
+    atomic_store(&r->statics_from_cache, found == SW_OK);
     if (found == SW_ERR_NOT_FOUND)
         sw__log(SW_LOG_WARN,
                 "static LODs: %s has no LOD cache: the levels are built in the worker pool as "
@@ -548,6 +547,24 @@ static void statics_task(void *ctx)
                           : "no LOD builder is installed: every face is drawn per frame");
     atomic_store(&r->statics, set);
     atomic_store(&r->statics_state, 2);
+}
+
+/* Cluster proxies: made in the pool from a LOD cache's chains (every chain is there) once a frame
+ * wants them — minutes of a pool thread at 10^6 surfaces, so a renderer that never draws them
+ * never pays. A converged frame is the same frame for the same view, so it draws the proxies
+ * once all are built and none before (it does not wait for them: `render` would wait for every
+ * proxy of the scene for a frame a few of them serve). */
+static void frame_proxies(sw_rt_renderer *r, sw_gpu_frame_desc *frame)
+{
+    sw_lod_static_set *set = frame->static_lods;
+    if (!set || frame->no_proxies)
+        return;
+    sw_status st = {0};
+    if (atomic_load(&r->statics_from_cache) && !sw_lod_static_set_proxies_started(set) &&
+        sw_lod_static_set_build_proxies(set, &st) != SW_OK)
+        sw__log(SW_LOG_WARN, "static LODs: %s: no cluster proxies", st.message);
+    if (!frame->walkthrough && !sw_lod_static_set_proxies_done(set))
+        frame->no_proxies = 1;
 }
 
 /* The static LODs of the cache's scene for this frame: their clustering is started in the pool
@@ -572,13 +589,11 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
     if (!frame->walkthrough)
         sw_th_group_wait(r->pool, &r->statics_group);
     const int state = atomic_load(&r->statics_state);
-    /* converged frames are the same frame for the same view: proxies made meanwhile would not be */
-    if (state == 2 && !frame->walkthrough && !frame->no_proxies && atomic_load(&r->statics))
-        sw_lod_static_set_wait_proxies(atomic_load(&r->statics));
     if (state == 3 && !frame->walkthrough)
         return sw__fail(status, r->statics_failure.result, "static LODs: %s",
                         r->statics_failure.message);
     frame->static_lods = state == 2 ? atomic_load(&r->statics) : NULL;
+    frame_proxies(r, frame);
     return SW_OK;
 }
 

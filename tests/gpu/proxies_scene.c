@@ -32,10 +32,14 @@ proxies_scene *proxies_scene_open(const char *path)
         proxies_scene_free(ps);
         return NULL;
     }
-    sw_lod_static_set_wait_proxies(ps->statics);
     printf("%s: %u units, %u adopted from its LOD cache\n", path,
            sw_lod_static_set_unit_count(ps->statics), adopted);
     return ps;
+}
+
+void proxies_scene_wait(proxies_scene *ps)
+{
+    sw_lod_static_set_wait_proxies(ps->statics);
 }
 
 void proxies_scene_free(proxies_scene *ps)

@@ -15,9 +15,11 @@ struct sw_sg_scene;
 struct sw_lod_static_set;
 typedef struct proxies_scene proxies_scene;
 
-/* Opens `path`, adopts its LOD cache, builds the proxies and waits for them; NULL on failure
+/* Opens `path`, adopts its LOD cache and starts building the proxies in the pool; NULL on failure
  * (said on stderr). */
 proxies_scene *proxies_scene_open(const char *path);
+/* Returns once every proxy is built. */
+void proxies_scene_wait(proxies_scene *ps);
 void proxies_scene_free(proxies_scene *ps); /* NULL allowed */
 const struct sw_sg_scene *proxies_scene_scene(const proxies_scene *ps);
 struct sw_lod_static_set *proxies_scene_statics(const proxies_scene *ps);

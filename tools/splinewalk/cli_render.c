@@ -54,7 +54,7 @@ static const char k_usage[] =
     "                      one merged mesh whose certified error is within the bound\n"
     "  --lod-colors        colour each surface by how it is drawn: static levels fine to coarse\n"
     "                      blue, teal, green, yellow, orange, pink; per-frame tessellation grey,\n"
-    "                      violet where cut by exact trim edges\n"
+    "                      violet where cut by exact trim edges; cluster proxies red\n"
     "  --static-force K    (with --static-lod; inspection of the joins) super-surface i at choice\n"
     "                      (i + K) mod (n + 1) of its n levels good enough for the view, the last\n"
     "                      choice meaning per-frame: neighbours at different levels\n"

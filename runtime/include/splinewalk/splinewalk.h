@@ -358,10 +358,12 @@ typedef struct sw_frame_desc {
                                 the LOD cache is read, BVH nodes of many super-surface instances
                                 get one merged mesh with a certified error, built in the worker
                                 pool, and a frame draws it instead of the node's instances where
-                                that error is within ε_img; 1: none */
+                                that error is within ε_img (walkthrough frames as they are built,
+                                converged frames once all are, waiting for none); 1: none */
     int32_t lod_colors;      /* 1: each surface coloured by how it is drawn: static levels fine
                                 to coarse blue, teal, green, yellow, orange, pink; per-frame grey,
-                                violet where cut by exact trim edges (trim_edges) */
+                                violet where cut by exact trim edges (trim_edges); cluster
+                                proxies red */
     int32_t static_force;    /* tests of the joins: k > 0 draws super-surface i at choice
                                 (i + k) mod (n + 1) among its n levels good enough for the view,
                                 the last choice meaning the per-frame path: neighbours at
