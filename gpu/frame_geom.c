@@ -60,23 +60,6 @@ void sw__fr_eye_box_of(const double eye[3], const double obj[6], const double m[
     }
 }
 
-/* sqrt(|M|_1 |M|_inf): 1 for a rigid transform (the Frobenius norm would give sqrt(3) and make
- * every tolerance 1.7x tighter). */
-double sw__fr_stretch_bound(const double m[12])
-{
-    double col = 0.0, row = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        double c = 0.0, r = 0.0;
-        for (int j = 0; j < 3; ++j) {
-            c += fabs(m[4 * j + i]);
-            r += fabs(m[4 * i + j]);
-        }
-        col = fmax(col, c);
-        row = fmax(row, r);
-    }
-    return sqrt(col * row);
-}
-
 void sw__fr_cofactor3(const double m[12], double out[9])
 {
     for (int r = 0; r < 3; ++r) {

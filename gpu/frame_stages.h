@@ -523,7 +523,5 @@ double sw__fr_det3(const double m[12]);
 /* Cofactor matrix of the linear part (row-major 3 x 3): det(M) M^-T, the map of normals under any
  * invertible affine transform (up to the sign of det). */
 void sw__fr_cofactor3(const double m[12], double out[9]);
-/* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm, 1 for a rigid one. */
-double sw__fr_stretch_bound(const double m[12]);
 
 #endif

@@ -285,7 +285,7 @@ int sw__occ_map_add_face(sw__occ_map *m, const sw_gpu_occluders *oc, uint32_t fa
         bx[3] = fmax(bx[3], p[1]);
     }
     const double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    const double margin = m->edge_margin + of->err * sw__fr_stretch_bound(world) * m->f / zmin;
+    const double margin = m->edge_margin + of->err * sw_sg_stretch_bound(world) * m->f / zmin;
     /* a plane through (nearly) the eye is seen edge-on: it covers nothing */
     if (!(nn > 0.0) || !(fabs(d) > 1e-6 * nn * zmin) || !isfinite(margin))
         return 0;

@@ -35,7 +35,7 @@ typedef struct hl_face {
     sw__fr_selection *sel; /* NULL while planning: nothing is chosen */
     const occurrence *o;
     const sw_lod_hierarchy *h;
-    double scale; /* bounds the occurrence transform's stretch (sw__fr_stretch_bound) */
+    double scale; /* bounds the occurrence transform's stretch (sw_sg_stretch_bound) */
     int trimmed;
     hl_item *stack;
     size_t n_stack, cap_stack;
@@ -275,7 +275,7 @@ static void hl_face_init(hl_face *hf, const sw__fr_env *env, sw__fr_hierarchy *h
     hf->sel = sel;
     hf->o = o;
     hf->h = h;
-    hf->scale = sw__fr_stretch_bound(o->world);
+    hf->scale = sw_sg_stretch_bound(o->world);
     hf->trimmed = sw__fr_face_trimmed(env, o->face);
 }
 

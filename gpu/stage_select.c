@@ -15,8 +15,8 @@
  *     ε_world = ε_img z_min / (focal_px sqrt(1 + tan_corner^2))
  * of the exact surface is within ε_img pixels wherever it shows (sw_lod_object_tolerance); in the
  * faces' object space that is ε_world / s, s the bound of the instance transform's stretch the
- * hierarchy path uses too (sw__fr_stretch_bound: 1 for a rigid one). Kumar §4.4 measures the
- * distance to the box's centre ("the distance of the super-surface from the viewer"): it is no
+ * hierarchy path uses too (sw_sg_stretch_bound: at least 1 for a rigid one). Kumar §4.4 measures
+ * the distance to the box's centre ("the distance of the super-surface from the viewer"): it is no
  * bound for a large unit seen from close by, so we take the box's nearest depth. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
@@ -64,7 +64,7 @@ double sw__fr_unit_tolerance(const sw__fr_env *env, const double obj_box[6], con
     const double eps_world =
         sw_lod_object_tolerance(env->eps_px, z, v->focal_px, v->tan_x, v->tan_y);
     *extent_px = diag * env->eps_px / eps_world;
-    return eps_world / sw__fr_stretch_bound(m);
+    return eps_world / sw_sg_stretch_bound(m);
 }
 
 /* Coarsest level within tol that is kept, -1 when none. */

@@ -289,7 +289,7 @@ static int local_points(const occurrence *o, const sw__gpu_patch *pt, size_t n, 
             local[4 * i + k] = p[k] - p[3] * pt->centre[k];
         local[4 * i + 3] = p[3];
     }
-    if (!(sw__fr_stretch_bound(o->world) * radius_of(local, n) <= radius_of(pt->cpw, n)))
+    if (!(sw_sg_stretch_bound(o->world) * radius_of(local, n) <= radius_of(pt->cpw, n)))
         return 0;
     for (size_t i = 0; i < 4 * n; ++i)
         out[i] = (float)local[i];

@@ -66,6 +66,21 @@ int sw_sg_to_local(const double m[12], const double p[3], const double d[3], dou
     return finite;
 }
 
+double sw_sg_stretch_bound(const double m[12])
+{
+    double col = 0.0, row = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        double c = 0.0, r = 0.0;
+        for (int j = 0; j < 3; ++j) {
+            c += fabs(m[4 * j + i]);
+            r += fabs(m[4 * i + j]);
+        }
+        col = fmax(col, c);
+        row = fmax(row, r);
+    }
+    return sqrt(col * row);
+}
+
 void sw_sg_box_transform(const double m[12], const double b[6], double out[6])
 {
     for (int k = 0; k < 3; ++k) {

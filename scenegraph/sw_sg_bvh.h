@@ -149,6 +149,11 @@ void sw_sg_bvh_face_box(const sw_sg_scene *scene, uint32_t face, double box[6]);
  * sw_sg_bvh_build boxes an occurrence: a caller that boxes occurrences itself gets the same
  * doubles. */
 void sw_sg_box_transform(const double m[12], const double box[6], double out[6]);
+/* sqrt(|M|_1 |M|_inf) of the linear part of a row-major 3 x 4 transform: a bound of its spectral
+ * norm, so of how far it stretches any distance (1 for the identity and for rotations by quarter
+ * turns, up to sqrt(2) for other rotations; the Frobenius norm would give sqrt(3) even for the
+ * identity and make every tolerance 1.7x tighter). */
+double sw_sg_stretch_bound(const double m[12]);
 /* A world point p and direction d (either may be NULL) in the frame of the row-major 3 x 4
  * transform m (world = M x + T): M^-1 (p - T) into lp, M^-1 d into ld. 0 (outputs untouched or
  * partly written) when M is singular (|det| <= 1e-300) or a result is not finite. */

@@ -56,7 +56,7 @@ enum { MAX_FRAMES = 1000 };
 /* ε_img's share of the trim loop's cubic approximation. */
 static const double k_trim_share = 0.1;
 /* The frame's bound of an occurrence transform's stretch, sqrt(|M|_1 |M|_inf) of its linear part
- * (sw__fr_stretch_bound, gpu/frame_geom.c), is 1 for the identity this scene's node has: the node
+ * (sw_sg_stretch_bound, scenegraph/bvh.c), is 1 for the identity this scene's node has: the node
  * errors it compares with ε_obj / 2. */
 static const double k_frame_stretch = 1.0;
 

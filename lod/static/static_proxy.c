@@ -202,22 +202,6 @@ static int reserve(gather *g, size_t nv, size_t nt)
            sw__grow((void **)&g->tri, &g->cap_tri, 3 * (g->n_t + nt), sizeof *g->tri);
 }
 
-/* sqrt(|M|_1 |M|_inf) of the linear part: a bound of its spectral norm. */
-static double stretch_bound(const double m[12])
-{
-    double col = 0.0, row = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        double c = 0.0, r = 0.0;
-        for (int j = 0; j < 3; ++j) {
-            c += fabs(m[4 * j + i]);
-            r += fabs(m[4 * i + j]);
-        }
-        col = fmax(col, c);
-        row = fmax(row, r);
-    }
-    return sqrt(col * row);
-}
-
 /* Appends a mesh: positions mapped by m (3 x 4, row-major; NULL: moved by `shift`), normals by its
  * linear part (similarities: shading is two-sided, as the static levels' draws), one part. */
 static int append_mesh(gather *g, const sw_lod_static_level *lv, const double *m,
@@ -280,7 +264,7 @@ static int gather_instances(gather *g, uint32_t node, double within)
         if (ins->unit == SW_LOD_STATIC_NO_UNIT)
             return 0;
         const sw_lod_static_chain *c = sw_lod_static_set_get(g->set, ins->unit);
-        const double s = stretch_bound(it.world);
+        const double s = sw_sg_stretch_bound(it.world);
         const sw_lod_static_level *lv = c ? level_for(c, s, within) : NULL;
         if (!lv)
             return 0;
