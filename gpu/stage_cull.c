@@ -425,7 +425,7 @@ static int take_proxy(occ_walk *w, uint32_t node, const double eb[6])
         return 1;
     }
     vis->proxies[vis->n_proxies++] = node;
-    w->faces_taken += node_occurrences(w, &w->bvh->nodes[node]);
+    w->faces_taken += p->faces;
     return 1;
 }
 

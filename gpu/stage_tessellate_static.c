@@ -16,7 +16,6 @@
  * from both sides' errors because both are bounded by the same ε_img. */
 #include "frame_stages.h"
 #include "sw_hooks.h"
-#include "sw_lod_proxy.h"
 #include "sw_status_util.h"
 
 #include <math.h>
@@ -193,16 +192,10 @@ sw_result sw__fr_tess_proxies(sw__fr_tess *t, const sw__fr_visible *vis, sw_stat
         const sw_lod_proxy *p = sw_lod_static_set_proxy(t->env->statics, vis->proxies[i]);
         for (uint32_t k = 0; k < p->n_parts && r == SW_OK; ++k)
             r = proxy_part(t, p, k, status);
-        const sw_sg_bvh_node *node =
-            &sw_lod_static_set_instances(t->env->statics)->bvh->nodes[vis->proxies[i]];
-        const sw_lod_static_instances *ins = sw_lod_static_set_instances(t->env->statics);
-        uint64_t faces = 0;
-        for (uint32_t it = node->first; it < node->first + node->count; ++it)
-            faces += ins->instances[ins->bvh->items[it].face].n_occ;
         t->st->proxies_drawn++;
-        t->st->proxy_instances += node->count;
-        t->st->proxy_faces += faces;
-        t->st->faces_drawn += faces;
+        t->st->proxy_instances += p->instances;
+        t->st->proxy_faces += p->faces;
+        t->st->faces_drawn += p->faces;
     }
     return r;
 }

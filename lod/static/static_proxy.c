@@ -167,6 +167,7 @@ typedef struct gather {
     uint32_t n_colors;
     double err; /* the inputs' own error, world units */
     uint32_t instances;
+    uint64_t faces;
 } gather;
 
 static void gather_free(gather *g)
@@ -272,6 +273,7 @@ static int gather_instances(gather *g, uint32_t node, double within)
             return 0;
         g->err = fmax(g->err, lv->eps * s);
         g->instances++;
+        g->faces += ins->n_occ;
     }
     return 1;
 }
@@ -285,6 +287,7 @@ static int gather_proxy(gather *g, const sw_lod_proxy *x)
             return 0;
     g->err = fmax(g->err, x->err);
     g->instances += x->instances;
+    g->faces += x->faces;
     return 1;
 }
 
@@ -536,6 +539,7 @@ static void build_node(const sw_lod_static_set *set, sw__lod_proxies *p, uint32_
         for (int k = 0; k < 3; ++k)
             x->centre[k] = g.centre[k];
         x->instances = g.instances;
+        x->faces = g.faces;
         x->input_triangles = g.n_t;
         p->staged[node] = x;
     } else {

@@ -62,10 +62,6 @@ sw_result sw_lod_proxy_cluster(const sw_lod_proxy_input *in, double cell, const 
                                sw_lod_proxy_mesh *out, sw_status *status);
 void sw_lod_proxy_mesh_free(sw_lod_proxy_mesh *m); /* NULL allowed */
 
-/* Distance from p to the triangle (a, b, c) (degenerate ones too), in double. */
-double sw_lod_point_triangle_distance(const double p[3], const double a[3], const double b[3],
-                                      const double c[3]);
-
 #ifdef __cplusplus
 }
 #endif

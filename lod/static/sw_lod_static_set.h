@@ -194,6 +194,7 @@ typedef struct sw_lod_proxy {
     double input_err; /* of it, the inputs' own (their levels' ε, child proxies' err) */
     double cell;      /* the clustering's cell */
     uint32_t n_triangles, instances;
+    uint64_t faces; /* face occurrences of those instances */
     uint64_t input_triangles, vanished;
 } sw_lod_proxy;
 
