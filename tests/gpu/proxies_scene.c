@@ -82,7 +82,9 @@ uint32_t proxies_scene_check(const proxies_scene *ps, uint32_t *n, uint64_t *cou
             continue;
         ++*n;
         tris += p->n_triangles;
-        int ok = isfinite(p->err) && p->err >= p->input_err && p->n_parts > 0;
+        /* the clustering moves no vertex farther than its cell's diagonal */
+        const double most = p->input_err + sqrt(3.0) * p->cell * (1.0 + 1e-12);
+        int ok = isfinite(p->err) && p->err >= p->input_err && p->err <= most && p->n_parts > 0;
         for (uint32_t i = 0; i < p->n_parts; ++i)
             ok = ok && p->parts[i].n_triangles > 0;
         bad += !ok;

@@ -25,7 +25,8 @@ const struct sw_sg_scene *proxies_scene_scene(const proxies_scene *ps);
 struct sw_lod_static_set *proxies_scene_statics(const proxies_scene *ps);
 void proxies_scene_box(const proxies_scene *ps, double box[6]);
 /* Prints the proxies' counts; returns how many have a bound that is not finite, below their
- * inputs' own error, or an empty part (and sets *n to the proxies found, *counted to the set's
+ * inputs' own error or above it by more than a cell's diagonal (what the clustering can move a
+ * vertex), or an empty part (and sets *n to the proxies found, *counted to the set's
  * count of them). */
 uint32_t proxies_scene_check(const proxies_scene *ps, uint32_t *n, uint64_t *counted);
 

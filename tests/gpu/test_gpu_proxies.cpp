@@ -192,14 +192,18 @@ void compare_view(sw_gpu_context *ctx, const scene_set &s, const char *name,
     sw_gpu_image_free(&per_frame);
 }
 
-/* Every proxy's bound: finite, at least its inputs' own error, its parts non-empty. */
+/* Every proxy's bound: finite, its inputs' own error plus at most a cell's diagonal (a
+ * representative outside its cell breaks it), its parts non-empty. */
 void check_proxies(const proxies_scene *ps)
 {
     uint32_t n = 0;
     uint64_t counted = 0;
     const uint32_t bad = proxies_scene_check(ps, &n, &counted);
     CHECK(n > 0 && n == counted, "%u proxies found, %llu counted", n, (unsigned long long)counted);
-    CHECK(bad == 0, "%u proxies with a bound below their inputs' error or an empty part", bad);
+    CHECK(bad == 0,
+          "%u proxies with a bound outside [inputs' error, + a cell's diagonal] or an "
+          "empty part",
+          bad);
 }
 
 /* Frames drawn while the pool builds and publishes the proxies (what ThreadSanitizer checks in CI:
