@@ -13,7 +13,8 @@
 #include <string.h>
 
 #define LODS_MAGIC "SWLODS\0"
-#define LODS_VERSION 2u /* 2: the level settings after the key */
+#define LODS_VERSION 3u     /* 2: the level settings after the key; 3: the proxies at the end */
+#define LODS_OLDEST_READ 2u /* version 2 is read as a cache without proxies */
 #define LODS_MAX_LEVELS SW_LOD_CACHE_MAX_LEVELS
 
 /* ---- the key ----------------------------------------------------------------------------------
@@ -114,6 +115,64 @@ static void put_settings(writer *w, const sw_lod_static_desc *d)
     put_u32(w, d->max_vertices_per_patch);
 }
 
+/* Floats from doubles in steps (positions rounded to float by their builder: exact). */
+static void put_floats(writer *w, const double *v, size_t n)
+{
+    float buf[1024];
+    for (size_t at = 0; at < n; at += 1024) {
+        const size_t m = n - at < 1024 ? n - at : 1024;
+        for (size_t i = 0; i < m; ++i)
+            buf[i] = (float)v[at + i];
+        put(w, buf, m * sizeof *buf);
+    }
+}
+
+static void put_proxy(writer *w, uint32_t node, const sw_lod_proxy *x)
+{
+    put_u32(w, node);
+    const double d[3] = {x->err, x->input_err, x->cell};
+    put(w, d, sizeof d);
+    put_u32(w, x->instances);
+    const uint64_t c[3] = {x->faces, x->input_triangles, x->vanished};
+    put(w, c, sizeof c);
+    put_u32(w, x->n_parts);
+    for (uint32_t k = 0; k < x->n_parts; ++k) {
+        const sw_lod_static_level *l = &x->parts[k];
+        put(w, x->colors[k], sizeof x->colors[k]);
+        put_u32(w, l->n_vertices);
+        put_u32(w, l->n_triangles);
+        put_floats(w, l->positions, 3 * (size_t)l->n_vertices);
+        put(w, l->normals, 3 * (size_t)l->n_vertices * sizeof *l->normals);
+        put(w, l->triangles, 3 * (size_t)l->n_triangles * sizeof *l->triangles);
+    }
+}
+
+/* The proxies once every build has finished (none while some are still being built). */
+static void put_proxies(writer *w, const sw_lod_static_set *set)
+{
+    if (!sw_lod_static_set_proxies_done(set)) {
+        put_u32(w, 0);
+        return;
+    }
+    const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
+    sw_lod_static_set_stats ss;
+    sw_lod_static_set_get_stats(set, &ss);
+    uint32_t n = 0;
+    for (uint32_t node = 0; node < bvh->n_nodes; ++node)
+        n += sw_lod_static_set_proxy(set, node) != NULL;
+    put_u32(w, 1);
+    put_u32(w, sw__lod_proxies_key(set));
+    put_u32(w, bvh->n_nodes);
+    put_u32(w, n);
+    const uint64_t c[2] = {ss.proxies_failed, ss.proxies_pruned};
+    put(w, c, sizeof c);
+    for (uint32_t node = 0; node < bvh->n_nodes; ++node) {
+        const sw_lod_proxy *x = sw_lod_static_set_proxy(set, node);
+        if (x)
+            put_proxy(w, node, x);
+    }
+}
+
 sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,
                                       sw_status *status)
 {
@@ -138,6 +197,7 @@ sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, 
         for (int32_t k = 0; k < c->n_levels; ++k)
             put_level(&w, &c->levels[k]);
     }
+    put_proxies(&w, set);
     if (w.oom) {
         sw__free(w.p);
         return sw__fail(status, SW_ERR_OUT_OF_MEMORY, "static LOD cache: out of memory");
@@ -294,6 +354,143 @@ static sw_result read_chain(reader *r, const sw_lod_static_set *set, uint32_t un
     return SW_OK;
 }
 
+/* Positions stored as float, back to double, each within the node's box grown by `reach` around
+ * its centre (a proxy's vertices are within its bound of the surfaces its node's box holds). */
+static sw_result read_positions(reader *r, const double half[3], double reach,
+                                sw_lod_static_level *l)
+{
+    const uint64_t n = 3 * (uint64_t)l->n_vertices;
+    float *f = take_array(r, n, sizeof *f);
+    if (f)
+        l->positions = sw__malloc((size_t)(n ? n : 1) * sizeof *l->positions);
+    if (!f || !l->positions) {
+        sw__free(f);
+        return bad(r, "a proxy's positions run past the end (or out of memory)", NULL);
+    }
+    int ok = 1;
+    for (uint64_t i = 0; i < n; ++i) {
+        l->positions[i] = (double)f[i];
+        ok &= isfinite(f[i]) && fabs(l->positions[i]) <= half[i % 3] + reach;
+    }
+    sw__free(f);
+    return ok ? SW_OK : bad(r, "a proxy's vertex lies outside its node's box", NULL);
+}
+
+static sw_result read_part(reader *r, const double half[3], double reach, sw_lod_proxy *x,
+                           uint32_t k)
+{
+    sw_lod_static_level *l = &x->parts[k];
+    if (!take(r, x->colors[k], sizeof x->colors[k]) || !take(r, &l->n_vertices, 4) ||
+        !take(r, &l->n_triangles, 4))
+        return bad(r, "truncated proxy part", NULL);
+    if (!finite_all_f(x->colors[k], 4) || l->n_vertices == 0 || l->n_triangles == 0)
+        return bad(r, "a proxy part with a non-finite colour or no triangle", NULL);
+    sw_result res = read_positions(r, half, reach, l);
+    if (res != SW_OK)
+        return res;
+    const uint64_t nv = l->n_vertices, nt = l->n_triangles;
+    if (!(l->normals = take_array(r, 3 * nv, sizeof *l->normals)) ||
+        !(l->triangles = take_array(r, 3 * nt, sizeof *l->triangles)))
+        return bad(r, "a proxy's arrays run past the end (or out of memory)", NULL);
+    if (!finite_all_f(l->normals, 3 * nv))
+        return bad(r, "a proxy normal is not finite", NULL);
+    for (uint64_t t = 0; t < 3 * nt; ++t)
+        if (l->triangles[t] >= nv)
+            return bad(r, "a proxy triangle names a vertex out of range", NULL);
+    x->n_triangles += l->n_triangles;
+    return SW_OK;
+}
+
+/* One proxy after its node (checked by the caller): header, parts, centre from the node's box. */
+static sw_result read_proxy(reader *r, const sw_sg_bvh *bvh, uint32_t node, sw_lod_proxy *x)
+{
+    double d[3];
+    uint64_t c[3];
+    uint32_t n_parts;
+    if (!take(r, d, sizeof d) || !take(r, &x->instances, 4) || !take(r, c, sizeof c) ||
+        !take(r, &n_parts, 4))
+        return bad(r, "truncated proxy header", NULL);
+    x->err = d[0], x->input_err = d[1], x->cell = d[2];
+    x->faces = c[0], x->input_triangles = c[1], x->vanished = c[2];
+    if (!finite_all(d, 3) || !(x->input_err >= 0.0) || !(x->err >= x->input_err) ||
+        !(x->cell > 0.0) || x->instances > bvh->nodes[node].count || n_parts == 0 ||
+        n_parts > (r->n - r->at) / 24)
+        return bad(r, "a proxy's bound, cell, instance or part count is out of range", NULL);
+    x->parts = sw__calloc(n_parts, sizeof *x->parts);
+    x->colors = sw__calloc(n_parts, sizeof *x->colors);
+    if (!x->parts || !x->colors)
+        return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+    double box[6], half[3];
+    sw_sg_bvh_node_box(bvh, node, box);
+    for (int k = 0; k < 3; ++k) {
+        x->centre[k] = 0.5 * (box[k] + box[3 + k]);
+        half[k] = 0.5 * (box[3 + k] - box[k]);
+    }
+    /* the float rounding of a coordinate, at most half an ulp of it, on top of the bound */
+    const double reach = x->err * (1.0 + 1e-9) + 1e-6 * fmax(half[0], fmax(half[1], half[2]));
+    for (uint32_t k = 0; k < n_parts; ++k) {
+        x->n_parts = k + 1; /* what sw__lod_proxy_free frees */
+        sw_result res = read_part(r, half, reach, x, k);
+        if (res != SW_OK)
+            return res;
+    }
+    if (!sw__lod_proxy_find_lines(x))
+        return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+    return SW_OK;
+}
+
+static void free_proxies(sw_lod_proxy **by_node, uint32_t n)
+{
+    if (!by_node)
+        return;
+    for (uint32_t i = 0; i < n; ++i)
+        sw__lod_proxy_free(by_node[i]);
+    sw__free(by_node);
+}
+
+/* The proxies after the chains: *by_node (one per BVH node) when stored, current and wanted; NULL
+ * when none are stored, they are stale (another BVH, other instances) or the set ignores them:
+ * then the rest of the string is not read. */
+static sw_result read_proxies(reader *r, const sw_lod_static_set *set, sw_lod_proxy ***by_node)
+{
+    *by_node = NULL;
+    uint32_t has, key, n_nodes, n;
+    uint64_t counts[2];
+    if (!take(r, &has, 4) || has > 1)
+        return bad(r, "the proxies' flag is not 0 or 1", NULL);
+    if (!has)
+        return SW_OK;
+    if (!take(r, &key, 4) || !take(r, &n_nodes, 4) || !take(r, &n, 4) ||
+        !take(r, counts, sizeof counts))
+        return bad(r, "truncated proxies header", NULL);
+    const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
+    if (n_nodes != bvh->n_nodes || key != sw__lod_proxies_key(set) ||
+        sw__lod_static_set_ignores_cached_proxies(set)) {
+        r->at = r->n; /* stale or not wanted: built again */
+        return SW_OK;
+    }
+    if (n > n_nodes)
+        return bad(r, "more proxies than nodes", NULL);
+    if (!(*by_node = sw__calloc(n_nodes ? n_nodes : 1, sizeof **by_node)))
+        return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+    int64_t last = -1;
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t node;
+        if (!take(r, &node, 4))
+            return bad(r, "truncated proxy", NULL);
+        if ((int64_t)node <= last || !sw__lod_proxy_candidate(set, node))
+            return bad(r, "a proxy's node is out of order or has too few instances", NULL);
+        last = node;
+        sw_lod_proxy *x = (*by_node)[node] = sw__calloc(1, sizeof *x);
+        if (!x)
+            return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+        sw_result res = read_proxy(r, bvh, node, x);
+        if (res != SW_OK)
+            return res;
+    }
+    return SW_OK;
+}
+
 static void free_chains(sw_lod_static_chain **chains, uint32_t n)
 {
     for (uint32_t u = 0; u < n; ++u)
@@ -312,11 +509,11 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
     uint64_t key = 0;
     if (!take(&r, magic, 8) || memcmp(magic, LODS_MAGIC, 8) != 0)
         return bad(&r, "not a static LOD cache (bad magic)", NULL);
-    if (!take(&r, &version, 4) || version != LODS_VERSION)
+    if (!take(&r, &version, 4) || version < LODS_OLDEST_READ || version > LODS_VERSION)
         return sw__fail(status, SW_ERR_VERSION,
-                        "%s: LODS offset 8: cache version %u, this program reads %u: run "
+                        "%s: LODS offset 8: cache version %u, this program reads %u to %u: run "
                         "`splinewalk build-lod` again",
-                        what, version, LODS_VERSION);
+                        what, version, LODS_OLDEST_READ, LODS_VERSION);
     sw_lod_static_cache_settings settings;
     if (!take(&r, &n, 4) || !take(&r, &key, 8))
         return bad(&r, "truncated header", NULL);
@@ -340,10 +537,16 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
         else if (has)
             res = read_chain(&r, set, u, &chains[u]);
     }
+    sw_lod_proxy **proxies = NULL;
+    if (res == SW_OK && version >= 3)
+        res = read_proxies(&r, set, &proxies);
+    const uint32_t n_nodes = sw_lod_static_set_instances(set)->bvh->n_nodes;
     if (res == SW_OK && r.at != r.n)
-        res = bad(&r, "bytes after the last chain", NULL);
+        res = bad(&r, version >= 3 ? "bytes after the last proxy" : "bytes after the last chain",
+                  NULL);
     if (res != SW_OK) {
         free_chains(chains, n);
+        free_proxies(proxies, n_nodes);
         return res;
     }
     for (uint32_t u = 0; u < n; ++u) {
@@ -353,6 +556,10 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
         chains[u] = NULL;
     }
     sw__free(chains);
+    /* refused when proxies were started before (built here): those stay, these go */
+    if (proxies)
+        (void)sw__lod_static_set_adopt_proxies(set, proxies);
+    free_proxies(proxies, n_nodes);
     return SW_OK;
 }
 
@@ -404,6 +611,47 @@ static sw_result summarize_chain(reader *r, sw_lod_static_cache_summary *out)
     return res;
 }
 
+/* The proxies after the chains into the summary, their arrays skipped. */
+static sw_result summarize_proxies(reader *r, sw_lod_static_cache_summary *out)
+{
+    const size_t start = r->at;
+    uint32_t has, key, n_nodes, n;
+    uint64_t counts[2];
+    if (!take(r, &has, 4) || has > 1)
+        return bad(r, "the proxies' flag is not 0 or 1", NULL);
+    if (!has)
+        return SW_OK;
+    if (!take(r, &key, 4) || !take(r, &n_nodes, 4) || !take(r, &n, 4) ||
+        !take(r, counts, sizeof counts) || n > n_nodes)
+        return bad(r, "truncated or inconsistent proxies header", NULL);
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t node, instances, n_parts;
+        double d[3];
+        uint64_t c[3];
+        if (!take(r, &node, 4) || !take(r, d, sizeof d) || !take(r, &instances, 4) ||
+            !take(r, c, sizeof c) || !take(r, &n_parts, 4))
+            return bad(r, "truncated proxy header", NULL);
+        if (!finite_all(d, 3) || !(d[0] >= 0.0))
+            return bad(r, "a proxy's bound is not a finite non-negative number", NULL);
+        out->proxy_err_min = i ? fmin(out->proxy_err_min, d[0]) : d[0];
+        out->proxy_err_max = i ? fmax(out->proxy_err_max, d[0]) : d[0];
+        out->proxy_instances = instances > out->proxy_instances ? instances : out->proxy_instances;
+        for (uint32_t k = 0; k < n_parts; ++k) {
+            float color[4];
+            uint32_t nv, nt;
+            if (!take(r, color, sizeof color) || !take(r, &nv, 4) || !take(r, &nt, 4))
+                return bad(r, "truncated proxy part", NULL);
+            if (!skip(r, nv, 6 * sizeof(float)) || !skip(r, nt, 3 * sizeof(uint32_t)))
+                return bad(r, "a proxy's arrays run past the end", NULL);
+            out->proxy_vertices += nv;
+            out->proxy_triangles += nt;
+        }
+    }
+    out->proxies = n;
+    out->proxy_bytes = r->at - start;
+    return SW_OK;
+}
+
 sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const char *what,
                                         sw_lod_static_cache_summary *out, sw_status *status)
 {
@@ -412,11 +660,12 @@ sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const cha
     char magic[8];
     if (!take(&r, magic, 8) || memcmp(magic, LODS_MAGIC, 8) != 0)
         return bad(&r, "not a static LOD cache (bad magic)", NULL);
-    if (!take(&r, &out->version, 4) || out->version != LODS_VERSION)
+    if (!take(&r, &out->version, 4) || out->version < LODS_OLDEST_READ ||
+        out->version > LODS_VERSION)
         return sw__fail(status, SW_ERR_VERSION,
-                        "%s: LODS offset 8: cache version %u, this program reads %u: run "
+                        "%s: LODS offset 8: cache version %u, this program reads %u to %u: run "
                         "`splinewalk build-lod` again",
-                        what, out->version, LODS_VERSION);
+                        what, out->version, LODS_OLDEST_READ, LODS_VERSION);
     if (!take(&r, &out->units, 4) || !take(&r, &out->key, 8))
         return bad(&r, "truncated header", NULL);
     sw_result res = take_settings(&r, &out->settings);
@@ -427,7 +676,11 @@ sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const cha
         else if (has)
             res = summarize_chain(&r, out);
     }
+    if (res == SW_OK && out->version >= 3)
+        res = summarize_proxies(&r, out);
     if (res == SW_OK && r.at != r.n)
-        res = bad(&r, "bytes after the last chain", NULL);
+        res =
+            bad(&r, out->version >= 3 ? "bytes after the last proxy" : "bytes after the last chain",
+                NULL);
     return res;
 }

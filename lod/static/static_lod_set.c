@@ -31,7 +31,8 @@ struct sw_lod_static_set {
     const sw_sg_scene *scene;
     sw_th_pool *pool;
     sw_lod_static_desc levels;
-    int keep_undrawn; /* sw_lod_static_set_desc */
+    int keep_undrawn;          /* sw_lod_static_set_desc */
+    int ignore_cached_proxies; /* sw_lod_static_set_desc */
     sw_lod_supersurfaces *ss;
     uint32_t n_faces;
     uint32_t *unit_of_face;       /* n_faces */
@@ -435,6 +436,7 @@ sw_result sw_lod_static_set_create(const sw_sg_scene *scene, sw_th_pool *pool,
     s->pool = pool;
     s->serial = atomic_fetch_add(&g_set_serial, 1) + 1;
     s->keep_undrawn = desc && desc->keep_undrawn;
+    s->ignore_cached_proxies = desc && desc->ignore_cached_proxies;
     s->n_faces = sw_sg_scene_view_ptr(scene)->n_faces;
     /* resolved now: the cache key (lod/static/static_lod_io.c) hashes the values the chains get */
     sw_result r = sw_lod_static_desc_resolve(desc ? &desc->levels : NULL, &s->levels, status);
@@ -482,6 +484,16 @@ int sw__lod_static_set_cancelled(const sw_lod_static_set *s)
 sw_result sw_lod_static_set_build_proxies(sw_lod_static_set *s, sw_status *status)
 {
     return sw__lod_proxies_start(s, s->proxies, s->pool, status);
+}
+
+sw_result sw__lod_static_set_adopt_proxies(sw_lod_static_set *s, sw_lod_proxy **by_node)
+{
+    return sw__lod_proxies_adopt(s->proxies, by_node);
+}
+
+int sw__lod_static_set_ignores_cached_proxies(const sw_lod_static_set *s)
+{
+    return s->ignore_cached_proxies;
 }
 
 int sw_lod_static_set_proxies_started(const sw_lod_static_set *s)

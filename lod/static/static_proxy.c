@@ -18,6 +18,7 @@
  * drops the rest; each proxy is published by one pointer store (release) and never changes, so
  * frames read it with no lock and draw what exists. */
 #include "sw_clock.h"
+#include "sw_crc32c.h"
 #include "sw_hooks.h"
 #include "sw_lod_proxy.h"
 #include "sw_lod_static_set.h"
@@ -60,7 +61,8 @@ struct sw__lod_proxies {
     uint32_t n_nodes;
     _Atomic int started;
     _Atomic int64_t subtrees_left;
-    _Atomic int done; /* every build finished (the last task's nodes above included) */
+    _Atomic int done;    /* every build finished (the last task's nodes above included) */
+    _Atomic int adopted; /* read from a cache, not built */
     _Atomic uint32_t next_key;
     _Atomic uint64_t built, failed, pruned, triangles, bytes, ns;
     sw_th_group group;
@@ -86,7 +88,7 @@ sw_result sw__lod_proxies_create(uint32_t n_nodes, sw__lod_proxies **out, sw_sta
     return SW_OK;
 }
 
-static void proxy_free(sw_lod_proxy *x)
+void sw__lod_proxy_free(sw_lod_proxy *x)
 {
     if (!x)
         return;
@@ -110,8 +112,8 @@ void sw__lod_proxies_destroy(sw_th_pool *pool, sw__lod_proxies *p)
         return;
     sw_th_group_wait(pool, &p->group);
     for (uint32_t n = 0; n < p->n_nodes; ++n) {
-        proxy_free(atomic_load(&p->node[n]));
-        proxy_free(p->staged[n]); /* a cancelled build's */
+        sw__lod_proxy_free(atomic_load(&p->node[n]));
+        sw__lod_proxy_free(p->staged[n]); /* a cancelled build's */
     }
     sw__free(p->node);
     sw__free(p->staged);
@@ -151,6 +153,7 @@ void sw__lod_proxies_stats(const sw__lod_proxies *p, sw_lod_static_set_stats *ou
     out->proxy_bytes = (size_t)atomic_load(&p->bytes);
     out->proxy_seconds = 1e-9 * (double)atomic_load(&p->ns);
     out->proxies_building = atomic_load(&p->started) && !atomic_load(&p->done);
+    out->proxies_adopted = atomic_load(&p->adopted);
 }
 
 /* ---- one proxy's inputs ------------------------------------------------------------------------
@@ -336,6 +339,42 @@ static int open_edges(const sw_lod_static_level *lv, uint32_t **out, uint32_t *n
     return 1;
 }
 
+int sw__lod_proxy_find_lines(sw_lod_proxy *x)
+{
+    if (!x->lines)
+        x->lines = sw__calloc(x->n_parts ? x->n_parts : 1, sizeof *x->lines);
+    if (!x->n_lines)
+        x->n_lines = sw__calloc(x->n_parts ? x->n_parts : 1, sizeof *x->n_lines);
+    if (!x->lines || !x->n_lines)
+        return 0;
+    for (uint32_t k = 0; k < x->n_parts; ++k)
+        if (!x->lines[k] && !open_edges(&x->parts[k], &x->lines[k], &x->n_lines[k]))
+            return 0;
+    return 1;
+}
+
+/* Rounds the parts' positions (relative to the centre) to float, as the LOD cache stores them, and
+ * returns the farthest a vertex moved: what the bound grows by (the affine argument of
+ * sw_lod_proxy.h again: no point of a triangle moves farther than its corners do). A proxy built
+ * and one read back from a cache are then the same, bit for bit. */
+static double round_to_float(sw_lod_proxy *x)
+{
+    double most = 0.0;
+    for (uint32_t k = 0; k < x->n_parts; ++k) {
+        double *p = x->parts[k].positions;
+        for (uint32_t v = 0; v < x->parts[k].n_vertices; ++v, p += 3) {
+            double d2 = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const double r = (double)(float)p[c];
+                d2 += (r - p[c]) * (r - p[c]);
+                p[c] = r;
+            }
+            most = fmax(most, sqrt(d2));
+        }
+    }
+    return most;
+}
+
 /* The output split into one level per part (its vertices are grouped by part). */
 static sw_lod_proxy *split_parts(const gather *g, const sw_lod_proxy_mesh *m)
 {
@@ -350,7 +389,7 @@ static sw_lod_proxy *split_parts(const gather *g, const sw_lod_proxy_mesh *m)
     uint32_t *first = sw__calloc((size_t)g->n_colors + 1, sizeof *first);
     if (!x->parts || !x->colors || !x->lines || !x->n_lines || !first) {
         sw__free(first);
-        proxy_free(x);
+        sw__lod_proxy_free(x);
         return NULL;
     }
     for (uint32_t v = 0; v < m->n_vertices; ++v)
@@ -385,12 +424,11 @@ static sw_lod_proxy *split_parts(const gather *g, const sw_lod_proxy_mesh *m)
                 lv->triangles[3 * (size_t)lv->n_triangles + (size_t)c] = tr[c] - first[k];
             lv->n_triangles++;
         }
-        ok = open_edges(lv, &x->lines[x->n_parts - 1], &x->n_lines[x->n_parts - 1]);
     }
     sw__free(nt);
     sw__free(first);
-    if (!ok) {
-        proxy_free(x);
+    if (!ok || !sw__lod_proxy_find_lines(x)) {
+        sw__lod_proxy_free(x);
         return NULL;
     }
     return x;
@@ -421,7 +459,7 @@ static sw_lod_proxy *cluster_inputs(const gather *g, double diag, double h, doub
     }
     sw_lod_proxy *x = m.n_triangles && isfinite(m.bound) ? split_parts(g, &m) : NULL;
     if (x) {
-        x->err = g->err + m.bound;
+        x->err = g->err + m.bound + round_to_float(x);
         x->input_err = g->err;
         x->n_triangles = m.n_triangles;
         x->vanished = m.vanished;
@@ -461,7 +499,7 @@ static void publish(sw__lod_proxies *p, uint32_t node)
 
 static void drop_staged(sw__lod_proxies *p, uint32_t node)
 {
-    proxy_free(p->staged[node]);
+    sw__lod_proxy_free(p->staged[node]);
     p->staged[node] = NULL;
     atomic_fetch_add(&p->pruned, 1);
 }
@@ -501,6 +539,49 @@ static void publish_within(const sw_sg_bvh *bvh, sw__lod_proxies *p, uint32_t ro
 static int is_candidate(const sw_sg_bvh *bvh, int32_t node)
 {
     return node >= 0 && bvh->nodes[node].count >= k_min_instances;
+}
+
+int sw__lod_proxy_candidate(const sw_lod_static_set *set, uint32_t node)
+{
+    const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
+    return node < bvh->n_nodes && is_candidate(bvh, (int32_t)node);
+}
+
+/* What a set's proxies are made from besides the chains: its instances (units, transforms,
+ * colours), their BVH and the rules of this file. A proxy is in world coordinates, so a cache's
+ * proxies are stale when any of it differs. */
+uint32_t sw__lod_proxies_key(const sw_lod_static_set *set)
+{
+    const sw_lod_static_instances *in = sw_lod_static_set_instances(set);
+    const sw_sg_bvh *bvh = in->bvh;
+    const double rules[6] = {k_aim_of_diagonal,  k_input_share,          k_cell_share,
+                             k_max_cells_of_aim, (double)k_proxy_budget, (double)k_min_instances};
+    const int32_t more[2] = {k_split_depth, k_max_parts};
+    uint32_t h = sw__crc32c(0, rules, sizeof rules);
+    h = sw__crc32c(h, more, sizeof more);
+    h = sw__crc32c(h, &bvh->n_nodes, sizeof bvh->n_nodes);
+    h = sw__crc32c(h, bvh->nodes, (size_t)bvh->n_nodes * sizeof *bvh->nodes);
+    h = sw__crc32c(h, bvh->items, (size_t)bvh->n_items * sizeof *bvh->items);
+    h = sw__crc32c(h, bvh->places, (size_t)bvh->n_places * sizeof *bvh->places);
+    h = sw__crc32c(h, bvh->origin, sizeof bvh->origin);
+    h = sw__crc32c(h, in->instances, (size_t)in->n_instances * sizeof *in->instances);
+    return sw__crc32c(h, in->occs, (size_t)in->n_occs * sizeof *in->occs);
+}
+
+sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node)
+{
+    int expect = 0;
+    if (!atomic_compare_exchange_strong(&p->started, &expect, 1))
+        return SW_ERR_INVALID_ARGUMENT; /* built or being built here: those stay */
+    for (uint32_t n = 0; n < p->n_nodes; ++n)
+        if (by_node[n]) {
+            p->staged[n] = by_node[n];
+            by_node[n] = NULL;
+            publish(p, n);
+        }
+    atomic_store(&p->adopted, 1);
+    atomic_store_explicit(&p->done, 1, memory_order_release);
+    return SW_OK;
 }
 
 /* Builds node's proxy from its children's proxies or instances, and publishes it. */

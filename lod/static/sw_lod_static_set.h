@@ -100,6 +100,8 @@ typedef struct sw_lod_static_set_desc {
                                   diagonal */
     int keep_undrawn; /* 1: chains keep the levels no frame draws (sw_lod_static_drop_undrawn),
                          for tests that force them into a frame to check their joins */
+    int ignore_cached_proxies; /* 1: sw_lod_static_set_load adopts a cache's chains only, so that
+                                  the proxies are built (tests of the build against the cache) */
 } sw_lod_static_set_desc;
 
 typedef struct sw_lod_static_set_stats {
@@ -115,6 +117,7 @@ typedef struct sw_lod_static_set_stats {
     size_t proxy_bytes;
     double proxy_seconds; /* summed over builds */
     int proxies_building; /* 1 while builds are queued or running */
+    int proxies_adopted;  /* 1: the proxies were read from a cache (sw_lod_static_set_load) */
 } sw_lod_static_set_stats;
 
 /* Clusters the scene (§3), forms the units and their instances with the instances' BVH; builds no
@@ -212,8 +215,22 @@ void sw_lod_static_set_wait_proxies(sw_lod_static_set *set);
 /* The proxy of a node of sw_lod_static_set_instances()->bvh once built, else NULL. No lock. */
 const sw_lod_proxy *sw_lod_static_set_proxy(const sw_lod_static_set *set, uint32_t node);
 
-/* static_proxy.c and static_lod_set.c */
+/* static_proxy.c, static_lod_set.c and static_lod_io.c */
 typedef struct sw__lod_proxies sw__lod_proxies;
+void sw__lod_proxy_free(sw_lod_proxy *x); /* NULL ok; parts up to n_parts, lines if any */
+/* Finds the open edges of every part that has none yet (lines, n_lines); 0: out of memory. */
+int sw__lod_proxy_find_lines(sw_lod_proxy *x);
+/* 1 when the node is one the set's proxy builds consider (enough instances under it). */
+int sw__lod_proxy_candidate(const sw_lod_static_set *set, uint32_t node);
+/* Hashes what proxies are made from besides the chains (instances, transforms, colours, BVH) and
+ * the build's rules: a cache's proxies are stale when it differs. */
+uint32_t sw__lod_proxies_key(const sw_lod_static_set *set);
+/* Publishes by_node[n] (one per BVH node, NULL: none), taking them (entries set NULL), and marks
+ * the proxies started and done; SW_ERR_INVALID_ARGUMENT (nothing taken) when the set's proxies
+ * were already started. */
+sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node);
+sw_result sw__lod_static_set_adopt_proxies(sw_lod_static_set *set, sw_lod_proxy **by_node);
+int sw__lod_static_set_ignores_cached_proxies(const sw_lod_static_set *set);
 sw_result sw__lod_proxies_create(uint32_t n_nodes, sw__lod_proxies **out, sw_status *status);
 void sw__lod_proxies_destroy(sw_th_pool *pool, sw__lod_proxies *p); /* waits for its builds */
 sw_result sw__lod_proxies_start(const sw_lod_static_set *set, sw__lod_proxies *p, sw_th_pool *pool,
@@ -226,8 +243,9 @@ int sw__lod_proxies_done(const sw__lod_proxies *p);
 int sw__lod_static_set_cancelled(const sw_lod_static_set *set);
 
 /* ---- the LOD cache (static_lod_io.c) ---------------------------------------------------------
- * The READY chains as one byte string (the .sws file's LODS section, `splinewalk build-lod`):
- *   "SWLODS\0\0", u32 version 2, u32 unit count, u64 key, the level settings (f64 δ (0: relative),
+ * The READY chains and the proxies as one byte string (the .sws file's LODS section, `splinewalk
+ * build-lod`):
+ *   "SWLODS\0\0", u32 version 3, u32 unit count, u64 key, the level settings (f64 δ (0: relative),
  *   f64 δ relative to the diagonal (0 when δ is given), f64 eps_first, eps_growth, the ε rule,
  *   i32 n_levels, u32 max_vertices, u32 max_vertices_per_patch), then per unit a u32 (0: no chain,
  *   1: a chain follows): i32 levels, u32 patches, f64 δ, and per level u32 vertices, u32
@@ -237,7 +255,16 @@ int sw__lod_static_set_cancelled(const sw_lod_static_set *set);
  * (sw_lod_static_drop_undrawn); a reader drops such levels of an older cache as it reads them.
  * The key hashes the units (their faces and patches) and the
  * level settings, so a cache made for another clustering, scene or setting is refused rather than
- * misread. */
+ * misread.
+ *   Then the cluster proxies: u32 0 (none stored) or 1, and after a 1: u32 key
+ *   (sw__lod_proxies_key), u32 BVH nodes, u32 proxies, u64 candidates that failed, u64 pruned,
+ *   and per proxy in increasing node order: u32 node, f64 err, input_err, cell, u32 instances,
+ *   u64 faces, input_triangles, vanished, u32 parts, and per part f32 colour[4], u32 vertices,
+ *   u32 triangles, positions relative to the centre of the node's box (f32 x 3: the builder rounds
+ *   them so and counts the rounding in err), normals (f32 x 3), triangles (u32 x 3). Open edges
+ *   are found again on reading. Version 2 is version 3 without the proxies (read as such).
+ * Proxies of a stale key (other instances, transforms, colours or build rules) are skipped, the
+ * chains still adopted; the renderer then builds the proxies in the pool. */
 
 /* *out (malloc, the caller frees) and *size. Errors: SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,
@@ -272,6 +299,11 @@ typedef struct sw_lod_static_cache_summary {
                                                         them (sw_lod_static_drop_undrawn) */
     uint64_t level_vertices[SW_LOD_CACHE_MAX_LEVELS], level_triangles[SW_LOD_CACHE_MAX_LEVELS];
     double level_eps_min[SW_LOD_CACHE_MAX_LEVELS], level_eps_max[SW_LOD_CACHE_MAX_LEVELS];
+    uint32_t proxies;                         /* stored cluster proxies (0: none stored) */
+    uint64_t proxy_triangles, proxy_vertices; /* over them */
+    uint64_t proxy_instances;                 /* under the largest proxy (its node's) */
+    double proxy_err_min, proxy_err_max;      /* world units */
+    size_t proxy_bytes;                       /* of the section's bytes */
 } sw_lod_static_cache_summary;
 /* Errors: SW_ERR_FORMAT (with the offset), SW_ERR_VERSION. */
 sw_result sw_lod_static_cache_summarize(const void *data, size_t size, const char *what,

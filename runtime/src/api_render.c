@@ -549,20 +549,27 @@ static void statics_task(void *ctx)
     atomic_store(&r->statics_state, 2);
 }
 
-/* Cluster proxies: made in the pool from a LOD cache's chains (every chain is there) once a frame
- * wants them — minutes of a pool thread at 10^6 surfaces, so a renderer that never draws them
- * never pays. A converged frame is the same frame for the same view, so it draws the proxies
- * once all are built and none before (it does not wait for them: `render` would wait for every
- * proxy of the scene for a frame a few of them serve). */
+/* Cluster proxies: read with the LOD cache when it holds them (build-lod stores them), else made in
+ * the pool from its chains (every chain is there) once a frame wants them — minutes of a pool
+ * thread at 10^6 surfaces, so a renderer that never draws them never pays. A converged frame is the
+ * same frame for the same view, so it draws the proxies once all are built and none before (it does
+ * not wait for them: `render` would wait for every proxy of the scene for a frame a few of them
+ * serve). */
 static void frame_proxies(sw_rt_renderer *r, sw_gpu_frame_desc *frame)
 {
     sw_lod_static_set *set = frame->static_lods;
     if (!set || frame->no_proxies)
         return;
     sw_status st = {0};
-    if (atomic_load(&r->statics_from_cache) && !sw_lod_static_set_proxies_started(set) &&
-        sw_lod_static_set_build_proxies(set, &st) != SW_OK)
-        sw__log(SW_LOG_WARN, "static LODs: %s: no cluster proxies", st.message);
+    if (atomic_load(&r->statics_from_cache) && !sw_lod_static_set_proxies_started(set)) {
+        const char *path = sw_sg_scene_path_ptr(r->cache_scene->sg);
+        sw__log(SW_LOG_INFO,
+                "cluster proxies: %s's LOD cache holds none made for this scene: building them "
+                "in the background (`splinewalk build-lod` stores them)",
+                path && *path ? path : "the scene");
+        if (sw_lod_static_set_build_proxies(set, &st) != SW_OK)
+            sw__log(SW_LOG_WARN, "static LODs: %s: no cluster proxies", st.message);
+    }
     if (!frame->walkthrough && !sw_lod_static_set_proxies_done(set))
         frame->no_proxies = 1;
 }

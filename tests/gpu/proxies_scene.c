@@ -22,9 +22,12 @@ proxies_scene *proxies_scene_open(const char *path)
     const void *cache = NULL;
     size_t bytes = 0;
     uint32_t adopted = 0;
+    /* the cache's own proxies are left out: frames are drawn while the pool builds them (the
+       same ones: test_proxy_cache) */
+    const sw_lod_static_set_desc desc = {.ignore_cached_proxies = 1};
     if (!ps || sw_sg_scene_open(path, &ps->scene, &st) != SW_OK ||
         sw_th_pool_create(&pd, &ps->pool) != SW_OK ||
-        sw_lod_static_set_create(ps->scene, ps->pool, NULL, &ps->statics, &st) != SW_OK ||
+        sw_lod_static_set_create(ps->scene, ps->pool, &desc, &ps->statics, &st) != SW_OK ||
         sw_sg_scene_lods(ps->scene, &cache, &bytes, &st) != SW_OK ||
         sw_lod_static_set_load(ps->statics, cache, bytes, path, &adopted, &st) != SW_OK ||
         sw_lod_static_set_build_proxies(ps->statics, &st) != SW_OK) {

@@ -15,8 +15,8 @@ struct sw_sg_scene;
 struct sw_lod_static_set;
 typedef struct proxies_scene proxies_scene;
 
-/* Opens `path`, adopts its LOD cache and starts building the proxies in the pool; NULL on failure
- * (said on stderr). */
+/* Opens `path`, adopts its LOD cache's chains (not its proxies) and starts building the proxies in
+ * the pool; NULL on failure (said on stderr). */
 proxies_scene *proxies_scene_open(const char *path);
 /* Returns once every proxy is built. */
 void proxies_scene_wait(proxies_scene *ps);

@@ -204,6 +204,14 @@ static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t
                    c->level_dropped[k]);
         printf("\n");
     }
+    if (c->version < 3 || c->proxy_bytes == 0)
+        printf("    proxies       none stored (walkthroughs build them in the background)\n");
+    else
+        printf("    proxies       %u cluster proxies, %llu triangles, %llu vertices, %.2f MiB, "
+               "error %g-%g, up to %llu instances each\n",
+               c->proxies, (unsigned long long)c->proxy_triangles,
+               (unsigned long long)c->proxy_vertices, (double)c->proxy_bytes / (1024.0 * 1024.0),
+               c->proxy_err_min, c->proxy_err_max, (unsigned long long)c->proxy_instances);
 }
 
 static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t bytes,
@@ -233,7 +241,15 @@ static void print_lod_json(int got, const sw_lod_static_cache_summary *c, size_t
                k ? ", " : "", c->level_chains[k], c->level_dropped[k],
                (unsigned long long)c->level_triangles[k], (unsigned long long)c->level_vertices[k],
                level_bytes(c, k), c->level_eps_min[k], c->level_eps_max[k]);
-    printf("]}");
+    printf("], \"proxies\": ");
+    if (c->version < 3 || c->proxy_bytes == 0)
+        printf("null}");
+    else
+        printf("{\"count\": %u, \"triangles\": %llu, \"vertices\": %llu, \"bytes\": %zu, "
+               "\"err_min\": %.17g, \"err_max\": %.17g, \"max_instances\": %llu}}",
+               c->proxies, (unsigned long long)c->proxy_triangles,
+               (unsigned long long)c->proxy_vertices, c->proxy_bytes, c->proxy_err_min,
+               c->proxy_err_max, (unsigned long long)c->proxy_instances);
 }
 
 int sw_cli_info(int argc, char **argv)

@@ -20,7 +20,7 @@ static const char k_usage[] =
     "usage: splinewalk profile SCENE --path PATH --out DIR [--frames N] [--size WxH] [--error PX]\n"
     "                          [--converged] [--sequential | --threads N]\n"
     "                          [--eval hierarchy|bezier|exact] [--no-static-lod] [--no-proxies]\n"
-    "                          [--lod-colors]"
+    "                          [--lod-colors]\n"
     "                          [--no-occlusion] [--no-exact-edges] [--no-kept-grids]\n"
     "                          [--memory-budget HOST[,GPU]]\n"
     "\n"
