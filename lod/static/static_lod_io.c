@@ -115,14 +115,42 @@ static void put_settings(writer *w, const sw_lod_static_desc *d)
     put_u32(w, d->max_vertices_per_patch);
 }
 
-/* Floats from doubles in steps (positions rounded to float by their builder: exact). */
-static void put_floats(writer *w, const double *v, size_t n)
+/* Positions as their codes within +-range (rounded so by their builder: exact). */
+static void put_positions(writer *w, const double *v, size_t n_vertices, const double range[3])
 {
-    float buf[1024];
-    for (size_t at = 0; at < n; at += 1024) {
-        const size_t m = n - at < 1024 ? n - at : 1024;
+    uint16_t buf[3 * 512];
+    for (size_t at = 0; at < n_vertices; at += 512) {
+        const size_t m = n_vertices - at < 512 ? n_vertices - at : 512;
+        for (size_t i = 0; i < 3 * m; ++i)
+            buf[i] = sw__lod_proxy_coord_pack(v[3 * at + i], range[i % 3]);
+        put(w, buf, 3 * m * sizeof *buf);
+    }
+}
+
+/* Normals as their octahedral codes (a proxy's are rounded so by its builder: exact). */
+static void put_normals(writer *w, const float *n, size_t count)
+{
+    int16_t buf[2 * 512];
+    for (size_t at = 0; at < count; at += 512) {
+        const size_t m = count - at < 512 ? count - at : 512;
         for (size_t i = 0; i < m; ++i)
-            buf[i] = (float)v[at + i];
+            sw__lod_proxy_normal_pack(n + 3 * (at + i), buf + 2 * i);
+        put(w, buf, 2 * m * sizeof *buf);
+    }
+}
+
+/* Triangle indices, u16 when every index fits (a part of at most 65536 vertices). */
+static void put_indices(writer *w, const uint32_t *t, size_t count, uint32_t n_vertices)
+{
+    if (n_vertices > 65536) {
+        put(w, t, count * sizeof *t);
+        return;
+    }
+    uint16_t buf[1024];
+    for (size_t at = 0; at < count; at += 1024) {
+        const size_t m = count - at < 1024 ? count - at : 1024;
+        for (size_t i = 0; i < m; ++i)
+            buf[i] = (uint16_t)t[at + i];
         put(w, buf, m * sizeof *buf);
     }
 }
@@ -130,7 +158,7 @@ static void put_floats(writer *w, const double *v, size_t n)
 static void put_proxy(writer *w, uint32_t node, const sw_lod_proxy *x)
 {
     put_u32(w, node);
-    const double d[3] = {x->err, x->input_err, x->cell};
+    const double d[6] = {x->err, x->input_err, x->cell, x->range[0], x->range[1], x->range[2]};
     put(w, d, sizeof d);
     put_u32(w, x->instances);
     const uint64_t c[3] = {x->faces, x->input_triangles, x->vanished};
@@ -141,9 +169,9 @@ static void put_proxy(writer *w, uint32_t node, const sw_lod_proxy *x)
         put(w, x->colors[k], sizeof x->colors[k]);
         put_u32(w, l->n_vertices);
         put_u32(w, l->n_triangles);
-        put_floats(w, l->positions, 3 * (size_t)l->n_vertices);
-        put(w, l->normals, 3 * (size_t)l->n_vertices * sizeof *l->normals);
-        put(w, l->triangles, 3 * (size_t)l->n_triangles * sizeof *l->triangles);
+        put_positions(w, l->positions, l->n_vertices, x->range);
+        put_normals(w, l->normals, l->n_vertices);
+        put_indices(w, l->triangles, 3 * (size_t)l->n_triangles, l->n_vertices);
     }
 }
 
@@ -354,30 +382,37 @@ static sw_result read_chain(reader *r, const sw_lod_static_set *set, uint32_t un
     return SW_OK;
 }
 
-/* Positions stored as float, back to double, each within the node's box grown by `reach` around
- * its centre (a proxy's vertices are within its bound of the surfaces its node's box holds). */
-static sw_result read_positions(reader *r, const double half[3], double reach,
-                                sw_lod_static_level *l)
+/* count triangle indices of a part of nv vertices (u16 when nv <= 65536), as u32. */
+static uint32_t *take_indices(reader *r, uint64_t count, uint64_t nv)
 {
-    const uint64_t n = 3 * (uint64_t)l->n_vertices;
-    float *f = take_array(r, n, sizeof *f);
-    if (f)
-        l->positions = sw__malloc((size_t)(n ? n : 1) * sizeof *l->positions);
-    if (!f || !l->positions) {
-        sw__free(f);
-        return bad(r, "a proxy's positions run past the end (or out of memory)", NULL);
-    }
-    int ok = 1;
-    for (uint64_t i = 0; i < n; ++i) {
-        l->positions[i] = (double)f[i];
-        ok &= isfinite(f[i]) && fabs(l->positions[i]) <= half[i % 3] + reach;
-    }
-    sw__free(f);
-    return ok ? SW_OK : bad(r, "a proxy's vertex lies outside its node's box", NULL);
+    if (nv > 65536)
+        return take_array(r, count, sizeof(uint32_t));
+    uint16_t *s = take_array(r, count, sizeof *s);
+    uint32_t *t = s ? sw__malloc((size_t)(count ? count : 1) * sizeof *t) : NULL;
+    for (uint64_t i = 0; t && i < count; ++i)
+        t[i] = s[i];
+    sw__free(s);
+    return t;
 }
 
-static sw_result read_part(reader *r, const double half[3], double reach, sw_lod_proxy *x,
-                           uint32_t k)
+/* Positions stored as codes within the proxy's range, back to double. */
+static sw_result read_positions(reader *r, const double range[3], sw_lod_static_level *l)
+{
+    const uint64_t n = 3 * (uint64_t)l->n_vertices;
+    uint16_t *q = take_array(r, n, sizeof *q);
+    if (q)
+        l->positions = sw__malloc((size_t)(n ? n : 1) * sizeof *l->positions);
+    if (!q || !l->positions) {
+        sw__free(q);
+        return bad(r, "a proxy's positions run past the end (or out of memory)", NULL);
+    }
+    for (uint64_t i = 0; i < n; ++i)
+        l->positions[i] = sw__lod_proxy_coord_unpack(q[i], range[i % 3]);
+    sw__free(q);
+    return SW_OK;
+}
+
+static sw_result read_part(reader *r, sw_lod_proxy *x, uint32_t k)
 {
     sw_lod_static_level *l = &x->parts[k];
     if (!take(r, x->colors[k], sizeof x->colors[k]) || !take(r, &l->n_vertices, 4) ||
@@ -385,15 +420,18 @@ static sw_result read_part(reader *r, const double half[3], double reach, sw_lod
         return bad(r, "truncated proxy part", NULL);
     if (!finite_all_f(x->colors[k], 4) || l->n_vertices == 0 || l->n_triangles == 0)
         return bad(r, "a proxy part with a non-finite colour or no triangle", NULL);
-    sw_result res = read_positions(r, half, reach, l);
+    sw_result res = read_positions(r, x->range, l);
     if (res != SW_OK)
         return res;
     const uint64_t nv = l->n_vertices, nt = l->n_triangles;
-    if (!(l->normals = take_array(r, 3 * nv, sizeof *l->normals)) ||
-        !(l->triangles = take_array(r, 3 * nt, sizeof *l->triangles)))
+    int16_t *codes = take_array(r, 2 * nv, sizeof *codes);
+    if (codes)
+        l->normals = sw__malloc((size_t)nv * 3 * sizeof *l->normals);
+    for (uint64_t v = 0; l->normals && v < nv; ++v)
+        sw__lod_proxy_normal_unpack(codes + 2 * v, l->normals + 3 * v);
+    sw__free(codes);
+    if (!l->normals || !(l->triangles = take_indices(r, 3 * nt, nv)))
         return bad(r, "a proxy's arrays run past the end (or out of memory)", NULL);
-    if (!finite_all_f(l->normals, 3 * nv))
-        return bad(r, "a proxy normal is not finite", NULL);
     for (uint64_t t = 0; t < 3 * nt; ++t)
         if (l->triangles[t] >= nv)
             return bad(r, "a proxy triangle names a vertex out of range", NULL);
@@ -404,7 +442,7 @@ static sw_result read_part(reader *r, const double half[3], double reach, sw_lod
 /* One proxy after its node (checked by the caller): header, parts, centre from the node's box. */
 static sw_result read_proxy(reader *r, const sw_sg_bvh *bvh, uint32_t node, sw_lod_proxy *x)
 {
-    double d[3];
+    double d[6];
     uint64_t c[3];
     uint32_t n_parts;
     if (!take(r, d, sizeof d) || !take(r, &x->instances, 4) || !take(r, c, sizeof c) ||
@@ -412,7 +450,7 @@ static sw_result read_proxy(reader *r, const sw_sg_bvh *bvh, uint32_t node, sw_l
         return bad(r, "truncated proxy header", NULL);
     x->err = d[0], x->input_err = d[1], x->cell = d[2];
     x->faces = c[0], x->input_triangles = c[1], x->vanished = c[2];
-    if (!finite_all(d, 3) || !(x->input_err >= 0.0) || !(x->err >= x->input_err) ||
+    if (!finite_all(d, 6) || !(x->input_err >= 0.0) || !(x->err >= x->input_err) ||
         !(x->cell > 0.0) || x->instances > bvh->nodes[node].count || n_parts == 0 ||
         n_parts > (r->n - r->at) / 24)
         return bad(r, "a proxy's bound, cell, instance or part count is out of range", NULL);
@@ -420,17 +458,20 @@ static sw_result read_proxy(reader *r, const sw_sg_bvh *bvh, uint32_t node, sw_l
     x->colors = sw__calloc(n_parts, sizeof *x->colors);
     if (!x->parts || !x->colors)
         return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
-    double box[6], half[3];
+    /* the vertices lie within ±range of the centre, which lies within the node's box grown by
+       the bound (a proxy is within it of the surfaces the box holds) */
+    double box[6];
     sw_sg_bvh_node_box(bvh, node, box);
     for (int k = 0; k < 3; ++k) {
         x->centre[k] = 0.5 * (box[k] + box[3 + k]);
-        half[k] = 0.5 * (box[3 + k] - box[k]);
+        x->range[k] = d[3 + k];
+        const double reach = 0.5 * (box[3 + k] - box[k]) + x->err;
+        if (!(x->range[k] >= 0.0) || x->range[k] > reach * (1.0 + 1e-9))
+            return bad(r, "a proxy's vertices reach outside its node's box", NULL);
     }
-    /* the float rounding of a coordinate, at most half an ulp of it, on top of the bound */
-    const double reach = x->err * (1.0 + 1e-9) + 1e-6 * fmax(half[0], fmax(half[1], half[2]));
     for (uint32_t k = 0; k < n_parts; ++k) {
         x->n_parts = k + 1; /* what sw__lod_proxy_free frees */
-        sw_result res = read_part(r, half, reach, x, k);
+        sw_result res = read_part(r, x, k);
         if (res != SW_OK)
             return res;
     }
@@ -626,12 +667,12 @@ static sw_result summarize_proxies(reader *r, sw_lod_static_cache_summary *out)
         return bad(r, "truncated or inconsistent proxies header", NULL);
     for (uint32_t i = 0; i < n; ++i) {
         uint32_t node, instances, n_parts;
-        double d[3];
+        double d[6];
         uint64_t c[3];
         if (!take(r, &node, 4) || !take(r, d, sizeof d) || !take(r, &instances, 4) ||
             !take(r, c, sizeof c) || !take(r, &n_parts, 4))
             return bad(r, "truncated proxy header", NULL);
-        if (!finite_all(d, 3) || !(d[0] >= 0.0))
+        if (!finite_all(d, 6) || !(d[0] >= 0.0))
             return bad(r, "a proxy's bound is not a finite non-negative number", NULL);
         out->proxy_err_min = i ? fmin(out->proxy_err_min, d[0]) : d[0];
         out->proxy_err_max = i ? fmax(out->proxy_err_max, d[0]) : d[0];
@@ -641,7 +682,8 @@ static sw_result summarize_proxies(reader *r, sw_lod_static_cache_summary *out)
             uint32_t nv, nt;
             if (!take(r, color, sizeof color) || !take(r, &nv, 4) || !take(r, &nt, 4))
                 return bad(r, "truncated proxy part", NULL);
-            if (!skip(r, nv, 6 * sizeof(float)) || !skip(r, nt, 3 * sizeof(uint32_t)))
+            if (!skip(r, nv, 3 * sizeof(uint16_t) + 2 * sizeof(int16_t)) ||
+                !skip(r, nt, 3 * (nv > 65536 ? sizeof(uint32_t) : sizeof(uint16_t))))
                 return bad(r, "a proxy's arrays run past the end", NULL);
             out->proxy_vertices += nv;
             out->proxy_triangles += nt;

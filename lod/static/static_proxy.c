@@ -353,23 +353,86 @@ int sw__lod_proxy_find_lines(sw_lod_proxy *x)
     return 1;
 }
 
-/* Rounds the parts' positions (relative to the centre) to float, as the LOD cache stores them, and
- * returns the farthest a vertex moved: what the bound grows by (the affine argument of
- * sw_lod_proxy.h again: no point of a triangle moves farther than its corners do). A proxy built
- * and one read back from a cache are then the same, bit for bit. */
-static double round_to_float(sw_lod_proxy *x)
+/* The sign bit's: -0.0 is negative, so that a normal decoded on the fold's seam encodes to the
+ * code it came from (the cache stores what the builder kept). */
+static double sign_of(double x)
 {
+    return signbit(x) ? -1.0 : 1.0;
+}
+
+/* Octahedral normal encoding (Meyer et al. 2010, "On floating-point normal vectors"): the unit
+ * sphere projected on the octahedron |x| + |y| + |z| = 1, its lower half folded over the upper,
+ * two snorm16 of the square that results: 4 bytes instead of 12, within about 1e-4 rad, which
+ * shading does not show. A zero normal reads back as +z. */
+void sw__lod_proxy_normal_pack(const float n[3], int16_t q[2])
+{
+    const double s = fabs(n[0]) + fabs(n[1]) + fabs(n[2]);
+    double u = s > 0.0 ? n[0] / s : 0.0, v = s > 0.0 ? n[1] / s : 0.0;
+    if (n[2] < 0.0f) {
+        const double pu = u;
+        u = (1.0 - fabs(v)) * sign_of(pu);
+        v = (1.0 - fabs(pu)) * sign_of(v);
+    }
+    q[0] = (int16_t)lrint(fmax(-1.0, fmin(1.0, u)) * 32767.0);
+    q[1] = (int16_t)lrint(fmax(-1.0, fmin(1.0, v)) * 32767.0);
+}
+
+void sw__lod_proxy_normal_unpack(const int16_t q[2], float n[3])
+{
+    double u = fmax(-1.0, q[0] / 32767.0), v = fmax(-1.0, q[1] / 32767.0);
+    const double z = 1.0 - fabs(u) - fabs(v);
+    if (z < 0.0) {
+        const double pu = u;
+        u = (1.0 - fabs(v)) * sign_of(pu);
+        v = (1.0 - fabs(pu)) * sign_of(v);
+    }
+    const double len = sqrt(u * u + v * v + z * z);
+    n[0] = (float)(u / len);
+    n[1] = (float)(v / len);
+    n[2] = (float)(z / len);
+}
+
+uint16_t sw__lod_proxy_coord_pack(double x, double range)
+{
+    if (!(range > 0.0))
+        return 0;
+    return (uint16_t)lrint(fmax(0.0, fmin(65535.0, (x + range) * (32767.5 / range))));
+}
+
+double sw__lod_proxy_coord_unpack(uint16_t q, double range)
+{
+    return range > 0.0 ? (double)q * (range / 32767.5) - range : 0.0;
+}
+
+/* Rounds the parts' vertices as the LOD cache stores them — each coordinate (relative to the
+ * centre) to one of 65536 steps across ±range, range the largest extent of the proxy's vertices
+ * along that axis; normals to their octahedral code — and returns the farthest a position moved:
+ * what the bound grows by (the affine argument of sw_lod_proxy.h again: no point of a triangle
+ * moves farther than its corners do; at most half a step per axis, 1/75,000 of the extent). A
+ * proxy built and one read back from a cache are then the same, bit for bit. */
+static double round_as_stored(sw_lod_proxy *x)
+{
+    for (int c = 0; c < 3; ++c)
+        x->range[c] = 0.0;
+    for (uint32_t k = 0; k < x->n_parts; ++k)
+        for (uint32_t i = 0; i < 3 * x->parts[k].n_vertices; ++i)
+            x->range[i % 3] = fmax(x->range[i % 3], fabs(x->parts[k].positions[i]));
     double most = 0.0;
     for (uint32_t k = 0; k < x->n_parts; ++k) {
         double *p = x->parts[k].positions;
-        for (uint32_t v = 0; v < x->parts[k].n_vertices; ++v, p += 3) {
+        float *nrm = x->parts[k].normals;
+        for (uint32_t v = 0; v < x->parts[k].n_vertices; ++v, p += 3, nrm += 3) {
             double d2 = 0.0;
             for (int c = 0; c < 3; ++c) {
-                const double r = (double)(float)p[c];
+                const double r = sw__lod_proxy_coord_unpack(
+                    sw__lod_proxy_coord_pack(p[c], x->range[c]), x->range[c]);
                 d2 += (r - p[c]) * (r - p[c]);
                 p[c] = r;
             }
             most = fmax(most, sqrt(d2));
+            int16_t q[2];
+            sw__lod_proxy_normal_pack(nrm, q);
+            sw__lod_proxy_normal_unpack(q, nrm);
         }
     }
     return most;
@@ -459,7 +522,7 @@ static sw_lod_proxy *cluster_inputs(const gather *g, double diag, double h, doub
     }
     sw_lod_proxy *x = m.n_triangles && isfinite(m.bound) ? split_parts(g, &m) : NULL;
     if (x) {
-        x->err = g->err + m.bound + round_to_float(x);
+        x->err = g->err + m.bound + round_as_stored(x);
         x->input_err = g->err;
         x->n_triangles = m.n_triangles;
         x->vanished = m.vanished;

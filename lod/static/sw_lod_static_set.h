@@ -196,6 +196,7 @@ typedef struct sw_lod_proxy {
     double err;       /* world units, both ways, to the exact surfaces of the instances */
     double input_err; /* of it, the inputs' own (their levels' ε, child proxies' err) */
     double cell;      /* the clustering's cell */
+    double range[3];  /* positions lie within +-range of the centre (quantized so: the LOD cache) */
     uint32_t n_triangles, instances;
     uint64_t faces; /* face occurrences of those instances */
     uint64_t input_triangles, vanished;
@@ -218,6 +219,12 @@ const sw_lod_proxy *sw_lod_static_set_proxy(const sw_lod_static_set *set, uint32
 /* static_proxy.c, static_lod_set.c and static_lod_io.c */
 typedef struct sw__lod_proxies sw__lod_proxies;
 void sw__lod_proxy_free(sw_lod_proxy *x); /* NULL ok; parts up to n_parts, lines if any */
+/* A coordinate within +-range as the LOD cache stores a proxy's (65536 steps), and back. */
+uint16_t sw__lod_proxy_coord_pack(double x, double range);
+double sw__lod_proxy_coord_unpack(uint16_t q, double range);
+/* A unit normal as the LOD cache stores a proxy's (octahedral, two snorm16), and back. */
+void sw__lod_proxy_normal_pack(const float n[3], int16_t q[2]);
+void sw__lod_proxy_normal_unpack(const int16_t q[2], float n[3]);
 /* Finds the open edges of every part that has none yet (lines, n_lines); 0: out of memory. */
 int sw__lod_proxy_find_lines(sw_lod_proxy *x);
 /* 1 when the node is one the set's proxy builds consider (enough instances under it). */
@@ -258,13 +265,16 @@ int sw__lod_static_set_cancelled(const sw_lod_static_set *set);
  * misread.
  *   Then the cluster proxies: u32 0 (none stored) or 1, and after a 1: u32 key
  *   (sw__lod_proxies_key), u32 BVH nodes, u32 proxies, u64 candidates that failed, u64 pruned,
- *   and per proxy in increasing node order: u32 node, f64 err, input_err, cell, u32 instances,
- *   u64 faces, input_triangles, vanished, u32 parts, and per part f32 colour[4], u32 vertices,
- *   u32 triangles, positions relative to the centre of the node's box (f32 x 3: the builder rounds
- *   them so and counts the rounding in err), normals (f32 x 3), triangles (u32 x 3). Open edges
- *   are found again on reading. Version 2 is version 3 without the proxies (read as such).
- * Proxies of a stale key (other instances, transforms, colours or build rules) are skipped, the
- * chains still adopted; the renderer then builds the proxies in the pool. */
+ *   and per proxy in increasing node order: u32 node, f64 err, input_err, cell, range[3],
+ *   u32 instances, u64 faces, input_triangles, vanished, u32 parts, and per part f32 colour[4],
+ *   u32 vertices, u32 triangles, positions relative to the centre of the node's box, each
+ *   coordinate one of 65536 steps across +-range (u16 x 3: sw__lod_proxy_coord_pack; the builder
+ *   rounds them so and counts the rounding in err), normals (octahedral, i16 x 2:
+ *   sw__lod_proxy_normal_pack; the builder rounds them so too), triangles (u16 x 3 when the part
+ *   has at most 65536 vertices, else u32 x 3). Open edges are found again on reading. Version 2 is
+ * version 3 without the proxies (read as such). Proxies of a stale key (other instances,
+ * transforms, colours or build rules) are skipped, the chains still adopted; the renderer then
+ * builds the proxies in the pool. */
 
 /* *out (malloc, the caller frees) and *size. Errors: SW_ERR_OUT_OF_MEMORY. */
 sw_result sw_lod_static_set_serialize(const sw_lod_static_set *set, void **out, size_t *size,

@@ -4,14 +4,14 @@
  *  - read from the cache, the proxies are published at once (started, done, adopted) and equal,
  *    node for node and bit for bit (bound, cell, counts, colours, positions, normals, triangles,
  *    open edges), to the proxies a second set builds in its pool from the same chains (catches: a
- *    field written and read in different orders, positions the builder leaves in double while the
- *    cache stores float, a bound that does not count that rounding — then both would hold
- *    different meshes —, a build that is not reproducible, open edges found differently);
+ *    field written and read in different orders, positions or normals the builder leaves finer
+ *    than the cache stores them — then both would hold different meshes —, a build that is not
+ *    reproducible, open edges found differently);
  *  - that built set serialized is the cache build-lod wrote, byte for byte;
  *  - the summary `splinewalk info` prints counts the proxies and triangles the set holds;
  *  - refused as a whole (SW_ERR_FORMAT, no chain adopted, no proxy): a cut anywhere in the
- *    proxies, a triangle index out of range, a vertex moved out of its node's box, a bound below
- *    its inputs' error, a proxy on a node with too few instances;
+ *    proxies, a triangle index out of range, vertices reaching out of their node's box, a bound
+ * below its inputs' error, a proxy on a node with too few instances;
  *  - a stale key (other instances or transforms) and a version-2 cache (no proxies) adopt the
  *    chains and leave the proxies to be built.
  * usage: test_proxy_cache SCENE.sws (with a LOD cache holding proxies)
@@ -145,7 +145,7 @@ static void expect_refused(const fixture *f, const unsigned char *blob, size_t s
 
 /* The first proxy's header and first part in a blob (offsets after the proxies' header). */
 typedef struct first_proxy {
-    size_t node, err, input_err, n_vertices, positions, triangles;
+    size_t node, err, input_err, range, n_vertices, positions, triangles;
     uint32_t nv;
 } first_proxy;
 
@@ -156,11 +156,12 @@ static first_proxy locate_first(const unsigned char *blob, size_t at)
     p.node = at;
     p.err = at + 4;
     p.input_err = at + 12;
-    at += 4 + 24 + 4 + 24 + 4; /* node, err/input_err/cell, instances, 3 counts, parts */
+    p.range = at + 28;
+    at += 4 + 48 + 4 + 24 + 4; /* node, err/input_err/cell/range, instances, 3 counts, parts */
     p.n_vertices = at + 16;    /* after the colour */
     memcpy(&p.nv, blob + p.n_vertices, 4);
     p.positions = at + 24;
-    p.triangles = p.positions + 24 * (size_t)p.nv; /* after positions and normals */
+    p.triangles = p.positions + 10 * (size_t)p.nv; /* after position and normal codes */
     return p;
 }
 
@@ -181,13 +182,18 @@ static void check_damage(const fixture *f, const unsigned char *blob, size_t siz
     }
     printf("  cuts in the proxies: refused\n");
     memcpy(bad, blob, size);
-    const uint32_t nv = p.nv;
-    memcpy(bad + p.triangles + 4, &nv, 4);
+    const uint32_t nv = p.nv; /* one past the last vertex, as u16 or u32 as the part stores it */
+    const uint16_t nv16 = (uint16_t)nv;
+    if (nv > 65536)
+        memcpy(bad + p.triangles + 4, &nv, 4);
+    else if (nv < 65536)
+        memcpy(bad + p.triangles + 2, &nv16, 2);
+    CHECK(nv != 65536, "the first part has 65536 vertices: no u16 index is out of range");
     expect_refused(f, bad, size, "a triangle index out of range:");
     memcpy(bad, blob, size);
-    const float far = 1e30f;
-    memcpy(bad + p.positions, &far, 4);
-    expect_refused(f, bad, size, "a vertex far out of its box:");
+    const double far = 1e30;
+    memcpy(bad + p.range, &far, 8);
+    expect_refused(f, bad, size, "vertices far out of the box:");
     memcpy(bad, blob, size);
     double err;
     memcpy(&err, blob + p.input_err, 8);
