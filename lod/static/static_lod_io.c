@@ -406,10 +406,13 @@ static sw_result read_positions(reader *r, const double range[3], sw_lod_static_
         sw__free(q);
         return bad(r, "a proxy's positions run past the end (or out of memory)", NULL);
     }
-    for (uint64_t i = 0; i < n; ++i)
+    int ok = 1;
+    for (uint64_t i = 0; i < n; ++i) {
         l->positions[i] = sw__lod_proxy_coord_unpack(q[i], range[i % 3]);
+        ok &= isfinite(l->positions[i]);
+    }
     sw__free(q);
-    return SW_OK;
+    return ok ? SW_OK : bad(r, "a proxy position is not finite", NULL);
 }
 
 static sw_result read_part(reader *r, sw_lod_proxy *x, uint32_t k)
@@ -466,7 +469,7 @@ static sw_result read_proxy(reader *r, const sw_sg_bvh *bvh, uint32_t node, sw_l
         x->centre[k] = 0.5 * (box[k] + box[3 + k]);
         x->range[k] = d[3 + k];
         const double reach = 0.5 * (box[3 + k] - box[k]) + x->err;
-        if (!(x->range[k] >= 0.0) || x->range[k] > reach * (1.0 + 1e-9))
+        if (!(x->range[k] >= 0.0) || !isfinite(reach) || x->range[k] > reach * (1.0 + 1e-9))
             return bad(r, "a proxy's vertices reach outside its node's box", NULL);
     }
     for (uint32_t k = 0; k < n_parts; ++k) {
@@ -492,7 +495,8 @@ static void free_proxies(sw_lod_proxy **by_node, uint32_t n)
 /* The proxies after the chains: *by_node (one per BVH node) when stored, current and wanted; NULL
  * when none are stored, they are stale (another BVH, other instances) or the set ignores them:
  * then the rest of the string is not read. */
-static sw_result read_proxies(reader *r, const sw_lod_static_set *set, sw_lod_proxy ***by_node)
+static sw_result read_proxies(reader *r, const sw_lod_static_set *set, sw_lod_proxy ***by_node,
+                              uint64_t *failed, uint64_t *pruned)
 {
     *by_node = NULL;
     uint32_t has, key, n_nodes, n;
@@ -514,6 +518,8 @@ static sw_result read_proxies(reader *r, const sw_lod_static_set *set, sw_lod_pr
         return bad(r, "more proxies than nodes", NULL);
     if (!(*by_node = sw__calloc(n_nodes ? n_nodes : 1, sizeof **by_node)))
         return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
+    *failed = counts[0];
+    *pruned = counts[1];
     int64_t last = -1;
     for (uint32_t i = 0; i < n; ++i) {
         uint32_t node;
@@ -579,8 +585,9 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
             res = read_chain(&r, set, u, &chains[u]);
     }
     sw_lod_proxy **proxies = NULL;
+    uint64_t failed = 0, pruned = 0; /* the build's counts, kept for a later write */
     if (res == SW_OK && version >= 3)
-        res = read_proxies(&r, set, &proxies);
+        res = read_proxies(&r, set, &proxies, &failed, &pruned);
     const uint32_t n_nodes = sw_lod_static_set_instances(set)->bvh->n_nodes;
     if (res == SW_OK && r.at != r.n)
         res = bad(&r, version >= 3 ? "bytes after the last proxy" : "bytes after the last chain",
@@ -599,7 +606,7 @@ sw_result sw_lod_static_set_load(sw_lod_static_set *set, const void *data, size_
     sw__free(chains);
     /* refused when proxies were started before (built here): those stay, these go */
     if (proxies)
-        (void)sw__lod_static_set_adopt_proxies(set, proxies);
+        (void)sw__lod_static_set_adopt_proxies(set, proxies, failed, pruned);
     free_proxies(proxies, n_nodes);
     return SW_OK;
 }

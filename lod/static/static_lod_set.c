@@ -486,9 +486,10 @@ sw_result sw_lod_static_set_build_proxies(sw_lod_static_set *s, sw_status *statu
     return sw__lod_proxies_start(s, s->proxies, s->pool, status);
 }
 
-sw_result sw__lod_static_set_adopt_proxies(sw_lod_static_set *s, sw_lod_proxy **by_node)
+sw_result sw__lod_static_set_adopt_proxies(sw_lod_static_set *s, sw_lod_proxy **by_node,
+                                           uint64_t failed, uint64_t pruned)
 {
-    return sw__lod_proxies_adopt(s->proxies, by_node);
+    return sw__lod_proxies_adopt(s->proxies, by_node, failed, pruned);
 }
 
 int sw__lod_static_set_ignores_cached_proxies(const sw_lod_static_set *s)

@@ -631,7 +631,8 @@ uint32_t sw__lod_proxies_key(const sw_lod_static_set *set)
     return sw__crc32c(h, in->occs, (size_t)in->n_occs * sizeof *in->occs);
 }
 
-sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node)
+sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node, uint64_t failed,
+                                uint64_t pruned)
 {
     int expect = 0;
     if (!atomic_compare_exchange_strong(&p->started, &expect, 1))
@@ -642,6 +643,8 @@ sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node)
             by_node[n] = NULL;
             publish(p, n);
         }
+    atomic_store(&p->failed, failed);
+    atomic_store(&p->pruned, pruned);
     atomic_store(&p->adopted, 1);
     atomic_store_explicit(&p->done, 1, memory_order_release);
     return SW_OK;

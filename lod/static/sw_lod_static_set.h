@@ -232,11 +232,14 @@ int sw__lod_proxy_candidate(const sw_lod_static_set *set, uint32_t node);
 /* Hashes what proxies are made from besides the chains (instances, transforms, colours, BVH) and
  * the build's rules: a cache's proxies are stale when it differs. */
 uint32_t sw__lod_proxies_key(const sw_lod_static_set *set);
-/* Publishes by_node[n] (one per BVH node, NULL: none), taking them (entries set NULL), and marks
- * the proxies started and done; SW_ERR_INVALID_ARGUMENT (nothing taken) when the set's proxies
- * were already started. */
-sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node);
-sw_result sw__lod_static_set_adopt_proxies(sw_lod_static_set *set, sw_lod_proxy **by_node);
+/* Publishes by_node[n] (one per BVH node, NULL: none), taking them (entries set NULL), with the
+ * counts of their build (nodes that could not have one, proxies dropped over the budget), and
+ * marks the proxies started and done; SW_ERR_INVALID_ARGUMENT (nothing taken) when the set's
+ * proxies were already started. */
+sw_result sw__lod_proxies_adopt(sw__lod_proxies *p, sw_lod_proxy **by_node, uint64_t failed,
+                                uint64_t pruned);
+sw_result sw__lod_static_set_adopt_proxies(sw_lod_static_set *set, sw_lod_proxy **by_node,
+                                           uint64_t failed, uint64_t pruned);
 int sw__lod_static_set_ignores_cached_proxies(const sw_lod_static_set *set);
 sw_result sw__lod_proxies_create(uint32_t n_nodes, sw__lod_proxies **out, sw_status *status);
 void sw__lod_proxies_destroy(sw_th_pool *pool, sw__lod_proxies *p); /* waits for its builds */

@@ -7,6 +7,8 @@
  *    field written and read in different orders, positions or normals the builder leaves finer
  *    than the cache stores them — then both would hold different meshes —, a build that is not
  *    reproducible, open edges found differently);
+ *  - the build's counts (proxies, triangles, nodes that could not have one, proxies dropped over
+ *    the budget) read back with them;
  *  - that built set serialized is the cache build-lod wrote, byte for byte;
  *  - the summary `splinewalk info` prints counts the proxies and triangles the set holds;
  *  - refused as a whole (SW_ERR_FORMAT, no chain adopted, no proxy): a cut anywhere in the
@@ -283,6 +285,16 @@ int main(int argc, char **argv)
     CHECK(sw_lod_static_set_build_proxies(built, &st) == SW_OK, "build: %s", st.message);
     sw_lod_static_set_wait_proxies(built);
     const uint32_t n = check_same_proxies(read, built);
+    sw_lod_static_set_stats rs, bs;
+    sw_lod_static_set_get_stats(read, &rs);
+    sw_lod_static_set_get_stats(built, &bs);
+    CHECK(rs.proxies_failed == bs.proxies_failed && rs.proxies_pruned == bs.proxies_pruned &&
+              rs.proxies == bs.proxies && rs.proxy_triangles == bs.proxy_triangles &&
+              rs.proxies_adopted && !bs.proxies_adopted,
+          "stats read / built: %llu / %llu proxies, %llu / %llu failed, %llu / %llu pruned",
+          (unsigned long long)rs.proxies, (unsigned long long)bs.proxies,
+          (unsigned long long)rs.proxies_failed, (unsigned long long)bs.proxies_failed,
+          (unsigned long long)rs.proxies_pruned, (unsigned long long)bs.proxies_pruned);
     CHECK(n > 0, "no proxies in %s", argv[1]);
     printf("%s: %u proxies read equal to %u built\n", argv[1], n, n);
 

@@ -206,6 +206,9 @@ static void print_lod_text(int got, const sw_lod_static_cache_summary *c, size_t
     }
     if (c->version < 3 || c->proxy_bytes == 0)
         printf("    proxies       none stored (walkthroughs build them in the background)\n");
+    else if (c->proxies == 0)
+        printf(
+            "    proxies       none: no node of the instances' hierarchy has enough instances\n");
     else
         printf("    proxies       %u cluster proxies, %llu triangles, %llu vertices, %.2f MiB, "
                "error %g-%g, up to %llu instances each\n",
