@@ -26,7 +26,11 @@
  * views; test_proxy_cluster catches it), the open edges' lines left out (no hole this metric can
  * tell from a real gap between two cars).
  *
- * Usage: test_gpu_proxies CARPARK.sws   (with a LOD cache) */
+ * With --occlusion the frames with proxies are occlusion-culled too (the scene's planar faces as
+ * occluders), against frames with neither: the two output-sensitive paths together, by hand on
+ * other scenes (docs/performance.md: the 10^4 building).
+ *
+ * Usage: test_gpu_proxies SCENE.sws [--occlusion]   (with a LOD cache; ctest: the car park) */
 #include "../images/edge_metric.hpp"
 #include "gpu_test_compare.h"
 #include "sw_gpu_internal.h"
@@ -48,6 +52,7 @@ const int k_w = 640, k_h = 360;
 struct scene_set {
     const sw_sg_scene *scene = nullptr;
     sw_lod_static_set *statics = nullptr;
+    const sw_gpu_occluders *occluders = nullptr; /* --occlusion: with the proxies' frames */
 };
 
 /* no_proxies 2: no static LODs either (every face by the per-frame path). */
@@ -62,6 +67,7 @@ sw_result frame(sw_gpu_context *ctx, const scene_set &s, const sw_gpu_camera &ca
     d.want_depth = 1;
     d.static_lods = no_proxies == 2 ? nullptr : s.statics;
     d.no_proxies = no_proxies;
+    d.occluders = no_proxies ? nullptr : s.occluders;
     return sw_gpu_render_scene(ctx, s.scene, &d, img, fs, st);
 }
 
@@ -243,8 +249,9 @@ sw_gpu_camera along_rows(const double b[6])
 
 int main(int argc, char **argv)
 {
-    if (argc != 2) {
-        fprintf(stderr, "usage: %s CARPARK.sws\n", argv[0]);
+    const bool occlusion = argc == 3 && !std::strcmp(argv[2], "--occlusion");
+    if (argc != 2 && !occlusion) {
+        fprintf(stderr, "usage: %s SCENE.sws [--occlusion]\n", argv[0]);
         return 2;
     }
     sw_status st = {};
@@ -258,6 +265,12 @@ int main(int argc, char **argv)
     scene_set s;
     s.scene = proxies_scene_scene(ps);
     s.statics = proxies_scene_statics(ps);
+    sw_gpu_occluders *occluders = nullptr;
+    if (occlusion && sw_gpu_occluders_build(s.scene, &occluders, &st) != SW_OK) {
+        fprintf(stderr, "FAIL: occluders: %s\n", st.message);
+        return 1;
+    }
+    s.occluders = occluders;
     double b[6];
     proxies_scene_box(ps, b);
     drawn_while_built(ctx, s, b);
@@ -277,6 +290,7 @@ int main(int argc, char **argv)
     CHECK(2 * sum.static_on < sum.static_off,
           "proxies stand for too few instances: %llu of %llu still drawn one by one",
           (unsigned long long)sum.static_on, (unsigned long long)sum.static_off);
+    sw_gpu_occluders_free(occluders);
     sw_gpu_context_free(ctx);
     proxies_scene_free(ps);
     puts(g_failures ? "FAIL" : "PASS");
