@@ -492,6 +492,27 @@ static void free_proxies(sw_lod_proxy **by_node, uint32_t n)
     sw__free(by_node);
 }
 
+/* The flag and header in front of the proxies (has 0: none stored, the rest unset). */
+typedef struct proxies_header {
+    uint32_t has, key, n_nodes, n;
+    uint64_t failed, pruned;
+} proxies_header;
+
+static sw_result take_proxies_header(reader *r, proxies_header *h)
+{
+    memset(h, 0, sizeof *h);
+    if (!take(r, &h->has, 4) || h->has > 1)
+        return bad(r, "the proxies' flag is not 0 or 1", NULL);
+    if (!h->has)
+        return SW_OK;
+    if (!take(r, &h->key, 4) || !take(r, &h->n_nodes, 4) || !take(r, &h->n, 4) ||
+        !take(r, &h->failed, 8) || !take(r, &h->pruned, 8))
+        return bad(r, "truncated proxies header", NULL);
+    if (h->n > h->n_nodes)
+        return bad(r, "more proxies than nodes", NULL);
+    return SW_OK;
+}
+
 /* The proxies after the chains: *by_node (one per BVH node) when stored, current and wanted; NULL
  * when none are stored, they are stale (another BVH, other instances) or the set ignores them:
  * then the rest of the string is not read. */
@@ -499,29 +520,22 @@ static sw_result read_proxies(reader *r, const sw_lod_static_set *set, sw_lod_pr
                               uint64_t *failed, uint64_t *pruned)
 {
     *by_node = NULL;
-    uint32_t has, key, n_nodes, n;
-    uint64_t counts[2];
-    if (!take(r, &has, 4) || has > 1)
-        return bad(r, "the proxies' flag is not 0 or 1", NULL);
-    if (!has)
-        return SW_OK;
-    if (!take(r, &key, 4) || !take(r, &n_nodes, 4) || !take(r, &n, 4) ||
-        !take(r, counts, sizeof counts))
-        return bad(r, "truncated proxies header", NULL);
+    proxies_header h;
+    sw_result res = take_proxies_header(r, &h);
+    if (res != SW_OK || !h.has)
+        return res;
     const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
-    if (n_nodes != bvh->n_nodes || key != sw__lod_proxies_key(set) ||
+    if (h.n_nodes != bvh->n_nodes || h.key != sw__lod_proxies_key(set) ||
         sw__lod_static_set_ignores_cached_proxies(set)) {
         r->at = r->n; /* stale or not wanted: built again */
         return SW_OK;
     }
-    if (n > n_nodes)
-        return bad(r, "more proxies than nodes", NULL);
-    if (!(*by_node = sw__calloc(n_nodes ? n_nodes : 1, sizeof **by_node)))
+    if (!(*by_node = sw__calloc(h.n_nodes ? h.n_nodes : 1, sizeof **by_node)))
         return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
-    *failed = counts[0];
-    *pruned = counts[1];
+    *failed = h.failed;
+    *pruned = h.pruned;
     int64_t last = -1;
-    for (uint32_t i = 0; i < n; ++i) {
+    for (uint32_t i = 0; i < h.n; ++i) {
         uint32_t node;
         if (!take(r, &node, 4))
             return bad(r, "truncated proxy", NULL);
@@ -531,7 +545,7 @@ static sw_result read_proxies(reader *r, const sw_lod_static_set *set, sw_lod_pr
         sw_lod_proxy *x = (*by_node)[node] = sw__calloc(1, sizeof *x);
         if (!x)
             return sw__fail(r->status, SW_ERR_OUT_OF_MEMORY, "%s: out of memory", r->what);
-        sw_result res = read_proxy(r, bvh, node, x);
+        res = read_proxy(r, bvh, node, x);
         if (res != SW_OK)
             return res;
     }
@@ -663,16 +677,11 @@ static sw_result summarize_chain(reader *r, sw_lod_static_cache_summary *out)
 static sw_result summarize_proxies(reader *r, sw_lod_static_cache_summary *out)
 {
     const size_t start = r->at;
-    uint32_t has, key, n_nodes, n;
-    uint64_t counts[2];
-    if (!take(r, &has, 4) || has > 1)
-        return bad(r, "the proxies' flag is not 0 or 1", NULL);
-    if (!has)
-        return SW_OK;
-    if (!take(r, &key, 4) || !take(r, &n_nodes, 4) || !take(r, &n, 4) ||
-        !take(r, counts, sizeof counts) || n > n_nodes)
-        return bad(r, "truncated or inconsistent proxies header", NULL);
-    for (uint32_t i = 0; i < n; ++i) {
+    proxies_header h;
+    sw_result res = take_proxies_header(r, &h);
+    if (res != SW_OK || !h.has)
+        return res;
+    for (uint32_t i = 0; i < h.n; ++i) {
         uint32_t node, instances, n_parts;
         double d[6];
         uint64_t c[3];
@@ -696,7 +705,7 @@ static sw_result summarize_proxies(reader *r, sw_lod_static_cache_summary *out)
             out->proxy_triangles += nt;
         }
     }
-    out->proxies = n;
+    out->proxies = h.n;
     out->proxy_bytes = r->at - start;
     return SW_OK;
 }
