@@ -53,6 +53,8 @@ typedef struct sw_rt_renderer {
     sw_th_group statics_group;
     sw_status statics_failure;
     _Atomic int statics_from_cache; /* the set's chains came from the scene's LOD cache */
+    int statics_skip_proxies; /* the frame that asked for the set wanted no proxies: the cache's
+                                 are not read (built in the pool if a later frame wants them) */
     sw_rt_scene *cache_scene; /* retained while the cache lives; NULL = none */
     uint32_t worker_threads;  /* the pool's size; 0 = one per online processor */
     int time_pool_tasks;      /* sw_rt_renderer_time_pool_tasks: the pool times its tasks */
@@ -524,7 +526,8 @@ static void statics_task(void *ctx)
         return;
     }
     sw_lod_static_set *set = NULL;
-    sw_result res = sw_lod_static_set_create(r->cache_scene->sg, r->pool, NULL, &set, &st);
+    const sw_lod_static_set_desc desc = {.ignore_cached_proxies = r->statics_skip_proxies};
+    sw_result res = sw_lod_static_set_create(r->cache_scene->sg, r->pool, &desc, &set, &st);
     if (res != SW_OK) {
         r->statics_failure = st;
         r->statics_failure.result = res;
@@ -581,6 +584,7 @@ static sw_result frame_statics(sw_rt_renderer *r, sw_gpu_frame_desc *frame, sw_s
 {
     int expect = 0;
     if (atomic_compare_exchange_strong(&r->statics_state, &expect, 1)) {
+        r->statics_skip_proxies = frame->no_proxies; /* read by the task it submits */
         const sw_th_task task = {statics_task,
                                  r,
                                  SW_TH_PRIORITY_BACKGROUND,
