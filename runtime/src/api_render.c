@@ -566,10 +566,12 @@ static void frame_proxies(sw_rt_renderer *r, sw_gpu_frame_desc *frame)
     sw_status st = {0};
     if (atomic_load(&r->statics_from_cache) && !sw_lod_static_set_proxies_started(set)) {
         const char *path = sw_sg_scene_path_ptr(r->cache_scene->sg);
-        sw__log(SW_LOG_INFO,
-                "cluster proxies: %s's LOD cache holds none made for this scene: building them "
-                "in the background (`splinewalk build-lod` stores them)",
-                path && *path ? path : "the scene");
+        sw__log(SW_LOG_INFO, "cluster proxies: %s: building them in the background (%s)",
+                path && *path ? path : "the scene",
+                r->statics_skip_proxies
+                    ? "the first frame wanted none, so the LOD cache's were not read"
+                    : "its LOD cache holds none made for this scene: `splinewalk build-lod` "
+                      "stores them");
         if (sw_lod_static_set_build_proxies(set, &st) != SW_OK)
             sw__log(SW_LOG_WARN, "static LODs: %s: no cluster proxies", st.message);
     }
