@@ -465,8 +465,8 @@ static sw_result read_proxy(reader *r, const sw_sg_bvh *bvh, uint32_t node, sw_l
        the bound (a proxy is within it of the surfaces the box holds) */
     double box[6];
     sw_sg_bvh_node_box(bvh, node, box);
+    sw__lod_proxy_centre(box, x->centre);
     for (int k = 0; k < 3; ++k) {
-        x->centre[k] = 0.5 * (box[k] + box[3 + k]);
         x->range[k] = d[3 + k];
         const double reach = 0.5 * (box[3 + k] - box[k]) + x->err;
         if (!(x->range[k] >= 0.0) || !isfinite(reach) || x->range[k] > reach * (1.0 + 1e-9))

@@ -604,6 +604,12 @@ static int is_candidate(const sw_sg_bvh *bvh, int32_t node)
     return node >= 0 && bvh->nodes[node].count >= k_min_instances;
 }
 
+void sw__lod_proxy_centre(const double box[6], double centre[3])
+{
+    for (int k = 0; k < 3; ++k)
+        centre[k] = 0.5 * (box[k] + box[3 + k]);
+}
+
 int sw__lod_proxy_candidate(const sw_lod_static_set *set, uint32_t node)
 {
     const sw_sg_bvh *bvh = sw_lod_static_set_instances(set)->bvh;
@@ -664,8 +670,7 @@ static void build_node(const sw_lod_static_set *set, sw__lod_proxies *p, uint32_
     g.in = in;
     double box[6];
     sw_sg_bvh_node_box(bvh, node, box);
-    for (int k = 0; k < 3; ++k)
-        g.centre[k] = 0.5 * (box[k] + box[3 + k]);
+    sw__lod_proxy_centre(box, g.centre);
     const double diag = box_diagonal(box), aim = diag * k_aim_of_diagonal;
     const double within = k_input_share * aim, cell = k_cell_share * aim;
     int ok = 1, from_proxies = 0;

@@ -227,6 +227,9 @@ void sw__lod_proxy_normal_pack(const float n[3], int16_t q[2]);
 void sw__lod_proxy_normal_unpack(const int16_t q[2], float n[3]);
 /* Finds the open edges of every part that has none yet (lines, n_lines); 0: out of memory. */
 int sw__lod_proxy_find_lines(sw_lod_proxy *x);
+/* The point a proxy's positions are relative to: the centre of its node's box (the builder's and
+ * the cache reader's, computed alike so that a proxy read back is the one built). */
+void sw__lod_proxy_centre(const double box[6], double centre[3]);
 /* 1 when the node is one the set's proxy builds consider (enough instances under it). */
 int sw__lod_proxy_candidate(const sw_lod_static_set *set, uint32_t node);
 /* Hashes what proxies are made from besides the chains (instances, transforms, colours, BVH) and
